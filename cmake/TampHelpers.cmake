@@ -1,0 +1,72 @@
+# Small helpers so every library, test and benchmark is declared the same way. Sources are listed,
+# never globbed.
+#
+#   tamp_add_library(tamp_foo SOURCES src/a.cc ... [PUBLIC_DEPS ...] [PRIVATE_DEPS ...])
+#       A static library with include/ as its public include directory, and an alias tamp::foo.
+#   tamp_add_executable(name SOURCES ... [DEPS ...])
+#   tamp_add_test(name SOURCES ... [DEPS ...] [LABELS ...] [TIMEOUT s])
+#       A GoogleTest binary; each TEST becomes a ctest entry (discovered before running, not at
+#       build time). Tests run with TAMP_SOURCE_DIR/TAMP_SHARED_DIR/TAMP_BIN_DIR in the environment.
+#   tamp_add_benchmark(name SOURCES ... [DEPS ...])   Google Benchmark or own bench tool; not a test.
+#   tamp_add_fuzzer(name SOURCES ... [DEPS ...])      libFuzzer target, only with TAMP_FUZZ (clang).
+
+function(tamp_add_library name)
+  cmake_parse_arguments(L "" "" "SOURCES;PUBLIC_DEPS;PRIVATE_DEPS" ${ARGN})
+  add_library(${name} STATIC ${L_SOURCES})
+  target_include_directories(${name} PUBLIC $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>)
+  target_link_libraries(${name} PUBLIC ${L_PUBLIC_DEPS} PRIVATE ${L_PRIVATE_DEPS} tamp_warnings)
+  string(REGEX REPLACE "^tamp_" "" short ${name})
+  add_library(tamp::${short} ALIAS ${name})
+endfunction()
+
+function(tamp_add_executable name)
+  cmake_parse_arguments(E "" "" "SOURCES;DEPS" ${ARGN})
+  add_executable(${name} ${E_SOURCES})
+  target_link_libraries(${name} PRIVATE ${E_DEPS} tamp_warnings)
+endfunction()
+
+set(TAMP_TEST_ENV
+  "TAMP_SOURCE_DIR=${CMAKE_SOURCE_DIR}"
+  "TAMP_SHARED_DIR=${TAMP_SHARED_DIR}"
+  "TAMP_BIN_DIR=${CMAKE_BINARY_DIR}/bin"
+  "SKIP_DEFAULT_XML_FILE=1")
+
+function(tamp_add_test name)
+  if(NOT TAMP_BUILD_TESTS)
+    return()
+  endif()
+  cmake_parse_arguments(T "" "TIMEOUT" "SOURCES;DEPS;LABELS" ${ARGN})
+  if(NOT T_TIMEOUT)
+    set(T_TIMEOUT 300)
+  endif()
+  add_executable(${name} ${T_SOURCES})
+  target_link_libraries(${name} PRIVATE ${T_DEPS} GTest::gtest GTest::gmock GTest::gtest_main tamp_warnings)
+  target_compile_definitions(${name} PRIVATE
+    TAMP_SOURCE_DIR="${CMAKE_SOURCE_DIR}" TAMP_SHARED_DIR="${TAMP_SHARED_DIR}"
+    TAMP_BIN_DIR="${CMAKE_BINARY_DIR}/bin")
+  gtest_discover_tests(${name}
+    DISCOVERY_MODE PRE_TEST
+    PROPERTIES ENVIRONMENT "${TAMP_TEST_ENV}" TIMEOUT ${T_TIMEOUT} LABELS "${T_LABELS}")
+endfunction()
+
+function(tamp_add_benchmark name)
+  if(NOT TAMP_BUILD_BENCHMARKS)
+    return()
+  endif()
+  cmake_parse_arguments(B "" "" "SOURCES;DEPS" ${ARGN})
+  add_executable(${name} ${B_SOURCES})
+  target_link_libraries(${name} PRIVATE ${B_DEPS} tamp_warnings)
+  target_compile_definitions(${name} PRIVATE
+    TAMP_SOURCE_DIR="${CMAKE_SOURCE_DIR}" TAMP_SHARED_DIR="${TAMP_SHARED_DIR}")
+endfunction()
+
+function(tamp_add_fuzzer name)
+  if(NOT TAMP_FUZZ)
+    return()
+  endif()
+  cmake_parse_arguments(F "" "" "SOURCES;DEPS" ${ARGN})
+  add_executable(${name} ${F_SOURCES})
+  target_compile_options(${name} PRIVATE -fsanitize=fuzzer,address,undefined)
+  target_link_options(${name} PRIVATE -fsanitize=fuzzer,address,undefined)
+  target_link_libraries(${name} PRIVATE ${F_DEPS})
+endfunction()

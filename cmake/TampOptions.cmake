@@ -1,0 +1,23 @@
+# Build options. Presets in CMakePresets.json set these; defaults suit a developer build.
+option(TAMP_WITH_DDS "Build the Fast DDS layer, IDL types, service nodes and executables" ON)
+option(TAMP_BUILD_TESTS "Build unit and integration tests" ON)
+option(TAMP_BUILD_BENCHMARKS "Build benchmark executables (not run by ctest)" ON)
+option(TAMP_WERROR "Treat warnings as errors (CI)" OFF)
+option(TAMP_SANITIZE "Build with AddressSanitizer + UndefinedBehaviorSanitizer" OFF)
+option(TAMP_FUZZ "Build libFuzzer targets (needs clang)" OFF)
+
+find_program(TAMP_CCACHE ccache)
+if(TAMP_CCACHE AND NOT CMAKE_CXX_COMPILER_LAUNCHER)
+  set(CMAKE_CXX_COMPILER_LAUNCHER ${TAMP_CCACHE})
+endif()
+
+# One INTERFACE target carries the warning policy; every project target links it PRIVATE.
+add_library(tamp_warnings INTERFACE)
+target_compile_options(tamp_warnings INTERFACE
+  -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor -Woverloaded-virtual
+  $<$<BOOL:${TAMP_WERROR}>:-Werror>)
+
+if(TAMP_SANITIZE)
+  add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
+  add_link_options(-fsanitize=address,undefined)
+endif()

@@ -1,0 +1,23 @@
+#pragma once
+/// @file
+/// Where the project's data lives at run time. `configDir()` is `$TAMP_CONFIG_DIR` when set, else
+/// the source tree's `config/` (compiled in), so binaries run from a build tree or an install.
+
+#include <filesystem>
+#include <string>
+
+#include "tamp/core/error.h"
+
+namespace tamp {
+
+std::filesystem::path configDir();
+/// `../shared` next to the source tree (external benchmark data), or `$TAMP_SHARED_DIR`.
+std::filesystem::path sharedDir();
+/// `relative` resolved against the directory of `base_file` (for paths inside config files);
+/// absolute paths are returned unchanged.
+std::filesystem::path resolveRelativeTo(const std::filesystem::path& base_file,
+                                        const std::filesystem::path& relative);
+/// Reads a whole file; a failure gives a kIo/kNotFound error naming the file.
+Result<std::string> readTextFile(const std::filesystem::path& file);
+
+}  // namespace tamp

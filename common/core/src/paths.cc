@@ -1,0 +1,43 @@
+#include "tamp/core/paths.h"
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "tamp/core/error.h"
+
+namespace tamp {
+
+std::filesystem::path configDir() {
+  if (const char* env = std::getenv("TAMP_CONFIG_DIR"); env != nullptr && *env != '\0') return env;
+  return TAMP_DEFAULT_CONFIG_DIR;
+}
+
+std::filesystem::path sharedDir() {
+  if (const char* env = std::getenv("TAMP_SHARED_DIR"); env != nullptr && *env != '\0') return env;
+  return TAMP_DEFAULT_SHARED_DIR;
+}
+
+std::filesystem::path resolveRelativeTo(const std::filesystem::path& base_file,
+                                        const std::filesystem::path& relative) {
+  if (relative.is_absolute()) return relative;
+  return (base_file.parent_path() / relative).lexically_normal();
+}
+
+Result<std::string> readTextFile(const std::filesystem::path& file) {
+  std::error_code ec;
+  if (!std::filesystem::exists(file, ec)) {
+    return Error(ErrorCode::kNotFound, "file does not exist", SourceLocation{file.string()});
+  }
+  if (std::filesystem::is_directory(file, ec)) {
+    return Error(ErrorCode::kIo, "is a directory, expected a file", SourceLocation{file.string()});
+  }
+  std::ifstream in(file, std::ios::binary);
+  if (!in) return Error(ErrorCode::kIo, "cannot open for reading", SourceLocation{file.string()});
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  if (in.bad()) return Error(ErrorCode::kIo, "read failed", SourceLocation{file.string()});
+  return ss.str();
+}
+
+}  // namespace tamp

@@ -5,6 +5,16 @@ option(TAMP_BUILD_BENCHMARKS "Build benchmark executables (not run by ctest)" ON
 option(TAMP_WERROR "Treat warnings as errors (CI)" OFF)
 option(TAMP_SANITIZE "Build with AddressSanitizer + UndefinedBehaviorSanitizer" OFF)
 option(TAMP_FUZZ "Build libFuzzer targets (needs clang)" OFF)
+# Developer option for parallel work in one checkout: configure only these areas of common/ and
+# services/ (e.g. "dds;symbolic_planner"); core and config are always built. Empty: everything.
+set(TAMP_ONLY_AREAS "" CACHE STRING "Only configure these common/ and services/ areas (developers)")
+function(tamp_area_enabled area out)
+  if(TAMP_ONLY_AREAS STREQUAL "" OR area IN_LIST TAMP_ONLY_AREAS)
+    set(${out} TRUE PARENT_SCOPE)
+  else()
+    set(${out} FALSE PARENT_SCOPE)
+  endif()
+endfunction()
 
 find_program(TAMP_CCACHE ccache)
 if(TAMP_CCACHE AND NOT CMAKE_CXX_COMPILER_LAUNCHER)

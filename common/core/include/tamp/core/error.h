@@ -40,6 +40,10 @@ struct SourceLocation {
   int line{0};    ///< 1-based; 0 = unknown
   int column{0};  ///< 1-based; 0 = unknown
   std::string field;  ///< dotted path inside a structured file, e.g. "world.objects[2].mass"
+
+  SourceLocation() = default;
+  SourceLocation(std::string file_, int line_ = 0, int column_ = 0, std::string field_ = {})  // NOLINT
+      : file(std::move(file_)), line(line_), column(column_), field(std::move(field_)) {}
 };
 
 struct Error {

@@ -1,0 +1,83 @@
+#pragma once
+/// @file
+/// Service liveness. Every service publishes a `msg::Heartbeat` on tamp/heartbeat (keyed by
+/// "<name>@<host>:<pid>") every `period_s` and whenever its state changes; on clean shutdown it
+/// publishes SERVICE_STOPPING and unregisters. `HeartbeatMonitor` keeps the latest heartbeat of
+/// each service; a service is alive while its last heartbeat is younger than 3 periods and its
+/// instance was not unregistered (a killed process's writer disappears with it).
+
+#include <condition_variable>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "tamp/dds/topics.h"
+
+namespace tamp::dds {
+
+class HeartbeatPublisher {
+ public:
+  HeartbeatPublisher(std::shared_ptr<Participant> p, const std::string& name, double period_s = 1.0);
+  ~HeartbeatPublisher();
+
+  const std::string& serviceId() const { return service_id_; }
+  void setState(msg::ServiceState state);
+  void setDetail(const std::string& detail);
+  /// Called at each beat to fill the request counters (e.g. from the node's RPC servers).
+  void setCounters(std::function<std::pair<uint64_t, uint64_t>()> served_failed);
+
+ private:
+  void publish();
+  std::shared_ptr<Participant> participant_;
+  Writer<msg::Heartbeat> writer_;
+  std::string service_id_;
+  double period_s_;
+  std::mutex mutex_;
+  msg::Heartbeat beat_;
+  std::function<std::pair<uint64_t, uint64_t>()> counters_;
+  std::condition_variable_any cv_;
+  std::jthread thread_;
+};
+
+struct ServiceInfo {
+  std::string service_id;
+  std::string name;
+  std::string host;
+  uint32_t pid{0};
+  msg::ServiceState state{msg::SERVICE_STARTING};
+  double uptime_s{0};
+  double age_s{0};          ///< seconds since its last heartbeat was received
+  double period_s{1.0};
+  uint64_t served{0};
+  uint64_t failed{0};
+  std::string version;
+  std::string detail;
+  bool alive{false};
+};
+
+const char* toString(msg::ServiceState state);
+
+class HeartbeatMonitor {
+ public:
+  explicit HeartbeatMonitor(std::shared_ptr<Participant> p);
+  /// Every service heard of, alive ones first, by name.
+  std::vector<ServiceInfo> services() const;
+  /// Waits until `count` alive services called `name` are seen (or the termination fires).
+  bool waitFor(const std::string& name, int count, const Termination& until) const;
+
+ private:
+  struct Entry {
+    msg::Heartbeat beat;
+    Clock::time_point received;
+    bool gone{false};
+  };
+  void onBeat(const msg::Heartbeat& hb, const SampleMeta& meta);
+  mutable std::mutex mutex_;
+  std::map<std::string, Entry> entries_;
+  Reader<msg::Heartbeat> reader_;
+};
+
+}  // namespace tamp::dds

@@ -1,0 +1,82 @@
+#pragma once
+/// @file
+/// A DDS domain participant created from the project's XML QoS profiles (config/dds/), owned RAII.
+///
+/// Every writer, reader and RPC endpoint holds a `std::shared_ptr<Participant>`, so the participant
+/// outlives its entities. The domain id comes from `ParticipantOptions::domain_id`, else from the
+/// environment variable `TAMP_DOMAIN_ID`, else 0: tests pick their own domain and run in parallel
+/// without seeing each other.
+
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include "tamp/core/error.h"
+
+namespace eprosima::fastdds::dds {
+class DomainParticipant;
+class Publisher;
+class Subscriber;
+class Topic;
+class TopicDataType;
+}  // namespace eprosima::fastdds::dds
+
+namespace tamp::dds {
+
+/// Participant profiles defined in config/dds/tamp_profiles.xml.
+inline constexpr const char* kProfileDefault = "tamp_default";  ///< UDPv4 + shared memory
+inline constexpr const char* kProfileUdp = "tamp_udp";          ///< UDPv4 only
+inline constexpr const char* kProfileShm = "tamp_shm";          ///< shared memory only (one host)
+
+struct ParticipantOptions {
+  int domain_id{-1};                  ///< 0..232; -1: $TAMP_DOMAIN_ID or 0
+  std::string profile{kProfileDefault};  ///< participant profile name; $TAMP_DDS_PROFILE overrides the default
+  std::string name;                   ///< participant name shown by DDS tools; default "tamp"
+  std::filesystem::path profiles_file;  ///< default: $TAMP_DDS_PROFILES or configDir()/dds/tamp_profiles.xml
+};
+
+/// The domain id the options resolve to (flag, then $TAMP_DOMAIN_ID, then 0); an error names the
+/// offending value when it is not an integer in [0, 232].
+Result<int> resolveDomainId(int flag_value);
+
+class Participant : public std::enable_shared_from_this<Participant> {
+ public:
+  /// Loads the XML profiles (once per process and file) and creates the participant.
+  /// Errors: kNotFound/kParseError for the profiles file, kInvalidArgument for a bad domain id or
+  /// unknown profile, kInternal when Fast DDS refuses.
+  static Result<std::shared_ptr<Participant>> create(const ParticipantOptions& options = {});
+  ~Participant();
+  Participant(const Participant&) = delete;
+  Participant& operator=(const Participant&) = delete;
+
+  int domainId() const { return domain_id_; }
+  const std::string& name() const { return name_; }
+  const std::string& profile() const { return profile_; }
+  /// This participant's GUID prefix as hex, unique per process and domain.
+  std::string guid() const;
+
+  // ---- used by Writer/Reader/RPC (not needed by application code) ----
+  /// Registers the type (once) and returns the topic `name` (created once per participant).
+  /// @throws std::runtime_error when a topic of that name exists with another type.
+  eprosima::fastdds::dds::Topic* topic(const std::string& name,
+                                       const std::function<eprosima::fastdds::dds::TopicDataType*()>& make_type);
+  eprosima::fastdds::dds::Publisher* publisher() const { return publisher_; }
+  eprosima::fastdds::dds::Subscriber* subscriber() const { return subscriber_; }
+  eprosima::fastdds::dds::DomainParticipant* native() const { return participant_; }
+
+ private:
+  Participant() = default;
+  eprosima::fastdds::dds::DomainParticipant* participant_{nullptr};
+  eprosima::fastdds::dds::Publisher* publisher_{nullptr};
+  eprosima::fastdds::dds::Subscriber* subscriber_{nullptr};
+  std::mutex mutex_;
+  std::map<std::string, eprosima::fastdds::dds::Topic*> topics_;
+  int domain_id_{0};
+  std::string name_;
+  std::string profile_;
+};
+
+}  // namespace tamp::dds

@@ -1,0 +1,94 @@
+#pragma once
+/// @file
+/// The skeleton every service process follows (the Fast DDS examples' app pattern):
+///
+///   services/<svc>/main.cc:
+///     int main(int argc, char** argv) {
+///       return tamp::dds::serviceMain(argc, argv, "symbolic_planner", "FF task planner service",
+///           [](const tamp::dds::ServiceArgs& a) { return tamp::symbolic_planner::PlannerNode::create(a); });
+///     }
+///
+/// `serviceMain` blocks SIGINT/SIGTERM before any thread exists, parses the standard arguments
+/// (--domain, --profile, --config, --name, --log-level), builds the node, runs it until a signal
+/// or stop(), and returns an exit code (0 clean stop, 30 bad arguments/config, 40 DDS failure).
+///
+/// A `ServiceNode` owns the participant, publishes heartbeats and answers echo requests on
+/// "tamp/<name>/echo" (`tamp ping <name>`). Subclasses create their servers, writers and readers
+/// in `create()` and may do periodic work in `spinOnce()`.
+
+#include <atomic>
+#include <condition_variable>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "tamp/dds/heartbeat.h"
+#include "tamp/dds/rpc.h"
+
+namespace tamp::dds {
+
+/// The command line every service accepts.
+struct ServiceArgs {
+  std::string name;         ///< service name (heartbeat, echo topic); default: the service's own
+  int domain_id{-1};        ///< -1: $TAMP_DOMAIN_ID or 0
+  std::string profile;      ///< DDS participant profile; empty: tamp_default
+  std::string config_file;  ///< service parameters (YAML); empty: the service's defaults
+  std::string log_level{"info"};
+  double heartbeat_period_s{1.0};
+};
+
+/// Parses the standard arguments. Returns an error for bad arguments; `--help` prints usage and
+/// returns kCancelled (exit 0).
+Result<ServiceArgs> parseServiceArgs(int argc, char** argv, const std::string& default_name,
+                                     const std::string& description);
+
+class ServiceNode {
+ public:
+  ServiceNode(const ServiceNode&) = delete;
+  ServiceNode& operator=(const ServiceNode&) = delete;
+  virtual ~ServiceNode();
+
+  /// Marks the service ready and blocks until stop(); calls spinOnce() every spin period.
+  /// Returns the exit code.
+  int run();
+  /// Thread-safe; run() returns soon after.
+  void stop();
+
+  const std::string& name() const { return name_; }
+  const std::shared_ptr<Participant>& participant() const { return participant_; }
+  HeartbeatPublisher& heartbeat() { return *heartbeat_; }
+
+ protected:
+  /// Creates the participant, heartbeat and echo server. Throws std::runtime_error when DDS fails
+  /// (serviceMain turns that into exit code 40 with the message).
+  explicit ServiceNode(const ServiceArgs& args);
+  /// Periodic work on the run() thread (default: none).
+  virtual void spinOnce() {}
+  /// How often spinOnce() runs.
+  virtual double spinPeriodSeconds() const { return 0.1; }
+  /// Sum of requests served/failed by the node's servers, for the heartbeat (default: echo only).
+  virtual std::pair<uint64_t, uint64_t> requestCounters() const;
+
+ private:
+  std::string name_;
+  std::shared_ptr<Participant> participant_;
+  std::unique_ptr<HeartbeatPublisher> heartbeat_;
+  std::unique_ptr<RpcServer<msg::EchoRequest, msg::EchoReply>> echo_;
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  bool stop_{false};
+};
+
+/// Echo service name of a node: "tamp/<node>/echo".
+std::string echoService(const std::string& node_name);
+/// The echo handler (payload back, optional simulated work that honours the termination).
+msg::EchoReply echoHandler(const msg::EchoRequest& req, const RequestContext& ctx);
+
+using NodeFactory = std::function<Result<std::unique_ptr<ServiceNode>>(const ServiceArgs&)>;
+
+/// Blocks termination signals, parses arguments, builds the node with `make`, runs it, and maps
+/// every failure to an exit code with a one-line message on stderr.
+int serviceMain(int argc, char** argv, const std::string& default_name, const std::string& description,
+                const NodeFactory& make);
+
+}  // namespace tamp::dds

@@ -1,0 +1,217 @@
+#include "tamp/dds/endpoint.h"
+
+#include <cstring>
+#include <sstream>
+#include <thread>
+
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/DataReaderListener.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/topic/ContentFilteredTopic.hpp>
+#include <fastdds/dds/topic/Topic.hpp>
+#include <fastdds/dds/topic/TopicDataType.hpp>
+
+#include "tamp/core/log.h"
+
+namespace fdds = eprosima::fastdds::dds;
+
+namespace tamp::dds {
+namespace {
+
+std::string rcName(const ReturnCode_t& r) {
+  switch (r()) {
+    case ReturnCode_t::RETCODE_OK: return "OK";
+    case ReturnCode_t::RETCODE_ERROR: return "ERROR";
+    case ReturnCode_t::RETCODE_UNSUPPORTED: return "UNSUPPORTED";
+    case ReturnCode_t::RETCODE_BAD_PARAMETER: return "BAD_PARAMETER";
+    case ReturnCode_t::RETCODE_PRECONDITION_NOT_MET: return "PRECONDITION_NOT_MET";
+    case ReturnCode_t::RETCODE_OUT_OF_RESOURCES: return "OUT_OF_RESOURCES";
+    case ReturnCode_t::RETCODE_NOT_ENABLED: return "NOT_ENABLED";
+    case ReturnCode_t::RETCODE_IMMUTABLE_POLICY: return "IMMUTABLE_POLICY";
+    case ReturnCode_t::RETCODE_INCONSISTENT_POLICY: return "INCONSISTENT_POLICY";
+    case ReturnCode_t::RETCODE_ALREADY_DELETED: return "ALREADY_DELETED";
+    case ReturnCode_t::RETCODE_TIMEOUT: return "TIMEOUT";
+    case ReturnCode_t::RETCODE_NO_DATA: return "NO_DATA";
+    case ReturnCode_t::RETCODE_ILLEGAL_OPERATION: return "ILLEGAL_OPERATION";
+    default: return "code " + std::to_string(r());
+  }
+}
+
+Status fromReturnCode(const ReturnCode_t& r, const std::string& what) {
+  if (r == ReturnCode_t::RETCODE_OK) return Status::Ok();
+  return Error(r == ReturnCode_t::RETCODE_TIMEOUT ? ErrorCode::kTimeout : ErrorCode::kInternal,
+               what + " failed: " + rcName(r));
+}
+
+std::string guidString(const eprosima::fastrtps::rtps::GUID_t& g) {
+  std::ostringstream ss;
+  ss << g;
+  return ss.str();
+}
+
+}  // namespace
+
+// ---- writer --------------------------------------------------------------------------------------
+
+WriterBase::WriterBase(std::shared_ptr<Participant> p, const std::string& topic,
+                       const std::function<fdds::TopicDataType*()>& make_type, QosClass qos,
+                       const WriterOptions& options)
+    : participant_(std::move(p)), topic_name_(topic) {
+  fdds::Topic* t = participant_->topic(topic, make_type);
+  type_ = participant_->native()->find_type(t->get_type_name()).get();
+  const std::string profile = options.profile.empty() ? writerProfile(qos) : options.profile;
+  writer_ = participant_->publisher()->create_datawriter_with_profile(t, profile);
+  if (writer_ == nullptr) {
+    throw std::runtime_error("cannot create a DDS writer on '" + topic + "' with profile '" + profile +
+                             "' (is the profile defined in the XML profiles file?)");
+  }
+}
+
+WriterBase::~WriterBase() {
+  if (writer_ == nullptr) return;
+  ReturnCode_t r = participant_->publisher()->delete_datawriter(writer_);
+  if (r != ReturnCode_t::RETCODE_OK) log::get("dds")->warn("delete_datawriter({}) failed: {}", topic_name_, rcName(r));
+}
+
+Status WriterBase::writeRaw(const void* sample) {
+  ReturnCode_t r = writer_->write(const_cast<void*>(sample), fdds::HANDLE_NIL);
+  return fromReturnCode(r, "write on '" + topic_name_ + "'");
+}
+
+Status WriterBase::disposeRaw(const void* sample) {
+  ReturnCode_t r = writer_->dispose(const_cast<void*>(sample), fdds::HANDLE_NIL);
+  return fromReturnCode(r, "dispose on '" + topic_name_ + "'");
+}
+
+Status WriterBase::unregisterRaw(const void* sample) {
+  ReturnCode_t r = writer_->unregister_instance(const_cast<void*>(sample), fdds::HANDLE_NIL);
+  return fromReturnCode(r, "unregister_instance on '" + topic_name_ + "'");
+}
+
+uint32_t WriterBase::serializedSizeRaw(const void* sample) const {
+  return type_->getSerializedSizeProvider(const_cast<void*>(sample))();
+}
+
+int WriterBase::matchedReaders() const {
+  fdds::PublicationMatchedStatus st;
+  if (writer_->get_publication_matched_status(st) != ReturnCode_t::RETCODE_OK) return 0;
+  return st.current_count;
+}
+
+bool WriterBase::waitForReaders(const Termination& until, int count) const {
+  while (matchedReaders() < count) {
+    if (until()) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return true;
+}
+
+// ---- reader --------------------------------------------------------------------------------------
+
+class ReaderBase::Listener : public fdds::DataReaderListener {
+ public:
+  explicit Listener(ReaderBase* owner) : owner_(owner) {}
+  void on_data_available(fdds::DataReader*) override {
+    std::lock_guard lock(owner_->callback_mutex_);
+    if (!owner_->listening_) return;
+    try {
+      owner_->onDataAvailable();
+    } catch (const std::exception& e) {
+      owner_->countCallbackError();
+      log::get("dds")->error("reader callback on '{}' threw: {}", owner_->topic_name_, e.what());
+    } catch (...) {
+      owner_->countCallbackError();
+      log::get("dds")->error("reader callback on '{}' threw an unknown exception", owner_->topic_name_);
+    }
+  }
+
+ private:
+  ReaderBase* owner_;
+};
+
+ReaderBase::ReaderBase(std::shared_ptr<Participant> p, const std::string& topic,
+                       const std::function<fdds::TopicDataType*()>& make_type, QosClass qos,
+                       const ReaderOptions& options)
+    : participant_(std::move(p)), topic_name_(topic) {
+  fdds::Topic* t = participant_->topic(topic, make_type);
+  fdds::TopicDescription* desc = t;
+  if (!options.filter.empty()) {
+    static std::atomic<uint64_t> counter{0};
+    const std::string name = topic + "/filtered/" + std::to_string(++counter);
+    filtered_ = participant_->native()->create_contentfilteredtopic(name, t, options.filter,
+                                                                    options.filter_parameters);
+    if (filtered_ == nullptr) {
+      throw std::runtime_error("cannot create content filter '" + options.filter + "' on '" + topic + "'");
+    }
+    desc = filtered_;
+  }
+  const std::string profile = options.profile.empty() ? readerProfile(qos) : options.profile;
+  reader_ = participant_->subscriber()->create_datareader_with_profile(desc, profile);
+  if (reader_ == nullptr) {
+    throw std::runtime_error("cannot create a DDS reader on '" + topic + "' with profile '" + profile + "'");
+  }
+  listener_ = std::make_unique<Listener>(this);
+}
+
+ReaderBase::~ReaderBase() {
+  stopListening();
+  if (reader_ != nullptr) {
+    ReturnCode_t r = participant_->subscriber()->delete_datareader(reader_);
+    if (r != ReturnCode_t::RETCODE_OK) log::get("dds")->warn("delete_datareader({}) failed: {}", topic_name_, rcName(r));
+  }
+  if (filtered_ != nullptr) {
+    ReturnCode_t r = participant_->native()->delete_contentfilteredtopic(filtered_);
+    if (r != ReturnCode_t::RETCODE_OK) log::get("dds")->warn("delete_contentfilteredtopic failed: {}", rcName(r));
+  }
+}
+
+void ReaderBase::startListening() {
+  {
+    std::lock_guard lock(callback_mutex_);
+    listening_ = true;
+  }
+  ReturnCode_t r = reader_->set_listener(listener_.get(), fdds::StatusMask::data_available());
+  if (r != ReturnCode_t::RETCODE_OK) {
+    throw std::runtime_error("cannot attach a listener on '" + topic_name_ + "': " + rcName(r));
+  }
+  // Samples that arrived before the listener was attached (transient-local history) are in the
+  // reader already and raise no new event: deliver them now.
+  listener_->on_data_available(reader_);
+}
+
+void ReaderBase::stopListening() {
+  if (reader_ != nullptr) (void)reader_->set_listener(nullptr);
+  std::lock_guard lock(callback_mutex_);  // waits for a running callback
+  listening_ = false;
+}
+
+bool ReaderBase::takeNextRaw(void* sample, SampleMeta& meta) {
+  fdds::SampleInfo info;
+  ReturnCode_t r = reader_->take_next_sample(sample, &info);
+  if (r != ReturnCode_t::RETCODE_OK) return false;
+  meta.alive = info.valid_data && info.instance_state == fdds::ALIVE_INSTANCE_STATE;
+  std::memcpy(meta.instance.data(), info.instance_handle.value, 16);
+  meta.source_stamp_ns = static_cast<int64_t>(info.source_timestamp.to_ns());
+  meta.writer_guid = guidString(info.sample_identity.writer_guid());
+  return true;
+}
+
+int ReaderBase::matchedWriters() const {
+  fdds::SubscriptionMatchedStatus st;
+  if (reader_->get_subscription_matched_status(st) != ReturnCode_t::RETCODE_OK) return 0;
+  return st.current_count;
+}
+
+bool ReaderBase::waitForWriters(const Termination& until, int count) const {
+  while (matchedWriters() < count) {
+    if (until()) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return true;
+}
+
+}  // namespace tamp::dds

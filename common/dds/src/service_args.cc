@@ -1,0 +1,34 @@
+// The only translation unit of tamp_dds that includes CLI11 (it is slow to compile).
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+
+#include "tamp/dds/service_node.h"
+
+namespace tamp::dds {
+
+Result<ServiceArgs> parseServiceArgs(int argc, char** argv, const std::string& default_name,
+                                     const std::string& description) {
+  ServiceArgs a;
+  a.name = default_name;
+  CLI::App app{description, default_name};
+  app.add_option("--name", a.name, "service name (heartbeat and echo topic)");
+  app.add_option("--domain", a.domain_id, "DDS domain id (default: $TAMP_DOMAIN_ID or 0)")->check(CLI::Range(0, 232));
+  app.add_option("--profile", a.profile, "DDS participant profile: tamp_default, tamp_udp, tamp_shm");
+  app.add_option("--config", a.config_file, "service parameters (YAML)")->check(CLI::ExistingFile);
+  app.add_option("--log-level", a.log_level, "trace, debug, info, warn, error, off");
+  app.add_option("--heartbeat-period", a.heartbeat_period_s, "seconds between heartbeats")
+      ->check(CLI::Range(0.01, 60.0));
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp&) {
+    std::cout << app.help();
+    return Error(ErrorCode::kCancelled, "help");
+  } catch (const CLI::ParseError& e) {
+    return Error(ErrorCode::kInvalidArgument, e.what());
+  }
+  if (a.name.empty()) return Error(ErrorCode::kInvalidArgument, "--name must not be empty");
+  return a;
+}
+
+}  // namespace tamp::dds

@@ -1,0 +1,137 @@
+#include "tamp/dds/service_node.h"
+
+#include <pthread.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <iostream>
+#include <thread>
+
+namespace tamp::dds {
+
+std::string echoService(const std::string& node_name) { return "tamp/" + node_name + "/echo"; }
+
+msg::EchoReply echoHandler(const msg::EchoRequest& req, const RequestContext& ctx) {
+  msg::EchoReply rep;
+  if (!(req.work_s() >= 0.0) || req.work_s() > 3600.0) {
+    rep.header().code(msg::STATUS_INVALID_ARGUMENT);
+    rep.header().message("field 'work_s': must be in [0, 3600], got " + std::to_string(req.work_s()));
+    return rep;
+  }
+  if (req.work_s() > 0) {
+    const Deadline done = Deadline::in(req.work_s());
+    while (!done.expired()) {
+      if (ctx.termination()) {
+        rep.header().code(ctx.termination.reason() == StopReason::kDeadline ? msg::STATUS_TIMEOUT
+                                                                              : msg::STATUS_CANCELLED);
+        rep.header().message("echo work interrupted");
+        return rep;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+  }
+  rep.payload(req.payload());
+  rep.pid(static_cast<uint32_t>(::getpid()));
+  return rep;
+}
+
+ServiceNode::ServiceNode(const ServiceArgs& args) : name_(args.name) {
+  ParticipantOptions po;
+  po.domain_id = args.domain_id;
+  if (!args.profile.empty()) po.profile = args.profile;
+  po.name = "tamp/" + args.name;
+  auto p = Participant::create(po);
+  if (!p) throw std::runtime_error(p.error().toString());
+  participant_ = *p;
+  heartbeat_ = std::make_unique<HeartbeatPublisher>(participant_, name_, args.heartbeat_period_s);
+  echo_ = std::make_unique<RpcServer<msg::EchoRequest, msg::EchoReply>>(participant_, echoService(name_),
+                                                                       echoHandler);
+  heartbeat_->setCounters([this] { return requestCounters(); });
+}
+
+ServiceNode::~ServiceNode() {
+  if (heartbeat_) heartbeat_->setCounters({});
+}
+
+std::pair<uint64_t, uint64_t> ServiceNode::requestCounters() const {
+  return {echo_ ? echo_->served() : 0, echo_ ? echo_->failed() + echo_->rejected() : 0};
+}
+
+int ServiceNode::run() {
+  heartbeat_->setState(msg::SERVICE_READY);
+  log::get(name_)->info("{} ready on DDS domain {} (profile {})", name_, participant_->domainId(),
+                        participant_->profile());
+  std::unique_lock lock(mutex_);
+  while (!stop_) {
+    lock.unlock();
+    try {
+      spinOnce();
+    } catch (const std::exception& e) {
+      log::get(name_)->error("spinOnce failed: {}", e.what());
+      heartbeat_->setState(msg::SERVICE_DEGRADED);
+      heartbeat_->setDetail(e.what());
+    }
+    lock.lock();
+    cv_.wait_for(lock, std::chrono::duration<double>(spinPeriodSeconds()), [this] { return stop_; });
+  }
+  log::get(name_)->info("{} stopping", name_);
+  heartbeat_->setState(msg::SERVICE_STOPPING);
+  return 0;
+}
+
+void ServiceNode::stop() {
+  {
+    std::lock_guard lock(mutex_);
+    stop_ = true;
+  }
+  cv_.notify_all();
+}
+
+int serviceMain(int argc, char** argv, const std::string& default_name, const std::string& description,
+                const NodeFactory& make) {
+  // Block the termination signals in this thread before any other thread exists (DDS creates
+  // several); a dedicated thread waits for them and stops the node.
+  sigset_t set;
+  sigemptyset(&set);
+  sigaddset(&set, SIGINT);
+  sigaddset(&set, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &set, nullptr);
+
+  auto args = parseServiceArgs(argc, argv, default_name, description);
+  if (!args) {
+    if (args.error().code == ErrorCode::kCancelled) return 0;  // --help
+    std::cerr << default_name << ": " << args.error().toString() << "\n";
+    return 30;
+  }
+  try {
+    log::setLevel(args->log_level);
+  } catch (const std::exception& e) {
+    std::cerr << default_name << ": " << e.what() << "\n";
+    return 30;
+  }
+  std::unique_ptr<ServiceNode> node;
+  try {
+    auto made = make(*args);
+    if (!made) {
+      std::cerr << args->name << ": " << made.error().toString() << "\n";
+      return made.error().code == ErrorCode::kUnavailable || made.error().code == ErrorCode::kInternal ? 40 : 30;
+    }
+    node = std::move(*made);
+  } catch (const std::exception& e) {
+    std::cerr << args->name << ": cannot start: " << e.what() << "\n";
+    return 40;
+  }
+  std::jthread waiter([&node, set]() {
+    int sig = 0;
+    sigwait(&set, &sig);
+    if (sig != 0) node->stop();
+  });
+  const int rc = node->run();
+  // Wake the signal thread if we stopped for another reason.
+  pthread_kill(waiter.native_handle(), SIGTERM);
+  waiter.join();
+  node.reset();
+  return rc;
+}
+
+}  // namespace tamp::dds

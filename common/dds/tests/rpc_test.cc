@@ -1,0 +1,142 @@
+#include "tamp/dds/rpc.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "test_util.h"
+#include "tamp/dds/service_node.h"
+
+namespace tamp::dds {
+namespace {
+
+using ::testing::HasSubstr;
+using testing::makeParticipant;
+using Client = RpcClient<msg::EchoRequest, msg::EchoReply>;
+using Server = RpcServer<msg::EchoRequest, msg::EchoReply>;
+
+msg::EchoRequest echo(std::vector<uint8_t> payload, double work_s = 0.0) {
+  msg::EchoRequest r;
+  r.payload(std::move(payload));
+  r.work_s(work_s);
+  return r;
+}
+
+TEST(RpcTest, CallReturnsTheServersReply) {
+  auto p = makeParticipant();
+  ASSERT_TRUE(p);
+  Server server(p, "tamp/test/echo", echoHandler);
+  Client client(p, "tamp/test/echo");
+  auto rep = client.call(echo({1, 2, 3}), CallOptions{5.0, {}});
+  ASSERT_TRUE(rep.ok()) << rep.error().toString();
+  EXPECT_EQ(rep->payload(), (std::vector<uint8_t>{1, 2, 3}));
+  EXPECT_EQ(rep->header().client_id(), client.clientId());
+  EXPECT_FALSE(rep->header().server_id().empty());
+  EXPECT_EQ(server.served(), 1u);
+}
+
+TEST(RpcTest, ManyCallsFromTwoClientsAreCorrelated) {
+  auto p = makeParticipant();
+  ASSERT_TRUE(p);
+  Server server(p, "tamp/test/echo", echoHandler, RpcServerOptions{2, 256, 0});
+  Client a(p, "tamp/test/echo"), b(p, "tamp/test/echo");
+  auto run = [](Client& c, uint8_t tag) {
+    for (uint8_t i = 0; i < 20; ++i) {
+      auto rep = c.call(echo({tag, i}), CallOptions{5.0, {}});
+      ASSERT_TRUE(rep.ok()) << rep.error().toString();
+      ASSERT_EQ(rep->payload(), (std::vector<uint8_t>{tag, i}));
+    }
+  };
+  std::thread ta([&] { run(a, 1); });
+  std::thread tb([&] { run(b, 2); });
+  ta.join();
+  tb.join();
+  EXPECT_EQ(server.served(), 40u);
+}
+
+TEST(RpcTest, AbsentServerGivesUnavailableNotAHang) {
+  auto p = makeParticipant();
+  ASSERT_TRUE(p);
+  Client client(p, "tamp/test/nobody");
+  const Stopwatch sw;
+  auto rep = client.call(echo({1}), CallOptions{0.5, {}});
+  ASSERT_FALSE(rep.ok());
+  EXPECT_EQ(rep.error().code, ErrorCode::kUnavailable);
+  EXPECT_THAT(rep.error().message, HasSubstr("no server for 'tamp/test/nobody'"));
+  EXPECT_LT(sw.seconds(), 5.0);  // bounded by the deadline, not a hang (loose: scheduling noise)
+}
+
+TEST(RpcTest, HandlerExceptionBecomesInternalError) {
+  auto p = makeParticipant();
+  ASSERT_TRUE(p);
+  Server server(p, "tamp/test/throw", [](const msg::EchoRequest&, const RequestContext&) -> msg::EchoReply {
+    throw std::runtime_error("planner exploded");
+  });
+  Client client(p, "tamp/test/throw");
+  auto rep = client.call(echo({1}), CallOptions{5.0, {}});
+  ASSERT_FALSE(rep.ok());
+  EXPECT_EQ(rep.error().code, ErrorCode::kInternal);
+  EXPECT_THAT(rep.error().message, HasSubstr("planner exploded"));
+  // The server keeps serving.
+  EXPECT_EQ(server.failed(), 1u);
+}
+
+TEST(RpcTest, InvalidFieldIsReportedByName) {
+  auto p = makeParticipant();
+  ASSERT_TRUE(p);
+  Server server(p, "tamp/test/echo", echoHandler);
+  Client client(p, "tamp/test/echo");
+  auto rep = client.call(echo({1}, -1.0), CallOptions{5.0, {}});
+  ASSERT_FALSE(rep.ok());
+  EXPECT_EQ(rep.error().code, ErrorCode::kInvalidArgument);
+  EXPECT_THAT(rep.error().message, HasSubstr("field 'work_s'"));
+}
+
+TEST(RpcTest, OversizedRequestRejectedByClientAndByServer) {
+  auto p = makeParticipant();
+  ASSERT_TRUE(p);
+  Server server(p, "tamp/test/small", echoHandler, RpcServerOptions{1, 16, 1024});
+  // The client's own limit stops it before sending.
+  Client strict(p, "tamp/test/small", RpcClientOptions{1.0, 3, 1024});
+  auto r1 = strict.call(echo(std::vector<uint8_t>(4096, 7)), CallOptions{5.0, {}});
+  ASSERT_FALSE(r1.ok());
+  EXPECT_EQ(r1.error().code, ErrorCode::kInvalidArgument);
+  EXPECT_THAT(r1.error().message, HasSubstr("exceeds the limit of 1024 bytes"));
+  EXPECT_EQ(server.rejected(), 0u);
+  // A client with a larger limit sends it; the server refuses it with a clear reply.
+  Client lax(p, "tamp/test/small");
+  auto r2 = lax.call(echo(std::vector<uint8_t>(4096, 7)), CallOptions{5.0, {}});
+  ASSERT_FALSE(r2.ok());
+  EXPECT_EQ(r2.error().code, ErrorCode::kInvalidArgument);
+  EXPECT_THAT(r2.error().message, HasSubstr("exceeds the limit of 1024 bytes"));
+  EXPECT_EQ(server.rejected(), 1u);
+  // And still serves a valid one.
+  EXPECT_TRUE(lax.call(echo({1}), CallOptions{5.0, {}}).ok());
+}
+
+TEST(RpcTest, SlowHandlerTimesOutAndCancelStopsIt) {
+  auto p = makeParticipant();
+  ASSERT_TRUE(p);
+  Server server(p, "tamp/test/slow", echoHandler);
+  Client client(p, "tamp/test/slow", RpcClientOptions{10.0, 1, 0});
+  ASSERT_TRUE(client.waitForServer(Termination::after(5.0)));
+  auto rep = client.call(echo({1}, 30.0), CallOptions{0.3, {}});
+  ASSERT_FALSE(rep.ok());
+  EXPECT_EQ(rep.error().code, ErrorCode::kTimeout);
+
+  std::stop_source stop;
+  std::thread canceller([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    stop.request_stop();
+  });
+  auto rep2 = client.call(echo({1}, 30.0), CallOptions{30.0, stop.get_token()});
+  canceller.join();
+  ASSERT_FALSE(rep2.ok());
+  EXPECT_EQ(rep2.error().code, ErrorCode::kCancelled);
+  // The server got the budget with the first request and the cancel with the second: both
+  // handlers stop early and the server becomes free for a quick request.
+  auto rep3 = client.call(echo({9}), CallOptions{10.0, {}});
+  ASSERT_TRUE(rep3.ok()) << rep3.error().toString();
+}
+
+}  // namespace
+}  // namespace tamp::dds

@@ -1,0 +1,255 @@
+#include "tamp/effort_estimator/features.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+#include <string>
+
+#include "tamp/core/geometry.h"
+
+namespace tamp::effort_estimator {
+namespace {
+
+Error invalid(std::string message, std::string field = "") {
+  return Error(ErrorCode::kInvalidArgument, std::move(message), SourceLocation{"", 0, 0, std::move(field)});
+}
+
+bool knownKind(ActionKind k) {
+  return std::find(kAllActionKinds.begin(), kAllActionKinds.end(), k) != kAllActionKinds.end();
+}
+
+bool isBaseJoint(const std::string& name) {
+  return std::find(kBaseJointNames.begin(), kBaseJointNames.end(), name) != kBaseJointNames.end();
+}
+
+std::string fmt(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%g", v);
+  return buf;
+}
+
+/// Common path checks: non-empty, sizes match, finite values.
+Status checkPath(const JointPath& path) {
+  if (path.waypoints.empty()) return invalid("empty path (no waypoints)", "path.waypoints");
+  if (path.joint_names.empty()) return invalid("path has no joint names", "path.joint_names");
+  for (std::size_t i = 0; i < path.joint_names.size(); ++i) {
+    for (std::size_t j = 0; j < i; ++j) {
+      if (path.joint_names[i] == path.joint_names[j]) {
+        return invalid("duplicate joint name '" + path.joint_names[i] + "'", "path.joint_names");
+      }
+    }
+  }
+  for (std::size_t i = 0; i < path.waypoints.size(); ++i) {
+    const auto& w = path.waypoints[i];
+    const std::string field = "path.waypoints[" + std::to_string(i) + "]";
+    if (w.size() != path.joint_names.size()) {
+      return invalid("waypoint has " + std::to_string(w.size()) + " values for " +
+                         std::to_string(path.joint_names.size()) + " joints",
+                     field);
+    }
+    for (std::size_t j = 0; j < w.size(); ++j) {
+      if (!std::isfinite(w[j])) {
+        return invalid("value of joint '" + path.joint_names[j] + "' is not finite", field);
+      }
+    }
+  }
+  return Status::Ok();
+}
+
+Result<ActionFeatures> baseFeatures(const ActionDescription& a) {
+  const JointPath& path = a.path;
+  if (Status s = checkPath(path); !s) return s.error();
+  for (const auto& name : path.joint_names) {
+    if (!isBaseJoint(name)) {
+      return invalid("move_base path has non-base joint '" + name +
+                         "' (expected exactly base_x, base_y, base_theta)",
+                     "path.joint_names");
+    }
+  }
+  const int ix = path.indexOf(kBaseJointNames[0]);
+  const int iy = path.indexOf(kBaseJointNames[1]);
+  const int it = path.indexOf(kBaseJointNames[2]);
+  if (ix < 0 || iy < 0 || it < 0) {
+    return invalid("move_base path needs joints base_x, base_y and base_theta", "path.joint_names");
+  }
+  using Tol = FeatureTolerances;
+  std::vector<double> moves;
+  std::vector<double> turns;
+  double heading = path.waypoints.front()[it];
+  double run_length = 0.0;  // length of the straight run being accumulated (0 = none)
+  double run_heading = 0.0;
+  auto turnTo = [&](double target) {
+    const double turn = std::abs(angleDiff(target, heading));
+    if (turn > Tol::kMinTurnRad) turns.push_back(turn);
+    heading = target;
+  };
+  auto flushRun = [&]() {
+    if (run_length > 0.0) moves.push_back(run_length);
+    run_length = 0.0;
+  };
+  for (std::size_t i = 1; i < path.waypoints.size(); ++i) {
+    const auto& p = path.waypoints[i - 1];
+    const auto& q = path.waypoints[i];
+    const double dx = q[ix] - p[ix];
+    const double dy = q[iy] - p[iy];
+    const double d = std::hypot(dx, dy);
+    if (d < Tol::kMinTranslationM) {
+      // Turn in place to this waypoint's heading (if it asks for one).
+      if (std::abs(angleDiff(q[it], heading)) > Tol::kMinTurnRad) {
+        flushRun();
+        turnTo(q[it]);
+      }
+      continue;
+    }
+    const double phi = std::atan2(dy, dx);
+    if (run_length > 0.0 && std::abs(angleDiff(phi, run_heading)) <= Tol::kCollinearRad) {
+      run_length += d;
+      continue;
+    }
+    flushRun();
+    turnTo(phi);
+    run_heading = phi;
+    run_length = d;
+  }
+  flushRun();
+  turnTo(path.waypoints.back()[it]);
+
+  ActionFeatures f;
+  f.kind = ActionKind::kMoveBase;
+  f.moves = MoveSet(std::move(moves));
+  f.turns = MoveSet(std::move(turns));
+  f.object_mass_kg = a.object_mass_kg;
+  return f;
+}
+
+Result<ActionFeatures> armFeatures(const ActionDescription& a) {
+  const JointPath& path = a.path;
+  if (Status s = checkPath(path); !s) return s.error();
+  for (const auto& name : path.joint_names) {
+    if (isBaseJoint(name)) {
+      return invalid("move_arm path has base joint '" + name + "' (use move_base for the base)",
+                     "path.joint_names");
+    }
+  }
+  using Tol = FeatureTolerances;
+  const std::size_t n = path.joint_names.size();
+  std::vector<double> moves;
+  std::vector<double> run_delta(n, 0.0);  // joint displacement of the current straight run
+  std::vector<double> last_dir;           // unit direction of the last segment (empty = none)
+  std::vector<double> delta(n);
+  auto flushRun = [&]() {
+    double largest = 0.0;
+    for (double v : run_delta) largest = std::max(largest, std::abs(v));
+    if (largest >= Tol::kMinJointMove) moves.push_back(largest);
+    std::fill(run_delta.begin(), run_delta.end(), 0.0);
+    last_dir.clear();
+  };
+  for (std::size_t i = 1; i < path.waypoints.size(); ++i) {
+    double largest = 0.0;
+    double norm2 = 0.0;
+    for (std::size_t j = 0; j < n; ++j) {
+      delta[j] = path.waypoints[i][j] - path.waypoints[i - 1][j];
+      largest = std::max(largest, std::abs(delta[j]));
+      norm2 += delta[j] * delta[j];
+    }
+    if (largest < Tol::kMinJointMove) continue;
+    const double norm = std::sqrt(norm2);
+    double dot = 0.0;
+    if (!last_dir.empty()) {
+      for (std::size_t j = 0; j < n; ++j) dot += last_dir[j] * delta[j] / norm;
+    }
+    if (last_dir.empty() || dot < 1.0 - Tol::kArmCollinearCos) flushRun();
+    last_dir.resize(n);
+    for (std::size_t j = 0; j < n; ++j) {
+      run_delta[j] += delta[j];
+      last_dir[j] = delta[j] / norm;
+    }
+  }
+  flushRun();
+  ActionFeatures f;
+  f.kind = ActionKind::kMoveArm;
+  f.moves = MoveSet(std::move(moves));
+  f.object_mass_kg = a.object_mass_kg;
+  return f;
+}
+
+}  // namespace
+
+MoveSet::MoveSet(std::vector<double> lengths) : lengths_(std::move(lengths)) {
+  for (double d : lengths_) {
+    if (!std::isfinite(d) || d < 0.0) {
+      throw std::invalid_argument("MoveSet: move length must be finite and >= 0, got " + fmt(d));
+    }
+  }
+  std::sort(lengths_.begin(), lengths_.end());
+  prefix_.resize(lengths_.size() + 1);
+  prefix_sqrt_.resize(lengths_.size() + 1);
+  prefix_[0] = prefix_sqrt_[0] = 0.0;
+  for (std::size_t i = 0; i < lengths_.size(); ++i) {
+    prefix_[i + 1] = prefix_[i] + lengths_[i];
+    prefix_sqrt_[i + 1] = prefix_sqrt_[i] + std::sqrt(lengths_[i]);
+  }
+}
+
+std::size_t MoveSet::countBelow(double threshold) const {
+  return static_cast<std::size_t>(std::lower_bound(lengths_.begin(), lengths_.end(), threshold) -
+                                  lengths_.begin());
+}
+
+Result<ActionFeatures> extractFeatures(const ActionDescription& action) {
+  if (!knownKind(action.kind)) {
+    return invalid("unknown action kind " + std::to_string(static_cast<int>(action.kind)), "kind");
+  }
+  if (!std::isfinite(action.object_mass_kg) || action.object_mass_kg < 0.0) {
+    return invalid("object mass must be finite and >= 0 kg, got " + fmt(action.object_mass_kg),
+                   "object_mass_kg");
+  }
+  const bool manipulation = action.kind == ActionKind::kPick || action.kind == ActionKind::kPlace;
+  const std::string kind_name(toString(action.kind));
+  if (manipulation) {
+    if (!action.path.empty() || !action.path.joint_names.empty()) {
+      return invalid(kind_name + " takes approach_m/retreat_m, not a path", "path");
+    }
+    for (auto [value, field] : {std::pair{action.approach_m, "approach_m"},
+                                std::pair{action.retreat_m, "retreat_m"}}) {
+      if (!std::isfinite(value) || value < 0.0) {
+        return invalid(kind_name + ": distance must be finite and >= 0 m, got " + fmt(value), field);
+      }
+    }
+    ActionFeatures f;
+    f.kind = action.kind;
+    f.approach_m = action.approach_m;
+    f.retreat_m = action.retreat_m;
+    f.object_mass_kg = action.object_mass_kg;
+    return f;
+  }
+  if (action.approach_m != 0.0 || action.retreat_m != 0.0) {
+    return invalid(kind_name + " takes a path; approach_m/retreat_m are for pick/place only",
+                   action.approach_m != 0.0 ? "approach_m" : "retreat_m");
+  }
+  return action.kind == ActionKind::kMoveBase ? baseFeatures(action) : armFeatures(action);
+}
+
+Status validateFeatures(const ActionFeatures& f) {
+  if (!knownKind(f.kind)) return invalid("unknown action kind " + std::to_string(static_cast<int>(f.kind)), "kind");
+  if (!std::isfinite(f.object_mass_kg) || f.object_mass_kg < 0.0) {
+    return invalid("object mass must be finite and >= 0 kg, got " + fmt(f.object_mass_kg), "object_mass_kg");
+  }
+  const bool manipulation = f.kind == ActionKind::kPick || f.kind == ActionKind::kPlace;
+  if (manipulation) {
+    if (!f.moves.empty() || !f.turns.empty()) return invalid("pick/place features have no moves", "moves");
+    if (!std::isfinite(f.approach_m) || f.approach_m < 0.0) return invalid("bad approach distance", "approach_m");
+    if (!std::isfinite(f.retreat_m) || f.retreat_m < 0.0) return invalid("bad retreat distance", "retreat_m");
+    return Status::Ok();
+  }
+  if (f.approach_m != 0.0 || f.retreat_m != 0.0) {
+    return invalid("motion features have no approach/retreat distances", "approach_m");
+  }
+  if (f.kind == ActionKind::kMoveArm && !f.turns.empty()) {
+    return invalid("move_arm features have no turns", "turns");
+  }
+  return Status::Ok();  // MoveSet already guarantees finite, non-negative lengths
+}
+
+}  // namespace tamp::effort_estimator

@@ -1,0 +1,52 @@
+#include "tamp/effort_estimator/records.h"
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+namespace tamp::effort_estimator {
+namespace {
+
+std::string fmt(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%g", v);
+  return buf;
+}
+
+Status checkScalars(double duration_s, double timestamp_s, double max_duration_s) {
+  auto bad = [](std::string msg, std::string field) {
+    return Error(ErrorCode::kInvalidArgument, std::move(msg), SourceLocation{"", 0, 0, std::move(field)});
+  };
+  if (std::isnan(duration_s)) return bad("duration is NaN", "duration_s");
+  if (std::isinf(duration_s)) return bad("duration is infinite", "duration_s");
+  if (duration_s <= 0.0) return bad("duration must be positive, got " + fmt(duration_s) + " s", "duration_s");
+  if (duration_s > max_duration_s) {
+    return bad("duration " + fmt(duration_s) + " s exceeds the limit of " + fmt(max_duration_s) + " s",
+               "duration_s");
+  }
+  if (!std::isfinite(timestamp_s) || timestamp_s < 0.0) {
+    return bad("timestamp must be finite and >= 0, got " + fmt(timestamp_s), "timestamp_s");
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+Result<FeatureRecord> toFeatureRecord(const ExecutionRecord& record, double max_duration_s) {
+  if (Status s = checkScalars(record.duration_s, record.timestamp_s, max_duration_s); !s) return s.error();
+  auto features = extractFeatures(record.action);
+  if (!features) {
+    Error e = features.error();
+    e.where.field = e.where.field.empty() ? "action" : "action." + e.where.field;
+    return e;
+  }
+  return FeatureRecord{std::move(*features), record.duration_s, record.timestamp_s, record.source,
+                       record.record_id};
+}
+
+Status validateFeatureRecord(const FeatureRecord& record, double max_duration_s) {
+  if (Status s = checkScalars(record.duration_s, record.timestamp_s, max_duration_s); !s) return s;
+  return validateFeatures(record.features);
+}
+
+}  // namespace tamp::effort_estimator

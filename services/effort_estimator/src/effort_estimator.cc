@@ -118,6 +118,23 @@ Result<Estimate> EffortEstimator::estimate(const EstimateRequest& request) const
   return estimate(*features);
 }
 
+BatchEstimate EffortEstimator::estimateBatch(std::span<const EstimateRequest> requests) const {
+  const std::shared_ptr<const ModelSnapshot> snap = snapshot_.load();
+  BatchEstimate out;
+  out.snapshot_version = snap->version;
+  out.estimates.reserve(requests.size());
+  for (const EstimateRequest& r : requests) {
+    auto features = extractFeatures(r);
+    if (!features) {
+      out.estimates.emplace_back(features.error());
+    } else {
+      out.estimates.emplace_back(predict(snap->models[indexOf(features->kind)], *features));
+    }
+  }
+  estimates_.fetch_add(requests.size(), std::memory_order_relaxed);
+  return out;
+}
+
 Estimate EffortEstimator::estimate(const ActionFeatures& features) const {
   const std::shared_ptr<const ModelSnapshot> snap = snapshot_.load();
   estimates_.fetch_add(1, std::memory_order_relaxed);

@@ -68,6 +68,23 @@ TEST(EstimatorTest, BadRequestsAndRecordsAreRejectedWithAReason) {
   EXPECT_EQ(est.recordCount(ActionKind::kPick), 0u);
 }
 
+TEST(EstimatorTest, BatchEstimatesUseOneSnapshotAndKeepPerRequestErrors) {
+  EffortEstimator est(paramsFor(""), false);
+  std::mt19937_64 rng(12);
+  std::vector<EstimateRequest> reqs;
+  for (ActionKind k : kAllActionKinds) reqs.push_back(synthetic::randomAction(k, rng));
+  reqs.push_back(EstimateRequest{});  // move_base without a path
+  const BatchEstimate b = est.estimateBatch(reqs);
+  ASSERT_EQ(b.estimates.size(), 5u);
+  EXPECT_EQ(b.snapshot_version, 0u);
+  for (std::size_t i = 0; i < 4; ++i) {
+    ASSERT_TRUE(b.estimates[i].ok());
+    EXPECT_DOUBLE_EQ(b.estimates[i]->mean_s, est.estimate(reqs[i])->mean_s);
+  }
+  ASSERT_FALSE(b.estimates[4].ok());
+  EXPECT_THAT(b.estimates[4].error().message, HasSubstr("empty path"));
+}
+
 TEST(EstimatorTest, RefitMovesEstimatesTowardTheTruthAndBumpsVersions) {
   EffortEstimator est(paramsFor(""), false);
   std::mt19937_64 rng(3);

@@ -57,6 +57,7 @@ std::vector<BadRecord> badRecords() {
                "action.path.waypoints"});
   c.push_back({"mismatched_path", with([](auto& r) { r.action.path.waypoints[1].pop_back(); }),
                "waypoint has 2 values for 3 joints", "action.path.waypoints[1]"});
+  c.push_back({"failed_action", with([](auto& r) { r.success = false; }), "the action failed", "success"});
   c.push_back({"unknown_kind", with([](auto& r) { r.action.kind = static_cast<ActionKind>(42); }),
                "unknown action kind 42", "action.kind"});
   return c;

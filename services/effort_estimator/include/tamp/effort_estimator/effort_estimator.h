@@ -41,6 +41,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <span>
 #include <stop_token>
 #include <string>
 #include <thread>
@@ -69,6 +70,12 @@ struct ModelSnapshot {
 
   /// @throws std::invalid_argument for a kind not in the snapshot.
   const KindModel& model(ActionKind kind) const;
+};
+
+/// Estimates of many requests against one snapshot (the graph manager prices many edges at once).
+struct BatchEstimate {
+  std::vector<Result<Estimate>> estimates;  ///< one per request, in order
+  std::uint64_t snapshot_version{0};        ///< ModelSnapshot::version all estimates used
 };
 
 /// Result of one kind's refit (for logs, the CLI and tests).
@@ -107,6 +114,9 @@ class EffortEstimator {
   /// Predicted execution time of an action. Thread-safe, lock-free with respect to fits.
   /// @return the estimate, or kInvalidArgument naming what is wrong with the request.
   Result<Estimate> estimate(const EstimateRequest& request) const;
+  /// Estimates every request against the same snapshot (consistent even while a refit
+  /// publishes). Thread-safe; a bad request gives its own error and does not affect the others.
+  BatchEstimate estimateBatch(std::span<const EstimateRequest> requests) const;
   /// Same from precomputed features (validated by `extractFeatures`): the cheap path for callers
   /// that price the same edge again after a refit.
   Estimate estimate(const ActionFeatures& features) const;

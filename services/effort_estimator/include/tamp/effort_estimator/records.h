@@ -17,6 +17,9 @@ struct ExecutionRecord {
   double duration_s{0.0};     ///< measured execution time, s; must be finite and > 0
   double timestamp_s{0.0};    ///< when it finished, seconds since the Unix epoch; finite, >= 0
   std::string source;         ///< who measured it ("sim", "robot1/execution_monitor", ...)
+  /// False for an action that failed or was aborted: its duration is not an execution time of
+  /// the action, so the record is rejected (with that reason) rather than fitted.
+  bool success{true};
   /// Optional unique id (e.g. the DDS sample's id). A record whose non-empty id was already
   /// accepted is ignored, so a re-delivered record is not counted twice.
   std::string record_id;

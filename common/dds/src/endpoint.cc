@@ -192,7 +192,10 @@ void ReaderBase::stopListening() {
 bool ReaderBase::takeNextRaw(void* sample, SampleMeta& meta) {
   fdds::SampleInfo info;
   ReturnCode_t r = reader_->take_next_sample(sample, &info);
-  if (r != ReturnCode_t::RETCODE_OK) return false;
+  if (r != ReturnCode_t::RETCODE_OK) {
+    if (r != ReturnCode_t::RETCODE_NO_DATA) log::get("dds")->warn("take on '{}': {}", topic_name_, rcName(r));
+    return false;
+  }
   meta.alive = info.valid_data && info.instance_state == fdds::ALIVE_INSTANCE_STATE;
   std::memcpy(meta.instance.data(), info.instance_handle.value, 16);
   meta.source_stamp_ns = static_cast<int64_t>(info.source_timestamp.to_ns());

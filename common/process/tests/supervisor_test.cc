@@ -1,0 +1,92 @@
+#include "tamp/process/supervisor.h"
+
+#include <signal.h>
+
+#include <fstream>
+#include <functional>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+#include "tamp/core/termination.h"
+
+namespace tamp::process {
+namespace {
+
+bool waitUntil(Supervisor& s, const std::function<bool()>& pred, double seconds = 10.0) {
+  const Deadline d = Deadline::in(seconds);
+  while (!d.expired()) {
+    s.poll();
+    if (pred()) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return false;
+}
+
+TEST(SupervisorTest, MissingExecutableIsNamed) {
+  auto r = spawn(ProcessSpec{"x", "/nonexistent/bin/svc", {}, {}, {}, true, 5, 0.5});
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.error().code, ErrorCode::kNotFound);
+  EXPECT_NE(r.error().toString().find("/nonexistent/bin/svc"), std::string::npos);
+}
+
+TEST(SupervisorTest, CleanExitIsNotRestarted) {
+  Supervisor s;
+  s.add(ProcessSpec{"true", "/bin/true", {}, {}, {}, true, 5, 0.01});
+  ASSERT_TRUE(s.startAll().ok());
+  ASSERT_TRUE(waitUntil(s, [&] { return s.status("true")->phase == ProcessPhase::kExited; }));
+  EXPECT_EQ(s.status("true")->restarts, 0);
+  EXPECT_EQ(s.status("true")->last_exit, "exit 0");
+}
+
+TEST(SupervisorTest, KilledProcessIsRestartedUntilTheLimit) {
+  Supervisor s;
+  s.add(ProcessSpec{"sleeper", "/bin/sleep", {"30"}, {}, {}, true, 2, 0.01});
+  ASSERT_TRUE(s.startAll().ok());
+  const pid_t first = s.status("sleeper")->pid;
+  ASSERT_GT(first, 0);
+  ASSERT_TRUE(s.signal("sleeper", SIGKILL));
+  ASSERT_TRUE(waitUntil(s, [&] {
+    auto st = s.status("sleeper");
+    return st->phase == ProcessPhase::kRunning && st->pid != first;
+  }));
+  EXPECT_EQ(s.status("sleeper")->restarts, 1);
+  EXPECT_EQ(s.status("sleeper")->last_exit.rfind("signal 9", 0), 0u);
+  // Two more deaths exceed max_restarts = 2.
+  ASSERT_TRUE(s.signal("sleeper", SIGKILL));
+  ASSERT_TRUE(waitUntil(s, [&] { return s.status("sleeper")->restarts == 2 &&
+                                        s.status("sleeper")->phase == ProcessPhase::kRunning; }));
+  ASSERT_TRUE(s.signal("sleeper", SIGKILL));
+  ASSERT_TRUE(waitUntil(s, [&] { return s.status("sleeper")->phase == ProcessPhase::kFailed; }));
+}
+
+TEST(SupervisorTest, StopAllTerminatesAndEscalates) {
+  Supervisor s;
+  // A process that ignores SIGTERM must be killed after the grace period.
+  s.add(ProcessSpec{"stubborn", "/bin/sh", {"-c", "trap '' TERM; sleep 30"}, {}, {}, true, 5, 0.01});
+  s.add(ProcessSpec{"polite", "/bin/sleep", {"30"}, {}, {}, true, 5, 0.01});
+  ASSERT_TRUE(s.startAll().ok());
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  s.stopAll(0.3);
+  EXPECT_EQ(s.status("stubborn")->phase, ProcessPhase::kExited);
+  EXPECT_EQ(s.status("stubborn")->last_exit.rfind("signal 9", 0), 0u);
+  EXPECT_EQ(s.status("polite")->last_exit.rfind("signal 15", 0), 0u);
+}
+
+TEST(SupervisorTest, EnvironmentAndLogFile) {
+  const auto log = std::filesystem::temp_directory_path() / ("tamp_sup_" + std::to_string(::getpid()) + ".log");
+  std::filesystem::remove(log);
+  Supervisor s;
+  s.add(ProcessSpec{"env", "/bin/sh", {"-c", "echo domain=$TAMP_DOMAIN_ID"}, {{"TAMP_DOMAIN_ID", "77"}}, log, false,
+                    0, 0.1});
+  ASSERT_TRUE(s.startAll().ok());
+  ASSERT_TRUE(waitUntil(s, [&] { return s.status("env")->phase == ProcessPhase::kExited; }));
+  std::ifstream in(log);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "domain=77");
+  std::filesystem::remove(log);
+}
+
+}  // namespace
+}  // namespace tamp::process

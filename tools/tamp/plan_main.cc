@@ -1,0 +1,128 @@
+// tamp plan DOMAIN PROBLEM: plans with the symbolic planner and prints the plan in IPC format.
+// Exit codes: 0 plan found, 10 proven unsolvable, 11 incomplete search gave up, 20 timeout,
+// 21 out of memory, 30 input error, 31 invalid plan (--validate), 39 internal error.
+#include <cstdio>
+#include <iostream>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "cli_common.h"
+#include "tamp/core/paths.h"
+#include "tamp/symbolic_planner/planner.h"
+
+namespace sp = tamp::symbolic_planner;
+
+namespace {
+
+int exitCode(sp::PlanStatus s) {
+  switch (s) {
+    case sp::PlanStatus::kSolved: return tamp::cli::kExitOk;
+    case sp::PlanStatus::kUnsolvable: return tamp::cli::kExitNoSolution;
+    case sp::PlanStatus::kFailed: return tamp::cli::kExitNoSolution + 1;
+    case sp::PlanStatus::kTimeout:
+    case sp::PlanStatus::kCancelled: return tamp::cli::kExitTimeout;
+    case sp::PlanStatus::kOutOfMemory: return tamp::cli::kExitTimeout + 1;
+    case sp::PlanStatus::kInputError: return tamp::cli::kExitInputError;
+    case sp::PlanStatus::kInternalError: return tamp::cli::kExitInputError + 9;
+  }
+  return tamp::cli::kExitInputError + 9;
+}
+
+int validate(const std::string& domain_path, const std::string& problem_path, const std::string& plan_path) {
+  auto dt = tamp::readTextFile(domain_path);
+  if (!dt) return std::cerr << "error: " << dt.error().toString() << "\n", tamp::cli::kExitInputError;
+  auto pt = tamp::readTextFile(problem_path);
+  if (!pt) return std::cerr << "error: " << pt.error().toString() << "\n", tamp::cli::kExitInputError;
+  auto lt = tamp::readTextFile(plan_path);
+  if (!lt) return std::cerr << "error: " << lt.error().toString() << "\n", tamp::cli::kExitInputError;
+  auto d = sp::pddl::parseDomain(*dt, domain_path);
+  if (!d) return std::cerr << "error: " << d.error().toString() << "\n", tamp::cli::kExitInputError;
+  auto p = sp::pddl::parseProblem(*pt, *d, problem_path);
+  if (!p) return std::cerr << "error: " << p.error().toString() << "\n", tamp::cli::kExitInputError;
+  auto plan = sp::parsePlan(*lt, plan_path);
+  if (!plan) return std::cerr << "error: " << plan.error().toString() << "\n", tamp::cli::kExitInputError;
+  const sp::ValidationResult v = sp::validatePlan(*d, *p, *plan);
+  if (!v.valid) {
+    std::cout << "invalid plan: " << v.message << "\n";
+    return tamp::cli::kExitInputError + 1;
+  }
+  std::cout << "valid plan: " << plan->size() << " steps, cost " << v.cost << "\n";
+  return tamp::cli::kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Plans with the FF-style symbolic planner; prints the plan in IPC format.\n"
+               "Exit codes: 0 plan, 10 proven unsolvable, 11 incomplete search failed, 20 timeout,\n"
+               "21 out of memory, 30 input error, 31 invalid plan (--validate), 39 internal error.",
+               "tamp plan"};
+  std::string domain, problem, search = "ehc", heuristic, plan_out, validate_plan;
+  double timeout = 0.0, weight = 5.0;
+  size_t memory_mb = 4096;
+  bool stats = false, no_check = false, no_fallback = false;
+  app.add_option("domain", domain, "PDDL domain file")->required();
+  app.add_option("problem", problem, "PDDL problem file")->required();
+  app.add_option("--search", search, "ehc (FF: hill-climbing, then best-first), gbfs, wastar, astar")
+      ->check(CLI::IsMember({"ehc", "gbfs", "wastar", "astar"}));
+  app.add_option("--heuristic", heuristic, "ff, add, max, blind (default: ff; max for wastar/astar)")
+      ->check(CLI::IsMember({"ff", "add", "max", "blind"}));
+  app.add_option("--weight", weight, "weight of wastar (>= 1)")->check(CLI::Range(1.0, 1e6));
+  app.add_option("--timeout", timeout, "time limit in seconds (0 = none)")->check(CLI::Range(0.0, 1e9));
+  app.add_option("--memory-limit", memory_mb, "search memory budget in MiB (0 = none)");
+  app.add_option("-o,--output", plan_out, "also write the plan to this file");
+  app.add_option("--validate", validate_plan, "check this plan file against DOMAIN PROBLEM instead of planning");
+  app.add_flag("--stats", stats, "print statistics to stderr");
+  app.add_flag("--no-check", no_check, "do not replay the plan with the independent checker");
+  app.add_flag("--no-fallback", no_fallback, "ehc: do not fall back to best-first search");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);
+    return rc == 0 ? 0 : tamp::cli::kExitInputError;
+  }
+  if (!validate_plan.empty()) return validate(domain, problem, validate_plan);
+
+  sp::PlanRequest req;
+  req.domain_path = domain;
+  req.problem_path = problem;
+  req.search.algorithm = *sp::parseSearchAlgorithm(search);
+  req.search.weight = weight;
+  req.search.memory_limit_mb = memory_mb;
+  req.search.ehc_fallback = !no_fallback;
+  if (heuristic == "ff") req.search.heuristic = sp::HeuristicKind::kFF;
+  if (heuristic == "add") req.search.heuristic = sp::HeuristicKind::kAdd;
+  if (heuristic == "max") req.search.heuristic = sp::HeuristicKind::kMax;
+  if (heuristic == "blind") req.search.heuristic = sp::HeuristicKind::kBlind;
+  req.timeout_seconds = timeout;
+  req.check_plan = !no_check;
+  const sp::PlanReply reply = sp::plan(req, tamp::Termination());
+  if (stats) {
+    std::fprintf(stderr,
+                 "; status %s; parse %.4f s, ground %.4f s, search %.4f s; facts %zu, operators %zu; "
+                 "expanded %llu, evaluated %llu, initial h %lld%s\n",
+                 sp::toString(reply.status).c_str(), reply.stats.parse_seconds, reply.stats.ground_seconds,
+                 reply.stats.search_seconds, reply.stats.facts, reply.stats.operators,
+                 static_cast<unsigned long long>(reply.stats.expanded),
+                 static_cast<unsigned long long>(reply.stats.evaluated), static_cast<long long>(reply.stats.initial_h),
+                 reply.stats.ehc_failed ? "; ehc failed, used gbfs" : "");
+  }
+  if (reply.status != sp::PlanStatus::kSolved) {
+    std::cerr << (reply.status == sp::PlanStatus::kInputError ? "error: " : "") << reply.message << "\n";
+    std::cout << "; " << sp::toString(reply.status) << "\n";
+    return exitCode(reply.status);
+  }
+  const std::string text = sp::formatPlan(reply.plan, reply.cost);
+  std::fwrite(text.data(), 1, text.size(), stdout);
+  if (!plan_out.empty()) {
+    std::FILE* f = std::fopen(plan_out.c_str(), "w");
+    if (!f || std::fwrite(text.data(), 1, text.size(), f) != text.size()) {
+      std::cerr << "error: cannot write " << plan_out << "\n";
+      if (f) std::fclose(f);
+      return tamp::cli::kExitInputError;
+    }
+    std::fclose(f);
+  }
+  return tamp::cli::kExitOk;
+}

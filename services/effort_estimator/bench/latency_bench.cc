@@ -117,6 +117,7 @@ void BM_AddRecord(benchmark::State& state) {
   const std::filesystem::path dir =
       std::filesystem::temp_directory_path() / ("tamp_effort_bench_" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
   ee::EstimatorParams p = memoryParams();
   if (sqlite) p.store_directory = dir.string();
   p.refit_batch_size = 1 << 30;  // no refit during the measurement

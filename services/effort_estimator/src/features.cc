@@ -78,7 +78,6 @@ Result<ActionFeatures> baseFeatures(const ActionDescription& a) {
   std::vector<double> turns;
   double heading = path.waypoints.front()[it];
   double run_length = 0.0;  // length of the straight run being accumulated (0 = none)
-  double run_heading = 0.0;
   auto turnTo = [&](double target) {
     const double turn = std::abs(angleDiff(target, heading));
     if (turn > Tol::kMinTurnRad) turns.push_back(turn);
@@ -88,12 +87,16 @@ Result<ActionFeatures> baseFeatures(const ActionDescription& a) {
     if (run_length > 0.0) moves.push_back(run_length);
     run_length = 0.0;
   };
+  // Unit direction of the current run; a segment continues the run when its direction is within
+  // kCollinearRad of it (cross product test, so atan2 is only paid at the start of a run).
+  double run_ux = 0.0, run_uy = 0.0;
+  const double sin_tol = std::sin(Tol::kCollinearRad);
   for (std::size_t i = 1; i < path.waypoints.size(); ++i) {
     const auto& p = path.waypoints[i - 1];
     const auto& q = path.waypoints[i];
     const double dx = q[ix] - p[ix];
     const double dy = q[iy] - p[iy];
-    const double d = std::hypot(dx, dy);
+    const double d = std::sqrt(dx * dx + dy * dy);
     if (d < Tol::kMinTranslationM) {
       // Turn in place to this waypoint's heading (if it asks for one).
       if (std::abs(angleDiff(q[it], heading)) > Tol::kMinTurnRad) {
@@ -102,14 +105,19 @@ Result<ActionFeatures> baseFeatures(const ActionDescription& a) {
       }
       continue;
     }
-    const double phi = std::atan2(dy, dx);
-    if (run_length > 0.0 && std::abs(angleDiff(phi, run_heading)) <= Tol::kCollinearRad) {
-      run_length += d;
-      continue;
+    if (run_length > 0.0) {
+      const double dot = run_ux * dx + run_uy * dy;
+      const double cross = run_ux * dy - run_uy * dx;
+      if (dot > 0.0 && std::abs(cross) <= sin_tol * d) {
+        run_length += d;
+        continue;
+      }
     }
     flushRun();
+    const double phi = std::atan2(dy, dx);
     turnTo(phi);
-    run_heading = phi;
+    run_ux = dx / d;
+    run_uy = dy / d;
     run_length = d;
   }
   flushRun();

@@ -1,0 +1,297 @@
+// IPC benchmark driver: runs `tamp-plan` once per instance (one process each, like the reference
+// runs of FF and Fast Downward), measures end-to-end wall time and peak RSS of the child
+// (wait4/getrusage), kills it at the time limit, checks every plan with the independent lifted
+// plan checker, writes a per-instance CSV and prints a per-domain Markdown summary next to the
+// reference planners of the benchmark's reference_results.csv.
+//
+//   tamp_symbolic_planner_ipc_bench --planner build/planner/bin/tamp-plan \
+//       --set ../shared/benchmarks/pddl --out docs/bench/symbolic_planner_ipc.csv [--timeout 60]
+//       [--domain blocks] [--label ours] [-- extra planner args]
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "tamp/core/paths.h"
+#include "tamp/symbolic_planner/pddl.h"
+#include "tamp/symbolic_planner/validator.h"
+
+namespace fs = std::filesystem;
+namespace sp = tamp::symbolic_planner;
+
+namespace {
+
+struct Row {
+  std::string domain, problem, planner;
+  bool solved{false};
+  double wall_s{0};
+  long plan_length{-1};
+  double plan_cost{-1};
+  long peak_kb{0};
+  int exit_code{0};
+  std::string note;
+};
+
+struct RunResult {
+  int exit_code{-1};
+  bool killed{false};
+  double wall_s{0};
+  long peak_kb{0};
+  std::string out;
+};
+
+RunResult runChild(const std::vector<std::string>& argv, double timeout_s) {
+  RunResult r;
+  char tmpl[] = "/tmp/tamp_ipc_bench_XXXXXX";
+  const int fd = mkstemp(tmpl);
+  if (fd < 0) {
+    r.out = "mkstemp failed";
+    return r;
+  }
+  unlink(tmpl);
+  const auto t0 = std::chrono::steady_clock::now();
+  const pid_t pid = fork();
+  if (pid == 0) {
+    dup2(fd, STDOUT_FILENO);
+    const int devnull = open("/dev/null", O_WRONLY);
+    if (devnull >= 0) dup2(devnull, STDERR_FILENO);
+    std::vector<char*> args;
+    for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+    args.push_back(nullptr);
+    execv(args[0], args.data());
+    _exit(127);
+  }
+  int status = 0;
+  struct rusage ru {};
+  for (;;) {
+    const pid_t w = wait4(pid, &status, WNOHANG, &ru);
+    if (w == pid) break;
+    const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (el > timeout_s && !r.killed) {
+      kill(pid, SIGKILL);
+      r.killed = true;
+    }
+    // Poll finely at first (most runs take milliseconds), then back off.
+    std::this_thread::sleep_for(el < 0.05 ? std::chrono::microseconds(100) : std::chrono::milliseconds(2));
+  }
+  r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  r.peak_kb = ru.ru_maxrss;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+  lseek(fd, 0, SEEK_SET);
+  char buf[65536];
+  ssize_t n;
+  while ((n = read(fd, buf, sizeof buf)) > 0) r.out.append(buf, static_cast<size_t>(n));
+  close(fd);
+  return r;
+}
+
+int instanceNumber(const fs::path& p) {
+  const std::string s = p.stem().string();
+  const auto dash = s.rfind('-');
+  try {
+    return std::stoi(s.substr(dash + 1));
+  } catch (...) {
+    return 0;
+  }
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return -1;
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+std::vector<std::string> splitCsv(const std::string& line) {
+  std::vector<std::string> out;
+  std::stringstream ss(line);
+  std::string f;
+  while (std::getline(ss, f, ',')) out.push_back(f);
+  if (!line.empty() && line.back() == ',') out.emplace_back();
+  return out;
+}
+
+std::vector<Row> readReference(const fs::path& csv) {
+  std::vector<Row> rows;
+  std::ifstream in(csv);
+  std::string line;
+  std::vector<std::string> header;
+  while (std::getline(in, line)) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    auto f = splitCsv(line);
+    if (header.empty()) {
+      header = f;
+      continue;
+    }
+    std::map<std::string, std::string> m;
+    for (size_t i = 0; i < header.size() && i < f.size(); ++i) m[header[i]] = f[i];
+    Row r;
+    r.domain = m["domain"];
+    r.problem = m["problem"];
+    r.planner = m["planner"];
+    r.solved = m["solved"] == "1";
+    r.wall_s = m["wall_s"].empty() ? 0 : std::stod(m["wall_s"]);
+    r.plan_length = m["plan_length"].empty() ? -1 : std::stol(m["plan_length"]);
+    r.plan_cost = m.count("plan_cost") && !m["plan_cost"].empty() ? std::stod(m["plan_cost"]) : r.plan_length;
+    r.peak_kb = m["peak_kb"].empty() ? 0 : std::stol(m["peak_kb"]);
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string planner, set, out_csv, only_domain, label = "tamp-plan";
+  double timeout = 60;
+  std::vector<std::string> extra;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto next = [&]() -> std::string {
+      if (i + 1 >= argc) {
+        std::cerr << "missing value after " << a << "\n";
+        std::exit(30);
+      }
+      return argv[++i];
+    };
+    if (a == "--planner") planner = next();
+    else if (a == "--set") set = next();
+    else if (a == "--out") out_csv = next();
+    else if (a == "--timeout") timeout = std::stod(next());
+    else if (a == "--domain") only_domain = next();
+    else if (a == "--label") label = next();
+    else if (a == "--") {
+      for (++i; i < argc; ++i) extra.push_back(argv[i]);
+    } else {
+      std::cerr << "usage: " << argv[0]
+                << " --planner PATH --set BENCH_DIR [--out CSV] [--timeout S] [--domain D] [--label L] [-- ARGS]\n";
+      return 30;
+    }
+  }
+  if (planner.empty() || set.empty()) {
+    std::cerr << "--planner and --set are required\n";
+    return 30;
+  }
+  std::vector<fs::path> domains;
+  for (const auto& e : fs::directory_iterator(set)) {
+    if (e.is_directory() && fs::exists(e.path() / "domain.pddl")) domains.push_back(e.path());
+  }
+  std::sort(domains.begin(), domains.end());
+  std::vector<Row> rows;
+  for (const auto& dir : domains) {
+    const std::string dname = dir.filename().string();
+    if (!only_domain.empty() && dname != only_domain) continue;
+    std::vector<fs::path> inst;
+    for (const auto& e : fs::directory_iterator(dir)) {
+      const std::string n = e.path().filename().string();
+      if (n.rfind("instance-", 0) == 0 && e.path().extension() == ".pddl") inst.push_back(e.path());
+    }
+    std::sort(inst.begin(), inst.end(), [](const fs::path& a, const fs::path& b) { return instanceNumber(a) < instanceNumber(b); });
+    auto dtext = tamp::readTextFile(dir / "domain.pddl");
+    auto dom = dtext ? sp::pddl::parseDomain(*dtext, (dir / "domain.pddl").string()) : tamp::Result<sp::pddl::Domain>(dtext.error());
+    for (const auto& p : inst) {
+      std::vector<std::string> args{planner, (dir / "domain.pddl").string(), p.string(), "--no-check"};
+      args.insert(args.end(), extra.begin(), extra.end());
+      RunResult rr = runChild(args, timeout);
+      Row row;
+      row.domain = dname;
+      row.problem = p.stem().string();
+      row.planner = label;
+      row.wall_s = rr.wall_s;
+      row.peak_kb = rr.peak_kb;
+      row.exit_code = rr.exit_code;
+      if (rr.exit_code == 0 && !rr.killed && dom) {
+        auto plan = sp::parsePlan(rr.out, p.string() + ".plan");
+        auto ptext = tamp::readTextFile(p);
+        if (plan && ptext) {
+          auto prob = sp::pddl::parseProblem(*ptext, *dom, p.string());
+          if (prob) {
+            const sp::ValidationResult v = sp::validatePlan(*dom, *prob, *plan);
+            row.solved = v.valid;
+            row.plan_length = static_cast<long>(plan->size());
+            row.plan_cost = v.cost;
+            if (!v.valid) row.note = "INVALID: " + v.message;
+          }
+        }
+      } else if (rr.killed) {
+        row.note = "killed at time limit";
+      }
+      std::fprintf(stderr, "%-12s %-14s exit %3d  %8.3f s  %7ld KB  len %4ld  %s\n", dname.c_str(), row.problem.c_str(),
+                   row.exit_code, row.wall_s, row.peak_kb, row.plan_length, row.note.c_str());
+      rows.push_back(row);
+    }
+  }
+  if (!out_csv.empty()) {
+    std::ofstream out(out_csv);
+    out << "domain,problem,planner,solved,wall_s,plan_length,plan_cost,peak_kb,exit_code,note\n";
+    for (const auto& r : rows) {
+      char b[512];
+      std::snprintf(b, sizeof b, "%s,%s,%s,%d,%.4f,%s,%s,%ld,%d,%s\n", r.domain.c_str(), r.problem.c_str(),
+                    r.planner.c_str(), r.solved ? 1 : 0, r.wall_s,
+                    r.solved ? std::to_string(r.plan_length).c_str() : "",
+                    r.solved ? std::to_string(static_cast<long>(r.plan_cost)).c_str() : "", r.peak_kb, r.exit_code,
+                    r.note.c_str());
+      out << b;
+    }
+  }
+  // Summary next to the references.
+  const fs::path ref_csv = fs::path(set) / "reference_results.csv";
+  std::vector<Row> ref = fs::exists(ref_csv) ? readReference(ref_csv) : std::vector<Row>{};
+  std::map<std::string, std::vector<Row>> by;  // "domain|planner"
+  std::vector<std::string> planners{label};
+  for (const auto& r : ref) {
+    if (!only_domain.empty() && r.domain != only_domain) continue;
+    by[r.domain + "|" + r.planner].push_back(r);
+    if (std::find(planners.begin(), planners.end(), r.planner) == planners.end()) planners.push_back(r.planner);
+  }
+  for (const auto& r : rows) by[r.domain + "|" + r.planner].push_back(r);
+  std::printf("| domain | planner | coverage | median time (s) | median length | median cost | median peak RSS (MB) | FF-solved by us |\n");
+  std::printf("|---|---|---|---|---|---|---|---|\n");
+  std::vector<std::string> dnames;
+  for (const auto& d : domains) {
+    if (only_domain.empty() || d.filename() == only_domain) dnames.push_back(d.filename().string());
+  }
+  for (const auto& d : dnames) {
+    for (const auto& pl : planners) {
+      auto it = by.find(d + "|" + pl);
+      if (it == by.end()) continue;
+      std::vector<double> t, len, cost, kb;
+      int solved = 0;
+      for (const auto& r : it->second) {
+        if (!r.solved) continue;
+        ++solved;
+        t.push_back(r.wall_s);
+        len.push_back(static_cast<double>(r.plan_length));
+        cost.push_back(r.plan_cost);
+        kb.push_back(static_cast<double>(r.peak_kb) / 1024.0);
+      }
+      std::string ff_cov = "";
+      if (pl == label) {
+        int ff_solved = 0, both = 0;
+        for (const auto& r : ref) {
+          if (r.domain != d || r.planner != "ff-v2.3" || !r.solved) continue;
+          ++ff_solved;
+          for (const auto& o : it->second) both += (o.problem == r.problem && o.solved) ? 1 : 0;
+        }
+        ff_cov = std::to_string(both) + "/" + std::to_string(ff_solved);
+      }
+      std::printf("| %s | %s | %d/%zu | %.4f | %.1f | %.1f | %.1f | %s |\n", d.c_str(), pl.c_str(), solved, it->second.size(),
+                  median(t), median(len), median(cost), median(kb), ff_cov.c_str());
+    }
+  }
+  return 0;
+}

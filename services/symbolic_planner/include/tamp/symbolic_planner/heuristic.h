@@ -1,0 +1,65 @@
+#pragma once
+/// @file
+/// Delete-relaxation heuristics over a grounded `Task`.
+///
+/// All of them share one counter-based relaxed exploration (as in FF and Fast Downward's
+/// `relaxation_heuristic`): every relaxed operator (an operator's unconditional part, and each of
+/// its conditional effects with the condition added to the precondition) keeps a counter of
+/// unsatisfied preconditions; facts are settled in order of cost from a priority queue, so the
+/// exploration stops as soon as a goal conjunct is settled.
+///
+/// - `hmax`: cost of the costliest goal/precondition (admissible).
+/// - `hadd`: sum of the costs (not admissible, informative).
+/// - `hff`: the cost of a relaxed plan extracted backwards through the best supporters of `hadd`
+///   (Hoffmann & Nebel 2001, with FD's h_add supporters), with FF's *helpful actions*: the
+///   operators applicable in the state that add a sub-goal of the relaxed plan's first layer.
+///
+/// Contract (tested for every heuristic): h(s) = 0 when s satisfies the goal, h(s) >= 0, and
+/// `kDeadEnd` exactly when the goal is unreachable even under the relaxation (so `kDeadEnd`
+/// proves s unsolvable).
+
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <vector>
+
+#include "tamp/symbolic_planner/task.h"
+
+namespace tamp::symbolic_planner {
+
+/// How operator costs enter the heuristic.
+enum class CostType {
+  kUnit,     ///< every operator costs 1 (plan length)
+  kCost,     ///< the operator's cost
+  kPlusOne,  ///< cost + 1 (LAMA's choice for zero-cost actions in satisficing search)
+};
+
+enum class HeuristicKind { kFF, kAdd, kMax, kBlind };
+
+class Heuristic {
+ public:
+  static constexpr Cost kDeadEnd = std::numeric_limits<Cost>::max();
+  virtual ~Heuristic() = default;
+  /// Sets the goal for subsequent evaluations (the task stays the same).
+  virtual void setGoal(const Goal& goal) = 0;
+  /// Heuristic value of `state` (numWords() words), or kDeadEnd.
+  virtual Cost evaluate(const uint64_t* state) = 0;
+  /// Helpful actions of the last evaluation (empty when the heuristic does not compute them).
+  virtual const std::vector<OpId>& preferred() const { return no_ops_; }
+  virtual bool computesPreferred() const { return false; }
+
+ protected:
+  std::vector<OpId> no_ops_;
+};
+
+/// A heuristic for `task` (which must outlive it). @throws std::invalid_argument on misuse
+/// (unknown kind).
+std::unique_ptr<Heuristic> makeHeuristic(HeuristicKind kind, const Task& task, CostType cost_type);
+
+/// Operator cost under `type`.
+inline Cost adjustedCost(const Operator& op, CostType type, bool unit_task) {
+  if (type == CostType::kUnit || unit_task) return 1;
+  return type == CostType::kPlusOne ? op.cost + 1 : op.cost;
+}
+
+}  // namespace tamp::symbolic_planner

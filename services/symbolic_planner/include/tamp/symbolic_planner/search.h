@@ -1,0 +1,93 @@
+#pragma once
+/// @file
+/// Forward state-space searches over a grounded `Task`.
+///
+/// - `kEhc`: FF's enforced hill-climbing: from the current state, a breadth-first search over
+///   helpful actions until a state with a strictly better h_FF is found; on failure (dead end or
+///   exhausted plateau) it falls back to complete greedy best-first search from the start
+///   (`ehc_fallback`), as FF does.
+/// - `kGbfs`: eager greedy best-first search on h_FF with a second open list for successors through
+///   helpful (preferred) operators, alternating with a boost on progress (as Fast Downward's
+///   `eager_greedy([ff], preferred=[ff])`). Complete: it proves unsolvability by exhaustion.
+/// - `kWAstar` / `kAstar`: (weighted) A* with re-opening on f = g + w*h; with the admissible
+///   h_max (the default for these) A* returns cost-optimal plans and weighted A* plans within a
+///   factor `weight` of optimal.
+///
+/// States live in a `StateRegistry` (one contiguous pool, open-addressing hash set of ids): no
+/// per-node allocation. Every search checks its `Termination` and a memory budget.
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "tamp/core/termination.h"
+#include "tamp/symbolic_planner/heuristic.h"
+#include "tamp/symbolic_planner/task.h"
+
+namespace tamp::symbolic_planner {
+
+enum class SearchAlgorithm { kEhc, kGbfs, kWAstar, kAstar };
+
+/// Parses "ehc", "gbfs", "wastar", "astar"; nullopt otherwise.
+std::optional<SearchAlgorithm> parseSearchAlgorithm(const std::string& name);
+std::string toString(SearchAlgorithm a);
+
+struct SearchOptions {
+  SearchAlgorithm algorithm{SearchAlgorithm::kEhc};
+  /// Heuristic; nullopt = h_FF for ehc/gbfs, h_max for wastar/astar (admissible).
+  std::optional<HeuristicKind> heuristic;
+  /// How action costs enter the heuristic; nullopt = unit for ehc/gbfs on unit-cost tasks,
+  /// cost+1 for ehc/gbfs on tasks with costs, the real cost for wastar/astar.
+  std::optional<CostType> cost_type;
+  double weight{5.0};           ///< wastar only; must be >= 1
+  bool ehc_fallback{true};      ///< ehc: complete GBFS when hill-climbing fails
+  bool goal_agenda{true};       ///< ehc: FF's goal agenda (achieve ordered goal subsets in turn)
+  bool preferred_operators{true};  ///< gbfs: use the helpful-action open list
+  int preferred_boost{1000};    ///< gbfs: preferred-queue priority boost on progress
+  size_t memory_limit_mb{4096};  ///< search data (states + nodes); 0 = unlimited
+
+  /// @throws std::invalid_argument naming the bad field (weight < 1, ...).
+  void validate() const;
+};
+
+enum class SearchStatus {
+  kSolved,       ///< plan found
+  kUnsolvable,   ///< proven: no plan exists (relaxed dead end or exhausted complete search)
+  kFailed,       ///< an incomplete search (ehc without fallback) gave up; nothing is proven
+  kTimeout,      ///< deadline passed
+  kCancelled,    ///< stop requested
+  kOutOfMemory,  ///< memory budget exhausted
+};
+std::string toString(SearchStatus s);
+
+struct SearchStatistics {
+  uint64_t expanded{0};
+  uint64_t generated{0};
+  uint64_t evaluated{0};
+  uint64_t reopened{0};
+  uint64_t registered_states{0};
+  Cost initial_h{0};
+  bool ehc_failed{false};  ///< ehc fell back to gbfs
+  double seconds{0.0};
+};
+
+struct SearchResult {
+  SearchStatus status{SearchStatus::kFailed};
+  std::vector<OpId> plan;
+  Cost cost{0};  ///< sum of operator costs (plan length on unit-cost tasks)
+  SearchStatistics stats;
+};
+
+/// Searches from `init` (task.numWords() words) to `goal`.
+/// @throws std::invalid_argument when options are invalid or `init` has the wrong size.
+SearchResult search(const Task& task, const StateBits& init, const Goal& goal, const SearchOptions& options,
+                    const Termination& term);
+
+/// Same, with a caller-owned heuristic (already built for `task`; its goal is set here). Lets a
+/// session reuse heuristic tables across queries.
+SearchResult search(const Task& task, const StateBits& init, const Goal& goal, const SearchOptions& options,
+                    Heuristic& heuristic, const Termination& term);
+
+}  // namespace tamp::symbolic_planner

@@ -1,0 +1,633 @@
+#include "tamp/symbolic_planner/search.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace tamp::symbolic_planner {
+namespace {
+
+constexpr uint32_t kNone = UINT32_MAX;
+
+/// All states of one search in one pool; an open-addressing hash set of ids.
+class StateRegistry {
+ public:
+  explicit StateRegistry(size_t words) : w_(words == 0 ? 1 : words), slots_(1024, kNone) {}
+
+  std::pair<uint32_t, bool> insert(const uint64_t* s) {
+    if ((n_ + 1) * 4 > slots_.size() * 3) grow();
+    const uint64_t h = hash(s);
+    size_t i = h & (slots_.size() - 1);
+    while (slots_[i] != kNone) {
+      if (hashes_[slots_[i]] == static_cast<uint32_t>(h) && std::equal(s, s + w_, get(slots_[i]))) return {slots_[i], false};
+      i = (i + 1) & (slots_.size() - 1);
+    }
+    const uint32_t id = static_cast<uint32_t>(n_++);
+    pool_.insert(pool_.end(), s, s + w_);
+    hashes_.push_back(static_cast<uint32_t>(h));
+    slots_[i] = id;
+    return {id, true};
+  }
+  const uint64_t* get(uint32_t id) const { return pool_.data() + static_cast<size_t>(id) * w_; }
+  size_t size() const { return n_; }
+  size_t bytes() const { return pool_.capacity() * 8 + slots_.size() * 4 + hashes_.capacity() * 4; }
+  size_t words() const { return w_; }
+
+ private:
+  uint64_t hash(const uint64_t* s) const {
+    uint64_t h = 0x243F6A8885A308D3ULL;
+    for (size_t i = 0; i < w_; ++i) {
+      h ^= s[i];
+      h *= 0x9E3779B97F4A7C15ULL;
+      h ^= h >> 32;
+    }
+    return h;
+  }
+  void grow() {
+    std::vector<uint32_t> ns(slots_.size() * 2, kNone);
+    for (uint32_t id = 0; id < n_; ++id) {
+      size_t i = hash(get(id)) & (ns.size() - 1);
+      while (ns[i] != kNone) i = (i + 1) & (ns.size() - 1);
+      ns[i] = id;
+    }
+    slots_.swap(ns);
+  }
+  size_t w_;
+  size_t n_{0};
+  std::vector<uint64_t> pool_;
+  std::vector<uint32_t> hashes_;
+  std::vector<uint32_t> slots_;
+};
+
+struct HeapEntry {
+  Cost key1;
+  Cost key2;
+  uint64_t order;
+  uint32_t id;
+};
+struct HeapCmp {
+  bool operator()(const HeapEntry& a, const HeapEntry& b) const {
+    if (a.key1 != b.key1) return a.key1 > b.key1;
+    if (a.key2 != b.key2) return a.key2 > b.key2;
+    return a.order > b.order;
+  }
+};
+class OpenList {
+ public:
+  void push(Cost k1, Cost k2, uint32_t id) {
+    v_.push_back({k1, k2, counter_++, id});
+    std::push_heap(v_.begin(), v_.end(), HeapCmp{});
+  }
+  HeapEntry pop() {
+    std::pop_heap(v_.begin(), v_.end(), HeapCmp{});
+    HeapEntry e = v_.back();
+    v_.pop_back();
+    return e;
+  }
+  bool empty() const { return v_.empty(); }
+  size_t bytes() const { return v_.capacity() * sizeof(HeapEntry); }
+
+ private:
+  std::vector<HeapEntry> v_;
+  uint64_t counter_{0};
+};
+
+/// FF's goal agenda (Koehler & Hoffmann 2000, approximation <=_h as in FF): goal j is ordered
+/// before goal i when, with i true and kept true, j looks unachievable: every achiever of j
+/// deletes i, or needs a precondition that only i-deleting achievers (or achievers needing a fact
+/// in i's False set) provide. Returns the goal facts in entries to be achieved incrementally.
+std::vector<std::vector<FactId>> goalAgenda(const Task& task, const std::vector<FactId>& goals) {
+  const size_t n = goals.size();
+  if (n < 2) return {goals};
+  struct Eff {
+    const std::vector<FactId>* pre;
+    const std::vector<FactId>* cond;
+    const std::vector<FactId>* add;
+    const std::vector<FactId>* del;
+    const std::vector<FactId>* del2;
+  };
+  std::vector<Eff> effs;
+  for (const auto& op : task.ops) {
+    static const std::vector<FactId> kEmpty;
+    effs.push_back({&op.pre, &kEmpty, &op.add, &op.del, &kEmpty});
+    for (const auto& ce : op.cond_effects) effs.push_back({&op.pre, &ce.cond, &ce.add, &ce.del, &op.del});
+  }
+  const size_t nf = task.numFacts();
+  std::vector<std::vector<uint32_t>> adders(nf), users(nf), deleters(nf);
+  for (uint32_t e = 0; e < effs.size(); ++e) {
+    for (FactId f : *effs[e].add) adders[f].push_back(e);
+    for (FactId f : *effs[e].pre) users[f].push_back(e);
+    for (FactId f : *effs[e].cond) users[f].push_back(e);
+    for (FactId f : *effs[e].del) deleters[f].push_back(e);
+    for (FactId f : *effs[e].del2) deleters[f].push_back(e);
+  }
+  std::vector<char> usable(effs.size(), 1);
+  std::vector<uint32_t> del_count(nf, 0);
+  auto possiblyAchievable = [&](FactId f) {
+    for (uint32_t e : adders[f]) {
+      if (!usable[e]) continue;
+      bool ok = true;
+      auto check = [&](const std::vector<FactId>& pre) {
+        for (FactId p : pre) {
+          bool any = false;
+          for (uint32_t a : adders[p]) {
+            if (usable[a]) {
+              any = true;
+              break;
+            }
+          }
+          if (!any) {
+            ok = false;
+            return;
+          }
+        }
+      };
+      check(*effs[e].pre);
+      if (ok) check(*effs[e].cond);
+      if (ok) return true;
+    }
+    return false;
+  };
+  std::vector<std::vector<char>> m(n, std::vector<char>(n, 0));
+  for (size_t i = 0; i < n; ++i) {
+    m[i][i] = 1;
+    const FactId gi = goals[i];
+    // False set: facts deleted by every achiever of gi.
+    std::vector<FactId> touched;
+    for (uint32_t e : adders[gi]) {
+      for (const auto* dl : {effs[e].del, effs[e].del2}) {
+        for (FactId f : *dl) {
+          if (del_count[f]++ == 0) touched.push_back(f);
+        }
+      }
+    }
+    std::vector<uint32_t> excluded;
+    for (FactId f : touched) {
+      if (del_count[f] == adders[gi].size()) {
+        for (uint32_t e : users[f]) excluded.push_back(e);
+      }
+      del_count[f] = 0;
+    }
+    for (uint32_t e : deleters[gi]) excluded.push_back(e);
+    for (uint32_t e : excluded) usable[e] = 0;
+    for (size_t j = 0; j < n; ++j) {
+      if (j != i && !possiblyAchievable(goals[j])) m[j][i] = 1;
+    }
+    for (uint32_t e : excluded) usable[e] = 1;
+  }
+  for (size_t j = 0; j < n; ++j) {
+    for (size_t i = 0; i < n; ++i) {
+      if (!m[i][j]) continue;
+      for (size_t k = 0; k < n; ++k) {
+        if (m[j][k]) m[i][k] = 1;
+      }
+    }
+  }
+  std::vector<int> degree(n, 0), hits(n, 0);
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t j = 0; j < n; ++j) {
+      if (i != j && m[i][j]) {
+        --degree[i];
+        ++degree[j];
+        ++hits[i];
+        ++hits[j];
+      }
+    }
+  }
+  std::vector<size_t> order(n);
+  for (size_t i = 0; i < n; ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    const bool da = hits[a] == 0, db = hits[b] == 0;
+    if (da != db) return !da;  // disconnected goals last
+    if (da) return false;
+    return degree[a] < degree[b];
+  });
+  std::vector<std::vector<FactId>> agenda;
+  for (size_t k = 0; k < n; ++k) {
+    const size_t g = order[k];
+    const bool new_entry = k == 0 || degree[g] != degree[order[k - 1]] ||
+                           (hits[g] == 0) != (hits[order[k - 1]] == 0);
+    if (new_entry) agenda.emplace_back();
+    agenda.back().push_back(goals[g]);
+  }
+  return agenda;
+}
+
+class Searcher {
+ public:
+  Searcher(const Task& task, const StateBits& init, const Goal& goal, const SearchOptions& opt, Heuristic& h,
+           const Termination& term)
+      : task_(task), init_(init), goal_(goal), opt_(opt), h_(h), term_(term), reg_(task.numWords()) {
+    buf_.resize(task.numWords());
+    succ_.resize(task.numWords());
+  }
+
+  SearchResult run() {
+    Stopwatch sw;
+    h_.setGoal(goal_);
+    SearchResult r;
+    if (goal_.unsatisfiable()) {
+      r.status = SearchStatus::kUnsolvable;
+    } else {
+      switch (opt_.algorithm) {
+        case SearchAlgorithm::kEhc: r = ehc(); break;
+        case SearchAlgorithm::kGbfs: r = gbfs(); break;
+        case SearchAlgorithm::kWAstar: r = astar(opt_.weight); break;
+        case SearchAlgorithm::kAstar: r = astar(1.0); break;
+      }
+    }
+    r.stats = stats_;
+    r.stats.registered_states = reg_.size();
+    r.stats.seconds = sw.seconds();
+    r.cost = 0;
+    for (OpId o : r.plan) r.cost += task_.unit_cost ? 1 : task_.ops[o].cost;
+    return r;
+  }
+
+ private:
+  // --- per-state data ---------------------------------------------------------------------------
+  uint32_t registerState(const uint64_t* s, bool* is_new) {
+    auto [id, inserted] = reg_.insert(s);
+    *is_new = inserted;
+    if (inserted) {
+      parent_.push_back(kNone);
+      op_.push_back(kNone);
+      g_.push_back(0);
+      h_cache_.push_back(kUnknown);
+      pref_begin_.push_back(0);
+      pref_count_.push_back(0);
+      flag_.push_back(0);
+    }
+    return id;
+  }
+
+  static constexpr Cost kUnknown = -1;
+
+  Cost evaluate(uint32_t id) {
+    if (h_cache_[id] != kUnknown) return h_cache_[id];
+    ++stats_.evaluated;
+    const Cost h = h_.evaluate(reg_.get(id));
+    h_cache_[id] = h;
+    if (h_.computesPreferred()) {
+      const auto& p = h_.preferred();
+      pref_begin_[id] = pref_pool_.size();
+      pref_count_[id] = static_cast<uint32_t>(p.size());
+      pref_pool_.insert(pref_pool_.end(), p.begin(), p.end());
+    }
+    return h;
+  }
+
+  std::vector<OpId> path(uint32_t id, uint32_t stop) const {
+    std::vector<OpId> out;
+    while (id != stop && parent_[id] != kNone) {
+      out.push_back(op_[id]);
+      id = parent_[id];
+    }
+    std::reverse(out.begin(), out.end());
+    return out;
+  }
+
+  size_t memoryBytes() const {
+    return reg_.bytes() + parent_.capacity() * (4 + 4 + 8 + 8 + 8 + 4 + 1) + pref_pool_.capacity() * 4 +
+           open_bytes_;
+  }
+
+  /// Checks time and memory every 256 calls; returns a terminal status or nullopt.
+  std::optional<SearchStatus> checkLimits() {
+    if ((++checks_ & 255) != 0) return std::nullopt;
+    const StopReason why = term_.reason();
+    if (why == StopReason::kDeadline) return SearchStatus::kTimeout;
+    if (why == StopReason::kStopRequested) return SearchStatus::kCancelled;
+    if (opt_.memory_limit_mb > 0 && memoryBytes() > opt_.memory_limit_mb * 1024 * 1024) return SearchStatus::kOutOfMemory;
+    return std::nullopt;
+  }
+
+  SearchResult finish(SearchStatus st, std::vector<OpId> plan = {}) {
+    SearchResult r;
+    r.status = st;
+    r.plan = std::move(plan);
+    return r;
+  }
+
+  // --- enforced hill-climbing ----------------------------------------------------------------
+  SearchResult ehc() {
+    bool is_new = false;
+    uint32_t cur = registerState(init_.data(), &is_new);
+    if (task_.goalReached(reg_.get(cur), goal_)) return finish(SearchStatus::kSolved);
+    // Goal agenda (FF) for a single conjunctive goal; otherwise one entry with the whole goal.
+    std::vector<std::vector<FactId>> agenda;
+    if (opt_.goal_agenda && goal_.conjuncts.size() == 1 && goal_.conjuncts[0].neg.empty()) {
+      agenda = goalAgenda(task_, goal_.conjuncts[0].pos);
+    }
+    std::vector<OpId> plan;
+    if (agenda.size() <= 1) {
+      return ehcTo(goal_, cur, plan, true);
+    }
+    std::vector<FactId> so_far;
+    for (size_t k = 0; k < agenda.size(); ++k) {
+      so_far.insert(so_far.end(), agenda[k].begin(), agenda[k].end());
+      std::sort(so_far.begin(), so_far.end());
+      Goal partial;
+      partial.conjuncts.push_back(GoalConjunct{so_far, {}});
+      const bool last = k + 1 == agenda.size();
+      SearchResult r = ehcTo(last ? goal_ : partial, cur, plan, k == 0);
+      if (r.status != SearchStatus::kSolved || last) return r;
+      // Continue from the state the entry was reached in.
+      StateBits st = init_;
+      StateBits nxt(st.size());
+      for (OpId o : plan) {
+        task_.apply(st.data(), o, nxt.data());
+        st.swap(nxt);
+      }
+      cur = registerState(st.data(), &is_new);
+    }
+    return finish(SearchStatus::kFailed);
+  }
+
+  /// Hill-climbs from `cur` to `goal`, appending to `plan`. On success returns kSolved with the
+  /// whole plan so far; on failure falls back to GBFS from the start (full goal).
+  SearchResult ehcTo(const Goal& goal, uint32_t cur, std::vector<OpId>& plan, bool first) {
+    h_.setGoal(goal);
+    std::fill(h_cache_.begin(), h_cache_.end(), kUnknown);
+    pref_pool_.clear();
+    bool is_new = false;
+    if (task_.goalReached(reg_.get(cur), goal)) return finish(SearchStatus::kSolved, plan);
+    Cost hcur = evaluate(cur);
+    if (first) stats_.initial_h = hcur;
+    if (hcur == Heuristic::kDeadEnd) {
+      if (first && &goal == &goal_) return finish(SearchStatus::kUnsolvable);
+      return fallback();
+    }
+    std::vector<uint32_t> queue;
+    for (;;) {
+      ++iter_;
+      queue.clear();
+      queue.push_back(cur);
+      stamp_.resize(reg_.size(), 0);
+      stamp_[cur] = iter_;
+      uint32_t found = kNone;
+      for (size_t head = 0; head < queue.size() && found == kNone; ++head) {
+        if (auto st = checkLimits()) return finish(*st);
+        const uint32_t id = queue[head];
+        std::copy(reg_.get(id), reg_.get(id) + reg_.words(), buf_.begin());
+        ++stats_.expanded;
+        // Helpful actions of `id` (copied: the pool may grow while we generate).
+        pref_tmp_.assign(pref_pool_.begin() + static_cast<std::ptrdiff_t>(pref_begin_[id]),
+                         pref_pool_.begin() + static_cast<std::ptrdiff_t>(pref_begin_[id] + pref_count_[id]));
+        for (OpId o : pref_tmp_) {
+          task_.apply(buf_.data(), o, succ_.data());
+          ++stats_.generated;
+          const uint32_t sid = registerState(succ_.data(), &is_new);
+          if (stamp_.size() < reg_.size()) stamp_.resize(reg_.size(), 0);
+          if (stamp_[sid] == iter_) continue;
+          stamp_[sid] = iter_;
+          parent_[sid] = id;
+          op_[sid] = o;
+          if (task_.goalReached(succ_.data(), goal)) {
+            found = sid;
+            break;
+          }
+          const Cost h = evaluate(sid);
+          if (h == Heuristic::kDeadEnd) continue;
+          if (h < hcur) {
+            found = sid;
+            break;
+          }
+          queue.push_back(sid);
+        }
+      }
+      if (found == kNone) return fallback();
+      std::vector<OpId> seg = path(found, cur);
+      plan.insert(plan.end(), seg.begin(), seg.end());
+      cur = found;
+      parent_[cur] = kNone;
+      if (task_.goalReached(reg_.get(cur), goal)) return finish(SearchStatus::kSolved, plan);
+      hcur = h_cache_[cur];
+    }
+  }
+
+  SearchResult fallback() {
+    stats_.ehc_failed = true;
+    if (!opt_.ehc_fallback) return finish(SearchStatus::kFailed);
+    h_.setGoal(goal_);
+    return gbfs();
+  }
+
+  // --- greedy best-first search ----------------------------------------------------------------
+  SearchResult gbfs() {
+    // A fresh registry: EHC's parent links are not valid for GBFS paths.
+    reg_ = StateRegistry(task_.numWords());
+    parent_.clear(); op_.clear(); g_.clear(); h_cache_.clear(); pref_begin_.clear(); pref_count_.clear(); flag_.clear();
+    pref_pool_.clear();
+    bool is_new = false;
+    const uint32_t root = registerState(init_.data(), &is_new);
+    if (task_.goalReached(reg_.get(root), goal_)) return finish(SearchStatus::kSolved);
+    const Cost h0 = evaluate(root);
+    if (stats_.initial_h == 0) stats_.initial_h = h0;
+    if (h0 == Heuristic::kDeadEnd) return finish(SearchStatus::kUnsolvable);
+    const bool use_pref = opt_.preferred_operators && h_.computesPreferred();
+    OpenList regular, preferred;
+    regular.push(h0, 0, root);
+    if (use_pref) preferred.push(h0, 0, root);
+    int64_t prio_regular = 0, prio_pref = 0;
+    Cost best_h = h0;
+    std::vector<OpId> ops;
+    std::vector<uint32_t> pref_mark(task_.ops.size(), 0);
+    uint32_t mark = 0;
+    for (;;) {
+      if (auto st = checkLimits()) return finish(*st);
+      open_bytes_ = regular.bytes() + preferred.bytes();
+      OpenList* list = nullptr;
+      if (use_pref && !preferred.empty() && (regular.empty() || prio_pref <= prio_regular)) {
+        list = &preferred;
+        ++prio_pref;
+      } else if (!regular.empty()) {
+        list = &regular;
+        ++prio_regular;
+      } else if (use_pref && !preferred.empty()) {
+        list = &preferred;
+      } else {
+        return finish(SearchStatus::kUnsolvable);
+      }
+      const uint32_t id = list->pop().id;
+      if (flag_[id] & 1) continue;  // closed
+      flag_[id] |= 1;
+      ++stats_.expanded;
+      std::copy(reg_.get(id), reg_.get(id) + reg_.words(), buf_.begin());
+      ++mark;
+      for (uint32_t i = 0; i < pref_count_[id]; ++i) pref_mark[pref_pool_[pref_begin_[id] + i]] = mark;
+      ops.clear();
+      task_.applicableOps(buf_.data(), ops);
+      for (OpId o : ops) {
+        task_.apply(buf_.data(), o, succ_.data());
+        ++stats_.generated;
+        const uint32_t sid = registerState(succ_.data(), &is_new);
+        if (!is_new) continue;
+        parent_[sid] = id;
+        op_[sid] = o;
+        if (task_.goalReached(succ_.data(), goal_)) return finish(SearchStatus::kSolved, path(sid, kNone));
+        const Cost h = evaluate(sid);
+        if (h == Heuristic::kDeadEnd) {
+          flag_[sid] |= 1;
+          continue;
+        }
+        regular.push(h, 0, sid);
+        if (use_pref && pref_mark[o] == mark) preferred.push(h, 0, sid);
+        if (h < best_h) {
+          best_h = h;
+          prio_pref -= opt_.preferred_boost;
+        }
+      }
+    }
+  }
+
+  // --- (weighted) A* ----------------------------------------------------------------------------
+  SearchResult astar(double w) {
+    bool is_new = false;
+    const uint32_t root = registerState(init_.data(), &is_new);
+    const Cost h0 = evaluate(root);
+    stats_.initial_h = h0;
+    if (h0 == Heuristic::kDeadEnd) return finish(SearchStatus::kUnsolvable);
+    auto fval = [&](Cost g, Cost h) { return g + static_cast<Cost>(std::ceil(w * static_cast<double>(h) - 1e-9)); };
+    OpenList open;
+    g_[root] = 0;
+    open.push(fval(0, h0), h0, root);
+    std::vector<OpId> ops;
+    while (!open.empty()) {
+      if (auto st = checkLimits()) return finish(*st);
+      open_bytes_ = open.bytes();
+      const HeapEntry e = open.pop();
+      const uint32_t id = e.id;
+      if (e.key1 != fval(g_[id], h_cache_[id])) continue;  // stale entry
+      if (flag_[id] & 1) continue;
+      flag_[id] |= 1;
+      if (task_.goalReached(reg_.get(id), goal_)) return finish(SearchStatus::kSolved, path(id, kNone));
+      ++stats_.expanded;
+      std::copy(reg_.get(id), reg_.get(id) + reg_.words(), buf_.begin());
+      ops.clear();
+      task_.applicableOps(buf_.data(), ops);
+      const Cost gid = g_[id];
+      for (OpId o : ops) {
+        task_.apply(buf_.data(), o, succ_.data());
+        ++stats_.generated;
+        const uint32_t sid = registerState(succ_.data(), &is_new);
+        const Cost ng = gid + (task_.unit_cost ? 1 : task_.ops[o].cost);
+        if (is_new) {
+          const Cost h = evaluate(sid);
+          if (h == Heuristic::kDeadEnd) {
+            flag_[sid] |= 3;  // closed + dead
+            continue;
+          }
+          g_[sid] = ng;
+          parent_[sid] = id;
+          op_[sid] = o;
+          open.push(fval(ng, h), h, sid);
+        } else if (!(flag_[sid] & 2) && ng < g_[sid]) {
+          if (flag_[sid] & 1) {
+            ++stats_.reopened;
+            flag_[sid] &= static_cast<uint8_t>(~1U);
+          }
+          g_[sid] = ng;
+          parent_[sid] = id;
+          op_[sid] = o;
+          open.push(fval(ng, h_cache_[sid]), h_cache_[sid], sid);
+        }
+      }
+    }
+    return finish(SearchStatus::kUnsolvable);
+  }
+
+  const Task& task_;
+  const StateBits& init_;
+  const Goal& goal_;
+  const SearchOptions& opt_;
+  Heuristic& h_;
+  const Termination& term_;
+  StateRegistry reg_;
+  std::vector<uint32_t> parent_, op_;
+  std::vector<Cost> g_, h_cache_;
+  std::vector<size_t> pref_begin_;
+  std::vector<uint32_t> pref_count_;
+  std::vector<uint8_t> flag_;
+  std::vector<OpId> pref_pool_, pref_tmp_;
+  StateBits buf_, succ_;
+  SearchStatistics stats_;
+  uint64_t checks_{0};
+  size_t open_bytes_{0};
+  std::vector<uint32_t> stamp_;  // ehc: BFS iteration that reached each state
+  uint32_t iter_{0};
+};
+
+CostType defaultCostType(const SearchOptions& o, const Task& t) {
+  if (o.cost_type) return *o.cost_type;
+  if (t.unit_cost) return CostType::kUnit;
+  const bool optimal = o.algorithm == SearchAlgorithm::kAstar || o.algorithm == SearchAlgorithm::kWAstar;
+  return optimal ? CostType::kCost : CostType::kPlusOne;
+}
+
+HeuristicKind defaultHeuristic(const SearchOptions& o) {
+  if (o.heuristic) return *o.heuristic;
+  const bool optimal = o.algorithm == SearchAlgorithm::kAstar || o.algorithm == SearchAlgorithm::kWAstar;
+  return optimal ? HeuristicKind::kMax : HeuristicKind::kFF;
+}
+
+}  // namespace
+
+std::optional<SearchAlgorithm> parseSearchAlgorithm(const std::string& name) {
+  if (name == "ehc") return SearchAlgorithm::kEhc;
+  if (name == "gbfs") return SearchAlgorithm::kGbfs;
+  if (name == "wastar") return SearchAlgorithm::kWAstar;
+  if (name == "astar") return SearchAlgorithm::kAstar;
+  return std::nullopt;
+}
+
+std::string toString(SearchAlgorithm a) {
+  switch (a) {
+    case SearchAlgorithm::kEhc: return "ehc";
+    case SearchAlgorithm::kGbfs: return "gbfs";
+    case SearchAlgorithm::kWAstar: return "wastar";
+    case SearchAlgorithm::kAstar: return "astar";
+  }
+  return "unknown";
+}
+
+std::string toString(SearchStatus s) {
+  switch (s) {
+    case SearchStatus::kSolved: return "solved";
+    case SearchStatus::kUnsolvable: return "unsolvable";
+    case SearchStatus::kFailed: return "failed";
+    case SearchStatus::kTimeout: return "timeout";
+    case SearchStatus::kCancelled: return "cancelled";
+    case SearchStatus::kOutOfMemory: return "out of memory";
+  }
+  return "unknown";
+}
+
+void SearchOptions::validate() const {
+  if (!(weight >= 1.0) || !std::isfinite(weight)) {
+    throw std::invalid_argument("SearchOptions::weight must be a finite number >= 1, got " + std::to_string(weight));
+  }
+  if (preferred_boost < 0) {
+    throw std::invalid_argument("SearchOptions::preferred_boost must be >= 0, got " + std::to_string(preferred_boost));
+  }
+}
+
+SearchResult search(const Task& task, const StateBits& init, const Goal& goal, const SearchOptions& options,
+                    Heuristic& heuristic, const Termination& term) {
+  options.validate();
+  if (init.size() != task.numWords()) {
+    throw std::invalid_argument("search: initial state has " + std::to_string(init.size()) + " words, task needs " +
+                                std::to_string(task.numWords()));
+  }
+  Searcher s(task, init, goal, options, heuristic, term);
+  return s.run();
+}
+
+SearchResult search(const Task& task, const StateBits& init, const Goal& goal, const SearchOptions& options,
+                    const Termination& term) {
+  options.validate();
+  auto h = makeHeuristic(defaultHeuristic(options), task, defaultCostType(options, task));
+  return search(task, init, goal, options, *h, term);
+}
+
+}  // namespace tamp::symbolic_planner

@@ -1,0 +1,127 @@
+#include "tamp/symbolic_planner/task.h"
+
+#include <algorithm>
+#include <bit>
+
+namespace tamp::symbolic_planner {
+
+void Task::finalize() {
+  const size_t n = numFacts();
+  achievers.assign(n, {});
+  std::vector<uint32_t> pre_count(n, 0);
+  for (OpId o = 0; o < ops.size(); ++o) {
+    auto& op = ops[o];
+    auto addAch = [&](FactId f) {
+      if (achievers[f].empty() || achievers[f].back() != o) achievers[f].push_back(o);
+    };
+    for (FactId f : op.add) addAch(f);
+    for (const auto& ce : op.cond_effects) {
+      for (FactId f : ce.add) addAch(f);
+    }
+    for (FactId f : op.pre) ++pre_count[f];
+  }
+  // Key precondition: the one whose fact has the fewest... we use a proxy for "rarely true":
+  // facts that are preconditions of few operators are specific (e.g. an object's position);
+  // facts shared by many operators (hand-empty) are often true.
+  ops_by_key_.assign(n, {});
+  ops_without_pre_.clear();
+  for (OpId o = 0; o < ops.size(); ++o) {
+    const auto& pre = ops[o].pre;
+    if (pre.empty()) {
+      ops_without_pre_.push_back(o);
+      continue;
+    }
+    FactId key = pre[0];
+    for (FactId f : pre) {
+      if (pre_count[f] < pre_count[key]) key = f;
+    }
+    ops_by_key_[key].push_back(o);
+  }
+}
+
+void Task::apply(const uint64_t* s, OpId o, uint64_t* out) const {
+  const size_t w = numWords();
+  std::copy(s, s + w, out);
+  const Operator& op = ops[o];
+  for (FactId f : op.del) clearBit(out, f);
+  if (op.cond_effects.empty()) {
+    for (FactId f : op.add) setBit(out, f);
+    return;
+  }
+  // Conditions are evaluated in the old state `s`; deletes before adds.
+  thread_local std::vector<const ConditionalEffect*> firing;
+  firing.clear();
+  for (const auto& ce : op.cond_effects) {
+    bool ok = true;
+    for (FactId f : ce.cond) {
+      if (!testBit(s, f)) {
+        ok = false;
+        break;
+      }
+    }
+    if (ok) firing.push_back(&ce);
+  }
+  for (const auto* ce : firing) {
+    for (FactId f : ce->del) clearBit(out, f);
+  }
+  for (FactId f : op.add) setBit(out, f);
+  for (const auto* ce : firing) {
+    for (FactId f : ce->add) setBit(out, f);
+  }
+  if (op.needs_fixup) {
+    auto fix = [&](FactId f) {
+      const int32_t c = complement[f];
+      if (c < 0) return;
+      // A primary fact and its complement: the complement is the negation of the primary.
+      const bool f_is_primary = f < static_cast<FactId>(c);
+      const FactId p = f_is_primary ? f : static_cast<FactId>(c);
+      const FactId q = f_is_primary ? static_cast<FactId>(c) : f;
+      if (testBit(out, p)) clearBit(out, q); else setBit(out, q);
+    };
+    for (FactId f : op.add) fix(f);
+    for (FactId f : op.del) fix(f);
+    for (const auto* ce : firing) {
+      for (FactId f : ce->add) fix(f);
+      for (FactId f : ce->del) fix(f);
+    }
+  }
+}
+
+void Task::applicableOps(const uint64_t* s, std::vector<OpId>& out) const {
+  for (OpId o : ops_without_pre_) out.push_back(o);
+  const size_t w = numWords();
+  for (size_t i = 0; i < w; ++i) {
+    uint64_t word = s[i];
+    while (word) {
+      const int b = std::countr_zero(word);
+      word &= word - 1;
+      const FactId f = static_cast<FactId>(i * 64 + static_cast<size_t>(b));
+      for (OpId o : ops_by_key_[f]) {
+        if (applicable(s, o)) out.push_back(o);
+      }
+    }
+  }
+}
+
+bool Task::goalReached(const uint64_t* s, const Goal& g) const {
+  for (const auto& c : g.conjuncts) {
+    bool ok = true;
+    for (FactId f : c.pos) {
+      if (!testBit(s, f)) {
+        ok = false;
+        break;
+      }
+    }
+    if (!ok) continue;
+    for (FactId f : c.neg) {
+      if (testBit(s, f)) {
+        ok = false;
+        break;
+      }
+    }
+    if (ok) return true;
+  }
+  return false;
+}
+
+}  // namespace tamp::symbolic_planner

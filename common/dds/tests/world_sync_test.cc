@@ -1,0 +1,117 @@
+#include "tamp/dds/world_sync.h"
+
+#include <thread>
+
+#include <gtest/gtest.h>
+
+#include "test_util.h"
+
+namespace tamp::dds {
+namespace {
+
+world::World sampleWorld() {
+  world::World w("kitchen");
+  world::Object table;
+  table.id = "table";
+  table.label = "table";
+  table.kind = world::ObjectKind::kStatic;
+  table.shape = world::Shape::box(1.2, 0.8, 0.75);
+  table.pose.translation() = Eigen::Vector3d(2, 0, 0.375);
+  EXPECT_TRUE(w.addObject(table).ok());
+  world::Object can;
+  can.id = "can";
+  can.label = "can";
+  can.kind = world::ObjectKind::kMovable;
+  can.shape = world::Shape::cylinder(0.033, 0.12);
+  can.pose.translation() = Eigen::Vector3d(2, 0.1, 0.81);
+  can.mass = 0.35;
+  can.graspable = true;
+  can.region = "table_top";
+  EXPECT_TRUE(w.addObject(can).ok());
+  world::Object wall;
+  wall.id = "wall";
+  wall.label = "L wall";
+  wall.shape = world::Shape::prism({{0, 0}, {2, 0}, {2, 0.2}, {0.2, 0.2}, {0.2, 2}, {0, 2}}, 1.0);
+  wall.pose.translation() = Eigen::Vector3d(-3, -3, 0.5);
+  EXPECT_TRUE(w.addObject(wall).ok());
+  EXPECT_TRUE(w.addRegion(world::Region{"table_top", "table top", world::RegionKind::kTable,
+                                        {{1.4, -0.4}, {2.6, -0.4}, {2.6, 0.4}, {1.4, 0.4}}, 0.75})
+                  .ok());
+  EXPECT_TRUE(w.addLocation(world::Location{"near_table", "near table", Pose2D{1.0, 0.0, 0.0}}).ok());
+  return w;
+}
+
+bool waitFor(const std::function<bool()>& pred) {
+  const Deadline d = Deadline::in(10.0);
+  while (!d.expired()) {
+    if (pred()) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return false;
+}
+
+TEST(WorldSyncTest, MirrorAssemblesThePublishedWorldAndFollowsChanges) {
+  auto p = testing::makeParticipant();
+  ASSERT_TRUE(p);
+  WorldPublisher pub(p);
+  world::World w = sampleWorld();
+  ASSERT_TRUE(pub.publish(w).ok());
+
+  WorldMirror mirror(p);  // late joiner: transient-local state
+  ASSERT_TRUE(mirror.waitForPublishedVersion(w.version(), Termination::after(10.0)));
+  ASSERT_TRUE(waitFor([&] { return mirror.snapshot().objectCount() == 3; }));
+  world::World got = mirror.snapshot();
+  EXPECT_EQ(got.object("can"), w.object("can"));
+  EXPECT_EQ(got.object("wall"), w.object("wall"));
+  ASSERT_NE(got.findRegion("table_top"), nullptr);
+  EXPECT_EQ(*got.findRegion("table_top"), *w.findRegion("table_top"));
+  ASSERT_NE(got.findLocation("near_table"), nullptr);
+  EXPECT_EQ(got.findLocation("near_table")->pose, (Pose2D{1.0, 0.0, 0.0}));
+
+  Eigen::Isometry3d moved = w.object("can").pose;
+  moved.translation().x() = 2.3;
+  ASSERT_TRUE(w.setObjectPose("can", moved).ok());
+  ASSERT_TRUE(w.removeObject("wall").ok());
+  ASSERT_TRUE(pub.publish(w).ok());
+  ASSERT_TRUE(waitFor([&] {
+    auto s = mirror.snapshot();
+    return s.findObject("wall") == nullptr && s.findObject("can") != nullptr &&
+           std::abs(s.object("can").pose.translation().x() - 2.3) < 1e-12;
+  }));
+}
+
+TEST(WorldSyncTest, PublisherRefusesHiddenObjects) {
+  auto p = testing::makeParticipant();
+  ASSERT_TRUE(p);
+  WorldPublisher pub(p);
+  world::World w = sampleWorld();
+  world::Object ghost = w.object("can");
+  ghost.id = "ghost";
+  ghost.hidden = true;
+  ASSERT_TRUE(w.addObject(ghost).ok());
+  Status s = pub.publish(w);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.error().message.find("hidden"), std::string::npos);
+  EXPECT_TRUE(pub.publish(w.plannerView()).ok());
+}
+
+TEST(WorldSyncTest, MalformedObjectMessageIsIgnored) {
+  auto p = testing::makeParticipant();
+  ASSERT_TRUE(p);
+  WorldMirror mirror(p);
+  Writer<msg::WorldObject> raw(p, topics::kWorldObjects);
+  msg::WorldObject bad = toMsg(sampleWorld().object("can"), 1);
+  bad.id("broken");
+  bad.shape().dimensions({-1.0, 0.1});  // negative radius
+  ASSERT_TRUE(raw.write(bad).ok());
+  msg::WorldObject good = toMsg(sampleWorld().object("can"), 1);
+  ASSERT_TRUE(raw.write(good).ok());
+  ASSERT_TRUE(waitFor([&] { return mirror.snapshot().findObject("can") != nullptr; }));
+  EXPECT_EQ(mirror.snapshot().findObject("broken"), nullptr);
+  auto r = fromMsg(bad);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.error().where.field, "objects[broken].shape");
+}
+
+}  // namespace
+}  // namespace tamp::dds

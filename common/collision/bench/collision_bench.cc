@@ -5,6 +5,7 @@
 #include <benchmark/benchmark.h>
 
 #include "tamp/collision/scene.h"
+#include "tamp/world/namo.h"
 
 namespace tamp::collision {
 namespace {
@@ -134,6 +135,57 @@ void BM_MoveOneObject(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_MoveOneObject);
+
+// Real NAMO worlds: disc robot of the benchmark's radius at random poses in the workspace.
+world::NamoWorld loadNamoWorld(const std::string& rel) {
+  return world::loadNamo(std::string(TAMP_SHARED_DIR) + "/benchmarks/namo/" + rel).value();
+}
+
+void namoBench(benchmark::State& state, const std::string& rel) {
+  const world::NamoWorld nw = loadNamoWorld(rel);
+  const auto mode = state.range(0) == 0 ? PrismMode::kConvexPieces : PrismMode::kMesh;
+  Scene s(nw.world, Scene::Options{mode});
+  s.setRobot(RobotGeometry::disc(nw.robot_radius, 1.0));
+  const Aabb b = nw.world.bounds();
+  std::mt19937 rng(42);
+  std::uniform_real_distribution<double> ux(b.min.x(), b.max.x()), uy(b.min.y(), b.max.y());
+  std::vector<Pose2D> poses;
+  for (int i = 0; i < 4096; ++i) poses.push_back({ux(rng), uy(rng), 0});
+  size_t i = 0, hits = 0;
+  for (auto _ : state) {
+    s.setBasePose(poses[i++ & 4095]);
+    hits += s.robotInCollision();
+  }
+  state.counters["hit_rate"] = static_cast<double>(hits) / static_cast<double>(state.iterations());
+  state.counters["objects"] = static_cast<double>(nw.world.objectCount());
+  state.counters["fcl_objects"] = static_cast<double>(s.fclObjectCount());
+}
+
+void BM_NamoMoghaddam08(benchmark::State& state) {
+  namoBench(state, "moghaddam_planning_2016_benchmark/moghaddam_planning_2016_benchmark_08.svg");
+}
+BENCHMARK(BM_NamoMoghaddam08)->ArgName("mesh")->Arg(0)->Arg(1);
+
+void BM_NamoAfterTheFeast(benchmark::State& state) {
+  namoBench(state,
+            "s-namo_cases/04_after_the_feast/04_after_the_feast_omniscient_complexified.json");
+}
+BENCHMARK(BM_NamoAfterTheFeast)->ArgName("mesh")->Arg(0)->Arg(1);
+
+void BM_NamoCitiSecondFloor(benchmark::State& state) {
+  namoBench(state, "s-namo_cases/05_citi_second_floor/05_citi_second_floor_omniscient.json");
+}
+BENCHMARK(BM_NamoCitiSecondFloor)->ArgName("mesh")->Arg(0)->Arg(1);
+
+void BM_LoadAndBuildCiti(benchmark::State& state) {
+  for (auto _ : state) {
+    const world::NamoWorld nw =
+        loadNamoWorld("s-namo_cases/05_citi_second_floor/05_citi_second_floor_omniscient.json");
+    Scene s(nw.world);
+    benchmark::DoNotOptimize(s.fclObjectCount());
+  }
+}
+BENCHMARK(BM_LoadAndBuildCiti)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace tamp::collision

@@ -1,10 +1,13 @@
 #include "tamp/collision/scene.h"
 
+#include <filesystem>
 #include <random>
 #include <sstream>
 
 #include <gtest/gtest.h>
 #include <octomap/OcTree.h>
+
+#include "tamp/world/namo.h"
 
 namespace tamp::collision {
 namespace {
@@ -325,6 +328,64 @@ TEST(SceneConsistencyTest, ConvexPiecesAgreeWithMeshAndWithPlanarGeometry) {
     hits += ca;
   }
   EXPECT_GT(hits, 100);
+}
+
+// REFERENCE.md: in every bare Moghaddam world the robot start and goal squares overlap no static
+// polygon and no convex movable polygon (they may touch). A 1 % smaller square must be free.
+TEST(SceneNamoTest, MoghaddamStartAndGoalSquaresAreFree) {
+  const std::filesystem::path dir =
+      std::filesystem::path(TAMP_SHARED_DIR) / "benchmarks/namo/moghaddam_planning_2016_benchmark";
+  int worlds = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    if (entry.path().extension() != ".svg") continue;
+    auto loaded = world::loadNamo(entry.path());
+    ASSERT_TRUE(loaded.ok()) << loaded.error().toString();
+    const world::NamoWorld& nw = *loaded;
+    Scene scene(nw.world);
+    world::Polygon2 shrunk;
+    for (const auto& p : nw.robot_footprint) shrunk.push_back(0.99 * p);
+    const Shape square = Shape::prism(shrunk, 0.5);
+    std::vector<std::string> allowed;  // non-convex movables may overlap (README)
+    for (const auto& o : nw.world.objects()) {
+      if (o.kind == ObjectKind::kMovable && !world::isConvex(o.shape.polygon))
+        allowed.push_back(o.id);
+    }
+    for (const Pose2D& p : {nw.start, nw.goals.at(0).pose}) {
+      const auto hits = scene.shapeCollisions(square, at(p.x, p.y, 0.3), Filter::allBut(allowed));
+      EXPECT_TRUE(hits.empty()) << entry.path().filename() << " at " << p << " hits "
+                                << hits.front();
+    }
+    // A disc of the reference radius at the start is free of static obstacles too.
+    scene.setRobot(RobotGeometry::disc(nw.robot_radius * 0.99, 1.0));
+    scene.setBasePose(nw.start);
+    EXPECT_FALSE(scene.robotInCollision(Filter::staticOnly())) << entry.path().filename();
+    ++worlds;
+  }
+  EXPECT_EQ(worlds, 19);
+}
+
+// The 1691-vertex costmap outline of 05_citi_second_floor decomposes into convex pieces whose
+// union has the outline's area; the robot's start is free and a point inside the wall is not.
+TEST(SceneNamoTest, LargeNonConvexOutline) {
+  auto loaded = world::loadNamo(
+      std::filesystem::path(TAMP_SHARED_DIR) /
+      "benchmarks/namo/s-namo_cases/05_citi_second_floor/05_citi_second_floor_omniscient.json");
+  ASSERT_TRUE(loaded.ok()) << loaded.error().toString();
+  const world::Object& wall = loaded->world.object("ext_obstacle");
+  ASSERT_GT(wall.shape.polygon.size(), 1000u);
+  const auto pieces = world::convexDecomposition(wall.shape.polygon);
+  double area = 0;
+  for (const auto& p : pieces) area += world::signedArea(p);
+  EXPECT_NEAR(area, world::signedArea(wall.shape.polygon),
+              1e-6 * std::abs(world::signedArea(wall.shape.polygon)));
+  Scene scene(loaded->world);
+  scene.setRobot(RobotGeometry::disc(loaded->robot_radius, 1.0));
+  scene.setBasePose(loaded->start);
+  EXPECT_FALSE(scene.robotInCollision());
+  const Eigen::Vector2d v = wall.shape.polygon[0];  // a vertex of the outline: on the wall
+  const Eigen::Vector3d w = wall.pose * Eigen::Vector3d(v.x(), v.y(), 0.0);
+  EXPECT_EQ(scene.shapeCollisions(Shape::sphere(0.05), at(w.x(), w.y(), 0.3)),
+            std::vector<std::string>{"ext_obstacle"});
 }
 
 }  // namespace

@@ -102,7 +102,8 @@ TEST(WorldTest, AddFindRemoveAndVersion) {
 
 TEST(WorldTest, CopiesShareObjectsUntilModified) {
   World w;
-  for (int i = 0; i < 50; ++i) ASSERT_TRUE(w.addObject(box(std::string("o").append(std::to_string(i)), i, 0)));
+  for (int i = 0; i < 50; ++i)
+    ASSERT_TRUE(w.addObject(box(std::string("o").append(std::to_string(i)), i, 0)));
   World c = w;
   EXPECT_EQ(w.objectPtr("o7").get(), c.objectPtr("o7").get());
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();

@@ -52,6 +52,11 @@ Status checkPath(const JointPath& path) {
       if (!std::isfinite(w[j])) {
         return invalid("value of joint '" + path.joint_names[j] + "' is not finite", field);
       }
+      if (std::abs(w[j]) > InputLimits::kMaxAbsPathValue) {
+        return invalid("value " + fmt(w[j]) + " of joint '" + path.joint_names[j] + "' exceeds the limit of " +
+                           fmt(InputLimits::kMaxAbsPathValue),
+                       field);
+      }
     }
   }
   return Status::Ok();
@@ -209,8 +214,10 @@ Result<ActionFeatures> extractFeatures(const ActionDescription& action) {
   if (!knownKind(action.kind)) {
     return invalid("unknown action kind " + std::to_string(static_cast<int>(action.kind)), "kind");
   }
-  if (!std::isfinite(action.object_mass_kg) || action.object_mass_kg < 0.0) {
-    return invalid("object mass must be finite and >= 0 kg, got " + fmt(action.object_mass_kg),
+  if (!std::isfinite(action.object_mass_kg) || action.object_mass_kg < 0.0 ||
+      action.object_mass_kg > InputLimits::kMaxObjectMassKg) {
+    return invalid("object mass must be finite and in [0, " + fmt(InputLimits::kMaxObjectMassKg) + "] kg, got " +
+                       fmt(action.object_mass_kg),
                    "object_mass_kg");
   }
   const bool manipulation = action.kind == ActionKind::kPick || action.kind == ActionKind::kPlace;
@@ -221,8 +228,10 @@ Result<ActionFeatures> extractFeatures(const ActionDescription& action) {
     }
     for (auto [value, field] : {std::pair{action.approach_m, "approach_m"},
                                 std::pair{action.retreat_m, "retreat_m"}}) {
-      if (!std::isfinite(value) || value < 0.0) {
-        return invalid(kind_name + ": distance must be finite and >= 0 m, got " + fmt(value), field);
+      if (!std::isfinite(value) || value < 0.0 || value > InputLimits::kMaxDistanceM) {
+        return invalid(kind_name + ": distance must be finite and in [0, " + fmt(InputLimits::kMaxDistanceM) +
+                           "] m, got " + fmt(value),
+                       field);
       }
     }
     ActionFeatures f;
@@ -241,14 +250,21 @@ Result<ActionFeatures> extractFeatures(const ActionDescription& action) {
 
 Status validateFeatures(const ActionFeatures& f) {
   if (!knownKind(f.kind)) return invalid("unknown action kind " + std::to_string(static_cast<int>(f.kind)), "kind");
-  if (!std::isfinite(f.object_mass_kg) || f.object_mass_kg < 0.0) {
-    return invalid("object mass must be finite and >= 0 kg, got " + fmt(f.object_mass_kg), "object_mass_kg");
+  if (!std::isfinite(f.object_mass_kg) || f.object_mass_kg < 0.0 || f.object_mass_kg > InputLimits::kMaxObjectMassKg) {
+    return invalid("object mass must be finite and in [0, " + fmt(InputLimits::kMaxObjectMassKg) + "] kg, got " +
+                       fmt(f.object_mass_kg),
+                   "object_mass_kg");
   }
   const bool manipulation = f.kind == ActionKind::kPick || f.kind == ActionKind::kPlace;
   if (manipulation) {
     if (!f.moves.empty() || !f.turns.empty()) return invalid("pick/place features have no moves", "moves");
-    if (!std::isfinite(f.approach_m) || f.approach_m < 0.0) return invalid("bad approach distance", "approach_m");
-    if (!std::isfinite(f.retreat_m) || f.retreat_m < 0.0) return invalid("bad retreat distance", "retreat_m");
+    for (auto [value, field] : {std::pair{f.approach_m, "approach_m"}, std::pair{f.retreat_m, "retreat_m"}}) {
+      if (!std::isfinite(value) || value < 0.0 || value > InputLimits::kMaxDistanceM) {
+        return invalid("distance must be finite and in [0, " + fmt(InputLimits::kMaxDistanceM) + "] m, got " +
+                           fmt(value),
+                       field);
+      }
+    }
     return Status::Ok();
   }
   if (f.approach_m != 0.0 || f.retreat_m != 0.0) {
@@ -257,7 +273,14 @@ Status validateFeatures(const ActionFeatures& f) {
   if (f.kind == ActionKind::kMoveArm && !f.turns.empty()) {
     return invalid("move_arm features have no turns", "turns");
   }
-  return Status::Ok();  // MoveSet already guarantees finite, non-negative lengths
+  // MoveSet guarantees finite, non-negative lengths; bound them as extraction would.
+  const double max_move = 2.0 * InputLimits::kMaxAbsPathValue * std::sqrt(2.0);
+  for (const MoveSet* set : {&f.moves, &f.turns}) {
+    if (!set->empty() && set->lengths().back() > max_move) {
+      return invalid("move of " + fmt(set->lengths().back()) + " exceeds the input limits", set == &f.moves ? "moves" : "turns");
+    }
+  }
+  return Status::Ok();
 }
 
 }  // namespace tamp::effort_estimator

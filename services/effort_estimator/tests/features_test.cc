@@ -154,10 +154,16 @@ std::vector<BadCase> badCases() {
   ActionDescription neg;
   neg.kind = ActionKind::kPlace;
   neg.approach_m = -0.1;
-  c.push_back({"negative_approach", neg, "distance must be finite and >= 0", "approach_m"});
+  c.push_back({"negative_approach", neg, "distance must be finite and in [0, 100] m", "approach_m"});
   ActionDescription heavy = basePath({{0, 0, 0}});
   heavy.object_mass_kg = -1;
-  c.push_back({"negative_mass", heavy, "object mass must be finite and >= 0", "object_mass_kg"});
+  c.push_back({"negative_mass", heavy, "object mass must be finite and in [0, 10000] kg", "object_mass_kg"});
+  c.push_back({"huge_coordinate", basePath({{0, 0, 0}, {1e300, 0, 0}}), "exceeds the limit of 100000",
+               "path.waypoints[1]"});
+  ActionDescription far;
+  far.kind = ActionKind::kPlace;
+  far.approach_m = 8.6e245;  // found by fuzz_effort_record: overflowed the model before the limit
+  c.push_back({"huge_distance", far, "distance must be finite and in [0, 100] m", "approach_m"});
   ActionDescription unknown;
   unknown.kind = static_cast<ActionKind>(9);
   c.push_back({"unknown_kind", unknown, "unknown action kind 9", "kind"});

@@ -99,6 +99,14 @@ struct FeatureTolerances {
   static constexpr double kArmCollinearCos = 1e-6;
 };
 
+/// Plausibility limits of action inputs: beyond them a request is rejected (a value of 1e300 m is
+/// a corrupt message, not an action, and would overflow the models).
+struct InputLimits {
+  static constexpr double kMaxAbsPathValue = 1e5;   ///< |waypoint value|: m for the base, rad/m for joints
+  static constexpr double kMaxDistanceM = 100.0;    ///< approach_m, retreat_m
+  static constexpr double kMaxObjectMassKg = 1e4;   ///< object_mass_kg
+};
+
 /// Reduces an action to its features.
 ///
 /// move_base is executed stop-and-turn: from the first waypoint's pose, for each straight run of
@@ -109,7 +117,8 @@ struct FeatureTolerances {
 ///
 /// @return the features, or a kInvalidArgument error whose message says what is wrong (unknown
 ///   kind, empty path, waypoint size mismatch, missing or unexpected joints, non-finite values,
-///   negative distances or mass, a path given to pick/place or distances to a motion).
+///   negative distances or mass, values beyond `InputLimits`, a path given to pick/place or
+///   distances to a motion).
 Result<ActionFeatures> extractFeatures(const ActionDescription& action);
 
 /// Checks features built by hand (e.g. read from a store): finite, non-negative, kind-consistent.

@@ -1,0 +1,695 @@
+#include "tamp/perception/perception.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <map>
+#include <numbers>
+#include <set>
+#include <stdexcept>
+
+#include "tamp/core/geometry.h"
+#include "tamp/perception/assignment.h"
+#include "tamp/perception/validation.h"
+#include "tamp/perception/visibility.h"
+#include "tamp/world/polygon.h"
+
+namespace tamp::perception {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+std::string describePose(const Eigen::Isometry3d& T) {
+  const Eigen::Vector3d t = T.translation();
+  char buf[96];
+  std::snprintf(buf, sizeof(buf), "(%.2f, %.2f, %.2f) yaw %.2f", t.x(), t.y(), t.z(), yawOf(T));
+  return buf;
+}
+
+std::string describeShape(const world::Shape& s) {
+  char buf[96] = "shape";
+  switch (s.kind) {
+    case world::ShapeKind::kBox:
+      std::snprintf(buf, sizeof(buf), "box %.2f x %.2f x %.2f m", s.size.x(), s.size.y(), s.size.z());
+      break;
+    case world::ShapeKind::kCylinder:
+      std::snprintf(buf, sizeof(buf), "cylinder r %.2f h %.2f m", s.radius, s.height);
+      break;
+    case world::ShapeKind::kSphere:
+      std::snprintf(buf, sizeof(buf), "sphere r %.2f m", s.radius);
+      break;
+    case world::ShapeKind::kPrism:
+      std::snprintf(buf, sizeof(buf), "prism h %.2f m", s.height);
+      break;
+  }
+  return buf;
+}
+
+/// A lower-case id prefix from a free-text label ("Red Crate" -> "red_crate").
+std::string idPrefix(const std::string& label) {
+  std::string out;
+  for (char c : label) {
+    const auto u = static_cast<unsigned char>(c);
+    if (std::isalnum(u)) {
+      out += static_cast<char>(std::tolower(u));
+    } else if (!out.empty() && out.back() != '_') {
+      out += '_';
+    }
+  }
+  while (!out.empty() && out.back() == '_') out.pop_back();
+  if (out.empty() || !std::isalpha(static_cast<unsigned char>(out[0]))) out = "object" + (out.empty() ? "" : "_" + out);
+  if (out.size() > 48) out.resize(48);
+  return out;
+}
+
+double footprintMajor(const world::Shape& s) {
+  const Aabb b = s.localAabb();
+  return std::max(b.max.x() - b.min.x(), b.max.y() - b.min.y());
+}
+double footprintMinor(const world::Shape& s) {
+  const Aabb b = s.localAabb();
+  return std::min(b.max.x() - b.min.x(), b.max.y() - b.min.y());
+}
+
+struct Track {
+  std::string id;
+  std::string label;
+  TrackInfo::State state{TrackInfo::State::kTentative};
+  bool from_prior{false};
+  bool size_known{false};  ///< shape from a class or the prior; otherwise grown from what is seen
+  world::ObjectKind kind{world::ObjectKind::kMovable};
+  world::Shape shape;
+  Eigen::Isometry3d pose{Eigen::Isometry3d::Identity()};
+  Eigen::Isometry3d event_pose{Eigen::Isometry3d::Identity()};  ///< at the last added/moved event
+  double confidence{0.0};
+  int64_t last_seen_ns{0};
+  int64_t first_seen_ns{0};
+  int hits{0};
+  int misses{0};
+  double mass{0.0};
+  bool graspable{false};
+  int cylinder_votes{0};
+  int box_votes{0};
+  const ObjectClass* cls{nullptr};
+  // This frame's measurement (tentatives: for the confirmation).
+  bool matched{false};
+};
+
+}  // namespace
+
+std::string_view toString(EventType type) {
+  switch (type) {
+    case EventType::kAdded:
+      return "added";
+    case EventType::kMoved:
+      return "moved";
+    case EventType::kRemoved:
+      return "removed";
+    case EventType::kGone:
+      return "gone";
+  }
+  return "?";
+}
+
+PoseError poseError(const world::Shape& shape, const Eigen::Isometry3d& truth, const Eigen::Isometry3d& estimate) {
+  PoseError e;
+  const Eigen::Vector3d d = estimate.translation() - truth.translation();
+  e.xy = d.head<2>().norm();
+  e.z = std::abs(d.z());
+  e.yaw = yawError(shape, yawOf(truth), yawOf(estimate));
+  return e;
+}
+
+struct Perception::Impl {
+  PerceptionParams params;
+  std::vector<ObjectClass> classes;
+  world::World prior;
+  world::World world;
+  Segmenter segmenter;
+  std::unique_ptr<OccupancyMap> occupancy;
+  std::map<std::string, Track> tracks;  // by id (tentatives: "tentative_<n>")
+  std::uint64_t frames{0};
+  int64_t last_stamp{std::numeric_limits<int64_t>::min()};
+  int next_tentative{1};
+  double floor_height{0.0};
+
+  Impl(world::World prior_world, PerceptionParams p)
+      : params(std::move(p)), prior(std::move(prior_world)), world(prior), segmenter(params, prior) {}
+
+  // ---- helpers ----------------------------------------------------------------------------------
+
+  bool idTaken(const std::string& id) const { return tracks.count(id) > 0 || world.findObject(id) != nullptr; }
+
+  std::string newId(const std::string& label) const {
+    const std::string prefix = idPrefix(label);
+    for (int n = 1;; ++n) {
+      std::string id = prefix + "_" + std::to_string(n);
+      if (!idTaken(id)) return id;
+    }
+  }
+
+  /// Height of the surface under a cluster whose lowest point is at `zmin`.
+  double supportBelow(const Eigen::Vector2d& xy, double zmin, const std::vector<SupportPlane>& planes) const {
+    const double tol = 0.05;
+    double best = -kInf;
+    for (const auto& pl : planes) {
+      if (pl.height > zmin + tol) continue;
+      if (pl.hull.size() >= 3 && !world::containsPoint(pl.hull, xy)) continue;
+      best = std::max(best, pl.height);
+    }
+    for (const auto& r : prior.regions()) {
+      if (r.height <= zmin + tol && r.contains(xy)) best = std::max(best, r.height);
+    }
+    for (const auto& o : prior.objects()) {
+      if (o.kind != world::ObjectKind::kStatic) continue;
+      const Aabb b = o.aabb();
+      if (b.max.z() > zmin + tol || b.max.z() <= best) continue;
+      const Eigen::Vector3d top(xy.x(), xy.y(), b.max.z() - 1e-3);
+      if (pointInShape(o.shape, o.pose, top, 0.0)) best = b.max.z();
+    }
+    return std::isfinite(best) ? best : floor_height;
+  }
+
+  /// The class a detection fits best (compatible size, least mismatch), or nullptr.
+  const ObjectClass* bestClass(const Detection& d, const Eigen::Vector3d& sensor) const {
+    const ObjectClass* best = nullptr;
+    double best_cost = kInf;
+    for (const auto& c : classes) {
+      const ShapeFit f = fitShape(d, c.shape, sensor, params.tracking);
+      if (!f.compatible) continue;
+      const bool round = c.shape.kind == world::ShapeKind::kCylinder || c.shape.kind == world::ShapeKind::kSphere;
+      const bool det_round = d.kind == world::ShapeKind::kCylinder;
+      const double h = std::max(params.tracking.height_tolerance, 0.2 * 2 * c.shape.halfHeight());
+      const double cost = std::abs(f.height_error) / h + f.deficit / std::max(params.tracking.size_tolerance, 0.01) * 0.5 +
+                          f.residual / 0.01 + (round != det_round ? 1.0 : 0.0);
+      if (cost < best_cost) {
+        best_cost = cost;
+        best = &c;
+      }
+    }
+    return best;
+  }
+
+  world::Object objectOf(const Track& t) const {
+    world::Object o;
+    o.id = t.id;
+    o.label = t.label;
+    o.kind = t.kind;
+    o.shape = t.shape;
+    o.pose = t.pose;
+    o.mass = t.kind == world::ObjectKind::kMovable ? std::max(t.mass, params.classify.min_mass) : std::max(t.mass, 0.0);
+    o.graspable = t.graspable;
+    const double bottom = t.pose.translation().z() - t.shape.halfHeight();
+    if (const world::Region* r = world.regionBelow(Eigen::Vector3d(t.pose.translation().x(), t.pose.translation().y(), bottom + 0.01), 0.05)) {
+      o.region = r->id;
+    }
+    return o;
+  }
+
+  /// Mass, graspability and kind of a track without a class (size thresholds).
+  void classifyBySize(Track& t) const {
+    const ClassifyParams& c = params.classify;
+    const double major = footprintMajor(t.shape), minor = footprintMinor(t.shape);
+    const double height = 2 * t.shape.halfHeight();
+    t.kind = major <= c.movable_max_extent && height <= c.movable_max_height ? world::ObjectKind::kMovable
+                                                                              : world::ObjectKind::kStatic;
+    t.mass = std::max(c.min_mass, c.density * t.shape.volume());
+    t.graspable = t.kind == world::ObjectKind::kMovable && minor <= c.graspable_max_width && t.mass <= c.graspable_max_mass;
+  }
+
+  /// Shape of a size-unknown track grown by a new detection (never shrinks: partial views).
+  void growShape(Track& t, const Detection& d) const {
+    (d.kind == world::ShapeKind::kCylinder ? t.cylinder_votes : t.box_votes) += 1;
+    const bool cylinder = t.cylinder_votes > t.box_votes;
+    const double h = std::max(2 * t.shape.halfHeight(), d.height);
+    const double max_size = params.clusters.max_size;
+    if (cylinder) {
+      const double r_old = t.shape.kind == world::ShapeKind::kCylinder ? t.shape.radius : 0.0;
+      const double r = std::min(std::max(r_old, d.kind == world::ShapeKind::kCylinder ? d.shape.radius : d.majorExtent() / 2), max_size / 2);
+      t.shape = world::Shape::cylinder(std::max(r, 1e-3), std::max(h, 1e-3));
+    } else {
+      Eigen::Vector2d e = d.rect.extents;
+      if (t.shape.kind == world::ShapeKind::kBox) {
+        // Keep the track's axis order: match the detection's extents to the closer assignment.
+        const Eigen::Vector2d old(t.shape.size.x(), t.shape.size.y());
+        const Eigen::Vector2d sw(e.y(), e.x());
+        const double yaw_t = yawOf(t.pose), yaw_d = d.rect.yaw;
+        const double dyaw = std::abs(std::remainder(yaw_t - yaw_d, std::numbers::pi));
+        if (dyaw > std::numbers::pi / 4) e = sw;
+        e = e.cwiseMax(old);
+      }
+      e = e.cwiseMin(max_size);
+      t.shape = world::Shape::box(std::max(e.x(), 1e-3), std::max(e.y(), 1e-3), std::max(h, 1e-3));
+    }
+  }
+
+  void pushEvent(FrameResult& r, EventType type, const Track& t, const Eigen::Isometry3d& pose, std::string why,
+                 int64_t stamp) const {
+    WorldEvent e;
+    e.type = type;
+    e.object_id = t.id;
+    e.kind = t.kind;
+    e.pose = pose;
+    e.description = std::move(why);
+    e.stamp_ns = stamp;
+    r.events.push_back(std::move(e));
+  }
+};
+
+// ---- construction -------------------------------------------------------------------------------
+
+Perception::Perception(world::World prior, PerceptionParams params) {
+  if (Status s = params.validate(); !s.ok()) throw std::invalid_argument(s.error().toString());
+  if (prior.hiddenCount() > 0) {
+    throw std::invalid_argument("Perception: the prior world has " + std::to_string(prior.hiddenCount()) +
+                                " hidden object(s); pass its plannerView()");
+  }
+  impl_ = std::make_unique<Impl>(std::move(prior), std::move(params));
+  Impl& I = *impl_;
+  I.classes = I.params.classes;
+  for (auto& c : classesFromWorld(I.prior)) {
+    const bool known = std::any_of(I.classes.begin(), I.classes.end(), [&](const ObjectClass& k) { return k.label == c.label; });
+    if (!known) I.classes.push_back(std::move(c));
+  }
+  if (I.params.occupancy.enabled) I.occupancy = std::make_unique<OccupancyMap>(I.params.occupancy);
+  for (const auto& r : I.prior.regions()) {
+    if (r.kind == world::RegionKind::kFloor) I.floor_height = r.height;
+  }
+  for (const auto& o : I.prior.objects()) {
+    if (o.kind != world::ObjectKind::kMovable) continue;
+    Track t;
+    t.id = o.id;
+    t.label = o.label;
+    t.state = TrackInfo::State::kActive;
+    t.from_prior = true;
+    t.size_known = true;
+    t.kind = o.kind;
+    t.shape = o.shape;
+    t.pose = o.pose;
+    t.event_pose = o.pose;
+    t.confidence = 1.0;
+    t.mass = o.mass;
+    t.graspable = o.graspable;
+    I.tracks.emplace(t.id, std::move(t));
+  }
+}
+
+Perception::~Perception() = default;
+
+const world::World& Perception::world() const { return impl_->world; }
+const PerceptionParams& Perception::params() const { return impl_->params; }
+const std::vector<ObjectClass>& Perception::classes() const { return impl_->classes; }
+std::uint64_t Perception::frames() const { return impl_->frames; }
+const OccupancyMap* Perception::occupancy() const { return impl_->occupancy.get(); }
+std::string Perception::occupancyBinary() const { return impl_->occupancy ? impl_->occupancy->toBinary() : std::string(); }
+
+namespace {
+TrackInfo infoOf(const Track& t) {
+  TrackInfo i;
+  i.id = t.id;
+  i.label = t.label;
+  i.state = t.state;
+  i.from_prior = t.from_prior;
+  i.kind = t.kind;
+  i.shape = t.shape;
+  i.pose = t.pose;
+  i.confidence = t.confidence;
+  i.last_seen_ns = t.last_seen_ns;
+  i.hits = t.hits;
+  i.misses = t.misses;
+  return i;
+}
+}  // namespace
+
+std::vector<TrackInfo> Perception::tracks() const {
+  std::vector<TrackInfo> out;
+  for (const auto& [id, t] : impl_->tracks) out.push_back(infoOf(t));
+  return out;
+}
+
+std::optional<TrackInfo> Perception::track(std::string_view id) const {
+  auto it = impl_->tracks.find(std::string(id));
+  if (it == impl_->tracks.end()) return std::nullopt;
+  return infoOf(it->second);
+}
+
+Result<WorldEvent> Perception::removeObject(std::string_view id, const std::string& reason) {
+  Impl& I = *impl_;
+  const world::Object* o = I.world.findObject(id);
+  if (o == nullptr) return Error(ErrorCode::kNotFound, "no object '" + std::string(id) + "' in the world model");
+  if (I.prior.findObject(id) != nullptr && o->kind == world::ObjectKind::kStatic) {
+    return Error(ErrorCode::kInvalidArgument, "'" + std::string(id) + "' is part of the static map");
+  }
+  WorldEvent e;
+  e.type = EventType::kRemoved;
+  e.object_id = o->id;
+  e.kind = o->kind;
+  e.pose = o->pose;
+  e.description = "removed on request: " + reason;
+  e.stamp_ns = I.last_stamp == std::numeric_limits<int64_t>::min() ? 0 : I.last_stamp;
+  if (Status s = I.world.removeObject(id); !s.ok()) return s.error();
+  I.tracks.erase(std::string(id));
+  return e;
+}
+
+// ---- the frame ----------------------------------------------------------------------------------
+
+Result<FrameResult> Perception::processFrame(const PointCloudFrame& frame, const Termination& term) {
+  Impl& I = *impl_;
+  const PerceptionParams& P = I.params;
+  const TrackingParams& T = P.tracking;
+  FrameResult result;
+  Stopwatch total, watch;
+
+  if (Status s = validateFrame(frame, P.max_points); !s.ok()) return s.error();
+  if (frame.stamp_ns < I.last_stamp) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "frame is older than the previous one (" + std::to_string(frame.stamp_ns) + " < " +
+                     std::to_string(I.last_stamp) + " ns)",
+                 SourceLocation{"", 0, 0, "stamp_ns"});
+  }
+  result.times.validate = watch.millis();
+  result.stats.input_points = frame.size();
+
+  auto seg = I.segmenter.run(frame, term);
+  if (!seg) return seg.error();
+  const Segmentation& S = *seg;
+  result.times.transform_crop = S.times.transform_crop;
+  result.times.voxel = S.times.voxel;
+  result.times.planes = S.times.planes;
+  result.times.static_objects = S.times.static_objects;
+  result.times.clustering = S.times.clustering;
+  result.stats.valid_points = S.valid_points;
+  result.stats.cropped_points = S.cropped_points;
+  result.stats.voxel_points = S.scan.size();
+  result.stats.plane_points = S.plane_points;
+  result.stats.static_points = S.static_points;
+  result.stats.planes = static_cast<int>(S.planes.size());
+  result.stats.clusters = static_cast<int>(S.clusters.size());
+  result.planes = S.planes;
+  if (term()) {
+    return Error(term.reason() == StopReason::kStopRequested ? ErrorCode::kCancelled : ErrorCode::kTimeout,
+                 "stopped before shape fitting");
+  }
+
+  // Committed from here on: the rest is bounded and quick.
+  I.last_stamp = frame.stamp_ns;
+  ++I.frames;
+  const int64_t stamp = frame.stamp_ns;
+  const Eigen::Vector3d sensor = frame.world_T_sensor.translation();
+  const world::World before = I.world;
+
+  // The lowest support seen is the floor (unexplained points hugging it are noise).
+  double floor_z = I.floor_height;
+  if (!S.planes.empty()) {
+    floor_z = std::min_element(S.planes.begin(), S.planes.end(), [](const auto& a, const auto& b) {
+                return a.height < b.height;
+              })->height;
+  }
+
+  // ---- shape fitting ------------------------------------------------------------------------
+  watch.reset();
+  std::vector<Eigen::Vector3f> unexplained = S.small_cluster_points;
+  std::vector<std::size_t> det_cluster;  // detection -> cluster index
+  for (std::size_t ci = 0; ci < S.clusters.size(); ++ci) {
+    const auto& c = S.clusters[ci];
+    std::vector<Eigen::Vector3d> pts;
+    pts.reserve(c.size());
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    double zmin = kInf;
+    for (const auto& p : c) {
+      pts.emplace_back(p.cast<double>());
+      mean += p.head<2>().cast<double>();
+      zmin = std::min(zmin, double(p.z()));
+    }
+    mean /= static_cast<double>(c.size());
+    const double support = I.supportBelow(mean, zmin, S.planes);
+    Detection d = describeCluster(std::move(pts), support, P.clusters);
+    const double major = d.majorExtent();
+    if (d.height < P.clusters.min_height || major < P.clusters.min_size) {
+      // Too flat or too small to be an object: noise unless clearly above the floor.
+      if (d.top_z > floor_z + P.clusters.min_height) unexplained.insert(unexplained.end(), c.begin(), c.end());
+      continue;
+    }
+    if (major > P.clusters.max_size) {
+      unexplained.insert(unexplained.end(), c.begin(), c.end());
+      continue;
+    }
+    result.detections.push_back(std::move(d));
+    det_cluster.push_back(ci);
+  }
+  result.stats.detections = static_cast<int>(result.detections.size());
+  result.times.fitting = watch.millis();
+
+  // ---- association ------------------------------------------------------------------------------
+  watch.reset();
+  std::vector<Track*> candidates;
+  for (auto& [id, t] : I.tracks) {
+    t.matched = false;
+    if (t.state != TrackInfo::State::kGone) candidates.push_back(&t);
+  }
+  const auto& dets = result.detections;
+  std::vector<std::vector<double>> cost(dets.size(), std::vector<double>(candidates.size(), kInf));
+  std::vector<std::vector<ShapeFit>> fits(dets.size(), std::vector<ShapeFit>(candidates.size()));
+  for (std::size_t i = 0; i < dets.size(); ++i) {
+    for (std::size_t j = 0; j < candidates.size(); ++j) {
+      const Track& t = *candidates[j];
+      ShapeFit f;
+      if (t.size_known) {
+        f = fitShape(dets[i], t.shape, sensor, T, yawOf(t.pose));
+        if (!f.compatible) continue;
+      } else {
+        f.pose = dets[i].pose;
+        f.height_error = dets[i].height - 2 * t.shape.halfHeight();
+        if (std::abs(f.height_error) > std::max(T.height_tolerance, 0.3 * dets[i].height)) continue;
+        // The detection's observed centre is biased towards the sensor; compare it with the
+        // track's by their footprints' overlap instead of their centres alone.
+      }
+      const double dist = (f.pose.translation().head<2>() - t.pose.translation().head<2>()).norm();
+      double gate = T.gate_distance;
+      if (!t.size_known) gate += 0.5 * footprintMajor(t.shape);
+      if (dist > gate) continue;
+      const bool round = t.shape.kind == world::ShapeKind::kCylinder || t.shape.kind == world::ShapeKind::kSphere;
+      const bool det_round = dets[i].kind == world::ShapeKind::kCylinder;
+      cost[i][j] = dist + 0.5 * f.residual + (t.state == TrackInfo::State::kTentative ? 0.05 : 0.0) +
+                   (round != det_round ? 0.05 : 0.0);
+      fits[i][j] = f;
+    }
+  }
+  const std::vector<int> assign = solveAssignment(cost);
+
+  std::vector<char> det_used(dets.size(), 0);
+  for (std::size_t i = 0; i < dets.size(); ++i) {
+    if (assign[i] < 0) continue;
+    det_used[i] = 1;
+    Track& t = *candidates[static_cast<std::size_t>(assign[i])];
+    const ShapeFit& f = fits[i][static_cast<std::size_t>(assign[i])];
+    t.matched = true;
+    ++t.hits;
+    t.misses = 0;
+    t.last_seen_ns = stamp;
+    t.confidence = t.confidence + (1.0 - t.confidence) * 0.3;
+    Eigen::Isometry3d meas = f.pose;
+    if (!t.size_known) {
+      I.growShape(t, dets[i]);
+      // Refit the grown shape (anchored on the seen faces) for the pose.
+      meas = fitShape(dets[i], t.shape, sensor, T, yawOf(t.pose)).pose;
+    }
+    const double jump = (meas.translation() - t.pose.translation()).norm();
+    if (jump > T.snap_distance || t.hits <= 1) {
+      t.pose = meas;
+    } else {
+      const double a = T.smoothing;
+      const Eigen::Vector3d pos = t.pose.translation() + a * (meas.translation() - t.pose.translation());
+      double yaw_t = yawOf(t.pose), yaw_m = yawOf(meas);
+      const double sym = yawSymmetry(t.shape);
+      double dy = sym > 0 ? yaw_m - yaw_t - sym * std::round((yaw_m - yaw_t) / sym) : 0.0;
+      t.pose = uprightPose(pos.x(), pos.y(), meas.translation().z(), sym > 0 ? wrapAngle(yaw_t + a * dy) : 0.0);
+    }
+    result.stats.matched += t.state == TrackInfo::State::kActive ? 1 : 0;
+  }
+
+  // Unmatched detections become tentative objects (class from the priors, else by size).
+  for (std::size_t i = 0; i < dets.size(); ++i) {
+    if (det_used[i]) continue;
+    const Detection& d = dets[i];
+    Track t;
+    t.id = "tentative_" + std::to_string(I.next_tentative++);
+    t.state = TrackInfo::State::kTentative;
+    t.hits = 1;
+    t.first_seen_ns = stamp;
+    t.last_seen_ns = stamp;
+    t.confidence = 0.3;
+    t.matched = true;
+    if (const ObjectClass* c = I.bestClass(d, sensor)) {
+      t.cls = c;
+      t.label = c->label;
+      t.size_known = true;
+      t.shape = c->shape;
+      t.kind = c->kind;
+      t.mass = c->mass;
+      t.graspable = c->graspable;
+      t.pose = fitShape(d, c->shape, sensor, T).pose;
+    } else {
+      t.size_known = false;
+      t.shape = d.shape;
+      (d.kind == world::ShapeKind::kCylinder ? t.cylinder_votes : t.box_votes) = 1;
+      t.pose = d.pose;
+      t.label = d.kind == world::ShapeKind::kCylinder ? "cylinder" : "box";
+    }
+    I.tracks.emplace(t.id, std::move(t));
+  }
+  double tracking_ms = watch.millis();
+
+  // ---- expected objects not detected: seen empty, hidden, or out of view ------------------------
+  watch.reset();
+  std::optional<RangeImage> image;
+  std::vector<std::string> dropped;
+  for (auto& [id, t] : I.tracks) {
+    if (t.matched || t.state == TrackInfo::State::kGone) continue;
+    if (!image) image.emplace(frame, T.visibility_bin);
+    world::Object o;
+    o.shape = t.shape;
+    o.pose = t.pose;
+    const ObjectVisibility v = image->checkObject(o, T.visibility_margin);
+    const bool decidable = v.testable >= T.gone_min_samples;
+    const bool seen_empty = decidable && v.throughFraction() >= T.gone_fraction && v.presentFraction() < T.present_fraction;
+    if (t.state == TrackInfo::State::kTentative) {
+      if (seen_empty || stamp - t.last_seen_ns > static_cast<int64_t>(T.tentative_timeout_s * 1e9)) dropped.push_back(id);
+      continue;
+    }
+    if (seen_empty) {
+      ++t.misses;
+      t.confidence *= 0.5;
+      if (t.misses >= T.gone_frames) {
+        t.state = TrackInfo::State::kGone;
+        (void)I.world.removeObject(t.id);
+        char why[160];
+        std::snprintf(why, sizeof(why), "not at %s although in view: %d of %d samples seen through in %d frame(s)",
+                      describePose(t.pose).c_str(), v.through, v.testable, t.misses);
+        I.pushEvent(result, EventType::kGone, t, t.pose, why, stamp);
+      }
+    } else if (decidable && v.presentFraction() >= T.present_fraction) {
+      t.misses = 0;  // something is there though no cluster matched (e.g. merged with a neighbour)
+    }
+  }
+  for (const auto& id : dropped) I.tracks.erase(id);
+  result.times.visibility = watch.millis();
+
+  // ---- confirmations, reacquisitions, world updates ----------------------------------------------
+  watch.reset();
+  std::vector<std::string> confirmed;
+  for (auto& [id, t] : I.tracks) {
+    if (t.state == TrackInfo::State::kTentative && t.matched && t.hits >= T.confirm_hits) confirmed.push_back(id);
+  }
+  for (const auto& tid : confirmed) {
+    Track t = std::move(I.tracks.at(tid));
+    I.tracks.erase(tid);
+    // A gone object of the same shape: reacquired under its id.
+    Track* lost = nullptr;
+    if (T.reacquire) {
+      double best = kInf;
+      for (auto& [gid, g] : I.tracks) {
+        if (g.state != TrackInfo::State::kGone || !(g.shape == t.shape) || g.label != t.label) continue;
+        const double d = (g.pose.translation() - t.pose.translation()).norm();
+        if (d < best) {
+          best = d;
+          lost = &g;
+        }
+      }
+    }
+    if (lost != nullptr) {
+      const Eigen::Isometry3d was = lost->pose;
+      lost->state = TrackInfo::State::kActive;
+      lost->pose = t.pose;
+      lost->event_pose = t.pose;
+      lost->hits += t.hits;
+      lost->misses = 0;
+      lost->last_seen_ns = stamp;
+      lost->confidence = std::max(lost->confidence, t.confidence);
+      (void)I.world.addObject(I.objectOf(*lost));
+      char why[200];
+      std::snprintf(why, sizeof(why), "reacquired at %s, %.2f m from where it was lost",
+                    describePose(t.pose).c_str(), (t.pose.translation() - was.translation()).norm());
+      I.pushEvent(result, EventType::kMoved, *lost, lost->pose, why, stamp);
+      continue;
+    }
+    if (!t.size_known) I.classifyBySize(t);
+    t.id = I.newId(t.label);
+    t.state = TrackInfo::State::kActive;
+    t.event_pose = t.pose;
+    const world::Object o = I.objectOf(t);
+    if (Status s = I.world.addObject(o); !s.ok()) continue;  // cannot happen: ids are fresh, shapes valid
+    std::string why = std::string("new ") + std::string(world::toString(t.kind)) + " " + describeShape(t.shape) +
+                      " at " + describePose(t.pose) + (t.cls != nullptr ? ", class " + t.cls->label : ", by size");
+    I.pushEvent(result, EventType::kAdded, t, t.pose, why, stamp);
+    I.tracks.emplace(t.id, std::move(t));
+  }
+
+  for (auto& [id, t] : I.tracks) {
+    if (t.state != TrackInfo::State::kActive || !t.matched) continue;
+    const world::Object* o = I.world.findObject(id);
+    if (o == nullptr) continue;
+    const double dpos = (o->pose.translation() - t.pose.translation()).norm();
+    const double dyaw = yawError(t.shape, yawOf(o->pose), yawOf(t.pose));
+    const bool grew = !(o->shape == t.shape);
+    if (dpos > T.update_distance || dyaw > T.update_angle || grew) {
+      world::Object updated = I.objectOf(t);
+      if (!t.from_prior && !t.size_known && t.cls == nullptr) {
+        // Keep mass/kind consistent with the grown size.
+        Track tmp = t;
+        I.classifyBySize(tmp);
+        t.kind = tmp.kind;
+        t.mass = tmp.mass;
+        t.graspable = tmp.graspable;
+        updated = I.objectOf(t);
+      }
+      (void)I.world.updateObject(updated);
+    }
+    const double moved = (t.event_pose.translation() - t.pose.translation()).norm();
+    const double turned = yawError(t.shape, yawOf(t.event_pose), yawOf(t.pose));
+    if (moved > T.move_event_distance || turned > T.move_event_angle) {
+      char why[200];
+      std::snprintf(why, sizeof(why), "moved %.2f m, turned %.2f rad, now at %s", moved, turned,
+                    describePose(t.pose).c_str());
+      t.event_pose = t.pose;
+      I.pushEvent(result, EventType::kMoved, t, t.pose, why, stamp);
+    }
+  }
+  for (const auto& [id, t] : I.tracks) result.stats.tentative += t.state == TrackInfo::State::kTentative ? 1 : 0;
+  tracking_ms += watch.millis();
+  result.times.tracking = tracking_ms;
+
+  // ---- occupancy of unexplained space -------------------------------------------------------------
+  watch.reset();
+  for (std::size_t i = 0; i < dets.size(); ++i) {
+    // Detections not (yet) part of a world object stay unexplained space until confirmed.
+    bool explained = false;
+    for (const auto& o : I.world.objects()) {
+      if (pointInShape(o.shape, o.pose, dets[i].pose.translation(), P.occupancy.explained_margin)) {
+        explained = true;
+        break;
+      }
+    }
+    if (!explained) {
+      const auto& c = S.clusters[det_cluster[i]];
+      unexplained.insert(unexplained.end(), c.begin(), c.end());
+    }
+  }
+  result.stats.unexplained_points = unexplained.size();
+  if (I.occupancy) {
+    I.occupancy->integrate(sensor, S.scan, unexplained);
+    for (const auto& o : I.world.objects()) {
+      if (o.kind == world::ObjectKind::kMovable || I.prior.findObject(o.id) == nullptr) I.occupancy->clearObject(o);
+    }
+  }
+  result.times.occupancy = watch.millis();
+
+  result.world_changed = !world::diff(before, I.world).empty();
+  result.times.total = total.millis();
+  return result;
+}
+
+}  // namespace tamp::perception

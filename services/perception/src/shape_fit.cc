@@ -1,0 +1,445 @@
+#include "tamp/perception/shape_fit.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <stdexcept>
+
+#include <Eigen/Dense>
+
+#include "tamp/core/geometry.h"
+#include "tamp/world/polygon.h"
+
+namespace tamp::perception {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+double cross(const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
+}
+
+double segmentDistance(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  const Eigen::Vector2d ab = b - a;
+  const double len2 = ab.squaredNorm();
+  const double t = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+  return (a + t * ab - p).norm();
+}
+
+/// Distance from p to the boundary of a closed polygon (ring of vertices).
+double ringDistance(const Eigen::Vector2d& p, const std::vector<Eigen::Vector2d>& ring) {
+  if (ring.empty()) return std::numeric_limits<double>::infinity();
+  if (ring.size() == 1) return (p - ring[0]).norm();
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < ring.size(); ++i) {
+    best = std::min(best, segmentDistance(p, ring[i], ring[(i + 1) % ring.size()]));
+  }
+  return best;
+}
+
+/// Distance from p (xy) to the boundary of a centred rectangle of half extents h in its frame.
+double rectBoundaryDistance(const Eigen::Vector2d& local, const Eigen::Vector2d& h) {
+  const double dx = std::abs(local.x()) - h.x();
+  const double dy = std::abs(local.y()) - h.y();
+  if (dx <= 0 && dy <= 0) return std::min(-dx, -dy);  // inside: nearest edge
+  return std::hypot(std::max(dx, 0.0), std::max(dy, 0.0));
+}
+
+Eigen::Vector2d axis(double yaw) { return {std::cos(yaw), std::sin(yaw)}; }
+
+double rms(double sum_sq, std::size_t n) { return n > 0 ? std::sqrt(sum_sq / static_cast<double>(n)) : 0.0; }
+
+}  // namespace
+
+// ---- planar geometry ----------------------------------------------------------------------------
+
+std::vector<Eigen::Vector2d> convexHull(std::vector<Eigen::Vector2d> pts) {
+  std::sort(pts.begin(), pts.end(), [](const auto& a, const auto& b) {
+    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
+  });
+  pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
+  if (pts.size() < 3) return pts;
+  std::vector<Eigen::Vector2d> hull(2 * pts.size());
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    while (k >= 2 && cross(hull[k - 2], hull[k - 1], pts[i]) <= 0) --k;
+    hull[k++] = pts[i];
+  }
+  for (std::size_t i = pts.size() - 1, t = k + 1; i > 0; --i) {
+    while (k >= t && cross(hull[k - 2], hull[k - 1], pts[i - 1]) <= 0) --k;
+    hull[k++] = pts[i - 1];
+  }
+  hull.resize(k - 1);
+  return hull;
+}
+
+Rect2 minAreaRect(const std::vector<Eigen::Vector2d>& hull) {
+  Rect2 best;
+  if (hull.empty()) return best;
+  if (hull.size() == 1) {
+    best.centre = hull[0];
+    return best;
+  }
+  double best_area = std::numeric_limits<double>::infinity();
+  const std::size_t edges = hull.size() == 2 ? 1 : hull.size();
+  for (std::size_t i = 0; i < edges; ++i) {
+    const Eigen::Vector2d e = hull[(i + 1) % hull.size()] - hull[i];
+    if (e.norm() < 1e-12) continue;
+    const Eigen::Vector2d u = e.normalized();
+    const Eigen::Vector2d v(-u.y(), u.x());
+    double umin = std::numeric_limits<double>::infinity(), umax = -umin, vmin = umin, vmax = -umin;
+    for (const auto& p : hull) {
+      const double a = p.dot(u), b = p.dot(v);
+      umin = std::min(umin, a);
+      umax = std::max(umax, a);
+      vmin = std::min(vmin, b);
+      vmax = std::max(vmax, b);
+    }
+    // Ties (equal areas, e.g. both orientations of a segment) keep the first.
+    const double area = (umax - umin) * std::max(vmax - vmin, 1e-12);
+    if (area < best_area - 1e-15) {
+      best_area = area;
+      best.centre = u * (0.5 * (umin + umax)) + v * (0.5 * (vmin + vmax));
+      best.yaw = std::atan2(u.y(), u.x());
+      best.extents = {umax - umin, vmax - vmin};
+    }
+  }
+  // Normalise the yaw to [0, pi/2) (the rectangle is the same under quarter turns with the
+  // extents swapped).
+  double yaw = std::fmod(best.yaw, kPi);
+  if (yaw < 0) yaw += kPi;
+  if (yaw >= kPi / 2) {
+    yaw -= kPi / 2;
+    std::swap(best.extents.x(), best.extents.y());
+  }
+  if (yaw >= kPi / 2 - 1e-12) yaw = 0.0;
+  best.yaw = yaw;
+  return best;
+}
+
+Circle fitCircle(const std::vector<Eigen::Vector2d>& points) {
+  Circle c;
+  const std::size_t n = points.size();
+  if (n < 3) return c;
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (const auto& p : points) mean += p;
+  mean /= static_cast<double>(n);
+  // Kasa: x^2 + y^2 + D x + E y + F = 0 in centred coordinates.
+  Eigen::MatrixXd A(n, 3);
+  Eigen::VectorXd b(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector2d q = points[i] - mean;
+    A(static_cast<Eigen::Index>(i), 0) = q.x();
+    A(static_cast<Eigen::Index>(i), 1) = q.y();
+    A(static_cast<Eigen::Index>(i), 2) = 1.0;
+    b(static_cast<Eigen::Index>(i)) = -q.squaredNorm();
+  }
+  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(A);
+  qr.setThreshold(1e-10);
+  if (qr.rank() < 3) return c;
+  const Eigen::Vector3d s = qr.solve(b);
+  Eigen::Vector2d centre(-s(0) / 2, -s(1) / 2);
+  double r2 = centre.squaredNorm() - s(2);
+  if (!(r2 > 0) || !std::isfinite(r2)) return c;
+  double r = std::sqrt(r2);
+  // Gauss-Newton on the geometric residuals |p - c| - r.
+  for (int it = 0; it < 20; ++it) {
+    Eigen::Matrix3d JtJ = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d Jtr = Eigen::Vector3d::Zero();
+    for (const auto& p : points) {
+      const Eigen::Vector2d d = (p - mean) - centre;
+      const double dn = d.norm();
+      if (dn < 1e-12) continue;
+      const Eigen::Vector3d J(-d.x() / dn, -d.y() / dn, -1.0);
+      const double res = dn - r;
+      JtJ += J * J.transpose();
+      Jtr += J * res;
+    }
+    const Eigen::Vector3d step = JtJ.ldlt().solve(-Jtr);
+    if (!step.allFinite()) break;
+    centre += step.head<2>();
+    r += step(2);
+    if (step.norm() < 1e-9) break;
+  }
+  if (!(r > 0) || !std::isfinite(r) || !centre.allFinite()) return c;
+  double sum = 0;
+  for (const auto& p : points) {
+    const double res = ((p - mean) - centre).norm() - r;
+    sum += res * res;
+  }
+  c.centre = centre + mean;
+  c.radius = r;
+  c.rms = rms(sum, n);
+  c.ok = true;
+  return c;
+}
+
+Circle fitCircleFixedRadius(const std::vector<Eigen::Vector2d>& points, double radius,
+                            const Eigen::Vector2d& initial) {
+  Circle c;
+  c.centre = initial;
+  c.radius = radius;
+  if (points.empty() || !(radius > 0)) return c;
+  Eigen::Vector2d centre = initial;
+  double lambda = 1e-6;
+  auto cost = [&](const Eigen::Vector2d& cc) {
+    double s = 0;
+    for (const auto& p : points) {
+      const double res = (p - cc).norm() - radius;
+      s += res * res;
+    }
+    return s;
+  };
+  double current = cost(centre);
+  for (int it = 0; it < 30; ++it) {
+    Eigen::Matrix2d JtJ = Eigen::Matrix2d::Zero();
+    Eigen::Vector2d Jtr = Eigen::Vector2d::Zero();
+    for (const auto& p : points) {
+      const Eigen::Vector2d d = p - centre;
+      const double dn = d.norm();
+      if (dn < 1e-12) continue;
+      const Eigen::Vector2d J = -d / dn;
+      JtJ += J * J.transpose();
+      Jtr += J * (dn - radius);
+    }
+    // Levenberg-Marquardt damping: the fixed-radius problem is ill-posed along a short arc.
+    const Eigen::Vector2d step = (JtJ + lambda * Eigen::Matrix2d::Identity()).ldlt().solve(-Jtr);
+    if (!step.allFinite()) break;
+    const double next = cost(centre + step);
+    if (next < current) {
+      centre += step;
+      current = next;
+      lambda *= 0.3;
+      if (step.norm() < 1e-9) break;
+    } else {
+      lambda *= 10;
+      if (lambda > 1e6) break;
+    }
+  }
+  c.centre = centre;
+  c.rms = rms(current, points.size());
+  c.ok = centre.allFinite();
+  return c;
+}
+
+// ---- detections ---------------------------------------------------------------------------------
+
+double Detection::majorExtent() const { return std::max(rect.extents.x(), rect.extents.y()); }
+double Detection::minorExtent() const { return std::min(rect.extents.x(), rect.extents.y()); }
+
+Detection describeCluster(std::vector<Eigen::Vector3d> points, double support_z, const ClusterParams& params) {
+  require(points.size() >= 3, "describeCluster: need >= 3 points, got " + std::to_string(points.size()));
+  Detection d;
+  d.points = std::move(points);
+  d.support_z = support_z;
+  d.top_z = -std::numeric_limits<double>::infinity();
+  std::vector<Eigen::Vector2d> xy;
+  xy.reserve(d.points.size());
+  for (const auto& p : d.points) {
+    d.top_z = std::max(d.top_z, p.z());
+    xy.emplace_back(p.x(), p.y());
+  }
+  d.height = std::max(d.top_z - support_z, 0.0);
+  const std::vector<Eigen::Vector2d> hull = convexHull(xy);
+  d.rect = minAreaRect(hull);
+
+  // Points near the hull boundary carry the outline (the interior is the top face).
+  const double band = std::max(0.01, 0.5 * params.tolerance);
+  for (const auto& p : xy) {
+    if (ringDistance(p, hull) <= band) d.boundary.push_back(p);
+  }
+  if (d.boundary.size() < 3) d.boundary = xy;
+
+  const Eigen::Vector2d a0 = axis(d.rect.yaw), a1 = axis(d.rect.yaw + kPi / 2);
+  const Eigen::Vector2d half = d.rect.extents / 2;
+  double sum = 0;
+  for (const auto& p : d.boundary) {
+    const Eigen::Vector2d q = p - d.rect.centre;
+    const double dist = rectBoundaryDistance({q.dot(a0), q.dot(a1)}, half);
+    sum += dist * dist;
+  }
+  d.rect_rms = rms(sum, d.boundary.size());
+  d.circle = fitCircle(d.boundary);
+
+  // A cylinder when a circle explains the outline clearly better than a rectangle and is about
+  // as large as the points' spread (a straight face fits a huge circle with a small residual).
+  const bool cylinder = d.circle.ok && d.circle.rms < params.cylinder_residual_ratio * d.rect_rms &&
+                        d.circle.radius <= 0.65 * d.majorExtent() + 0.01 && d.rect_rms > 0.002;
+  const double h = std::max(d.height, 1e-3);
+  if (cylinder) {
+    d.kind = world::ShapeKind::kCylinder;
+    d.shape = world::Shape::cylinder(std::max(d.circle.radius, 1e-3), h);
+    d.pose = uprightPose(d.circle.centre.x(), d.circle.centre.y(), support_z + h / 2, 0.0);
+  } else {
+    d.kind = world::ShapeKind::kBox;
+    d.shape = world::Shape::box(std::max(d.rect.extents.x(), 1e-3), std::max(d.rect.extents.y(), 1e-3), h);
+    d.pose = uprightPose(d.rect.centre.x(), d.rect.centre.y(), support_z + h / 2, d.rect.yaw);
+  }
+  return d;
+}
+
+// ---- known shapes -------------------------------------------------------------------------------
+
+ShapeFit fitShape(const Detection& det, const world::Shape& shape, const Eigen::Vector3d& sensor,
+                  const TrackingParams& params, double yaw_hint) {
+  ShapeFit fit;
+  const Aabb local = shape.localAabb();
+  const double shape_height = local.max.z() - local.min.z();
+  fit.height_error = det.height - shape_height;
+  const Eigen::Vector2d sensor_xy = sensor.head<2>();
+  const double z = det.support_z - local.min.z();  // bottom face on the support
+
+  if (shape.kind == world::ShapeKind::kCylinder || shape.kind == world::ShapeKind::kSphere) {
+    const double r = shape.radius;
+    Eigen::Vector2d init;
+    if (det.circle.ok && std::abs(det.circle.radius - r) < 0.3 * r) {
+      init = det.circle.centre;
+    } else {
+      Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+      for (const auto& p : det.boundary) mean += p;
+      mean /= static_cast<double>(std::max<std::size_t>(det.boundary.size(), 1));
+      Eigen::Vector2d away = mean - sensor_xy;
+      away = away.norm() > 1e-9 ? away.normalized() : Eigen::Vector2d(1, 0);
+      init = mean + 0.5 * r * away;
+    }
+    Circle c = fitCircleFixedRadius(det.boundary, r, init);
+    // A fit that wandered off the points (short arcs are ambiguous) falls back to the start.
+    if (!c.ok || (c.centre - init).norm() > r + params.size_tolerance) c = fitCircleFixedRadius({}, r, init);
+    fit.pose = uprightPose(c.centre.x(), c.centre.y(), z, 0.0);
+    fit.residual = c.rms;
+    fit.excess = std::max(0.0, det.majorExtent() - 2 * r);
+    fit.deficit = std::max(0.0, 2 * r - det.rect.extents.x()) + std::max(0.0, 2 * r - det.rect.extents.y());
+  } else {
+    // Box (a prism by its bounding box, whose centre may be off the prism's frame origin).
+    const Eigen::Vector2d dims(local.max.x() - local.min.x(), local.max.y() - local.min.y());
+    const Eigen::Vector2d offset = 0.5 * Eigen::Vector2d(local.max.x() + local.min.x(), local.max.y() + local.min.y());
+    const Eigen::Vector2d e = det.rect.extents;
+    auto excessOf = [&](const Eigen::Vector2d& L) {
+      return std::max(0.0, e.x() - L.x()) + std::max(0.0, e.y() - L.y());
+    };
+    auto deficitOf = [&](const Eigen::Vector2d& L) {
+      return std::max(0.0, L.x() - e.x()) + std::max(0.0, L.y() - e.y());
+    };
+    const Eigen::Vector2d La = dims, Lb(dims.y(), dims.x());
+    const double xa = excessOf(La), xb = excessOf(Lb);
+    const bool swapped = xb < xa - 1e-9 || (std::abs(xb - xa) <= 1e-9 && deficitOf(Lb) < deficitOf(La) - 1e-9);
+    const Eigen::Vector2d L = swapped ? Lb : La;
+    fit.excess = swapped ? xb : xa;
+    fit.deficit = deficitOf(L);
+
+    // Anchor each axis on the face the sensor saw.
+    const Eigen::Vector2d a0 = axis(det.rect.yaw), a1 = axis(det.rect.yaw + kPi / 2);
+    const Eigen::Vector2d s = sensor_xy - det.rect.centre;
+    const double su[2] = {s.dot(a0), s.dot(a1)};
+    double c[2] = {0, 0};
+    const double anchor_tol = 0.5 * params.size_tolerance;
+    for (int i = 0; i < 2; ++i) {
+      if (e(i) >= L(i) - anchor_tol) continue;
+      if (su[i] < -e(i) / 2) {
+        c[i] = -e(i) / 2 + L(i) / 2;
+      } else if (su[i] > e(i) / 2) {
+        c[i] = e(i) / 2 - L(i) / 2;
+      }
+    }
+    const Eigen::Vector2d centre = det.rect.centre + c[0] * a0 + c[1] * a1;
+    double yaw = det.rect.yaw + (swapped ? kPi / 2 : 0.0);
+    // The symmetric equivalent closest to the hint.
+    const double sym = yawSymmetry(world::Shape::box(dims.x(), dims.y(), 1.0));
+    yaw = yaw_hint + wrapAngle(yaw - yaw_hint);
+    yaw -= sym * std::round((yaw - yaw_hint) / sym);
+    yaw = wrapAngle(yaw);
+    // Residual: boundary points against the fitted rectangle.
+    const Eigen::Vector2d b0 = axis(yaw), b1 = axis(yaw + kPi / 2);
+    double sum = 0;
+    for (const auto& p : det.boundary) {
+      const Eigen::Vector2d q = p - centre;
+      const double dist = rectBoundaryDistance({q.dot(b0), q.dot(b1)}, dims / 2);
+      sum += dist * dist;
+    }
+    fit.residual = rms(sum, det.boundary.size());
+    // The object's frame origin is the box centre minus the (rotated) bounding-box offset.
+    const Eigen::Vector2d origin = centre - (offset.x() * b0 + offset.y() * b1);
+    fit.pose = uprightPose(origin.x(), origin.y(), z, yaw);
+  }
+  const double height_tol = std::max(params.height_tolerance, 0.2 * shape_height);
+  fit.compatible = fit.excess <= params.size_tolerance && std::abs(fit.height_error) <= height_tol;
+  return fit;
+}
+
+// ---- poses and shapes ---------------------------------------------------------------------------
+
+double yawOf(const Eigen::Isometry3d& pose) {
+  const Eigen::Matrix3d R = pose.rotation();
+  return wrapAngle(std::atan2(R(1, 0), R(0, 0)));
+}
+
+Eigen::Isometry3d uprightPose(double x, double y, double z, double yaw) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  T.translation() = Eigen::Vector3d(x, y, z);
+  return T;
+}
+
+double yawSymmetry(const world::Shape& shape, double square_tolerance) {
+  switch (shape.kind) {
+    case world::ShapeKind::kCylinder:
+    case world::ShapeKind::kSphere:
+      return 0.0;
+    case world::ShapeKind::kBox:
+      return std::abs(shape.size.x() - shape.size.y()) <= square_tolerance ? kPi / 2 : kPi;
+    case world::ShapeKind::kPrism:
+      return 2 * kPi;
+  }
+  return 2 * kPi;
+}
+
+double yawError(const world::Shape& shape, double a, double b) {
+  const double sym = yawSymmetry(shape);
+  if (sym <= 0) return 0.0;
+  double d = a - b;
+  d -= sym * std::round(d / sym);
+  return std::abs(d);
+}
+
+bool pointInShape(const world::Shape& shape, const Eigen::Isometry3d& pose, const Eigen::Vector3d& p, double margin) {
+  const Eigen::Vector3d q = pose.inverse() * p;
+  switch (shape.kind) {
+    case world::ShapeKind::kBox:
+      return (q.array().abs() <= (shape.size.array() / 2 + margin)).all();
+    case world::ShapeKind::kCylinder:
+      return std::abs(q.z()) <= shape.height / 2 + margin && q.head<2>().norm() <= shape.radius + margin;
+    case world::ShapeKind::kSphere:
+      return q.norm() <= shape.radius + margin;
+    case world::ShapeKind::kPrism: {
+      if (std::abs(q.z()) > shape.height / 2 + margin) return false;
+      const Eigen::Vector2d xy = q.head<2>();
+      if (world::containsPoint(shape.polygon, xy)) return true;
+      return margin > 0 && ringDistance(xy, shape.polygon) <= margin;
+    }
+  }
+  return false;
+}
+
+std::vector<Eigen::Vector3d> volumeSamples(const world::Shape& shape, const Eigen::Isometry3d& pose, int n,
+                                           double min_above_bottom) {
+  require(n >= 2, "volumeSamples: n must be >= 2, got " + std::to_string(n));
+  const Aabb b = shape.localAabb();
+  std::vector<Eigen::Vector3d> out;
+  out.reserve(static_cast<std::size_t>(n * n * n));
+  const Eigen::Isometry3d identity = Eigen::Isometry3d::Identity();
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      for (int k = 0; k < n; ++k) {
+        const Eigen::Vector3d t(i / double(n - 1), j / double(n - 1), k / double(n - 1));
+        const Eigen::Vector3d q = b.min + t.cwiseProduct(b.max - b.min);
+        if (q.z() < b.min.z() + min_above_bottom) continue;
+        if (!pointInShape(shape, identity, q, 1e-9)) continue;
+        out.push_back(pose * q);
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace tamp::perception

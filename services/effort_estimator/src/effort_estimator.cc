@@ -113,7 +113,7 @@ EffortEstimator::~EffortEstimator() {
 }
 
 Result<Estimate> EffortEstimator::estimate(const EstimateRequest& request) const {
-  auto features = extractFeatures(request);
+  auto features = extractFeatures(request, params_.features);
   if (!features) return features.error();
   return estimate(*features);
 }
@@ -124,7 +124,7 @@ BatchEstimate EffortEstimator::estimateBatch(std::span<const EstimateRequest> re
   out.snapshot_version = snap->version;
   out.estimates.reserve(requests.size());
   for (const EstimateRequest& r : requests) {
-    auto features = extractFeatures(r);
+    auto features = extractFeatures(r, params_.features);
     if (!features) {
       out.estimates.emplace_back(features.error());
     } else {
@@ -143,7 +143,7 @@ Estimate EffortEstimator::estimate(const ActionFeatures& features) const {
 
 Status EffortEstimator::addRecord(const ExecutionRecord& record) {
   auto log = tamp::log::get("effort_estimator");
-  auto fr = toFeatureRecord(record, params_.max_record_duration_s);
+  auto fr = toFeatureRecord(record, params_.max_record_duration_s, params_.features);
   if (!fr) {
     std::lock_guard lk(state_->mu);
     ++state_->counters.records_rejected;

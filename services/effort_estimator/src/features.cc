@@ -136,7 +136,7 @@ Result<ActionFeatures> baseFeatures(const ActionDescription& a) {
   return f;
 }
 
-Result<ActionFeatures> armFeatures(const ActionDescription& a) {
+Result<ActionFeatures> armFeatures(const ActionDescription& a, const FeatureOptions& options) {
   const JointPath& path = a.path;
   if (Status s = checkPath(path); !s) return s.error();
   for (const auto& name : path.joint_names) {
@@ -147,13 +147,20 @@ Result<ActionFeatures> armFeatures(const ActionDescription& a) {
   }
   using Tol = FeatureTolerances;
   const std::size_t n = path.joint_names.size();
+  std::vector<double> inv_scale(n, 1.0);
+  if (!options.joint_scales.empty()) {
+    for (std::size_t j = 0; j < n; ++j) {
+      const auto it = options.joint_scales.find(path.joint_names[j]);
+      if (it != options.joint_scales.end()) inv_scale[j] = 1.0 / it->second;
+    }
+  }
   std::vector<double> moves;
   std::vector<double> run_delta(n, 0.0);  // joint displacement of the current straight run
   std::vector<double> last_dir;           // unit direction of the last segment (empty = none)
   std::vector<double> delta(n);
   auto flushRun = [&]() {
     double largest = 0.0;
-    for (double v : run_delta) largest = std::max(largest, std::abs(v));
+    for (std::size_t j = 0; j < n; ++j) largest = std::max(largest, std::abs(run_delta[j]) * inv_scale[j]);
     if (largest >= Tol::kMinJointMove) moves.push_back(largest);
     std::fill(run_delta.begin(), run_delta.end(), 0.0);
     last_dir.clear();
@@ -210,7 +217,22 @@ std::size_t MoveSet::countBelow(double threshold) const {
                                   lengths_.begin());
 }
 
-Result<ActionFeatures> extractFeatures(const ActionDescription& action) {
+Status FeatureOptions::validate() const {
+  for (const auto& [joint, scale] : joint_scales) {
+    if (!(std::isfinite(scale) && scale > 0.0)) {
+      return invalid("scale of joint '" + joint + "' must be positive and finite, got " + fmt(scale),
+                     "joint_scales." + joint);
+    }
+  }
+  return Status::Ok();
+}
+
+Result<ActionFeatures> extractFeatures(const ActionDescription& action, const FeatureOptions& options) {
+  for (const auto& [joint, scale] : options.joint_scales) {
+    if (!(std::isfinite(scale) && scale > 0.0)) {
+      throw std::invalid_argument("extractFeatures: " + options.validate().error().toString());
+    }
+  }
   if (!knownKind(action.kind)) {
     return invalid("unknown action kind " + std::to_string(static_cast<int>(action.kind)), "kind");
   }
@@ -245,7 +267,7 @@ Result<ActionFeatures> extractFeatures(const ActionDescription& action) {
     return invalid(kind_name + " takes a path; approach_m/retreat_m are for pick/place only",
                    action.approach_m != 0.0 ? "approach_m" : "retreat_m");
   }
-  return action.kind == ActionKind::kMoveBase ? baseFeatures(action) : armFeatures(action);
+  return action.kind == ActionKind::kMoveBase ? baseFeatures(action) : armFeatures(action, options);
 }
 
 Status validateFeatures(const ActionFeatures& f) {

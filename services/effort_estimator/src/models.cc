@@ -102,8 +102,9 @@ double predictDuration(const ActionFeatures& features, std::span<const double> p
   return detail::duration<double>(features, params.data());
 }
 
-Result<double> predictDuration(const ActionDescription& action, std::span<const double> params) {
-  auto features = extractFeatures(action);
+Result<double> predictDuration(const ActionDescription& action, std::span<const double> params,
+                               const FeatureOptions& options) {
+  auto features = extractFeatures(action, options);
   if (!features) return features.error();
   return predictDuration(*features, params);
 }

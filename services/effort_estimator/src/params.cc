@@ -75,6 +75,11 @@ Status EstimatorParams::validate() const {
       errors.push_back(e);
     }
   }
+  if (Status s = features.validate(); !s) {
+    Error e = s.error();
+    e.where.field = "arm_" + e.where.field;
+    errors.push_back(e);
+  }
   if (errors.empty()) return Status::Ok();
   return Error(ErrorCode::kInvalidArgument, "invalid effort estimator parameters:\n" + joinErrors(errors));
 }
@@ -126,6 +131,19 @@ Result<EstimatorParams> parseEstimatorParams(const std::string& yaml_text, const
       }
     }
     kr.refuseUnknownKeys();
+  }
+  {
+    config::FieldReader scales = r.child("arm_joint_scales", false);
+    if (scales.isMap()) {
+      for (auto it = scales.node().begin(); it != scales.node().end(); ++it) {
+        const std::string joint = it->first.as<std::string>();
+        double scale = 0.0;
+        if (scales.required(joint, scale) &&
+            scales.check(std::isfinite(scale) && scale > 0.0, joint, "must be positive, got " + fmt(scale))) {
+          p.features.joint_scales[joint] = scale;
+        }
+      }
+    }
   }
   r.refuseUnknownKeys();
   if (!r.ok()) return r.status().error();

@@ -32,14 +32,15 @@ Status checkScalars(double duration_s, double timestamp_s, double max_duration_s
 
 }  // namespace
 
-Result<FeatureRecord> toFeatureRecord(const ExecutionRecord& record, double max_duration_s) {
+Result<FeatureRecord> toFeatureRecord(const ExecutionRecord& record, double max_duration_s,
+                                      const FeatureOptions& options) {
   if (!record.success) {
     return Error(ErrorCode::kInvalidArgument,
                  "the action failed (success = false): its duration is not an execution time and is not fitted",
                  SourceLocation{"", 0, 0, "success"});
   }
   if (Status s = checkScalars(record.duration_s, record.timestamp_s, max_duration_s); !s) return s.error();
-  auto features = extractFeatures(record.action);
+  auto features = extractFeatures(record.action, options);
   if (!features) {
     Error e = features.error();
     e.where.field = e.where.field.empty() ? "action" : "action." + e.where.field;

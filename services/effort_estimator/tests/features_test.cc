@@ -106,6 +106,20 @@ TEST(ArmFeaturesTest, CornerSplitsMoves) {
   EXPECT_THAT(f->moves.lengths(), ElementsAre(DoubleNear(0.3, 1e-12), DoubleNear(0.3, 1e-12), DoubleNear(0.5, 1e-12)));
 }
 
+TEST(ArmFeaturesTest, JointScalesMakeTheSlowestJointTheOneWithTheLargestScaledMove) {
+  FeatureOptions o;
+  o.joint_scales["j2"] = 4.0;  // j2 is four times faster than j1
+  auto f = extractFeatures(armPath({{0, 0}, {0.3, 0.8}}), o);
+  ASSERT_TRUE(f.ok());
+  EXPECT_THAT(f->moves.lengths(), ElementsAre(DoubleNear(0.3, 1e-12)));  // max(0.3/1, 0.8/4)
+  auto g = extractFeatures(armPath({{0, 0}, {0.3, 0.8}}));
+  ASSERT_TRUE(g.ok());
+  EXPECT_THAT(g->moves.lengths(), ElementsAre(DoubleNear(0.8, 1e-12)));
+  o.joint_scales["j1"] = 0.0;
+  EXPECT_FALSE(o.validate().ok());
+  EXPECT_THROW((void)extractFeatures(armPath({{0, 0}}), o), std::invalid_argument);
+}
+
 TEST(ManipulationFeaturesTest, KeepsDistancesAndMass) {
   ActionDescription a;
   a.kind = ActionKind::kPick;

@@ -31,6 +31,16 @@ TEST(ParamsTest, OverridesPriorCentres) {
   EXPECT_EQ(p->fit.loss, LossKind::kHuber);
 }
 
+TEST(ParamsTest, ReadsArmJointScales) {
+  auto p = parseEstimatorParams("arm_joint_scales:\n  arm_joint_5: 1.3\n  arm_joint_6: 1.3\n", "p.yaml");
+  ASSERT_TRUE(p.ok()) << p.error().toString();
+  EXPECT_DOUBLE_EQ(p->features.joint_scales.at("arm_joint_5"), 1.3);
+  auto bad = parseEstimatorParams("arm_joint_scales:\n  arm_joint_5: -1\n  arm_joint_6: fast\n", "p.yaml");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_THAT(bad.error().message, HasSubstr("p.yaml:2:16: field 'arm_joint_scales.arm_joint_5': must be positive, got -1"));
+  EXPECT_THAT(bad.error().message, HasSubstr("field 'arm_joint_scales.arm_joint_6': expected a number, got 'fast'"));
+}
+
 TEST(ParamsTest, ReportsEveryErrorWithFileLineAndField) {
   auto p = parseEstimatorParams(
       "refit_batch_size: 0\n"

@@ -1,5 +1,6 @@
 #include "synthetic.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -69,7 +70,42 @@ ActionDescription manipulationAction(ActionKind kind, std::mt19937_64& rng, cons
   return a;
 }
 
+/// The "real robot" of the mismatch mode (see ExecutionNoise::mismatch).
+double mismatchedDuration(const ActionDescription& a, std::span<const double> p) {
+  const double nominal = *predictDuration(a, p);
+  switch (a.kind) {
+    case ActionKind::kMoveBase:
+      return nominal + 0.08 * static_cast<double>(a.path.waypoints.size());
+    case ActionKind::kMoveArm: {
+      static constexpr double kSpeed[] = {1.0, 1.0, 0.8, 0.8, 1.3, 1.3};
+      static constexpr double kAccel[] = {1.0, 0.9, 0.8, 0.7, 1.3, 1.5};
+      const double slow = 1.0 + p[4] * a.object_mass_kg;
+      double t = p[3];
+      for (std::size_t i = 1; i < a.path.waypoints.size(); ++i) {
+        double seg = 0.0;
+        for (std::size_t j = 0; j < a.path.joint_names.size(); ++j) {
+          const double d = std::abs(a.path.waypoints[i][j] - a.path.waypoints[i - 1][j]);
+          seg = std::max(seg, trapezoidTime(d, kSpeed[j % 6] * p[0] / slow, kAccel[j % 6] * p[1] / slow));
+        }
+        t += seg + p[2];
+      }
+      return t;
+    }
+    case ActionKind::kPick:
+    case ActionKind::kPlace:
+      return nominal + 0.1 * a.object_mass_kg * a.object_mass_kg;
+  }
+  return nominal;
+}
+
 }  // namespace
+
+FeatureOptions urdfJointScales() {
+  FeatureOptions o;
+  const double scales[] = {1.0, 1.0, 0.8, 0.8, 1.3, 1.3};
+  for (int j = 0; j < 6; ++j) o.joint_scales["arm_joint_" + std::to_string(j + 1)] = scales[j];
+  return o;
+}
 
 ActionDescription randomAction(ActionKind kind, std::mt19937_64& rng, const ActionDistribution& dist) {
   switch (kind) {
@@ -98,7 +134,8 @@ ExecutionRecord simulate(const ActionDescription& action, std::span<const double
                          const ExecutionNoise& noise, std::mt19937_64& rng, double timestamp_s) {
   auto t = predictDuration(action, params);
   if (!t) throw std::invalid_argument("simulate: " + t.error().toString());
-  double d = *t * std::exp(noise.log_stddev * std::normal_distribution<double>(0.0, 1.0)(rng));
+  const double base = noise.mismatch ? mismatchedDuration(action, params) : *t;
+  double d = base * std::exp(noise.log_stddev * std::normal_distribution<double>(0.0, 1.0)(rng));
   if (noise.outlier_fraction > 0 && uniform(rng, 0, 1) < noise.outlier_fraction) {
     d *= uniform(rng, noise.outlier_min, noise.outlier_max);
   }

@@ -25,16 +25,26 @@ ActionDescription randomAction(ActionKind kind, std::mt19937_64& rng, const Acti
 /// The "true" parameters of the simulated robot: the defaults times fixed factors in 0.6-2.0.
 std::vector<double> trueParameters(ActionKind kind);
 
+/// Per-joint speed scales of the mismatched robot's arm (what its URDF velocity limits say), as
+/// the estimator would be configured for it: 1, 1, 0.8, 0.8, 1.3, 1.3 for arm_joint_1..6.
+FeatureOptions urdfJointScales();
+
 /// Noise of a simulated execution.
 struct ExecutionNoise {
   double log_stddev{0.03};      ///< multiplicative noise, stddev of log(duration)
   double outlier_fraction{0.0}; ///< probability of a stall
   double outlier_min{1.5};      ///< a stall multiplies the duration by U(min, max)
   double outlier_max{3.0};
+  /// Execute with a robot that does NOT follow the estimator's model exactly (unmodelled
+  /// effects): arm joints whose acceleration limits do not scale like their speed limits
+  /// (speed scales `urdfJointScales()`, acceleration scales 1, 0.9, 0.8, 0.7, 1.3, 1.5), a 0.08 s
+  /// re-targeting pause per base waypoint, and a gripper time that grows with the square of the
+  /// mass (+0.1 s/kg^2).
+  bool mismatch{false};
 };
 
-/// Executes `action` with `params`: the model's duration times exp(N(0, log_stddev)), sometimes
-/// times a stall factor.
+/// Executes `action` with `params`: the model's duration (or the mismatched robot's, see
+/// ExecutionNoise::mismatch) times exp(N(0, log_stddev)), sometimes times a stall factor.
 ExecutionRecord simulate(const ActionDescription& action, std::span<const double> params,
                          const ExecutionNoise& noise, std::mt19937_64& rng, double timestamp_s = 0.0);
 

@@ -11,6 +11,7 @@
 
 #include <cstddef>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "tamp/core/error.h"
@@ -70,7 +71,7 @@ class MoveSet {
 /// The features of one action, the input of its time model.
 struct ActionFeatures {
   ActionKind kind{ActionKind::kMoveBase};
-  /// move_base: straight drives (m); move_arm: per merged path segment, the largest joint
+  /// move_base: straight drives (m); move_arm: per merged path segment, the largest scaled joint
   /// displacement (rad); pick/place: empty.
   MoveSet moves;
   /// move_base: turns in place (rad, absolute); otherwise empty.
@@ -99,6 +100,19 @@ struct FeatureTolerances {
   static constexpr double kArmCollinearCos = 1e-6;
 };
 
+/// Robot-specific knowledge the path-to-moves reduction needs.
+struct FeatureOptions {
+  /// Relative speed and acceleration limit of each arm joint, by joint name (e.g. its URDF
+  /// velocity limit divided by that of the fastest joint); joints not listed have scale 1; every
+  /// scale > 0 and finite. With per-joint limits v_j = s_j v and a_j = s_j a, joint j needs
+  /// trap(|dq_j|; s_j v, s_j a) = trap(|dq_j| / s_j; v, a), so a segment's synchronized time is
+  /// that of its largest scaled displacement max_j |dq_j| / s_j.
+  std::unordered_map<std::string, double> joint_scales;
+
+  /// Ok, or kInvalidArgument naming the joint with a bad scale.
+  Status validate() const;
+};
+
 /// Plausibility limits of action inputs: beyond them a request is rejected (a value of 1e300 m is
 /// a corrupt message, not an action, and would overflow the models).
 struct InputLimits {
@@ -113,13 +127,15 @@ struct InputLimits {
 /// the polyline (merged per `kCollinearRad`), turn in place to the run's heading, then drive it;
 /// at the end turn in place to the last waypoint's `base_theta`. A waypoint without translation
 /// but with a new `base_theta` is a turn in place to that angle. move_arm: each merged segment is
-/// one synchronized move whose length is its largest joint displacement.
+/// one synchronized move whose length is its largest scaled joint displacement (see
+/// FeatureOptions::joint_scales).
 ///
 /// @return the features, or a kInvalidArgument error whose message says what is wrong (unknown
 ///   kind, empty path, waypoint size mismatch, missing or unexpected joints, non-finite values,
 ///   negative distances or mass, values beyond `InputLimits`, a path given to pick/place or
 ///   distances to a motion).
-Result<ActionFeatures> extractFeatures(const ActionDescription& action);
+/// @throws std::invalid_argument if `options.validate()` fails (misuse).
+Result<ActionFeatures> extractFeatures(const ActionDescription& action, const FeatureOptions& options = {});
 
 /// Checks features built by hand (e.g. read from a store): finite, non-negative, kind-consistent.
 Status validateFeatures(const ActionFeatures& features);

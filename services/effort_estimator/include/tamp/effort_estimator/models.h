@@ -83,8 +83,10 @@ double trapezoidTime(double d, double v, double a);
 /// @throws std::invalid_argument if params has the wrong size or a non-positive/non-finite value.
 double predictDuration(const ActionFeatures& features, std::span<const double> params);
 
-/// Same, from an action description (features extracted first; errors as `extractFeatures`).
-Result<double> predictDuration(const ActionDescription& action, std::span<const double> params);
+/// Same, from an action description (features extracted first with `options`; errors as
+/// `extractFeatures`).
+Result<double> predictDuration(const ActionDescription& action, std::span<const double> params,
+                               const FeatureOptions& options = {});
 
 /// Execution time and its gradient with respect to log(params) (s per unit log change), for the
 /// propagation of parameter covariance. `gradient` gets `params.size()` entries.

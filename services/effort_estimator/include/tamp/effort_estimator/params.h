@@ -17,6 +17,8 @@
 ///   max_iterations: 100
 ///   defaults:                  # robot-specific prior centres, by kind and parameter name
 ///     move_base: {max_linear_speed: 0.6}
+///   arm_joint_scales:          # relative per-joint arm limits (URDF velocity limits), default 1
+///     arm_joint_5: 1.2
 
 #include <array>
 #include <filesystem>
@@ -37,6 +39,9 @@ struct EstimatorParams {
   int max_records_per_kind{5000};         ///< >= 1
   double max_record_duration_s{kDefaultMaxRecordDurationS};  ///< > 0; longer records are rejected
   FitOptions fit;                         ///< loss, prior weight, prior noise, iterations
+  /// Per-joint arm limit scales used to reduce paths (records and requests alike). Changing them
+  /// does not re-reduce records already stored.
+  FeatureOptions features;
   /// Prior per kind, in `kAllActionKinds` order; defaults from `modelSpec`, centres overridable.
   std::array<ModelPrior, 4> priors{ModelPrior::defaults(ActionKind::kMoveBase),
                                    ModelPrior::defaults(ActionKind::kMoveArm),

@@ -42,10 +42,12 @@ inline constexpr double kDefaultMaxRecordDurationS = 3600.0;
 /// Validates a record and extracts its features.
 /// @param max_duration_s records longer than this are rejected (a stuck action is not an
 ///   execution time).
+/// @param options robot-specific feature options (see extractFeatures).
 /// @return the feature record, or a kInvalidArgument error whose message gives the reason and
 ///   whose `where.field` names the offending field ("duration_s", "action.path.waypoints[3]", ...).
 Result<FeatureRecord> toFeatureRecord(const ExecutionRecord& record,
-                                      double max_duration_s = kDefaultMaxRecordDurationS);
+                                      double max_duration_s = kDefaultMaxRecordDurationS,
+                                      const FeatureOptions& options = {});
 
 /// Checks a feature record (e.g. one read back from a store) with the same rules.
 Status validateFeatureRecord(const FeatureRecord& record,

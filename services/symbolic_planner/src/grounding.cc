@@ -7,6 +7,7 @@
 #include <functional>
 #include <map>
 #include <unordered_map>
+#include <unordered_set>
 
 namespace tamp::symbolic_planner {
 namespace {
@@ -970,6 +971,7 @@ struct Grounder::Impl {
     task->unit_cost = !use_costs;
     std::vector<int64_t> bind;
     std::vector<Conj> pre_dnf, cond_dnf;
+    std::unordered_set<std::string> seen_ops;
     for (uint32_t b = 0; b < bindings.size(); ++b) {
       if ((b & 255) == 0 && term()) {
         return Error(term.reason() == StopReason::kDeadline ? ErrorCode::kTimeout : ErrorCode::kCancelled, "task construction interrupted");
@@ -1068,6 +1070,13 @@ struct Grounder::Impl {
         Operator op = proto;
         for (const auto& l : conj) op.pre.push_back(litFact(tb, l));
         sortUnique(op.pre);
+        // Variants of one action (top-level disjunctions, existentials) can ground to the same
+        // operator: keep one (effects depend on the action's own parameters only).
+        if (s.variants.size() > 1) {
+          std::string op_key = op.name;
+          for (FactId f : op.pre) op_key += "," + std::to_string(f);
+          if (!seen_ops.insert(std::move(op_key)).second) continue;
+        }
         task->ops.push_back(std::move(op));
       }
     }

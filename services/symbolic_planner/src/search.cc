@@ -359,6 +359,8 @@ class Searcher {
       return fallback();
     }
     std::vector<uint32_t> queue;
+    std::vector<OpId> all_ops;
+    bool helpful_only = true;
     for (;;) {
       ++iter_;
       queue.clear();
@@ -371,9 +373,14 @@ class Searcher {
         const uint32_t id = queue[head];
         std::copy(reg_.get(id), reg_.get(id) + reg_.words(), buf_.begin());
         ++stats_.expanded;
-        // Helpful actions of `id` (copied: the pool may grow while we generate).
-        pref_tmp_.assign(pref_pool_.begin() + static_cast<std::ptrdiff_t>(pref_begin_[id]),
-                         pref_pool_.begin() + static_cast<std::ptrdiff_t>(pref_begin_[id] + pref_count_[id]));
+        if (helpful_only) {
+          // Helpful actions of `id` (copied: the pool may grow while we generate).
+          pref_tmp_.assign(pref_pool_.begin() + static_cast<std::ptrdiff_t>(pref_begin_[id]),
+                           pref_pool_.begin() + static_cast<std::ptrdiff_t>(pref_begin_[id] + pref_count_[id]));
+        } else {
+          pref_tmp_.clear();
+          task_.applicableOps(buf_.data(), pref_tmp_);
+        }
         for (OpId o : pref_tmp_) {
           task_.apply(buf_.data(), o, succ_.data());
           ++stats_.generated;
@@ -385,18 +392,32 @@ class Searcher {
           op_[sid] = o;
           if (task_.goalReached(succ_.data(), goal)) {
             found = sid;
+            h_cache_[sid] = 0;
             break;
           }
           const Cost h = evaluate(sid);
           if (h == Heuristic::kDeadEnd) continue;
-          if (h < hcur) {
+          if (h < hcur && (found == kNone || h < h_cache_[found])) {
+            // A better state: finish this node's successors and keep the best of them
+            // (FF takes the first; the best sibling gives shorter plans at little cost).
             found = sid;
-            break;
+            if (!opt_.ehc_best_sibling) break;
+            continue;
           }
-          queue.push_back(sid);
+          if (found == kNone) queue.push_back(sid);
         }
       }
-      if (found == kNone) return fallback();
+      if (found == kNone) {
+        // The helpful actions may have pruned the way out of this plateau: search it once more
+        // with every applicable action before giving up on hill-climbing.
+        if (helpful_only && opt_.ehc_full_retry) {
+          helpful_only = false;
+          ++stats_.ehc_retries;
+          continue;
+        }
+        return fallback();
+      }
+      helpful_only = true;
       std::vector<OpId> seg = path(found, cur);
       plan.insert(plan.end(), seg.begin(), seg.end());
       cur = found;

@@ -1,1 +1,125 @@
+// Contract suite over every heuristic: h(goal) = 0, h >= 0, dead ends, admissibility of h_max.
 #include <gtest/gtest.h>
+
+#include <random>
+
+#include "tamp/symbolic_planner/heuristic.h"
+#include "tamp/symbolic_planner/search.h"
+#include "test_util.h"
+
+namespace tamp::symbolic_planner {
+namespace {
+
+class HeuristicContract : public ::testing::TestWithParam<std::tuple<HeuristicKind, CostType>> {};
+
+TEST_P(HeuristicContract, ZeroAtGoalNonNegativeAndDeadEndsOnRandomWalks) {
+  const auto [kind, ct] = GetParam();
+  const std::string dir = (test::sharedDir() / "benchmarks/pddl/gripper").string();
+  auto s = PlanningSession::fromText(test::readFile(dir + "/domain.pddl"), test::readFile(dir + "/instance-4.pddl"));
+  ASSERT_TRUE(s.ok());
+  Query q;
+  q.init = *(*s)->problemInit();
+  q.goal_formula = (*s)->problem().goal;
+  PlanReply r = (*s)->solve(q, Termination());
+  ASSERT_EQ(r.status, PlanStatus::kSolved);
+  const Task& t = *(*s)->task();
+  auto h = makeHeuristic(kind, t, ct);
+  // Goal: the state reached by the plan.
+  StateBits st(t.numWords(), 0);
+  {
+    // Rebuild the initial state through the task's fact names (problem init).
+    for (FactId f = 0; f < t.numFacts(); ++f) {
+      const std::string& n = t.fact_names[f];
+      for (const auto& a : (*s)->problem().init) {
+        if (pddl::toString(a) == n) setBit(st.data(), f);
+      }
+    }
+  }
+  // Goal conjunct = facts of the goal atoms.
+  Goal goal;
+  GoalConjunct gc;
+  for (const auto& c : (*s)->problem().goal.children) {
+    for (FactId f = 0; f < t.numFacts(); ++f) {
+      if (t.fact_names[f] == pddl::toString(c.atom)) gc.pos.push_back(f);
+    }
+  }
+  ASSERT_EQ(gc.pos.size(), (*s)->problem().goal.children.size());
+  goal.conjuncts.push_back(gc);
+  h->setGoal(goal);
+  // Random walks (fixed seed): h >= 0 everywhere, h = 0 exactly on goal states for h_ff/h_add/h_max.
+  std::mt19937 rng(42);
+  std::vector<OpId> ops;
+  StateBits next(st.size());
+  for (int walk = 0; walk < 20; ++walk) {
+    StateBits cur = st;
+    for (int step = 0; step < 60; ++step) {
+      const Cost v = h->evaluate(cur.data());
+      ASSERT_GE(v, 0);
+      ASSERT_NE(v, Heuristic::kDeadEnd);  // gripper has no dead ends
+      if (t.goalReached(cur.data(), goal)) {
+        ASSERT_EQ(v, 0);
+      } else if (kind != HeuristicKind::kBlind) {
+        ASSERT_GT(v, 0);
+      }
+      ops.clear();
+      t.applicableOps(cur.data(), ops);
+      ASSERT_FALSE(ops.empty());
+      // Helpful actions are applicable.
+      for (OpId o : h->preferred()) ASSERT_TRUE(t.applicable(cur.data(), o));
+      t.apply(cur.data(), ops[rng() % ops.size()], next.data());
+      cur.swap(next);
+    }
+  }
+  // The goal state itself.
+  StateBits g(st.size(), 0);
+  for (FactId f : gc.pos) setBit(g.data(), f);
+  EXPECT_EQ(h->evaluate(g.data()), 0);
+  // An unsatisfiable goal (no conjunct) is a dead end for every heuristic.
+  Goal none;
+  h->setGoal(none);
+  EXPECT_EQ(h->evaluate(st.data()), Heuristic::kDeadEnd);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    All, HeuristicContract,
+    ::testing::Combine(::testing::Values(HeuristicKind::kFF, HeuristicKind::kAdd, HeuristicKind::kMax, HeuristicKind::kBlind),
+                       ::testing::Values(CostType::kUnit, CostType::kCost, CostType::kPlusOne)));
+
+TEST(Heuristic, RelaxedDeadEndProvesUnsolvable) {
+  const std::string dom = R"((define (domain d) (:predicates (a) (b) (g))
+    (:action x :parameters () :precondition (a) :effect (and (b) (not (a))))
+    (:action y :parameters () :precondition (and (a) (b)) :effect (g))))";
+  // Nothing adds (a), and the initial state is empty: (g) is unreachable even when deletes are
+  // ignored, so the heuristic proves the task unsolvable before any expansion.
+  auto s = PlanningSession::fromText(dom, "(define (problem p) (:domain d) (:init) (:goal (g)))");
+  ASSERT_TRUE(s.ok());
+  Query q;
+  q.init = *(*s)->problemInit();
+  q.goal_formula = (*s)->problem().goal;
+  PlanReply r = (*s)->solve(q, Termination());
+  EXPECT_EQ(r.status, PlanStatus::kUnsolvable);
+  EXPECT_EQ(r.stats.expanded, 0U);  // proven before search: h(init) = dead end
+}
+
+TEST(Heuristic, HmaxIsAdmissibleAgainstOptimalCosts) {
+  // On the ADL domain with costs: h_max(init) <= optimal cost found by A* with blind search.
+  auto s = PlanningSession::fromText(test::kAdlDomain, test::kAdlProblem);
+  ASSERT_TRUE(s.ok());
+  Query q;
+  q.init = *(*s)->problemInit();
+  q.goal_formula = (*s)->problem().goal;
+  q.search.algorithm = SearchAlgorithm::kAstar;
+  q.search.heuristic = HeuristicKind::kBlind;
+  PlanReply blind = (*s)->solve(q, Termination());
+  ASSERT_EQ(blind.status, PlanStatus::kSolved) << blind.message;
+  q.search.heuristic = HeuristicKind::kMax;
+  PlanReply hmax = (*s)->solve(q, Termination());
+  ASSERT_EQ(hmax.status, PlanStatus::kSolved);
+  EXPECT_LE(hmax.stats.initial_h, blind.cost);
+  EXPECT_GT(hmax.stats.initial_h, 0);
+  EXPECT_EQ(hmax.cost, blind.cost);  // both optimal
+  EXPECT_LE(hmax.stats.expanded, blind.stats.expanded);
+}
+
+}  // namespace
+}  // namespace tamp::symbolic_planner

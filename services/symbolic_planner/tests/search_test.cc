@@ -1,1 +1,104 @@
 #include <gtest/gtest.h>
+
+#include <thread>
+
+#include "tamp/symbolic_planner/search.h"
+#include "test_util.h"
+
+namespace tamp::symbolic_planner {
+namespace {
+
+class EverySearch : public ::testing::TestWithParam<SearchAlgorithm> {};
+
+TEST_P(EverySearch, SolvesTheAdlTaskWithACheckedPlan) {
+  PlanReply r = test::planText(test::kAdlDomain, test::kAdlProblem, GetParam());
+  ASSERT_EQ(r.status, PlanStatus::kSolved) << r.message;  // check_plan: replayed by the checker
+  EXPECT_GT(r.plan.size(), 5U);
+  EXPECT_GT(r.cost, 0);
+}
+
+TEST_P(EverySearch, SolvesTheMobileManipulationProblems) {
+  const auto dir = test::sourceDir() / "config/pddl";
+  const std::string dom = test::readFile(dir / "mobile_manipulation.pddl");
+  for (const char* p : {"occluded_can.pddl", "namo_corridor.pddl", "holding_start.pddl"}) {
+    PlanReply r = test::planText(dom, test::readFile(dir / "problems" / p), GetParam());
+    ASSERT_EQ(r.status, PlanStatus::kSolved) << p << ": " << r.message;
+  }
+}
+
+TEST_P(EverySearch, ProvesUnsolvabilityByExhaustion) {
+  // Relaxed solvable (apply both actions), really unsolvable: each action deletes what the other
+  // adds. Every search (EHC through its best-first fallback) must exhaust the space and say so.
+  const std::string dom = R"((define (domain swap) (:predicates (p) (q))
+    (:action a :parameters () :effect (and (p) (not (q))))
+    (:action b :parameters () :effect (and (q) (not (p))))))";
+  const std::string prob = "(define (problem x) (:domain swap) (:init) (:goal (and (p) (q))))";
+  PlanReply r = test::planText(dom, prob, GetParam());
+  EXPECT_EQ(r.status, PlanStatus::kUnsolvable) << r.message;
+  EXPECT_GT(r.stats.expanded, 0U);
+}
+
+INSTANTIATE_TEST_SUITE_P(All, EverySearch,
+                         ::testing::Values(SearchAlgorithm::kEhc, SearchAlgorithm::kGbfs, SearchAlgorithm::kWAstar,
+                                           SearchAlgorithm::kAstar),
+                         [](const ::testing::TestParamInfo<SearchAlgorithm>& i) { return toString(i.param); });
+
+TEST(Search, AstarIsCostOptimalAndWastarWithinItsBound) {
+  // A cost trap: the short route (2 actions) costs 20, the long route (4 actions) costs 4.
+  const std::string dom = R"((define (domain trap) (:requirements :typing :action-costs)
+    (:types node) (:predicates (at ?n - node) (edge ?a ?b - node))
+    (:functions (total-cost) - number (w ?a ?b - node) - number)
+    (:action go :parameters (?a ?b - node) :precondition (and (at ?a) (edge ?a ?b))
+      :effect (and (not (at ?a)) (at ?b) (increase (total-cost) (w ?a ?b))))))";
+  const std::string prob = R"((define (problem p) (:domain trap) (:objects s m g x1 x2 x3 - node)
+    (:init (at s) (edge s m) (edge m g) (edge s x1) (edge x1 x2) (edge x2 x3) (edge x3 g)
+      (= (w s m) 10) (= (w m g) 10) (= (w s x1) 1) (= (w x1 x2) 1) (= (w x2 x3) 1) (= (w x3 g) 1)
+      (= (total-cost) 0))
+    (:goal (at g)) (:metric minimize (total-cost))))";
+  PlanReply a = test::planText(dom, prob, SearchAlgorithm::kAstar);
+  ASSERT_EQ(a.status, PlanStatus::kSolved) << a.message;
+  EXPECT_EQ(a.cost, 4);
+  EXPECT_EQ(a.plan.size(), 4U);
+  PlanReply w = test::planText(dom, prob, SearchAlgorithm::kWAstar);
+  ASSERT_EQ(w.status, PlanStatus::kSolved);
+  EXPECT_LE(w.cost, 5 * 4);
+}
+
+TEST(Search, RespectsDeadlineStopTokenAndMemoryBudget) {
+  const auto dir = test::sharedDir() / "benchmarks/pddl/blocks";
+  PlanRequest req;
+  req.domain_text = test::readFile(dir / "domain.pddl");
+  req.problem_text = test::readFile(dir / "instance-80.pddl");  // far beyond a few milliseconds
+  req.search.algorithm = SearchAlgorithm::kGbfs;
+  req.timeout_seconds = 0.05;
+  PlanReply r = plan(req, Termination());
+  EXPECT_EQ(r.status, PlanStatus::kTimeout) << r.message;
+
+  std::stop_source stop;
+  req.timeout_seconds = 0;
+  std::thread canceller([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    stop.request_stop();
+  });
+  PlanReply c = plan(req, Termination(Deadline::never(), stop.get_token()));
+  canceller.join();
+  EXPECT_EQ(c.status, PlanStatus::kCancelled) << c.message;
+
+  req.search.memory_limit_mb = 1;
+  req.timeout_seconds = 60;
+  PlanReply m = plan(req, Termination());
+  EXPECT_EQ(m.status, PlanStatus::kOutOfMemory) << m.message;
+}
+
+TEST(Search, OptionsAreValidated) {
+  SearchOptions o;
+  o.weight = 0.5;
+  EXPECT_THROW(o.validate(), std::invalid_argument);
+  o.weight = 2;
+  EXPECT_NO_THROW(o.validate());
+  EXPECT_EQ(parseSearchAlgorithm("astar"), SearchAlgorithm::kAstar);
+  EXPECT_FALSE(parseSearchAlgorithm("dfs").has_value());
+}
+
+}  // namespace
+}  // namespace tamp::symbolic_planner

@@ -44,6 +44,12 @@ struct SearchOptions {
   double weight{5.0};           ///< wastar only; must be >= 1
   bool ehc_fallback{true};      ///< ehc: complete GBFS when hill-climbing fails
   bool goal_agenda{true};       ///< ehc: FF's goal agenda (achieve ordered goal subsets in turn)
+  /// ehc: when the breadth-first search over helpful actions exhausts a plateau, search it again
+  /// with all applicable actions before falling back (FF gives up at once).
+  bool ehc_full_retry{true};
+  /// ehc: when a better state is found, evaluate the remaining successors of the same node and
+  /// continue from the best (FF continues from the first).
+  bool ehc_best_sibling{true};
   bool preferred_operators{true};  ///< gbfs: use the helpful-action open list
   int preferred_boost{1000};    ///< gbfs: preferred-queue priority boost on progress
   size_t memory_limit_mb{4096};  ///< search data (states + nodes); 0 = unlimited
@@ -70,6 +76,7 @@ struct SearchStatistics {
   uint64_t registered_states{0};
   Cost initial_h{0};
   bool ehc_failed{false};  ///< ehc fell back to gbfs
+  uint64_t ehc_retries{0};  ///< plateaus searched again without helpful-action pruning
   double seconds{0.0};
 };
 

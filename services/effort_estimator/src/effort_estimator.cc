@@ -27,7 +27,9 @@ std::size_t indexOf(ActionKind kind) {
 
 }  // namespace
 
-const KindModel& ModelSnapshot::model(ActionKind kind) const {
+KindModel ModelSnapshot::model(ActionKind kind) && { return static_cast<const ModelSnapshot&>(*this).model(kind); }
+
+const KindModel& ModelSnapshot::model(ActionKind kind) const& {
   const std::size_t i = indexOf(kind);
   if (i >= models.size() || models[i].kind != kind) {
     throw std::invalid_argument("snapshot has no model of '" + std::string(toString(kind)) + "'");

@@ -69,7 +69,9 @@ struct ModelSnapshot {
   std::vector<KindModel> models;
 
   /// @throws std::invalid_argument for a kind not in the snapshot.
-  const KindModel& model(ActionKind kind) const;
+  const KindModel& model(ActionKind kind) const&;
+  /// On a temporary (`est.snapshot().model(k)`) a copy, so that no reference dangles.
+  KindModel model(ActionKind kind) &&;
 };
 
 /// Estimates of many requests against one snapshot (the graph manager prices many edges at once).

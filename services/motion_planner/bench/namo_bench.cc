@@ -1,0 +1,445 @@
+// NAMO benchmark of the motion planner (issue 7), with the setup conventions of
+// <shared>/benchmarks/namo/REFERENCE.md so that figures are comparable:
+//  - worlds: every bare moghaddam_planning_2016_benchmark_NN.svg (robot square side 0.5 m, disc of
+//    its circumradius 0.354 m, yaw free, goal within 1 cm in x, y) and the JSON worlds (disc of
+//    the robot's circumradius); loaded by tamp::world::loadNamo;
+//  - OMPL baselines: geometric RRTConnect, KPIECE1, LBKPIECE1 with default parameters (KPIECE
+//    projection x, y with 0.25 m cells), motion-check resolution 0.02 in the SE(2) metric, raw
+//    paths, static obstacles only (lazy); `rrtc+simp` = RRTConnect followed by OMPL's
+//    simplification (shortcut + reduce vertices, static obstacles);
+//  - counting: a path is interpolated every 5 mm and the movables the disc touches are counted
+//    (here, not by the planner: a scene built by this tool);
+//  - ours: MotionPlanner lazy mode (LBKPIECE1 + effort-aware roadmap search + shortcutting) and
+//    full mode (time to a path or to a proven `no path`).
+// Fixed seeds: OMPL's global seed is set once at start; runs are in a fixed order.
+//
+// Usage: tamp_motion_planner_namo_bench [--runs 20] [--full-runs 3] [--time-limit 5]
+//          [--filter substring] [--json out.json] [--markdown out.md] [--no-baselines]
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <numeric>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+#include <ompl/base/SpaceInformation.h>
+#include <ompl/base/ProjectionEvaluator.h>
+#include <ompl/base/goals/GoalSampleableRegion.h>
+#include <ompl/base/spaces/SE2StateSpace.h>
+#include <ompl/geometric/PathGeometric.h>
+#include <ompl/geometric/PathSimplifier.h>
+#include <ompl/geometric/planners/kpiece/KPIECE1.h>
+#include <ompl/geometric/planners/kpiece/LBKPIECE1.h>
+#include <ompl/geometric/planners/rrt/RRTConnect.h>
+#include <ompl/util/Console.h>
+
+#include "tamp/core/paths.h"
+#include "tamp/motion_planner/motion_planner.h"
+#include "tamp/world/namo.h"
+
+namespace ob = ompl::base;
+namespace og = ompl::geometric;
+namespace fs = std::filesystem;
+using namespace tamp;
+
+namespace {
+
+struct Run {
+  bool success{false};
+  double time_ms{0};
+  double length{0};
+  int crossed{0};
+  double mass{0};
+  std::string status;  // full mode
+};
+
+struct WorldCase {
+  std::string name;
+  fs::path file;
+  world::NamoWorld nw;
+};
+
+double percentile(std::vector<double> v, double p) {
+  if (v.empty()) return NAN;
+  std::sort(v.begin(), v.end());
+  const double idx = p * (static_cast<double>(v.size()) - 1);
+  const auto lo = static_cast<std::size_t>(std::floor(idx));
+  const auto hi = static_cast<std::size_t>(std::ceil(idx));
+  return v[lo] + (v[hi] - v[lo]) * (idx - static_cast<double>(lo));
+}
+
+/// Movables (and their mass) a disc touches along a base path, every 5 mm.
+std::pair<int, double> crossed(const world::World& w, double radius, const std::vector<Pose2D>& path) {
+  collision::Scene scene(w);
+  scene.setRobot(collision::RobotGeometry::disc(radius, 1.0));
+  std::vector<std::string> ids;
+  for (std::size_t i = 0; i < path.size(); ++i) {
+    const Pose2D a = path[i];
+    const Pose2D b = i + 1 < path.size() ? path[i + 1] : a;
+    const int n = std::max(1, static_cast<int>(std::ceil(std::hypot(b.x - a.x, b.y - a.y) / 0.005)));
+    for (int k = 0; k < n || (k == 0 && i + 1 == path.size()); ++k) {
+      const double t = static_cast<double>(k) / n;
+      scene.setBasePose(Pose2D{a.x + t * (b.x - a.x), a.y + t * (b.y - a.y), 0.0});
+      for (auto& id : scene.robotCollisions(collision::Filter::movableOnly())) ids.push_back(id);
+      if (i + 1 == path.size()) break;
+    }
+  }
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  double mass = 0;
+  for (const auto& id : ids) mass += w.object(id).mass;
+  return {static_cast<int>(ids.size()), mass};
+}
+
+double xyLength(const std::vector<Pose2D>& p) {
+  double l = 0;
+  for (std::size_t i = 1; i < p.size(); ++i) l += std::hypot(p[i].x - p[i - 1].x, p[i].y - p[i - 1].y);
+  return l;
+}
+
+/// KPIECE projection: x, y with 0.25 m cells (REFERENCE.md).
+class XY : public ob::ProjectionEvaluator {
+ public:
+  using ob::ProjectionEvaluator::ProjectionEvaluator;
+  unsigned int getDimension() const override { return 2; }
+  void defaultCellSizes() override { cellSizes_ = {0.25, 0.25}; }
+  void project(const ob::State* s, Eigen::Ref<Eigen::VectorXd> p) const override {
+    const auto* b = s->as<ob::SE2StateSpace::StateType>();
+    p(0) = b->getX();
+    p(1) = b->getY();
+  }
+};
+
+class XYGoal : public ob::GoalSampleableRegion {
+ public:
+  XYGoal(const ob::SpaceInformationPtr& si, double x, double y) : ob::GoalSampleableRegion(si), x_(x), y_(y) {
+    setThreshold(0.01);
+  }
+  double distanceGoal(const ob::State* s) const override {
+    const auto* b = s->as<ob::SE2StateSpace::StateType>();
+    return std::hypot(b->getX() - x_, b->getY() - y_);
+  }
+  void sampleGoal(ob::State* s) const override {
+    auto* b = s->as<ob::SE2StateSpace::StateType>();
+    b->setXY(x_, y_);
+    b->setYaw(rng_.uniformReal(-M_PI, M_PI));
+  }
+  unsigned int maxSampleCount() const override { return 1000000u; }
+
+ private:
+  double x_, y_;
+  mutable ompl::RNG rng_;
+};
+
+/// An OMPL baseline run: raw lazy path against static obstacles.
+struct Baseline {
+  const WorldCase& wc;
+  collision::Scene scene;
+  ob::SpaceInformationPtr si;
+  explicit Baseline(const WorldCase& c) : wc(c), scene(c.nw.world) {
+    scene.setRobot(collision::RobotGeometry::disc(c.nw.robot_radius, 1.0));
+    auto space = std::make_shared<ob::SE2StateSpace>();
+    Aabb b = c.nw.world.bounds();
+    b.extend(Eigen::Vector3d(c.nw.start.x, c.nw.start.y, 0));
+    ob::RealVectorBounds rb(2);
+    rb.setLow(0, b.min.x() - 0.5);
+    rb.setLow(1, b.min.y() - 0.5);
+    rb.setHigh(0, b.max.x() + 0.5);
+    rb.setHigh(1, b.max.y() + 0.5);
+    space->setBounds(rb);
+    space->registerDefaultProjection(std::make_shared<XY>(space));
+    si = std::make_shared<ob::SpaceInformation>(space);
+    si->setStateValidityChecker([this](const ob::State* s) {
+      if (!si->satisfiesBounds(s)) return false;
+      const auto* st = s->as<ob::SE2StateSpace::StateType>();
+      scene.setBasePose(Pose2D{st->getX(), st->getY(), st->getYaw()});
+      return !scene.robotInCollision(collision::Filter::staticOnly());
+    });
+    si->setStateValidityCheckingResolution(0.02 / space->getMaximumExtent());
+    si->setup();
+  }
+
+  std::pair<Run, Run> run(const std::string& planner, double limit, bool simplify) {
+    ob::PlannerPtr p;
+    if (planner == "rrtconnect") p = std::make_shared<og::RRTConnect>(si);
+    if (planner == "kpiece") p = std::make_shared<og::KPIECE1>(si);
+    if (planner == "lbkpiece") p = std::make_shared<og::LBKPIECE1>(si);
+    auto pdef = std::make_shared<ob::ProblemDefinition>(si);
+    ob::ScopedState<ob::SE2StateSpace> start(si->getStateSpace());
+    start->setXY(wc.nw.start.x, wc.nw.start.y);
+    start->setYaw(wrapAngle(wc.nw.start.theta));
+    pdef->addStartState(start);
+    pdef->setGoal(std::make_shared<XYGoal>(si, wc.nw.goals[0].pose.x, wc.nw.goals[0].pose.y));
+    p->setProblemDefinition(pdef);
+    p->setup();
+    const auto t0 = std::chrono::steady_clock::now();
+    p->solve(ob::timedPlannerTerminationCondition(limit));
+    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    Run raw, simp;
+    raw.time_ms = ms;
+    raw.success = pdef->hasExactSolution();
+    if (!raw.success) return {raw, simp};
+    og::PathGeometric path = *pdef->getSolutionPath()->as<og::PathGeometric>();
+    auto poses = [](const og::PathGeometric& pg) {
+      std::vector<Pose2D> out;
+      for (std::size_t i = 0; i < pg.getStateCount(); ++i) {
+        const auto* s = pg.getState(i)->as<ob::SE2StateSpace::StateType>();
+        out.push_back(Pose2D{s->getX(), s->getY(), s->getYaw()});
+      }
+      return out;
+    };
+    auto pp = poses(path);
+    raw.length = xyLength(pp);
+    std::tie(raw.crossed, raw.mass) = crossed(wc.nw.world, wc.nw.robot_radius, pp);
+    if (simplify) {
+      const auto t1 = std::chrono::steady_clock::now();
+      og::PathSimplifier s(si);
+      s.simplifyMax(path);
+      simp.time_ms = ms + std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count();
+      simp.success = true;
+      auto sp = poses(path);
+      simp.length = xyLength(sp);
+      std::tie(simp.crossed, simp.mass) = crossed(wc.nw.world, wc.nw.robot_radius, sp);
+    }
+    return {raw, simp};
+  }
+};
+
+struct Summary {
+  int runs{0}, ok{0};
+  double med_ms{NAN}, p95_ms{NAN}, med_len{NAN}, med_cross{NAN}, mean_cross{NAN}, med_mass{NAN};
+};
+
+Summary summarize(const std::vector<Run>& runs) {
+  Summary s;
+  s.runs = static_cast<int>(runs.size());
+  std::vector<double> t, l, c, m;
+  for (const auto& r : runs) {
+    t.push_back(r.time_ms);
+    if (!r.success) continue;
+    ++s.ok;
+    l.push_back(r.length);
+    c.push_back(r.crossed);
+    m.push_back(r.mass);
+  }
+  s.med_ms = percentile(t, 0.5);
+  s.p95_ms = percentile(t, 0.95);
+  s.med_len = percentile(l, 0.5);
+  s.med_cross = percentile(c, 0.5);
+  s.med_mass = percentile(m, 0.5);
+  s.mean_cross = c.empty() ? NAN : std::accumulate(c.begin(), c.end(), 0.0) / static_cast<double>(c.size());
+  return s;
+}
+
+std::vector<WorldCase> loadWorlds(const std::string& filter) {
+  const fs::path root = sharedDir() / "benchmarks" / "namo";
+  std::vector<std::pair<std::string, fs::path>> files;
+  for (int n : {2, 4, 5, 7, 8, 10, 11, 13, 14, 16, 17, 19, 20, 22, 23, 25, 26, 28, 29}) {
+    char name[64];
+    std::snprintf(name, sizeof(name), "moghaddam_planning_2016_benchmark_%02d.svg", n);
+    char shortname[16];
+    std::snprintf(shortname, sizeof(shortname), "%02d", n);
+    files.emplace_back(shortname, root / "moghaddam_planning_2016_benchmark" / name);
+  }
+  // JSON worlds with movables (omniscient variants: full knowledge; the planning problem is the
+  // same as the partial-knowledge variant's).
+  files.emplace_back("m01", root / "moghaddam_planning_2016_benchmark/01/01_omniscient.json");
+  files.emplace_back("two_rooms", root / "first_level/01_two_rooms_corridor/01_two_rooms_corridor_omniscient.json");
+  files.emplace_back("big_crossing", root / "first_level/03_big_crossing/03_big_crossing_omniscient.json");
+  files.emplace_back("basic", root / "s-namo_cases/01_basic/01_basic_omniscient.json");
+  files.emplace_back("opening", root / "s-namo_cases/02_basic_with_opening/02_basic_with_opening_omniscient.json");
+  files.emplace_back("feast", root / "s-namo_cases/04_after_the_feast/04_after_the_feast_omniscient.json");
+  files.emplace_back("feast_cplx", root / "s-namo_cases/04_after_the_feast/04_after_the_feast_omniscient_complexified.json");
+  files.emplace_back("citi", root / "s-namo_cases/05_citi_second_floor/05_citi_second_floor_omniscient.json");
+  files.emplace_back("chen", root / "stilman_2005_thesis/04_chen_difficult_problem/04_chen_difficult_problem_omniscient.json");
+  std::vector<WorldCase> out;
+  for (auto& [name, file] : files) {
+    if (!filter.empty() && name.find(filter) == std::string::npos) continue;
+    auto w = world::loadNamo(file);
+    if (!w) {
+      std::cerr << "skip " << name << ": " << w.error().toString() << "\n";
+      continue;
+    }
+    if (w->goals.empty()) {
+      std::cerr << "skip " << name << ": no goal\n";
+      continue;
+    }
+    out.push_back(WorldCase{name, file, std::move(*w)});
+  }
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int runs = 20, full_runs = 3;
+  double limit = 5.0;
+  std::string filter, json_out, md_out;
+  bool baselines = true;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto next = [&]() -> std::string {
+      if (i + 1 >= argc) {
+        std::cerr << a << " needs a value\n";
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    if (a == "--runs") runs = std::stoi(next());
+    else if (a == "--full-runs") full_runs = std::stoi(next());
+    else if (a == "--time-limit") limit = std::stod(next());
+    else if (a == "--filter") filter = next();
+    else if (a == "--json") json_out = next();
+    else if (a == "--markdown") md_out = next();
+    else if (a == "--no-baselines") baselines = false;
+    else {
+      std::cerr << "usage: " << argv[0]
+                << " [--runs N] [--full-runs N] [--time-limit s] [--filter s] [--json f] [--markdown f] [--no-baselines]\n";
+      return 2;
+    }
+  }
+  motion_planner::seedRandomness(42);
+  ompl::msg::setLogLevel(ompl::msg::LOG_NONE);
+  const auto worlds = loadWorlds(filter);
+  const std::vector<std::string> methods = {"ours", "rrtconnect", "kpiece", "lbkpiece", "rrtc+simp"};
+  std::map<std::string, std::map<std::string, std::vector<Run>>> results;  // world -> method -> runs
+  std::map<std::string, std::vector<Run>> full;                           // world -> full runs
+  nlohmann::json js;
+  js["time_limit_s"] = limit;
+  js["runs"] = runs;
+  for (const auto& wc : worlds) {
+    std::cerr << "world " << wc.name << " (" << wc.nw.world.objectCount() << " objects, r = " << wc.nw.robot_radius
+              << " m)\n";
+    motion_planner::MotionPlanner mp(collision::RobotGeometry::disc(wc.nw.robot_radius, 1.0));
+    mp.setWorld(wc.nw.world);
+    motion_planner::MotionRequest req;
+    req.start.base = wc.nw.start;
+    req.goal = motion_planner::MotionGoal::basePoseGoal(wc.nw.goals[0].pose, !wc.nw.goals[0].has_orientation);
+    int reported_mismatch = 0;
+    for (int r = 0; r < runs; ++r) {
+      const auto res = mp.plan(req, Termination::after(limit));
+      Run run;
+      run.success = res.ok();
+      run.time_ms = res.planning_time_s * 1e3;
+      if (run.success) {
+        std::vector<Pose2D> poses;
+        for (const auto& w : res.path.waypoints) poses.push_back(Pose2D{w[0], w[1], w[2]});
+        run.length = xyLength(poses);
+        std::tie(run.crossed, run.mass) = crossed(wc.nw.world, wc.nw.robot_radius, poses);
+        if (run.crossed != static_cast<int>(res.blocking.size())) ++reported_mismatch;
+        nlohmann::json jr{{"method", "ours"}, {"world", wc.name}, {"run", r}, {"time_ms", run.time_ms},
+                          {"length", run.length}, {"crossed", run.crossed}, {"mass", run.mass},
+                          {"raw_crossed", res.stats.raw_blocking.size()}, {"cost_s", res.cost_s},
+                          {"raw_cost_s", res.stats.raw_cost_s}, {"sampling_ms", res.stats.sampling_ms},
+                          {"optimize_ms", res.stats.optimize_ms}, {"shortcut_ms", res.stats.shortcut_ms},
+                          {"analysis_ms", res.stats.analysis_ms}, {"roadmap_nodes", res.stats.roadmap_nodes},
+                          {"search_iterations", res.stats.search_iterations},
+                          {"edges_evaluated", res.stats.edges_evaluated},
+                          {"optimize_completed", res.stats.optimize_completed}};
+        js["runs_detail"].push_back(jr);
+      }
+      results[wc.name]["ours"].push_back(run);
+    }
+    if (reported_mismatch > 0) std::cerr << "  WARNING: " << reported_mismatch << " runs where the report differs\n";
+    if (baselines) {
+      Baseline base(wc);
+      for (const std::string p : {"rrtconnect", "kpiece", "lbkpiece"}) {
+        for (int r = 0; r < runs; ++r) {
+          auto [raw, simp] = base.run(p, limit, p == "rrtconnect");
+          results[wc.name][p].push_back(raw);
+          if (p == "rrtconnect") results[wc.name]["rrtc+simp"].push_back(simp);
+        }
+      }
+    }
+    req.mode = motion_planner::MotionMode::kFull;
+    for (int r = 0; r < full_runs; ++r) {
+      const auto res = mp.plan(req, Termination::after(limit));
+      Run run;
+      run.time_ms = res.planning_time_s * 1e3;
+      run.success = res.ok();
+      run.status = std::string(motion_planner::toString(res.status)) +
+                   (res.status == motion_planner::MotionStatus::kNoPath && res.reason.find("proven") != std::string::npos
+                        ? " (proven)"
+                        : "");
+      full[wc.name].push_back(run);
+    }
+  }
+
+  // ---- report ----
+  std::ostringstream md;
+  auto f1 = [](double v) {
+    char b[32];
+    std::snprintf(b, sizeof(b), std::isnan(v) ? "-" : "%.1f", v);
+    return std::string(b);
+  };
+  auto f2 = [](double v) {
+    char b[32];
+    std::snprintf(b, sizeof(b), std::isnan(v) ? "-" : (v < 10 ? "%.2f" : "%.1f"), v);
+    return std::string(b);
+  };
+  md << "Per world, median over " << runs << " runs: movables crossed / path length (m) / planning time median, p95 (ms); "
+     << "success if < 100 %\n\n";
+  md << "| world | objects (movable) |";
+  for (const auto& m : methods) md << " " << m << " |";
+  md << " full mode |\n|---|---|";
+  for (std::size_t i = 0; i < methods.size(); ++i) md << "---|";
+  md << "---|\n";
+  std::map<std::string, std::vector<Run>> agg;
+  for (const auto& wc : worlds) {
+    int movable = 0;
+    for (const auto& o : wc.nw.world.objects()) movable += o.kind == world::ObjectKind::kMovable;
+    md << "| " << wc.name << " | " << wc.nw.world.objectCount() << " (" << movable << ") |";
+    for (const auto& m : methods) {
+      const auto& rs = results[wc.name][m];
+      if (rs.empty()) {
+        md << " - |";
+        continue;
+      }
+      agg[m].insert(agg[m].end(), rs.begin(), rs.end());
+      const Summary s = summarize(rs);
+      md << " " << f1(s.med_cross) << " / " << f1(s.med_len) << " / " << f2(s.med_ms) << ", " << f2(s.p95_ms);
+      if (s.ok < s.runs) md << " (" << (100 * s.ok / s.runs) << " %)";
+      md << " |";
+      js["summary"][wc.name][m] = {{"success", s.ok}, {"runs", s.runs}, {"median_ms", s.med_ms}, {"p95_ms", s.p95_ms},
+                                   {"median_length", s.med_len}, {"median_crossed", s.med_cross},
+                                   {"mean_crossed", s.mean_cross}, {"median_mass", s.med_mass}};
+    }
+    std::map<std::string, int> statuses;
+    std::vector<double> ft;
+    for (const auto& r : full[wc.name]) {
+      ++statuses[r.status];
+      ft.push_back(r.time_ms);
+    }
+    std::string st;
+    for (const auto& [k, v] : statuses) st += (st.empty() ? "" : ", ") + k + (v > 1 ? " x" + std::to_string(v) : "");
+    md << " " << st << ", " << f2(percentile(ft, 0.5)) << " ms |\n";
+    js["full"][wc.name] = {{"statuses", statuses}, {"median_ms", percentile(ft, 0.5)}, {"max_ms", percentile(ft, 1.0)}};
+  }
+  md << "\nAggregate over " << worlds.size() << " worlds:\n\n| method | success | median ms | p95 ms | median crossed | mean crossed | "
+        "total crossed | median length (m) | mean mass crossed (kg) |\n|---|---|---|---|---|---|---|---|---|\n";
+  for (const auto& m : methods) {
+    if (agg[m].empty()) continue;
+    const Summary s = summarize(agg[m]);
+    double total = 0, mass = 0;
+    for (const auto& r : agg[m]) {
+      total += r.crossed;
+      mass += r.mass;
+    }
+    md << "| " << m << " | " << s.ok << "/" << s.runs << " | " << f2(s.med_ms) << " | " << f2(s.p95_ms) << " | "
+       << f1(s.med_cross) << " | " << f2(s.mean_cross) << " | " << total << " | " << f1(s.med_len) << " | "
+       << f1(mass / std::max(1, s.ok)) << " |\n";
+    js["aggregate"][m] = {{"success", s.ok}, {"runs", s.runs}, {"median_ms", s.med_ms}, {"p95_ms", s.p95_ms},
+                          {"median_crossed", s.med_cross}, {"mean_crossed", s.mean_cross}, {"total_crossed", total},
+                          {"median_length", s.med_len}};
+  }
+  std::cout << md.str();
+  if (!md_out.empty()) std::ofstream(md_out) << md.str();
+  if (!json_out.empty()) std::ofstream(json_out) << js.dump(1) << "\n";
+  return 0;
+}

@@ -1,0 +1,237 @@
+#pragma once
+/// @file
+/// The motion layer of the conditional TAMP system: lazy paths that report the movable objects in
+/// the way, collision-free paths, placements and grasps.
+///
+/// # Design
+///
+/// The paper (`spec/conditional-tamp-effort-based.tex`, Sections 3-4) computes, for every edge of
+/// the reachability graph, a path with a *lazy* KPIECE against the static world; each movable
+/// object that path sweeps through becomes a sub-task of the graph manager ("move o away" or "go
+/// around o"). KPIECE (I. A. Sucan and L. E. Kavraki, "Kinodynamic motion planning by
+/// interior-exterior cell exploration", WAFR 2008 / Springer 2009) grows a tree guided by a grid
+/// on a low-dimensional projection of the state space, preferring exterior cells and little
+/// explored ones; its lazy bi-directional variant (OMPL's LBKPIECE1) grows two trees without
+/// checking motions and validates the edges of a connecting path only when it is a candidate,
+/// removing invalid edges and going on -- the laziness the paper relies on.
+///
+/// **Lazy mode** (`MotionMode::kLazy`):
+///  1. *Lazy KPIECE* (LBKPIECE1 by default) against static geometry only: states and the
+///     candidate path's edges are checked against static objects, never against movables.
+///  2. *Worth executing*: the raw lazy path crosses whatever movables happen to lie on it (on the
+///     NAMO benchmark a median of 3-4, up to 19). The path is improved for the cost
+///       J = length / speed + sum over crossed objects o of effort(o)      (seconds)
+///     where effort(o) prices moving o (pick + place + transfer, the effort estimator's models;
+///     see CostParams). A roadmap of the static free space -- the lazy path's states plus
+///     uniform samples, k-nearest-neighbour edges -- is searched with A* under a lower bound of
+///     J (length plus the objects touched at the edge's end that were not touched at its start);
+///     the edges of each candidate are then evaluated (static validity and the movables touched
+///     along them, checked densely), and the search repeats until the best candidate is fully
+///     evaluated (LazySP: Dellin & Srinivasa, ICAPS 2016; lazy edge evaluation as in Bohlin &
+///     Kavraki's Lazy PRM, ICRA 2000). Because the raw path is in the roadmap, the result never
+///     costs more than it. Effort-aware shortcutting follows: a shortcut is taken when the
+///     static check passes and J decreases, so it never adds an object whose effort exceeds the
+///     length it saves.
+///  3. *Blocking report*: the final path is checked densely against movables; per object its id,
+///     where contact starts and ends (waypoint index and path fraction), the swept states and
+///     base poses while in contact, its mass and effort.
+///
+/// **Full mode** (`MotionMode::kFull`): KPIECE (LBKPIECE1 by default) against everything known,
+/// then shortcutting, or a clear `no path`. For the base (and the whole body with a known base
+/// goal) a conservative grid over the base's inscribed disc proves `no path` when start and goal
+/// lie in different components (ProofParams), interleaved with the planner; otherwise the
+/// deadline ends the search with kTimeout.
+///
+/// Both modes end with a trapezoidal time parameterization (trajectory_timing.h).
+///
+/// **Groups**: the base (SE(2): base_x, base_y, base_theta) with the arm fixed at the start
+/// configuration; the arm (its joints, base fixed); the whole body (SE(2) x arm joints). A held
+/// object moves rigidly with the tool link (the base link of a planar robot) and collides like a
+/// robot part. Goals: a configuration over the group's joints, a base pose (base and whole
+/// body; optionally any yaw), or an end-effector pose reached through IK (arm: from the start
+/// base; whole body: from base poses sampled around the target).
+///
+/// **Scene**: one `collision::Scene` per planner mirrors the world (`setWorld` applies only the
+/// diff, so updates between calls are cheap); FCL is reached only through tamp::collision and
+/// OMPL only in this library's .cc files. A planner is not thread-safe: one per thread.
+///
+/// **Determinism**: call `seedRandomness()` once before the first planner exists (OMPL's global
+/// seed); the library's own samplers are seeded from `MotionPlannerParams::seed`.
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "tamp/collision/scene.h"
+#include "tamp/core/error.h"
+#include "tamp/core/geometry.h"
+#include "tamp/core/termination.h"
+#include "tamp/core/trajectory.h"
+#include "tamp/motion_planner/grasps.h"
+#include "tamp/motion_planner/params.h"
+#include "tamp/motion_planner/placement.h"
+#include "tamp/robot/robot_model.h"
+#include "tamp/world/world.h"
+
+namespace tamp::motion_planner {
+
+enum class PlanningGroup { kBase, kArm, kWholeBody };
+enum class MotionMode { kLazy, kFull };
+
+/// What the caller can act on.
+enum class MotionStatus {
+  kSolved,            ///< a path (lazy: static-free, see `blocking`; full: collision-free)
+  kNoPath,            ///< no path exists (proven), or the goal has no IK solution; see `reason`
+  kStartInCollision,  ///< the start touches `colliding_object` (full: any object; lazy: static)
+  kGoalInCollision,   ///< the goal touches `colliding_object`
+  kTimeout,           ///< the deadline passed (or a stop was requested) before a path was found
+  kInvalidRequest,    ///< the request is malformed; `reason` names the field
+};
+std::string_view toString(PlanningGroup group);  ///< "base", "arm", "whole_body"
+std::string_view toString(MotionMode mode);      ///< "lazy", "full"
+std::string_view toString(MotionStatus status);  ///< "solved", "no_path", ...
+
+struct MotionGoal {
+  enum class Kind { kConfiguration, kBasePose, kEndEffectorPose };
+  Kind kind{Kind::kConfiguration};
+  std::vector<double> configuration;  ///< kConfiguration: one value per `groupJointNames(group)`
+  Pose2D base;                        ///< kBasePose
+  bool any_base_yaw{false};           ///< kBasePose: the yaw is free (rotation-symmetric robots)
+  Eigen::Isometry3d end_effector{Eigen::Isometry3d::Identity()};  ///< kEndEffectorPose: world_T_tool
+
+  static MotionGoal configurationGoal(std::vector<double> q);
+  static MotionGoal basePoseGoal(const Pose2D& pose, bool any_yaw = false);
+  static MotionGoal endEffectorGoal(const Eigen::Isometry3d& world_T_tool);
+};
+
+struct MotionRequest {
+  PlanningGroup group{PlanningGroup::kBase};
+  MotionMode mode{MotionMode::kLazy};
+  robot::RobotState start;  ///< the full robot state (planar robots: `arm` empty)
+  MotionGoal goal;
+  /// A movable object held by the gripper (planar robots: carried by the base), or empty. When
+  /// the world's `held()` names it, its `link_T_object` is used; otherwise the object keeps its
+  /// current pose relative to the link at the start state.
+  std::string held_object;
+  std::vector<std::string> ignored_objects;  ///< treated as absent (e.g. the object to pick)
+  /// Lazy mode: multiplier on every object's effort in the path cost. 1 (default): the effort
+  /// model as it is; 0: ignore objects (the shortest static-free path); larger values avoid
+  /// objects at the price of longer detours. Must be finite and >= 0.
+  double object_cost_scale{1.0};
+};
+
+/// A movable object a lazy path sweeps through.
+struct BlockingObject {
+  std::string object_id;
+  double enter_fraction{0.0};       ///< path parameter in [0, 1] (space metric) where contact starts
+  double exit_fraction{0.0};        ///< and where the last contact ends
+  std::size_t enter_waypoint{0};    ///< index of the waypoint that starts the segment of first contact
+  std::size_t exit_waypoint{0};     ///< index of the waypoint that ends the segment of last contact
+  std::vector<std::pair<double, double>> intervals;  ///< every contact interval (fractions)
+  std::vector<Pose2D> swept_base;   ///< base poses while in contact (every `swept_spacing`)
+  std::vector<std::vector<double>> swept_configurations;  ///< group configurations, same samples
+  double mass{0.0};                 ///< kg
+  double effort_s{0.0};             ///< effort of moving it (CostParams), before object_cost_scale
+};
+
+/// Diagnostics of one call (milliseconds, counts).
+struct PlanningStats {
+  double sampling_ms{0.0};      ///< lazy KPIECE (or the full-mode planner)
+  double optimize_ms{0.0};      ///< roadmap search (lazy)
+  double shortcut_ms{0.0};
+  double analysis_ms{0.0};      ///< blocking report
+  double proof_ms{0.0};         ///< full mode: infeasibility grid
+  std::uint64_t validity_checks{0};
+  std::size_t roadmap_nodes{0};
+  std::size_t roadmap_edges{0};
+  std::size_t edges_evaluated{0};
+  int search_iterations{0};
+  double raw_path_length{0.0};  ///< the planner's raw path (lazy: before optimization)
+  std::vector<std::string> raw_blocking;  ///< movables the raw lazy path crosses
+  double raw_cost_s{0.0};       ///< J of the raw lazy path
+  bool optimize_completed{false};  ///< the roadmap search finished before its budget
+};
+
+struct MotionResult {
+  MotionStatus status{MotionStatus::kInvalidRequest};
+  std::string reason;            ///< why, when not solved (names the field or object)
+  std::string colliding_object;  ///< for kStartInCollision / kGoalInCollision ("self:a/b" for self-collision)
+  JointPath path;                ///< over `groupJointNames(group)`; yaw unwrapped
+  Trajectory trajectory;         ///< trapezoidal time parameterization of `path`
+  std::vector<BlockingObject> blocking;  ///< lazy mode: movables on the path, by first contact
+  double path_length{0.0};       ///< base: xy length (m); arm: joint-space length (rad); whole body: space metric
+  double cost_s{0.0};            ///< J of the returned path (lazy mode), seconds
+  double planning_time_s{0.0};
+  PlanningStats stats;
+  bool ok() const { return status == MotionStatus::kSolved; }
+};
+
+/// Seeds OMPL's global random number generator. Call once, before any planner exists; later
+/// calls are ignored (OMPL cannot re-seed deterministically). Returns false when ignored.
+bool seedRandomness(std::uint32_t seed);
+
+/// Prices moving an object out of the way, in seconds (see CostParams). Replaceable so that the
+/// graph manager can use the effort estimator's refitted models.
+using ObjectEffortFn = std::function<double(const world::Object&)>;
+
+/// The default effort model: pick + place + transfer with the effort estimator's default time
+/// models (tamp::effort_estimator::modelSpec defaults) and `params`.
+double defaultObjectEffort(const world::Object& object, const CostParams& params);
+
+class MotionPlanner {
+ public:
+  /// A mobile manipulator: every group. Throws std::invalid_argument when `params` is invalid.
+  MotionPlanner(robot::RobotModel model, MotionPlannerParams params = {});
+  /// A planar robot (NAMO disc or box): base group only; `geometry` must have links, with link 0
+  /// the base. Throws std::invalid_argument when `params` or `geometry` is invalid.
+  MotionPlanner(collision::RobotGeometry planar_geometry, MotionPlannerParams params = {});
+  ~MotionPlanner();
+  MotionPlanner(MotionPlanner&&) noexcept;
+  MotionPlanner& operator=(MotionPlanner&&) noexcept;
+  MotionPlanner(const MotionPlanner&) = delete;
+  MotionPlanner& operator=(const MotionPlanner&) = delete;
+
+  /// Brings the scene to `world`'s planner view (hidden objects dropped): the first call builds
+  /// it, later calls apply the diff.
+  void setWorld(const world::World& world);
+  const world::World& world() const;
+  /// Replaces the object effort model (default: defaultObjectEffort with params().cost).
+  void setObjectEffort(ObjectEffortFn fn);
+
+  const MotionPlannerParams& params() const;
+  bool hasArm() const;
+  const robot::RobotModel* robotModel() const;  ///< nullptr for planar robots
+  /// Joint names of a group's configurations and paths (base: base_x, base_y, base_theta).
+  std::vector<std::string> groupJointNames(PlanningGroup group) const;
+  /// Radius of the robot's footprint (base) around the base origin, m.
+  double footprintRadius() const;
+
+  /// Plans one motion. Never throws for bad input: a malformed request gives kInvalidRequest
+  /// naming the field. Checks `termination` throughout.
+  MotionResult plan(const MotionRequest& request, const Termination& termination = {});
+
+  /// Stable, collision-free, reachable placements (placement.h), best (shortest transfer) first.
+  /// Errors: kNotFound (object, region), kInvalidArgument (a static object, a bad field),
+  /// kTimeout when `termination` fired before any placement was found. Fewer than requested (or
+  /// none) is not an error.
+  Result<std::vector<Placement>> samplePlacements(const PlacementRequest& request,
+                                                  const Termination& termination = {});
+
+  /// Grasps of a box or cylinder (grasps.h), top grasps first. Errors: kNotFound (object),
+  /// kInvalidArgument (bad field, not graspable), kUnsupported (shape, planar robot), kTimeout.
+  Result<std::vector<Grasp>> generateGrasps(const GraspRequest& request,
+                                            const Termination& termination = {});
+
+  struct Impl;  ///< opaque: private to the library's .cc files
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace tamp::motion_planner

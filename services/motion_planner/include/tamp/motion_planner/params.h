@@ -1,0 +1,145 @@
+#pragma once
+/// @file
+/// Parameters of the motion planning service: documented structs with defaults and `validate()`,
+/// loaded from YAML (`config/services/motion_planner.yaml`) with tamp::config::FieldReader, which
+/// refuses unknown keys and names file:line:column and the field of every bad value.
+///
+/// Units: metres, radians, seconds, kilograms. "Space metric" is the OMPL state-space distance of
+/// the planning group: SE(2) = xy distance + 0.5 m/rad x |yaw difference|; joint space = the
+/// Euclidean norm of the joint differences (rad); whole body = SE(2) + 0.5 x joint space.
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "tamp/core/error.h"
+
+namespace tamp::motion_planner {
+
+/// Which OMPL planner a stage uses.
+enum class PlannerKind {
+  kLbkpiece,    ///< ompl::geometric::LBKPIECE1: lazy bi-directional KPIECE (Sucan & Kavraki 2009)
+  kKpiece,      ///< ompl::geometric::KPIECE1: KPIECE, every motion checked
+  kRrtConnect,  ///< ompl::geometric::RRTConnect
+};
+/// "lbkpiece", "kpiece", "rrtconnect".
+std::string_view toString(PlannerKind kind);
+std::optional<PlannerKind> plannerKindFromString(std::string_view name);
+
+/// Sampling-based planning (both modes).
+struct SamplingParams {
+  double validity_resolution{0.02};       ///< longest motion checked by one state, space metric; > 0
+  double kpiece_cell_size{0.25};          ///< KPIECE grid cell edge on the base (x, y) projection, m; > 0
+  double arm_cell_size{0.3};              ///< KPIECE cell edge on the arm projection, rad; > 0
+  double range{0.0};                      ///< longest tree extension, space metric; 0: OMPL's default
+  double goal_position_tolerance{0.01};   ///< base goal x, y tolerance, m; > 0
+  double goal_orientation_tolerance{0.02};///< base goal yaw and joint goal tolerance, rad; > 0
+  double workspace_margin{0.5};           ///< added around the world's bounds for the base bounds, m; >= 0
+  PlannerKind lazy_planner{PlannerKind::kLbkpiece};  ///< base group, lazy mode (static geometry)
+  PlannerKind full_planner{PlannerKind::kLbkpiece};  ///< base group, full mode (everything known)
+  /// Arm and whole-body groups, both modes. KPIECE1 by default: LBKPIECE1 needs 0.3-3 s in the
+  /// arm's joint space from the folded `stow` configuration where KPIECE1 needs ~15 ms
+  /// (docs/benchmarks.md); the lazy mode's laziness is then in the movables, not in the edges.
+  PlannerKind arm_planner{PlannerKind::kKpiece};
+};
+
+/// Lazy mode: making the lazy path worth executing (see motion_planner.h).
+struct LazyParams {
+  bool optimize{true};              ///< effort-aware roadmap search + shortcutting of the lazy path
+  int roadmap_samples{600};         ///< uniform samples of the static free space; >= 0
+  int roadmap_neighbors{12};        ///< k of the k-nearest-neighbour connections; >= 2
+  double path_node_spacing{0.5};    ///< the lazy path is cut into roadmap nodes this far apart (space metric); > 0
+  double optimize_budget_s{0.04};   ///< time cap of the roadmap search (the request's deadline also applies); > 0
+  int shortcut_attempts{150};       ///< effort-aware shortcut attempts; >= 0
+  double contact_resolution{0.01};  ///< dense re-check of the final path against movables, space metric; > 0
+  double swept_spacing{0.05};       ///< spacing of the reported swept states, space metric; > 0
+};
+
+/// The path cost that decides which movable objects a lazy path may cross:
+///   cost [s] = path length / speed + sum over crossed objects o of scale x effort(o).
+/// effort(o) is the execution time of moving o out of the way: pick + place (the effort
+/// estimator's default time models, tamp::effort_estimator, with o's mass) + driving
+/// `transfer_distance` to a placement and back; objects the gripper cannot hold (not graspable)
+/// cost `non_graspable_factor` times as much (pushing, two-handed handling, ...).
+struct CostParams {
+  double base_speed{0.5};             ///< m/s: base path length -> time; > 0
+  double arm_speed{1.0};              ///< rad/s: arm path length -> time; > 0
+  double approach_distance{0.10};     ///< m, pick and place approach; >= 0
+  double retreat_distance{0.10};      ///< m, pick and place retreat; >= 0
+  double transfer_distance{1.5};      ///< m, one way, to where the object is put; >= 0
+  double non_graspable_factor{3.0};   ///< >= 1
+};
+
+/// Full mode on the base (and whole body with a known base goal): the proof of `no path`.
+/// A grid over the base bounds whose cells keep the robot's inscribed disc free somewhere inside
+/// them over-approximates the free space; when start and goal fall in different 8-connected
+/// components of those cells, no path exists (a proof, not a timeout). Cells are refined from
+/// `proof_cell_size` down to `proof_min_cell_size`, interleaved with the planner.
+struct ProofParams {
+  bool enabled{true};
+  double cell_size{0.1};       ///< m, first (coarsest) grid; > 0
+  double min_cell_size{0.02};  ///< m, finest grid; in (0, cell_size]
+  int max_cells{4000000};      ///< grids with more cells are skipped; >= 1
+};
+
+/// Trapezoidal time parameterization (stop at every waypoint; see trajectory_timing.h).
+struct TimingParams {
+  double base_linear_speed{0.5};   ///< m/s; > 0
+  double base_linear_accel{0.5};   ///< m/s^2; > 0
+  double base_angular_speed{1.0};  ///< rad/s; > 0
+  double base_angular_accel{1.5};  ///< rad/s^2; > 0
+  double arm_accel{2.0};           ///< rad/s^2 for every arm joint; > 0 (URDF gives speeds only)
+  double arm_speed_scale{1.0};     ///< fraction of the URDF joint speed used; in (0, 1]
+  double sample_period{0.05};      ///< s between trajectory points (plus every phase change); > 0
+};
+
+/// Placement sampling (findEffectStates).
+struct PlacementParams {
+  int max_attempts{400};            ///< object poses tried per request; >= 1
+  double support_margin{0.01};      ///< m the footprint keeps inside the region's polygon; >= 0
+  double base_distance_min{0.45};   ///< m, base-to-object distances tried for reachability; > 0
+  double base_distance_max{0.85};   ///< m; >= base_distance_min
+  int base_poses_per_placement{12}; ///< base poses tried per placement; >= 1
+  double planar_reach{1.0};         ///< m, planar robots (no arm): object within this of a free base pose; > 0
+  double tool_clearance{0.02};      ///< m above the object's top face for the tool reachability test; >= 0
+};
+
+/// Grasp generation.
+struct GraspParams {
+  double approach_distance{0.10};   ///< m, pre-grasp offset along the approach axis; > 0
+  double retreat_distance{0.10};    ///< m, lift after closing (world +z); >= 0
+  double finger_margin{0.005};      ///< m, opening beyond the object's width (each side); >= 0
+  double side_height_fraction{0.5}; ///< side grasps at this fraction of the object's height; in [0, 1]
+  int cylinder_yaw_samples{8};      ///< yaws tried around a cylinder's axis; >= 1
+  double base_distance_min{0.45};   ///< m, base poses tried when none is given; > 0
+  double base_distance_max{0.85};   ///< m; >= base_distance_min
+  int base_poses{16};               ///< base poses tried per grasp when none is given; >= 1
+};
+
+struct MotionPlannerParams {
+  std::uint32_t seed{42};  ///< OMPL's global seed (see seedRandomness()) and our own samplers
+  SamplingParams sampling;
+  LazyParams lazy;
+  CostParams cost;
+  ProofParams proof;
+  TimingParams timing;
+  PlacementParams placement;
+  GraspParams grasp;
+
+  /// Ok, or kInvalidArgument listing every bad field by its dotted name ("lazy.roadmap_samples").
+  Status validate() const;
+};
+
+/// Loads and validates a YAML file; every key is optional (the defaults above), unknown keys are
+/// errors except the top-level `foreign_sections` (read by someone else, e.g. the DDS node's
+/// `node` section). Errors name file:line:column and the field.
+Result<MotionPlannerParams> loadMotionPlannerParams(const std::filesystem::path& file,
+                                                    const std::vector<std::string>& foreign_sections = {});
+/// Same from text; `name` is used as the file name in messages.
+Result<MotionPlannerParams> parseMotionPlannerParams(const std::string& yaml_text, const std::string& name,
+                                                     const std::vector<std::string>& foreign_sections = {});
+
+}  // namespace tamp::motion_planner

@@ -1,0 +1,344 @@
+// Robot binding, planning-group state spaces and the collision oracle.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include <ompl/base/ProjectionEvaluator.h>
+#include <ompl/base/spaces/RealVectorStateSpace.h>
+#include <ompl/base/spaces/SE2StateSpace.h>
+
+#include "internal.h"
+
+namespace tamp::motion_planner::detail {
+namespace {
+
+/// Distance from point p to segment a-b (2-D).
+double segmentDistance(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  const Eigen::Vector2d ab = b - a;
+  const double l2 = ab.squaredNorm();
+  const double t = l2 > 0 ? std::clamp((p - a).dot(ab) / l2, 0.0, 1.0) : 0.0;
+  return (a + t * ab - p).norm();
+}
+
+/// KPIECE projection of the base: (x, y) of the SE(2) state (itself or the first component).
+class BaseXYProjection : public ob::ProjectionEvaluator {
+ public:
+  BaseXYProjection(const ob::StateSpacePtr& space, double cell, bool compound)
+      : ob::ProjectionEvaluator(space), cell_(cell), compound_(compound) {}
+  unsigned int getDimension() const override { return 2; }
+  void defaultCellSizes() override { cellSizes_ = {cell_, cell_}; }
+  void project(const ob::State* s, Eigen::Ref<Eigen::VectorXd> out) const override {
+    const auto* b = compound_ ? s->as<ob::CompoundState>()->as<ob::SE2StateSpace::StateType>(0)
+                              : s->as<ob::SE2StateSpace::StateType>();
+    out(0) = b->getX();
+    out(1) = b->getY();
+  }
+
+ private:
+  double cell_;
+  bool compound_;
+};
+
+/// KPIECE projection of the arm: its first (up to) three joints.
+class ArmProjection : public ob::ProjectionEvaluator {
+ public:
+  ArmProjection(const ob::StateSpacePtr& space, double cell, unsigned dims)
+      : ob::ProjectionEvaluator(space), cell_(cell), dims_(dims) {}
+  unsigned int getDimension() const override { return dims_; }
+  void defaultCellSizes() override { cellSizes_.assign(dims_, cell_); }
+  void project(const ob::State* s, Eigen::Ref<Eigen::VectorXd> out) const override {
+    const auto* v = s->as<ob::RealVectorStateSpace::StateType>();
+    for (unsigned i = 0; i < dims_; ++i) out(i) = v->values[i];
+  }
+
+ private:
+  double cell_;
+  unsigned dims_;
+};
+
+}  // namespace
+
+// ---- RobotBinding -----------------------------------------------------------------------------
+
+RobotBinding::RobotBinding(robot::RobotModel model)
+    : model_(std::move(model)), geometry_(model_->collisionGeometry()), hold_link_(model_->options().tool_link) {
+  computeFootprint();
+}
+
+RobotBinding::RobotBinding(collision::RobotGeometry planar) : geometry_(std::move(planar)) {
+  if (geometry_.links.empty()) throw std::invalid_argument("planar robot geometry has no links");
+  for (const auto& p : geometry_.parts) {
+    if (p.link < 0 || static_cast<std::size_t>(p.link) >= geometry_.links.size()) {
+      throw std::invalid_argument("planar robot geometry: part on link index " + std::to_string(p.link) +
+                                  " out of range");
+    }
+    if (auto why = p.shape.invalidReason()) throw std::invalid_argument("planar robot geometry: " + *why);
+  }
+  if (geometry_.parts.empty()) throw std::invalid_argument("planar robot geometry has no parts");
+  hold_link_ = geometry_.links.front();
+  computeFootprint();
+}
+
+void RobotBinding::computeFootprint() {
+  // Parts rigidly on the base: link 0 (planar robots: every link sits at the base pose).
+  for (const auto& p : geometry_.parts) {
+    if (model_ && p.link != 0) continue;
+    const world::Polygon2 local = p.shape.footprint(32);
+    world::Polygon2 poly;
+    for (const auto& v : local) {
+      const Eigen::Vector3d w = p.link_T_shape * Eigen::Vector3d(v.x(), v.y(), 0.0);
+      poly.emplace_back(w.x(), w.y());
+      footprint_radius_ = std::max(footprint_radius_, w.head<2>().norm());
+    }
+    if (poly.size() < 3 || !world::containsPoint(poly, Eigen::Vector2d::Zero())) continue;
+    double r = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < poly.size(); ++i) {
+      r = std::min(r, segmentDistance(Eigen::Vector2d::Zero(), poly[i], poly[(i + 1) % poly.size()]));
+    }
+    // A shape's footprint polygon is inscribed in curved shapes: exact enough (32 sides).
+    if (r > inscribed_radius_) {
+      inscribed_radius_ = r;
+      const Aabb box = p.shape.aabb(p.link_T_shape);
+      inscribed_zmin_ = box.min.z();
+      inscribed_zmax_ = box.max.z();
+    }
+  }
+  if (model_) footprint_radius_ = std::max(footprint_radius_, model_->baseRadius());
+}
+
+void RobotBinding::linkPoses(const robot::RobotState& s, std::vector<Eigen::Isometry3d>& out) const {
+  if (model_) {
+    model_->linkPoses(s, out);
+    return;
+  }
+  out.assign(geometry_.links.size(), s.base.toIsometry());
+}
+
+// ---- GroupSpace -------------------------------------------------------------------------------
+
+GroupSpace::GroupSpace(const RobotBinding& robot, PlanningGroup group, const robot::RobotState& start,
+                       const Aabb& base_bounds, const SamplingParams& params)
+    : robot_(robot), group_(group), start_(start), base_bounds_(base_bounds) {
+  if (group != PlanningGroup::kBase && !robot.hasArm()) {
+    throw std::invalid_argument("group '" + std::string(toString(group)) + "' needs a robot with an arm");
+  }
+  std::shared_ptr<ob::SE2StateSpace> se2;
+  if (group != PlanningGroup::kArm) {
+    se2 = std::make_shared<ob::SE2StateSpace>();
+    ob::RealVectorBounds b(2);
+    b.setLow(0, base_bounds.min.x());
+    b.setLow(1, base_bounds.min.y());
+    b.setHigh(0, base_bounds.max.x());
+    b.setHigh(1, base_bounds.max.y());
+    se2->setBounds(b);
+    for (auto n : kBaseJointNames) names_.emplace_back(n);
+  }
+  std::shared_ptr<ob::RealVectorStateSpace> arm;
+  if (group != PlanningGroup::kBase) {
+    const auto& model = *robot.model();
+    arm = std::make_shared<ob::RealVectorStateSpace>(static_cast<unsigned>(model.armDof()));
+    ob::RealVectorBounds b(static_cast<unsigned>(model.armDof()));
+    for (std::size_t i = 0; i < model.armDof(); ++i) {
+      const auto& l = model.armLimits()[i];
+      b.setLow(static_cast<unsigned>(i), std::isfinite(l.lower) ? l.lower : -M_PI);
+      b.setHigh(static_cast<unsigned>(i), std::isfinite(l.upper) ? l.upper : M_PI);
+    }
+    arm->setBounds(b);
+    for (const auto& n : model.armJointNames()) names_.push_back(n);
+  }
+  switch (group) {
+    case PlanningGroup::kBase:
+      space_ = se2;
+      space_->registerDefaultProjection(std::make_shared<BaseXYProjection>(space_, params.kpiece_cell_size, false));
+      break;
+    case PlanningGroup::kArm:
+      space_ = arm;
+      space_->registerDefaultProjection(std::make_shared<ArmProjection>(
+          space_, params.arm_cell_size, std::min<unsigned>(3, static_cast<unsigned>(robot.armDof()))));
+      break;
+    case PlanningGroup::kWholeBody: {
+      auto c = std::make_shared<ob::CompoundStateSpace>();
+      c->addSubspace(se2, 1.0);
+      c->addSubspace(arm, 0.5);
+      c->lock();
+      space_ = c;
+      space_->registerDefaultProjection(std::make_shared<BaseXYProjection>(space_, params.kpiece_cell_size, true));
+      break;
+    }
+  }
+  space_->setup();
+  scratch_ = start_;
+  if (group == PlanningGroup::kBase) {
+    // The robot moves rigidly with its base: link poses relative to the base, once.
+    robot::RobotState at_origin = start_;
+    at_origin.base = Pose2D{};
+    robot_.linkPoses(at_origin, base_T_link_);
+  }
+}
+
+std::vector<double> GroupSpace::values(const ob::State* s) const {
+  std::vector<double> v;
+  v.reserve(names_.size());
+  const ob::SE2StateSpace::StateType* b = nullptr;
+  const ob::RealVectorStateSpace::StateType* a = nullptr;
+  switch (group_) {
+    case PlanningGroup::kBase: b = s->as<ob::SE2StateSpace::StateType>(); break;
+    case PlanningGroup::kArm: a = s->as<ob::RealVectorStateSpace::StateType>(); break;
+    case PlanningGroup::kWholeBody:
+      b = s->as<ob::CompoundState>()->as<ob::SE2StateSpace::StateType>(0);
+      a = s->as<ob::CompoundState>()->as<ob::RealVectorStateSpace::StateType>(1);
+      break;
+  }
+  if (b) {
+    v.push_back(b->getX());
+    v.push_back(b->getY());
+    v.push_back(b->getYaw());
+  }
+  if (a) {
+    for (std::size_t i = 0; i < robot_.armDof(); ++i) v.push_back(a->values[i]);
+  }
+  return v;
+}
+
+void GroupSpace::setValues(const std::vector<double>& v, ob::State* s) const {
+  if (v.size() != names_.size()) {
+    throw std::invalid_argument("GroupSpace::setValues: " + std::to_string(v.size()) + " values for " +
+                                std::to_string(names_.size()) + " joints");
+  }
+  ob::SE2StateSpace::StateType* b = nullptr;
+  ob::RealVectorStateSpace::StateType* a = nullptr;
+  switch (group_) {
+    case PlanningGroup::kBase: b = s->as<ob::SE2StateSpace::StateType>(); break;
+    case PlanningGroup::kArm: a = s->as<ob::RealVectorStateSpace::StateType>(); break;
+    case PlanningGroup::kWholeBody:
+      b = s->as<ob::CompoundState>()->as<ob::SE2StateSpace::StateType>(0);
+      a = s->as<ob::CompoundState>()->as<ob::RealVectorStateSpace::StateType>(1);
+      break;
+  }
+  std::size_t k = 0;
+  if (b) {
+    b->setXY(v[0], v[1]);
+    b->setYaw(wrapAngle(v[2]));
+    k = 3;
+  }
+  if (a) {
+    for (std::size_t i = 0; i < robot_.armDof(); ++i) a->values[i] = v[k + i];
+  }
+}
+
+Pose2D GroupSpace::basePose(const ob::State* s) const {
+  const ob::SE2StateSpace::StateType* b = nullptr;
+  if (group_ == PlanningGroup::kBase) b = s->as<ob::SE2StateSpace::StateType>();
+  if (group_ == PlanningGroup::kWholeBody) b = s->as<ob::CompoundState>()->as<ob::SE2StateSpace::StateType>(0);
+  if (!b) return start_.base;
+  return Pose2D{b->getX(), b->getY(), b->getYaw()};
+}
+
+robot::RobotState GroupSpace::robotState(const ob::State* s) const {
+  robot::RobotState r = start_;
+  r.base = basePose(s);
+  if (movesArm()) {
+    const auto* a = group_ == PlanningGroup::kArm
+                        ? s->as<ob::RealVectorStateSpace::StateType>()
+                        : s->as<ob::CompoundState>()->as<ob::RealVectorStateSpace::StateType>(1);
+    for (std::size_t i = 0; i < robot_.armDof(); ++i) r.arm[i] = a->values[i];
+  }
+  return r;
+}
+
+void GroupSpace::placeRobot(const ob::State* s, collision::Scene& scene) const {
+  if (group_ == PlanningGroup::kBase) {
+    const Eigen::Isometry3d world_T_base = basePose(s).toIsometry();
+    poses_.resize(base_T_link_.size());
+    for (std::size_t i = 0; i < base_T_link_.size(); ++i) poses_[i] = world_T_base * base_T_link_[i];
+    scene.setLinkPoses(poses_);
+    return;
+  }
+  scratch_.base = basePose(s);
+  const auto* a = group_ == PlanningGroup::kArm
+                      ? s->as<ob::RealVectorStateSpace::StateType>()
+                      : s->as<ob::CompoundState>()->as<ob::RealVectorStateSpace::StateType>(1);
+  for (std::size_t i = 0; i < robot_.armDof(); ++i) scratch_.arm[i] = a->values[i];
+  robot_.linkPoses(scratch_, poses_);
+  scene.setLinkPoses(poses_);
+}
+
+// ---- Oracle -----------------------------------------------------------------------------------
+
+Oracle::Oracle(collision::Scene& scene, const GroupSpace& gs, std::vector<std::string> ignored,
+               std::vector<MovableInfo> movables, double reach_radius)
+    : scene_(scene), gs_(gs), movables_(std::move(movables)) {
+  static_filter_ = collision::Filter{collision::kStaticObjects | collision::kUnknownSpace, {}, ignored};
+  all_filter_ = collision::Filter{collision::kAllGroups, {}, ignored};
+  movable_filter_ = collision::Filter{collision::kMovableObjects, {}, std::move(ignored)};
+  for (std::size_t i = 0; i < movables_.size(); ++i) index_[movables_[i].id] = static_cast<int>(i);
+  self_check_ = gs.movesArm();
+  rigid_ = gs.group() == PlanningGroup::kBase && reach_radius > 0;
+  reach_radius_ = reach_radius;
+}
+
+bool Oracle::selfFree() { return scene_.selfCollisions().empty(); }
+
+bool Oracle::staticFree(const ob::State* s) {
+  ++checks_;
+  gs_.placeRobot(s, scene_);
+  if (scene_.robotInCollision(static_filter_)) return false;
+  return !self_check_ || selfFree();
+}
+
+bool Oracle::allFree(const ob::State* s) {
+  ++checks_;
+  gs_.placeRobot(s, scene_);
+  if (scene_.robotInCollision(all_filter_)) return false;
+  return !self_check_ || selfFree();
+}
+
+void Oracle::touched(const ob::State* s, std::vector<int>& out) {
+  out.clear();
+  if (movables_.empty()) return;
+  ++checks_;
+  gs_.placeRobot(s, scene_);
+  for (const auto& id : scene_.robotCollisions(movable_filter_)) {
+    auto it = index_.find(id);
+    if (it != index_.end()) out.push_back(it->second);
+  }
+  std::sort(out.begin(), out.end());
+}
+
+bool Oracle::touches(const ob::State* s, int index) {
+  ++checks_;
+  gs_.placeRobot(s, scene_);
+  collision::Filter f{collision::kMovableObjects, {movables_[static_cast<std::size_t>(index)].id}, {}};
+  return scene_.robotInCollision(f);
+}
+
+std::string Oracle::collidingObject(const ob::State* s, bool include_movables) {
+  gs_.placeRobot(s, scene_);
+  const auto ids = scene_.robotCollisions(include_movables ? all_filter_ : static_filter_);
+  if (!ids.empty()) return ids.front();
+  if (self_check_ || !scene_.attachedObjects().empty()) {
+    const auto self = scene_.selfCollisions();
+    if (!self.empty()) return "self:" + self.front().first + "/" + self.front().second;
+  }
+  return {};
+}
+
+void Oracle::candidates(const ob::State* a, const ob::State* b, std::vector<int>& out) const {
+  out.clear();
+  if (!rigid_) {
+    for (std::size_t i = 0; i < movables_.size(); ++i) out.push_back(static_cast<int>(i));
+    return;
+  }
+  const Pose2D pa = gs_.basePose(a), pb = gs_.basePose(b);
+  const double r = reach_radius_;
+  const double x0 = std::min(pa.x, pb.x) - r, x1 = std::max(pa.x, pb.x) + r;
+  const double y0 = std::min(pa.y, pb.y) - r, y1 = std::max(pa.y, pb.y) + r;
+  for (std::size_t i = 0; i < movables_.size(); ++i) {
+    const Aabb& box = movables_[i].aabb;
+    if (box.max.x() < x0 || box.min.x() > x1 || box.max.y() < y0 || box.min.y() > y1) continue;
+    out.push_back(static_cast<int>(i));
+  }
+}
+
+}  // namespace tamp::motion_planner::detail

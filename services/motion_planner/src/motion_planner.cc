@@ -1,0 +1,706 @@
+// MotionPlanner: request validation, the lazy and full pipelines (see motion_planner.h).
+#include "tamp/motion_planner/motion_planner.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <mutex>
+
+#include <ompl/base/ProblemDefinition.h>
+#include <ompl/base/goals/GoalSampleableRegion.h>
+#include <ompl/base/goals/GoalState.h>
+#include <ompl/base/goals/GoalStates.h>
+#include <ompl/base/spaces/SE2StateSpace.h>
+#include <ompl/geometric/PathSimplifier.h>
+#include <ompl/geometric/planners/kpiece/KPIECE1.h>
+#include <ompl/geometric/planners/kpiece/LBKPIECE1.h>
+#include <ompl/geometric/planners/rrt/RRTConnect.h>
+#include <ompl/util/Console.h>
+#include <ompl/util/RandomNumbers.h>
+
+#include "planner_impl.h"
+#include "tamp/core/log.h"
+
+namespace tamp::motion_planner {
+
+namespace ob = ompl::base;
+namespace og = ompl::geometric;
+
+// ---- names --------------------------------------------------------------------------------------
+
+std::string_view toString(PlanningGroup group) {
+  switch (group) {
+    case PlanningGroup::kBase: return "base";
+    case PlanningGroup::kArm: return "arm";
+    case PlanningGroup::kWholeBody: return "whole_body";
+  }
+  return "?";
+}
+
+std::string_view toString(MotionMode mode) { return mode == MotionMode::kLazy ? "lazy" : "full"; }
+
+std::string_view toString(MotionStatus status) {
+  switch (status) {
+    case MotionStatus::kSolved: return "solved";
+    case MotionStatus::kNoPath: return "no_path";
+    case MotionStatus::kStartInCollision: return "start_in_collision";
+    case MotionStatus::kGoalInCollision: return "goal_in_collision";
+    case MotionStatus::kTimeout: return "timeout";
+    case MotionStatus::kInvalidRequest: return "invalid_request";
+  }
+  return "?";
+}
+
+MotionGoal MotionGoal::configurationGoal(std::vector<double> q) {
+  MotionGoal g;
+  g.kind = Kind::kConfiguration;
+  g.configuration = std::move(q);
+  return g;
+}
+
+MotionGoal MotionGoal::basePoseGoal(const Pose2D& pose, bool any_yaw) {
+  MotionGoal g;
+  g.kind = Kind::kBasePose;
+  g.base = pose;
+  g.any_base_yaw = any_yaw;
+  return g;
+}
+
+MotionGoal MotionGoal::endEffectorGoal(const Eigen::Isometry3d& world_T_tool) {
+  MotionGoal g;
+  g.kind = Kind::kEndEffectorPose;
+  g.end_effector = world_T_tool;
+  return g;
+}
+
+bool seedRandomness(std::uint32_t seed) {
+  static std::once_flag once;
+  bool done = false;
+  std::call_once(once, [&] {
+    ompl::RNG::setSeed(seed == 0 ? 1 : seed);
+    done = true;
+  });
+  return done;
+}
+
+namespace {
+
+std::string fmt(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%g", v);
+  return buf;
+}
+
+bool finite(const Pose2D& p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.theta); }
+
+/// Base goal with a position tolerance and a free yaw (rotation-symmetric robots).
+class AnyYawGoal : public ob::GoalSampleableRegion {
+ public:
+  AnyYawGoal(const ob::SpaceInformationPtr& si, const detail::GroupSpace& gs, const ob::State* templ,
+             double x, double y, double tol)
+      : ob::GoalSampleableRegion(si), gs_(gs), templ_(si->cloneState(templ)), x_(x), y_(y) {
+    setThreshold(tol);
+  }
+  ~AnyYawGoal() override { si_->freeState(templ_); }
+  double distanceGoal(const ob::State* s) const override {
+    const Pose2D p = gs_.basePose(s);
+    double d = std::hypot(p.x - x_, p.y - y_);
+    if (gs_.movesArm()) {  // whole body: the arm must match too
+      const auto v = gs_.values(s), t = gs_.values(templ_);
+      for (std::size_t i = 3; i < v.size(); ++i) d += std::abs(v[i] - t[i]);
+    }
+    return d;
+  }
+  void sampleGoal(ob::State* s) const override {
+    si_->copyState(s, templ_);
+    auto v = gs_.values(s);
+    v[2] = rng_.uniformReal(-M_PI, M_PI);
+    gs_.setValues(v, s);
+  }
+  unsigned int maxSampleCount() const override { return 1000000u; }
+
+ private:
+  const detail::GroupSpace& gs_;
+  ob::State* templ_;
+  double x_, y_;
+  mutable ompl::RNG rng_;
+};
+
+ob::PlannerPtr makePlanner(PlannerKind kind, const ob::SpaceInformationPtr& si, double range) {
+  switch (kind) {
+    case PlannerKind::kLbkpiece: {
+      auto p = std::make_shared<og::LBKPIECE1>(si);
+      if (range > 0) p->setRange(range);
+      return p;
+    }
+    case PlannerKind::kKpiece: {
+      auto p = std::make_shared<og::KPIECE1>(si);
+      if (range > 0) p->setRange(range);
+      return p;
+    }
+    case PlannerKind::kRrtConnect: {
+      auto p = std::make_shared<og::RRTConnect>(si);
+      if (range > 0) p->setRange(range);
+      return p;
+    }
+  }
+  return nullptr;
+}
+
+ob::PlannerTerminationCondition ptcOf(const Termination& t) {
+  return ob::PlannerTerminationCondition([t] { return t(); });
+}
+
+}  // namespace
+
+// ---- Impl ---------------------------------------------------------------------------------------
+
+MotionPlanner::Impl::Impl(MotionPlannerParams p, detail::RobotBinding r)
+    : params(std::move(p)), robot(std::move(r)) {
+  scene.setRobot(robot.geometry());
+  effort = [c = params.cost](const world::Object& o) { return defaultObjectEffort(o, c); };
+}
+
+Result<MotionPlanner::Impl::AttachGuard> MotionPlanner::Impl::attach(const std::string& object_id,
+                                                                   const robot::RobotState& start,
+                                                                   const std::string& field) {
+  const world::Object* obj = world.findObject(object_id);
+  if (!obj) return Error(ErrorCode::kInvalidArgument, field + ": no object '" + object_id + "' in the world");
+  if (obj->kind != world::ObjectKind::kMovable) {
+    return Error(ErrorCode::kInvalidArgument, field + ": object '" + object_id + "' is static and cannot be held");
+  }
+  Eigen::Isometry3d link_T_object;
+  const auto& held = world.held();
+  if (held && held->object_id == object_id && held->link == robot.holdLink()) {
+    link_T_object = held->link_T_object;
+  } else {
+    std::vector<Eigen::Isometry3d> poses;
+    robot.linkPoses(start, poses);
+    const auto& links = robot.geometry().links;
+    const auto it = std::find(links.begin(), links.end(), robot.holdLink());
+    const Eigen::Isometry3d world_T_link = poses[static_cast<std::size_t>(it - links.begin())];
+    link_T_object = world_T_link.inverse() * obj->pose;
+  }
+  if (Status s = scene.attach(object_id, robot.holdLink(), link_T_object); !s) {
+    return Error(ErrorCode::kInvalidArgument, field + ": " + s.error().message);
+  }
+  return AttachGuard(&scene, object_id);
+}
+
+double MotionPlanner::Impl::reachRadius(const robot::RobotState& s, const std::string& held) const {
+  std::vector<Eigen::Isometry3d> poses;
+  robot.linkPoses(s, poses);
+  double r = 0.0;
+  const Eigen::Vector2d c(s.base.x, s.base.y);
+  auto extend = [&](const Aabb& b) {
+    for (double x : {b.min.x(), b.max.x()})
+      for (double y : {b.min.y(), b.max.y()}) r = std::max(r, (Eigen::Vector2d(x, y) - c).norm());
+  };
+  for (const auto& p : robot.geometry().parts) extend(p.shape.aabb(poses[static_cast<std::size_t>(p.link)] * p.link_T_shape));
+  if (!held.empty()) {
+    if (const world::Object* o = world.findObject(held)) {
+      // Its pose relative to the hold link is fixed: at the start it is where the world has it
+      // (or where the world's held record puts it).
+      extend(o->aabb());
+    }
+  }
+  return r + 1e-3;
+}
+
+Aabb MotionPlanner::Impl::baseBounds(const std::vector<Eigen::Vector2d>& extra) const {
+  Aabb b = world.bounds();
+  for (const auto& p : extra) b.extend(Eigen::Vector3d(p.x(), p.y(), 0.0));
+  if (b.empty()) b.extend(Eigen::Vector3d::Zero());
+  const double m = params.sampling.workspace_margin;
+  b.min.x() -= m;
+  b.min.y() -= m;
+  b.max.x() += m;
+  b.max.y() += m;
+  // A degenerate extent (a single point) still needs a non-empty box for OMPL.
+  if (b.max.x() - b.min.x() < 1e-3) b.max.x() = b.min.x() + 1e-3;
+  if (b.max.y() - b.min.y() < 1e-3) b.max.y() = b.min.y() + 1e-3;
+  return b;
+}
+
+TimingLimits MotionPlanner::Impl::timingLimits() const {
+  TimingLimits l;
+  const auto& t = params.timing;
+  l.base_linear = {t.base_linear_speed, t.base_linear_accel};
+  l.base_angular = {t.base_angular_speed, t.base_angular_accel};
+  l.sample_period = t.sample_period;
+  if (const auto* m = robot.model()) {
+    for (std::size_t i = 0; i < m->armDof(); ++i) {
+      l.joint_names.push_back(m->armJointNames()[i]);
+      const double v = m->armLimits()[i].velocity > 0 ? m->armLimits()[i].velocity : 1.0;
+      l.joints.push_back({v * t.arm_speed_scale, t.arm_accel});
+    }
+  }
+  return l;
+}
+
+std::optional<std::vector<double>> solveIk(MotionPlanner::Impl& impl, const Pose2D& base,
+                                           const Eigen::Isometry3d& world_T_tool, const std::vector<double>& seed,
+                                           const collision::Filter& filter, double gripper, std::uint32_t seed_rng,
+                                           int attempts, const Termination& termination) {
+  const robot::RobotModel* m = impl.robot.model();
+  if (!m) return std::nullopt;
+  robot::RobotState st = m->defaultState(base);
+  st.gripper = gripper;
+  std::vector<Eigen::Isometry3d> poses;
+  robot::IkOptions opt;
+  opt.seed = seed_rng;
+  opt.max_attempts = attempts;
+  opt.position_tolerance = 1e-4;
+  opt.orientation_tolerance = 1e-3;
+  opt.accept = [&](const std::vector<double>& q) {
+    st.arm = q;
+    m->linkPoses(st, poses);
+    impl.scene.setLinkPoses(poses);
+    return !impl.scene.robotInCollision(filter) && impl.scene.selfCollisions().empty();
+  };
+  const Eigen::Isometry3d base_T_tool = base.toIsometry().inverse() * world_T_tool;
+  std::vector<double> s = seed.size() == m->armDof() ? seed : m->defaultState().arm;
+  auto r = m->inverseKinematics(base_T_tool, s, opt, termination);
+  if (!r.ok()) return std::nullopt;
+  return r.q;
+}
+
+// ---- MotionPlanner ------------------------------------------------------------------------------
+
+MotionPlanner::MotionPlanner(robot::RobotModel model, MotionPlannerParams params) {
+  if (Status s = params.validate(); !s) throw std::invalid_argument(s.error().message);
+  ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
+  impl_ = std::make_unique<Impl>(std::move(params), detail::RobotBinding(std::move(model)));
+}
+
+MotionPlanner::MotionPlanner(collision::RobotGeometry planar_geometry, MotionPlannerParams params) {
+  if (Status s = params.validate(); !s) throw std::invalid_argument(s.error().message);
+  ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
+  impl_ = std::make_unique<Impl>(std::move(params), detail::RobotBinding(std::move(planar_geometry)));
+}
+
+MotionPlanner::~MotionPlanner() = default;
+MotionPlanner::MotionPlanner(MotionPlanner&&) noexcept = default;
+MotionPlanner& MotionPlanner::operator=(MotionPlanner&&) noexcept = default;
+
+void MotionPlanner::setWorld(const world::World& world) {
+  impl_->world = world.plannerView();
+  impl_->scene.syncWorld(impl_->world);
+}
+
+const world::World& MotionPlanner::world() const { return impl_->world; }
+
+void MotionPlanner::setObjectEffort(ObjectEffortFn fn) {
+  if (!fn) throw std::invalid_argument("setObjectEffort: empty function");
+  impl_->effort = std::move(fn);
+}
+
+const MotionPlannerParams& MotionPlanner::params() const { return impl_->params; }
+bool MotionPlanner::hasArm() const { return impl_->robot.hasArm(); }
+const robot::RobotModel* MotionPlanner::robotModel() const { return impl_->robot.model(); }
+double MotionPlanner::footprintRadius() const { return impl_->robot.footprintRadius(); }
+
+std::vector<std::string> MotionPlanner::groupJointNames(PlanningGroup group) const {
+  std::vector<std::string> names;
+  if (group != PlanningGroup::kArm) {
+    for (auto n : kBaseJointNames) names.emplace_back(n);
+  }
+  if (group != PlanningGroup::kBase && impl_->robot.model()) {
+    for (const auto& n : impl_->robot.model()->armJointNames()) names.push_back(n);
+  }
+  return names;
+}
+
+namespace {
+
+/// Validates the request against the robot and the world; the first problem, naming the field.
+std::optional<std::string> validateRequest(const MotionRequest& r, const MotionPlanner::Impl& impl,
+                                           const std::vector<std::string>& group_names) {
+  const auto* m = impl.robot.model();
+  if (r.group != PlanningGroup::kBase && !m) {
+    return "group: '" + std::string(toString(r.group)) + "' needs a robot with an arm (this robot is planar)";
+  }
+  if (!finite(r.start.base)) return std::string("start.base: not finite");
+  const std::size_t dof = impl.robot.armDof();
+  if (r.start.arm.size() != dof) {
+    return "start.arm: expected " + std::to_string(dof) + " values, got " + std::to_string(r.start.arm.size());
+  }
+  for (std::size_t i = 0; i < dof; ++i) {
+    const double q = r.start.arm[i];
+    const auto& l = m->armLimits()[i];
+    if (!std::isfinite(q)) return "start.arm[" + std::to_string(i) + "]: not finite";
+    if (q < l.lower - 1e-6 || q > l.upper + 1e-6) {
+      return "start.arm[" + std::to_string(i) + "] (" + m->armJointNames()[i] + "): " + fmt(q) + " outside [" +
+             fmt(l.lower) + ", " + fmt(l.upper) + "]";
+    }
+  }
+  if (!std::isfinite(r.start.gripper)) return std::string("start.gripper: not finite");
+  const auto& g = r.goal;
+  switch (g.kind) {
+    case MotionGoal::Kind::kConfiguration: {
+      if (g.configuration.size() != group_names.size()) {
+        return "goal.configuration: expected " + std::to_string(group_names.size()) + " values (" +
+               std::string(toString(r.group)) + " joints), got " + std::to_string(g.configuration.size());
+      }
+      const std::size_t off = r.group == PlanningGroup::kArm ? 0 : 3;
+      for (std::size_t i = 0; i < g.configuration.size(); ++i) {
+        const double q = g.configuration[i];
+        if (!std::isfinite(q)) return "goal.configuration[" + std::to_string(i) + "] (" + group_names[i] + "): not finite";
+        if (i >= off) {
+          const auto& l = m->armLimits()[i - off];
+          if (q < l.lower - 1e-6 || q > l.upper + 1e-6) {
+            return "goal.configuration[" + std::to_string(i) + "] (" + group_names[i] + "): " + fmt(q) +
+                   " outside [" + fmt(l.lower) + ", " + fmt(l.upper) + "]";
+          }
+        }
+      }
+      break;
+    }
+    case MotionGoal::Kind::kBasePose:
+      if (r.group == PlanningGroup::kArm) return std::string("goal: a base pose goal needs group base or whole_body");
+      if (!finite(g.base)) return std::string("goal.base: not finite");
+      break;
+    case MotionGoal::Kind::kEndEffectorPose: {
+      if (r.group == PlanningGroup::kBase) {
+        return std::string("goal: an end-effector goal needs group arm or whole_body");
+      }
+      if (!g.end_effector.matrix().allFinite()) return std::string("goal.end_effector: not finite");
+      const Eigen::Matrix3d R = g.end_effector.linear();
+      if (((R * R.transpose()) - Eigen::Matrix3d::Identity()).norm() > 1e-6) {
+        return std::string("goal.end_effector: rotation is not orthonormal");
+      }
+      break;
+    }
+  }
+  if (!r.held_object.empty()) {
+    const world::Object* o = impl.world.findObject(r.held_object);
+    if (!o) return "held_object: no object '" + r.held_object + "' in the world";
+    if (o->kind != world::ObjectKind::kMovable) return "held_object: object '" + r.held_object + "' is static";
+  }
+  for (std::size_t i = 0; i < r.ignored_objects.size(); ++i) {
+    if (!impl.world.findObject(r.ignored_objects[i])) {
+      return "ignored_objects[" + std::to_string(i) + "]: no object '" + r.ignored_objects[i] + "' in the world";
+    }
+  }
+  if (!std::isfinite(r.object_cost_scale) || r.object_cost_scale < 0) {
+    return "object_cost_scale: must be finite and >= 0, got " + fmt(r.object_cost_scale);
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& termination) {
+  Impl& impl = *impl_;
+  const auto& P = impl.params;
+  Stopwatch clock;
+  MotionResult res;
+  auto finish = [&](MotionStatus st, std::string reason, std::string object = {}) {
+    res.status = st;
+    res.reason = std::move(reason);
+    res.colliding_object = std::move(object);
+    res.planning_time_s = clock.seconds();
+    return res;
+  };
+  const std::vector<std::string> names = groupJointNames(req.group);
+  if (auto why = validateRequest(req, impl, names)) return finish(MotionStatus::kInvalidRequest, *why);
+
+  // Base bounds: the world, the start and a base goal.
+  std::vector<Eigen::Vector2d> extra{{req.start.base.x, req.start.base.y}};
+  if (req.goal.kind == MotionGoal::Kind::kBasePose) extra.emplace_back(req.goal.base.x, req.goal.base.y);
+  if (req.goal.kind == MotionGoal::Kind::kConfiguration && req.group != PlanningGroup::kArm) {
+    extra.emplace_back(req.goal.configuration[0], req.goal.configuration[1]);
+  }
+  if (req.goal.kind == MotionGoal::Kind::kEndEffectorPose) {
+    extra.emplace_back(req.goal.end_effector.translation().x(), req.goal.end_effector.translation().y());
+  }
+  const Aabb bounds = impl.baseBounds(extra);
+
+  // The held object moves with the robot for this request.
+  const std::string held = !req.held_object.empty() ? req.held_object
+                           : impl.world.held() ? impl.world.held()->object_id
+                                               : std::string();
+  Impl::AttachGuard guard;
+  if (!held.empty()) {
+    auto g = impl.attach(held, req.start, req.held_object.empty() ? "world.held" : "held_object");
+    if (!g) return finish(MotionStatus::kInvalidRequest, g.error().message);
+    guard = std::move(*g);
+  }
+
+  detail::GroupSpace gs(impl.robot, req.group, req.start, bounds, P.sampling);
+  const auto& space = gs.space();
+  std::vector<std::string> ignored = req.ignored_objects;
+  std::vector<detail::MovableInfo> movables;
+  for (const auto& o : impl.world.objects()) {
+    if (o.kind != world::ObjectKind::kMovable || o.id == held) continue;
+    if (std::find(ignored.begin(), ignored.end(), o.id) != ignored.end()) continue;
+    detail::MovableInfo mi;
+    mi.id = o.id;
+    mi.mass = o.mass;
+    mi.effort_s = impl.effort(o);
+    mi.cost_s = mi.effort_s * req.object_cost_scale;
+    mi.aabb = o.aabb();
+    movables.push_back(std::move(mi));
+  }
+  const double reach = req.group == PlanningGroup::kBase ? impl.reachRadius(req.start, held) : 0.0;
+  detail::Oracle oracle(impl.scene, gs, ignored, std::move(movables), reach);
+  const bool lazy = req.mode == MotionMode::kLazy;
+
+  auto makeSi = [&](bool full) {
+    auto si = std::make_shared<ob::SpaceInformation>(space);
+    si->setStateValidityChecker(std::make_shared<detail::OracleValidityChecker>(si, oracle, full));
+    si->setStateValidityCheckingResolution(
+        std::min(1.0, P.sampling.validity_resolution / std::max(1e-9, space->getMaximumExtent())));
+    si->setup();
+    return si;
+  };
+  const ob::SpaceInformationPtr si = makeSi(!lazy);
+  auto freeState = [&](ob::State* s) { space->freeState(s); };
+  std::unique_ptr<ob::State, decltype(freeState)> start(space->allocState(), freeState);
+  {
+    std::vector<double> v;
+    if (gs.hasBase()) v = {req.start.base.x, req.start.base.y, wrapAngle(req.start.base.theta)};
+    if (gs.movesArm()) v.insert(v.end(), req.start.arm.begin(), req.start.arm.end());
+    gs.setValues(v, start.get());
+  }
+  auto collides = [&](const ob::State* s) { return lazy ? !oracle.staticFree(s) : !oracle.allFree(s); };
+  auto selfHit = [&]() -> std::string {
+    if (impl.scene.attachedObjects().empty() && !gs.movesArm()) return {};
+    const auto self = impl.scene.selfCollisions();
+    return self.empty() ? std::string() : "self:" + self.front().first + "/" + self.front().second;
+  };
+  if (collides(start.get())) {
+    const std::string who = oracle.collidingObject(start.get(), !lazy);
+    return finish(MotionStatus::kStartInCollision, "the start state touches '" + who + "'", who);
+  }
+  gs.placeRobot(start.get(), impl.scene);
+  if (std::string s = selfHit(); !s.empty()) {
+    return finish(MotionStatus::kStartInCollision, "the start state is in self-collision (" + s + ")", s);
+  }
+
+  // ---- goal ----
+  auto pdef = std::make_shared<ob::ProblemDefinition>(si);
+  pdef->addStartState(start.get());
+  std::optional<Eigen::Vector2d> base_goal;  // for the proof
+  std::vector<ob::State*> goal_states;
+  struct GoalFree {
+    std::vector<ob::State*>& v;
+    const ob::StateSpacePtr& sp;
+    ~GoalFree() {
+      for (auto* s : v) sp->freeState(s);
+    }
+  } goal_free{goal_states, space};
+  const auto& G = req.goal;
+  auto checkGoal = [&](ob::State* s, std::string& who) {
+    if (collides(s)) {
+      who = oracle.collidingObject(s, !lazy);
+      return false;
+    }
+    gs.placeRobot(s, impl.scene);
+    who = gs.movesArm() ? selfHit() : std::string();
+    return who.empty();
+  };
+  if (G.kind == MotionGoal::Kind::kConfiguration || G.kind == MotionGoal::Kind::kBasePose) {
+    std::vector<double> v;
+    if (G.kind == MotionGoal::Kind::kConfiguration) {
+      v = G.configuration;
+    } else {
+      v = {G.base.x, G.base.y, wrapAngle(G.base.theta)};
+      if (gs.movesArm()) v.insert(v.end(), req.start.arm.begin(), req.start.arm.end());
+    }
+    ob::State* gsState = space->allocState();
+    goal_states.push_back(gsState);
+    gs.setValues(v, gsState);
+    if (gs.hasBase()) base_goal = Eigen::Vector2d(v[0], v[1]);
+    std::string who;
+    const bool any_yaw = G.kind == MotionGoal::Kind::kBasePose && G.any_base_yaw;
+    bool free = checkGoal(gsState, who);
+    if (!free && any_yaw) {  // another yaw may fit
+      auto vv = v;
+      for (int k = 1; k < 16 && !free; ++k) {
+        vv[2] = wrapAngle(v[2] + k * M_PI / 8);
+        gs.setValues(vv, gsState);
+        std::string w2;
+        free = checkGoal(gsState, w2);
+      }
+    }
+    if (!free) return finish(MotionStatus::kGoalInCollision, "the goal state touches '" + who + "'", who);
+    if (any_yaw) {
+      pdef->setGoal(std::make_shared<AnyYawGoal>(si, gs, gsState, v[0], v[1], P.sampling.goal_position_tolerance));
+    } else {
+      pdef->setGoalState(gsState, gs.hasBase() ? P.sampling.goal_position_tolerance
+                                               : P.sampling.goal_orientation_tolerance);
+    }
+  } else {  // end-effector pose through IK
+    const auto* m = impl.robot.model();
+    collision::Filter filter = lazy ? collision::Filter{collision::kStaticObjects | collision::kUnknownSpace, {}, ignored}
+                                    : collision::Filter{collision::kAllGroups, {}, ignored};
+    std::vector<Pose2D> bases;
+    if (req.group == PlanningGroup::kArm) {
+      bases.push_back(req.start.base);
+    } else {
+      const Eigen::Vector3d t = G.end_effector.translation();
+      const auto& gp = P.grasp;
+      for (int ring = 0; ring < 3; ++ring) {
+        const double d = gp.base_distance_min + (gp.base_distance_max - gp.base_distance_min) * ring / 2.0;
+        for (int k = 0; k < gp.base_poses; ++k) {
+          // Start from the direction of the robot, alternate around it.
+          const double a0 = std::atan2(req.start.base.y - t.y(), req.start.base.x - t.x());
+          const double a = a0 + ((k % 2) ? 1 : -1) * ((k + 1) / 2) * (2 * M_PI / gp.base_poses);
+          Pose2D b{t.x() + d * std::cos(a), t.y() + d * std::sin(a), wrapAngle(a + M_PI)};
+          if (b.x < bounds.min.x() || b.x > bounds.max.x() || b.y < bounds.min.y() || b.y > bounds.max.y()) continue;
+          bases.push_back(b);
+        }
+      }
+    }
+    std::string reject;
+    int found = 0;
+    for (std::size_t bi = 0; bi < bases.size() && found < 3; ++bi) {
+      if (termination()) return finish(MotionStatus::kTimeout, "the deadline passed while solving IK for the goal");
+      auto q = solveIk(impl, bases[bi], G.end_effector, req.start.arm, filter, req.start.gripper,
+                       P.seed + static_cast<std::uint32_t>(bi), 16, termination);
+      if (!q) continue;
+      std::vector<double> v;
+      if (gs.hasBase()) v = {bases[bi].x, bases[bi].y, bases[bi].theta};
+      v.insert(v.end(), q->begin(), q->end());
+      ob::State* s = space->allocState();
+      goal_states.push_back(s);
+      gs.setValues(v, s);
+      if (!checkGoal(s, reject)) {
+        space->freeState(s);
+        goal_states.pop_back();
+        continue;
+      }
+      ++found;
+    }
+    if (found == 0) {
+      // Distinguish "unreachable" from "reachable only in collision".
+      const auto* mm = m;
+      auto q = mm->inverseKinematics(req.start.base.toIsometry().inverse() * G.end_effector, req.start.arm);
+      if (req.group == PlanningGroup::kArm && q.ok()) {
+        ob::State* s = space->allocState();
+        goal_states.push_back(s);
+        gs.setValues(q.q, s);
+        std::string who = oracle.collidingObject(s, !lazy);
+        if (!who.empty()) {
+          return finish(MotionStatus::kGoalInCollision, "every IK solution of the goal touches an object, e.g. '" + who + "'",
+                        who);
+        }
+      }
+      return finish(MotionStatus::kNoPath, "goal.end_effector: no collision-free IK solution (" +
+                                               std::to_string(bases.size()) + " base pose(s) tried)");
+    }
+    auto goals = std::make_shared<ob::GoalStates>(si);
+    for (auto* s : goal_states) goals->addState(s);
+    goals->setThreshold(P.sampling.goal_orientation_tolerance);
+    pdef->setGoal(goals);
+  }
+
+  // ---- search (+ infeasibility proof, interleaved) ----
+  Stopwatch phase;
+  const PlannerKind kind = req.group != PlanningGroup::kBase ? P.sampling.arm_planner
+                           : lazy                            ? P.sampling.lazy_planner
+                                                             : P.sampling.full_planner;
+  auto planner = makePlanner(kind, si, P.sampling.range);
+  planner->setProblemDefinition(pdef);
+  planner->setup();
+  std::vector<double> proof_cells;
+  if (P.proof.enabled && gs.hasBase() && base_goal) {
+    for (double c = P.proof.cell_size; c >= P.proof.min_cell_size - 1e-12; c *= 0.5) proof_cells.push_back(c);
+  }
+  const collision::Filter proof_filter =
+      lazy ? collision::Filter{collision::kStaticObjects | collision::kUnknownSpace, {}, ignored}
+           : collision::Filter{collision::kAllGroups, {}, ignored};
+  std::size_t proof_level = 0;
+  double slice = lazy ? 0.25 : 0.05;
+  bool solved = false;
+  bool first = true;
+  while (!solved) {
+    if (proof_level < proof_cells.size() && (!lazy || !first)) {
+      Stopwatch pw;
+      const auto outcome = detail::proveDisconnected(impl.scene, proof_filter, impl.robot, bounds, req.start.base,
+                                                     *base_goal, P.sampling.goal_position_tolerance,
+                                                     proof_cells[proof_level], P.proof.max_cells, termination);
+      res.stats.proof_ms += pw.millis();
+      ++proof_level;
+      if (outcome == detail::ProofOutcome::kDisconnected) {
+        res.stats.sampling_ms = phase.millis() - res.stats.proof_ms;
+        res.stats.validity_checks = oracle.checks();
+        return finish(MotionStatus::kNoPath,
+                      std::string("no path: start and goal are in different components of the ") +
+                          (lazy ? "static " : "") + "free space of the base (proven on a " +
+                          fmt(proof_cells[proof_level - 1]) + " m grid)");
+      }
+      if (outcome == detail::ProofOutcome::kSkipped) proof_level = proof_cells.size();
+    }
+    first = false;
+    if (termination()) break;
+    const Termination slice_term = termination.tightened(Deadline::in(slice));
+    planner->solve(ptcOf(slice_term));
+    solved = pdef->hasExactSolution();
+    slice *= 2;
+  }
+  res.stats.sampling_ms = phase.millis() - res.stats.proof_ms;
+  if (!solved) {
+    res.stats.validity_checks = oracle.checks();
+    const bool stop = termination.reason() == StopReason::kStopRequested;
+    return finish(MotionStatus::kTimeout,
+                  std::string(stop ? "stop requested" : "the deadline passed") + " before a " + (lazy ? "lazy " : "") +
+                      "path was found" +
+                      (proof_cells.empty() ? std::string(" (no infeasibility proof for this group)")
+                                           : std::string(" (infeasibility not proven)")));
+  }
+  og::PathGeometric raw = *pdef->getSolutionPath()->as<og::PathGeometric>();
+  res.stats.raw_path_length = detail::reportedLength(gs, raw);
+
+  og::PathGeometric final_path(si);
+  const double spu = gs.secondsPerUnit(P.cost);
+  const double res_check = P.sampling.validity_resolution;
+  if (lazy) {
+    phase.reset();
+    detail::EvaluatedPath raw_eval = detail::evaluatePath(oracle, raw, res_check, 0.0);
+    const detail::PathCost raw_cost = raw_eval.cost(oracle, spu);
+    res.stats.raw_cost_s = raw_cost.cost;
+    for (int o : raw_cost.objects) res.stats.raw_blocking.push_back(oracle.movables()[static_cast<std::size_t>(o)].id);
+    og::PathGeometric best = raw;
+    if (P.lazy.optimize && req.object_cost_scale > 0 && !raw_cost.objects.empty()) {
+      auto rm = detail::effortRoadmapSearch(oracle, si, raw, P.lazy, res_check, spu, termination, res.stats);
+      if (rm) {
+        detail::EvaluatedPath rm_eval = detail::evaluatePath(oracle, *rm, res_check, 0.0);
+        if (rm_eval.cost(oracle, spu).cost < raw_cost.cost) best = *rm;
+      }
+    }
+    res.stats.optimize_ms = phase.millis();
+    phase.reset();
+    detail::EvaluatedPath ep = detail::evaluatePath(oracle, best, res_check, P.lazy.path_node_spacing * 0.5);
+    std::mt19937 rng(P.seed);
+    detail::effortShortcut(oracle, ep, P.lazy.shortcut_attempts, res_check, spu, rng, termination);
+    res.cost_s = ep.cost(oracle, spu).cost;
+    final_path = ep.path;
+    res.stats.shortcut_ms = phase.millis();
+    phase.reset();
+    res.blocking = detail::blockingReport(oracle, final_path, P.lazy.contact_resolution, P.lazy.swept_spacing);
+    res.stats.analysis_ms = phase.millis();
+  } else {
+    phase.reset();
+    final_path = raw;
+    og::PathSimplifier simplifier(si);
+    const Termination simp = termination.tightened(Deadline::in(0.05));
+    for (int round = 0; round < 4 && !simp(); ++round) {
+      bool better = simplifier.shortcutPath(final_path, 0, 0, 0.33, 0.005);
+      better |= simplifier.reduceVertices(final_path);
+      if (!better) break;
+    }
+    simplifier.collapseCloseVertices(final_path);
+    res.stats.shortcut_ms = phase.millis();
+  }
+  res.stats.validity_checks = oracle.checks();
+  res.path = detail::toJointPath(gs, final_path);
+  res.path_length = detail::reportedLength(gs, final_path);
+  auto traj = timeParameterize(res.path, impl.timingLimits());
+  if (!traj) return finish(MotionStatus::kInvalidRequest, "time parameterization: " + traj.error().message);
+  res.trajectory = std::move(*traj);
+  return finish(MotionStatus::kSolved, {});
+}
+
+}  // namespace tamp::motion_planner

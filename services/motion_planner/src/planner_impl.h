@@ -1,0 +1,80 @@
+#pragma once
+// Private: the state of a MotionPlanner, shared by motion_planner.cc, placement.cc, grasps.cc.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "internal.h"
+#include "tamp/motion_planner/trajectory_timing.h"
+
+namespace tamp::motion_planner {
+
+struct MotionPlanner::Impl {
+  MotionPlannerParams params;
+  detail::RobotBinding robot;
+  collision::Scene scene;
+  world::World world;  // planner view
+  ObjectEffortFn effort;
+
+  Impl(MotionPlannerParams p, detail::RobotBinding r);
+
+  /// Attaches an object to the hold link for the lifetime of the guard (or nothing).
+  class AttachGuard {
+   public:
+    AttachGuard() = default;
+    AttachGuard(collision::Scene* s, std::string id) : scene_(s), id_(std::move(id)) {}
+    AttachGuard(AttachGuard&& o) noexcept : scene_(o.scene_), id_(std::move(o.id_)) { o.scene_ = nullptr; }
+    AttachGuard& operator=(AttachGuard&& o) noexcept {
+      if (this != &o) {
+        release();
+        scene_ = o.scene_;
+        id_ = std::move(o.id_);
+        o.scene_ = nullptr;
+      }
+      return *this;
+    }
+    AttachGuard(const AttachGuard&) = delete;
+    AttachGuard& operator=(const AttachGuard&) = delete;
+    ~AttachGuard() { release(); }
+    void release() {
+      if (scene_) (void)scene_->detach(id_);
+      scene_ = nullptr;
+    }
+
+   private:
+    collision::Scene* scene_{nullptr};
+    std::string id_;
+  };
+  /// Attaches `object_id` (validated by the caller) in state `start`; the world's held record is
+  /// used when it names the same object. Errors name the field `field`.
+  Result<AttachGuard> attach(const std::string& object_id, const robot::RobotState& start,
+                             const std::string& field);
+
+  /// The robot's xy radius about its base origin in state `s`, attached objects included.
+  double reachRadius(const robot::RobotState& s, const std::string& held) const;
+  /// Base xy bounds: the world's bounds plus `extra` points, grown by the workspace margin.
+  Aabb baseBounds(const std::vector<Eigen::Vector2d>& extra) const;
+  /// Timing limits of a group's joints.
+  TimingLimits timingLimits() const;
+};
+
+/// Collision-free (all objects but `ignore`) IK from a given base; empty when none.
+std::optional<std::vector<double>> solveIk(MotionPlanner::Impl& impl, const Pose2D& base,
+                                           const Eigen::Isometry3d& world_T_tool,
+                                           const std::vector<double>& seed, const collision::Filter& filter,
+                                           double gripper, std::uint32_t seed_rng, int attempts,
+                                           const Termination& termination);
+
+/// A grasp candidate in the object's frame (see grasps.h).
+struct GraspCandidate {
+  GraspType type{GraspType::kTop};
+  Eigen::Isometry3d object_T_tool{Eigen::Isometry3d::Identity()};
+  double width{0.0};  ///< m, between the fingers
+};
+/// Candidates for a box or cylinder whose width fits `max_opening` (m per finger) with the margin;
+/// top grasps first. Other shapes: none.
+std::vector<GraspCandidate> graspCandidates(const world::Shape& shape, const GraspParams& params,
+                                            double max_opening);
+
+}  // namespace tamp::motion_planner

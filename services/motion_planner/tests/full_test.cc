@@ -1,0 +1,216 @@
+// Full mode: collision-free paths (re-checked densely by an independent 2-D checker), proven
+// `no path`, statuses for bad input, timeouts, held objects.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <stop_token>
+
+#include "tamp/motion_planner/motion_planner.h"
+#include "test_worlds.h"
+
+namespace tamp::motion_planner {
+namespace {
+
+using testing::discClearance;
+
+constexpr double kRadius = 0.3;
+
+class FullTest : public ::testing::Test {
+ protected:
+  void SetUp() override { seedRandomness(42); }
+  static MotionPlanner planner(const world::World& w, MotionPlannerParams p = {}) {
+    MotionPlanner mp(collision::RobotGeometry::disc(kRadius, 1.0), p);
+    mp.setWorld(w);
+    return mp;
+  }
+  static MotionRequest request(Pose2D from, Pose2D to) {
+    MotionRequest r;
+    r.mode = MotionMode::kFull;
+    r.start.base = from;
+    r.goal = MotionGoal::basePoseGoal(to);
+    return r;
+  }
+};
+
+TEST_F(FullTest, PathThroughTheOpenDoorIsCollisionFreeWhenRecheckedDensely) {
+  const world::World w = testing::corridorWorld(false);
+  MotionPlanner mp = planner(w);
+  for (int run = 0; run < 5; ++run) {
+    const MotionResult r = mp.plan(request({2, 3, 0.5}, {8, 1, -1.0}), Termination::after(5.0));
+    ASSERT_EQ(r.status, MotionStatus::kSolved) << r.reason;
+    // Every 2 mm along the path the disc keeps clear of every object (walls and movables).
+    EXPECT_GE(discClearance(w, r.path, kRadius, 0.002), 0.0) << "run " << run;
+    EXPECT_TRUE(r.blocking.empty());
+    EXPECT_NEAR(r.path.waypoints.back()[0], 8.0, 0.011);
+    EXPECT_NEAR(r.path.waypoints.back()[1], 1.0, 0.011);
+    EXPECT_NEAR(std::remainder(r.path.waypoints.back()[2] + 1.0, 2 * M_PI), 0.0, 0.03);
+    // Shortcut: not much longer than the shortest route through the door (~6.4 m).
+    EXPECT_LT(r.path_length, 7.5);
+  }
+}
+
+TEST_F(FullTest, BlockedDoorIsAProvenNoPath) {
+  const world::World w = testing::corridorWorld(true);
+  MotionPlanner mp = planner(w);
+  const MotionResult r = mp.plan(request({2, 2, 0}, {8, 2, 0}), Termination::after(10.0));
+  EXPECT_EQ(r.status, MotionStatus::kNoPath) << r.reason;
+  EXPECT_NE(r.reason.find("proven"), std::string::npos) << r.reason;
+  EXPECT_LT(r.planning_time_s, 10.0);
+}
+
+TEST_F(FullTest, StartAndGoalInCollisionNameTheObject) {
+  const world::World w = testing::corridorWorld(true);
+  MotionPlanner mp = planner(w);
+  MotionResult r = mp.plan(request({5, 2, 0}, {8, 2, 0}), Termination::after(2.0));
+  EXPECT_EQ(r.status, MotionStatus::kStartInCollision);
+  EXPECT_EQ(r.colliding_object, "crate");
+  EXPECT_NE(r.reason.find("crate"), std::string::npos);
+  r = mp.plan(request({2, 2, 0}, {8.8, 3.4, 0}), Termination::after(2.0));
+  EXPECT_EQ(r.status, MotionStatus::kGoalInCollision);
+  EXPECT_EQ(r.colliding_object, "far_box");
+}
+
+TEST_F(FullTest, MalformedRequestsNameTheField) {
+  const world::World w = testing::corridorWorld(false);
+  MotionPlanner mp = planner(w);
+  MotionRequest r = request({2, 2, 0}, {8, 2, 0});
+  r.goal.base.x = std::nan("");
+  MotionResult res = mp.plan(r, Termination::after(1.0));
+  EXPECT_EQ(res.status, MotionStatus::kInvalidRequest);
+  EXPECT_NE(res.reason.find("goal.base"), std::string::npos) << res.reason;
+
+  r = request({2, 2, 0}, {8, 2, 0});
+  r.start.base.theta = INFINITY;
+  res = mp.plan(r, Termination::after(1.0));
+  EXPECT_EQ(res.status, MotionStatus::kInvalidRequest);
+  EXPECT_NE(res.reason.find("start.base"), std::string::npos) << res.reason;
+
+  r = request({2, 2, 0}, {8, 2, 0});
+  r.ignored_objects = {"far_box", "no_such_thing"};
+  res = mp.plan(r, Termination::after(1.0));
+  EXPECT_EQ(res.status, MotionStatus::kInvalidRequest);
+  EXPECT_NE(res.reason.find("ignored_objects[1]"), std::string::npos) << res.reason;
+  EXPECT_NE(res.reason.find("no_such_thing"), std::string::npos) << res.reason;
+
+  r = request({2, 2, 0}, {8, 2, 0});
+  r.held_object = "ghost";
+  res = mp.plan(r, Termination::after(1.0));
+  EXPECT_EQ(res.status, MotionStatus::kInvalidRequest);
+  EXPECT_NE(res.reason.find("held_object"), std::string::npos) << res.reason;
+
+  r = request({2, 2, 0}, {8, 2, 0});
+  r.held_object = "wall_north";
+  res = mp.plan(r, Termination::after(1.0));
+  EXPECT_EQ(res.status, MotionStatus::kInvalidRequest);
+  EXPECT_NE(res.reason.find("static"), std::string::npos) << res.reason;
+
+  r = request({2, 2, 0}, {8, 2, 0});
+  r.object_cost_scale = -1;
+  res = mp.plan(r, Termination::after(1.0));
+  EXPECT_EQ(res.status, MotionStatus::kInvalidRequest);
+  EXPECT_NE(res.reason.find("object_cost_scale"), std::string::npos) << res.reason;
+
+  r = request({2, 2, 0}, {8, 2, 0});
+  r.group = PlanningGroup::kArm;
+  res = mp.plan(r, Termination::after(1.0));
+  EXPECT_EQ(res.status, MotionStatus::kInvalidRequest);
+  EXPECT_NE(res.reason.find("group"), std::string::npos) << res.reason;
+
+  r = request({2, 2, 0}, {8, 2, 0});
+  r.goal = MotionGoal::configurationGoal({8, 2});
+  res = mp.plan(r, Termination::after(1.0));
+  EXPECT_EQ(res.status, MotionStatus::kInvalidRequest);
+  EXPECT_NE(res.reason.find("goal.configuration"), std::string::npos) << res.reason;
+
+  r = request({2, 2, 0}, {8, 2, 0});
+  r.start.arm = {0.1};
+  res = mp.plan(r, Termination::after(1.0));
+  EXPECT_EQ(res.status, MotionStatus::kInvalidRequest);
+  EXPECT_NE(res.reason.find("start.arm"), std::string::npos) << res.reason;
+
+  r = request({2, 2, 0}, {8, 2, 0});
+  r.goal = MotionGoal::endEffectorGoal(Eigen::Isometry3d::Identity());
+  res = mp.plan(r, Termination::after(1.0));
+  EXPECT_EQ(res.status, MotionStatus::kInvalidRequest);
+  EXPECT_NE(res.reason.find("goal"), std::string::npos) << res.reason;
+}
+
+TEST_F(FullTest, ExpiredDeadlineAndStopRequestGiveTimeout) {
+  const world::World w = testing::corridorWorld(false);
+  MotionPlannerParams p;
+  p.proof.enabled = false;
+  MotionPlanner mp = planner(w, p);
+  MotionResult r = mp.plan(request({2, 3, 0}, {8, 1, 0}), Termination(Deadline::in(-1.0)));
+  EXPECT_EQ(r.status, MotionStatus::kTimeout) << r.reason;
+  std::stop_source stop;
+  stop.request_stop();
+  r = mp.plan(request({2, 3, 0}, {8, 1, 0}), Termination(Deadline::never(), stop.get_token()));
+  EXPECT_EQ(r.status, MotionStatus::kTimeout);
+  EXPECT_NE(r.reason.find("stop"), std::string::npos) << r.reason;
+}
+
+TEST_F(FullTest, WithoutProofANoPathRunsToTheDeadline) {
+  const world::World w = testing::corridorWorld(true);
+  MotionPlannerParams p;
+  p.proof.enabled = false;
+  MotionPlanner mp = planner(w, p);
+  const MotionResult r = mp.plan(request({2, 2, 0}, {8, 2, 0}), Termination::after(0.3));
+  EXPECT_EQ(r.status, MotionStatus::kTimeout) << r.reason;
+  EXPECT_GE(r.planning_time_s, 0.29);
+}
+
+TEST_F(FullTest, HeldObjectCollidesAsPartOfTheRobot) {
+  // A movable bar carried by the (disc) base, sticking out to its left (0.35 .. 1.15 m): it does
+  // not fit through the 1 m door sideways, so the robot must turn. Re-check: points of the bar's
+  // footprint against the walls, in 2-D.
+  world::World w = testing::corridorWorld(false);
+  world::Object bar = testing::box("bar", 2.0, 2.75, 0.1, 0.8, true, 0.2, 1.0);
+  bar.pose.translation().z() = 0.6;
+  ASSERT_TRUE(w.addObject(bar).ok());
+  MotionPlanner mp = planner(w);
+  MotionRequest req = request({2, 2, 0}, {8, 2, 0});
+  req.held_object = "bar";
+  const MotionResult r = mp.plan(req, Termination::after(10.0));
+  ASSERT_EQ(r.status, MotionStatus::kSolved) << r.reason;
+  // Independent check of the bar's footprint (a 0.1 x 0.8 rectangle at base offset (0, 0.75)).
+  auto wallHit = [&](double x, double y) {
+    for (const auto& o : w.objects()) {
+      if (o.kind != world::ObjectKind::kStatic) continue;
+      const Eigen::Vector3d c = o.pose.translation();
+      if (std::abs(x - c.x()) <= o.shape.size.x() / 2 && std::abs(y - c.y()) <= o.shape.size.y() / 2) return true;
+    }
+    return false;
+  };
+  const auto& wp = r.path.waypoints;
+  for (std::size_t i = 0; i + 1 < wp.size(); ++i) {
+    for (int k = 0; k <= 100; ++k) {
+      const double t = k / 100.0;
+      const double x = wp[i][0] + t * (wp[i + 1][0] - wp[i][0]);
+      const double y = wp[i][1] + t * (wp[i + 1][1] - wp[i][1]);
+      const double th = wp[i][2] + t * (wp[i + 1][2] - wp[i][2]);
+      for (double u : {-0.05, 0.0, 0.05}) {
+        for (double v = 0.35; v <= 1.15 + 1e-9; v += 0.05) {
+          const double px = x + std::cos(th) * u - std::sin(th) * v;
+          const double py = y + std::sin(th) * u + std::cos(th) * v;
+          ASSERT_FALSE(wallHit(px, py)) << "bar hits a wall at waypoint " << i << " t=" << t;
+        }
+      }
+    }
+  }
+}
+
+TEST_F(FullTest, HeldObjectInAWallAtTheStartIsStartInCollision) {
+  world::World w = testing::corridorWorld(false);
+  world::Object bar = testing::box("bar", 2.0, 3.9, 0.1, 0.8, true, 0.2, 1.0);
+  bar.pose.translation().z() = 0.6;
+  ASSERT_TRUE(w.addObject(bar).ok());
+  MotionPlanner mp = planner(w);
+  MotionRequest req = request({2, 3.3, 0}, {8, 2, 0});
+  req.held_object = "bar";
+  const MotionResult r = mp.plan(req, Termination::after(2.0));
+  EXPECT_EQ(r.status, MotionStatus::kStartInCollision) << r.reason;
+  EXPECT_EQ(r.colliding_object, "wall_north");
+}
+
+}  // namespace
+}  // namespace tamp::motion_planner

@@ -1,0 +1,211 @@
+// Lazy mode: the objects in the way, where contact starts and ends, and effort-aware improvement.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "tamp/motion_planner/motion_planner.h"
+#include "test_worlds.h"
+
+namespace tamp::motion_planner {
+namespace {
+
+using testing::discClearance;
+using testing::discTouches;
+
+constexpr double kRadius = 0.3;
+
+class LazyTest : public ::testing::Test {
+ protected:
+  void SetUp() override { seedRandomness(42); }
+  static MotionPlanner planner(const world::World& w, MotionPlannerParams p = {}) {
+    MotionPlanner mp(collision::RobotGeometry::disc(kRadius, 1.0), p);
+    mp.setWorld(w);
+    return mp;
+  }
+  static MotionRequest baseRequest(Pose2D from, Pose2D to, MotionMode mode = MotionMode::kLazy) {
+    MotionRequest r;
+    r.group = PlanningGroup::kBase;
+    r.mode = mode;
+    r.start.base = from;
+    r.goal = MotionGoal::basePoseGoal(to);
+    return r;
+  }
+  static std::vector<std::string> ids(const std::vector<BlockingObject>& b) {
+    std::vector<std::string> out;
+    for (const auto& o : b) out.push_back(o.object_id);
+    std::sort(out.begin(), out.end());
+    return out;
+  }
+};
+
+TEST_F(LazyTest, ReportsExactlyTheObjectThatBlocksTheDoor) {
+  const world::World w = testing::corridorWorld(true);
+  MotionPlanner mp = planner(w);
+  const MotionResult r = mp.plan(baseRequest({2, 2, 0}, {8, 2, 0}), Termination::after(5.0));
+  ASSERT_EQ(r.status, MotionStatus::kSolved) << r.reason;
+  EXPECT_EQ(ids(r.blocking), std::vector<std::string>{"crate"});
+  // The path avoids static geometry (independent 2-D check, 5 mm steps) ...
+  EXPECT_GT(discClearance(w, r.path, kRadius, 0.005, {}, /*movables=*/false), -1e-3);
+  // ... and the independent check sees exactly the reported movables.
+  EXPECT_EQ(discTouches(w, r.path, kRadius, 0.005), ids(r.blocking));
+  // Start and goal as requested.
+  ASSERT_GE(r.path.waypoints.size(), 2u);
+  EXPECT_NEAR(r.path.waypoints.front()[0], 2.0, 1e-9);
+  EXPECT_NEAR(r.path.waypoints.back()[0], 8.0, 0.011);
+  EXPECT_NEAR(r.path.waypoints.back()[1], 2.0, 0.011);
+}
+
+TEST_F(LazyTest, ContactIntervalMatchesTheGeometry) {
+  const world::World w = testing::corridorWorld(true);
+  MotionPlanner mp = planner(w);
+  const MotionResult r = mp.plan(baseRequest({2, 2, 0}, {8, 2, 0}), Termination::after(5.0));
+  ASSERT_EQ(r.status, MotionStatus::kSolved) << r.reason;
+  ASSERT_EQ(r.blocking.size(), 1u);
+  const BlockingObject& b = r.blocking[0];
+  EXPECT_EQ(b.mass, 8.0);
+  EXPECT_GT(b.effort_s, 0.0);
+  ASSERT_EQ(b.intervals.size(), 1u);
+  EXPECT_LT(b.enter_fraction, b.exit_fraction);
+  EXPECT_LE(b.enter_waypoint, b.exit_waypoint);
+  EXPECT_LT(b.exit_waypoint, r.path.waypoints.size());
+  ASSERT_FALSE(b.swept_base.empty());
+  EXPECT_EQ(b.swept_base.size(), b.swept_configurations.size());
+  // Every swept pose is in contact with the crate: the disc centre is within radius of the box
+  // (crate: x in [4.8, 5.2], y in [1.5, 2.5]); the first and last are near the boundary.
+  for (const Pose2D& p : b.swept_base) {
+    const double dx = std::max(std::abs(p.x - 5.0) - 0.2, 0.0), dy = std::max(std::abs(p.y - 2.0) - 0.5, 0.0);
+    EXPECT_LE(std::hypot(dx, dy), kRadius + 0.02) << p;
+  }
+  // The contact starts where the disc reaches x = 4.8 - r along the path (and ends past 5.2 + r),
+  // up to the bisection tolerance; compute the fractions independently from the waypoints.
+  std::vector<double> cum{0.0};
+  for (std::size_t i = 1; i < r.path.waypoints.size(); ++i) {
+    const auto& a = r.path.waypoints[i - 1];
+    const auto& c = r.path.waypoints[i];
+    cum.push_back(cum.back() + std::hypot(c[0] - a[0], c[1] - a[1]) + 0.5 * std::abs(c[2] - a[2]));
+  }
+  auto at = [&](double f) {  // base position at path fraction f (space metric)
+    const double s = f * cum.back();
+    for (std::size_t i = 1; i < cum.size(); ++i) {
+      if (s <= cum[i] || i + 1 == cum.size()) {
+        const double t = cum[i] > cum[i - 1] ? (s - cum[i - 1]) / (cum[i] - cum[i - 1]) : 0.0;
+        const auto& a = r.path.waypoints[i - 1];
+        const auto& c = r.path.waypoints[i];
+        return Eigen::Vector2d(a[0] + t * (c[0] - a[0]), a[1] + t * (c[1] - a[1]));
+      }
+    }
+    return Eigen::Vector2d(r.path.waypoints.back()[0], r.path.waypoints.back()[1]);
+  };
+  auto dist = [](const Eigen::Vector2d& p) {
+    const double dx = std::max(std::abs(p.x() - 5.0) - 0.2, 0.0), dy = std::max(std::abs(p.y() - 2.0) - 0.5, 0.0);
+    return std::hypot(dx, dy);
+  };
+  EXPECT_NEAR(dist(at(b.enter_fraction)), kRadius, 0.02);
+  EXPECT_NEAR(dist(at(b.exit_fraction)), kRadius, 0.02);
+}
+
+TEST_F(LazyTest, GoesAroundALightObjectWhenTheDetourIsCheaper) {
+  const world::World w = testing::openRoomWorld();
+  MotionPlanner mp = planner(w);
+  const MotionResult r = mp.plan(baseRequest({2, 3, 0}, {8, 3, 0}), Termination::after(5.0));
+  ASSERT_EQ(r.status, MotionStatus::kSolved) << r.reason;
+  EXPECT_TRUE(r.blocking.empty()) << "crossed " << r.blocking.front().object_id;
+  EXPECT_TRUE(discTouches(w, r.path, kRadius, 0.005).empty());
+  // The detour is short: the straight line is 6 m, going around a 0.6 m box with r = 0.3 costs little.
+  EXPECT_LT(r.path_length, 6.0 * 1.15);
+}
+
+TEST_F(LazyTest, PrefersOneLightObjectOverTwoHeavyOnes) {
+  const world::World w = testing::twoDoorWorld();
+  MotionPlanner mp = planner(w);
+  const MotionResult r = mp.plan(baseRequest({2, 0.9, 0}, {8, 0.9, 0}), Termination::after(5.0));
+  ASSERT_EQ(r.status, MotionStatus::kSolved) << r.reason;
+  EXPECT_EQ(ids(r.blocking), std::vector<std::string>{"light"});
+  EXPECT_EQ(discTouches(w, r.path, kRadius, 0.005), std::vector<std::string>{"light"});
+  // Its cost is below that of crossing both heavy objects on the straight line.
+  double heavy = 0.0;
+  for (const auto& o : w.objects()) {
+    if (o.id == "heavy_a" || o.id == "heavy_b") heavy += defaultObjectEffort(o, mp.params().cost);
+  }
+  EXPECT_LT(r.cost_s, heavy + 6.0 / mp.params().cost.base_speed);
+  EXPECT_LE(r.cost_s, r.stats.raw_cost_s + 1e-9);
+}
+
+TEST_F(LazyTest, ReportMatchesIndependentCheckForAnyCostScale) {
+  const world::World w = testing::twoDoorWorld();
+  for (double scale : {0.0, 0.2, 1.0, 10.0}) {
+    MotionPlanner mp = planner(w);
+    MotionRequest req = baseRequest({2, 0.9, 0}, {8, 0.9, 0});
+    req.object_cost_scale = scale;
+    const MotionResult r = mp.plan(req, Termination::after(5.0));
+    ASSERT_EQ(r.status, MotionStatus::kSolved) << r.reason;
+    EXPECT_EQ(discTouches(w, r.path, kRadius, 0.005), ids(r.blocking)) << "scale " << scale;
+    EXPECT_GT(discClearance(w, r.path, kRadius, 0.005, {}, false), -1e-3) << "scale " << scale;
+  }
+}
+
+TEST_F(LazyTest, IgnoredObjectsAreNeitherObstaclesNorReported) {
+  const world::World w = testing::corridorWorld(true);
+  MotionPlanner mp = planner(w);
+  MotionRequest req = baseRequest({2, 2, 0}, {8, 2, 0});
+  req.ignored_objects = {"crate"};
+  const MotionResult r = mp.plan(req, Termination::after(5.0));
+  ASSERT_EQ(r.status, MotionStatus::kSolved) << r.reason;
+  EXPECT_TRUE(r.blocking.empty());
+}
+
+TEST_F(LazyTest, GoalInsideAMovableIsAllowedAndReported) {
+  const world::World w = testing::corridorWorld(true);
+  MotionPlanner mp = planner(w);
+  const MotionResult r = mp.plan(baseRequest({2, 2, 0}, {8.8, 3.4, 0}), Termination::after(5.0));
+  ASSERT_EQ(r.status, MotionStatus::kSolved) << r.reason;
+  const auto got = ids(r.blocking);
+  EXPECT_NE(std::find(got.begin(), got.end(), "far_box"), got.end());
+  EXPECT_NEAR(r.blocking.back().exit_fraction, 1.0, 1e-9);
+}
+
+TEST_F(LazyTest, StaticCollisionAtStartOrGoalNamesTheObject) {
+  const world::World w = testing::corridorWorld(true);
+  MotionPlanner mp = planner(w);
+  MotionResult r = mp.plan(baseRequest({5, 0.5, 0}, {8, 2, 0}), Termination::after(2.0));
+  EXPECT_EQ(r.status, MotionStatus::kStartInCollision);
+  EXPECT_EQ(r.colliding_object, "wall_mid_low");
+  r = mp.plan(baseRequest({2, 2, 0}, {5, 3.5, 0}), Termination::after(2.0));
+  EXPECT_EQ(r.status, MotionStatus::kGoalInCollision);
+  EXPECT_EQ(r.colliding_object, "wall_mid_high");
+}
+
+TEST_F(LazyTest, TrajectoryFollowsThePath) {
+  const world::World w = testing::corridorWorld(true);
+  MotionPlanner mp = planner(w);
+  const MotionResult r = mp.plan(baseRequest({2, 2, 0}, {8, 2, 0}), Termination::after(5.0));
+  ASSERT_EQ(r.status, MotionStatus::kSolved) << r.reason;
+  ASSERT_FALSE(r.trajectory.empty());
+  EXPECT_EQ(r.trajectory.joint_names, r.path.joint_names);
+  EXPECT_NO_THROW(r.trajectory.validate());
+  EXPECT_EQ(r.trajectory.points.front().positions, r.path.waypoints.front());
+  for (std::size_t j = 0; j < 3; ++j) {
+    EXPECT_NEAR(r.trajectory.points.back().positions[j], r.path.waypoints.back()[j], 1e-9);
+  }
+  EXPECT_GT(r.trajectory.duration(), r.path_length / mp.params().timing.base_linear_speed);
+}
+
+TEST_F(LazyTest, WorldUpdatesBetweenCallsAreApplied) {
+  world::World w = testing::corridorWorld(true);
+  MotionPlanner mp = planner(w);
+  MotionResult r = mp.plan(baseRequest({2, 2, 0}, {8, 2, 0}), Termination::after(5.0));
+  ASSERT_EQ(ids(r.blocking), std::vector<std::string>{"crate"});
+  // Move the crate out of the door: the next call sees it.
+  Eigen::Isometry3d p = w.object("crate").pose;
+  p.translation().x() = 2.0;
+  p.translation().y() = 3.4;
+  ASSERT_TRUE(w.setObjectPose("crate", p).ok());
+  mp.setWorld(w);
+  r = mp.plan(baseRequest({2, 1.0, 0}, {8, 2, 0}), Termination::after(5.0));
+  ASSERT_EQ(r.status, MotionStatus::kSolved) << r.reason;
+  EXPECT_TRUE(r.blocking.empty()) << r.blocking.front().object_id;
+}
+
+}  // namespace
+}  // namespace tamp::motion_planner

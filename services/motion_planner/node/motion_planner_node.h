@@ -1,0 +1,75 @@
+#pragma once
+/// @file
+/// The motion planning service over DDS: a thin adapter around tamp::motion_planner::MotionPlanner.
+///
+/// - Serves `services::kMotion`, `kPlacement` and `kGrasp` (idl/motion.idl) with one RpcServer
+///   each; requests run one at a time on the planner (one scene, guarded by a mutex).
+/// - Mirrors the world model (`tamp::dds::WorldMirror`, topics tamp/world/objects + meta); before
+///   each request the planner's scene is brought to the mirror's latest world (a diff: cheap when
+///   little changed). A request naming a `world_version` waits (at most `world_wait_s`) for it.
+/// - Motion outcomes are typed in the reply (`MotionReply::status` + `reason`), including
+///   MOTION_INVALID_REQUEST for malformed requests (the reason names the IDL field); the reply
+///   header says STATUS_OK then. Placement and grasp errors use the header's status code
+///   (NOT_FOUND, INVALID_ARGUMENT, UNSUPPORTED, TIMEOUT, UNAVAILABLE) and message.
+/// - Budget: the client's remaining budget (RequestContext) and its cancellation; a request
+///   without budget gets `default_budget_s`.
+
+#include <filesystem>
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include "tamp/dds/service_node.h"
+#include "tamp/dds/world_sync.h"
+#include "tamp/motion_planner/motion_planner.h"
+
+namespace tamp::motion_planner {
+
+/// The service's configuration file: the planner parameters (params.h) plus a `node` section.
+struct NodeConfig {
+  std::string robot{"mobile_manipulator"};  ///< "mobile_manipulator" or "disc"
+  std::filesystem::path urdf;               ///< mobile_manipulator: URDF; empty: RobotModel::loadDefault()
+  double disc_radius{0.354};                ///< disc: m, > 0
+  double disc_height{1.0};                  ///< disc: m, > 0
+  std::string world_id{"world"};
+  double default_budget_s{5.0};             ///< > 0
+  double world_wait_s{2.0};                 ///< >= 0
+  MotionPlannerParams params;
+};
+
+/// Reads a configuration file (`config/services/motion_planner.yaml` layout); errors name
+/// file:line:column and the field.
+Result<NodeConfig> loadNodeConfig(const std::filesystem::path& file);
+Result<NodeConfig> parseNodeConfig(const std::string& yaml_text, const std::string& name);
+
+class MotionPlannerNode : public dds::ServiceNode {
+ public:
+  /// For serviceMain: reads `args.config_file` (default: configDir()/services/motion_planner.yaml).
+  static Result<std::unique_ptr<dds::ServiceNode>> create(const dds::ServiceArgs& args);
+  /// With a configuration in hand (tests, embedded use). Throws std::runtime_error when DDS fails.
+  static Result<std::unique_ptr<MotionPlannerNode>> create(const dds::ServiceArgs& args, NodeConfig config);
+  ~MotionPlannerNode() override;
+
+  msg::MotionReply handleMotion(const msg::MotionRequest& req, const dds::RequestContext& ctx);
+  msg::PlacementReply handlePlacement(const msg::PlacementRequest& req, const dds::RequestContext& ctx);
+  msg::GraspReply handleGrasp(const msg::GraspRequest& req, const dds::RequestContext& ctx);
+
+ protected:
+  std::pair<uint64_t, uint64_t> requestCounters() const override;
+
+ private:
+  MotionPlannerNode(const dds::ServiceArgs& args, NodeConfig config, MotionPlanner planner);
+  /// The request's termination (default budget when none), and the world brought up to date.
+  /// Returns an error when the requested world version does not arrive in time.
+  Result<Termination> prepare(uint64_t world_version, const dds::RequestContext& ctx);
+
+  NodeConfig config_;
+  std::mutex mutex_;  // guards planner_
+  MotionPlanner planner_;
+  std::unique_ptr<dds::WorldMirror> mirror_;
+  std::unique_ptr<dds::RpcServer<msg::MotionRequest, msg::MotionReply>> motion_;
+  std::unique_ptr<dds::RpcServer<msg::PlacementRequest, msg::PlacementReply>> placement_;
+  std::unique_ptr<dds::RpcServer<msg::GraspRequest, msg::GraspReply>> grasp_;
+};
+
+}  // namespace tamp::motion_planner

@@ -16,6 +16,7 @@
 #include <kdl/frames.hpp>
 #include <kdl/jntarray.hpp>
 
+#include "tamp/config/yaml_reader.h"
 #include "tamp/core/paths.h"
 #include "tamp/core/trajectory.h"
 
@@ -210,7 +211,67 @@ Result<RobotModel> RobotModel::loadFile(const std::filesystem::path& file,
 }
 
 Result<RobotModel> RobotModel::loadDefault() {
-  return loadFile(configDir() / "robots" / "mobile_manipulator.urdf");
+  return loadDescription(configDir() / "robots" / "mobile_manipulator.yaml");
+}
+
+Result<RobotModel> RobotModel::loadDescription(const std::filesystem::path& yaml_file) {
+  auto doc = config::loadYamlFile(yaml_file);
+  if (!doc) return doc.error();
+  config::FieldReader r(*doc);
+  RobotModelOptions o;
+  std::string urdf;
+  r.required("urdf", urdf);
+  r.optional("base_link", o.base_link);
+  r.optional("tool_link", o.tool_link);
+  r.optional("gripper_joint", o.gripper_joint);
+  r.optional("camera_frame", o.camera_frame);
+  {
+    auto g = r.child("gripper", false);
+    if (r.has("gripper")) {
+      g.required("open", o.gripper_open);
+      g.required("closed", o.gripper_closed);
+      g.refuseUnknownKeys();
+    }
+  }
+  {
+    auto named = r.child("named_configurations", false);
+    if (named.isMap()) {
+      for (auto it = named.node().begin(); it != named.node().end(); ++it) {
+        const std::string name = it->first.as<std::string>();
+        std::vector<double> q;
+        if (named.required(name, q)) o.named_configurations.emplace_back(name, std::move(q));
+      }
+    }
+  }
+  r.refuseUnknownKeys();
+  if (!r.ok()) return r.errors().size() == 1 ? r.errors().front() : r.status().error();
+  auto model = loadFile(resolveRelativeTo(yaml_file, urdf), o);
+  if (!model) return model.error();
+  // Named configurations must fit the arm; gripper values its joint.
+  std::vector<Error> errors;
+  const config::FieldReader named = r.child("named_configurations", false);
+  for (const auto& [name, q] : o.named_configurations) {
+    const SourceLocation where = named.locationOf(name);
+    if (q.size() != model->armDof()) {
+      errors.emplace_back(ErrorCode::kInvalidArgument,
+                          "has " + std::to_string(q.size()) + " values, the arm has " +
+                              std::to_string(model->armDof()) + " joints",
+                          where);
+    } else if (!model->withinLimits(q)) {
+      errors.emplace_back(ErrorCode::kInvalidArgument, "is outside the joint limits", where);
+    }
+  }
+  const auto gl = model->gripperLimits();
+  if (!model->gripperJointName().empty() &&
+      (o.gripper_open < gl.lower || o.gripper_open > gl.upper || o.gripper_closed < gl.lower ||
+       o.gripper_closed > gl.upper)) {
+    errors.emplace_back(ErrorCode::kInvalidArgument,
+                        "open/closed values must be within the gripper joint limits",
+                        r.locationOf("gripper"));
+  }
+  if (errors.size() == 1) return errors.front();
+  if (!errors.empty()) return Error(errors.front().code, joinErrors(errors));
+  return model;
 }
 
 Result<RobotModel> RobotModel::fromUrdfString(const std::string& xml, const std::string& source,
@@ -651,11 +712,28 @@ std::vector<double> RobotModel::randomArmConfiguration(std::mt19937& rng) const 
 RobotState RobotModel::defaultState(const Pose2D& base) const {
   RobotState s;
   s.base = base;
-  s.arm.assign(armDof(), 0.0);
-  for (size_t k = 0; k < s.arm.size(); ++k)
-    s.arm[k] = std::clamp(0.0, impl_->arm_limits[k].lower, impl_->arm_limits[k].upper);
-  s.gripper = impl_->gripper_joint >= 0 ? gripperLimits().lower : 0.0;
+  if (auto stow = namedConfiguration("stow")) {
+    s.arm = *stow;
+  } else {
+    s.arm.assign(armDof(), 0.0);
+    for (size_t k = 0; k < s.arm.size(); ++k)
+      s.arm[k] = std::clamp(0.0, impl_->arm_limits[k].lower, impl_->arm_limits[k].upper);
+  }
+  s.gripper = impl_->gripper_joint >= 0 ? impl_->options.gripper_closed : 0.0;
   return s;
+}
+
+std::optional<std::vector<double>> RobotModel::namedConfiguration(std::string_view name) const {
+  for (const auto& [n, q] : impl_->options.named_configurations) {
+    if (n == name && q.size() == armDof()) return q;
+  }
+  return std::nullopt;
+}
+
+std::vector<std::string> RobotModel::namedConfigurationNames() const {
+  std::vector<std::string> out;
+  for (const auto& nq : impl_->options.named_configurations) out.push_back(nq.first);
+  return out;
 }
 
 // ---- kinematics ---------------------------------------------------------------------------------

@@ -1,5 +1,6 @@
 #include "tamp/robot/robot_model.h"
 
+#include <fstream>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -261,6 +262,70 @@ TEST(RobotModelTest, JointValueConversions) {
   const auto bad = r.fromJointValues({"elbow"}, std::vector<double>{1.0}, s);
   ASSERT_FALSE(bad.ok());
   EXPECT_EQ(bad.error().message, "joint 'elbow' is not a joint of robot 'mobile_manipulator'");
+}
+
+TEST(RobotDescriptionTest, NamedConfigurations) {
+  auto loaded = RobotModel::loadDescription(std::filesystem::path(TAMP_SOURCE_DIR) /
+                                            "config/robots/mobile_manipulator.yaml");
+  ASSERT_TRUE(loaded.ok()) << loaded.error().toString();
+  const RobotModel& r = *loaded;
+  EXPECT_EQ(r.namedConfigurationNames(), (std::vector<std::string>{"stow", "ready"}));
+  EXPECT_EQ(r.defaultState().arm, *r.namedConfiguration("stow"));
+  EXPECT_DOUBLE_EQ(r.options().gripper_open, 0.04);
+  collision::Scene scene;
+  scene.setRobot(r.collisionGeometry());
+  std::vector<Eigen::Isometry3d> P;
+  for (const auto& name : r.namedConfigurationNames()) {
+    RobotState s = r.defaultState();
+    s.arm = *r.namedConfiguration(name);
+    for (double g : {r.options().gripper_closed, r.options().gripper_open}) {
+      s.gripper = g;
+      r.linkPoses(s, P);
+      scene.setLinkPoses(P);
+      EXPECT_TRUE(scene.selfCollisions().empty()) << name;
+    }
+  }
+  // Stowed, every arm link stays within the base footprint (the base can move without sweeping
+  // the arm through the world).
+  RobotState s = r.defaultState();
+  r.linkPoses(s, P);
+  for (size_t k = 0; k < P.size(); ++k) {
+    const Eigen::Vector3d t = P[k].translation();
+    EXPECT_LT(std::abs(t.x()), 0.3) << r.linkNames()[k];
+    EXPECT_LT(std::abs(t.y()), 0.25) << r.linkNames()[k];
+  }
+  EXPECT_FALSE(r.namedConfiguration("dance").has_value());
+}
+
+TEST(RobotDescriptionTest, BrokenDescriptionsNameTheField) {
+  const auto dir = std::filesystem::temp_directory_path() / "tamp_robot_desc_test";
+  std::filesystem::create_directories(dir);
+  std::filesystem::copy_file(
+      std::filesystem::path(TAMP_SOURCE_DIR) / "config/robots/mobile_manipulator.urdf",
+      dir / "mobile_manipulator.urdf", std::filesystem::copy_options::overwrite_existing);
+  const auto write = [&](const std::string& text) {
+    std::ofstream(dir / "robot.yaml") << text;
+    return RobotModel::loadDescription(dir / "robot.yaml");
+  };
+  const std::string file = (dir / "robot.yaml").string();
+  auto r1 = write("urdf: mobile_manipulator.urdf\nnamed_configurations:\n  stow: [0, 0, 0]\n");
+  ASSERT_FALSE(r1.ok());
+  EXPECT_EQ(r1.error().toString(),
+            file + ":3:9: field 'named_configurations.stow': has 3 values, the arm has 6 joints");
+  auto r2 =
+      write("urdf: mobile_manipulator.urdf\nnamed_configurations:\n  up: [0, 0, 9, 0, 0, 0]\n");
+  ASSERT_FALSE(r2.ok());
+  EXPECT_EQ(r2.error().toString(),
+            file + ":3:7: field 'named_configurations.up': is outside the joint limits");
+  auto r3 = write("urdf: mobile_manipulator.urdf\ntool: gripper_tcp\n");
+  ASSERT_FALSE(r3.ok());
+  EXPECT_EQ(r3.error().toString(), file +
+                                       ":2:1: field 'tool': unknown key 'tool' (expected one of: "
+                                       "base_link, camera_frame, gripper, "
+                                       "gripper_joint, named_configurations, tool_link, urdf)");
+  auto r4 = write("urdf: missing.urdf\n");
+  ASSERT_FALSE(r4.ok());
+  EXPECT_EQ(r4.error().code, ErrorCode::kNotFound);
 }
 
 // ---- broken URDFs ------------------------------------------------------------------------------

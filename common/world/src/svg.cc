@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cmath>
 #include <map>
+#include <optional>
 
 #include <tinyxml2.h>
 #include <Eigen/Geometry>

@@ -66,12 +66,17 @@ struct Joint {
   double mimic_offset{0.0};
 };
 
-/// Which URDF frames play which role.
+/// Which URDF frames play which role, and named configurations (the robot description YAML,
+/// config/robots/mobile_manipulator.yaml, next to the URDF).
 struct RobotModelOptions {
   std::string base_link{"base_link"};    ///< root of the arm chain, on the floor
   std::string tool_link{"gripper_tcp"};  ///< tip of the arm chain (tool centre point)
   std::string gripper_joint{"gripper_finger_left_joint"};  ///< empty: no gripper
   std::string camera_frame{"camera_optical_frame"};        ///< empty: no sensor
+  double gripper_open{0.04};   ///< gripper joint value when open (m per finger)
+  double gripper_closed{0.0};  ///< gripper joint value when closed
+  /// Named arm configurations (arm joints in chain order), e.g. "stow" (the PDDL constant).
+  std::vector<std::pair<std::string, std::vector<double>>> named_configurations;
 };
 
 /// A full configuration of the robot.
@@ -118,7 +123,12 @@ class RobotModel {
   /// Same from text; `source_name` is used as the file name in messages.
   static Result<RobotModel> fromUrdfString(const std::string& xml, const std::string& source_name,
                                            const RobotModelOptions& options = {});
-  /// The project's robot: configDir()/robots/mobile_manipulator.urdf.
+  /// Loads a robot description YAML (urdf path relative to it, frame roles, gripper values,
+  /// named configurations; see config/robots/mobile_manipulator.yaml). Errors name the YAML's
+  /// file, line and field, or the URDF's. Named configurations must have one value per arm joint
+  /// within the limits.
+  static Result<RobotModel> loadDescription(const std::filesystem::path& yaml_file);
+  /// The project's robot: configDir()/robots/mobile_manipulator.yaml.
   static Result<RobotModel> loadDefault();
 
   RobotModel(const RobotModel& other);
@@ -157,8 +167,13 @@ class RobotModel {
   bool withinLimits(std::span<const double> arm, double tolerance = 1e-9) const;
   /// A uniformly random arm configuration within the limits.
   std::vector<double> randomArmConfiguration(std::mt19937& rng) const;
-  /// A state with the base at `base`, the arm at zero (clamped into the limits), gripper closed.
+  /// A state with the base at `base`, the arm at "stow" if named (else zero clamped into the
+  /// limits), gripper closed.
   RobotState defaultState(const Pose2D& base = {}) const;
+  /// A named arm configuration, or nullopt.
+  std::optional<std::vector<double>> namedConfiguration(std::string_view name) const;
+  /// Names of the named configurations, in file order.
+  std::vector<std::string> namedConfigurationNames() const;
 
   // ---- kinematics ------------------------------------------------------------------------------
   /// base_link_T_tool for the arm joints (KDL). Throws std::invalid_argument on a wrong size.

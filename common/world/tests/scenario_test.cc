@@ -1,0 +1,390 @@
+#include "tamp/world/scenario.h"
+
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <set>
+
+#include <gtest/gtest.h>
+
+#include "tamp/collision/scene.h"
+
+namespace tamp::world {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path scenarioDir() { return fs::path(TAMP_SOURCE_DIR) / "config" / "scenarios"; }
+
+const robot::RobotModel& robotModel() {
+  static const robot::RobotModel m = robot::RobotModel::loadDefault().value();
+  return m;
+}
+
+Scenario load(const std::string& name) {
+  auto r = loadScenario(scenarioDir() / (name + ".yaml"));
+  if (!r) throw std::runtime_error(r.error().toString());
+  return std::move(r).value();
+}
+
+std::vector<std::string> shippedScenarios() {
+  std::vector<std::string> out;
+  for (const auto& e : fs::directory_iterator(scenarioDir())) {
+    if (e.path().extension() == ".yaml") out.push_back(e.path().stem().string());
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// ---- a minimal PDDL problem reader, independent of the generator -------------------------------
+
+struct ProblemFacts {
+  std::set<std::pair<std::string, std::string>> objects;  // (name, type)
+  std::set<std::string> init, goal;
+};
+
+std::string section(const std::string& text, const std::string& key) {
+  const auto start = text.find("(" + key);
+  if (start == std::string::npos) return "";
+  int depth = 0;
+  for (size_t i = start; i < text.size(); ++i) {
+    if (text[i] == '(') ++depth;
+    if (text[i] == ')' && --depth == 0)
+      return text.substr(start + key.size() + 1, i - start - key.size() - 1);
+  }
+  return "";
+}
+
+std::string stripComments(const std::string& text) {
+  std::string out;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) out += line.substr(0, line.find(';')) + "\n";
+  return out;
+}
+
+std::set<std::string> atoms(const std::string& s) {
+  std::set<std::string> out;
+  static const std::regex atom(R"(\(([a-z-]+)((?:\s+[a-z_0-9-]+)*)\s*\))");
+  for (auto it = std::sregex_iterator(s.begin(), s.end(), atom); it != std::sregex_iterator();
+       ++it) {
+    std::string args = (*it)[2].str();
+    std::istringstream in(args);
+    std::string norm = "(" + (*it)[1].str();
+    for (std::string a; in >> a;) norm += " " + a;
+    norm += ")";
+    if ((*it)[1].str() != "and" && (*it)[1].str() != "total-cost") out.insert(norm);
+  }
+  return out;
+}
+
+ProblemFacts readProblem(const fs::path& file) {
+  std::ifstream in(file);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string text = stripComments(ss.str());
+  ProblemFacts f;
+  std::istringstream objs(section(text, ":objects"));
+  std::vector<std::string> pending;
+  for (std::string t; objs >> t;) {
+    if (t == "-") {
+      std::string type;
+      objs >> type;
+      for (const auto& n : pending) f.objects.insert({n, type});
+      pending.clear();
+    } else {
+      pending.push_back(t);
+    }
+  }
+  f.init = atoms(section(text, ":init"));
+  f.goal = atoms(section(text, ":goal"));
+  return f;
+}
+
+// ---- shipped scenarios
+// ---------------------------------------------------------------------------
+
+TEST(ScenarioTest, EveryShippedScenarioLoadsCleanly) {
+  const auto names = shippedScenarios();
+  EXPECT_GE(names.size(), 6u);
+  for (const auto& n : names) {
+    auto r = loadScenario(scenarioDir() / (n + ".yaml"));
+    ASSERT_TRUE(r.ok()) << n << ": " << r.error().toString();
+    EXPECT_EQ(r->name, n) << "scenario name must match its file name";
+    EXPECT_TRUE(fs::exists(r->domain)) << n;
+    EXPECT_FALSE(r->goal.empty()) << n;
+    for (const auto& w : r->warnings) ADD_FAILURE() << n << ": " << w;
+    // The PDDL problem derives without error.
+    auto p = toPddlProblem(*r, robotModel());
+    ASSERT_TRUE(p.ok()) << n << ": " << p.error().toString();
+  }
+}
+
+TEST(ScenarioTest, RobotIsFreeAtEveryLocation) {
+  for (const auto& n : shippedScenarios()) {
+    const Scenario sc = load(n);
+    collision::Scene scene(sc.world);  // the truth, hidden objects included
+    scene.setRobot(robotModel().collisionGeometry());
+    ASSERT_TRUE(scene.attachHeld());  // a held object moves with the gripper
+    std::vector<Eigen::Isometry3d> poses;
+    for (const auto& l : sc.world.locations()) {
+      robot::RobotState s = robotModel().defaultState(l.pose);
+      robotModel().linkPoses(s, poses);
+      scene.setLinkPoses(poses);
+      const auto hits = scene.robotCollisions();
+      EXPECT_TRUE(hits.empty()) << n << " at " << l.id << " hits "
+                                << (hits.empty() ? "" : hits.front());
+    }
+  }
+}
+
+TEST(ScenarioTest, GeneratedProblemsMatchTheHandWrittenOnes) {
+  for (const std::string n : {"occluded_can", "holding_start", "namo_corridor"}) {
+    const Scenario sc = load(n);
+    ASSERT_EQ(sc.problem, fs::path(TAMP_SOURCE_DIR) / "config/pddl/problems" / (n + ".pddl")) << n;
+    const ProblemFacts want = readProblem(sc.problem);
+    auto got = toPddlProblem(sc, robotModel());
+    ASSERT_TRUE(got.ok()) << got.error().toString();
+    const std::set<std::pair<std::string, std::string>> objs(got->objects.begin(),
+                                                             got->objects.end());
+    EXPECT_EQ(objs, want.objects) << n;
+    EXPECT_EQ(std::set<std::string>(got->init.begin(), got->init.end()), want.init) << n;
+    EXPECT_EQ(std::set<std::string>(got->goal.begin(), got->goal.end()), want.goal) << n;
+    // The text form reads back to the same facts.
+    const fs::path tmp = fs::temp_directory_path() / ("tamp_scenario_test_" + n + ".pddl");
+    std::ofstream(tmp) << got->text();
+    const ProblemFacts back = readProblem(tmp);
+    EXPECT_EQ(back.init, want.init) << got->text();
+    EXPECT_EQ(back.objects, want.objects) << got->text();
+  }
+}
+
+TEST(ScenarioTest, OccludedCanIsKinematicallyFeasible) {
+  const Scenario sc = load("occluded_can");
+  const Object& can = sc.world.object("can");
+  EXPECT_NEAR(can.pose.translation().z(), 0.75 + 0.06, 1e-12);  // resting on the table top
+  // From near_table, a top-down grasp of the can (tool 2 cm below its top).
+  const Pose2D base = sc.world.findLocation("near_table")->pose;
+  Eigen::Isometry3d target = Eigen::Isometry3d::Identity();
+  target.translation() = can.pose.translation() + Eigen::Vector3d(0, 0, 0.04);
+  target.linear() = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  const auto ik = robotModel().inverseKinematics(base.toIsometry().inverse() * target,
+                                                 robotModel().defaultState().arm);
+  EXPECT_TRUE(ik.ok()) << toString(ik.status);
+  // And the counter from near_counter.
+  EXPECT_TRUE(reachesRegion(robotModel(), sc.world.findLocation("near_counter")->pose,
+                            *sc.world.findRegion("counter")));
+  EXPECT_FALSE(reachesRegion(robotModel(), sc.world.findLocation("start")->pose,
+                             *sc.world.findRegion("table")));
+}
+
+TEST(ScenarioTest, HoldingStartPutsTheCupInTheGripper) {
+  const Scenario sc = load("holding_start");
+  ASSERT_TRUE(sc.world.held().has_value());
+  EXPECT_EQ(sc.world.held()->object_id, "cup");
+  EXPECT_EQ(sc.world.held()->link, "gripper_tcp");
+  const Eigen::Isometry3d tool = robotModel().toolPoseInWorld(sc.startState());
+  const Eigen::Vector3d expect = tool * Eigen::Vector3d(0, 0, 0.03);
+  EXPECT_LT((sc.world.object("cup").pose.translation() - expect).norm(), 1e-12);
+  EXPECT_TRUE(sc.world.object("cup").region.empty());
+  EXPECT_EQ(sc.robot.arm_configuration, "stow");
+  EXPECT_DOUBLE_EQ(sc.robot.gripper, 0.04);
+}
+
+TEST(ScenarioTest, HiddenCrateBlocksTheStraightPath) {
+  const Scenario sc = load("namo_room_hidden");
+  EXPECT_EQ(sc.world.hiddenCount(), 1u);
+  const World planner = sc.plannerWorld();
+  EXPECT_EQ(planner.findObject("crate"), nullptr);
+  collision::Scene seen(planner), truth(sc.world);
+  for (auto* s : {&seen, &truth}) s->setRobot(robotModel().collisionGeometry());
+  const Pose2D a = sc.world.findLocation("start")->pose, b = sc.world.findLocation("goal")->pose;
+  const double heading = std::atan2(b.y - a.y, b.x - a.x);
+  std::set<std::string> hit_seen, hit_truth;
+  std::vector<Eigen::Isometry3d> poses;
+  for (int i = 0; i <= 200; ++i) {
+    const double t = i / 200.0;
+    const Pose2D p{a.x + t * (b.x - a.x), a.y + t * (b.y - a.y), heading};
+    robotModel().linkPoses(robotModel().defaultState(p), poses);
+    for (auto* s : {&seen, &truth}) s->setLinkPoses(poses);
+    for (const auto& id : seen.robotCollisions()) hit_seen.insert(id);
+    for (const auto& id : truth.robotCollisions()) hit_truth.insert(id);
+  }
+  EXPECT_TRUE(hit_seen.empty()) << *hit_seen.begin();
+  EXPECT_EQ(hit_truth, std::set<std::string>{"crate"});
+}
+
+TEST(ScenarioTest, CorridorIsBlockedByTheBox) {
+  const Scenario sc = load("namo_corridor");
+  collision::Scene scene(sc.world);
+  scene.setRobot(robotModel().collisionGeometry());
+  std::vector<Eigen::Isometry3d> poses;
+  // Driving straight along the corridor axis (y = 1.2) hits the box and nothing else.
+  std::set<std::string> hits;
+  for (double x = 3.0; x <= 7.0; x += 0.05) {
+    robotModel().linkPoses(robotModel().defaultState({x, 1.2, 0.0}), poses);
+    scene.setLinkPoses(poses);
+    for (const auto& id : scene.robotCollisions()) hits.insert(id);
+  }
+  EXPECT_EQ(hits, std::set<std::string>{"box"});
+  // Without the box the corridor is passable; the detour opening is at y in [4.6, 5.8].
+  World w = sc.world;
+  ASSERT_TRUE(w.removeObject("box"));
+  collision::Scene empty(w);
+  empty.setRobot(robotModel().collisionGeometry());
+  for (double x = 3.0; x <= 7.0; x += 0.05) {
+    robotModel().linkPoses(robotModel().defaultState({x, 1.2, 0.0}), poses);
+    empty.setLinkPoses(poses);
+    EXPECT_FALSE(empty.robotInCollision()) << "x = " << x;
+    robotModel().linkPoses(robotModel().defaultState({x, 5.2, 0.0}), poses);
+    empty.setLinkPoses(poses);
+    EXPECT_FALSE(empty.robotInCollision()) << "detour x = " << x;
+  }
+  EXPECT_LT(sc.world.object("box").mass, 2.0);
+}
+
+TEST(ScenarioTest, FaultsAreParsed) {
+  const Scenario sc = load("holding_start_faults");
+  ASSERT_EQ(sc.faults.size(), 3u);
+  EXPECT_EQ(sc.faults[0].kind, FaultKind::kDropHeld);
+  EXPECT_DOUBLE_EQ(*sc.faults[0].at_time, 2.0);
+  EXPECT_EQ(sc.faults[1].kind, FaultKind::kActionFails);
+  EXPECT_EQ(*sc.faults[1].at_step, 3);
+  EXPECT_EQ(sc.faults[1].action, "pick");
+  EXPECT_EQ(sc.faults[2].kind, FaultKind::kObjectAppears);
+  ASSERT_TRUE(sc.faults[2].object.has_value());
+  EXPECT_EQ(sc.faults[2].object->id, "parcel");
+  EXPECT_NEAR(sc.faults[2].object->pose.translation().z(), 0.75 + 0.05, 1e-12);
+  EXPECT_EQ(sc.world.findObject("parcel"), nullptr);  // not in the world until it appears
+  EXPECT_EQ(sc.sim.seed, 3u);
+}
+
+TEST(ScenarioTest, NamoScenarios) {
+  const Scenario basic = load("namo_basic");
+  ASSERT_TRUE(basic.namo.has_value());
+  EXPECT_NEAR(basic.namo->robot_radius, 0.40, 1e-9);
+  EXPECT_EQ(basic.goal.base_location, "goal_01");
+  EXPECT_NE(basic.world.findObject("movable_box"), nullptr);
+  const Scenario m = load("namo_moghaddam_07");
+  EXPECT_NEAR(m.namo->robot_radius, 0.5 / std::sqrt(2.0), 1e-9);
+  // A NAMO world file works as a scenario on its own.
+  auto direct =
+      loadScenario(fs::path(TAMP_SHARED_DIR) /
+                   "benchmarks/namo/s-namo_cases/02_basic_with_opening/02_basic_with_opening.json");
+  ASSERT_TRUE(direct.ok()) << direct.error().toString();
+  EXPECT_EQ(direct->name, "namo_02_basic_with_opening");
+  EXPECT_NEAR(direct->namo->robot_radius, robotModel().baseRadius(), 1e-9);
+  EXPECT_TRUE(direct->goal.base.has_value());
+}
+
+// ---- broken scenarios: the exact error text
+// ------------------------------------------------------
+
+const std::string kFile = (scenarioDir() / "inline.yaml").string();
+
+std::string errorOf(const std::string& yaml) {
+  auto r = parseScenario(yaml, kFile);
+  if (r.ok()) return "(loaded)";
+  return r.error().toString();
+}
+
+const char* kMinimal = R"yaml(name: mini
+robot: {start: start}
+world:
+  regions: [{id: table, kind: table, rect: [1, -0.5, 2, 0.5], height: 0.75}]
+  locations: [{id: start, pose: [-1, 0, 0]}]
+  objects:
+    - {id: can, kind: movable, shape: {type: cylinder, radius: 0.03, height: 0.12}, on: table, at: [1.5, 0], mass: 0.3, graspable: true}
+goal: {pddl: ["(holding can)"]}
+)yaml";
+
+TEST(ScenarioErrorsTest, MinimalLoads) {
+  auto r = parseScenario(kMinimal, kFile);
+  ASSERT_TRUE(r.ok()) << r.error().toString();
+  EXPECT_EQ(r->robot.arm_configuration, "stow");
+  EXPECT_EQ(r->domain, fs::path(TAMP_SOURCE_DIR) / "config/pddl/mobile_manipulation.pddl");
+}
+
+std::string replaced(std::string s, const std::string& from, const std::string& to) {
+  const auto pos = s.find(from);
+  if (pos == std::string::npos) throw std::logic_error("no '" + from + "' in the template");
+  return s.replace(pos, from.size(), to);
+}
+
+TEST(ScenarioErrorsTest, ExactMessages) {
+  EXPECT_EQ(errorOf(replaced(kMinimal, "mass: 0.3", "mass: 0.3, colour: red")),
+            kFile +
+                ":7:121: field 'world.objects[0].colour': unknown key 'colour' (expected one of: "
+                "at, graspable, id, "
+                "kind, label, mass, on, pose, shape)");
+  EXPECT_EQ(errorOf(replaced(kMinimal, "on: table", "on: tabel")),
+            kFile + ":7:89: field 'world.objects[0].on': unknown region 'tabel'");
+  EXPECT_EQ(errorOf(replaced(kMinimal, "at: [1.5, 0]", "at: [3.5, 0]")),
+            kFile + ":7:100: field 'world.objects[0].at': [3.5, 0] is outside region 'table'");
+  EXPECT_EQ(errorOf(replaced(kMinimal, "type: cylinder", "type: cone")),
+            kFile +
+                ":7:46: field 'world.objects[0].shape.type': unknown shape type 'cone' (expected "
+                "box, cylinder, "
+                "sphere or prism)");
+  EXPECT_EQ(
+      errorOf(replaced(kMinimal, "radius: 0.03", "radius: -0.03")),
+      kFile + ":7:39: field 'world.objects[0].shape': cylinder radius must be positive, got -0.03");
+  EXPECT_EQ(errorOf(replaced(kMinimal, "mass: 0.3", "mass: 0")),
+            kFile +
+                ":7:116: field 'world.objects[0].mass': a movable object needs a positive mass "
+                "(kg), got 0");
+  EXPECT_EQ(errorOf(replaced(kMinimal, "robot: {start: start}", "robot: {start: home}")),
+            kFile + ":2:16: field 'robot.start': unknown location 'home'");
+  EXPECT_EQ(errorOf(replaced(kMinimal, "robot: {start: start}",
+                             "robot: {start: start, arm: [0, 0, 0, 0, 0, 3.5]}")),
+            kFile + ":2:28: field 'robot.arm': arm_joint_6 = 3.5 is outside its limits [-3, 3]");
+  EXPECT_EQ(
+      errorOf(replaced(kMinimal, "robot: {start: start}", "robot: {start: start, arm: dance}")),
+      kFile +
+          ":2:28: field 'robot.arm': unknown arm configuration 'dance' (robot has: stow, ready)");
+  EXPECT_EQ(errorOf(replaced(kMinimal, "(holding can)", "(holding table)")),
+            kFile +
+                ":8:14: field 'goal.pddl': 'table' in '(holding table)' is not a movable object "
+                "(hidden objects are "
+                "unknown to the planner)");
+  EXPECT_EQ(errorOf(replaced(kMinimal, "(holding can)", "(on can)")),
+            kFile + ":8:14: field 'goal.pddl': 'on' takes 2 arguments, got 1");
+  EXPECT_EQ(errorOf(replaced(kMinimal, "(holding can)", "(grasped can)")),
+            kFile + ":8:14: field 'goal.pddl': unknown predicate 'grasped' in '(grasped can)'");
+  EXPECT_EQ(errorOf(replaced(kMinimal, "name: mini", "name: Mini")),
+            kFile + ":1:7: field 'name': 'Mini' is not a valid id");
+  EXPECT_EQ(
+      errorOf(std::string(kMinimal) + "faults: [{type: drop_held, at_time: 1, at_step: 2}]\n"),
+      kFile + ":9:10: field 'faults[0]': give exactly one of 'at_time' (s) or 'at_step'");
+  EXPECT_EQ(errorOf(std::string(kMinimal) + "sim: {grasp_duration: -1}\n"),
+            kFile + ":9:23: field 'sim.grasp_duration': must be >= 0, got -1");
+  EXPECT_EQ(errorOf(replaced(kMinimal, "world:\n", "world:\n  namo: ${NOPE}/x.json\n")),
+            kFile +
+                ":4:9: field 'world.namo': unknown variable in path '${NOPE}/x.json' (known: "
+                "${TAMP_SHARED_DIR}, "
+                "${TAMP_CONFIG_DIR})");
+  EXPECT_EQ(errorOf("name: x\nrobot: [1\n"),
+            kFile + ":3:1: invalid YAML: end of sequence flow not found");
+}
+
+TEST(ScenarioErrorsTest, AllErrorsOfAFileAreReported) {
+  const std::string bad = replaced(replaced(kMinimal, "on: table", "on: tabel"),
+                                   "robot: {start: start}", "robot: {start: home}");
+  auto r = parseScenario(bad, kFile);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().message.find("unknown region 'tabel'"), std::string::npos)
+      << r.error().message;
+  EXPECT_NE(r.error().message.find("unknown location 'home'"), std::string::npos)
+      << r.error().message;
+}
+
+TEST(ScenarioErrorsTest, HeldObjectMustBeGraspable) {
+  const std::string y = replaced(
+      replaced(kMinimal, "robot: {start: start}", "robot: {start: start, holding: {object: can}}"),
+      "graspable: true", "graspable: false");
+  EXPECT_EQ(
+      errorOf(y),
+      kFile + ":2:41: field 'robot.holding.object': object 'can' must be movable and graspable");
+}
+
+}  // namespace
+}  // namespace tamp::world

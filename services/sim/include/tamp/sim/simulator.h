@@ -1,0 +1,168 @@
+#pragma once
+/// @file
+/// The simulator: a stand-in for the robot's drivers and the physical world behind the same
+/// messages a real robot would use (Conditional TAMP through an effort-based approach,
+/// spec/conditional-tamp-effort-based.tex: the execution loop of section 4, whose measured
+/// durations feed the effort estimator and whose unexpected events trigger online replanning).
+///
+/// Design overview
+/// - **Ground truth.** The simulator owns the true `world::World`, hidden objects included, and
+///   a `collision::Scene` over all of it; the planner only ever sees `plannerView()`.
+/// - **Kinematics.** The robot is the URDF `robot::RobotModel`: link poses by FK, collision
+///   geometry from the URDF, held objects attached to the tool link.
+/// - **Time.** An action's duration is `effort_estimator::predictDuration(features, true_params)`
+///   times a log-normal factor exp(sigma * N(0, 1)) (sigma = `SimParams::duration_noise`, median
+///   1), with the features extracted from the command exactly as the estimator does. The motion
+///   follows the commanded path re-timed by the same physical model:
+///   - move_base: stop-and-turn, as the model assumes: overhead, then for each straight run of
+///     the path (merged as in `extractFeatures`) a turn in place to the run's heading and a
+///     trapezoidal drive along the run's waypoints, a settle pause after each, and a final turn
+///     to the last waypoint's heading;
+///   - move_arm: overhead, then each straight run in joint space as one synchronized trapezoid
+///     (slowest joint at `max_joint_speed / f`, f = 1 + payload_slowdown * held mass) and a settle
+///     pause;
+///   - pick/place: the trajectory's waypoints up to the *grasp waypoint* (the one whose tool
+///     position is farthest from the first waypoint's) are the approach, travelled at the
+///     approach speed along the tool path; then the gripper acts (`gripper_time`); the rest is
+///     the retreat. approach_m / retreat_m are the tool-path lengths.
+///   The commanded times are validated but not followed: the robot runs at its own true speed.
+/// - **Contacts.** Before (and, if the world changes, during) an action, the whole motion is
+///   swept at a resolution such that no robot point (base, arm links, held object) moves more
+///   than `max_step_m` between checks, against every object, hidden ones included. The robot
+///   stops at the last collision-free sample (before contact) and the action ends kBlocked with
+///   the blocking object's id. Contacts that are part of the task are allowed: the gripper with
+///   the object it picks, a manipulated object with the surface it rests on or is placed on.
+///   Objects already touching the robot when an action starts do not block it. The floor plane
+///   z = 0 blocks too (reported as `kFloorId`). Self-collisions of the arm are not simulated.
+/// - **Manipulation.** A pick succeeds when, at the grasp waypoint, the object exists, is movable
+///   and graspable, is where the command says (within tolerance), the tool centre point is at it,
+///   it fits between the fingers and is not too heavy; it is then attached to the tool link and
+///   removed from its support region. Otherwise the gripper closes on nothing and the action
+///   fails after its retreat. A place releases the held object where the gripper is; it settles
+///   onto the support below (a table region or the floor) and the action succeeds when it ends
+///   upright, on a region, near the commanded pose and not in collision.
+/// - **Faults.** Scripted faults fire at a simulated time or during an action step; injected ones
+///   (`inject()`) fire at the next `step()`. A failed action stops the robot where it is.
+/// - **Records.** Every finished action yields an `effort_estimator::ExecutionRecord` (kind, path
+///   or approach/retreat distances, true object mass, measured duration, success).
+///
+/// Time is simulated: `step(dt)` advances it; `SimulationLoop` (loop.h) paces it against the wall
+/// clock. The class is not thread-safe: one thread drives it (the loop serialises access).
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "tamp/core/error.h"
+#include "tamp/core/point_cloud.h"
+#include "tamp/core/trajectory.h"
+#include "tamp/effort_estimator/records.h"
+#include "tamp/robot/robot_model.h"
+#include "tamp/sim/faults.h"
+#include "tamp/sim/params.h"
+#include "tamp/world/world.h"
+
+namespace tamp::sim {
+
+/// `ActionResult::blocking_object_id` when the robot would have gone through the floor.
+inline constexpr const char* kFloorId = "__floor__";
+
+/// One command for the robot: a trajectory to execute as an action of kind `kind`.
+struct ActionCommand {
+  std::string command_id;  ///< non-empty, unique per command (results and records carry it)
+  ActionKind kind{ActionKind::kMoveBase};
+  /// move_base: over exactly base_x, base_y, base_theta. move_arm / pick / place: over arm joints
+  /// (and optionally the gripper joint), no base joints. At least one point; the first point must
+  /// match the robot's current state (`SimParams::start_tolerance`); times strictly increasing.
+  Trajectory trajectory;
+  std::string object_id;  ///< pick/place: the object
+  /// pick: where the sender believes the object is (optional; checked when given).
+  /// place: where the object must go (required).
+  std::optional<Eigen::Isometry3d> object_pose;
+};
+
+enum class Outcome { kSucceeded, kBlocked, kFailed, kCancelled };
+std::string_view toString(Outcome outcome);  ///< "succeeded", "blocked", "failed", "cancelled"
+
+struct ActionResult {
+  std::string command_id;
+  Outcome outcome{Outcome::kFailed};
+  double duration_s{0.0};          ///< simulated time from start to stop
+  double progress{0.0};            ///< [0, 1]: fraction of the action's planned duration done
+  std::string blocking_object_id;  ///< kBlocked: the object the robot would have hit
+  std::string reason;              ///< empty on success; otherwise why (names the field for bad input)
+};
+
+/// The robot's state as its drivers would report it.
+struct RobotStateSample {
+  double time_s{0.0};                ///< simulated seconds since the start
+  robot::RobotState state;
+  std::vector<double> joint_velocities;  ///< over `RobotModel::fullJointNames()`
+  std::string held_object_id;        ///< empty: gripper empty
+  bool moving{false};
+};
+
+/// What happened during a `step()`.
+struct StepEvents {
+  std::vector<ActionResult> results;
+  std::vector<effort_estimator::ExecutionRecord> records;
+  std::vector<FaultEvent> faults;
+  bool world_changed{false};  ///< objects moved, appeared or disappeared (not just the robot)
+};
+
+class Simulator {
+ public:
+  /// @param truth the ground-truth world (hidden objects included). Its `held()` object, if any,
+  ///   must be held by the robot's tool link.
+  /// @param initial where the robot starts.
+  /// @param faults scripted faults.
+  /// @throws std::invalid_argument when `params` or a fault is invalid, the initial state does
+  ///   not fit the robot, or the held object is inconsistent (the message names the field).
+  Simulator(world::World truth, robot::RobotModel robot, robot::RobotState initial,
+            SimParams params, std::vector<Fault> faults = {});
+  ~Simulator();
+  Simulator(const Simulator&) = delete;
+  Simulator& operator=(const Simulator&) = delete;
+
+  /// Starts executing `command`. Rejections (kInvalidArgument naming the field: unknown or
+  /// duplicate joint, NaN, non-monotonic times, a start away from the current state, a missing
+  /// object pose, joint limits; kUnavailable while another action runs) leave the robot idle and
+  /// produce no record. An accepted command's outcome comes from later `step()` calls.
+  Status submit(const ActionCommand& command);
+  /// Stops the action `command_id` where the robot is; its result (kCancelled) comes with the
+  /// next `step()`. kNotFound when it is not the action in progress.
+  Status cancel(const std::string& command_id);
+  /// Queues a fault to fire at the next `step()`. kFailAction fails the action in progress, or
+  /// the next action at `trigger.fraction` of its duration when idle. kInvalidArgument for an
+  /// invalid fault (e.g. a spawned object with a taken id).
+  Status inject(Fault fault);
+
+  /// Advances simulated time by `dt` >= 0 seconds (throws std::invalid_argument otherwise).
+  StepEvents step(double dt);
+  /// Simulated seconds since construction.
+  double time() const;
+  bool busy() const;
+  /// Time left of the action in progress (0 when idle), simulated seconds.
+  double remainingActionTime() const;
+  /// Number of actions accepted so far (the next action's step index).
+  int actionCount() const;
+
+  RobotStateSample robotState() const;
+  /// The ground truth (hidden objects included; the held object at its current pose).
+  const world::World& world() const;
+  const robot::RobotModel& robot() const;
+  const SimParams& params() const;
+
+  /// A depth frame from the robot's sensor now; `stamp_ns` is stored in the frame.
+  PointCloudFrame captureCloud(std::int64_t stamp_ns, GroundTruthLabels* labels = nullptr);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace tamp::sim

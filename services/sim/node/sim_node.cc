@@ -1,0 +1,275 @@
+#include "sim_node.h"
+
+#include <cmath>
+#include <filesystem>
+
+#include "tamp/core/log.h"
+#include "tamp/core/paths.h"
+#include "tamp/dds/convert.h"
+#include "tamp/dds/world_sync.h"
+
+namespace tamp::sim {
+namespace {
+
+Error bad(const std::string& field, const std::string& message) {
+  return Error(ErrorCode::kInvalidArgument, field + ": " + message, SourceLocation{"", 0, 0, field});
+}
+
+const std::shared_ptr<spdlog::logger>& logger() {
+  static const auto l = tamp::log::get("sim");
+  return l;
+}
+
+}  // namespace
+
+msg::PointCloudFrame toMsg(const PointCloudFrame& f, std::uint64_t seq) {
+  msg::PointCloudFrame m;
+  m.header().stamp_ns(f.stamp_ns);
+  m.header().frame_id(f.sensor_id);
+  m.header().seq(seq);
+  m.sensor_id(f.sensor_id);
+  m.sensor_pose(dds::toMsg(f.world_T_sensor));
+  m.width(f.width);
+  m.height(f.height);
+  m.points(f.xyz);
+  return m;
+}
+
+Result<PointCloudFrame> fromMsg(const msg::PointCloudFrame& m) {
+  PointCloudFrame f;
+  f.sensor_id = m.sensor_id();
+  f.stamp_ns = m.header().stamp_ns();
+  auto pose = dds::fromMsg(m.sensor_pose(), "sensor_pose");
+  if (!pose) return pose.error();
+  f.world_T_sensor = *pose;
+  f.width = m.width();
+  f.height = m.height();
+  const std::uint64_t n = static_cast<std::uint64_t>(f.width) * f.height * 3u;
+  if (m.points().size() != n) {
+    return bad("points", "expected " + std::to_string(n) + " values (width " + std::to_string(f.width) +
+                             " x height " + std::to_string(f.height) + " x 3), got " +
+                             std::to_string(m.points().size()));
+  }
+  f.xyz = m.points();
+  return f;
+}
+
+Result<ActionCommand> fromMsg(const msg::TrajectoryCommand& m) {
+  ActionCommand c;
+  c.command_id = m.command_id();
+  const int kind = static_cast<int>(m.kind());
+  if (kind < 0 || kind > static_cast<int>(msg::ActionKind::ACTION_PLACE)) {
+    return bad("kind", "unknown action kind " + std::to_string(kind));
+  }
+  c.kind = dds::fromMsg(m.kind());
+  auto t = dds::fromMsg(m.trajectory(), "trajectory");
+  if (!t) return t.error();
+  c.trajectory = std::move(t).value();
+  c.object_id = m.object_id();
+  // object_target is meaningful for pick (where the object is believed to be) and place.
+  if (c.kind == ActionKind::kPick || c.kind == ActionKind::kPlace) {
+    const auto& q = m.object_target().orientation();
+    const bool unset = q.x() == 0 && q.y() == 0 && q.z() == 0 && q.w() == 0;
+    if (!(unset && c.kind == ActionKind::kPick)) {
+      auto pose = dds::fromMsg(m.object_target(), "object_target");
+      if (!pose) return pose.error();
+      c.object_pose = *pose;
+    }
+  }
+  return c;
+}
+
+msg::ActionResult toMsg(const ActionResult& r) {
+  msg::ActionResult m;
+  m.command_id(r.command_id);
+  switch (r.outcome) {
+    case Outcome::kSucceeded: m.outcome(msg::ActionOutcome::OUTCOME_SUCCEEDED); break;
+    case Outcome::kBlocked: m.outcome(msg::ActionOutcome::OUTCOME_BLOCKED); break;
+    case Outcome::kFailed: m.outcome(msg::ActionOutcome::OUTCOME_FAILED); break;
+    case Outcome::kCancelled: m.outcome(msg::ActionOutcome::OUTCOME_CANCELLED); break;
+  }
+  m.duration_s(r.duration_s);
+  m.progress(r.progress);
+  m.blocking_object_id(r.blocking_object_id);
+  m.reason(r.reason);
+  return m;
+}
+
+msg::ExecutionRecord toMsg(const effort_estimator::ExecutionRecord& r) {
+  msg::ExecutionRecord m;
+  m.record_id(r.record_id);
+  m.kind(dds::toMsg(r.action.kind));
+  m.path(dds::toMsg(r.action.path));
+  m.object_mass(r.action.object_mass_kg);
+  m.duration_s(r.duration_s);
+  m.success(r.success);
+  m.stamp_ns(static_cast<std::int64_t>(r.timestamp_s * 1e9));
+  m.source(r.source);
+  m.approach_m(r.action.approach_m);
+  m.retreat_m(r.action.retreat_m);
+  return m;
+}
+
+Result<Fault> fromMsg(const msg::FaultInjection& m) {
+  Fault f;
+  f.id = m.fault_id().empty() ? "injected" : m.fault_id();
+  f.reason = m.reason();
+  switch (m.type()) {
+    case msg::FaultType::FAULT_DROP_HELD_OBJECT: f.type = FaultType::kDropHeldObject; break;
+    case msg::FaultType::FAULT_FAIL_NEXT_ACTION: f.type = FaultType::kFailAction; break;
+    case msg::FaultType::FAULT_REMOVE_OBJECT:
+      f.type = FaultType::kRemoveObject;
+      f.object_id = m.object_id();
+      break;
+    case msg::FaultType::FAULT_SPAWN_OBJECT: {
+      f.type = FaultType::kSpawnObject;
+      auto shape = dds::fromMsg(m.shape(), "shape");
+      if (!shape) return shape.error();
+      auto pose = dds::fromMsg(m.pose(), "pose");
+      if (!pose) return pose.error();
+      f.object.id = m.object_id();
+      f.object.label = m.reason().empty() ? "spawned" : m.reason();
+      f.object.kind = world::ObjectKind::kStatic;
+      f.object.shape = *shape;
+      f.object.pose = *pose;
+      break;
+    }
+    default:
+      return bad("type", "unknown fault type " + std::to_string(static_cast<int>(m.type())));
+  }
+  if (Status s = f.validate(false); !s) return s.error();
+  return f;
+}
+
+msg::RobotState toMsg(const RobotStateSample& s, const std::vector<std::string>& joint_names,
+                      const std::string& robot_id, std::int64_t stamp_ns, std::uint64_t seq) {
+  msg::RobotState m;
+  m.header().stamp_ns(stamp_ns);
+  m.header().frame_id("world");
+  m.header().seq(seq);
+  m.robot_id(robot_id);
+  m.base(dds::toMsg(s.state.base));
+  m.joint_names(joint_names);
+  std::vector<double> q{s.state.base.x, s.state.base.y, s.state.base.theta};
+  q.insert(q.end(), s.state.arm.begin(), s.state.arm.end());
+  if (q.size() < joint_names.size()) q.push_back(s.state.gripper);
+  m.joint_positions(q);
+  m.joint_velocities(s.joint_velocities);
+  m.held_object_id(s.held_object_id);
+  m.moving(s.moving);
+  return m;
+}
+
+Result<std::unique_ptr<dds::ServiceNode>> SimNode::create(const dds::ServiceArgs& args) {
+  std::filesystem::path file = args.config_file;
+  if (file.empty() && std::filesystem::exists(configDir() / "services" / "sim.yaml")) {
+    file = configDir() / "services" / "sim.yaml";
+  }
+  auto params = file.empty() ? Result<SimParams>(SimParams{}) : loadSimParams(file);
+  if (!params) return params.error();
+  auto setup = loadSetup(*params);
+  if (!setup) return setup.error();
+  try {
+    return std::unique_ptr<dds::ServiceNode>(
+        std::make_unique<SimNode>(args, std::move(setup).value(), std::move(params).value()));
+  } catch (const std::invalid_argument& e) {
+    return Error(ErrorCode::kInvalidArgument, e.what());
+  }
+}
+
+SimNode::SimNode(const dds::ServiceArgs& args, SimSetup setup, SimParams params) : ServiceNode(args) {
+  robot_id_ = setup.robot.name();
+  joint_names_ = setup.robot.fullJointNames();
+  sim_ = std::make_unique<Simulator>(std::move(setup.world), std::move(setup.robot), setup.initial,
+                                     std::move(params), std::move(setup.faults));
+  const auto& p = participant();
+  state_writer_ = std::make_unique<dds::Writer<msg::RobotState>>(p, dds::topics::kRobotState);
+  cloud_writer_ = std::make_unique<dds::Writer<msg::PointCloudFrame>>(p, dds::topics::kPointCloud);
+  result_writer_ = std::make_unique<dds::Writer<msg::ActionResult>>(p, dds::topics::kActionResult);
+  record_writer_ = std::make_unique<dds::Writer<msg::ExecutionRecord>>(p, dds::topics::kExecutionRecords);
+  LoopCallbacks cb;
+  cb.on_state = [this](const RobotStateSample& s, std::int64_t stamp) {
+    if (Status st = state_writer_->write(toMsg(s, joint_names_, robot_id_, stamp, ++state_seq_)); !st) {
+      logger()->warn("robot state not published: {}", st.error().toString());
+    }
+  };
+  cb.on_cloud = [this](const PointCloudFrame& f) {
+    if (Status st = cloud_writer_->write(toMsg(f, ++cloud_seq_)); !st) {
+      logger()->warn("point cloud not published: {}", st.error().toString());
+    }
+  };
+  cb.on_result = [this](const ActionResult& r) {
+    if (Status st = result_writer_->write(toMsg(r)); !st) {
+      logger()->error("result of '{}' not published: {}", r.command_id, st.error().toString());
+    }
+  };
+  cb.on_record = [this](const effort_estimator::ExecutionRecord& r) {
+    if (Status st = record_writer_->write(toMsg(r)); !st) {
+      logger()->warn("execution record of '{}' not published: {}", r.record_id, st.error().toString());
+    }
+  };
+  cb.on_fault = [](const FaultEvent& e) {
+    logger()->info("fault '{}' ({}): {}", e.fault_id, toString(e.type), e.description);
+  };
+  loop_ = std::make_unique<SimulationLoop>(*sim_, std::move(cb));
+  command_reader_ = std::make_unique<dds::Reader<msg::TrajectoryCommand>>(
+      p, dds::topics::kTrajectoryCommand,
+      [this](const msg::TrajectoryCommand& m, const dds::SampleMeta&) { onCommand(m); });
+  fault_reader_ = std::make_unique<dds::Reader<msg::FaultInjection>>(
+      p, dds::topics::kFaultInjection,
+      [this](const msg::FaultInjection& m, const dds::SampleMeta&) { onFault(m); });
+  loop_->start();
+}
+
+SimNode::~SimNode() {
+  // Stop input first, then the loop (its callbacks use the writers).
+  command_reader_.reset();
+  fault_reader_.reset();
+  if (loop_) loop_->stop();
+}
+
+void SimNode::onCommand(const msg::TrajectoryCommand& m) {
+  try {
+    ++commands_;
+    if (m.cancel()) {
+      if (Status s = loop_->cancel(m.command_id()); !s) {
+        logger()->warn("cancel '{}': {}", m.command_id(), s.error().message);
+      }
+      return;
+    }
+    auto cmd = fromMsg(m);
+    if (!cmd) {
+      ++rejected_;
+      ActionResult r;
+      r.command_id = m.command_id();
+      r.outcome = Outcome::kFailed;
+      r.reason = "rejected: " + cmd.error().toString();  // names the field (convert.h errors)
+      logger()->warn("command '{}' rejected: {}", m.command_id(), r.reason);
+      (void)result_writer_->write(toMsg(r));
+      return;
+    }
+    if (Status s = loop_->submit(*cmd); !s) {  // the loop reports the rejection as a result
+      ++rejected_;
+      logger()->warn("command '{}' rejected: {}", m.command_id(), s.error().message);
+    }
+  } catch (const std::exception& e) {
+    logger()->error("command '{}': {}", m.command_id(), e.what());
+  }
+}
+
+void SimNode::onFault(const msg::FaultInjection& m) {
+  try {
+    auto f = fromMsg(m);
+    if (!f) {
+      logger()->warn("fault '{}' rejected: {}", m.fault_id(), f.error().toString());
+      return;
+    }
+    if (Status s = loop_->inject(std::move(f).value()); !s) {
+      logger()->warn("fault '{}' rejected: {}", m.fault_id(), s.error().message);
+    }
+  } catch (const std::exception& e) {
+    logger()->error("fault '{}': {}", m.fault_id(), e.what());
+  }
+}
+
+}  // namespace tamp::sim

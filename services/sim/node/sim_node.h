@@ -1,0 +1,70 @@
+#pragma once
+/// @file
+/// The simulator's DDS adapter: maps `tamp::sim::SimulationLoop` onto the robot's topics.
+///
+/// Subscribes: tamp/robot/trajectory (TrajectoryCommand; `cancel` cancels the command with that
+/// id), tamp/sim/fault (FaultInjection).
+/// Publishes: tamp/robot/state (RobotState, every `state_period_s` of simulated time),
+/// tamp/sensor/cloud (PointCloudFrame: every `cloud_period_s`, after each action), tamp/robot/result
+/// (ActionResult; a rejected command gets OUTCOME_FAILED with the reason naming the field),
+/// tamp/execution/record (ExecutionRecord, one per finished action).
+///
+/// Nothing escapes a DDS callback: malformed messages become failed results and log lines.
+
+#include <memory>
+
+#include "tamp/dds/service_node.h"
+#include "tamp/dds/topics.h"
+#include "tamp/sim/loop.h"
+#include "tamp/sim/setup.h"
+#include "tamp/sim/simulator.h"
+
+namespace tamp::sim {
+
+// ---- conversions (the node's boundary; exposed for tests) ---------------------------------------
+msg::PointCloudFrame toMsg(const PointCloudFrame& f, std::uint64_t seq = 0);
+/// kInvalidArgument naming the field when the point count is not width x height x 3 or the pose
+/// is not finite.
+Result<PointCloudFrame> fromMsg(const msg::PointCloudFrame& m);
+/// kInvalidArgument naming the field (trajectory.*, object_target, kind).
+Result<ActionCommand> fromMsg(const msg::TrajectoryCommand& m);
+msg::ActionResult toMsg(const ActionResult& r);
+msg::ExecutionRecord toMsg(const effort_estimator::ExecutionRecord& r);
+/// kInvalidArgument naming the field (type, object_id, shape, pose).
+Result<Fault> fromMsg(const msg::FaultInjection& m);
+msg::RobotState toMsg(const RobotStateSample& s, const std::vector<std::string>& joint_names,
+                      const std::string& robot_id, std::int64_t stamp_ns, std::uint64_t seq);
+
+class SimNode : public dds::ServiceNode {
+ public:
+  /// Loads the parameters (--config, else configDir()/services/sim.yaml when it exists, else the
+  /// defaults) and the scenario they name, then builds the node. Errors: bad parameters or
+  /// scenario (exit 30 through serviceMain).
+  static Result<std::unique_ptr<dds::ServiceNode>> create(const dds::ServiceArgs& args);
+  /// Builds the node around an explicit setup (tests, embedding). Throws std::runtime_error when
+  /// DDS fails and std::invalid_argument when the setup is invalid.
+  SimNode(const dds::ServiceArgs& args, SimSetup setup, SimParams params);
+  ~SimNode() override;
+
+  /// The running loop (e.g. for in-process tests to read the ground truth).
+  SimulationLoop& loop() { return *loop_; }
+
+ private:
+  void onCommand(const msg::TrajectoryCommand& m);
+  void onFault(const msg::FaultInjection& m);
+
+  std::unique_ptr<Simulator> sim_;
+  std::vector<std::string> joint_names_;
+  std::string robot_id_;
+  std::unique_ptr<dds::Writer<msg::RobotState>> state_writer_;
+  std::unique_ptr<dds::Writer<msg::PointCloudFrame>> cloud_writer_;
+  std::unique_ptr<dds::Writer<msg::ActionResult>> result_writer_;
+  std::unique_ptr<dds::Writer<msg::ExecutionRecord>> record_writer_;
+  std::unique_ptr<SimulationLoop> loop_;
+  std::unique_ptr<dds::Reader<msg::TrajectoryCommand>> command_reader_;
+  std::unique_ptr<dds::Reader<msg::FaultInjection>> fault_reader_;
+  std::atomic<std::uint64_t> state_seq_{0}, cloud_seq_{0};
+  std::atomic<std::uint64_t> commands_{0}, rejected_{0};
+};
+
+}  // namespace tamp::sim

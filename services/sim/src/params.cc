@@ -1,0 +1,274 @@
+#include "tamp/sim/params.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+
+#include "tamp/config/yaml_reader.h"
+#include "tamp/core/paths.h"
+#include "tamp/effort_estimator/models.h"
+
+namespace tamp::sim {
+namespace {
+
+std::string fmt(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%g", v);
+  return buf;
+}
+
+int kindIndex(ActionKind kind) {
+  const auto it = std::find(kAllActionKinds.begin(), kAllActionKinds.end(), kind);
+  if (it == kAllActionKinds.end()) {
+    throw std::invalid_argument("sim: unknown action kind " + std::to_string(static_cast<int>(kind)));
+  }
+  return static_cast<int>(it - kAllActionKinds.begin());
+}
+
+/// (field, ok, message) for every scalar rule; shared by validate() and the loader.
+struct Rule {
+  std::string field;
+  bool ok;
+  std::string message;
+};
+
+std::vector<Rule> rules(const SimParams& p) {
+  auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
+  auto nonneg = [](double v) { return std::isfinite(v) && v >= 0.0; };
+  return {
+      {"realtime_factor", nonneg(p.realtime_factor), "must be >= 0 (0 = as fast as possible), got " + fmt(p.realtime_factor)},
+      {"state_period_s", positive(p.state_period_s) && p.state_period_s <= 10.0,
+       "must be in (0, 10] s, got " + fmt(p.state_period_s)},
+      {"cloud_period_s", nonneg(p.cloud_period_s), "must be >= 0 s, got " + fmt(p.cloud_period_s)},
+      {"duration_noise", nonneg(p.duration_noise) && p.duration_noise <= 1.0,
+       "must be in [0, 1] (stddev of log duration), got " + fmt(p.duration_noise)},
+      {"max_step_m", positive(p.max_step_m) && p.max_step_m <= 0.5,
+       "must be in (0, 0.5] m, got " + fmt(p.max_step_m)},
+      {"start_tolerance.position_m", positive(p.start_tolerance.position_m),
+       "must be positive, got " + fmt(p.start_tolerance.position_m)},
+      {"start_tolerance.angle_rad", positive(p.start_tolerance.angle_rad),
+       "must be positive, got " + fmt(p.start_tolerance.angle_rad)},
+      {"grasp.position_tolerance_m", positive(p.grasp.position_tolerance_m),
+       "must be positive, got " + fmt(p.grasp.position_tolerance_m)},
+      {"grasp.tcp_tolerance_m", nonneg(p.grasp.tcp_tolerance_m),
+       "must be >= 0, got " + fmt(p.grasp.tcp_tolerance_m)},
+      {"grasp.max_payload_kg", positive(p.grasp.max_payload_kg),
+       "must be positive, got " + fmt(p.grasp.max_payload_kg)},
+      {"place.position_tolerance_m", positive(p.place.position_tolerance_m),
+       "must be positive, got " + fmt(p.place.position_tolerance_m)},
+      {"place.angle_tolerance_rad", positive(p.place.angle_tolerance_rad),
+       "must be positive, got " + fmt(p.place.angle_tolerance_rad)},
+      {"place.max_drop_m", nonneg(p.place.max_drop_m), "must be >= 0, got " + fmt(p.place.max_drop_m)},
+      {"place.max_tilt_rad", positive(p.place.max_tilt_rad) && p.place.max_tilt_rad < std::numbers::pi / 2,
+       "must be in (0, pi/2), got " + fmt(p.place.max_tilt_rad)},
+  };
+}
+
+}  // namespace
+
+TimeParameters TimeParameters::simulatedRobot() {
+  TimeParameters t;
+  for (ActionKind k : kAllActionKinds) t.of(k) = effort_estimator::modelSpec(k).defaults();
+  using K = ActionKind;
+  t.set(K::kMoveBase, "max_linear_speed", 0.4);
+  t.set(K::kMoveBase, "max_linear_accel", 0.3);
+  t.set(K::kMoveBase, "max_angular_speed", 1.2);
+  t.set(K::kMoveBase, "max_angular_accel", 1.0);
+  t.set(K::kMoveBase, "settle_time", 0.35);
+  t.set(K::kMoveBase, "overhead", 0.8);
+  t.set(K::kMoveArm, "max_joint_speed", 0.8);
+  t.set(K::kMoveArm, "max_joint_accel", 1.5);
+  t.set(K::kMoveArm, "settle_time", 0.15);
+  t.set(K::kMoveArm, "overhead", 0.5);
+  t.set(K::kMoveArm, "payload_slowdown", 0.15);
+  t.set(K::kPick, "approach_speed", 0.04);
+  t.set(K::kPick, "gripper_time", 2.2);
+  t.set(K::kPick, "payload_slowdown", 0.3);
+  t.set(K::kPlace, "approach_speed", 0.04);
+  t.set(K::kPlace, "gripper_time", 1.4);
+  t.set(K::kPlace, "payload_slowdown", 0.3);
+  return t;
+}
+
+const std::vector<double>& TimeParameters::of(ActionKind kind) const { return values[kindIndex(kind)]; }
+std::vector<double>& TimeParameters::of(ActionKind kind) { return values[kindIndex(kind)]; }
+
+double TimeParameters::get(ActionKind kind, const std::string& name) const {
+  const int i = effort_estimator::modelSpec(kind).indexOf(name);
+  if (i < 0 || i >= static_cast<int>(of(kind).size())) {
+    throw std::invalid_argument("TimeParameters: no parameter '" + name + "' for " +
+                                std::string(toString(kind)));
+  }
+  return of(kind)[i];
+}
+
+void TimeParameters::set(ActionKind kind, const std::string& name, double value) {
+  const auto& spec = effort_estimator::modelSpec(kind);
+  const int i = spec.indexOf(name);
+  if (i < 0) {
+    throw std::invalid_argument("TimeParameters: no parameter '" + name + "' for " +
+                                std::string(toString(kind)));
+  }
+  auto& v = of(kind);
+  if (v.size() != static_cast<std::size_t>(spec.size())) v = spec.defaults();
+  v[i] = value;
+}
+
+Status TimeParameters::validate() const {
+  std::vector<Error> errors;
+  for (ActionKind k : kAllActionKinds) {
+    const auto& spec = effort_estimator::modelSpec(k);
+    const auto& v = of(k);
+    const std::string base = "time_parameters." + std::string(toString(k));
+    if (v.size() != static_cast<std::size_t>(spec.size())) {
+      errors.emplace_back(ErrorCode::kInvalidArgument,
+                          "expected " + std::to_string(spec.size()) + " values, got " + std::to_string(v.size()),
+                          SourceLocation{"", 0, 0, base});
+      continue;
+    }
+    for (int i = 0; i < spec.size(); ++i) {
+      const auto& ps = spec.parameters[i];
+      if (!(std::isfinite(v[i]) && v[i] >= ps.lower && v[i] <= ps.upper)) {
+        errors.emplace_back(ErrorCode::kInvalidArgument,
+                            "must be within [" + fmt(ps.lower) + ", " + fmt(ps.upper) + "] " + ps.unit +
+                                ", got " + fmt(v[i]),
+                            SourceLocation{"", 0, 0, base + "." + ps.name});
+      }
+    }
+  }
+  if (errors.empty()) return Status::Ok();
+  Error e(ErrorCode::kInvalidArgument, joinErrors(errors), errors.front().where);
+  return e;
+}
+
+Status SimParams::validate() const {
+  std::vector<Error> errors;
+  for (const Rule& r : rules(*this)) {
+    if (!r.ok) errors.emplace_back(ErrorCode::kInvalidArgument, r.message, SourceLocation{"", 0, 0, r.field});
+  }
+  if (Status s = time_parameters.validate(); !s) errors.push_back(s.error());
+  if (Status s = sensor.validate(); !s) errors.push_back(s.error());
+  if (errors.empty()) return Status::Ok();
+  return Error(ErrorCode::kInvalidArgument, "invalid simulator parameters:\n" + joinErrors(errors),
+               errors.front().where);
+}
+
+Result<SimParams> parseSimParams(const std::string& yaml_text, const std::string& name) {
+  auto doc = config::parseYaml(yaml_text, name);
+  if (!doc) return doc.error();
+  SimParams p;
+  config::FieldReader r(*doc);
+  if (doc->root.IsNull()) return p;  // an empty file: every default
+  if (!r.isMap()) {
+    return Error(ErrorCode::kParseError, "expected a mapping of simulator parameters", SourceLocation{name});
+  }
+  r.optional("scenario", p.scenario);
+  r.optional("realtime_factor", p.realtime_factor);
+  r.optional("state_period_s", p.state_period_s);
+  r.optional("cloud_period_s", p.cloud_period_s);
+  r.optional("duration_noise", p.duration_noise);
+  int seed = static_cast<int>(p.seed);
+  if (r.optional("seed", seed)) {
+    if (r.check(seed >= 0, "seed", "must be >= 0, got " + std::to_string(seed))) p.seed = static_cast<std::uint64_t>(seed);
+  }
+  r.optional("max_step_m", p.max_step_m);
+  {
+    auto c = r.child("start_tolerance", false);
+    c.optional("position_m", p.start_tolerance.position_m);
+    c.optional("angle_rad", p.start_tolerance.angle_rad);
+    if (c.isMap()) c.refuseUnknownKeys();
+  }
+  {
+    auto c = r.child("grasp", false);
+    c.optional("position_tolerance_m", p.grasp.position_tolerance_m);
+    c.optional("tcp_tolerance_m", p.grasp.tcp_tolerance_m);
+    c.optional("max_payload_kg", p.grasp.max_payload_kg);
+    if (c.isMap()) c.refuseUnknownKeys();
+  }
+  {
+    auto c = r.child("place", false);
+    c.optional("position_tolerance_m", p.place.position_tolerance_m);
+    c.optional("angle_tolerance_rad", p.place.angle_tolerance_rad);
+    c.optional("max_drop_m", p.place.max_drop_m);
+    c.optional("max_tilt_rad", p.place.max_tilt_rad);
+    if (c.isMap()) c.refuseUnknownKeys();
+  }
+  for (const Rule& rule : rules(p)) {
+    // Nested fields are reported against their parent reader's key path.
+    const auto dot = rule.field.find('.');
+    if (dot == std::string::npos) {
+      r.check(rule.ok, rule.field, rule.message);
+    } else if (!rule.ok) {
+      r.child(rule.field.substr(0, dot), false).fail(rule.field.substr(dot + 1), rule.message);
+    }
+  }
+  for (auto& [kind_name, kr] : r.entries("time_parameters", false)) {
+    const auto kind = actionKindFromString(kind_name);
+    if (!kind) {
+      r.child("time_parameters").fail(kind_name, "unknown action kind '" + kind_name +
+                                                     "' (expected one of: move_base, move_arm, pick, place)");
+      continue;
+    }
+    const auto& spec = effort_estimator::modelSpec(*kind);
+    for (int i = 0; i < spec.size(); ++i) {
+      const auto& ps = spec.parameters[i];
+      double v = p.time_parameters.of(*kind)[i];
+      if (kr.optional(ps.name, v) &&
+          kr.check(std::isfinite(v) && v >= ps.lower && v <= ps.upper, ps.name,
+                   "must be within [" + fmt(ps.lower) + ", " + fmt(ps.upper) + "] " + ps.unit + ", got " + fmt(v))) {
+        p.time_parameters.of(*kind)[i] = v;
+      }
+    }
+    kr.refuseUnknownKeys();
+  }
+  {
+    auto c = r.child("sensor", false);
+    DepthSensorParams& s = p.sensor;
+    c.optional("sensor_id", s.sensor_id);
+    c.optional("frame", s.frame);
+    c.optional("width", s.width);
+    c.optional("height", s.height);
+    c.optional("horizontal_fov_rad", s.horizontal_fov_rad);
+    c.optional("min_range_m", s.min_range_m);
+    c.optional("max_range_m", s.max_range_m);
+    c.optional("noise_stddev_m", s.noise_stddev_m);
+    c.optional("noise_quadratic", s.noise_quadratic);
+    c.optional("dropout_probability", s.dropout_probability);
+    c.optional("see_robot", s.see_robot);
+    int sseed = static_cast<int>(s.seed);
+    if (c.optional("seed", sseed) && c.check(sseed >= 0, "seed", "must be >= 0")) s.seed = static_cast<std::uint64_t>(sseed);
+    if (c.isMap()) {
+      c.refuseUnknownKeys();
+      if (Status st = s.validate(); !st) {
+        // One error per bad field, located in the file ("sensor.width: must be ..." -> key width).
+        std::string msg = st.error().message;
+        std::size_t pos = 0;
+        while (pos < msg.size()) {
+          std::size_t end = msg.find("; ", pos);
+          if (end == std::string::npos) end = msg.size();
+          const std::string part = msg.substr(pos, end - pos);
+          const auto colon = part.find(": ");
+          std::string key = part.substr(0, colon);
+          if (key.rfind("sensor.", 0) == 0) key = key.substr(7);
+          c.fail(key, colon == std::string::npos ? part : part.substr(colon + 2));
+          pos = end + 2;
+        }
+      }
+    }
+  }
+  r.refuseUnknownKeys();
+  if (!r.ok()) return r.status().error();
+  if (Status s = p.validate(); !s) return s.error();
+  return p;
+}
+
+Result<SimParams> loadSimParams(const std::filesystem::path& file) {
+  auto text = readTextFile(file);
+  if (!text) return text.error();
+  auto p = parseSimParams(*text, file.string());
+  if (p && !p->scenario.empty()) p->scenario = resolveRelativeTo(file, p->scenario).string();
+  return p;
+}
+
+}  // namespace tamp::sim

@@ -1,0 +1,1266 @@
+#include "tamp/sim/simulator.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <random>
+#include <set>
+#include <stdexcept>
+
+#include "tamp/collision/scene.h"
+#include "tamp/core/geometry.h"
+#include "tamp/core/log.h"
+#include "tamp/effort_estimator/features.h"
+#include "tamp/effort_estimator/models.h"
+#include "tamp/sim/depth_sensor.h"
+
+namespace tamp::sim {
+namespace {
+
+using Vec = Eigen::VectorXd;
+using effort_estimator::FeatureTolerances;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kFloorTolerance = 1e-4;
+constexpr double kSupportProbe = 0.005;  // m: how far below an object its supports are looked for  // m below z = 0 that counts as touching the floor
+
+const std::shared_ptr<spdlog::logger>& logger() {
+  static const auto l = tamp::log::get("sim");
+  return l;
+}
+
+std::string fmt(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.4g", v);
+  return buf;
+}
+
+Error invalid(const std::string& field, const std::string& message) {
+  return Error(ErrorCode::kInvalidArgument, field + ": " + message, SourceLocation{"", 0, 0, field});
+}
+
+// ---- trapezoidal stop-to-stop profile (effort_estimator/models.h) -------------------------------
+
+/// Distance covered after time tau of a move of length L (max speed v, max acceleration a).
+double trapPosition(double tau, double L, double v, double a) {
+  if (L <= 0.0 || tau <= 0.0) return 0.0;
+  const double T = effort_estimator::trapezoidTime(L, v, a);
+  if (tau >= T) return L;
+  if (L >= v * v / a) {
+    const double ta = v / a;
+    const double da = 0.5 * v * ta;
+    if (tau < ta) return 0.5 * a * tau * tau;
+    if (tau < T - ta) return da + v * (tau - ta);
+    return L - 0.5 * a * (T - tau) * (T - tau);
+  }
+  if (tau < 0.5 * T) return 0.5 * a * tau * tau;
+  return L - 0.5 * a * (T - tau) * (T - tau);
+}
+
+/// Inverse of trapPosition: the time at which distance s is reached.
+double trapTimeAt(double s, double L, double v, double a) {
+  if (L <= 0.0 || s <= 0.0) return 0.0;
+  const double T = effort_estimator::trapezoidTime(L, v, a);
+  if (s >= L) return T;
+  if (L >= v * v / a) {
+    const double ta = v / a;
+    const double da = 0.5 * v * ta;
+    if (s < da) return std::sqrt(2.0 * s / a);
+    if (s < L - da) return ta + (s - da) / v;
+    return T - std::sqrt(2.0 * (L - s) / a);
+  }
+  if (s < 0.5 * L) return std::sqrt(2.0 * s / a);
+  return T - std::sqrt(2.0 * (L - s) / a);
+}
+
+double boundingRadius(const world::Shape& s) {
+  switch (s.kind) {
+    case world::ShapeKind::kBox:
+      return 0.5 * s.size.norm();
+    case world::ShapeKind::kSphere:
+      return s.radius;
+    case world::ShapeKind::kCylinder:
+      return std::hypot(s.radius, 0.5 * s.height);
+    case world::ShapeKind::kPrism: {
+      double r = 0.0;
+      for (const auto& v : s.polygon) r = std::max(r, v.norm());
+      return std::hypot(r, 0.5 * s.height);
+    }
+  }
+  return 0.0;
+}
+
+/// Width of `s` along the unit direction `d` (shape frame).
+double widthAlong(const world::Shape& s, const Eigen::Vector3d& d) {
+  switch (s.kind) {
+    case world::ShapeKind::kBox:
+      return s.size.cwiseProduct(d.cwiseAbs()).sum();
+    case world::ShapeKind::kSphere:
+      return 2.0 * s.radius;
+    case world::ShapeKind::kCylinder:
+      return 2.0 * s.radius * std::hypot(d.x(), d.y()) + s.height * std::abs(d.z());
+    case world::ShapeKind::kPrism: {
+      double lo = kInf, hi = -kInf;
+      for (const auto& v : s.polygon) {
+        const double p = v.x() * d.x() + v.y() * d.y();
+        lo = std::min(lo, p);
+        hi = std::max(hi, p);
+      }
+      return (hi - lo) + s.height * std::abs(d.z());
+    }
+  }
+  return 0.0;
+}
+
+/// A piecewise-linear path in the full joint space with a cumulative parameter u (metres of
+/// drive, radians of turn, scaled joint displacement, or metres of tool path).
+struct GeoPath {
+  std::vector<Vec> q;
+  std::vector<double> u;
+
+  Vec at(double fraction) const {
+    if (q.size() == 1 || u.back() <= 0.0) return fraction >= 1.0 ? q.back() : q.front();
+    const double target = std::clamp(fraction, 0.0, 1.0) * u.back();
+    const auto it = std::upper_bound(u.begin(), u.end(), target);
+    if (it == u.end()) return q.back();
+    const std::size_t j = static_cast<std::size_t>(it - u.begin());  // u[j-1] <= target < u[j]
+    const double span = u[j] - u[j - 1];
+    const double w = span > 0.0 ? (target - u[j - 1]) / span : 1.0;
+    return q[j - 1] + w * (q[j] - q[j - 1]);
+  }
+};
+
+struct Phase {
+  enum class Kind { kPause, kMotion, kGripper } kind{Kind::kPause};
+  double nominal{0.0};  // model duration, s (before the noise factor)
+  double t0{0.0}, t1{0.0};  // actual times relative to the action start
+  GeoPath path;             // kMotion
+  double length{0.0}, v{1.0}, a{1.0};
+  Vec start, end;
+};
+
+/// A scripted fault scheduled within the action in progress.
+struct ScheduledFault {
+  std::size_t index;  // into Impl::scripted
+  double rel_time;
+};
+
+struct Active {
+  ActionCommand cmd;
+  int step{0};
+  double start{0.0};  // sim time
+  double k{1.0};      // noise factor
+  std::vector<Phase> phases;
+  double total{0.0};
+  double end{0.0};  // relative time the action ends (total or an early stop)
+  Outcome outcome{Outcome::kSucceeded};
+  std::string blocking;
+  std::string reason;
+  std::string failure;  // a manipulation failure found at the grasp (reported at the end)
+  int gripper_phase{-1};
+  bool gripper_done{false};
+  double approach_m{0.0}, retreat_m{0.0}, mass{0.0};
+  std::vector<std::string> ignore_objects;
+  std::vector<std::pair<std::string, std::string>> ignore_pairs;  // (robot part / attached, object)
+  std::vector<ScheduledFault> faults;
+  std::optional<Fault> fail_fault;  // injected "fail next action"
+  double fail_at{kInf};
+};
+
+}  // namespace
+
+std::string_view toString(Outcome outcome) {
+  switch (outcome) {
+    case Outcome::kSucceeded: return "succeeded";
+    case Outcome::kBlocked: return "blocked";
+    case Outcome::kFailed: return "failed";
+    case Outcome::kCancelled: return "cancelled";
+  }
+  return "unknown";
+}
+
+struct Simulator::Impl {
+  world::World world;
+  robot::RobotModel robot;
+  SimParams params;
+  collision::Scene scene;
+  DepthSensor sensor;
+  effort_estimator::FeatureOptions feature_options;
+  std::vector<std::string> full_names;
+  int dof{0};
+  bool has_gripper{false};
+  int tool_link{-1};
+  double r_arm{0.0};   // bound: displacement of any arm point per radian of any arm joint
+  double r_base{0.0};  // bound: displacement of any robot point per radian of base turn
+  Vec idle;            // the robot's state when no action runs
+  double now{0.0};
+  double epoch_s{0.0};
+  int actions{0};
+  std::mt19937_64 rng;
+  std::vector<Fault> scripted;
+  std::vector<bool> fired;
+  std::vector<Fault> injected;        // fire at the next step()
+  std::optional<Fault> fail_next;     // injected kFailAction while idle
+  std::optional<Active> active;
+  std::vector<Eigen::Isometry3d> link_poses;  // scratch
+
+  Impl(world::World w, robot::RobotModel r, SimParams p)
+      : world(std::move(w)), robot(std::move(r)), params(std::move(p)), sensor(params.sensor) {}
+
+  // ---- state conversions ------------------------------------------------------------------------
+  robot::RobotState toState(const Vec& q) const {
+    robot::RobotState s;
+    s.base = Pose2D{q[0], q[1], q[2]};
+    s.arm.assign(q.data() + 3, q.data() + 3 + dof);
+    if (has_gripper) s.gripper = q[3 + dof];
+    return s;
+  }
+  Vec toVec(const robot::RobotState& s) const {
+    Vec q(static_cast<Eigen::Index>(full_names.size()));
+    q[0] = s.base.x;
+    q[1] = s.base.y;
+    q[2] = s.base.theta;
+    for (int j = 0; j < dof; ++j) q[3 + j] = s.arm[j];
+    if (has_gripper) q[3 + dof] = s.gripper;
+    return q;
+  }
+
+  double heldMass() const {
+    if (!world.held()) return 0.0;
+    const auto* o = world.findObject(world.held()->object_id);
+    return o ? o->mass : 0.0;
+  }
+  double heldExtent() const {
+    if (!world.held()) return 0.0;
+    const auto* o = world.findObject(world.held()->object_id);
+    return o ? world.held()->link_T_object.translation().norm() + boundingRadius(o->shape) : 0.0;
+  }
+
+  void computeBounds() {
+    // Distal links of the first arm joint (the arm, the gripper and its fingers).
+    const auto& joints = robot.joints();
+    const auto* first = robot.findJoint(robot.armJointNames().front());
+    std::set<std::string> distal{first->child_link};
+    double chain = 0.0;
+    for (bool grew = true; grew;) {
+      grew = false;
+      for (const auto& j : joints) {
+        if (distal.count(j.parent_link) && !distal.count(j.child_link)) {
+          distal.insert(j.child_link);
+          chain += j.parent_T_joint.translation().norm();
+          grew = true;
+        }
+      }
+    }
+    const auto& geo = robot.collisionGeometry();
+    double arm_part = 0.0;
+    robot.linkPoses(robot.defaultState(Pose2D{}), link_poses);
+    double base_fixed = 0.0;
+    for (const auto& part : geo.parts) {
+      const double r = boundingRadius(part.shape);
+      if (distal.count(geo.links[part.link])) {
+        arm_part = std::max(arm_part, part.link_T_shape.translation().norm() + r);
+      } else {
+        base_fixed = std::max(base_fixed, (link_poses[part.link] * part.link_T_shape).translation().norm() + r);
+      }
+    }
+    r_arm = chain + arm_part;
+    const int li = robot.linkIndex(first->parent_link);
+    const double shoulder = (link_poses[li] * first->parent_T_joint).translation().norm();
+    r_base = std::max(base_fixed, shoulder + r_arm);
+  }
+
+  /// Upper bound of the displacement of any robot point between q0 and q1.
+  double displacementBound(const Vec& q0, const Vec& q1) const {
+    const double extra = heldExtent();
+    double arm = 0.0;
+    for (int j = 0; j < dof; ++j) arm += std::abs(q1[3 + j] - q0[3 + j]);
+    double b = std::hypot(q1[0] - q0[0], q1[1] - q0[1]) + std::abs(q1[2] - q0[2]) * (r_base + extra) +
+               arm * (r_arm + extra);
+    if (has_gripper) b += std::abs(q1[3 + dof] - q0[3 + dof]);
+    return b;
+  }
+
+  // ---- collision --------------------------------------------------------------------------------
+  /// The first object the robot at q touches, or "" (objects and pairs of `a` ignored).
+  std::string contactAt(const Vec& q, const Active* a) {
+    robot.linkPoses(toState(q), link_poses);
+    scene.setLinkPoses(link_poses);
+    collision::Filter filter;
+    if (a) filter.ignore = a->ignore_objects;
+    for (const auto& c : scene.robotContacts(filter)) {
+      bool ignored = false;
+      if (a) {
+        for (const auto& [r, o] : a->ignore_pairs) ignored |= (c.robot == r && c.object == o);
+      }
+      if (!ignored) return c.object;
+    }
+    // The floor plane: no part of the robot may go below it.
+    const auto& geo = robot.collisionGeometry();
+    for (const auto& part : geo.parts) {
+      if (part.shape.aabb(link_poses[part.link] * part.link_T_shape).min.z() < -kFloorTolerance) {
+        return std::string(kFloorId);
+      }
+    }
+    return "";
+  }
+
+  std::vector<std::string> objectsTouching(const Vec& q) {
+    robot.linkPoses(toState(q), link_poses);
+    scene.setLinkPoses(link_poses);
+    return scene.robotCollisions();
+  }
+
+  /// Objects an object at `pose` rests on: those it touches (or nearly: probed 5 mm lower) whose
+  /// top is not above its bottom.
+  std::vector<std::string> supportsOf(const world::Object& o, const Eigen::Isometry3d& pose) {
+    std::vector<std::string> out;
+    const double bottom = o.shape.aabb(pose).min.z();
+    Eigen::Isometry3d probe = pose;
+    probe.translation().z() -= kSupportProbe;
+    for (const auto& id : scene.shapeCollisions(o.shape, probe, collision::Filter::allBut({o.id}))) {
+      const auto* other = world.findObject(id);
+      if (other && other->aabb().max.z() <= bottom + kSupportProbe) out.push_back(id);
+    }
+    return out;
+  }
+
+  double fractionAt(const Phase& p, double rel, double k) const {
+    if (p.length <= 0.0) return rel >= p.t1 ? 1.0 : 0.0;
+    const double s = trapPosition((rel - p.t0) / k, p.length, p.v, p.a);
+    return s / p.length;
+  }
+
+  Vec stateAt(const Active& a, double rel) const {
+    rel = std::clamp(rel, 0.0, a.end);
+    for (const Phase& p : a.phases) {
+      if (rel > p.t1) continue;
+      if (p.kind != Phase::Kind::kMotion) return p.start;
+      return p.path.at(fractionAt(p, rel, a.k));
+    }
+    return a.phases.empty() ? idle : a.phases.back().end;
+  }
+
+  /// Sweeps the rest of the action from relative time `from`: the relative time at which the
+  /// robot must stop before a contact (and the object), or nothing when the way is clear.
+  std::optional<std::pair<double, std::string>> sweep(Active& a, double from) {
+    for (const Phase& p : a.phases) {
+      if (p.kind != Phase::Kind::kMotion || p.t1 <= from) continue;
+      const double f_from = p.t0 >= from ? 0.0 : fractionAt(p, from, a.k);
+      const double U = p.path.u.back();
+      double f_prev = f_from;
+      const double t_prev0 = std::max(from, p.t0);
+      // The starting sample itself (a new object may have appeared on the robot).
+      if (from > 0.0 || p.t0 > 0.0) {
+        const std::string hit = contactAt(p.path.at(f_from), &a);
+        if (!hit.empty()) return std::pair{t_prev0, hit};
+      }
+      for (std::size_t j = 1; j < p.path.q.size(); ++j) {
+        const double u0 = p.path.u[j - 1], u1 = p.path.u[j];
+        if (U > 0.0 && u1 / U <= f_from) continue;
+        const int n = std::max(
+            1, static_cast<int>(std::ceil(displacementBound(p.path.q[j - 1], p.path.q[j]) / params.max_step_m)));
+        for (int i = 1; i <= n; ++i) {
+          const double w = static_cast<double>(i) / n;
+          const double f = U > 0.0 ? (u0 + w * (u1 - u0)) / U : 1.0;
+          if (f <= f_from) continue;
+          const Vec q = p.path.q[j - 1] + w * (p.path.q[j] - p.path.q[j - 1]);
+          const std::string hit = contactAt(q, &a);
+          if (!hit.empty()) {
+            const double t = f_prev <= f_from ? t_prev0
+                                               : p.t0 + a.k * trapTimeAt(f_prev * p.length, p.length, p.v, p.a);
+            return std::pair{t, hit};
+          }
+          f_prev = f;
+        }
+      }
+    }
+    return std::nullopt;
+  }
+
+  /// Re-checks the action in progress after the world changed at relative time `rel`.
+  void resweep(double rel) {
+    if (!active) return;
+    Active& a = *active;
+    if (a.outcome != Outcome::kSucceeded) return;  // already stopping
+    a.end = a.total;
+    a.blocking.clear();
+    if (auto stop = sweep(a, rel)) {
+      a.end = std::max(rel, stop->first);
+      a.outcome = Outcome::kBlocked;
+      a.blocking = stop->second;
+    }
+  }
+
+  void syncScene() {
+    scene.syncWorld(world);
+  }
+
+  /// Keeps the held object's world pose where the gripper is.
+  void syncHeldPose(const Vec& q) {
+    if (!world.held()) return;
+    auto pose = robot.heldObjectPose(toState(q), *world.held());
+    if (pose) (void)world.setObjectPose(world.held()->object_id, *pose);
+  }
+
+  Vec current() const { return active ? stateAt(*active, now - active->start) : idle; }
+
+  // ---- physics of objects -----------------------------------------------------------------------
+  /// Where an object released at `pose` comes to rest: upright (yaw kept) on the support below
+  /// its bottom (a table region, else the floor at z = 0). Returns the pose, the region id, the
+  /// drop height and the tilt it was released with.
+  struct Settled {
+    Eigen::Isometry3d pose;
+    std::string region;
+    double drop{0.0};
+    double tilt{0.0};
+    bool on_region{false};
+  };
+  Settled settle(const world::Object& o, const Eigen::Isometry3d& pose) const {
+    Settled s;
+    const double bottom = o.shape.aabb(pose).min.z();
+    const Eigen::Vector3d probe(pose.translation().x(), pose.translation().y(), bottom);
+    const world::Region* region = world.regionBelow(probe, 0.02);
+    const double surface = region ? region->height : 0.0;
+    s.region = region ? region->id : "";
+    s.on_region = region != nullptr;
+    s.drop = bottom - surface;
+    s.tilt = std::acos(std::clamp(pose.linear()(2, 2), -1.0, 1.0));
+    const double yaw = std::atan2(pose.linear()(1, 0), pose.linear()(0, 0));
+    s.pose = Eigen::Isometry3d::Identity();
+    s.pose.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    s.pose.translation() = Eigen::Vector3d(probe.x(), probe.y(), surface + o.shape.halfHeight());
+    return s;
+  }
+
+  /// Drops the held object where it is (a fault). Returns its id ("" when the gripper is empty).
+  std::string dropHeld(const Vec& q) {
+    if (!world.held()) return "";
+    syncHeldPose(q);
+    const std::string id = world.held()->object_id;
+    world::Object o = world.object(id);
+    const Settled s = settle(o, o.pose);
+    (void)scene.detach(id);
+    (void)world.setHeld(std::nullopt);
+    o.pose = s.pose;
+    o.region = s.region;
+    (void)world.updateObject(o);
+    syncScene();
+    return id;
+  }
+
+  // ---- faults -----------------------------------------------------------------------------------
+  FaultEvent fire(const Fault& f, StepEvents& ev) {
+    FaultEvent e;
+    e.fault_id = f.id;
+    e.type = f.type;
+    e.time_s = now;
+    const double rel = active ? now - active->start : 0.0;
+    switch (f.type) {
+      case FaultType::kDropHeldObject: {
+        e.object_id = dropHeld(current());
+        e.description = e.object_id.empty() ? "drop: the gripper was empty"
+                                            : "dropped '" + e.object_id + "'";
+        if (!e.object_id.empty()) {
+          ev.world_changed = true;
+          resweep(rel);
+        }
+        break;
+      }
+      case FaultType::kSpawnObject: {
+        e.object_id = f.object.id;
+        if (Status s = world.addObject(f.object); !s) {
+          e.description = "spawn failed: " + s.error().message;
+        } else {
+          e.description = "object '" + f.object.id + "' appeared";
+          syncScene();
+          ev.world_changed = true;
+          resweep(rel);
+        }
+        break;
+      }
+      case FaultType::kRemoveObject: {
+        e.object_id = f.object_id;
+        if (Status s = world.removeObject(f.object_id); !s) {
+          e.description = "remove failed: " + s.error().message;
+        } else {
+          e.description = "object '" + f.object_id + "' disappeared";
+          syncScene();
+          ev.world_changed = true;
+          resweep(rel);
+        }
+        break;
+      }
+      case FaultType::kFailAction: {
+        if (active && active->outcome == Outcome::kSucceeded) {
+          active->outcome = Outcome::kFailed;
+          active->reason = "action failed (fault '" + f.id + "')" + (f.reason.empty() ? "" : ": " + f.reason);
+          active->end = std::max(0.0, std::min(active->end, rel));
+          active->blocking.clear();
+          e.description = "action '" + active->cmd.command_id + "' failed";
+        } else {
+          fail_next = f;
+          e.description = "the next action will fail";
+        }
+        break;
+      }
+    }
+    if (!f.reason.empty()) e.description += " (" + f.reason + ")";
+    logger()->info("fault '{}' at t={:.3f}s: {}", f.id, now, e.description);
+    return e;
+  }
+
+  // ---- manipulation events ----------------------------------------------------------------------
+  /// Why a pick with the robot at q would fail, or "".
+  std::string pickFailure(const ActionCommand& c, const Vec& q) const {
+    if (world.held()) return "the gripper already holds '" + world.held()->object_id + "'";
+    const world::Object* o = world.findObject(c.object_id);
+    if (!o) return "there is no object '" + c.object_id + "' to grasp";
+    if (o->kind != world::ObjectKind::kMovable || !o->graspable) return "'" + o->id + "' is not graspable";
+    if (c.object_pose) {
+      const double off = (o->pose.translation() - c.object_pose->translation()).norm();
+      if (off > params.grasp.position_tolerance_m) {
+        return "'" + o->id + "' is not where the command says: " + fmt(off) + " m away (tolerance " +
+               fmt(params.grasp.position_tolerance_m) + " m)";
+      }
+    }
+    const robot::RobotState s = toState(q);
+    const Eigen::Isometry3d tool = robot.toolPoseInWorld(s);
+    const Eigen::Vector3d local = o->pose.inverse() * tool.translation();
+    const Aabb box = o->shape.localAabb();
+    const Eigen::Vector3d outside =
+        (box.min - local).cwiseMax(local - box.max).cwiseMax(Eigen::Vector3d::Zero());
+    if (outside.norm() > params.grasp.tcp_tolerance_m) {
+      return "the gripper closes " + fmt(outside.norm()) + " m away from '" + o->id + "'";
+    }
+    if (has_gripper) {
+      const Eigen::Vector3d across = o->pose.linear().transpose() * tool.linear().col(1);
+      const double width = widthAlong(o->shape, across);
+      const double opening = 2.0 * robot.gripperLimits().upper;
+      if (width > opening) {
+        return "'" + o->id + "' is " + fmt(width) + " m wide across the fingers; the gripper opens " +
+               fmt(opening) + " m";
+      }
+    }
+    if (o->mass > params.grasp.max_payload_kg) {
+      return "'" + o->id + "' (" + fmt(o->mass) + " kg) exceeds the payload limit of " +
+             fmt(params.grasp.max_payload_kg) + " kg";
+    }
+    return "";
+  }
+
+  void gripperEvent(Active& a, StepEvents& ev) {
+    a.gripper_done = true;
+    const Vec q = stateAt(a, now - a.start);
+    const ActionCommand& c = a.cmd;
+    if (c.kind == ActionKind::kPick) {
+      a.failure = pickFailure(c, q);
+      if (!a.failure.empty()) {
+        logger()->info("pick '{}' fails: {}", c.command_id, a.failure);
+        return;
+      }
+      world::Object o = world.object(c.object_id);
+      o.region.clear();
+      (void)world.updateObject(o);
+      (void)world.setHeld(robot.hold(o.id, toState(q), o.pose));
+      syncScene();
+      (void)scene.attachHeld();
+      ev.world_changed = true;
+      return;
+    }
+    // Place: release the held object where the gripper is; it settles onto the support below.
+    if (!world.held() || world.held()->object_id != c.object_id) {
+      a.failure = "the gripper does not hold '" + c.object_id + "'";
+      return;
+    }
+    syncHeldPose(q);
+    world::Object o = world.object(c.object_id);
+    const Eigen::Isometry3d released = o.pose;
+    const Settled s = settle(o, released);
+    (void)scene.detach(o.id);
+    (void)world.setHeld(std::nullopt);
+    o.pose = s.pose;
+    o.region = s.region;
+    (void)world.updateObject(o);
+    syncScene();
+    ev.world_changed = true;
+    const Eigen::Isometry3d& target = *c.object_pose;
+    const double off = (released.translation() - target.translation()).norm();
+    const double turn = Eigen::AngleAxisd(released.linear().transpose() * target.linear()).angle();
+    if (s.tilt > params.place.max_tilt_rad) {
+      a.failure = "'" + o.id + "' released tilted by " + fmt(s.tilt) + " rad and toppled";
+    } else if (s.drop > params.place.max_drop_m) {
+      a.failure = "'" + o.id + "' released " + fmt(s.drop) + " m above its support and dropped";
+    } else if (s.drop < -0.01) {
+      a.failure = "'" + o.id + "' released " + fmt(-s.drop) + " m below the support surface";
+    } else if (!s.on_region) {
+      a.failure = "'" + o.id + "' is not on a support region";
+    } else if (off > params.place.position_tolerance_m) {
+      a.failure = "'" + o.id + "' released " + fmt(off) + " m from the commanded pose (tolerance " +
+                  fmt(params.place.position_tolerance_m) + " m)";
+    } else if (turn > params.place.angle_tolerance_rad) {
+      a.failure = "'" + o.id + "' released rotated by " + fmt(turn) + " rad from the commanded pose";
+    } else {
+      for (const auto& other : scene.shapeCollisions(o.shape, o.pose, collision::Filter::allBut({o.id}))) {
+        const auto* x = world.findObject(other);
+        if (x && x->aabb().max.z() <= o.aabb().min.z() + kSupportProbe) continue;  // its support
+        a.failure = "'" + o.id + "' lands in collision with '" + other + "'";
+        break;
+      }
+    }
+    if (!a.failure.empty()) logger()->info("place '{}' fails: {}", c.command_id, a.failure);
+  }
+
+  void finish(StepEvents& ev) {
+    Active& a = *active;
+    if (a.outcome == Outcome::kSucceeded && !a.failure.empty()) {
+      a.outcome = Outcome::kFailed;
+      a.reason = a.failure;
+    }
+    ActionResult r;
+    r.command_id = a.cmd.command_id;
+    r.outcome = a.outcome;
+    r.duration_s = a.end;
+    r.progress = a.total > 0.0 ? std::clamp(a.end / a.total, 0.0, 1.0) : 1.0;
+    r.blocking_object_id = a.blocking;
+    r.reason = a.outcome == Outcome::kBlocked && a.reason.empty()
+                   ? "stopped before contact with '" + a.blocking + "'"
+                   : a.reason;
+    idle = stateAt(a, a.end);
+    // Velocities are zero at rest: the state is exactly the stop state.
+    effort_estimator::ExecutionRecord rec;
+    rec.action.kind = a.cmd.kind;
+    if (a.cmd.kind == ActionKind::kMoveBase || a.cmd.kind == ActionKind::kMoveArm) {
+      rec.action.path = a.cmd.trajectory.path();
+    } else {
+      rec.action.approach_m = a.approach_m;
+      rec.action.retreat_m = a.retreat_m;
+    }
+    rec.action.object_mass_kg = a.mass;
+    rec.duration_s = a.end;
+    rec.timestamp_s = epoch_s + now;
+    rec.source = "sim";
+    rec.success = a.outcome == Outcome::kSucceeded;
+    rec.record_id = a.cmd.command_id;
+    logger()->info("'{}' ({}) {} after {:.3f}s{}", r.command_id, toString(a.cmd.kind),
+                  toString(r.outcome), r.duration_s, r.reason.empty() ? "" : ": " + r.reason);
+    ev.results.push_back(std::move(r));
+    ev.records.push_back(std::move(rec));
+    active.reset();
+    syncHeldPose(idle);
+  }
+
+  // ---- command validation and planning ----------------------------------------------------------
+  Result<std::vector<int>> validate(const ActionCommand& c) const;
+  Result<Active> plan(const ActionCommand& c, const std::vector<int>& columns);
+};
+
+Result<std::vector<int>> Simulator::Impl::validate(const ActionCommand& c) const {
+  if (c.command_id.empty()) return invalid("command_id", "must not be empty");
+  const Trajectory& t = c.trajectory;
+  const std::string kind(toString(c.kind));
+  if (std::find(kAllActionKinds.begin(), kAllActionKinds.end(), c.kind) == kAllActionKinds.end()) {
+    return invalid("kind", "unknown action kind " + std::to_string(static_cast<int>(c.kind)));
+  }
+  if (t.joint_names.empty()) return invalid("trajectory.joint_names", "no joints");
+  if (t.points.empty()) return invalid("trajectory.points", "no points");
+  std::vector<int> cols;
+  for (std::size_t j = 0; j < t.joint_names.size(); ++j) {
+    const std::string field = "trajectory.joint_names[" + std::to_string(j) + "]";
+    const std::string& name = t.joint_names[j];
+    const auto it = std::find(full_names.begin(), full_names.end(), name);
+    if (it == full_names.end()) {
+      return invalid(field, "unknown joint '" + name + "' (robot joints: base_x, base_y, base_theta, the arm joints" +
+                                (has_gripper ? ", " + full_names.back() : std::string()) + ")");
+    }
+    for (std::size_t i = 0; i < j; ++i) {
+      if (t.joint_names[i] == name) return invalid(field, "duplicate joint '" + name + "'");
+    }
+    const int col = static_cast<int>(it - full_names.begin());
+    if (c.kind == ActionKind::kMoveBase && col >= 3) {
+      return invalid(field, "move_base moves base_x, base_y and base_theta only, got '" + name + "'");
+    }
+    if (c.kind != ActionKind::kMoveBase && col < 3) {
+      return invalid(field, kind + " cannot move the base joint '" + name + "' (use move_base)");
+    }
+    cols.push_back(col);
+  }
+  if (c.kind == ActionKind::kMoveBase && cols.size() != 3) {
+    return invalid("trajectory.joint_names", "move_base needs base_x, base_y and base_theta");
+  }
+  const Vec q = current();
+  double last_time = -kInf;
+  for (std::size_t i = 0; i < t.points.size(); ++i) {
+    const TrajectoryPoint& p = t.points[i];
+    const std::string field = "trajectory.points[" + std::to_string(i) + "]";
+    if (!std::isfinite(p.time_from_start) || p.time_from_start < 0.0) {
+      return invalid(field + ".time_from_start", "must be finite and >= 0, got " + fmt(p.time_from_start));
+    }
+    if (p.time_from_start <= last_time) {
+      return invalid(field + ".time_from_start", "times must increase strictly: " + fmt(p.time_from_start) +
+                                                   " s after " + fmt(last_time) + " s");
+    }
+    last_time = p.time_from_start;
+    if (p.positions.size() != cols.size()) {
+      return invalid(field + ".positions", "has " + std::to_string(p.positions.size()) + " values for " +
+                                               std::to_string(cols.size()) + " joints");
+    }
+    if (!p.velocities.empty() && p.velocities.size() != cols.size()) {
+      return invalid(field + ".velocities", "has " + std::to_string(p.velocities.size()) + " values for " +
+                                                std::to_string(cols.size()) + " joints (or give none)");
+    }
+    for (std::size_t j = 0; j < cols.size(); ++j) {
+      const std::string pf = field + ".positions[" + std::to_string(j) + "]";
+      const double v = p.positions[j];
+      const std::string& name = t.joint_names[j];
+      if (!std::isfinite(v)) return invalid(pf, name + " is not finite");
+      if (std::abs(v) > effort_estimator::InputLimits::kMaxAbsPathValue) {
+        return invalid(pf, name + " = " + fmt(v) + " is implausibly large");
+      }
+      if (!p.velocities.empty() && !std::isfinite(p.velocities[j])) {
+        return invalid(field + ".velocities[" + std::to_string(j) + "]", name + " is not finite");
+      }
+      const int col = cols[j];
+      if (col >= 3) {
+        const robot::JointLimits lim = col < 3 + dof ? robot.armLimits()[col - 3] : robot.gripperLimits();
+        if (v < lim.lower - 1e-6 || v > lim.upper + 1e-6) {
+          return invalid(pf, name + " = " + fmt(v) + " is outside its limits [" + fmt(lim.lower) + ", " +
+                                 fmt(lim.upper) + "]");
+        }
+      }
+      if (i == 0) {
+        const bool angular = col == 2 || (col >= 3 && col < 3 + dof);
+        const double diff = col == 2 ? std::abs(angleDiff(v, q[col])) : std::abs(v - q[col]);
+        const double tol = angular ? params.start_tolerance.angle_rad : params.start_tolerance.position_m;
+        if (diff > tol) {
+          return invalid(pf, "the trajectory starts with " + name + " = " + fmt(v) + " but the robot is at " +
+                                 fmt(q[col]) + " (tolerance " + fmt(tol) + ")");
+        }
+      }
+    }
+  }
+  const bool manipulation = c.kind == ActionKind::kPick || c.kind == ActionKind::kPlace;
+  if (manipulation) {
+    if (!world::isValidId(c.object_id)) {
+      return invalid("object_id", kind + " needs a valid object id, got '" + c.object_id + "'");
+    }
+    if (c.kind == ActionKind::kPlace && !c.object_pose) {
+      return invalid("object_pose", "place needs the pose where the object goes");
+    }
+    if (c.object_pose && !c.object_pose->matrix().allFinite()) {
+      return invalid("object_pose", "is not finite");
+    }
+  } else if (!c.object_id.empty()) {
+    return invalid("object_id", kind + " takes no object (got '" + c.object_id + "')");
+  }
+  return cols;
+}
+
+Result<Active> Simulator::Impl::plan(const ActionCommand& c, const std::vector<int>& cols) {
+  const TimeParameters& tp = params.time_parameters;
+  const std::vector<double>& P = tp.of(c.kind);
+  Active a;
+  a.cmd = c;
+  Vec cur = current();
+  // Waypoints as full joint vectors (joints not commanded keep their current value).
+  std::vector<Vec> wp;
+  for (const auto& p : c.trajectory.points) {
+    Vec q = cur;
+    for (std::size_t j = 0; j < cols.size(); ++j) q[cols[j]] = p.positions[j];
+    wp.push_back(q);
+  }
+  auto pause = [&](double d) {
+    if (d <= 0.0) return;
+    Phase ph;
+    ph.kind = Phase::Kind::kPause;
+    ph.nominal = d;
+    ph.start = ph.end = cur;
+    a.phases.push_back(std::move(ph));
+  };
+  auto motion = [&](GeoPath path, double length, double v, double acc) {
+    Phase ph;
+    ph.kind = Phase::Kind::kMotion;
+    ph.length = length;
+    ph.v = v;
+    ph.a = acc;
+    ph.nominal = effort_estimator::trapezoidTime(length, v, acc);
+    ph.start = path.q.front();
+    ph.end = path.q.back();
+    ph.path = std::move(path);
+    cur = ph.end;
+    a.phases.push_back(std::move(ph));
+  };
+
+  effort_estimator::ActionDescription desc;
+  desc.kind = c.kind;
+  if (c.kind == ActionKind::kMoveBase) {
+    // Stop-and-turn exactly as effort_estimator::extractFeatures reduces the path.
+    const double v = P[0], acc = P[1], w = P[2], alpha = P[3], settle = P[4], overhead = P[5];
+    a.mass = heldMass();
+    pause(overhead);
+    double heading = wp.front()[2];
+    double run_length = 0.0, run_ux = 0.0, run_uy = 0.0;
+    GeoPath run;
+    auto turnTo = [&](double target) {
+      const double turn = angleDiff(target, heading);
+      heading = target;
+      if (std::abs(turn) <= FeatureTolerances::kMinTurnRad) return;
+      GeoPath g;
+      Vec end = cur;
+      end[2] = cur[2] + angleDiff(target, cur[2]);
+      g.q = {cur, end};
+      g.u = {0.0, std::abs(end[2] - cur[2])};
+      motion(std::move(g), std::abs(turn), w, alpha);
+      pause(settle);
+    };
+    auto flushRun = [&]() {
+      if (run_length > 0.0) {
+        motion(std::move(run), run_length, v, acc);
+        pause(settle);
+      }
+      run = GeoPath{};
+      run_length = 0.0;
+    };
+    const double sin_tol = std::sin(FeatureTolerances::kCollinearRad);
+    auto addPoint = [&](const Vec& q) {
+      Vec s = cur;
+      if (!run.q.empty()) s = run.q.back();
+      Vec n = s;
+      n[0] = q[0];
+      n[1] = q[1];
+      run.u.push_back(run.u.back() + std::hypot(n[0] - s[0], n[1] - s[1]));
+      run.q.push_back(n);
+    };
+    for (std::size_t i = 1; i < wp.size(); ++i) {
+      const Vec& p = wp[i - 1];
+      const Vec& q = wp[i];
+      const double dx = q[0] - p[0], dy = q[1] - p[1];
+      const double d = std::sqrt(dx * dx + dy * dy);
+      if (d < FeatureTolerances::kMinTranslationM) {
+        if (std::abs(angleDiff(q[2], heading)) > FeatureTolerances::kMinTurnRad) {
+          flushRun();
+          turnTo(q[2]);
+        }
+        continue;
+      }
+      if (run_length > 0.0) {
+        const double dot = run_ux * dx + run_uy * dy;
+        const double cross = run_ux * dy - run_uy * dx;
+        if (dot > 0.0 && std::abs(cross) <= sin_tol * d) {
+          run_length += d;
+          addPoint(q);
+          continue;
+        }
+      }
+      flushRun();
+      turnTo(std::atan2(dy, dx));
+      run_ux = dx / d;
+      run_uy = dy / d;
+      run_length = d;
+      run.q = {cur};
+      run.u = {0.0};
+      addPoint(q);
+    }
+    flushRun();
+    turnTo(wp.back()[2]);
+    desc.path = c.trajectory.path();
+  } else if (c.kind == ActionKind::kMoveArm) {
+    const double f = 1.0 + P[4] * heldMass();
+    const double v = P[0] / f, acc = P[1] / f, settle = P[2], overhead = P[3];
+    a.mass = heldMass();
+    pause(overhead);
+    const std::size_t n = cols.size();
+    std::vector<double> inv_scale(n, 1.0);
+    for (std::size_t j = 0; j < n; ++j) {
+      const auto it = feature_options.joint_scales.find(c.trajectory.joint_names[j]);
+      if (it != feature_options.joint_scales.end()) inv_scale[j] = 1.0 / it->second;
+    }
+    std::vector<double> run_delta(n, 0.0), last_dir, delta(n);
+    auto flushRun = [&]() {
+      double largest = 0.0;
+      for (std::size_t j = 0; j < n; ++j) largest = std::max(largest, std::abs(run_delta[j]) * inv_scale[j]);
+      if (largest >= FeatureTolerances::kMinJointMove) {
+        GeoPath g;
+        Vec end = cur;
+        for (std::size_t j = 0; j < n; ++j) end[cols[j]] += run_delta[j];
+        g.q = {cur, end};
+        g.u = {0.0, largest};
+        motion(std::move(g), largest, v, acc);
+        pause(settle);
+      }
+      std::fill(run_delta.begin(), run_delta.end(), 0.0);
+      last_dir.clear();
+    };
+    for (std::size_t i = 1; i < wp.size(); ++i) {
+      double largest = 0.0, norm2 = 0.0;
+      for (std::size_t j = 0; j < n; ++j) {
+        delta[j] = wp[i][cols[j]] - wp[i - 1][cols[j]];
+        largest = std::max(largest, std::abs(delta[j]));
+        norm2 += delta[j] * delta[j];
+      }
+      if (largest < FeatureTolerances::kMinJointMove) continue;
+      const double norm = std::sqrt(norm2);
+      double dot = 0.0;
+      if (!last_dir.empty()) {
+        for (std::size_t j = 0; j < n; ++j) dot += last_dir[j] * delta[j] / norm;
+      }
+      if (last_dir.empty() || dot < 1.0 - FeatureTolerances::kArmCollinearCos) flushRun();
+      last_dir.resize(n);
+      for (std::size_t j = 0; j < n; ++j) {
+        run_delta[j] += delta[j];
+        last_dir[j] = delta[j] / norm;
+      }
+    }
+    flushRun();
+    desc.path = c.trajectory.path();
+  } else {
+    // Pick / place: approach to the grasp waypoint along the tool path, gripper, retreat.
+    const double speed = P[0], acc = P[1], gripper_time = P[2], slowdown = P[3];
+    const world::Object* obj = world.findObject(c.object_id);
+    wp.front() = cur;
+    std::vector<Eigen::Vector3d> tool;
+    auto toolAt = [&](const Vec& q) {
+      robot.linkPoses(toState(q), link_poses);
+      return link_poses[tool_link].translation();
+    };
+    for (const Vec& q : wp) tool.push_back(toolAt(q));
+    std::size_t g = 0;
+    double far = -1.0;
+    for (std::size_t i = 0; i < wp.size(); ++i) {
+      const double d = (tool[i] - tool[0]).norm();
+      if (d > far + 1e-12) {
+        far = d;
+        g = i;
+      }
+    }
+    // The mass carried: a pick that will fail at the grasp waypoint (as the world is now) carries
+    // nothing on its retreat; a place carries the held object on its approach.
+    if (c.kind == ActionKind::kPick) {
+      a.mass = obj && pickFailure(c, wp[g]).empty() ? obj->mass : 0.0;
+    } else {
+      a.mass = world.held() && world.held()->object_id == c.object_id ? heldMass() : 0.0;
+    }
+    const double f = 1.0 + slowdown * a.mass;
+    // Dense tool path of waypoints [from, to].
+    auto toolPath = [&](std::size_t from, std::size_t to) {
+      GeoPath p;
+      p.q = {wp[from]};
+      p.u = {0.0};
+      Eigen::Vector3d last = tool[from];
+      for (std::size_t i = from + 1; i <= to; ++i) {
+        const int n = std::max(1, static_cast<int>(std::ceil(displacementBound(wp[i - 1], wp[i]) /
+                                                             params.max_step_m)));
+        for (int k = 1; k <= n; ++k) {
+          const Vec q = wp[i - 1] + (static_cast<double>(k) / n) * (wp[i] - wp[i - 1]);
+          const Eigen::Vector3d x = toolAt(q);
+          p.u.push_back(p.u.back() + (x - last).norm());
+          p.q.push_back(q);
+          last = x;
+        }
+      }
+      return p;
+    };
+    GeoPath approach = toolPath(0, g);
+    GeoPath retreat = toolPath(g, wp.size() - 1);
+    a.approach_m = approach.u.back();
+    a.retreat_m = retreat.u.back();
+    const bool pick = c.kind == ActionKind::kPick;
+    const double fa = pick ? 1.0 : f, fr = pick ? f : 1.0;
+    if (approach.q.size() > 1) motion(std::move(approach), a.approach_m, speed / fa, acc / fa);
+    Phase grip;
+    grip.kind = Phase::Kind::kGripper;
+    grip.nominal = gripper_time;
+    grip.start = grip.end = cur;
+    a.gripper_phase = static_cast<int>(a.phases.size());
+    a.phases.push_back(std::move(grip));
+    if (retreat.q.size() > 1) motion(std::move(retreat), a.retreat_m, speed / fr, acc / fr);
+    desc.approach_m = a.approach_m;
+    desc.retreat_m = a.retreat_m;
+    // Contacts that belong to the task.
+    if (pick) {
+      a.ignore_objects.push_back(c.object_id);
+      if (obj) {
+        for (const auto& s : supportsOf(*obj, obj->pose)) a.ignore_pairs.emplace_back(obj->id, s);
+      }
+    } else if (obj && c.object_pose) {
+      for (const auto& s : supportsOf(*obj, *c.object_pose)) a.ignore_pairs.emplace_back(obj->id, s);
+    }
+  }
+  desc.object_mass_kg = a.mass;
+
+  // The timeline: nominal model times stretched by the execution noise.
+  const auto features = effort_estimator::extractFeatures(desc, feature_options);
+  if (!features) return Error(ErrorCode::kInvalidArgument, features.error().message, features.error().where);
+  const double model = effort_estimator::predictDuration(*features, P);
+  double nominal = 0.0;
+  for (const Phase& p : a.phases) nominal += p.nominal;
+  if (std::abs(nominal - model) > 1e-6 * std::max(1.0, model)) {
+    return Error(ErrorCode::kInternal, "sim: execution timeline (" + fmt(nominal) +
+                                           " s) disagrees with the time model (" + fmt(model) + " s)");
+  }
+  a.k = params.duration_noise > 0.0
+            ? std::exp(params.duration_noise * std::normal_distribution<double>(0.0, 1.0)(rng))
+            : 1.0;
+  double t = 0.0;
+  for (Phase& p : a.phases) {
+    p.t0 = t;
+    t += a.k * p.nominal;
+    p.t1 = t;
+  }
+  a.total = t;
+  a.end = t;
+  if (a.phases.empty()) {  // nothing to do (a single-point motion)
+    Phase ph;
+    ph.start = ph.end = cur;
+    a.phases.push_back(ph);
+  }
+  // Objects touching the robot at the start do not block it (it may back away from them).
+  for (const auto& id : objectsTouching(a.phases.front().start)) {
+    if (std::find(a.ignore_objects.begin(), a.ignore_objects.end(), id) == a.ignore_objects.end()) {
+      a.ignore_objects.push_back(id);
+    }
+  }
+  return a;
+}
+
+// ---- Simulator --------------------------------------------------------------------------------
+
+Simulator::Simulator(world::World truth, robot::RobotModel robot, robot::RobotState initial,
+                     SimParams params, std::vector<Fault> faults)
+    : impl_(std::make_unique<Impl>(std::move(truth), std::move(robot), std::move(params))) {
+  Impl& m = *impl_;
+  if (Status s = m.params.validate(); !s) throw std::invalid_argument("Simulator: " + s.error().message);
+  m.full_names = m.robot.fullJointNames();
+  m.dof = static_cast<int>(m.robot.armDof());
+  m.has_gripper = !m.robot.gripperJointName().empty();
+  m.tool_link = m.robot.linkIndex(m.robot.options().tool_link);
+  if (m.dof < 1 || m.tool_link < 0) throw std::invalid_argument("Simulator: the robot has no arm / tool link");
+  if (initial.arm.size() != static_cast<std::size_t>(m.dof)) {
+    throw std::invalid_argument("Simulator: initial state has " + std::to_string(initial.arm.size()) +
+                                " arm values, the robot has " + std::to_string(m.dof) + " arm joints");
+  }
+  // Per-joint speed scales from the URDF (the true robot's joints are not all equally fast).
+  double fastest = 0.0;
+  for (const auto& l : m.robot.armLimits()) fastest = std::max(fastest, l.velocity);
+  if (fastest > 0.0) {
+    for (int j = 0; j < m.dof; ++j) {
+      const double vj = m.robot.armLimits()[j].velocity;
+      if (vj > 0.0) m.feature_options.joint_scales[m.robot.armJointNames()[j]] = vj / fastest;
+    }
+  }
+  m.computeBounds();
+  m.idle = m.toVec(initial);
+  if (!m.idle.allFinite()) throw std::invalid_argument("Simulator: initial state is not finite");
+  if (const auto& h = m.world.held()) {
+    if (h->link != m.robot.options().tool_link) {
+      throw std::invalid_argument("Simulator: held object '" + h->object_id + "' is held by link '" + h->link +
+                                  "', not by the tool link '" + m.robot.options().tool_link + "'");
+    }
+  }
+  for (std::size_t i = 0; i < faults.size(); ++i) {
+    if (Status s = faults[i].validate(true); !s) {
+      throw std::invalid_argument("Simulator: faults[" + std::to_string(i) + "]." + s.error().message);
+    }
+  }
+  m.scripted = std::move(faults);
+  m.fired.assign(m.scripted.size(), false);
+  m.rng.seed(m.params.seed);
+  m.scene = collision::Scene(m.world);
+  m.scene.setRobot(m.robot.collisionGeometry());
+  if (Status s = m.scene.attachHeld(); !s) throw std::invalid_argument("Simulator: " + s.error().message);
+  m.syncHeldPose(m.idle);
+  m.syncScene();
+  m.epoch_s = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+Simulator::~Simulator() = default;
+
+Status Simulator::submit(const ActionCommand& command) {
+  Impl& m = *impl_;
+  if (m.active) {
+    return Error(ErrorCode::kUnavailable,
+                 "busy: action '" + m.active->cmd.command_id + "' is still running", SourceLocation{"", 0, 0, "command_id"});
+  }
+  auto cols = m.validate(command);
+  if (!cols) return cols.error();
+  auto planned = m.plan(command, *cols);
+  if (!planned) return planned.error();
+  Active& a = *planned;
+  a.step = m.actions++;
+  a.start = m.now;
+  for (std::size_t i = 0; i < m.scripted.size(); ++i) {
+    if (!m.fired[i] && m.scripted[i].trigger.step == a.step) {
+      a.faults.push_back({i, m.scripted[i].trigger.fraction * a.total});
+    }
+  }
+  if (m.fail_next) {
+    a.fail_fault = m.fail_next;
+    a.fail_at = m.fail_next->trigger.fraction * a.total;
+    m.fail_next.reset();
+  }
+  m.active = std::move(a);
+  if (auto stop = m.sweep(*m.active, 0.0)) {
+    m.active->end = stop->first;
+    m.active->outcome = Outcome::kBlocked;
+    m.active->blocking = stop->second;
+  }
+  logger()->debug("'{}' ({}) accepted: {:.3f}s planned{}", command.command_id, toString(command.kind),
+                m.active->total,
+                m.active->outcome == Outcome::kBlocked ? ", will stop before '" + m.active->blocking + "'" : "");
+  return Status::Ok();
+}
+
+Status Simulator::cancel(const std::string& command_id) {
+  Impl& m = *impl_;
+  if (!m.active || m.active->cmd.command_id != command_id) {
+    return Error(ErrorCode::kNotFound, "no action '" + command_id + "' in progress");
+  }
+  Active& a = *m.active;
+  const double rel = m.now - a.start;
+  if (rel < a.end) {
+    a.end = rel;
+    a.outcome = Outcome::kCancelled;
+    a.blocking.clear();
+    a.reason = "cancelled";
+  }
+  return Status::Ok();
+}
+
+Status Simulator::inject(Fault fault) {
+  Impl& m = *impl_;
+  if (Status s = fault.validate(false); !s) return s;
+  if (fault.type == FaultType::kSpawnObject && m.world.findObject(fault.object.id)) {
+    return invalid("object.id", "an object '" + fault.object.id + "' exists already");
+  }
+  if (fault.type == FaultType::kRemoveObject && !m.world.findObject(fault.object_id)) {
+    return Error(ErrorCode::kNotFound, "object_id: no object '" + fault.object_id + "'",
+                 SourceLocation{"", 0, 0, "object_id"});
+  }
+  m.injected.push_back(std::move(fault));
+  return Status::Ok();
+}
+
+StepEvents Simulator::step(double dt) {
+  if (!(dt >= 0.0) || !std::isfinite(dt)) throw std::invalid_argument("Simulator::step: dt must be >= 0, got " + fmt(dt));
+  Impl& m = *impl_;
+  StepEvents ev;
+  for (const Fault& f : std::exchange(m.injected, {})) ev.faults.push_back(m.fire(f, ev));
+  const double target = m.now + dt;
+  for (;;) {
+    // The next event: a timed fault, a fault of this step, the gripper, a failure, the end.
+    double next = target;
+    int kind = -1;  // 0 timed fault, 1 step fault, 2 fail-next, 3 gripper, 4 end
+    std::size_t which = 0;
+    for (std::size_t i = 0; i < m.scripted.size(); ++i) {
+      if (!m.fired[i] && m.scripted[i].trigger.time_s && *m.scripted[i].trigger.time_s < next + 1e-12 &&
+          (kind == -1 || *m.scripted[i].trigger.time_s < next)) {
+        next = std::max(m.now, *m.scripted[i].trigger.time_s);
+        kind = 0;
+        which = i;
+      }
+    }
+    if (m.active) {
+      Active& a = *m.active;
+      for (std::size_t i = 0; i < a.faults.size(); ++i) {
+        const double t = a.start + std::min(a.faults[i].rel_time, a.end);
+        if (!m.fired[a.faults[i].index] && (t < next || (kind == -1 && t <= next))) {
+          next = std::max(m.now, t);
+          kind = 1;
+          which = i;
+        }
+      }
+      if (a.fail_fault) {
+        const double t = a.start + std::min(a.fail_at, a.end);
+        if (t < next || (kind == -1 && t <= next)) {
+          next = std::max(m.now, t);
+          kind = 2;
+        }
+      }
+      if (a.gripper_phase >= 0 && !a.gripper_done) {
+        const double t = a.start + a.phases[a.gripper_phase].t1;
+        if (a.phases[a.gripper_phase].t1 <= a.end && (t < next || (kind == -1 && t <= next))) {
+          next = std::max(m.now, t);
+          kind = 3;
+        }
+      }
+      const double t_end = a.start + a.end;
+      if (t_end < next || (kind == -1 && t_end <= next)) {
+        next = std::max(m.now, t_end);
+        kind = 4;
+      }
+    }
+    m.now = next;
+    if (kind == -1) break;
+    switch (kind) {
+      case 0:
+        m.fired[which] = true;
+        ev.faults.push_back(m.fire(m.scripted[which], ev));
+        break;
+      case 1: {
+        const std::size_t idx = m.active->faults[which].index;
+        m.fired[idx] = true;
+        ev.faults.push_back(m.fire(m.scripted[idx], ev));
+        break;
+      }
+      case 2: {
+        Fault f = *m.active->fail_fault;
+        m.active->fail_fault.reset();
+        ev.faults.push_back(m.fire(f, ev));
+        break;
+      }
+      case 3:
+        m.gripperEvent(*m.active, ev);
+        break;
+      case 4:
+        m.finish(ev);
+        break;
+    }
+  }
+  m.syncHeldPose(m.current());
+  return ev;
+}
+
+double Simulator::time() const { return impl_->now; }
+bool Simulator::busy() const { return impl_->active.has_value(); }
+double Simulator::remainingActionTime() const {
+  const Impl& m = *impl_;
+  return m.active ? std::max(0.0, m.active->start + m.active->end - m.now) : 0.0;
+}
+int Simulator::actionCount() const { return impl_->actions; }
+
+RobotStateSample Simulator::robotState() const {
+  const Impl& m = *impl_;
+  RobotStateSample s;
+  s.time_s = m.now;
+  const Vec q = m.current();
+  s.state = m.toState(q);
+  s.state.base.theta = wrapAngle(s.state.base.theta);
+  s.joint_velocities.assign(m.full_names.size(), 0.0);
+  if (m.active) {
+    const Active& a = *m.active;
+    const double rel = m.now - a.start;
+    const double h = 1e-3;
+    const double lo = std::max(0.0, rel - h), hi = std::min(a.end, rel + h);
+    if (hi > lo) {
+      const Vec dq = (m.stateAt(a, hi) - m.stateAt(a, lo)) / (hi - lo);
+      for (std::size_t j = 0; j < m.full_names.size(); ++j) s.joint_velocities[j] = dq[static_cast<Eigen::Index>(j)];
+      s.moving = dq.cwiseAbs().maxCoeff() > 1e-9;
+    }
+  }
+  if (m.world.held()) s.held_object_id = m.world.held()->object_id;
+  return s;
+}
+
+const world::World& Simulator::world() const { return impl_->world; }
+const robot::RobotModel& Simulator::robot() const { return impl_->robot; }
+const SimParams& Simulator::params() const { return impl_->params; }
+
+PointCloudFrame Simulator::captureCloud(std::int64_t stamp_ns, GroundTruthLabels* labels) {
+  Impl& m = *impl_;
+  const Vec q = m.current();
+  m.syncHeldPose(q);
+  return m.sensor.capture(m.world, m.robot, m.toState(q), stamp_ns, labels);
+}
+
+}  // namespace tamp::sim

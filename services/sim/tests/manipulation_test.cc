@@ -1,0 +1,229 @@
+// Pick and place in the simulator: real kinematics (IK of the URDF arm), attachment to the
+// gripper, support regions, and the physical checks that make a pick or a place fail.
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "sim_test_util.h"
+
+namespace tamp::sim {
+namespace {
+
+using namespace tamp::sim::testing;
+
+constexpr double kTableTop = 0.75;
+
+/// A table in front of the robot (x in [0.4, 1.0]) with a can on it, and a second table to the
+/// left (y in [0.45, 1.25]) to place the can on.
+world::World kitchen(double can_mass = 0.4) {
+  world::World w = emptyRoom();
+  EXPECT_TRUE(w.addObject(box("table", 0.6, 0.8, kTableTop, at(0.7, 0.0, kTableTop / 2))));
+  EXPECT_TRUE(w.addObject(box("side_table", 0.8, 0.8, kTableTop, at(0.0, 0.85, kTableTop / 2))));
+  world::Region top;
+  top.id = "table_top";
+  top.kind = world::RegionKind::kTable;
+  top.polygon = {{0.4, -0.4}, {1.0, -0.4}, {1.0, 0.4}, {0.4, 0.4}};
+  top.height = kTableTop;
+  EXPECT_TRUE(w.addRegion(top));
+  top.id = "side_top";
+  top.polygon = {{-0.4, 0.45}, {0.4, 0.45}, {0.4, 1.25}, {-0.4, 1.25}};
+  EXPECT_TRUE(w.addRegion(top));
+  world::Object can;
+  can.id = "can";
+  can.kind = world::ObjectKind::kMovable;
+  can.shape = world::Shape::cylinder(0.03, 0.12);
+  can.pose = at(0.58, 0.0, kTableTop + 0.06);
+  can.mass = can_mass;
+  can.graspable = true;
+  can.region = "table_top";
+  EXPECT_TRUE(w.addObject(can));
+  return w;
+}
+
+/// Arm configuration putting the tool (pointing down) at world `p` for a base at the origin.
+std::vector<double> topGrasp(const Eigen::Vector3d& p, const std::vector<double>& seed) {
+  Eigen::Isometry3d target = Eigen::Isometry3d::Identity();
+  target.linear() = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  target.translation() = p;
+  const auto ik = robotModel().inverseKinematics(target, seed);
+  EXPECT_TRUE(ik.ok()) << toString(ik.status) << " for " << p.transpose();
+  return ik.q;
+}
+
+/// A robot in front of the table, arm above the can: pre-grasp and grasp configurations.
+struct PickSetup {
+  std::vector<double> pregrasp, grasp;
+};
+PickSetup pickSetup(const Eigen::Vector3d& can) {
+  PickSetup s;
+  s.pregrasp = topGrasp(can + Eigen::Vector3d(0, 0, 0.10), std::vector<double>{0, 0.5, 1.0, 0, 1.5, 0});
+  s.grasp = topGrasp(can, s.pregrasp);
+  return s;
+}
+
+/// Moves the arm to `q` (checked).
+void moveArmTo(Simulator& sim, const std::vector<double>& q, const std::string& id) {
+  ASSERT_TRUE(sim.submit(armCommand(id, ActionKind::kMoveArm, {sim.robotState().state.arm, q})));
+  const StepEvents e = runToEnd(sim);
+  ASSERT_EQ(e.results.size(), 1u);
+  ASSERT_EQ(e.results[0].outcome, Outcome::kSucceeded) << e.results[0].reason;
+}
+
+TEST(ManipulationTest, PickAttachesTheObjectAndPlacePutsItOnARegion) {
+  const SimParams params = exactParams();
+  Simulator sim(kitchen(), robotModel(), upright(), params);
+  const Eigen::Vector3d can = sim.world().object("can").pose.translation();
+  const PickSetup ps = pickSetup(can);
+  moveArmTo(sim, ps.pregrasp, "to_pregrasp");
+
+  ActionCommand pick = armCommand("pick", ActionKind::kPick, {ps.pregrasp, ps.grasp, ps.pregrasp});
+  pick.object_id = "can";
+  pick.object_pose = sim.world().object("can").pose;
+  ASSERT_TRUE(sim.submit(pick));
+  StepEvents e = runToEnd(sim);
+  ASSERT_EQ(e.results.size(), 1u);
+  ASSERT_EQ(e.results[0].outcome, Outcome::kSucceeded) << e.results[0].reason;
+  EXPECT_TRUE(e.world_changed);
+  // Held by the tool link, lifted 10 cm with the gripper, no longer on the table region.
+  ASSERT_TRUE(sim.world().held());
+  EXPECT_EQ(sim.world().held()->object_id, "can");
+  EXPECT_EQ(sim.world().held()->link, "gripper_tcp");
+  EXPECT_EQ(sim.robotState().held_object_id, "can");
+  const world::Object& held = sim.world().object("can");
+  EXPECT_TRUE(held.region.empty());
+  EXPECT_NEAR(held.pose.translation().z(), can.z() + 0.10, 2e-3);
+  // Timing: approach and retreat are the tool's 10 cm, the model with the TRUE pick
+  // parameters and the can's true mass on the retreat.
+  ASSERT_EQ(e.records.size(), 1u);
+  const auto& rec = e.records[0];
+  EXPECT_TRUE(rec.action.path.empty());
+  EXPECT_NEAR(rec.action.approach_m, 0.10, 2e-3);
+  EXPECT_NEAR(rec.action.retreat_m, 0.10, 2e-3);
+  EXPECT_DOUBLE_EQ(rec.action.object_mass_kg, 0.4);
+  const auto& truth = params.time_parameters.of(ActionKind::kPick);
+  EXPECT_NEAR(e.results[0].duration_s, modelTime(rec, truth), 1e-9);
+  const double f = 1 + 0.3 * 0.4;
+  auto trap = [](double d, double v, double a) { return d >= v * v / a ? d / v + v / a : 2 * std::sqrt(d / a); };
+  EXPECT_NEAR(e.results[0].duration_s,
+              trap(rec.action.approach_m, 0.04, 0.2) + 2.2 + trap(rec.action.retreat_m, 0.04 / f, 0.2 / f), 1e-9);
+
+  // Carry it: turn the base; the can moves with the gripper.
+  ASSERT_TRUE(sim.submit(moveBase("turn", {{0, 0, 0}, {0, 0, M_PI / 2}})));
+  e = runToEnd(sim);
+  ASSERT_EQ(e.results.at(0).outcome, Outcome::kSucceeded) << e.results[0].reason;
+  EXPECT_DOUBLE_EQ(e.records.at(0).action.object_mass_kg, 0.4);
+  const Eigen::Vector3d carried = sim.world().object("can").pose.translation();
+  EXPECT_NEAR(carried.x(), -can.y(), 2e-3);  // rotated by +90 deg about the base origin
+  EXPECT_NEAR(carried.y(), can.x(), 2e-3);
+  const auto tool = robotModel().toolPoseInWorld(sim.robotState().state);
+  EXPECT_TRUE((tool * sim.world().held()->link_T_object).translation().isApprox(carried, 1e-9));
+
+  // Place it on the side table (now in front of the robot) at the grasp height.
+  Eigen::Isometry3d target = sim.world().object("can").pose;
+  target.translation().z() = kTableTop + 0.06;
+  ActionCommand place = armCommand("place", ActionKind::kPlace, {ps.pregrasp, ps.grasp, ps.pregrasp});
+  place.object_id = "can";
+  place.object_pose = target;
+  ASSERT_TRUE(sim.submit(place));
+  e = runToEnd(sim);
+  ASSERT_EQ(e.results.size(), 1u);
+  EXPECT_EQ(e.results[0].outcome, Outcome::kSucceeded) << e.results[0].reason;
+  EXPECT_FALSE(sim.world().held());
+  const world::Object& placed = sim.world().object("can");
+  EXPECT_EQ(placed.region, "side_top");
+  EXPECT_NEAR(placed.pose.translation().z(), kTableTop + 0.06, 1e-9);  // resting on the surface
+  EXPECT_LT((placed.pose.translation() - target.translation()).norm(), 3e-3);
+  EXPECT_NEAR(placed.pose.linear()(2, 2), 1.0, 1e-12);
+  EXPECT_NEAR(e.results[0].duration_s, modelTime(e.records.at(0), params.time_parameters.of(ActionKind::kPlace)),
+              1e-9);
+  EXPECT_DOUBLE_EQ(e.records[0].action.object_mass_kg, 0.4);
+  // Moving away leaves it there.
+  ASSERT_TRUE(sim.submit(moveBase("leave", {{0, 0, M_PI / 2}, {0, 0, 0}})));
+  runToEnd(sim);
+  EXPECT_TRUE(sim.world().object("can").pose.isApprox(placed.pose, 0));
+}
+
+TEST(ManipulationTest, PickFailsWhenTheObjectIsNotWhereTheCommandSays) {
+  Simulator sim(kitchen(), robotModel(), upright(), exactParams());
+  const world::Object can = sim.world().object("can");
+  const PickSetup ps = pickSetup(can.pose.translation());
+  moveArmTo(sim, ps.pregrasp, "to_pregrasp");
+  // The command believes the can is 10 cm further to the side.
+  ActionCommand pick = armCommand("pick", ActionKind::kPick, {ps.pregrasp, ps.grasp, ps.pregrasp});
+  pick.object_id = "can";
+  pick.object_pose = can.pose * at(0, 0.10, 0);
+  ASSERT_TRUE(sim.submit(pick));
+  const StepEvents e = runToEnd(sim);
+  ASSERT_EQ(e.results.size(), 1u);
+  EXPECT_EQ(e.results[0].outcome, Outcome::kFailed);
+  EXPECT_NE(e.results[0].reason.find("not where the command says"), std::string::npos) << e.results[0].reason;
+  EXPECT_FALSE(e.records.at(0).success);
+  EXPECT_FALSE(sim.world().held());
+  EXPECT_TRUE(sim.world().object("can").pose.isApprox(can.pose, 0));
+  EXPECT_EQ(sim.world().object("can").region, "table_top");
+  // The arm still completed its retreat (the gripper closed on nothing).
+  for (int j = 0; j < 6; ++j) EXPECT_NEAR(sim.robotState().state.arm[j], ps.pregrasp[j], 1e-9);
+}
+
+TEST(ManipulationTest, PickFailsForAnObjectOutOfTheGripperOrTooHeavy) {
+  {
+    // The gripper closes 10 cm beside the can.
+    Simulator sim(kitchen(), robotModel(), upright(), exactParams());
+    const Eigen::Vector3d can = sim.world().object("can").pose.translation();
+    const PickSetup ps = pickSetup(can + Eigen::Vector3d(0, 0.10, 0));
+    moveArmTo(sim, ps.pregrasp, "to_pregrasp");
+    ActionCommand pick = armCommand("pick", ActionKind::kPick, {ps.pregrasp, ps.grasp, ps.pregrasp});
+    pick.object_id = "can";
+    ASSERT_TRUE(sim.submit(pick));
+    const StepEvents e = runToEnd(sim);
+    EXPECT_EQ(e.results.at(0).outcome, Outcome::kFailed);
+    EXPECT_NE(e.results[0].reason.find("m away from 'can'"), std::string::npos) << e.results[0].reason;
+    EXPECT_FALSE(sim.world().held());
+  }
+  {
+    Simulator sim(kitchen(/*can_mass=*/12.0), robotModel(), upright(), exactParams());
+    const PickSetup ps = pickSetup(sim.world().object("can").pose.translation());
+    moveArmTo(sim, ps.pregrasp, "to_pregrasp");
+    ActionCommand pick = armCommand("pick", ActionKind::kPick, {ps.pregrasp, ps.grasp, ps.pregrasp});
+    pick.object_id = "can";
+    ASSERT_TRUE(sim.submit(pick));
+    const StepEvents e = runToEnd(sim);
+    EXPECT_EQ(e.results.at(0).outcome, Outcome::kFailed);
+    EXPECT_NE(e.results[0].reason.find("payload limit"), std::string::npos) << e.results[0].reason;
+    // A failed pick is recorded without the object's mass (nothing was carried).
+    EXPECT_DOUBLE_EQ(e.records.at(0).action.object_mass_kg, 0.0);
+  }
+}
+
+TEST(ManipulationTest, ScriptedDropDuringACarryPutsTheObjectOnTheFloor) {
+  Fault drop;
+  drop.id = "slip";
+  drop.type = FaultType::kDropHeldObject;
+  drop.trigger.step = 2;  // 0: move_arm, 1: pick, 2: the carry
+  drop.trigger.fraction = 0.6;
+  Simulator sim(kitchen(), robotModel(), upright(), exactParams(), {drop});
+  const PickSetup ps = pickSetup(sim.world().object("can").pose.translation());
+  moveArmTo(sim, ps.pregrasp, "to_pregrasp");
+  ActionCommand pick = armCommand("pick", ActionKind::kPick, {ps.pregrasp, ps.grasp, ps.pregrasp});
+  pick.object_id = "can";
+  ASSERT_TRUE(sim.submit(pick));
+  ASSERT_EQ(runToEnd(sim).results.at(0).outcome, Outcome::kSucceeded);
+  ASSERT_TRUE(sim.world().held());
+  // Carry it backwards and away from the table (turn, drive), dropping it on the way.
+  ASSERT_TRUE(sim.submit(moveBase("carry", {{0, 0, 0}, {0, 0, -M_PI / 2}, {0, -2, -M_PI / 2}})));
+  const StepEvents e = runToEnd(sim);
+  ASSERT_EQ(e.faults.size(), 1u);
+  EXPECT_EQ(e.faults[0].fault_id, "slip");
+  EXPECT_EQ(e.faults[0].object_id, "can");
+  EXPECT_FALSE(sim.world().held());
+  EXPECT_EQ(sim.robotState().held_object_id, "");
+  const world::Object& can = sim.world().object("can");
+  EXPECT_NEAR(can.pose.translation().z(), 0.06, 1e-9);  // on the floor, upright
+  EXPECT_EQ(can.region, "floor");
+  // It fell in front of the robot, on its path: the rest of the drive is blocked by it.
+  EXPECT_EQ(e.results.at(0).outcome, Outcome::kBlocked);
+  EXPECT_EQ(e.results[0].blocking_object_id, "can");
+}
+
+}  // namespace
+}  // namespace tamp::sim

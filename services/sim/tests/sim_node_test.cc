@@ -1,0 +1,202 @@
+// The simulator's DDS node in-process on an isolated domain: a TrajectoryCommand in, an
+// ActionResult, robot states, an execution record and a point cloud out; a malformed command
+// answered with a failed result naming the field; an injected fault applied.
+#include "sim_node.h"
+
+#include <condition_variable>
+#include <mutex>
+
+#include <gtest/gtest.h>
+
+#include "../../../common/dds/tests/test_util.h"
+#include "sim_test_util.h"
+#include "tamp/dds/convert.h"
+
+namespace tamp::sim {
+namespace {
+
+using namespace tamp::sim::testing;
+
+template <typename T>
+class Inbox {
+ public:
+  void push(const T& v) {
+    std::lock_guard l(m_);
+    items_.push_back(v);
+    cv_.notify_all();
+  }
+  /// Waits (bounded, so that a broken node fails instead of hanging) for an item matching `pred`.
+  std::optional<T> waitFor(const std::function<bool(const T&)>& pred, double seconds = 30.0) {
+    std::unique_lock l(m_);
+    std::optional<T> found;
+    cv_.wait_for(l, std::chrono::duration<double>(seconds), [&] {
+      for (const auto& x : items_) {
+        if (pred(x)) {
+          found = x;
+          return true;
+        }
+      }
+      return false;
+    });
+    return found;
+  }
+  std::size_t size() {
+    std::lock_guard l(m_);
+    return items_.size();
+  }
+
+ private:
+  std::mutex m_;
+  std::condition_variable cv_;
+  std::vector<T> items_;
+};
+
+TEST(SimNodeTest, ExecutesATrajectoryCommandOverDds) {
+  const int domain = dds::testing::isolatedDomain();
+  dds::ServiceArgs args;
+  args.name = "sim_test";
+  args.domain_id = domain;
+  SimParams params = exactParams();
+  params.sensor.width = 40;
+  params.sensor.height = 30;
+  world::World w = emptyRoom();
+  ASSERT_TRUE(w.addObject(box("hidden_wall", 0.2, 3.0, 1.0, at(2.5, 0.0, 0.5), false, true)));
+  SimNode node(args, SimSetup(w, robotModel(), upright()), params);
+
+  auto p = dds::testing::makeParticipant(domain);
+  ASSERT_TRUE(p);
+  Inbox<msg::ActionResult> results;
+  Inbox<msg::RobotState> states;
+  Inbox<msg::ExecutionRecord> records;
+  Inbox<msg::PointCloudFrame> clouds;
+  dds::Reader<msg::ActionResult> rr(p, dds::topics::kActionResult,
+                                    [&](const msg::ActionResult& m, const dds::SampleMeta&) { results.push(m); });
+  dds::Reader<msg::RobotState> sr(p, dds::topics::kRobotState,
+                                  [&](const msg::RobotState& m, const dds::SampleMeta&) { states.push(m); });
+  dds::Reader<msg::ExecutionRecord> er(p, dds::topics::kExecutionRecords,
+                                       [&](const msg::ExecutionRecord& m, const dds::SampleMeta&) { records.push(m); });
+  dds::Reader<msg::PointCloudFrame> cr(p, dds::topics::kPointCloud,
+                                       [&](const msg::PointCloudFrame& m, const dds::SampleMeta&) { clouds.push(m); });
+  dds::Writer<msg::TrajectoryCommand> cw(p, dds::topics::kTrajectoryCommand);
+  dds::Writer<msg::FaultInjection> fw(p, dds::topics::kFaultInjection);
+  ASSERT_TRUE(cw.waitForReaders(Termination::after(20)));
+  ASSERT_TRUE(rr.waitForWriters(Termination::after(20)));
+  ASSERT_TRUE(fw.waitForReaders(Termination::after(20)));
+
+  // 1. A malformed command: the third point goes back in time (rejected by the message
+  //    conversion, which names the flattened field).
+  msg::TrajectoryCommand bad;
+  bad.command_id("bad");
+  bad.kind(msg::ActionKind::ACTION_MOVE_BASE);
+  bad.trajectory(dds::toMsg(moveBase("bad", {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}}).trajectory));
+  bad.trajectory().times()[2] = 0.5;
+  ASSERT_TRUE(cw.write(bad));
+  auto r_bad = results.waitFor([](const msg::ActionResult& r) { return r.command_id() == "bad"; });
+  ASSERT_TRUE(r_bad);
+  EXPECT_EQ(r_bad->outcome(), msg::ActionOutcome::OUTCOME_FAILED);
+  EXPECT_NE(r_bad->reason().find("trajectory.times"), std::string::npos) << r_bad->reason();
+  // 1b. Well-formed as a message but not as a command: an unknown joint (rejected by the
+  //     simulator, which names the joint's field).
+  msg::TrajectoryCommand bad2 = bad;
+  bad2.command_id("bad2");
+  bad2.trajectory(dds::toMsg(moveBase("bad2", {{0, 0, 0}, {1, 0, 0}}).trajectory));
+  bad2.trajectory().joint_names()[1] = "base_yy";
+  ASSERT_TRUE(cw.write(bad2));
+  auto r_bad2 = results.waitFor([](const msg::ActionResult& r) { return r.command_id() == "bad2"; });
+  ASSERT_TRUE(r_bad2);
+  EXPECT_EQ(r_bad2->outcome(), msg::ActionOutcome::OUTCOME_FAILED);
+  EXPECT_NE(r_bad2->reason().find("trajectory.joint_names[1]: unknown joint 'base_yy'"), std::string::npos)
+      << r_bad2->reason();
+
+  // 2. A good command into the hidden wall: blocked, with the wall's id.
+  msg::TrajectoryCommand go;
+  go.command_id("go");
+  go.kind(msg::ActionKind::ACTION_MOVE_BASE);
+  go.trajectory(dds::toMsg(moveBase("go", {{0, 0, 0}, {4, 0, 0}}).trajectory));
+  ASSERT_TRUE(cw.write(go));
+  auto r_go = results.waitFor([](const msg::ActionResult& r) { return r.command_id() == "go"; });
+  ASSERT_TRUE(r_go);
+  EXPECT_EQ(r_go->outcome(), msg::ActionOutcome::OUTCOME_BLOCKED) << r_go->reason();
+  EXPECT_EQ(r_go->blocking_object_id(), "hidden_wall");
+  EXPECT_GT(r_go->duration_s(), 0.0);
+  EXPECT_GT(r_go->progress(), 0.0);
+  EXPECT_LT(r_go->progress(), 1.0);
+  auto rec = records.waitFor([](const msg::ExecutionRecord& r) { return r.record_id() == "go"; });
+  ASSERT_TRUE(rec);
+  EXPECT_FALSE(rec->success());
+  EXPECT_EQ(rec->kind(), msg::ActionKind::ACTION_MOVE_BASE);
+  EXPECT_DOUBLE_EQ(rec->duration_s(), r_go->duration_s());
+  EXPECT_EQ(rec->source(), "sim");
+  // The robot state stream shows the robot stopped in front of the wall (x ~ 2.4 - 0.3).
+  auto st = states.waitFor([](const msg::RobotState& s) { return !s.moving() && s.base().x() > 2.0; });
+  ASSERT_TRUE(st);
+  EXPECT_NEAR(st->base().x(), 2.1, 0.011);
+  EXPECT_EQ(st->joint_names().size(), robotModel().fullJointNames().size());
+  EXPECT_EQ(st->joint_positions().size(), st->joint_names().size());
+  EXPECT_EQ(st->robot_id(), robotModel().name());
+  // A cloud after the action, from the camera, seeing the (hidden) wall ahead.
+  auto cloud = clouds.waitFor([&](const msg::PointCloudFrame&) { return true; });
+  ASSERT_TRUE(cloud);
+  auto frame = fromMsg(*cloud);
+  ASSERT_TRUE(frame) << frame.error().toString();
+  EXPECT_EQ(frame->width, 40u);
+  EXPECT_EQ(frame->height, 30u);
+
+  // 3. An injected fault: a box appears.
+  msg::FaultInjection f;
+  f.fault_id("surprise");
+  f.type(msg::FaultType::FAULT_SPAWN_OBJECT);
+  f.object_id("surprise_box");
+  msg::ShapeSpec shape;
+  shape.type(msg::ShapeType::SHAPE_BOX);
+  shape.dimensions({0.3, 0.3, 0.3});
+  f.shape(shape);
+  f.pose(dds::toMsg(at(-2, 0, 0.15)));
+  ASSERT_TRUE(fw.write(f));
+  bool appeared = false;
+  for (int i = 0; i < 300 && !appeared; ++i) {
+    node.loop().withSimulator([&](Simulator& s) { appeared = s.world().findObject("surprise_box") != nullptr; });
+    if (!appeared) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  EXPECT_TRUE(appeared);
+}
+
+TEST(SimNodeTest, ConversionsRejectMalformedMessages) {
+  msg::PointCloudFrame m = toMsg(PointCloudFrame{"cam", 5, Eigen::Isometry3d::Identity(), 2, 2,
+                                                 std::vector<float>(12, 1.0f)});
+  auto ok = fromMsg(m);
+  ASSERT_TRUE(ok);
+  EXPECT_EQ(ok->xyz.size(), 12u);
+  EXPECT_EQ(ok->stamp_ns, 5);
+  m.points().pop_back();
+  auto bad = fromMsg(m);
+  ASSERT_FALSE(bad);
+  EXPECT_EQ(bad.error().where.field, "points");
+
+  msg::TrajectoryCommand c;
+  c.command_id("c");
+  c.kind(msg::ActionKind::ACTION_PLACE);
+  c.trajectory(dds::toMsg(armCommand("c", ActionKind::kPlace, {std::vector<double>(6, 0.0)}).trajectory));
+  auto place = fromMsg(c);  // place with a zero quaternion target: rejected, field named
+  ASSERT_FALSE(place);
+  EXPECT_EQ(place.error().where.field.rfind("object_target", 0), 0u) << place.error().toString();
+  c.trajectory().positions().pop_back();
+  auto short_traj = fromMsg(c);
+  ASSERT_FALSE(short_traj);
+  EXPECT_EQ(short_traj.error().where.field, "trajectory.positions");
+
+  msg::FaultInjection f;
+  f.type(msg::FaultType::FAULT_SPAWN_OBJECT);
+  f.object_id("BAD ID");
+  msg::ShapeSpec shape;
+  shape.type(msg::ShapeType::SHAPE_SPHERE);
+  shape.dimensions({0.1});
+  f.shape(shape);
+  f.pose(dds::toMsg(Eigen::Isometry3d::Identity()));
+  auto fault = fromMsg(f);
+  ASSERT_FALSE(fault);
+  EXPECT_EQ(fault.error().where.field, "object");
+}
+
+}  // namespace
+}  // namespace tamp::sim

@@ -16,7 +16,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   std::string_view all(reinterpret_cast<const char*>(data), size);
   const size_t cut = all.find('\0');
   const std::string_view dom = all.substr(0, cut);
-  const std::string_view prob = cut == std::string_view::npos ? std::string_view() : all.substr(cut + 1);
+  const std::string_view prob =
+      cut == std::string_view::npos ? std::string_view() : all.substr(cut + 1);
   auto d = sp::pddl::parseDomain(dom, "fuzz-domain");
   if (!d) {
     (void)d.error().toString();

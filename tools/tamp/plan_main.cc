@@ -58,7 +58,7 @@ int main(int argc, char** argv) {
                "Exit codes: 0 plan, 10 proven unsolvable, 11 incomplete search failed, 20 timeout,\n"
                "21 out of memory, 30 input error, 31 invalid plan (--validate), 39 internal error.",
                "tamp plan"};
-  std::string domain, problem, search = "ehc", heuristic, plan_out, validate_plan;
+  std::string domain, problem, search = "ehc", heuristic, cost_type, plan_out, validate_plan;
   double timeout = 0.0, weight = 5.0;
   size_t memory_mb = 4096;
   bool stats = false, no_check = false, no_fallback = false, no_agenda = false;
@@ -68,6 +68,10 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"ehc", "gbfs", "wastar", "astar"}));
   app.add_option("--heuristic", heuristic, "ff, add, max, blind (default: ff; max for wastar/astar)")
       ->check(CLI::IsMember({"ff", "add", "max", "blind"}));
+  app.add_option("--cost-type", cost_type,
+                 "how action costs enter the heuristic: unit, cost, plusone (default: plusone for ehc/gbfs "
+                 "on tasks with costs, cost for wastar/astar)")
+      ->check(CLI::IsMember({"unit", "cost", "plusone"}));
   app.add_option("--weight", weight, "weight of wastar (>= 1)")->check(CLI::Range(1.0, 1e6));
   app.add_option("--timeout", timeout, "time limit in seconds (0 = none)")->check(CLI::Range(0.0, 1e9));
   app.add_option("--memory-limit", memory_mb, "search memory budget in MiB (0 = none)");
@@ -97,6 +101,9 @@ int main(int argc, char** argv) {
   if (heuristic == "add") req.search.heuristic = sp::HeuristicKind::kAdd;
   if (heuristic == "max") req.search.heuristic = sp::HeuristicKind::kMax;
   if (heuristic == "blind") req.search.heuristic = sp::HeuristicKind::kBlind;
+  if (cost_type == "unit") req.search.cost_type = sp::CostType::kUnit;
+  if (cost_type == "cost") req.search.cost_type = sp::CostType::kCost;
+  if (cost_type == "plusone") req.search.cost_type = sp::CostType::kPlusOne;
   req.timeout_seconds = timeout;
   req.check_plan = !no_check;
   const sp::PlanReply reply = sp::plan(req, tamp::Termination());

@@ -4,7 +4,7 @@
 // plan checker, writes a per-instance CSV and prints a per-domain Markdown summary next to the
 // reference planners of the benchmark's reference_results.csv.
 //
-//   tamp_symbolic_planner_ipc_bench --planner build/planner/bin/tamp-plan \
+//   tamp_symbolic_planner_ipc_bench --planner build/planner/bin/tamp-plan
 //       --set ../shared/benchmarks/pddl --out docs/bench/symbolic_planner_ipc.csv [--timeout 60]
 //       [--domain blocks] [--label ours] [-- extra planner args]
 #include <fcntl.h>
@@ -39,6 +39,7 @@ struct Row {
   std::string domain, problem, planner;
   bool solved{false};
   double wall_s{0};
+  double cpu_s{0};
   long plan_length{-1};
   double plan_cost{-1};
   long peak_kb{0};
@@ -50,6 +51,7 @@ struct RunResult {
   int exit_code{-1};
   bool killed{false};
   double wall_s{0};
+  double cpu_s{0};
   long peak_kb{0};
   std::string out;
 };
@@ -90,6 +92,8 @@ RunResult runChild(const std::vector<std::string>& argv, double timeout_s) {
   }
   r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   r.peak_kb = ru.ru_maxrss;
+  r.cpu_s = static_cast<double>(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) +
+            1e-6 * static_cast<double>(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
   lseek(fd, 0, SEEK_SET);
   char buf[65536];
@@ -212,6 +216,7 @@ int main(int argc, char** argv) {
       row.problem = p.stem().string();
       row.planner = label;
       row.wall_s = rr.wall_s;
+      row.cpu_s = rr.cpu_s;
       row.peak_kb = rr.peak_kb;
       row.exit_code = rr.exit_code;
       if (rr.exit_code == 0 && !rr.killed && dom) {
@@ -237,11 +242,11 @@ int main(int argc, char** argv) {
   }
   if (!out_csv.empty()) {
     std::ofstream out(out_csv);
-    out << "domain,problem,planner,solved,wall_s,plan_length,plan_cost,peak_kb,exit_code,note\n";
+    out << "domain,problem,planner,solved,wall_s,cpu_s,plan_length,plan_cost,peak_kb,exit_code,note\n";
     for (const auto& r : rows) {
       char b[512];
-      std::snprintf(b, sizeof b, "%s,%s,%s,%d,%.4f,%s,%s,%ld,%d,%s\n", r.domain.c_str(), r.problem.c_str(),
-                    r.planner.c_str(), r.solved ? 1 : 0, r.wall_s,
+      std::snprintf(b, sizeof b, "%s,%s,%s,%d,%.4f,%.4f,%s,%s,%ld,%d,%s\n", r.domain.c_str(), r.problem.c_str(),
+                    r.planner.c_str(), r.solved ? 1 : 0, r.wall_s, r.cpu_s,
                     r.solved ? std::to_string(r.plan_length).c_str() : "",
                     r.solved ? std::to_string(static_cast<long>(r.plan_cost)).c_str() : "", r.peak_kb, r.exit_code,
                     r.note.c_str());
@@ -259,8 +264,8 @@ int main(int argc, char** argv) {
     if (std::find(planners.begin(), planners.end(), r.planner) == planners.end()) planners.push_back(r.planner);
   }
   for (const auto& r : rows) by[r.domain + "|" + r.planner].push_back(r);
-  std::printf("| domain | planner | coverage | median time (s) | median length | median cost | median peak RSS (MB) | FF-solved by us |\n");
-  std::printf("|---|---|---|---|---|---|---|---|\n");
+  std::printf("| domain | planner | coverage | median wall time (s) | median CPU time (s) | median length | median cost | median peak RSS (MB) | FF-solved by us |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|\n");
   std::vector<std::string> dnames;
   for (const auto& d : domains) {
     if (only_domain.empty() || d.filename() == only_domain) dnames.push_back(d.filename().string());
@@ -269,12 +274,13 @@ int main(int argc, char** argv) {
     for (const auto& pl : planners) {
       auto it = by.find(d + "|" + pl);
       if (it == by.end()) continue;
-      std::vector<double> t, len, cost, kb;
+      std::vector<double> t, cpu, len, cost, kb;
       int solved = 0;
       for (const auto& r : it->second) {
         if (!r.solved) continue;
         ++solved;
         t.push_back(r.wall_s);
+        cpu.push_back(r.cpu_s);
         len.push_back(static_cast<double>(r.plan_length));
         cost.push_back(r.plan_cost);
         kb.push_back(static_cast<double>(r.peak_kb) / 1024.0);
@@ -289,8 +295,9 @@ int main(int argc, char** argv) {
         }
         ff_cov = std::to_string(both) + "/" + std::to_string(ff_solved);
       }
-      std::printf("| %s | %s | %d/%zu | %.4f | %.1f | %.1f | %.1f | %s |\n", d.c_str(), pl.c_str(), solved, it->second.size(),
-                  median(t), median(len), median(cost), median(kb), ff_cov.c_str());
+      const std::string cpu_s = pl == label ? std::to_string(median(cpu)).substr(0, 6) : "–";
+      std::printf("| %s | %s | %d/%zu | %.4f | %s | %.1f | %.1f | %.1f | %s |\n", d.c_str(), pl.c_str(), solved,
+                  it->second.size(), median(t), cpu_s.c_str(), median(len), median(cost), median(kb), ff_cov.c_str());
     }
   }
   return 0;

@@ -209,6 +209,7 @@ class RelaxationHeuristic : public Heuristic {
     Cost h = 0;
     stack_.clear();
     g1_.clear();
+    plan_first_.clear();
     for (FactId f : gc.pos) stack_.push_back(f);
     while (!stack_.empty()) {
       const FactId f = stack_.back();
@@ -268,6 +269,7 @@ class RelaxationHeuristic : public Heuristic {
     for (FactId f : gc.pos) addGoal(f);
     Cost h = 0;
     g1_.clear();
+    plan_first_.clear();
     for (size_t i = layers - 1; i >= 1; --i) {
       for (size_t k = 0; k < layer_goals_[i].size(); ++k) {
         const FactId g = layer_goals_[i][k];
@@ -291,6 +293,7 @@ class RelaxationHeuristic : public Heuristic {
         if (op_mark_[o] != mark_) {
           op_mark_[o] = mark_;
           h += 1;
+          if (i == 1) plan_first_.push_back(o);
         }
         for (uint32_t p = rop_pre_begin_[best]; p < rop_pre_begin_[best + 1]; ++p) {
           const FactId q = rop_pre_[p];
@@ -313,6 +316,12 @@ class RelaxationHeuristic : public Heuristic {
     if (pref_mark_ == 0 || pref_stamp_.size() != task_.ops.size()) {
       pref_stamp_.assign(task_.ops.size(), 0);
       pref_mark_ = 1;
+    }
+    // The relaxed plan's own first-layer actions first (EHC tries helpful actions in order).
+    for (OpId o : plan_first_) {
+      if (pref_stamp_[o] == pref_mark_ || !task_.applicable(s, o)) continue;
+      pref_stamp_[o] = pref_mark_;
+      preferred_.push_back(o);
     }
     for (FactId g : g1_) {
       for (OpId o : task_.achievers[g]) {
@@ -359,6 +368,7 @@ class RelaxationHeuristic : public Heuristic {
   std::vector<uint32_t> fact_mark_, op_mark_, pref_stamp_;
   uint32_t mark_{0}, pref_mark_{0};
   std::vector<FactId> stack_, g1_;
+  std::vector<OpId> plan_first_;
   std::vector<OpId> preferred_;
 };
 

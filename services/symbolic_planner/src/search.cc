@@ -213,6 +213,40 @@ std::vector<std::vector<FactId>> goalAgenda(const Task& task, const std::vector<
   return agenda;
 }
 
+/// Greedy action elimination (Nakhost & Mueller 2010): drop an action together with every later
+/// action that becomes inapplicable without it, when the rest still reaches the goal. Never
+/// increases the cost (costs are non-negative); repeated until no action can be dropped.
+std::vector<OpId> eliminateRedundantActions(const Task& task, const StateBits& init, const Goal& goal,
+                                            std::vector<OpId> plan, const Termination& term) {
+  const size_t w = task.numWords();
+  StateBits cur(w), nxt(w);
+  std::vector<StateBits> prefix;
+  bool changed = true;
+  while (changed && !term()) {
+    changed = false;
+    prefix.assign(1, init);
+    for (OpId o : plan) {
+      task.apply(prefix.back().data(), o, nxt.data());
+      prefix.push_back(nxt);
+    }
+    for (size_t i = 0; i < plan.size() && !changed; ++i) {
+      cur = prefix[i];
+      std::vector<OpId> kept(plan.begin(), plan.begin() + static_cast<std::ptrdiff_t>(i));
+      for (size_t j = i + 1; j < plan.size(); ++j) {
+        if (!task.applicable(cur.data(), plan[j])) continue;
+        task.apply(cur.data(), plan[j], nxt.data());
+        cur.swap(nxt);
+        kept.push_back(plan[j]);
+      }
+      if (task.goalReached(cur.data(), goal)) {
+        plan = std::move(kept);
+        changed = true;
+      }
+    }
+  }
+  return plan;
+}
+
 class Searcher {
  public:
   Searcher(const Task& task, const StateBits& init, const Goal& goal, const SearchOptions& opt, Heuristic& h,
@@ -235,6 +269,12 @@ class Searcher {
         case SearchAlgorithm::kWAstar: r = astar(opt_.weight); break;
         case SearchAlgorithm::kAstar: r = astar(1.0); break;
       }
+    }
+    const bool satisficing = opt_.algorithm == SearchAlgorithm::kEhc || opt_.algorithm == SearchAlgorithm::kGbfs;
+    if (r.status == SearchStatus::kSolved && satisficing && opt_.eliminate_redundant_actions) {
+      const size_t before = r.plan.size();
+      r.plan = eliminateRedundantActions(task_, init_, goal_, std::move(r.plan), term_);
+      stats_.eliminated_actions = before - r.plan.size();
     }
     r.stats = stats_;
     r.stats.registered_states = reg_.size();

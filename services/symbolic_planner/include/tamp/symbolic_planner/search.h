@@ -51,6 +51,8 @@ struct SearchOptions {
   /// continue from the best (FF continues from the first).
   bool ehc_best_sibling{true};
   bool preferred_operators{true};  ///< gbfs: use the helpful-action open list
+  /// ehc/gbfs: drop redundant actions from the plan found (greedy action elimination).
+  bool eliminate_redundant_actions{true};
   int preferred_boost{1000};    ///< gbfs: preferred-queue priority boost on progress
   size_t memory_limit_mb{4096};  ///< search data (states + nodes); 0 = unlimited
 
@@ -77,6 +79,7 @@ struct SearchStatistics {
   Cost initial_h{0};
   bool ehc_failed{false};  ///< ehc fell back to gbfs
   uint64_t ehc_retries{0};  ///< plateaus searched again without helpful-action pruning
+  uint64_t eliminated_actions{0};  ///< removed by action elimination
   double seconds{0.0};
 };
 

@@ -17,7 +17,7 @@ template <typename Rep>
 Rep errorReply(const Error& e) {
   Rep rep;
   rep.header().code(dds::toMsg(e.code));
-  rep.header().message(e.message);
+  rep.header().message(e.toString());  // names the field when the error knows it
   return rep;
 }
 
@@ -151,8 +151,8 @@ msg::MotionReply MotionPlannerNode::handleMotion(const msg::MotionRequest& req, 
   if (!request) {
     msg::MotionReply rep;
     rep.status(msg::MOTION_INVALID_REQUEST);
-    rep.reason(request.error().message);
-    rep.header().message(request.error().message);
+    rep.reason(request.error().toString());
+    rep.header().message(request.error().toString());
     return rep;
   }
   const MotionResult r = planner_.plan(*request, *term);

@@ -30,6 +30,12 @@ set(TAMP_TEST_ENV
   "TAMP_SHARED_DIR=${TAMP_SHARED_DIR}"
   "TAMP_BIN_DIR=${CMAKE_BINARY_DIR}/bin"
   "SKIP_DEFAULT_XML_FILE=1")
+if(TAMP_SANITIZE)
+  # Fast DDS 2.9 itself deletes its StatisticsReaderImpl through a base pointer of another size
+  # (RTPSReader::~RTPSReader, inside libfastrtps): ASan's new-delete-type-mismatch check fires in
+  # Debian's library, not in our code. Everything else stays on.
+  list(APPEND TAMP_TEST_ENV "ASAN_OPTIONS=new_delete_type_mismatch=0")
+endif()
 
 function(tamp_add_test name)
   if(NOT TAMP_BUILD_TESTS)

@@ -115,18 +115,13 @@ bool WriterBase::waitForReaders(const Termination& until, int count) const {
 class ReaderBase::Listener : public fdds::DataReaderListener {
  public:
   explicit Listener(ReaderBase* owner) : owner_(owner) {}
+  // Runs on a Fast DDS thread that holds the reader's lock: only raise the flag.
   void on_data_available(fdds::DataReader*) override {
-    std::lock_guard lock(owner_->callback_mutex_);
-    if (!owner_->listening_) return;
-    try {
-      owner_->onDataAvailable();
-    } catch (const std::exception& e) {
-      owner_->countCallbackError();
-      log::get("dds")->error("reader callback on '{}' threw: {}", owner_->topic_name_, e.what());
-    } catch (...) {
-      owner_->countCallbackError();
-      log::get("dds")->error("reader callback on '{}' threw an unknown exception", owner_->topic_name_);
+    {
+      std::lock_guard lock(owner_->signal_mutex_);
+      owner_->pending_ = true;
     }
+    owner_->signal_cv_.notify_one();
   }
 
  private:
@@ -171,22 +166,51 @@ ReaderBase::~ReaderBase() {
 
 void ReaderBase::startListening() {
   {
-    std::lock_guard lock(callback_mutex_);
-    listening_ = true;
+    std::lock_guard lock(signal_mutex_);
+    pending_ = true;  // deliver what arrived before the listener (transient-local history)
+    stop_ = false;
   }
+  dispatcher_ = std::thread([this] {
+    while (true) {
+      {
+        std::unique_lock lock(signal_mutex_);
+        signal_cv_.wait(lock, [this] { return pending_ || stop_; });
+        if (stop_) return;
+        pending_ = false;
+      }
+      try {
+        onDataAvailable();
+      } catch (const std::exception& e) {
+        countCallbackError();
+        log::get("dds")->error("reader callback on '{}' threw: {}", topic_name_, e.what());
+      } catch (...) {
+        countCallbackError();
+        log::get("dds")->error("reader callback on '{}' threw an unknown exception", topic_name_);
+      }
+    }
+  });
   ReturnCode_t r = reader_->set_listener(listener_.get(), fdds::StatusMask::data_available());
   if (r != ReturnCode_t::RETCODE_OK) {
+    stopListening();
     throw std::runtime_error("cannot attach a listener on '" + topic_name_ + "': " + rcName(r));
   }
-  // Samples that arrived before the listener was attached (transient-local history) are in the
-  // reader already and raise no new event: deliver them now.
-  listener_->on_data_available(reader_);
 }
 
 void ReaderBase::stopListening() {
   if (reader_ != nullptr) (void)reader_->set_listener(nullptr);
-  std::lock_guard lock(callback_mutex_);  // waits for a running callback
-  listening_ = false;
+  {
+    std::lock_guard lock(signal_mutex_);
+    stop_ = true;
+  }
+  signal_cv_.notify_one();
+  if (dispatcher_.joinable()) {
+    // A callback that destroys its own reader cannot join itself.
+    if (dispatcher_.get_id() == std::this_thread::get_id()) {
+      dispatcher_.detach();
+    } else {
+      dispatcher_.join();
+    }
+  }
 }
 
 bool ReaderBase::takeNextRaw(void* sample, SampleMeta& meta) {

@@ -2,7 +2,8 @@
 
 #include <fcntl.h>
 #include <signal.h>
-#include <spawn.h>
+#include <sys/prctl.h>
+#include <sys/syscall.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -28,6 +29,7 @@ Result<pid_t> spawn(const ProcessSpec& spec) {
   if (access(spec.executable.c_str(), X_OK) != 0) {
     return Error(ErrorCode::kNotFound, "not an executable file", SourceLocation{spec.executable.string()});
   }
+  // Everything the child needs is prepared before fork(): after it, only async-signal-safe calls.
   std::vector<std::string> argv_s{spec.executable.string()};
   argv_s.insert(argv_s.end(), spec.args.begin(), spec.args.end());
   std::vector<char*> argv;
@@ -46,33 +48,50 @@ Result<pid_t> spawn(const ProcessSpec& spec) {
   for (auto& e : env_s) envp.push_back(e.data());
   envp.push_back(nullptr);
 
-  posix_spawn_file_actions_t fa;
-  posix_spawn_file_actions_init(&fa);
+  int log_fd = -1;
   if (!spec.log_file.empty()) {
-    posix_spawn_file_actions_addopen(&fa, STDOUT_FILENO, spec.log_file.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-    posix_spawn_file_actions_adddup2(&fa, STDOUT_FILENO, STDERR_FILENO);
+    log_fd = open(spec.log_file.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+    if (log_fd < 0) {
+      return Error(ErrorCode::kIo, std::string("cannot open log file: ") + std::strerror(errno),
+                   SourceLocation{spec.log_file.string()});
+    }
   }
-  posix_spawnattr_t attr;
-  posix_spawnattr_init(&attr);
-  // Children start with default signal dispositions and an empty mask (the parent may block
-  // SIGINT/SIGTERM for its own signal thread).
-  sigset_t none, all;
-  sigemptyset(&none);
-  sigfillset(&all);
-  posix_spawnattr_setsigmask(&attr, &none);
-  posix_spawnattr_setsigdefault(&attr, &all);
-  // Each child leads its own process group, so signals reach its helpers too and a terminal's
-  // Ctrl-C goes to the supervisor, which stops the children in order.
-  posix_spawnattr_setpgroup(&attr, 0);
-  posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF | POSIX_SPAWN_SETPGROUP);
-  pid_t pid = -1;
-  const int rc = posix_spawn(&pid, spec.executable.c_str(), &fa, &attr, argv.data(), envp.data());
-  posix_spawn_file_actions_destroy(&fa);
-  posix_spawnattr_destroy(&attr);
-  if (rc != 0) {
-    return Error(ErrorCode::kIo, std::string("cannot start: ") + std::strerror(rc),
-                 SourceLocation{spec.executable.string()});
+  const pid_t parent = getpid();
+  const pid_t pid = fork();
+  if (pid < 0) {
+    const int e = errno;
+    if (log_fd >= 0) close(log_fd);
+    return Error(ErrorCode::kIo, std::string("fork: ") + std::strerror(e));
   }
+  if (pid == 0) {
+    // Child. Its own process group (signals reach its helpers; a terminal's Ctrl-C goes to the
+    // supervisor, which stops children in order), default signal handling, and it dies with the
+    // process that started it, so a crashed test or supervisor leaves no service behind.
+    setpgid(0, 0);
+    struct sigaction dfl {};
+    dfl.sa_handler = SIG_DFL;
+    for (int sig = 1; sig < NSIG; ++sig) sigaction(sig, &dfl, nullptr);
+    sigset_t none;
+    sigemptyset(&none);
+    sigprocmask(SIG_SETMASK, &none, nullptr);
+    prctl(PR_SET_PDEATHSIG, SIGTERM);
+    if (getppid() != parent) _exit(127);  // the parent died before prctl took effect
+    if (log_fd >= 0) {
+      dup2(log_fd, STDOUT_FILENO);
+      dup2(log_fd, STDERR_FILENO);
+    }
+    // Only stdin/stdout/stderr survive: an inherited lock file or socket would otherwise stay
+    // open as long as the service runs.
+    syscall(SYS_close_range, 3U, ~0U, 0U);
+    execve(argv[0], argv.data(), envp.data());
+    const int e = errno;
+    (void)!write(STDERR_FILENO, "tamp: exec failed\n", 18);
+    _exit(e == ENOENT ? 127 : 126);  // seen by the supervisor as "exit 127/126"
+  }
+  // Also from the parent, so that the group exists as soon as spawn() returns (no race with a
+  // signal sent right away); EACCES after the child's exec is harmless.
+  setpgid(pid, pid);
+  if (log_fd >= 0) close(log_fd);
   return pid;
 }
 

@@ -1,6 +1,8 @@
 #include "tamp/process/supervisor.h"
 
+#include <fcntl.h>
 #include <signal.h>
+#include <sys/wait.h>
 
 #include <fstream>
 #include <functional>
@@ -86,6 +88,68 @@ TEST(SupervisorTest, EnvironmentAndLogFile) {
   std::getline(in, line);
   EXPECT_EQ(line, "domain=77");
   std::filesystem::remove(log);
+}
+
+}  // namespace
+}  // namespace tamp::process
+
+namespace tamp::process {
+namespace {
+
+TEST(SupervisorTest, ChildDoesNotInheritDescriptors) {
+  // A descriptor open in the parent (e.g. a build lock) must not stay open in the service.
+  const auto path = std::filesystem::temp_directory_path() / ("tamp_sup_fd_" + std::to_string(::getpid()));
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT, 0644);  // not close-on-exec
+  ASSERT_GE(fd, 3);
+  const auto log = std::filesystem::temp_directory_path() / ("tamp_sup_fdlog_" + std::to_string(::getpid()));
+  std::filesystem::remove(log);
+  Supervisor s;
+  s.add(ProcessSpec{"fds", "/bin/sh", {"-c", "ls /proc/self/fd | wc -l"}, {}, log, false, 0, 0.1});
+  ASSERT_TRUE(s.startAll().ok());
+  const Deadline d = Deadline::in(10.0);
+  while (!d.expired() && s.status("fds")->phase != ProcessPhase::kExited) {
+    s.poll();
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ::close(fd);
+  std::ifstream in(log);
+  int count = 0;
+  in >> count;
+  // stdin, stdout, stderr, and the descriptor `ls` opens for /proc/self/fd.
+  EXPECT_EQ(count, 4);
+  std::filesystem::remove(path);
+  std::filesystem::remove(log);
+}
+
+TEST(SupervisorTest, ChildDiesWithItsParent) {
+  // A helper process starts a long sleeper through its own supervisor, then is killed: the
+  // sleeper must not outlive it.
+  const auto pidfile = std::filesystem::temp_directory_path() / ("tamp_sup_pid_" + std::to_string(::getpid()));
+  std::filesystem::remove(pidfile);
+  const pid_t helper = ::fork();
+  ASSERT_GE(helper, 0);
+  if (helper == 0) {
+    Supervisor inner;
+    inner.add(ProcessSpec{"sleeper", "/bin/sleep", {"60"}, {}, {}, false, 0, 0.1});
+    if (!inner.startAll().ok()) _exit(1);
+    std::ofstream(pidfile) << inner.status("sleeper")->pid;
+    ::pause();
+    _exit(0);
+  }
+  pid_t sleeper = 0;
+  const Deadline d = Deadline::in(10.0);
+  while (!d.expired() && sleeper == 0) {
+    std::ifstream in(pidfile);
+    in >> sleeper;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ASSERT_GT(sleeper, 0);
+  ::kill(helper, SIGKILL);
+  ::waitpid(helper, nullptr, 0);
+  const Deadline gone = Deadline::in(10.0);
+  while (!gone.expired() && ::kill(sleeper, 0) == 0) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  EXPECT_NE(::kill(sleeper, 0), 0) << "the child outlived its parent";
+  std::filesystem::remove(pidfile);
 }
 
 }  // namespace

@@ -7,19 +7,23 @@
 ///   tamp::dds::Reader<tamp::msg::Heartbeat> r(p, tamp::dds::topics::kHeartbeat,
 ///       [](const tamp::msg::Heartbeat& hb, const tamp::dds::SampleMeta& m) { ... });
 ///
-/// Callbacks run on a Fast DDS listener thread: keep them short, and nothing may escape them (an
-/// exception is caught, logged and counted). Destruction detaches the callback and waits for a
-/// running one to finish. Every Fast DDS `ReturnCode_t` is checked and turned into a Status.
+/// Callbacks run on the reader's own dispatch thread, never on a Fast DDS thread: the DDS listener
+/// only raises a flag, so a slow callback (a perception frame, a planning request) cannot stall
+/// the participant's receive path, and no lock of ours is ever held while Fast DDS holds its own.
+/// Nothing may escape a callback (an exception is caught, logged and counted). Destruction stops
+/// the dispatch thread after the running callback. Every Fast DDS `ReturnCode_t` is checked.
 
 #include <array>
 #include <atomic>
-#include <map>
+#include <condition_variable>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "tamp/core/error.h"
@@ -128,9 +132,11 @@ class ReaderBase {
   ReaderBase(std::shared_ptr<Participant> p, const std::string& topic,
              const std::function<eprosima::fastdds::dds::TopicDataType*()>& make_type, QosClass qos,
              const ReaderOptions& options);
-  /// Attaches the listener; derived constructors call it last, so no callback sees a half-built object.
+  /// Starts the dispatch thread and attaches the listener; derived constructors call it last, so
+  /// no callback sees a half-built object. Samples that arrived earlier are delivered first.
   void startListening();
-  /// Detaches the listener and waits for a running callback; derived destructors call it first.
+  /// Detaches the listener and joins the dispatch thread (after a running callback); derived
+  /// destructors call it first.
   void stopListening();
   /// Takes the next sample into `sample`. Returns false when none is left. For a not-alive
   /// instance, only the key fields of `sample` are filled.
@@ -145,8 +151,11 @@ class ReaderBase {
   eprosima::fastdds::dds::DataReader* reader_{nullptr};
   eprosima::fastdds::dds::ContentFilteredTopic* filtered_{nullptr};
   std::unique_ptr<Listener> listener_;
-  std::mutex callback_mutex_;
-  bool listening_{false};
+  std::mutex signal_mutex_;  // guards pending_/stop_ only; never held while calling Fast DDS
+  std::condition_variable signal_cv_;
+  bool pending_{false};
+  bool stop_{false};
+  std::thread dispatcher_;
   std::atomic<uint64_t> callback_errors_{0};
 };
 

@@ -61,7 +61,7 @@ int main(int argc, char** argv) {
   std::string domain, problem, search = "ehc", heuristic, cost_type, plan_out, validate_plan;
   double timeout = 0.0, weight = 5.0;
   size_t memory_mb = 4096;
-  bool stats = false, no_check = false, no_fallback = false, no_agenda = false;
+  bool stats = false, no_check = false, no_fallback = false, no_agenda = false, first_improvement = false;
   app.add_option("domain", domain, "PDDL domain file")->required();
   app.add_option("problem", problem, "PDDL problem file")->required();
   app.add_option("--search", search, "ehc (FF: hill-climbing, then best-first), gbfs, wastar, astar")
@@ -81,6 +81,8 @@ int main(int argc, char** argv) {
   app.add_flag("--no-check", no_check, "do not replay the plan with the independent checker");
   app.add_flag("--no-fallback", no_fallback, "ehc: do not fall back to best-first search");
   app.add_flag("--no-goal-agenda", no_agenda, "ehc: pursue all goals at once (no FF goal agenda)");
+  app.add_flag("--ehc-first-improvement", first_improvement,
+               "ehc: continue from the first better state (FF) instead of the best sibling");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -97,6 +99,7 @@ int main(int argc, char** argv) {
   req.search.memory_limit_mb = memory_mb;
   req.search.ehc_fallback = !no_fallback;
   req.search.goal_agenda = !no_agenda;
+  req.search.ehc_best_sibling = !first_improvement;
   if (heuristic == "ff") req.search.heuristic = sp::HeuristicKind::kFF;
   if (heuristic == "add") req.search.heuristic = sp::HeuristicKind::kAdd;
   if (heuristic == "max") req.search.heuristic = sp::HeuristicKind::kMax;

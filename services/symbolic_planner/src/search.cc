@@ -218,31 +218,27 @@ std::vector<std::vector<FactId>> goalAgenda(const Task& task, const std::vector<
 /// increases the cost (costs are non-negative); repeated until no action can be dropped.
 std::vector<OpId> eliminateRedundantActions(const Task& task, const StateBits& init, const Goal& goal,
                                             std::vector<OpId> plan, const Termination& term) {
+  // One left-to-right pass: O(n^2) applications for a plan of n actions.
   const size_t w = task.numWords();
-  StateBits cur(w), nxt(w);
-  std::vector<StateBits> prefix;
-  bool changed = true;
-  while (changed && !term()) {
-    changed = false;
-    prefix.assign(1, init);
-    for (OpId o : plan) {
-      task.apply(prefix.back().data(), o, nxt.data());
-      prefix.push_back(nxt);
+  StateBits prefix = init, cur(w), nxt(w);
+  std::vector<OpId> kept;
+  size_t i = 0;
+  while (i < plan.size() && !term()) {
+    cur = prefix;
+    kept.assign(plan.begin(), plan.begin() + static_cast<std::ptrdiff_t>(i));
+    for (size_t j = i + 1; j < plan.size(); ++j) {
+      if (!task.applicable(cur.data(), plan[j])) continue;
+      task.apply(cur.data(), plan[j], nxt.data());
+      cur.swap(nxt);
+      kept.push_back(plan[j]);
     }
-    for (size_t i = 0; i < plan.size() && !changed; ++i) {
-      cur = prefix[i];
-      std::vector<OpId> kept(plan.begin(), plan.begin() + static_cast<std::ptrdiff_t>(i));
-      for (size_t j = i + 1; j < plan.size(); ++j) {
-        if (!task.applicable(cur.data(), plan[j])) continue;
-        task.apply(cur.data(), plan[j], nxt.data());
-        cur.swap(nxt);
-        kept.push_back(plan[j]);
-      }
-      if (task.goalReached(cur.data(), goal)) {
-        plan = std::move(kept);
-        changed = true;
-      }
+    if (task.goalReached(cur.data(), goal)) {
+      plan.swap(kept);  // drop plan[i] (and what depended on it); retry at the same position
+      continue;
     }
+    task.apply(prefix.data(), plan[i], nxt.data());
+    prefix.swap(nxt);
+    ++i;
   }
   return plan;
 }

@@ -99,12 +99,35 @@ PointCloudFrame DepthSensor::render(const world::World& world,
   if (!world_T_sensor.matrix().allFinite()) {
     throw std::invalid_argument("DepthSensor: sensor pose is not finite");
   }
+  // Frustum culling: a shape whose world box lies entirely behind the sensor, beyond its range,
+  // or outside one of the four side planes cannot be hit by any pixel's ray.
+  const Eigen::Isometry3d sensor_T_world = world_T_sensor.inverse();
+  const double tan_x = (cx_ + 0.5) / fx_, tan_y = (cy_ + 0.5) / fx_;
+  auto visible = [&](const world::Shape& shape, const Eigen::Isometry3d& pose) {
+    const Aabb box = shape.aabb(pose);
+    int out[6] = {0, 0, 0, 0, 0, 0};
+    for (int k = 0; k < 8; ++k) {
+      const Eigen::Vector3d corner((k & 1) ? box.max.x() : box.min.x(), (k & 2) ? box.max.y() : box.min.y(),
+                                   (k & 4) ? box.max.z() : box.min.z());
+      const Eigen::Vector3d p = sensor_T_world * corner;
+      out[0] += p.z() <= 0.0;
+      out[1] += p.z() > params_.max_range_m;
+      out[2] += p.x() > tan_x * p.z();
+      out[3] += p.x() < -tan_x * p.z();
+      out[4] += p.y() > tan_y * p.z();
+      out[5] += p.y() < -tan_y * p.z();
+    }
+    for (int n : out) {
+      if (n == 8) return false;
+    }
+    return true;
+  };
   RayScene scene;
   scene.setFloor(0.0);
   std::vector<std::string> ids;
   ids.reserve(world.objectCount());
   for (const world::Object& o : world.objects()) {
-    scene.add(o.shape, o.pose, static_cast<int>(ids.size()));
+    if (visible(o.shape, o.pose)) scene.add(o.shape, o.pose, static_cast<int>(ids.size()));
     ids.push_back(o.id);
   }
   if (robot != nullptr) {
@@ -114,7 +137,8 @@ PointCloudFrame DepthSensor::render(const world::World& world,
     const int first_link_tag = static_cast<int>(ids.size());
     for (const auto& name : geometry.links) ids.push_back(name);
     for (const auto& part : geometry.parts) {
-      scene.add(part.shape, link_poses[part.link] * part.link_T_shape, first_link_tag + part.link);
+      const Eigen::Isometry3d pose = link_poses[part.link] * part.link_T_shape;
+      if (visible(part.shape, pose)) scene.add(part.shape, pose, first_link_tag + part.link);
     }
   }
   scene.build();

@@ -2,8 +2,6 @@
 
 #include <filesystem>
 
-#include "tamp/world/namo.h"
-
 namespace tamp::sim {
 
 world::World emptyRoom(double size_m) {
@@ -18,25 +16,92 @@ world::World emptyRoom(double size_m) {
   return w;
 }
 
-Result<SimSetup> loadSetup(const SimParams& params) {
-  auto robot = robot::RobotModel::loadDefault();
+SimParams withScenarioParameters(SimParams p, const world::SimParameters& s) {
+  using K = ActionKind;
+  TimeParameters& t = p.time_parameters;
+  t.set(K::kMoveBase, "max_linear_speed", s.base_max_linear_speed);
+  t.set(K::kMoveBase, "max_linear_accel", s.base_linear_accel);
+  t.set(K::kMoveBase, "max_angular_speed", s.base_max_angular_speed);
+  t.set(K::kMoveBase, "max_angular_accel", s.base_angular_accel);
+  t.set(K::kMoveBase, "settle_time", s.segment_stop_time);
+  t.set(K::kMoveArm, "max_joint_speed", s.arm_max_joint_speed);
+  t.set(K::kMoveArm, "max_joint_accel", s.arm_joint_accel);
+  t.set(K::kMoveArm, "settle_time", s.segment_stop_time);
+  t.set(K::kPick, "gripper_time", s.grasp_duration);
+  t.set(K::kPlace, "gripper_time", s.release_duration);
+  p.duration_noise = s.duration_noise_stddev;
+  p.seed = s.seed;
+  return p;
+}
+
+Result<std::vector<Fault>> scenarioFaults(const world::Scenario& scenario) {
+  std::vector<Fault> out;
+  for (std::size_t i = 0; i < scenario.faults.size(); ++i) {
+    const world::Fault& sf = scenario.faults[i];
+    const std::string field = "faults[" + std::to_string(i) + "]";
+    Fault f;
+    f.id = "fault_" + std::to_string(i);
+    f.reason = sf.reason;
+    f.trigger.time_s = sf.at_time;
+    f.trigger.step = sf.at_step;
+    switch (sf.kind) {
+      case world::FaultKind::kDropHeld:
+        f.type = FaultType::kDropHeldObject;
+        break;
+      case world::FaultKind::kObjectAppears:
+        f.type = FaultType::kSpawnObject;
+        if (!sf.object) {
+          return Error(ErrorCode::kInvalidArgument, field + ": object_appears without an object",
+                       SourceLocation{scenario.file.string(), 0, 0, field + ".object"});
+        }
+        f.object = *sf.object;
+        break;
+      case world::FaultKind::kActionFails:
+        f.type = FaultType::kFailAction;
+        if (!sf.action.empty()) {
+          f.action = actionKindFromString(sf.action);
+          if (!f.action) {
+            return Error(ErrorCode::kInvalidArgument, field + ": unknown action kind '" + sf.action + "'",
+                         SourceLocation{scenario.file.string(), 0, 0, field + ".action"});
+          }
+        }
+        break;
+    }
+    if (Status s = f.validate(true); !s) {
+      return Error(ErrorCode::kInvalidArgument, field + "." + s.error().message,
+                   SourceLocation{scenario.file.string(), 0, 0, field});
+    }
+    out.push_back(std::move(f));
+  }
+  return out;
+}
+
+Result<SimSetup> setupFromScenario(const world::Scenario& scenario) {
+  auto robot = robot::RobotModel::loadDescription(scenario.robot.description);
   if (!robot) return robot.error();
+  auto faults = scenarioFaults(scenario);
+  if (!faults) return faults.error();
+  return SimSetup(scenario.world, std::move(robot).value(), scenario.startState(), std::move(faults).value());
+}
+
+Result<SimSetup> loadSetup(SimParams& params) {
   if (params.scenario.empty()) {
+    auto robot = robot::RobotModel::loadDefault();
+    if (!robot) return robot.error();
     const auto initial = robot->defaultState(Pose2D{});
     return SimSetup(emptyRoom(), std::move(robot).value(), initial);
   }
-  const std::filesystem::path file(params.scenario);
-  const std::string ext = file.extension().string();
-  if (ext == ".svg" || ext == ".json") {
-    auto namo = world::loadNamo(file);
-    if (!namo) return namo.error();
-    const auto initial = robot->defaultState(namo->start);
-    return SimSetup(std::move(namo->world), std::move(robot).value(), initial);
+  auto scenario = world::loadScenario(params.scenario);
+  if (!scenario) return scenario.error();
+  auto setup = setupFromScenario(*scenario);
+  if (!setup) return setup.error();
+  SimParams p = withScenarioParameters(params, scenario->sim);
+  if (Status s = p.validate(); !s) {
+    return Error(ErrorCode::kInvalidArgument, "scenario '" + params.scenario + "': " + s.error().message,
+                 SourceLocation{params.scenario, 0, 0, "sim"});
   }
-  return Error(ErrorCode::kUnsupported,
-               "scenario '" + params.scenario +
-                   "': only NAMO worlds (.svg/.json) load here until the scenario loader exists",
-               SourceLocation{params.scenario, 0, 0, "scenario"});
+  params = std::move(p);
+  return setup;
 }
 
 }  // namespace tamp::sim

@@ -15,6 +15,7 @@
 #include "tamp/effort_estimator/features.h"
 #include "tamp/effort_estimator/models.h"
 #include "tamp/sim/depth_sensor.h"
+#include "tamp/sim/ray_scene.h"
 
 namespace tamp::sim {
 namespace {
@@ -193,6 +194,7 @@ struct Simulator::Impl {
   int tool_link{-1};
   double r_arm{0.0};   // bound: displacement of any arm point per radian of any arm joint
   double r_base{0.0};  // bound: displacement of any robot point per radian of base turn
+  std::vector<bool> hand_link;  // per link: part of the hand (gripper)
   Vec idle;            // the robot's state when no action runs
   double now{0.0};
   double epoch_s{0.0};
@@ -201,9 +203,15 @@ struct Simulator::Impl {
   std::vector<Fault> scripted;
   std::vector<bool> fired;
   std::vector<Fault> injected;        // fire at the next step()
-  std::optional<Fault> fail_next;     // injected kFailAction while idle
+  std::vector<Fault> pending_fails;   // kFailAction waiting for the next (matching) action
   std::optional<Active> active;
   std::vector<Eigen::Isometry3d> link_poses;  // scratch
+  struct Riding {
+    std::string id;
+    int link;
+    Eigen::Isometry3d link_T_object;
+  };
+  std::vector<Riding> riding;  // objects resting on the robot (dropped onto it), carried along
 
   Impl(world::World w, robot::RobotModel r, SimParams p)
       : world(std::move(w)), robot(std::move(r)), params(std::move(p)), sensor(params.sensor) {}
@@ -231,10 +239,20 @@ struct Simulator::Impl {
     const auto* o = world.findObject(world.held()->object_id);
     return o ? o->mass : 0.0;
   }
+  /// How far the held object and objects riding on the robot reach beyond its links (m).
   double heldExtent() const {
-    if (!world.held()) return 0.0;
-    const auto* o = world.findObject(world.held()->object_id);
-    return o ? world.held()->link_T_object.translation().norm() + boundingRadius(o->shape) : 0.0;
+    double r = 0.0;
+    if (world.held()) {
+      if (const auto* o = world.findObject(world.held()->object_id)) {
+        r = world.held()->link_T_object.translation().norm() + boundingRadius(o->shape);
+      }
+    }
+    for (const auto& ride : riding) {
+      if (const auto* o = world.findObject(ride.id)) {
+        r = std::max(r, ride.link_T_object.translation().norm() + boundingRadius(o->shape));
+      }
+    }
+    return r;
   }
 
   void computeBounds() {
@@ -266,6 +284,20 @@ struct Simulator::Impl {
       }
     }
     r_arm = chain + arm_part;
+    // The hand: links from the last arm joint on (a dropped object does not land on it).
+    const auto* last = robot.findJoint(robot.armJointNames().back());
+    std::set<std::string> hand{last->child_link};
+    for (bool grew = true; grew;) {
+      grew = false;
+      for (const auto& j : joints) {
+        if (hand.count(j.parent_link) && !hand.count(j.child_link)) {
+          hand.insert(j.child_link);
+          grew = true;
+        }
+      }
+    }
+    hand_link.assign(geo.links.size(), false);
+    for (std::size_t i = 0; i < geo.links.size(); ++i) hand_link[i] = hand.count(geo.links[i]) > 0;
     const int li = robot.linkIndex(first->parent_link);
     const double shoulder = (link_poses[li] * first->parent_T_joint).translation().norm();
     r_base = std::max(base_fixed, shoulder + r_arm);
@@ -397,41 +429,102 @@ struct Simulator::Impl {
     scene.syncWorld(world);
   }
 
-  /// Keeps the held object's world pose where the gripper is.
+  /// Keeps the world poses of the held object and of objects resting on the robot where the
+  /// robot's links are.
   void syncHeldPose(const Vec& q) {
-    if (!world.held()) return;
-    auto pose = robot.heldObjectPose(toState(q), *world.held());
-    if (pose) (void)world.setObjectPose(world.held()->object_id, *pose);
+    if (!world.held() && riding.empty()) return;
+    const robot::RobotState st = toState(q);
+    if (world.held()) {
+      auto pose = robot.heldObjectPose(st, *world.held());
+      if (pose) (void)world.setObjectPose(world.held()->object_id, *pose);
+    }
+    if (!riding.empty()) {
+      robot.linkPoses(st, link_poses);
+      for (const auto& r : riding) (void)world.setObjectPose(r.id, link_poses[r.link] * r.link_T_object);
+    }
   }
 
   Vec current() const { return active ? stateAt(*active, now - active->start) : idle; }
 
   // ---- physics of objects -----------------------------------------------------------------------
-  /// Where an object released at `pose` comes to rest: upright (yaw kept) on the support below
-  /// its bottom (a table region, else the floor at z = 0). Returns the pose, the region id, the
-  /// drop height and the tilt it was released with.
+  /// Where an object released at `pose` comes to rest.
   struct Settled {
     Eigen::Isometry3d pose;
-    std::string region;
-    double drop{0.0};
-    double tilt{0.0};
-    bool on_region{false};
+    std::string region;     ///< support region (its surface height matches), else empty
+    std::string support;    ///< object id or robot link it rests on; empty: the floor
+    int robot_link{-1};     ///< >= 0: it rests on this robot link
+    double drop{0.0};       ///< release height above the support (m; < 0: released into it)
+    double tilt{0.0};       ///< angle of its z axis from vertical at release (rad)
   };
-  Settled settle(const world::Object& o, const Eigen::Isometry3d& pose) const {
+  /// The object falls straight down from `pose` (a vertical ray from its centre, started 2 cm
+  /// above its bottom) onto the first surface: another object, a robot link, or the floor; it
+  /// comes to rest upright with its yaw kept. Physics beyond that (toppling, sliding off an edge
+  /// its centre is over) is not simulated.
+  Settled settle(const world::Object& o, const Eigen::Isometry3d& pose, const Vec& q) {
     Settled s;
     const double bottom = o.shape.aabb(pose).min.z();
-    const Eigen::Vector3d probe(pose.translation().x(), pose.translation().y(), bottom);
-    const world::Region* region = world.regionBelow(probe, 0.02);
-    const double surface = region ? region->height : 0.0;
-    s.region = region ? region->id : "";
-    s.on_region = region != nullptr;
+    const Eigen::Vector3d c = pose.translation();
+    RayScene rays;
+    rays.setFloor(0.0);
+    std::vector<std::string> ids;
+    for (const world::Object& other : world.objects()) {
+      if (other.id == o.id) continue;
+      rays.add(other.shape, other.pose, static_cast<int>(ids.size()));
+      ids.push_back(other.id);
+    }
+    robot.linkPoses(toState(q), link_poses);
+    const auto& geo = robot.collisionGeometry();
+    const int first_link = static_cast<int>(ids.size());
+    for (const auto& part : geo.parts) {
+      if (hand_link[part.link]) continue;
+      rays.add(part.shape, link_poses[part.link] * part.link_T_shape, first_link + part.link);
+    }
+    rays.build();
+    const double start = std::min(c.z(), bottom + 0.02);
+    const RayHit hit = rays.cast(Eigen::Vector3d(c.x(), c.y(), start), -Eigen::Vector3d::UnitZ(), 0.0, kInf);
+    const double surface = hit.hit() ? start - hit.t : 0.0;
+    if (hit.tag >= first_link) {
+      s.robot_link = hit.tag - first_link;
+      s.support = geo.links[s.robot_link];
+    } else if (hit.tag >= 0) {
+      s.support = ids[hit.tag];
+    }
+    if (s.robot_link < 0) {
+      const world::Region* region = world.regionBelow(Eigen::Vector3d(c.x(), c.y(), surface), 0.02);
+      if (region && std::abs(region->height - surface) <= 0.02) s.region = region->id;
+    }
     s.drop = bottom - surface;
     s.tilt = std::acos(std::clamp(pose.linear()(2, 2), -1.0, 1.0));
     const double yaw = std::atan2(pose.linear()(1, 0), pose.linear()(0, 0));
     s.pose = Eigen::Isometry3d::Identity();
     s.pose.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-    s.pose.translation() = Eigen::Vector3d(probe.x(), probe.y(), surface + o.shape.halfHeight());
+    s.pose.translation() = Eigen::Vector3d(c.x(), c.y(), surface + o.shape.halfHeight());
     return s;
+  }
+
+  /// Puts object `o` (detached, not held) at its settled place; one resting on the robot rides
+  /// along with that link (attached to it in the collision scene).
+  void rest(world::Object o, const Settled& s) {
+    o.pose = s.pose;
+    o.region = s.region;
+    (void)world.updateObject(o);
+    syncScene();
+    if (s.robot_link >= 0) {
+      const std::string& link = robot.collisionGeometry().links[s.robot_link];
+      const Eigen::Isometry3d link_T_object = link_poses[s.robot_link].inverse() * s.pose;
+      if (scene.attach(o.id, link, link_T_object)) riding.push_back({o.id, s.robot_link, link_T_object});
+    }
+  }
+
+  /// Stops tracking `id` as riding on the robot (it is being picked or removed).
+  void stopRiding(const std::string& id) {
+    for (auto it = riding.begin(); it != riding.end(); ++it) {
+      if (it->id == id) {
+        (void)scene.detach(id);
+        riding.erase(it);
+        return;
+      }
+    }
   }
 
   /// Drops the held object where it is (a fault). Returns its id ("" when the gripper is empty).
@@ -440,13 +533,10 @@ struct Simulator::Impl {
     syncHeldPose(q);
     const std::string id = world.held()->object_id;
     world::Object o = world.object(id);
-    const Settled s = settle(o, o.pose);
+    const Settled s = settle(o, o.pose, q);
     (void)scene.detach(id);
     (void)world.setHeld(std::nullopt);
-    o.pose = s.pose;
-    o.region = s.region;
-    (void)world.updateObject(o);
-    syncScene();
+    rest(std::move(o), s);
     return id;
   }
 
@@ -482,6 +572,7 @@ struct Simulator::Impl {
       }
       case FaultType::kRemoveObject: {
         e.object_id = f.object_id;
+        stopRiding(f.object_id);
         if (Status s = world.removeObject(f.object_id); !s) {
           e.description = "remove failed: " + s.error().message;
         } else {
@@ -493,15 +584,17 @@ struct Simulator::Impl {
         break;
       }
       case FaultType::kFailAction: {
-        if (active && active->outcome == Outcome::kSucceeded) {
+        const bool running = active && rel < active->end;
+        if (running && (!f.action || *f.action == active->cmd.kind)) {
           active->outcome = Outcome::kFailed;
           active->reason = "action failed (fault '" + f.id + "')" + (f.reason.empty() ? "" : ": " + f.reason);
-          active->end = std::max(0.0, std::min(active->end, rel));
+          active->end = std::max(0.0, rel);
           active->blocking.clear();
           e.description = "action '" + active->cmd.command_id + "' failed";
         } else {
-          fail_next = f;
-          e.description = "the next action will fail";
+          pending_fails.push_back(f);
+          e.description = "the next " + (f.action ? std::string(toString(*f.action)) + " " : std::string()) +
+                          "action will fail";
         }
         break;
       }
@@ -560,6 +653,7 @@ struct Simulator::Impl {
         logger()->info("pick '{}' fails: {}", c.command_id, a.failure);
         return;
       }
+      stopRiding(c.object_id);
       world::Object o = world.object(c.object_id);
       o.region.clear();
       (void)world.updateObject(o);
@@ -577,13 +671,11 @@ struct Simulator::Impl {
     syncHeldPose(q);
     world::Object o = world.object(c.object_id);
     const Eigen::Isometry3d released = o.pose;
-    const Settled s = settle(o, released);
     (void)scene.detach(o.id);
     (void)world.setHeld(std::nullopt);
-    o.pose = s.pose;
-    o.region = s.region;
-    (void)world.updateObject(o);
-    syncScene();
+    const Settled s = settle(o, released, q);
+    rest(o, s);
+    o = world.object(c.object_id);
     ev.world_changed = true;
     const Eigen::Isometry3d& target = *c.object_pose;
     const double off = (released.translation() - target.translation()).norm();
@@ -592,10 +684,13 @@ struct Simulator::Impl {
       a.failure = "'" + o.id + "' released tilted by " + fmt(s.tilt) + " rad and toppled";
     } else if (s.drop > params.place.max_drop_m) {
       a.failure = "'" + o.id + "' released " + fmt(s.drop) + " m above its support and dropped";
-    } else if (s.drop < -0.01) {
+    } else if (s.drop < -0.02) {
       a.failure = "'" + o.id + "' released " + fmt(-s.drop) + " m below the support surface";
-    } else if (!s.on_region) {
-      a.failure = "'" + o.id + "' is not on a support region";
+    } else if (s.robot_link >= 0) {
+      a.failure = "'" + o.id + "' came to rest on the robot ('" + s.support + "')";
+    } else if (s.region.empty()) {
+      a.failure = "'" + o.id + "' is not on a support region" +
+                  (s.support.empty() ? std::string() : " (it rests on '" + s.support + "')");
     } else if (off > params.place.position_tolerance_m) {
       a.failure = "'" + o.id + "' released " + fmt(off) + " m from the commanded pose (tolerance " +
                   fmt(params.place.position_tolerance_m) + " m)";
@@ -1090,14 +1185,22 @@ Status Simulator::submit(const ActionCommand& command) {
   a.step = m.actions++;
   a.start = m.now;
   for (std::size_t i = 0; i < m.scripted.size(); ++i) {
-    if (!m.fired[i] && m.scripted[i].trigger.step == a.step) {
-      a.faults.push_back({i, m.scripted[i].trigger.fraction * a.total});
+    const Fault& f = m.scripted[i];
+    if (m.fired[i] || f.trigger.step != a.step) continue;
+    if (f.type == FaultType::kFailAction && f.action && *f.action != a.cmd.kind) {
+      m.fired[i] = true;  // another kind: the first matching action from here on fails
+      m.pending_fails.push_back(f);
+      continue;
     }
+    a.faults.push_back({i, f.trigger.fraction * a.total});
   }
-  if (m.fail_next) {
-    a.fail_fault = m.fail_next;
-    a.fail_at = m.fail_next->trigger.fraction * a.total;
-    m.fail_next.reset();
+  for (auto it = m.pending_fails.begin(); it != m.pending_fails.end(); ++it) {
+    if (!it->action || *it->action == a.cmd.kind) {
+      a.fail_fault = *it;
+      a.fail_at = it->trigger.fraction * a.total;
+      m.pending_fails.erase(it);
+      break;
+    }
   }
   m.active = std::move(a);
   if (auto stop = m.sweep(*m.active, 0.0)) {

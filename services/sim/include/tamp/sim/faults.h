@@ -12,6 +12,7 @@
 #include <Eigen/Geometry>
 
 #include "tamp/core/error.h"
+#include "tamp/core/trajectory.h"
 #include "tamp/world/world.h"
 
 namespace tamp::sim {
@@ -27,7 +28,7 @@ std::optional<FaultType> faultTypeFromString(std::string_view name);
 
 /// When a scripted fault fires: at a simulated time, or during the `step`-th action the simulator
 /// executes (0-based, counting every accepted command) once `fraction` of its duration has
-/// elapsed. Exactly one of `time_s` and `step` is set.
+/// elapsed (at the latest when that action ends). Exactly one of `time_s` and `step` is set.
 struct FaultTrigger {
   std::optional<double> time_s;  ///< simulated seconds since the simulator started; >= 0
   std::optional<int> step;       ///< >= 0
@@ -40,6 +41,9 @@ struct Fault {
   FaultTrigger trigger;      ///< scripted faults only; injected ones fire at once
   world::Object object;      ///< kSpawnObject: the object (a valid, new id)
   std::string object_id;     ///< kRemoveObject: which object
+  /// kFailAction: only an action of this kind fails; when the action at the trigger is another
+  /// kind (or none runs), the first matching action at or after the trigger fails.
+  std::optional<ActionKind> action;
   std::string reason;        ///< free text reported with the failure
 
   /// Ok, or kInvalidArgument naming the field ("trigger.step", "object.id", ...). `scripted`

@@ -1,0 +1,116 @@
+// The simulator built from the shipped scenarios (config/scenarios): true parameters, start
+// state, hidden objects and scripted faults as the scenario loader gives them.
+#include <gtest/gtest.h>
+
+#include "sim_test_util.h"
+#include "tamp/sim/setup.h"
+
+namespace tamp::sim {
+namespace {
+
+using namespace tamp::sim::testing;
+
+std::string scenarioPath(const std::string& name) {
+  return (std::filesystem::path(TAMP_SOURCE_DIR) / "config/scenarios" / (name + ".yaml")).string();
+}
+
+TEST(ScenarioSetupTest, TakesTheTrueParametersFromTheScenario) {
+  SimParams params = exactParams();
+  params.scenario = scenarioPath("occluded_can");
+  auto setup = loadSetup(params);
+  ASSERT_TRUE(setup) << setup.error().toString();
+  const TimeParameters& t = params.time_parameters;
+  EXPECT_EQ(t.get(ActionKind::kMoveBase, "max_linear_speed"), 0.45);
+  EXPECT_EQ(t.get(ActionKind::kMoveBase, "max_linear_accel"), 0.4);
+  EXPECT_EQ(t.get(ActionKind::kMoveBase, "max_angular_speed"), 0.9);
+  EXPECT_EQ(t.get(ActionKind::kMoveBase, "max_angular_accel"), 1.2);
+  EXPECT_EQ(t.get(ActionKind::kMoveBase, "settle_time"), 0.25);
+  EXPECT_EQ(t.get(ActionKind::kMoveArm, "max_joint_speed"), 0.8);
+  EXPECT_EQ(t.get(ActionKind::kMoveArm, "settle_time"), 0.25);
+  EXPECT_EQ(t.get(ActionKind::kPick, "gripper_time"), 1.8);
+  EXPECT_EQ(t.get(ActionKind::kPlace, "gripper_time"), 1.2);
+  EXPECT_EQ(params.duration_noise, 0.05);
+  EXPECT_EQ(params.seed, 11u);
+  // Not in the scenario schema: the configured simulated robot's values.
+  EXPECT_EQ(t.get(ActionKind::kMoveBase, "overhead"),
+            TimeParameters::simulatedRobot().get(ActionKind::kMoveBase, "overhead"));
+  // The ground truth keeps what the planner does not see.
+  auto scenario = world::loadScenario(params.scenario);
+  ASSERT_TRUE(scenario);
+  EXPECT_EQ(setup->world.objectCount(), scenario->world.objectCount());
+  EXPECT_TRUE(setup->initial.base == scenario->startState().base);
+  Simulator sim(setup->world, setup->robot, setup->initial, params, setup->faults);
+  EXPECT_EQ(sim.world().objectCount(), scenario->world.objectCount());
+}
+
+TEST(ScenarioSetupTest, ScriptedFaultsOfHoldingStartFaults) {
+  SimParams params = exactParams();
+  params.scenario = scenarioPath("holding_start_faults");
+  auto setup = loadSetup(params);
+  ASSERT_TRUE(setup) << setup.error().toString();
+  ASSERT_EQ(setup->faults.size(), 3u);
+  EXPECT_EQ(setup->faults[0].type, FaultType::kDropHeldObject);
+  EXPECT_EQ(setup->faults[1].type, FaultType::kFailAction);
+  EXPECT_EQ(setup->faults[1].action, ActionKind::kPick);
+  EXPECT_EQ(setup->faults[1].trigger.step, 3);
+  EXPECT_EQ(setup->faults[2].type, FaultType::kSpawnObject);
+  Simulator sim(setup->world, setup->robot, setup->initial, params, setup->faults);
+  ASSERT_TRUE(sim.world().held());
+  EXPECT_EQ(sim.robotState().held_object_id, "cup");
+  // t = 2 s: the cup slips out of the gripper. The arm is stowed over the base: it falls onto
+  // the robot and rides along with the base from then on.
+  StepEvents e = sim.step(2.5);
+  ASSERT_EQ(e.faults.size(), 1u);
+  EXPECT_EQ(e.faults[0].object_id, "cup");
+  EXPECT_NEAR(e.faults[0].time_s, 2.0, 1e-12);
+  EXPECT_FALSE(sim.world().held());
+  EXPECT_EQ(sim.robotState().held_object_id, "");
+  const world::Object cup = sim.world().object("cup");
+  EXPECT_TRUE(cup.region.empty());
+  const Pose2D base = sim.robotState().state.base;
+  ASSERT_TRUE(sim.submit(moveBase("drive", {base, {base.x + 0.5, base.y, base.theta}})));
+  runToEnd(sim);
+  const world::Object moved = sim.world().object("cup");
+  EXPECT_NEAR(moved.pose.translation().x() - cup.pose.translation().x(), 0.5, 1e-9);
+  EXPECT_NEAR(moved.pose.translation().z(), cup.pose.translation().z(), 1e-12);
+  // t = 20 s: the parcel appears on the table.
+  e = sim.step(20.0 - sim.time() + 0.01);
+  ASSERT_EQ(e.faults.size(), 1u);
+  EXPECT_EQ(e.faults[0].object_id, "parcel");
+  const world::Object* parcel = sim.world().findObject("parcel");
+  ASSERT_NE(parcel, nullptr);
+  EXPECT_NEAR(parcel->pose.translation().z(), 0.75 + 0.05, 1e-9);
+}
+
+TEST(ScenarioSetupTest, AFailureFilteredByKindHitsTheFirstMatchingAction) {
+  Fault fail;
+  fail.id = "grasp_missed";
+  fail.type = FaultType::kFailAction;
+  fail.trigger.step = 0;
+  fail.action = ActionKind::kMoveArm;
+  fail.reason = "grasp missed";
+  Simulator sim(emptyRoom(), robotModel(), upright(), exactParams(), {fail});
+  // Step 0 is a move_base: not hit.
+  ASSERT_TRUE(sim.submit(moveBase("b0", {{0, 0, 0}, {0.5, 0, 0}})));
+  EXPECT_EQ(runToEnd(sim).results.at(0).outcome, Outcome::kSucceeded);
+  // Step 1, a move_arm: fails half-way.
+  ASSERT_TRUE(sim.submit(armCommand("a1", ActionKind::kMoveArm, {std::vector<double>(6, 0.0), {0, 0, 0, 0, 0, 1.0}})));
+  const StepEvents e = runToEnd(sim);
+  EXPECT_EQ(e.results.at(0).outcome, Outcome::kFailed);
+  EXPECT_NE(e.results[0].reason.find("grasp missed"), std::string::npos);
+  EXPECT_NEAR(e.results[0].progress, 0.5, 1e-9);
+  // Only once.
+  ASSERT_TRUE(sim.submit(armCommand("a2", ActionKind::kMoveArm, {sim.robotState().state.arm, {0, 0, 0, 0, 0, 0}})));
+  EXPECT_EQ(runToEnd(sim).results.at(0).outcome, Outcome::kSucceeded);
+}
+
+TEST(ScenarioSetupTest, UnknownScenarioIsAnError) {
+  SimParams params = exactParams();
+  params.scenario = "/nonexistent/scenario.yaml";
+  auto setup = loadSetup(params);
+  ASSERT_FALSE(setup);
+  EXPECT_NE(setup.error().toString().find("/nonexistent/scenario.yaml"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace tamp::sim

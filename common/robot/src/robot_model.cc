@@ -307,6 +307,49 @@ Result<RobotModel> RobotModel::fromUrdfString(const std::string& xml, const std:
     return it == joint_line.end() ? robot_el->GetLineNum() : it->second;
   };
 
+  // Tree structure checked here, before urdfdom: a link that is its own ancestor makes urdfdom
+  // build (and leak) a cyclic graph.
+  {
+    std::map<std::string, std::pair<std::string, std::string>>
+        parent_of;  // child -> (parent, joint)
+    for (const auto* e = robot_el->FirstChildElement("joint"); e != nullptr;
+         e = e->NextSiblingElement("joint")) {
+      const char* jn = e->Attribute("name");
+      const auto* pe = e->FirstChildElement("parent");
+      const auto* ce = e->FirstChildElement("child");
+      if (jn == nullptr || pe == nullptr || ce == nullptr || pe->Attribute("link") == nullptr ||
+          ce->Attribute("link") == nullptr) {
+        continue;  // urdfdom reports these
+      }
+      const std::string parent = pe->Attribute("link"), child = ce->Attribute("link");
+      if (parent == child) {
+        return err(
+            ErrorCode::kParseError,
+            "joint '" + std::string(jn) + "': parent and child are the same link '" + child + "'",
+            e->GetLineNum(), "joint." + std::string(jn));
+      }
+      auto [it, fresh] = parent_of.emplace(child, std::make_pair(parent, std::string(jn)));
+      if (!fresh) {
+        return err(ErrorCode::kParseError,
+                   "link '" + child + "' is the child of two joints, '" + it->second.second +
+                       "' and '" + jn + "'",
+                   e->GetLineNum(), "joint." + std::string(jn));
+      }
+    }
+    for (const auto& [child, pj] : parent_of) {
+      std::string at = child;
+      for (size_t steps = 0; steps <= parent_of.size(); ++steps) {
+        auto up = parent_of.find(at);
+        if (up == parent_of.end()) break;
+        at = up->second.first;
+        if (at == child) {
+          return err(ErrorCode::kParseError, "the joints form a cycle through link '" + child + "'",
+                     lineOfJoint(pj.second), "joint." + pj.second);
+        }
+      }
+    }
+  }
+
   // 2. urdfdom, with its diagnostics captured instead of printed.
   urdf::ModelInterfaceSharedPtr model;
   CaptureHandler capture;

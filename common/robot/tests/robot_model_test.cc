@@ -373,6 +373,26 @@ TEST(RobotModelErrorsTest, UnknownLinkInJointNamesTheJoint) {
   EXPECT_NE(r.error().message.find("invalid URDF: "), std::string::npos) << r.error().message;
 }
 
+TEST(RobotModelErrorsTest, CyclesAndSelfLoopsAreRefusedBeforeUrdfdom) {
+  std::string self = kTwoLinks;
+  self.replace(self.find("<child link=\"tip\"/>"), 19, "<child link=\"base_link\"/>");
+  auto r1 = RobotModel::fromUrdfString(self, "bad.urdf", minimal());
+  ASSERT_FALSE(r1.ok());
+  EXPECT_EQ(
+      r1.error().toString(),
+      "bad.urdf:4: field 'joint.j': joint 'j': parent and child are the same link 'base_link'");
+  const std::string cycle = R"(<robot name="r">
+  <link name="a"/><link name="b"/><link name="c"/>
+  <joint name="ab" type="fixed"><parent link="a"/><child link="b"/></joint>
+  <joint name="bc" type="fixed"><parent link="b"/><child link="c"/></joint>
+  <joint name="ca" type="fixed"><parent link="c"/><child link="a"/></joint>
+</robot>)";
+  auto r2 = RobotModel::fromUrdfString(cycle, "cycle.urdf", minimal());
+  ASSERT_FALSE(r2.ok());
+  EXPECT_EQ(r2.error().toString(),
+            "cycle.urdf:5: field 'joint.ca': the joints form a cycle through link 'a'");
+}
+
 TEST(RobotModelErrorsTest, MissingToolLink) {
   RobotModelOptions o = minimal();
   o.tool_link = "hand";

@@ -243,6 +243,11 @@ std::optional<Object> readObject(FieldReader& r, const World& w, bool hidden,
   return o;
 }
 
+/// r.node()[key] when r is a mapping, else an undefined node (indexing a scalar throws).
+YAML::Node valueOf(const FieldReader& r, const std::string& key) {
+  return r.isMap() ? YAML::Node(r.node()[key]) : YAML::Node(YAML::NodeType::Undefined);
+}
+
 /// "(pred a b)" -> {"pred", "a", "b"}; empty on a syntax error.
 std::vector<std::string> atomTokens(const std::string& atom) {
   std::string s = atom;
@@ -426,11 +431,32 @@ NamoOptions readNamoOptions(FieldReader& w) {
 
 }  // namespace
 
+namespace {
+Result<Scenario> parseScenarioImpl(const std::string& yaml_text, const std::string& file_name);
+}  // namespace
+
 Result<Scenario> parseScenario(const std::string& yaml_text, const std::string& file_name) {
+  // Last line of defence: a yaml-cpp exception from an unexpected node shape (e.g. a complex
+  // key) becomes a parse error at its mark instead of escaping.
+  try {
+    return parseScenarioImpl(yaml_text, file_name);
+  } catch (const YAML::Exception& e) {
+    return Error(ErrorCode::kParseError, "unexpected YAML structure: " + e.msg,
+                 SourceLocation{file_name, e.mark.line + 1, e.mark.column + 1, ""});
+  }
+}
+
+namespace {
+Result<Scenario> parseScenarioImpl(const std::string& yaml_text, const std::string& file_name) {
   auto doc = config::parseYaml(yaml_text, file_name);
   if (!doc) return doc.error();
   FieldReader r(*doc);
-  if (!r.isMap()) return r.status().error();
+  if (!r.isMap()) {
+    if (!r.ok()) return r.errors().front();
+    return Error(ErrorCode::kInvalidArgument,
+                 "a scenario is a mapping (name:, robot:, world:, goal:, ...)",
+                 SourceLocation{file_name, 1, 1, ""});
+  }
   Scenario sc;
   sc.file = file_name;
   if (r.required("name", sc.name) && !isValidId(sc.name))
@@ -529,7 +555,7 @@ Result<Scenario> parseScenario(const std::string& yaml_text, const std::string& 
   // Objects; the held one may omit its pose (it follows the gripper).
   std::string held_id;
   // (Indexing a missing key gives an invalid node: test IsDefined() before anything else.)
-  if (const YAML::Node rn = r.node()["robot"]; rn.IsDefined() && rn.IsMap()) {
+  if (const YAML::Node rn = valueOf(r, "robot"); rn.IsDefined() && rn.IsMap()) {
     if (const YAML::Node hn = rn["holding"]; hn.IsDefined() && hn.IsMap()) {
       if (const YAML::Node on = hn["object"]; on.IsDefined() && on.IsScalar())
         held_id = on.Scalar();
@@ -566,7 +592,7 @@ Result<Scenario> parseScenario(const std::string& yaml_text, const std::string& 
     }
     // start: a location id or a pose (then location "start" is added)
     rb.ignore("start");
-    const YAML::Node st = rb.node()["start"];
+    const YAML::Node st = valueOf(rb, "start");
     if (!st.IsDefined()) {
       if (sc.world.findLocation("start") != nullptr) {
         sc.robot.start_location = "start";
@@ -592,7 +618,7 @@ Result<Scenario> parseScenario(const std::string& yaml_text, const std::string& 
     }
     // arm: a named configuration or joint values
     rb.ignore("arm");
-    const YAML::Node arm = rb.node()["arm"];
+    const YAML::Node arm = valueOf(rb, "arm");
     if (model) {
       if (!arm.IsDefined() || arm.IsScalar()) {
         const std::string name = arm.IsDefined() ? arm.Scalar() : "stow";
@@ -623,7 +649,7 @@ Result<Scenario> parseScenario(const std::string& yaml_text, const std::string& 
     }
     // gripper: open | closed | metres
     rb.ignore("gripper");
-    const YAML::Node g = rb.node()["gripper"];
+    const YAML::Node g = valueOf(rb, "gripper");
     if (model) {
       sc.robot.gripper = model->options().gripper_closed;
       if (g.IsDefined()) {
@@ -665,7 +691,7 @@ Result<Scenario> parseScenario(const std::string& yaml_text, const std::string& 
     FieldReader g = r.child("goal");
     g.optional("pddl", sc.goal.pddl);
     g.ignore("base");
-    const YAML::Node b = g.node()["base"];
+    const YAML::Node b = valueOf(g, "base");
     if (b.IsDefined()) {
       if (b.IsScalar()) {
         const Location* l = sc.world.findLocation(b.Scalar());
@@ -819,6 +845,7 @@ Result<Scenario> parseScenario(const std::string& yaml_text, const std::string& 
   if (!r.ok()) return r.errors().size() == 1 ? r.errors().front() : r.status().error();
   return sc;
 }
+}  // namespace
 
 Result<Scenario> loadScenario(const std::filesystem::path& file) {
   const std::string ext = file.extension().string();

@@ -362,6 +362,11 @@ TEST(ScenarioErrorsTest, ExactMessages) {
                 ":4:9: field 'world.namo': unknown variable in path '${NOPE}/x.json' (known: "
                 "${TAMP_SHARED_DIR}, "
                 "${TAMP_CONFIG_DIR})");
+  EXPECT_EQ(errorOf(""),
+            kFile + ":1:1: a scenario is a mapping (name:, robot:, world:, goal:, ...)");
+  EXPECT_EQ(errorOf("- 1\n"), kFile + ":1:1: expected a mapping (key: value pairs)");
+  EXPECT_EQ(errorOf(replaced(kMinimal, "goal: {pddl: [\"(holding can)\"]}", "goal: base")),
+            kFile + ":8:7: field 'goal': expected a mapping (key: value pairs)");
   EXPECT_EQ(errorOf("name: x\nrobot: [1\n"),
             kFile + ":3:1: invalid YAML: end of sequence flow not found");
 }

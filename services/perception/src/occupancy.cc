@@ -16,6 +16,7 @@ namespace tamp::perception {
 struct OccupancyMap::Impl {
   OccupancyParams params;
   octomap::OcTree tree;
+  octomap::KeySet hits;  // voxels that received a hit and may be occupied
   explicit Impl(const OccupancyParams& p) : params(p), tree(p.resolution) {
     tree.setProbHit(p.prob_hit);
     tree.setProbMiss(p.prob_miss);
@@ -67,8 +68,34 @@ void OccupancyMap::integrate(const Eigen::Vector3d& origin, const std::vector<Ei
   for (const auto& k : free_cells) {
     if (hit_cells.count(k) == 0) tree.updateNode(k, false, true);
   }
-  for (const auto& k : hit_cells) tree.updateNode(k, true, true);
+  for (const auto& k : hit_cells) {
+    tree.updateNode(k, true, true);
+    impl_->hits.insert(k);
+  }
   tree.updateInnerOccupancy();
+}
+
+std::size_t OccupancyMap::clearSeenThrough(const RangeImage& image, double margin) {
+  octomap::OcTree& tree = impl_->tree;
+  const Eigen::Vector3d origin = image.worldTSensor().translation();
+  std::size_t updated = 0;
+  for (auto it = impl_->hits.begin(); it != impl_->hits.end();) {
+    const octomap::OcTreeNode* n = tree.search(*it);
+    if (n == nullptr || !tree.isNodeOccupied(n)) {
+      it = impl_->hits.erase(it);
+      continue;
+    }
+    const octomap::point3d c = tree.keyToCoord(*it);
+    const Eigen::Vector3d centre(c.x(), c.y(), c.z());
+    const double measured = image.nearestRange(centre);
+    if (measured > 0 && measured > (centre - origin).norm() + margin) {
+      tree.updateNode(*it, false, true);
+      ++updated;
+    }
+    ++it;
+  }
+  if (updated > 0) tree.updateInnerOccupancy();
+  return updated;
 }
 
 std::size_t OccupancyMap::clearObject(const world::Object& object) {
@@ -80,20 +107,29 @@ std::size_t OccupancyMap::clearObject(const world::Object& object) {
                             static_cast<float>(b.min.z() - m));
   const octomap::point3d hi(static_cast<float>(b.max.x() + m), static_cast<float>(b.max.y() + m),
                             static_cast<float>(b.max.z() + m));
-  std::vector<std::pair<octomap::OcTreeKey, unsigned>> doomed;
+  std::vector<octomap::OcTreeKey> explained;
   for (auto it = tree.begin_leafs_bbx(lo, hi), end = tree.end_leafs_bbx(); it != end; ++it) {
     if (!tree.isNodeOccupied(*it)) continue;
     const octomap::point3d c = it.getCoordinate();
     const double grow = m + 0.5 * (it.getSize() - tree.getResolution());
     if (pointInShape(object.shape, object.pose, Eigen::Vector3d(c.x(), c.y(), c.z()), grow)) {
-      doomed.emplace_back(it.getKey(), it.getDepth());
+      explained.push_back(it.getKey());
     }
   }
-  for (const auto& [key, depth] : doomed) tree.deleteNode(key, depth);
-  return doomed.size();
+  // Set to free rather than deleted: OctoMap 1.9's deleteNode() trips its own assertion
+  // (children == NULL) when an inner node loses its last child.
+  for (const auto& key : explained) {
+    tree.setNodeValue(key, tree.getClampingThresMinLog(), true);
+    impl_->hits.erase(key);
+  }
+  if (!explained.empty()) tree.updateInnerOccupancy();
+  return explained.size();
 }
 
-void OccupancyMap::clear() { impl_->tree.clear(); }
+void OccupancyMap::clear() {
+  impl_->tree.clear();
+  impl_->hits.clear();
+}
 
 CellState OccupancyMap::state(const Eigen::Vector3d& p) const {
   const octomap::OcTreeNode* n = impl_->tree.search(p.x(), p.y(), p.z());
@@ -134,6 +170,8 @@ std::size_t OccupancyMap::occupiedCount() const {
   }
   return n;
 }
+
+std::size_t OccupancyMap::hitVoxels() const { return impl_->hits.size(); }
 
 double OccupancyMap::resolution() const { return impl_->tree.getResolution(); }
 

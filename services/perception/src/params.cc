@@ -42,6 +42,11 @@ std::vector<Rule> rules(const PerceptionParams& p) {
   const ClassifyParams& k = p.classify;
   const OccupancyParams& o = p.occupancy;
   std::vector<Rule> r = {
+      {"sensor", "noise_stddev", nonNegative(p.sensor.noise_stddev), mustBeNonNegative(p.sensor.noise_stddev)},
+      {"sensor", "noise_quadratic", nonNegative(p.sensor.noise_quadratic), mustBeNonNegative(p.sensor.noise_quadratic)},
+      {"planes", "noise_sigmas", nonNegative(pl.noise_sigmas), mustBeNonNegative(pl.noise_sigmas)},
+      {"planes", "ransac_max_points", pl.ransac_max_points >= 100,
+       "must be >= 100, got " + std::to_string(pl.ransac_max_points)},
       {"crop", "workspace_margin", nonNegative(c.workspace_margin), mustBeNonNegative(c.workspace_margin)},
       {"crop", "min_range", nonNegative(c.min_range), mustBeNonNegative(c.min_range)},
       {"crop", "max_range", std::isfinite(c.max_range) && c.max_range > c.min_range,
@@ -174,6 +179,11 @@ Result<PerceptionParams> parsePerceptionParams(const std::string& yaml_text, con
     return it->second;
   };
   {
+    auto& s = section("sensor");
+    s.optional("noise_stddev", p.sensor.noise_stddev);
+    s.optional("noise_quadratic", p.sensor.noise_quadratic);
+  }
+  {
     auto& s = section("crop");
     std::vector<double> ws;
     if (s.optional("workspace", ws)) {
@@ -198,6 +208,8 @@ Result<PerceptionParams> parsePerceptionParams(const std::string& yaml_text, con
     s.optional("max_attempts", p.planes.max_attempts);
     s.optional("ransac_iterations", p.planes.ransac_iterations);
     s.optional("distance_threshold", p.planes.distance_threshold);
+    s.optional("noise_sigmas", p.planes.noise_sigmas);
+    s.optional("ransac_max_points", p.planes.ransac_max_points);
     s.optional("max_tilt", p.planes.max_tilt);
     s.optional("min_points", p.planes.min_points);
     s.optional("min_support_area", p.planes.min_support_area);
@@ -304,6 +316,7 @@ Result<PerceptionParams> parsePerceptionParams(const std::string& yaml_text, con
     section(rule.section).check(rule.ok, rule.field, rule.message);
   }
   for (auto& [key, s] : sections) s.refuseUnknownKeys();
+  r.ignore("node");  // the DDS node's own section (services/perception/node)
   r.refuseUnknownKeys();
   if (!r.ok()) return r.status().error();
   if (Status s = p.validate(); !s.ok()) return s.error();  // e.g. duplicate class labels

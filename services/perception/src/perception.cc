@@ -181,7 +181,7 @@ struct Perception::Impl {
       if (!f.compatible) continue;
       const bool round = c.shape.kind == world::ShapeKind::kCylinder || c.shape.kind == world::ShapeKind::kSphere;
       const bool det_round = d.kind == world::ShapeKind::kCylinder;
-      const double h = std::max(params.tracking.height_tolerance, 0.2 * 2 * c.shape.halfHeight());
+      const double h = std::max(params.tracking.height_tolerance, 0.1 * 2 * c.shape.halfHeight());
       const double cost = std::abs(f.height_error) / h + f.deficit / std::max(params.tracking.size_tolerance, 0.01) * 0.5 +
                           f.residual / 0.01 + (round != det_round ? 1.0 : 0.0);
       if (cost < best_cost) {
@@ -401,17 +401,24 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& frame, const
   const Eigen::Vector3d sensor = frame.world_T_sensor.translation();
   const world::World before = I.world;
 
-  // The lowest support seen is the floor (unexplained points hugging it are noise).
-  double floor_z = I.floor_height;
-  if (!S.planes.empty()) {
-    floor_z = std::min_element(S.planes.begin(), S.planes.end(), [](const auto& a, const auto& b) {
-                return a.height < b.height;
-              })->height;
-  }
-
   // ---- shape fitting ------------------------------------------------------------------------
   watch.reset();
-  std::vector<Eigen::Vector3f> unexplained = S.small_cluster_points;
+  // Unexplained points: small clusters that stand clearly above their support (a few returns
+  // hugging the floor are range noise, not an obstacle).
+  std::vector<Eigen::Vector3f> unexplained;
+  for (const auto& c : S.small_clusters) {
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    double zmin = kInf, zmax = -kInf;
+    for (const auto& p : c) {
+      mean += p.head<2>().cast<double>();
+      zmin = std::min(zmin, double(p.z()));
+      zmax = std::max(zmax, double(p.z()));
+    }
+    mean /= static_cast<double>(c.size());
+    if (zmax > I.supportBelow(mean, zmin, S.planes) + P.clusters.min_height) {
+      unexplained.insert(unexplained.end(), c.begin(), c.end());
+    }
+  }
   std::vector<std::size_t> det_cluster;  // detection -> cluster index
   for (std::size_t ci = 0; ci < S.clusters.size(); ++ci) {
     const auto& c = S.clusters[ci];
@@ -429,8 +436,8 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& frame, const
     Detection d = describeCluster(std::move(pts), support, P.clusters);
     const double major = d.majorExtent();
     if (d.height < P.clusters.min_height || major < P.clusters.min_size) {
-      // Too flat or too small to be an object: noise unless clearly above the floor.
-      if (d.top_z > floor_z + P.clusters.min_height) unexplained.insert(unexplained.end(), c.begin(), c.end());
+      // Too flat or too small to be an object: noise unless clearly above its support.
+      if (d.height > P.clusters.min_height) unexplained.insert(unexplained.end(), c.begin(), c.end());
       continue;
     }
     if (major > P.clusters.max_size) {
@@ -511,10 +518,26 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& frame, const
     result.stats.matched += t.state == TrackInfo::State::kActive ? 1 : 0;
   }
 
-  // Unmatched detections become tentative objects (class from the priors, else by size).
+  // Unmatched detections become tentative objects (class from the priors, else by size),
+  // unless they are mostly inside a tracked object (a fragment of it, e.g. a side face split
+  // off by range noise).
   for (std::size_t i = 0; i < dets.size(); ++i) {
     if (det_used[i]) continue;
     const Detection& d = dets[i];
+    bool fragment = false;
+    for (const auto& [id, t] : I.tracks) {
+      if (t.state == TrackInfo::State::kGone) continue;
+      std::size_t inside = 0;
+      for (const auto& p : d.points) inside += pointInShape(t.shape, t.pose, p, T.size_tolerance) ? 1 : 0;
+      if (2 * inside >= d.points.size()) {
+        fragment = true;
+        break;
+      }
+    }
+    if (fragment) {
+      det_used[i] = 1;
+      continue;
+    }
     Track t;
     t.id = "tentative_" + std::to_string(I.next_tentative++);
     t.state = TrackInfo::State::kTentative;
@@ -681,6 +704,10 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& frame, const
   result.stats.unexplained_points = unexplained.size();
   if (I.occupancy) {
     I.occupancy->integrate(sensor, S.scan, unexplained);
+    if (I.occupancy->hitVoxels() > 0) {
+      if (!image) image.emplace(frame, T.visibility_bin);
+      I.occupancy->clearSeenThrough(*image, T.visibility_margin);
+    }
     for (const auto& o : I.world.objects()) {
       if (o.kind == world::ObjectKind::kMovable || I.prior.findObject(o.id) == nullptr) I.occupancy->clearObject(o);
     }

@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include <pcl/console/print.h>
 #include <pcl/filters/voxel_grid.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
@@ -87,6 +88,8 @@ struct Segmenter::Impl {
 
 Segmenter::Segmenter(const PerceptionParams& params, const world::World& prior) : impl_(std::make_unique<Impl>()) {
   if (Status s = params.validate(); !s.ok()) throw std::invalid_argument(s.error().toString());
+  // PCL reports "no plane found" on stderr; that is an expected outcome here (the loop stops).
+  pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);
   impl_->params = params;
   if (params.crop.workspace) {
     impl_->workspace = *params.crop.workspace;
@@ -167,8 +170,11 @@ Result<Segmentation> Segmenter::run(const PointCloudFrame& frame, const Terminat
   watch.reset();
   std::vector<char> removed(cloud->size(), 0);
   {
-    auto search = std::make_shared<pcl::Indices>(cloud->size());
-    for (std::size_t i = 0; i < cloud->size(); ++i) (*search)[i] = static_cast<pcl::index_t>(i);
+    const Eigen::Vector3f origin = frame.world_T_sensor.translation().cast<float>();
+    std::vector<pcl::index_t> search(cloud->size());
+    for (std::size_t i = 0; i < cloud->size(); ++i) search[i] = static_cast<pcl::index_t>(i);
+    // PCL's RANSAC is seeded with a constant (SACSegmentation(random = false)): frames are
+    // reproducible.
     pcl::SACSegmentation<pcl::PointXYZ> seg;
     seg.setOptimizeCoefficients(true);
     seg.setModelType(pcl::SACMODEL_PERPENDICULAR_PLANE);
@@ -179,74 +185,118 @@ Result<Segmentation> Segmenter::run(const PointCloudFrame& frame, const Terminat
     seg.setMaxIterations(P.planes.ransac_iterations);
     seg.setInputCloud(cloud);
     const double voxel_area = P.planes.voxel_size * P.planes.voxel_size;
-    for (int attempt = 0; attempt < P.planes.max_attempts && static_cast<int>(out.planes.size()) < P.planes.max_planes;
-         ++attempt) {
-      if (static_cast<int>(search->size()) < P.planes.min_points) break;
+    std::vector<std::vector<Eigen::Vector2d>> plane_xy;  // inliers' xy per accepted plane (hulls)
+    for (int attempt = 0; attempt < P.planes.max_attempts; ++attempt) {
+      if (static_cast<int>(search.size()) < P.planes.min_points) break;
       if (term()) return stopped(term, "the next support plane").error();
-      pcl::PointIndices inliers;
+      // The model from an even subsample; inliers over every candidate point.
+      const std::size_t stride =
+          (search.size() + static_cast<std::size_t>(P.planes.ransac_max_points) - 1) / static_cast<std::size_t>(P.planes.ransac_max_points);
+      auto sub = std::make_shared<pcl::Indices>();
+      sub->reserve(search.size() / stride + 1);
+      for (std::size_t k = 0; k < search.size(); k += stride) sub->push_back(search[k]);
+      pcl::PointIndices sub_inliers;
       pcl::ModelCoefficients coeffs;
-      seg.setIndices(search);
-      seg.segment(inliers, coeffs);
-      if (static_cast<int>(inliers.indices.size()) < P.planes.min_points || coeffs.values.size() != 4) break;
-      Eigen::Vector4d c(coeffs.values[0], coeffs.values[1], coeffs.values[2], coeffs.values[3]);
+      seg.setIndices(sub);
+      seg.segment(sub_inliers, coeffs);
+      if (coeffs.values.size() != 4 || static_cast<int>(sub_inliers.indices.size() * stride) < P.planes.min_points) break;
+      Eigen::Vector4f c(coeffs.values[0], coeffs.values[1], coeffs.values[2], coeffs.values[3]);
       c /= c.head<3>().norm();
       if (c.z() < 0) c = -c;
+      const Eigen::Vector3f n = c.head<3>();
+      // Noise-aware band: the along-ray range noise projected on the plane normal.
+      std::vector<pcl::index_t> inliers;
+      std::vector<pcl::index_t> rest;
+      inliers.reserve(search.size());
+      rest.reserve(search.size());
+      const float base = static_cast<float>(P.planes.distance_threshold);
+      for (auto i : search) {
+        const Eigen::Vector3f q = cloud->points[static_cast<std::size_t>(i)].getVector3fMap();
+        const float dist = std::abs(n.dot(q) + c.w());
+        const Eigen::Vector3f ray = q - origin;
+        const float range = ray.norm();
+        const float cosine = range > 1e-6f ? std::abs(n.dot(ray)) / range : 1.0f;
+        const float band = std::max(base, static_cast<float>(P.planes.noise_sigmas * P.sensor.stddev(range)) * cosine);
+        (dist <= band ? inliers : rest).push_back(i);
+      }
+      search = std::move(rest);  // every inlier leaves the plane search, accepted or not
+      if (static_cast<int>(inliers.size()) < P.planes.min_points) continue;
       Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-      for (auto i : inliers.indices) centroid += cloud->points[static_cast<std::size_t>(i)].getVector3fMap().cast<double>();
-      centroid /= static_cast<double>(inliers.indices.size());
+      for (auto i : inliers) centroid += cloud->points[static_cast<std::size_t>(i)].getVector3fMap().cast<double>();
+      centroid /= static_cast<double>(inliers.size());
       SupportPlane plane;
-      plane.coefficients = c;
-      plane.height = -(c.x() * centroid.x() + c.y() * centroid.y() + c.w()) / c.z();
-      plane.inliers = static_cast<int>(inliers.indices.size());
-      plane.area = plane.inliers * voxel_area;
-      // Match a prior region: same height and most inliers over its polygon.
+      plane.coefficients = c.cast<double>();
+      plane.measured_height = -(plane.coefficients.x() * centroid.x() + plane.coefficients.y() * centroid.y() +
+                                plane.coefficients.w()) / plane.coefficients.z();
+      plane.height = plane.measured_height;
+      plane.inliers = static_cast<int>(inliers.size());
+      {
+        // Area from the distinct xy cells the inliers cover (range noise smears a surface over
+        // several voxel layers, so inliers x voxel^2 would overestimate it).
+        std::vector<std::int64_t> cells;
+        cells.reserve(inliers.size());
+        const float inv = 1.0f / static_cast<float>(P.planes.voxel_size);
+        for (auto i : inliers) {
+          const auto& q = cloud->points[static_cast<std::size_t>(i)];
+          const auto ix = static_cast<std::int64_t>(std::floor(q.x * inv)), iy = static_cast<std::int64_t>(std::floor(q.y * inv));
+          cells.push_back((ix << 32) ^ (iy & 0xffffffff));
+        }
+        std::sort(cells.begin(), cells.end());
+        plane.area = static_cast<double>(std::unique(cells.begin(), cells.end()) - cells.begin()) * voxel_area;
+      }
+      // Match a prior region: same height and most inliers over its polygon (tables first).
       const world::Region* region = nullptr;
       for (const auto& r : impl_->regions) {
-        if (std::abs(r.height - plane.height) > P.planes.region_height_tolerance) continue;
+        if (std::abs(r.height - plane.measured_height) > P.planes.region_height_tolerance) continue;
         std::size_t over = 0;
-        for (auto i : inliers.indices) {
+        for (auto i : inliers) {
           const auto& q = cloud->points[static_cast<std::size_t>(i)];
           if (r.contains(Eigen::Vector2d(q.x, q.y))) ++over;
         }
-        if (2 * over >= inliers.indices.size() && (region == nullptr || r.kind == world::RegionKind::kTable)) region = &r;
+        if (2 * over >= inliers.size() && (region == nullptr || r.kind == world::RegionKind::kTable)) region = &r;
       }
-      // A table region's polygon bounds what the plane removes (a box top at table height
+      // A rejected plane is an object's top: its points stay object points.
+      if (region == nullptr && plane.area < P.planes.min_support_area) continue;
+      if (region != nullptr) {
+        plane.region = region->id;
+        plane.height = region->height;
+      }
+      // A table region's polygon bounds what its plane removes (a box top at table height
       // elsewhere stays an object); a floor or an unmatched large plane removes all inliers.
-      const bool accepted = region != nullptr || plane.area >= P.planes.min_support_area;
-      if (accepted) {
-        plane.region = region != nullptr ? region->id : std::string();
-        const bool bounded = region != nullptr && region->kind == world::RegionKind::kTable;
-        world::Polygon2 grown;
-        if (bounded) {
-          const Eigen::Vector2d mid = world::areaCentroid(region->polygon);
-          for (const auto& v : region->polygon) {
-            const Eigen::Vector2d d = v - mid;
-            grown.push_back(d.norm() > 1e-9 ? Eigen::Vector2d(v + d.normalized() * P.planes.region_margin * 1.42) : v);
-          }
+      const bool bounded = region != nullptr && region->kind == world::RegionKind::kTable;
+      world::Polygon2 grown;
+      if (bounded) {
+        const Eigen::Vector2d mid = world::areaCentroid(region->polygon);
+        for (const auto& v : region->polygon) {
+          const Eigen::Vector2d d = v - mid;
+          grown.push_back(d.norm() > 1e-9 ? Eigen::Vector2d(v + d.normalized() * P.planes.region_margin * 1.42) : v);
         }
-        std::vector<Eigen::Vector2d> xy;
-        xy.reserve(inliers.indices.size());
-        for (auto i : inliers.indices) {
-          const auto& q = cloud->points[static_cast<std::size_t>(i)];
-          if (bounded && !world::containsPoint(grown, Eigen::Vector2d(q.x, q.y))) continue;  // an object's top
-          removed[static_cast<std::size_t>(i)] = 1;
-          xy.emplace_back(q.x, q.y);
-        }
-        out.plane_points += xy.size();
-        plane.hull = convexHull(std::move(xy));
-        out.planes.push_back(std::move(plane));
       }
-      // Every inlier leaves the plane search (a rejected plane is a box top: its points stay
-      // object points but must not be found again).
-      std::vector<char> in_plane(cloud->size(), 0);
-      for (auto i : inliers.indices) in_plane[static_cast<std::size_t>(i)] = 1;
-      auto next = std::make_shared<pcl::Indices>();
-      next->reserve(search->size());
-      for (auto i : *search) {
-        if (!in_plane[static_cast<std::size_t>(i)]) next->push_back(i);
+      std::vector<Eigen::Vector2d> xy;
+      xy.reserve(inliers.size());
+      for (auto i : inliers) {
+        const auto& q = cloud->points[static_cast<std::size_t>(i)];
+        if (bounded && !world::containsPoint(grown, Eigen::Vector2d(q.x, q.y))) continue;
+        removed[static_cast<std::size_t>(i)] = 1;
+        xy.emplace_back(q.x, q.y);
       }
-      search = next;
+      out.plane_points += xy.size();
+      // The same surface found twice (e.g. the far floor, noisier) merges into the first.
+      auto same = std::find_if(out.planes.begin(), out.planes.end(), [&](const SupportPlane& o) {
+        return o.region == plane.region && std::abs(o.height - plane.height) <= P.planes.region_height_tolerance;
+      });
+      if (same != out.planes.end()) {
+        auto& pts = plane_xy[static_cast<std::size_t>(same - out.planes.begin())];
+        pts.insert(pts.end(), xy.begin(), xy.end());
+        same->inliers += plane.inliers;
+        same->area += plane.area;
+        continue;
+      }
+      if (static_cast<int>(out.planes.size()) >= P.planes.max_planes) break;
+      out.planes.push_back(std::move(plane));
+      plane_xy.push_back(std::move(xy));
     }
+    for (std::size_t k = 0; k < out.planes.size(); ++k) out.planes[k].hull = convexHull(std::move(plane_xy[k]));
   }
   out.times.planes = ms(watch);
   if (term()) return stopped(term, "static-object removal").error();
@@ -291,7 +341,10 @@ Result<Segmentation> Segmenter::run(const PointCloudFrame& frame, const Terminat
         for (auto i : c.indices) pts.push_back(rest->points[static_cast<std::size_t>(i)].getVector3fMap());
         out.clusters.push_back(std::move(pts));
       } else if (size >= P.occupancy.min_cluster_points) {
-        for (auto i : c.indices) out.small_cluster_points.push_back(rest->points[static_cast<std::size_t>(i)].getVector3fMap());
+        std::vector<Eigen::Vector3f> pts;
+        pts.reserve(c.indices.size());
+        for (auto i : c.indices) pts.push_back(rest->points[static_cast<std::size_t>(i)].getVector3fMap());
+        out.small_clusters.push_back(std::move(pts));
       }
     }
   }

@@ -242,7 +242,6 @@ Detection describeCluster(std::vector<Eigen::Vector3d> points, double support_z,
   }
   d.height = std::max(d.top_z - support_z, 0.0);
   const std::vector<Eigen::Vector2d> hull = convexHull(xy);
-  d.rect = minAreaRect(hull);
 
   // Points near the hull boundary carry the outline (the interior is the top face).
   const double band = std::max(0.01, 0.5 * params.tolerance);
@@ -250,6 +249,71 @@ Detection describeCluster(std::vector<Eigen::Vector3d> points, double support_z,
     if (ringDistance(p, hull) <= band) d.boundary.push_back(p);
   }
   if (d.boundary.size() < 3) d.boundary = xy;
+
+  // Orientation: among the hull's edge directions, the rectangle whose edges the outline points
+  // lie on (closeness criterion, as in L-shape fitting). The minimum-area rectangle alone is
+  // ambiguous for an L-shaped view of two faces: its triangle hull has three rectangles of the
+  // same area.
+  d.rect = minAreaRect(hull);
+  if (hull.size() >= 3) {
+    double best = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < hull.size(); ++i) {
+      const Eigen::Vector2d e = hull[(i + 1) % hull.size()] - hull[i];
+      if (e.norm() < 1e-9) continue;
+      const double yaw = std::atan2(e.y(), e.x());
+      const Eigen::Vector2d u = axis(yaw), v = axis(yaw + kPi / 2);
+      double umin = std::numeric_limits<double>::infinity(), umax = -umin, vmin = umin, vmax = -umin;
+      for (const auto& p : hull) {
+        umin = std::min(umin, p.dot(u));
+        umax = std::max(umax, p.dot(u));
+        vmin = std::min(vmin, p.dot(v));
+        vmax = std::max(vmax, p.dot(v));
+      }
+      double score = 0;
+      for (const auto& p : d.boundary) {
+        const double du = std::min(p.dot(u) - umin, umax - p.dot(u));
+        const double dv = std::min(p.dot(v) - vmin, vmax - p.dot(v));
+        score += std::min(du, dv);
+      }
+      score += 1e-6 * (umax - umin) * (vmax - vmin);  // ties: the smaller rectangle
+      if (score < best - 1e-12) {
+        best = score;
+        Rect2 r;
+        r.centre = u * (0.5 * (umin + umax)) + v * (0.5 * (vmin + vmax));
+        r.extents = {umax - umin, vmax - vmin};
+        double y = std::fmod(yaw, kPi);
+        if (y < 0) y += kPi;
+        if (y >= kPi / 2) {
+          y -= kPi / 2;
+          std::swap(r.extents.x(), r.extents.y());
+        }
+        r.yaw = y >= kPi / 2 - 1e-12 ? 0.0 : y;
+        d.rect = r;
+      }
+    }
+  }
+  // The extents come from trimmed quantiles along the rectangle's axes, so that range noise
+  // smearing a few returns outwards does not grow the object.
+  if (xy.size() >= 50) {
+    const Eigen::Vector2d u = axis(d.rect.yaw), v = axis(d.rect.yaw + kPi / 2);
+    std::vector<double> pu, pv;
+    pu.reserve(xy.size());
+    pv.reserve(xy.size());
+    for (const auto& p : xy) {
+      pu.push_back(p.dot(u));
+      pv.push_back(p.dot(v));
+    }
+    auto quantile = [](std::vector<double>& a, double q) {
+      const auto k = static_cast<std::ptrdiff_t>(q * static_cast<double>(a.size() - 1));
+      std::nth_element(a.begin(), a.begin() + k, a.end());
+      return a[static_cast<std::size_t>(k)];
+    };
+    constexpr double kTrim = 0.02;
+    const double u0 = quantile(pu, kTrim), u1 = quantile(pu, 1 - kTrim);
+    const double v0 = quantile(pv, kTrim), v1 = quantile(pv, 1 - kTrim);
+    d.rect.centre = u * (0.5 * (u0 + u1)) + v * (0.5 * (v0 + v1));
+    d.rect.extents = {u1 - u0, v1 - v0};
+  }
 
   const Eigen::Vector2d a0 = axis(d.rect.yaw), a1 = axis(d.rect.yaw + kPi / 2);
   const Eigen::Vector2d half = d.rect.extents / 2;
@@ -362,7 +426,7 @@ ShapeFit fitShape(const Detection& det, const world::Shape& shape, const Eigen::
     const Eigen::Vector2d origin = centre - (offset.x() * b0 + offset.y() * b1);
     fit.pose = uprightPose(origin.x(), origin.y(), z, yaw);
   }
-  const double height_tol = std::max(params.height_tolerance, 0.2 * shape_height);
+  const double height_tol = std::max(params.height_tolerance, 0.1 * shape_height);
   fit.compatible = fit.excess <= params.size_tolerance && std::abs(fit.height_error) <= height_tol;
   return fit;
 }

@@ -4,7 +4,9 @@
 /// a cluster too small or too large to be an object, anything not yet confirmed as an object).
 /// Free space is cleared by ray insertion from the sensor origin to the frame's returns (one
 /// endpoint per `free_space_voxel`, up to `max_ray_range`), so an obstacle that went away is
-/// erased when the space it occupied is seen through. Space inside known objects is cleared
+/// erased when the space it occupied is seen through; because rays are sparse, occupied voxels
+/// are also tested against the frame's range image (`clearSeenThrough`), so a thin obstacle
+/// that went away is cleared even when no ray happened to cross it. Space inside known objects is cleared
 /// whenever they are added or move. OctoMap stays inside the .cc (pimpl).
 
 #include <memory>
@@ -14,6 +16,7 @@
 #include <Eigen/Geometry>
 
 #include "tamp/perception/params.h"
+#include "tamp/perception/visibility.h"
 #include "tamp/world/world.h"
 
 namespace tamp::perception {
@@ -33,14 +36,22 @@ class OccupancyMap {
   /// World frame, metres.
   void integrate(const Eigen::Vector3d& origin, const std::vector<Eigen::Vector3f>& scan,
                  const std::vector<Eigen::Vector3f>& occupied);
-  /// Deletes occupied voxels inside `object` grown by `explained_margin`. Returns how many.
+  /// Complements the (sparse) rays: every occupied voxel whose centre is seen through in
+  /// `image` (the nearest return in its direction lies beyond it + `margin`) gets a miss.
+  /// Cost: O(voxels that received hits). Returns how many voxels were updated.
+  std::size_t clearSeenThrough(const RangeImage& image, double margin);
+  /// Marks occupied voxels inside `object` grown by `explained_margin` free (known object, not
+  /// unknown space). Returns how many.
   std::size_t clearObject(const world::Object& object);
   void clear();
 
   CellState state(const Eigen::Vector3d& p) const;
   /// Centres of the occupied leaves (at the map resolution), world frame.
   std::vector<Eigen::Vector3d> occupiedVoxels() const;
+  /// Number of occupied leaves (walks the whole tree: for tests and statistics).
   std::size_t occupiedCount() const;
+  /// Voxels that received hits and were not cleared since (cheap; >= occupiedCount()).
+  std::size_t hitVoxels() const;
   double resolution() const;
   /// The map as an OctoMap binary stream (`# Octomap OcTree binary file` header +
   /// `writeBinaryData`), readable by `octomap::OcTree::readBinary` and hence by

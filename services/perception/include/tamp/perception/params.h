@@ -31,6 +31,15 @@ struct ObjectClass {
   std::optional<std::string> invalidReason() const;
 };
 
+/// The depth sensor's noise model (datasheet or calibration): the stddev of a return's range
+/// along its ray is `noise_stddev + noise_quadratic * range^2`. Widens the support-plane band
+/// with range, so the far floor's noise does not become obstacles.
+struct SensorNoise {
+  double noise_stddev{0.001};     ///< m, >= 0
+  double noise_quadratic{0.0015}; ///< 1/m, >= 0
+  double stddev(double range) const { return noise_stddev + noise_quadratic * range * range; }
+};
+
 /// Which points are looked at.
 struct CropParams {
   /// World-frame box of interest. Empty: the prior world's bounds() grown by `workspace_margin`
@@ -49,12 +58,18 @@ struct PlaneParams {
   int max_planes{4};                 ///< support planes accepted per frame, >= 0
   int max_attempts{8};               ///< RANSAC runs per frame (rejected planes count), >= max_planes
   int ransac_iterations{150};        ///< per run, >= 1
-  double distance_threshold{0.015};  ///< m, inlier band around a plane, > 0
+  double distance_threshold{0.015};  ///< m, RANSAC inlier band (and the least removal band), > 0
+  /// Points within this many noise stddevs of a support plane (the along-ray noise projected on
+  /// the plane normal, see SensorNoise) are removed with it, >= 0.
+  double noise_sigmas{3.0};
+  /// RANSAC runs on at most this many points (an even subsample); inliers are then classified
+  /// over every point. >= 100.
+  int ransac_max_points{6000};
   double max_tilt{0.12};             ///< rad, largest angle between a plane normal and world z
   int min_points{150};               ///< inliers of a plane, >= 3
-  /// A horizontal plane is a support surface when its inliers cover at least this area
-  /// (inliers x voxel^2), or when its height matches a prior region (table, floor).
-  double min_support_area{0.30};     ///< m^2, > 0
+  /// A horizontal plane is a support surface when its inliers cover at least this area (in xy,
+  /// at voxel resolution), or when its height matches a prior region (table, floor).
+  double min_support_area{0.50};     ///< m^2, > 0
   double region_height_tolerance{0.04};  ///< m, plane vs prior region height
   /// Inliers of a plane matched to a prior region are removed only inside the region's polygon
   /// grown by this margin (a box top at table height elsewhere stays an object).
@@ -79,7 +94,7 @@ struct ClusterParams {
 struct TrackingParams {
   double gate_distance{0.35};      ///< m, largest xy jump to still associate a detection, > 0
   double size_tolerance{0.05};     ///< m, a detection may exceed a shape by this much, >= 0
-  double height_tolerance{0.05};   ///< m, and at least 20 % of the height
+  double height_tolerance{0.03};   ///< m, and at least 10 % of the height
   int confirm_hits{2};             ///< detections before a new object enters the world, >= 1
   double tentative_timeout_s{5.0}; ///< a tentative object not seen again for this long is dropped
   int gone_frames{2};              ///< frames its place is seen empty before an object is gone, >= 1
@@ -113,7 +128,7 @@ struct ClassifyParams {
 struct OccupancyParams {
   bool enabled{true};
   double resolution{0.05};        ///< m, > 0
-  double free_space_voxel{0.10};  ///< m, rays are cast to one endpoint per voxel of this size
+  double free_space_voxel{0.20};  ///< m, rays are cast to one endpoint per voxel of this size
   double max_ray_range{5.0};      ///< m, free space is cleared up to this range, > 0
   double explained_margin{0.04};  ///< m, voxels inside known objects grown by this are cleared
   double prob_hit{0.7};           ///< in (0.5, 1)
@@ -126,6 +141,7 @@ struct OccupancyParams {
 };
 
 struct PerceptionParams {
+  SensorNoise sensor;
   CropParams crop;
   PlaneParams planes;
   ClusterParams clusters;
@@ -143,7 +159,8 @@ struct PerceptionParams {
 /// refused; a missing file is kNotFound. The YAML layout mirrors the structs:
 /// `crop: {max_range: 5}`, `planes: {voxel_size: 0.02}`, ..., and
 /// `classes: [{label: crate, shape: box, size: [0.4, 0.3, 0.3], kind: movable, mass: 3}]`
-/// (`shape: cylinder` takes `radius` and `height`).
+/// (`shape: cylinder` takes `radius` and `height`). A top-level `node:` section is left to the
+/// DDS node (services/perception/node).
 Result<PerceptionParams> loadPerceptionParams(const std::filesystem::path& file);
 /// Same from text; `name` is the file name used in messages.
 Result<PerceptionParams> parsePerceptionParams(const std::string& yaml_text, const std::string& name);

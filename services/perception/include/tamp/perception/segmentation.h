@@ -21,9 +21,10 @@ namespace tamp::perception {
 /// A horizontal support surface found in the frame (floor, table top).
 struct SupportPlane {
   Eigen::Vector4d coefficients{0, 0, 1, 0};  ///< a x + b y + c z + d = 0, unit normal, c > 0
-  double height{0.0};                        ///< z of the plane at its inliers' centroid, m
+  double height{0.0};            ///< support height, m: the matched prior region's, else measured
+  double measured_height{0.0};   ///< z of the fitted plane at its inliers' centroid, m
   int inliers{0};
-  double area{0.0};                          ///< inliers x voxel^2, m^2
+  double area{0.0};                          ///< xy area covered by the inliers, m^2
   world::Polygon2 hull;                      ///< convex hull of the inliers in xy
   std::string region;                        ///< prior region whose height it matches, or empty
 };
@@ -37,8 +38,9 @@ struct Segmentation {
   std::vector<SupportPlane> planes;
   /// Clusters large enough to be objects (>= clusters.min_points), world frame.
   std::vector<std::vector<Eigen::Vector3f>> clusters;
-  /// Points of smaller clusters (>= occupancy.min_cluster_points): unexplained, not objects.
-  std::vector<Eigen::Vector3f> small_cluster_points;
+  /// Smaller clusters (>= occupancy.min_cluster_points points, and clusters above
+  /// clusters.max_points): not objects, candidates for the occupancy map.
+  std::vector<std::vector<Eigen::Vector3f>> small_clusters;
   /// The cropped, voxel-filtered returns (free-space rays are cast to them), world frame.
   std::vector<Eigen::Vector3f> scan;
   std::size_t valid_points{0}, cropped_points{0}, plane_points{0}, static_points{0};

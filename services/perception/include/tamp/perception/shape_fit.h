@@ -81,7 +81,8 @@ struct ShapeFit {
   double excess{0.0};    ///< m, how far the detection's footprint exceeds the shape's
   double deficit{0.0};   ///< m, how much of the shape's footprint was not seen (sum over axes)
   double height_error{0.0};  ///< detection height - shape height, m
-  /// Size-compatible: excess <= size_tolerance and |height_error| <= the height tolerance.
+  /// Size-compatible: excess <= size_tolerance and |height_error| <= max(height_tolerance,
+  /// 10 % of the shape's height).
   bool compatible{false};
 };
 

@@ -1,0 +1,334 @@
+// tamp_perception_bench: perception time per cloud (by stage) for ~50k, ~300k and ~1M-point
+// frames, and detection recall + pose error against the ground truth over scenes rendered by
+// the simulator's depth camera. Prints Markdown tables (docs/benchmarks.md, "Perception").
+//
+//   tamp_perception_bench [--frames N] [--timing-only | --accuracy-only] [--scenarios DIR]
+//
+// Timing: a furnished room (static walls and table in the prior, 10 objects to find), frames
+// pre-rendered (not timed) from a robot turning on the spot; 3 warm-up frames, then N timed.
+// Accuracy: per scene, the prior is the static map only (every movable object must be found);
+// each scene is run twice, with the object classes known (sizes from the scenario's objects) and
+// without (size thresholds only). Ground truth objects count when the camera saw >= 100 pixels
+// of them in some frame; a perceived object matches a ground-truth one within 0.15 m (Hungarian).
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <map>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "tamp/core/termination.h"
+#include "tamp/perception/assignment.h"
+#include "tamp/perception/perception.h"
+#include "tamp/sim/depth_sensor.h"
+#include "test_scenes.h"
+
+namespace tp = tamp::perception;
+namespace tw = tamp::world;
+using tamp::perception::testing::box;
+using tamp::perception::testing::cylinder;
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+double quantile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const double pos = q * static_cast<double>(v.size() - 1);
+  const auto i = static_cast<std::size_t>(pos);
+  const double f = pos - static_cast<double>(i);
+  return i + 1 < v.size() ? v[i] * (1 - f) + v[i + 1] * f : v[i];
+}
+
+tw::Object staticBox(const std::string& id, double sx, double sy, double sz, double x, double y, double yaw = 0.0) {
+  return box(id, sx, sy, sz, x, y, yaw, 0.0, tw::ObjectKind::kStatic);
+}
+
+/// A 7 x 6 m room: walls, a table with two objects on it, eight objects on the floor.
+tw::World room() {
+  tw::World w("room");
+  (void)w.addRegion(tamp::perception::testing::floorRegion());
+  (void)w.addRegion(tw::Region{"table_top", "table", tw::RegionKind::kTable,
+                               {{2.9, 1.0}, {4.1, 1.0}, {4.1, 1.8}, {2.9, 1.8}}, 0.75});
+  (void)w.addObject(staticBox("wall_n", 7.0, 0.1, 1.5, 2.5, 3.0));
+  (void)w.addObject(staticBox("wall_s", 7.0, 0.1, 1.5, 2.5, -3.0));
+  (void)w.addObject(staticBox("wall_e", 0.1, 6.0, 1.5, 6.0, 0.0));
+  (void)w.addObject(staticBox("table", 1.2, 0.8, 0.75, 3.5, 1.4));
+  (void)w.addObject(box("crate_a", 0.4, 0.4, 0.3, 2.2, -0.8, 0.3));
+  (void)w.addObject(box("crate_b", 0.4, 0.4, 0.3, 4.2, -1.2, -0.2));
+  (void)w.addObject(box("parcel_a", 0.3, 0.2, 0.25, 1.7, 0.2, 0.9));
+  (void)w.addObject(box("parcel_b", 0.3, 0.2, 0.25, 3.0, -0.2, 0.1));
+  (void)w.addObject(box("cabinet", 0.6, 0.5, 1.0, 5.2, 1.0, 0.0));
+  (void)w.addObject(cylinder("bin", 0.15, 0.5, 2.6, 0.6));
+  (void)w.addObject(cylinder("bucket", 0.12, 0.3, 3.6, -2.0));
+  (void)w.addObject(cylinder("post", 0.08, 0.9, 4.6, 0.3));
+  (void)w.addObject(cylinder("can", 0.04, 0.12, 3.2, 1.3, 0.75));
+  (void)w.addObject(box("book", 0.2, 0.15, 0.05, 3.8, 1.5, 0.4, 0.75));
+  return w;
+}
+
+/// A cluttered store room seen from two sides: objects hiding each other.
+tw::World storeRoom() {
+  tw::World w("store_room");
+  (void)w.addRegion(tamp::perception::testing::floorRegion());
+  (void)w.addObject(staticBox("shelf", 0.4, 2.0, 1.8, 4.5, 0.0));
+  const double yaws[] = {0.0, 0.3, -0.4, 0.7, 0.2, -0.1};
+  int k = 0;
+  for (double x : {2.0, 2.8, 3.5}) {
+    for (double y : {-0.7, 0.6}) {
+      const std::string id = "box_" + std::to_string(k);
+      (void)w.addObject(box(id, 0.35, 0.25, 0.3 + 0.05 * (k % 3), x, y + 0.1 * (k % 2), yaws[k]));
+      ++k;
+    }
+  }
+  (void)w.addObject(cylinder("drum_0", 0.2, 0.6, 2.4, -1.6));
+  (void)w.addObject(cylinder("drum_1", 0.2, 0.6, 3.2, 1.7));
+  return w;
+}
+
+/// Tables with small things on them (cans, boxes), as in the pick-and-place scenarios.
+tw::World tableTops() {
+  tw::World w("table_tops");
+  (void)w.addRegion(tamp::perception::testing::floorRegion());
+  (void)w.addRegion(tw::Region{"table_1", "table", tw::RegionKind::kTable,
+                               {{1.6, -0.9}, {2.4, -0.9}, {2.4, 0.3}, {1.6, 0.3}}, 0.75});
+  (void)w.addRegion(tw::Region{"table_2", "table", tw::RegionKind::kTable,
+                               {{2.0, 0.8}, {3.2, 0.8}, {3.2, 1.6}, {2.0, 1.6}}, 0.72});
+  (void)w.addObject(staticBox("table_1", 0.8, 1.2, 0.75, 2.0, -0.3));
+  (void)w.addObject(staticBox("table_2", 1.2, 0.8, 0.72, 2.6, 1.2));
+  (void)w.addObject(cylinder("can_0", 0.04, 0.12, 1.8, -0.6, 0.75));
+  (void)w.addObject(cylinder("can_1", 0.04, 0.12, 2.1, 0.0, 0.75));
+  (void)w.addObject(cylinder("mug", 0.05, 0.1, 1.9, -0.2, 0.75));
+  (void)w.addObject(box("cereal", 0.2, 0.07, 0.3, 2.2, -0.7, 0.5, 0.75));
+  (void)w.addObject(box("tray", 0.4, 0.3, 0.06, 2.5, 1.1, 0.2, 0.72));
+  (void)w.addObject(box("kettle_box", 0.2, 0.2, 0.25, 2.9, 1.35, -0.3, 0.72));
+  (void)w.addObject(box("crate", 0.4, 0.4, 0.3, 1.2, 1.0, 0.6));
+  return w;
+}
+
+/// The static map of a world (what perception starts from in the accuracy runs).
+tw::World staticMap(const tw::World& truth) {
+  tw::World w = truth.plannerView();
+  std::vector<std::string> movable;
+  for (const auto& o : w.objects()) {
+    if (o.kind == tw::ObjectKind::kMovable) movable.push_back(o.id);
+  }
+  for (const auto& id : movable) (void)w.removeObject(id);
+  return w;
+}
+
+// ---- timing -----------------------------------------------------------------------------------
+
+struct SizeSpec {
+  const char* name;
+  int width, height;
+};
+
+void runTiming(int frames) {
+  const tw::World truth = room();
+  const tw::World prior = staticMap(truth);
+  std::printf("\n### Time per cloud (ms), room scene, %d timed frames after 3 warm-up frames\n\n", frames);
+  std::printf("| cloud | points (valid / cropped / voxels) | validate | transform+crop | voxel grid | planes | static map | clustering | fitting | association+tracking | visibility | occupancy | **total p50** | total p90 | max |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  const SizeSpec sizes[] = {{"50k", 256, 196}, {"300k", 640, 480}, {"1M", 1152, 864}};
+  for (const auto& s : sizes) {
+    tamp::perception::testing::Camera cam;
+    cam.width = s.width;
+    cam.height = s.height;
+    std::vector<tamp::PointCloudFrame> clouds;
+    for (int k = 0; k < frames + 3; ++k) {
+      const double yaw = 0.25 * std::sin(0.7 * k);
+      clouds.push_back(tamp::perception::testing::render(truth, tamp::perception::testing::mastCamera(0.3, 0.0, yaw), cam,
+                                                         1'000'000'000LL + k * 100'000'000LL, static_cast<std::uint64_t>(k)));
+    }
+    tp::PerceptionParams params;
+    params.classes = tp::classesFromWorld(truth);
+    tp::Perception perception(prior, params);
+    std::map<std::string, std::vector<double>> t;
+    std::vector<double> valid, cropped, voxels;
+    for (int k = 0; k < frames + 3; ++k) {
+      auto r = perception.processFrame(clouds[static_cast<std::size_t>(k)]);
+      if (!r) {
+        std::fprintf(stderr, "frame failed: %s\n", r.error().toString().c_str());
+        std::exit(1);
+      }
+      if (k < 3) continue;
+      const auto& T = r->times;
+      t["validate"].push_back(T.validate);
+      t["crop"].push_back(T.transform_crop);
+      t["voxel"].push_back(T.voxel);
+      t["planes"].push_back(T.planes);
+      t["static"].push_back(T.static_objects);
+      t["cluster"].push_back(T.clustering);
+      t["fit"].push_back(T.fitting);
+      t["track"].push_back(T.tracking);
+      t["vis"].push_back(T.visibility);
+      t["occ"].push_back(T.occupancy);
+      t["total"].push_back(T.total);
+      valid.push_back(static_cast<double>(r->stats.valid_points));
+      cropped.push_back(static_cast<double>(r->stats.cropped_points));
+      voxels.push_back(static_cast<double>(r->stats.voxel_points));
+    }
+    std::printf("| %s (%dx%d = %d) | %.0f / %.0f / %.0f |", s.name, s.width, s.height, s.width * s.height, quantile(valid, 0.5),
+                quantile(cropped, 0.5), quantile(voxels, 0.5));
+    for (const char* k : {"validate", "crop", "voxel", "planes", "static", "cluster", "fit", "track", "vis", "occ"}) {
+      std::printf(" %.2f |", quantile(t[k], 0.5));
+    }
+    std::printf(" **%.1f** | %.1f | %.1f |\n", quantile(t["total"], 0.5), quantile(t["total"], 0.9),
+                *std::max_element(t["total"].begin(), t["total"].end()));
+    std::fflush(stdout);
+  }
+  std::printf("\nStage columns are medians. The world model after the frames: objects found are checked by the accuracy part.\n");
+}
+
+// ---- accuracy ---------------------------------------------------------------------------------
+
+struct Scene {
+  std::string name;
+  tw::World truth;
+  std::vector<Eigen::Isometry3d> views;
+};
+
+struct Tally {
+  int truth{0}, found{0}, perceived{0}, false_pos{0};
+  std::vector<double> xy, z, yaw;
+};
+
+/// Runs one scene; returns the tally and prints a line.
+Tally runScene(const Scene& scene, bool with_classes, int frames_per_view) {
+  tp::PerceptionParams params;
+  if (with_classes) params.classes = tp::classesFromWorld(scene.truth);
+  const tw::World prior = staticMap(scene.truth);
+  tp::Perception perception(prior, params);
+  tamp::perception::testing::Camera cam;
+  cam.width = 640;
+  cam.height = 480;
+  // Ground truth: movable objects of which the camera saw >= 100 pixels in some view.
+  std::map<std::string, int> seen;
+  {
+    tamp::sim::DepthSensorParams quiet;
+    quiet.width = cam.width;
+    quiet.height = cam.height;
+    quiet.noise_stddev_m = quiet.noise_quadratic = quiet.dropout_probability = 0.0;
+    tamp::sim::DepthSensor sensor(quiet);
+    for (const auto& v : scene.views) {
+      tamp::sim::GroundTruthLabels labels;
+      (void)sensor.capture(scene.truth, v, 0, &labels);
+      std::map<int, int> count;
+      for (auto l : labels.pixel) {
+        if (l >= 0) ++count[l];
+      }
+      for (const auto& [l, n] : count) {
+        const std::string& id = labels.ids[static_cast<std::size_t>(l)];
+        seen[id] = std::max(seen[id], n);
+      }
+    }
+  }
+  int64_t stamp = 1'000'000'000;
+  std::uint64_t index = 0;
+  for (const auto& v : scene.views) {
+    for (int k = 0; k < frames_per_view; ++k) {
+      auto r = perception.processFrame(tamp::perception::testing::render(scene.truth, v, cam, stamp, index++));
+      stamp += 200'000'000;
+      if (!r) {
+        std::fprintf(stderr, "%s: %s\n", scene.name.c_str(), r.error().toString().c_str());
+        std::exit(1);
+      }
+    }
+  }
+  std::vector<const tw::Object*> gt, found;
+  for (const auto& o : scene.truth.objects()) {
+    if (o.kind == tw::ObjectKind::kMovable && seen[o.id] >= 100) gt.push_back(&o);
+  }
+  for (const auto& o : perception.world().objects()) {
+    if (prior.findObject(o.id) == nullptr) found.push_back(&o);
+  }
+  std::vector<std::vector<double>> cost(gt.size(), std::vector<double>(found.size(), INFINITY));
+  for (std::size_t i = 0; i < gt.size(); ++i) {
+    for (std::size_t j = 0; j < found.size(); ++j) {
+      const double d = (gt[i]->pose.translation().head<2>() - found[j]->pose.translation().head<2>()).norm();
+      if (d <= 0.15) cost[i][j] = d;
+    }
+  }
+  const auto assign = tp::solveAssignment(cost);
+  Tally t;
+  t.truth = static_cast<int>(gt.size());
+  t.perceived = static_cast<int>(found.size());
+  std::string missed;
+  for (std::size_t i = 0; i < gt.size(); ++i) {
+    if (assign[i] < 0) {
+      missed += " " + gt[i]->id;
+      continue;
+    }
+    ++t.found;
+    const tw::Object& f = *found[static_cast<std::size_t>(assign[i])];
+    const tp::PoseError e = tp::poseError(gt[i]->shape, gt[i]->pose, f.pose);
+    t.xy.push_back(e.xy);
+    t.z.push_back(e.z);
+    if (tp::yawSymmetry(gt[i]->shape) > 0) t.yaw.push_back(e.yaw);
+  }
+  t.false_pos = t.perceived - t.found;
+  std::printf("| %s | %s | %zu | %d | %d / %d | %d | %.3f / %.3f / %.3f | %.1f / %.1f | %s |\n", scene.name.c_str(),
+              with_classes ? "known" : "none", scene.views.size() * static_cast<std::size_t>(frames_per_view), t.truth,
+              t.found, t.truth, t.false_pos, quantile(t.xy, 0.5), quantile(t.xy, 0.9),
+              t.xy.empty() ? 0.0 : *std::max_element(t.xy.begin(), t.xy.end()), quantile(t.yaw, 0.5) * 180 / kPi,
+              quantile(t.yaw, 0.9) * 180 / kPi, missed.empty() ? "-" : missed.c_str());
+  std::fflush(stdout);
+  return t;
+}
+
+void runAccuracy() {
+  using tamp::perception::testing::mastCamera;
+  std::vector<Scene> scenes;
+  scenes.push_back({"room", room(), {mastCamera(0.3, 0, 0), mastCamera(0.3, 0, 0.45), mastCamera(0.3, 0, -0.45),
+                                     mastCamera(2.0, -2.2, 0.6), mastCamera(2.0, 2.2, -0.7)}});
+  scenes.push_back({"store_room", storeRoom(), {mastCamera(0.5, 0, 0), mastCamera(2.7, -2.6, kPi / 2),
+                                                 mastCamera(2.7, 2.6, -kPi / 2)}});
+  scenes.push_back({"table_tops", tableTops(), {mastCamera(0.6, -0.3, 0), mastCamera(1.3, 2.6, -1.0),
+                                                 mastCamera(0.4, 0.8, 0.1)}});
+  std::printf("\n### Detection recall and pose error (640x480 frames, 2 frames per view)\n\n");
+  std::printf("| scene | classes | frames | objects seen | found | false objects | xy error p50 / p90 / max (m) | yaw error p50 / p90 (deg) | missed |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|\n");
+  for (bool classes : {true, false}) {
+    Tally all;
+    for (const auto& s : scenes) {
+      const Tally t = runScene(s, classes, 2);
+      all.truth += t.truth;
+      all.found += t.found;
+      all.false_pos += t.false_pos;
+      all.xy.insert(all.xy.end(), t.xy.begin(), t.xy.end());
+      all.yaw.insert(all.yaw.end(), t.yaw.begin(), t.yaw.end());
+    }
+    std::printf("| **all** | %s | | %d | **%d / %d (%.0f %%)** | %d | %.3f / %.3f / %.3f | %.1f / %.1f | |\n", classes ? "known" : "none",
+                all.truth, all.found, all.truth, 100.0 * all.found / std::max(all.truth, 1), all.false_pos,
+                quantile(all.xy, 0.5), quantile(all.xy, 0.9), all.xy.empty() ? 0.0 : *std::max_element(all.xy.begin(), all.xy.end()),
+                quantile(all.yaw, 0.5) * 180 / kPi, quantile(all.yaw, 0.9) * 180 / kPi);
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int frames = 20;
+  bool timing = true, accuracy = true;
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--frames") && i + 1 < argc) {
+      frames = std::max(1, std::atoi(argv[++i]));
+    } else if (!std::strcmp(argv[i], "--timing-only")) {
+      accuracy = false;
+    } else if (!std::strcmp(argv[i], "--accuracy-only")) {
+      timing = false;
+    } else {
+      std::fprintf(stderr, "usage: %s [--frames N] [--timing-only | --accuracy-only]\n", argv[0]);
+      return 2;
+    }
+  }
+  if (timing) runTiming(frames);
+  if (accuracy) runAccuracy();
+  return 0;
+}

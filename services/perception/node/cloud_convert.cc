@@ -1,0 +1,87 @@
+#include "cloud_convert.h"
+
+#include "tamp/dds/convert.h"
+#include "tamp/perception/validation.h"
+
+namespace tamp::perception {
+
+msg::PointCloudFrame toMsg(const PointCloudFrame& f, uint64_t seq) {
+  msg::PointCloudFrame m;
+  m.header().stamp_ns(f.stamp_ns);
+  m.header().frame_id(f.sensor_id);
+  m.header().seq(seq);
+  m.sensor_id(f.sensor_id);
+  m.sensor_pose(dds::toMsg(f.world_T_sensor));
+  m.width(f.width);
+  m.height(f.height);
+  m.points(f.xyz);
+  return m;
+}
+
+Result<PointCloudFrame> fromMsg(const msg::PointCloudFrame& m, std::size_t max_points) {
+  auto bad = [](const std::string& field, const std::string& why) {
+    return Error(ErrorCode::kInvalidArgument, "malformed point cloud: " + why, SourceLocation{"", 0, 0, field});
+  };
+  const std::size_t values = m.points().size();
+  if (values == 0) return bad("points", "empty cloud (no points)");
+  if (values % 3 != 0) return bad("points", "size " + std::to_string(values) + " is not a multiple of 3");
+  if (values / 3 > max_points) {
+    return bad("points", std::to_string(values / 3) + " points exceed the limit of " + std::to_string(max_points));
+  }
+  auto pose = dds::fromMsg(m.sensor_pose(), "sensor_pose");
+  if (!pose) return pose.error();
+  PointCloudFrame f;
+  f.sensor_id = m.sensor_id();
+  f.stamp_ns = m.header().stamp_ns();
+  f.world_T_sensor = *pose;
+  f.width = m.width();
+  f.height = m.height();
+  f.xyz = m.points();
+  if (Status s = validateFrame(f, max_points); !s.ok()) {
+    Error e = s.error();
+    if (e.where.field == "xyz" || e.where.field.rfind("xyz[", 0) == 0) e.where.field.replace(0, 3, "points");
+    if (e.where.field == "world_T_sensor") e.where.field = "sensor_pose";
+    return e;
+  }
+  return f;
+}
+
+msg::WorldEvent toMsg(const WorldEvent& e, uint64_t seq) {
+  msg::WorldEvent m;
+  m.header().stamp_ns(e.stamp_ns);
+  m.header().frame_id("world");
+  m.header().seq(seq);
+  switch (e.type) {
+    case EventType::kAdded:
+      m.type(msg::WORLD_OBJECT_ADDED);
+      break;
+    case EventType::kMoved:
+      m.type(msg::WORLD_OBJECT_MOVED);
+      break;
+    case EventType::kRemoved:
+      m.type(msg::WORLD_OBJECT_REMOVED);
+      break;
+    case EventType::kGone:
+      m.type(msg::WORLD_OBJECT_GONE);
+      break;
+  }
+  m.object_id(e.object_id);
+  m.kind(e.kind == world::ObjectKind::kMovable ? msg::OBJECT_MOVABLE : msg::OBJECT_STATIC);
+  m.pose(dds::toMsg(e.pose));
+  m.description(e.description);
+  return m;
+}
+
+msg::OccupancyMap occupancyToMsg(const std::string& binary, double resolution, int64_t stamp_ns, uint64_t seq,
+                                 const std::string& map_id) {
+  msg::OccupancyMap m;
+  m.header().stamp_ns(stamp_ns);
+  m.header().frame_id("world");
+  m.header().seq(seq);
+  m.map_id(map_id);
+  m.resolution(resolution);
+  m.octree(std::vector<uint8_t>(binary.begin(), binary.end()));
+  return m;
+}
+
+}  // namespace tamp::perception

@@ -1,0 +1,160 @@
+#include "perception_node.h"
+
+#include <cmath>
+
+#include "cloud_convert.h"
+#include "tamp/config/yaml_reader.h"
+#include "tamp/core/log.h"
+#include "tamp/core/paths.h"
+
+namespace tamp::perception {
+
+Result<PerceptionNodeOptions> parseNodeOptions(const std::string& yaml_text, const std::string& name) {
+  auto params = parsePerceptionParams(yaml_text, name);
+  if (!params) return params.error();
+  PerceptionNodeOptions o;
+  o.params = std::move(*params);
+  auto doc = config::parseYaml(yaml_text, name);
+  if (!doc) return doc.error();
+  if (doc->root.IsMap() && doc->root["node"]) {
+    config::FieldReader r(*doc);
+    config::FieldReader n = r.child("node");
+    n.optional("world_id", o.world_id);
+    n.optional("occupancy_period_s", o.occupancy_period_s);
+    n.optional("frame_budget_s", o.frame_budget_s);
+    n.check(!o.world_id.empty(), "world_id", "must not be empty");
+    n.check(std::isfinite(o.occupancy_period_s) && o.occupancy_period_s >= 0, "occupancy_period_s",
+            "must be >= 0, got " + std::to_string(o.occupancy_period_s));
+    n.check(std::isfinite(o.frame_budget_s) && o.frame_budget_s > 0, "frame_budget_s",
+            "must be positive, got " + std::to_string(o.frame_budget_s));
+    n.refuseUnknownKeys();
+    if (!r.ok()) return r.status().error();
+  }
+  return o;
+}
+
+Result<PerceptionNodeOptions> loadNodeOptions(const std::filesystem::path& file) {
+  auto text = readTextFile(file);
+  if (!text) return text.error();
+  return parseNodeOptions(*text, file.string());
+}
+
+PerceptionNode::PerceptionNode(const dds::ServiceArgs& args, PerceptionNodeOptions options)
+    : ServiceNode(args),
+      options_(std::move(options)),
+      perception_(std::make_unique<Perception>(options_.prior.plannerView(), options_.params)),
+      world_pub_(participant(), options_.world_id),
+      events_(participant(), dds::topics::kWorldEvents),
+      occupancy_(participant(), dds::topics::kOccupancy) {
+  snapshot_ = perception_->world();
+  if (Status s = world_pub_.publish(snapshot_); !s.ok()) {
+    throw std::runtime_error("publishing the prior world: " + s.error().toString());
+  }
+  worker_ = std::jthread([this](std::stop_token st) { work(st); });
+  clouds_ = std::make_unique<dds::Reader<msg::PointCloudFrame>>(
+      participant(), dds::topics::kPointCloud,
+      [this](const msg::PointCloudFrame& m, const dds::SampleMeta& meta) {
+        if (meta.alive) onCloud(m);
+      });
+}
+
+PerceptionNode::~PerceptionNode() {
+  clouds_.reset();  // no more callbacks
+  worker_.request_stop();
+  cv_.notify_all();
+  if (worker_.joinable()) worker_.join();
+}
+
+Result<std::unique_ptr<dds::ServiceNode>> PerceptionNode::create(const dds::ServiceArgs& args) {
+  PerceptionNodeOptions options;
+  if (!args.config_file.empty()) {
+    auto o = loadNodeOptions(args.config_file);
+    if (!o) return o.error();
+    options = std::move(*o);
+  }
+  try {
+    return std::unique_ptr<dds::ServiceNode>(std::make_unique<PerceptionNode>(args, std::move(options)));
+  } catch (const std::invalid_argument& e) {
+    return Error(ErrorCode::kInvalidArgument, e.what());
+  }
+}
+
+world::World PerceptionNode::worldSnapshot() const {
+  std::lock_guard lock(mutex_);
+  return snapshot_;
+}
+
+std::pair<uint64_t, uint64_t> PerceptionNode::requestCounters() const {
+  return {processed_.load(), rejected_.load()};
+}
+
+void PerceptionNode::onCloud(const msg::PointCloudFrame& m) {
+  auto frame = fromMsg(m, options_.params.max_points);
+  if (!frame) {
+    ++rejected_;
+    log::get(name())->warn("rejected a point cloud from '{}': {}", m.sensor_id(), frame.error().toString());
+    return;
+  }
+  {
+    std::lock_guard lock(mutex_);
+    if (pending_) ++skipped_;  // the worker is behind: the newer frame replaces it
+    pending_ = std::move(*frame);
+  }
+  cv_.notify_one();
+}
+
+void PerceptionNode::work(std::stop_token stop) {
+  while (!stop.stop_requested()) {
+    std::optional<PointCloudFrame> frame;
+    {
+      std::unique_lock lock(mutex_);
+      cv_.wait(lock, stop, [this] { return pending_.has_value(); });
+      if (stop.stop_requested()) return;
+      frame = std::move(pending_);
+      pending_.reset();
+    }
+    try {
+      process(*frame);
+    } catch (const std::exception& e) {
+      ++rejected_;
+      log::get(name())->error("processing a frame failed: {}", e.what());
+    }
+  }
+}
+
+void PerceptionNode::process(const PointCloudFrame& frame) {
+  auto r = perception_->processFrame(frame, Termination::after(options_.frame_budget_s));
+  if (!r) {
+    ++rejected_;
+    log::get(name())->warn("frame from '{}' not processed: {}", frame.sensor_id, r.error().toString());
+    return;
+  }
+  ++processed_;
+  if (r->world_changed) {
+    {
+      std::lock_guard lock(mutex_);
+      snapshot_ = perception_->world();
+    }
+    if (Status s = world_pub_.publish(perception_->world()); !s.ok()) {
+      log::get(name())->error("publishing the world model failed: {}", s.error().toString());
+    }
+  }
+  for (const WorldEvent& e : r->events) {
+    log::get(name())->info("world event: {} {} ({})", toString(e.type), e.object_id, e.description);
+    if (Status s = events_.write(toMsg(e, ++event_seq_)); !s.ok()) {
+      log::get(name())->error("publishing a world event failed: {}", s.error().toString());
+    }
+  }
+  const auto now = Clock::now();
+  const bool due = !last_map_ || std::chrono::duration<double>(now - *last_map_).count() >= options_.occupancy_period_s;
+  if (perception_->occupancy() != nullptr && due) {
+    last_map_ = now;
+    const msg::OccupancyMap m =
+        occupancyToMsg(perception_->occupancyBinary(), perception_->occupancy()->resolution(), frame.stamp_ns, ++map_seq_);
+    if (Status s = occupancy_.write(m); !s.ok()) {
+      log::get(name())->error("publishing the occupancy map failed: {}", s.error().toString());
+    }
+  }
+}
+
+}  // namespace tamp::perception

@@ -1,0 +1,82 @@
+#pragma once
+/// @file
+/// The perception service on DDS: subscribes depth frames (`topics::kPointCloud`), runs
+/// `Perception` on the newest one (older frames waiting behind it are skipped: perception must
+/// not fall behind the sensor), and publishes
+/// - the world model with `dds::WorldPublisher` (keyed objects + meta, transient-local; only
+///   changed objects are written, removed ones disposed);
+/// - the world events (`topics::kWorldEvents`);
+/// - the OctoMap of unexplained space (`topics::kOccupancy`, the OctoMap binary stream) at most
+///   every `occupancy_period_s`.
+/// A malformed frame is rejected with a warning naming the field and counted; nothing escapes
+/// the DDS callback or the worker thread.
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+
+#include "tamp/dds/service_node.h"
+#include "tamp/dds/world_sync.h"
+#include "tamp/perception/perception.h"
+
+namespace tamp::perception {
+
+struct PerceptionNodeOptions {
+  PerceptionParams params;
+  world::World prior;                ///< static map + declared objects (planner view)
+  std::string world_id{"world"};     ///< WorldMeta key
+  double occupancy_period_s{1.0};    ///< >= 0; 0 publishes after every frame
+  double frame_budget_s{0.5};        ///< deadline of one frame's processing, > 0
+};
+
+/// Node options from the service's YAML (`config/services/perception.yaml`): the perception
+/// parameters plus a `node:` section (`world_id`, `occupancy_period_s`, `frame_budget_s`).
+/// The prior world is not part of this file (it comes from the scenario).
+Result<PerceptionNodeOptions> loadNodeOptions(const std::filesystem::path& file);
+Result<PerceptionNodeOptions> parseNodeOptions(const std::string& yaml_text, const std::string& name);
+
+class PerceptionNode : public dds::ServiceNode {
+ public:
+  /// Throws std::runtime_error when DDS fails, std::invalid_argument for invalid options.
+  PerceptionNode(const dds::ServiceArgs& args, PerceptionNodeOptions options);
+  ~PerceptionNode() override;
+
+  static Result<std::unique_ptr<dds::ServiceNode>> create(const dds::ServiceArgs& args);
+
+  std::uint64_t framesProcessed() const { return processed_.load(); }
+  std::uint64_t framesRejected() const { return rejected_.load(); }
+  std::uint64_t framesSkipped() const { return skipped_.load(); }
+  /// A copy of the current world model (thread-safe).
+  world::World worldSnapshot() const;
+
+ protected:
+  std::pair<uint64_t, uint64_t> requestCounters() const override;
+
+ private:
+  void onCloud(const msg::PointCloudFrame& m);
+  void work(std::stop_token stop);
+  void process(const PointCloudFrame& frame);
+
+  PerceptionNodeOptions options_;
+  std::unique_ptr<Perception> perception_;  // worker thread only (world copies under mutex_)
+  dds::WorldPublisher world_pub_;
+  dds::Writer<msg::WorldEvent> events_;
+  dds::Writer<msg::OccupancyMap> occupancy_;
+  mutable std::mutex mutex_;
+  std::condition_variable_any cv_;
+  std::optional<PointCloudFrame> pending_;
+  world::World snapshot_;
+  std::atomic<std::uint64_t> processed_{0}, rejected_{0}, skipped_{0};
+  std::uint64_t event_seq_{0}, map_seq_{0};
+  std::optional<Clock::time_point> last_map_;
+  std::jthread worker_;
+  std::unique_ptr<dds::Reader<msg::PointCloudFrame>> clouds_;  // last: callbacks need the rest
+};
+
+}  // namespace tamp::perception

@@ -1,0 +1,337 @@
+// Perception on frames rendered by the simulator's depth camera: detection and pose accuracy,
+// noise on an empty floor, a hidden object coming into view, moved and gone objects, unknown
+// obstacles in the occupancy map. Perception only sees the frames and the prior world; the
+// ground truth is used for the assertions.
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <numbers>
+
+#include <gtest/gtest.h>
+
+#include "tamp/collision/scene.h"
+#include "tamp/perception/perception.h"
+#include "test_scenes.h"
+
+namespace tamp::perception {
+namespace {
+
+using testing::box;
+using testing::cylinder;
+constexpr double kPi = std::numbers::pi;
+constexpr int64_t kSecond = 1'000'000'000;
+
+world::World tableWorld() {
+  world::World w("test");
+  EXPECT_TRUE(w.addRegion(testing::floorRegion()).ok());
+  EXPECT_TRUE(w.addRegion(world::Region{"table_top", "table", world::RegionKind::kTable,
+                                        {{1.9, 0.6}, {3.1, 0.6}, {3.1, 1.4}, {1.9, 1.4}}, 0.75})
+                  .ok());
+  EXPECT_TRUE(w.addObject(box("table", 1.2, 0.8, 0.75, 2.5, 1.0, 0.0, 0.0, world::ObjectKind::kStatic)).ok());
+  return w;
+}
+
+PerceptionParams paramsWithClasses() {
+  PerceptionParams p;
+  p.classes.push_back({"crate", world::Shape::box(0.4, 0.4, 0.3), world::ObjectKind::kMovable, 3.0, false});
+  p.classes.push_back({"can", world::Shape::cylinder(0.04, 0.12), world::ObjectKind::kMovable, 0.3, true});
+  return p;
+}
+
+/// Runs frames and collects the events; fails the test on a rejected frame.
+struct Runner {
+  explicit Runner(Perception& p) : perception(p) {}
+  Perception& perception;
+  testing::Camera camera;
+  int64_t stamp{kSecond};
+  std::uint64_t index{0};
+  std::vector<WorldEvent> events;
+
+  FrameResult frame(const world::World& truth, const Eigen::Isometry3d& sensor) {
+    const PointCloudFrame f = testing::render(truth, sensor, camera, stamp, index++);
+    stamp += kSecond / 5;
+    auto r = perception.processFrame(f);
+    EXPECT_TRUE(r.ok()) << r.error().toString();
+    if (!r.ok()) return {};
+    if (std::getenv("TAMP_PERCEPTION_DEBUG") != nullptr) print(*r);
+    events.insert(events.end(), r->events.begin(), r->events.end());
+    return *r;
+  }
+  void print(const FrameResult& r) const {
+    std::printf("frame %llu: planes %d clusters %d detections %d matched %d tentative %d, %.1f ms\n",
+                static_cast<unsigned long long>(index - 1), r.stats.planes, r.stats.clusters, r.stats.detections,
+                r.stats.matched, r.stats.tentative, r.times.total);
+    for (const auto& pl : r.planes) {
+      std::printf("  plane %.3f (measured %.3f) inliers %d area %.2f region '%s' normal %.3f %.3f %.3f\n", pl.height,
+                  pl.measured_height, pl.inliers, pl.area, pl.region.c_str(), pl.coefficients.x(), pl.coefficients.y(),
+                  pl.coefficients.z());
+    }
+    for (const auto& d : r.detections) {
+      std::printf("  detection %s h %.3f on %.3f rect %.3f x %.3f yaw %.2f at (%.3f, %.3f) circle r %.3f rms %.4f/%.4f n %zu\n",
+                  std::string(world::toString(d.kind)).c_str(), d.height, d.support_z, d.rect.extents.x(),
+                  d.rect.extents.y(), d.rect.yaw, d.pose.translation().x(), d.pose.translation().y(), d.circle.radius,
+                  d.circle.rms, d.rect_rms, d.points.size());
+    }
+    for (const auto& e : r.events) {
+      std::printf("  event %s %s: %s\n", std::string(toString(e.type)).c_str(), e.object_id.c_str(), e.description.c_str());
+    }
+  }
+  std::vector<WorldEvent> eventsOf(EventType type, const std::string& id = "") const {
+    std::vector<WorldEvent> out;
+    for (const auto& e : events) {
+      if (e.type == type && (id.empty() || e.object_id == id)) out.push_back(e);
+    }
+    return out;
+  }
+};
+
+/// The perceived (non-prior) object nearest to `truth` in xy, or nullptr.
+const world::Object* nearest(const world::World& w, const world::World& prior, const world::Object& truth) {
+  const world::Object* best = nullptr;
+  double d_best = 1e9;
+  for (const auto& o : w.objects()) {
+    if (prior.findObject(o.id) != nullptr && o.kind == world::ObjectKind::kStatic) continue;
+    const double d = (o.pose.translation().head<2>() - truth.pose.translation().head<2>()).norm();
+    if (d < d_best) {
+      d_best = d;
+      best = &o;
+    }
+  }
+  return best;
+}
+
+TEST(SceneTest, FindsEveryObjectAboveTheSizeThresholdWithinRange) {
+  world::World truth = tableWorld();
+  ASSERT_TRUE(truth.addObject(box("crate", 0.4, 0.4, 0.3, 3.0, -0.3, 0.1)).ok());         // class crate
+  ASSERT_TRUE(truth.addObject(cylinder("can", 0.04, 0.12, 2.3, 0.9, 0.75)).ok());          // class can, on the table
+  ASSERT_TRUE(truth.addObject(box("parcel", 0.3, 0.2, 0.25, 2.0, -0.6, 0.4)).ok());       // no class
+  ASSERT_TRUE(truth.addObject(cylinder("bin", 0.15, 0.5, 1.8, 0.35)).ok());                // no class
+  ASSERT_TRUE(truth.addObject(box("pebble", 0.03, 0.03, 0.03, 1.6, -0.2, 0.0)).ok());      // below min_size
+  ASSERT_TRUE(truth.addObject(box("far_box", 0.4, 0.4, 0.4, 8.0, 0.5, 0.0)).ok());        // beyond max_range
+  const world::World prior = tableWorld();
+  Perception perception(prior, paramsWithClasses());
+  Runner run(perception);
+  FrameResult last;
+  for (int k = 0; k < 4; ++k) last = run.frame(truth, testing::mastCamera(0, 0, 0.1 * (k % 2 == 0 ? 1 : -1)));
+
+  // Support planes: the floor and the table top, matched to their regions.
+  bool floor = false, table = false;
+  for (const auto& pl : last.planes) {
+    floor = floor || pl.region == "floor";
+    table = table || pl.region == "table_top";
+  }
+  EXPECT_TRUE(floor);
+  EXPECT_TRUE(table);
+
+  const world::World& w = perception.world();
+  struct Expect {
+    std::string id;
+    std::string label;  // class label, or "" for size-classified objects
+    double xy_tol, yaw_tol;
+  };
+  const std::vector<Expect> expected = {
+      {"crate", "crate", 0.03, 0.08}, {"can", "can", 0.02, 0.0}, {"parcel", "", 0.06, 0.12}, {"bin", "", 0.04, 0.0}};
+  for (const auto& e : expected) {
+    const world::Object& t = truth.object(e.id);
+    ASSERT_GT(testing::visiblePixels(truth, testing::mastCamera(0, 0, 0.1), run.camera, e.id), 30) << e.id;
+    const world::Object* o = nearest(w, prior, t);
+    ASSERT_NE(o, nullptr) << e.id;
+    const PoseError err = poseError(t.shape, t.pose, o->pose);
+    EXPECT_LT(err.xy, e.xy_tol) << e.id << " found as " << o->id;
+    EXPECT_LT(err.z, 0.03) << e.id;
+    if (e.yaw_tol > 0) {
+      EXPECT_LT(yawError(t.shape, yawOf(t.pose), yawOf(o->pose)), e.yaw_tol) << e.id;
+    }
+    EXPECT_EQ(o->kind, world::ObjectKind::kMovable) << e.id;
+    if (!e.label.empty()) {
+      EXPECT_EQ(o->label, e.label);
+      EXPECT_EQ(o->shape, t.shape) << e.id << ": a class object takes the class's full shape";
+    } else {
+      EXPECT_NEAR(2 * o->shape.halfHeight(), 2 * t.shape.halfHeight(), 0.03) << e.id;
+      EXPECT_EQ(o->shape.kind, t.shape.kind) << e.id;
+    }
+  }
+  EXPECT_EQ(w.findObject("can_1") != nullptr ? w.object("can_1").region : "", "table_top");
+  // Nothing else: the pebble is below the size threshold, the far box beyond the range.
+  EXPECT_EQ(w.objectCount(), prior.objectCount() + expected.size());
+  EXPECT_EQ(run.eventsOf(EventType::kAdded).size(), expected.size());
+  EXPECT_TRUE(run.eventsOf(EventType::kGone).empty());
+}
+
+TEST(SceneTest, NoFalseObjectFromSensorNoiseOnAnEmptyFloor) {
+  for (bool with_floor_region : {true, false}) {
+    world::World truth("empty");
+    if (with_floor_region) {
+      ASSERT_TRUE(truth.addRegion(testing::floorRegion()).ok());
+    }
+    PerceptionParams params;
+    params.sensor.noise_stddev = 0.002;  // a poor sensor (twice the default noise), configured as such
+    params.sensor.noise_quadratic = 0.003;
+    Perception perception(truth, params);
+    Runner run(perception);
+    run.camera.noise = 0.002;
+    run.camera.noise_quadratic = 0.003;
+    for (int k = 0; k < 12; ++k) {
+      const double yaw = 0.5 * k, x = 0.3 * (k % 3);
+      const FrameResult r = run.frame(truth, testing::mastCamera(x, -x, yaw));
+      EXPECT_EQ(r.stats.detections, 0) << "frame " << k;
+    }
+    EXPECT_EQ(perception.world().objectCount(), 0u);
+    EXPECT_TRUE(run.events.empty());
+    ASSERT_NE(perception.occupancy(), nullptr);
+    EXPECT_EQ(perception.occupancy()->occupiedCount(), 0u) << "floor noise became unknown obstacles";
+    for (const auto& t : perception.tracks()) ADD_FAILURE() << "track " << t.id;
+  }
+}
+
+TEST(SceneTest, FlagsAHiddenObjectOnceItComesIntoView) {
+  // A wall (in the static map) hides a box the planner does not know about.
+  world::World truth("hidden");
+  ASSERT_TRUE(truth.addRegion(testing::floorRegion()).ok());
+  ASSERT_TRUE(truth.addObject(box("wall", 0.1, 2.0, 1.4, 2.5, 0.0, 0.0, 0.0, world::ObjectKind::kStatic)).ok());
+  world::Object surprise = box("surprise", 0.35, 0.25, 0.3, 3.2, 0.1, 0.5);
+  surprise.hidden = true;
+  ASSERT_TRUE(truth.addObject(surprise).ok());
+  const world::World prior = truth.plannerView();
+  ASSERT_EQ(prior.findObject("surprise"), nullptr);
+  Perception perception(prior, PerceptionParams());
+  Runner run(perception);
+  for (int k = 0; k < 3; ++k) run.frame(truth, testing::mastCamera(0, 0, 0));
+  EXPECT_TRUE(run.events.empty()) << run.events.front().description;
+  EXPECT_EQ(perception.world().objectCount(), 1u);
+
+  // The robot walks around the wall: the box comes into view.
+  const Eigen::Isometry3d side = testing::mastCamera(3.2, -1.9, kPi / 2);
+  ASSERT_GT(testing::visiblePixels(truth, side, run.camera, "surprise"), 200);
+  run.frame(truth, side);
+  run.frame(truth, side);
+  const auto added = run.eventsOf(EventType::kAdded);
+  ASSERT_EQ(added.size(), 1u);
+  EXPECT_EQ(added[0].kind, world::ObjectKind::kMovable);
+  EXPECT_LT((added[0].pose.translation().head<2>() - surprise.pose.translation().head<2>()).norm(), 0.08);
+  const world::Object& o = perception.world().object(added[0].object_id);
+  EXPECT_NEAR(2 * o.shape.halfHeight(), 0.3, 0.03);
+  EXPECT_GT(o.mass, 0.0);
+}
+
+TEST(SceneTest, TracksAMovedObjectAndReacquiresItUnderItsId) {
+  world::World truth = tableWorld();
+  world::Object crate = box("crate_1", 0.4, 0.4, 0.3, 2.2, -0.4, 0.2);
+  crate.label = "crate";
+  crate.mass = 3.0;
+  ASSERT_TRUE(truth.addObject(crate).ok());
+  Perception perception(truth, PerceptionParams());  // the crate is known: prior = truth
+  Runner run(perception);
+  const auto cam = testing::mastCamera(0, 0, 0);
+  for (int k = 0; k < 2; ++k) run.frame(truth, cam);
+  EXPECT_TRUE(run.events.empty());
+  EXPECT_LT(poseError(crate.shape, crate.pose, perception.world().object("crate_1").pose).xy, 0.02);
+  const auto info = perception.track("crate_1");
+  ASSERT_TRUE(info.has_value());
+  EXPECT_EQ(info->hits, 2);
+  EXPECT_GT(info->last_seen_ns, 0);
+
+  // Pushed by 25 cm and turned: tracked (same id), one MOVED event, no new object.
+  Eigen::Isometry3d pushed = testing::box("x", 0.4, 0.4, 0.3, 2.4, -0.25, 0.45).pose;
+  ASSERT_TRUE(truth.setObjectPose("crate_1", pushed).ok());
+  for (int k = 0; k < 3; ++k) run.frame(truth, cam);
+  ASSERT_EQ(run.eventsOf(EventType::kMoved, "crate_1").size(), 1u);
+  EXPECT_TRUE(run.eventsOf(EventType::kAdded).empty());
+  PoseError err = poseError(crate.shape, pushed, perception.world().object("crate_1").pose);
+  EXPECT_LT(err.xy, 0.02);
+  EXPECT_LT(err.yaw, 0.05);
+
+  // Carried 1.6 m away (beyond the association gate): gone from its place, reacquired there.
+  Eigen::Isometry3d carried = testing::box("x", 0.4, 0.4, 0.3, 3.0, -1.5, -0.3).pose;
+  ASSERT_TRUE(truth.setObjectPose("crate_1", carried).ok());
+  for (int k = 0; k < 3; ++k) run.frame(truth, testing::mastCamera(0, 0, -0.2));
+  EXPECT_EQ(run.eventsOf(EventType::kGone, "crate_1").size(), 1u);
+  EXPECT_EQ(run.eventsOf(EventType::kMoved, "crate_1").size(), 2u);
+  EXPECT_TRUE(run.eventsOf(EventType::kAdded).empty()) << run.eventsOf(EventType::kAdded).front().description;
+  ASSERT_NE(perception.world().findObject("crate_1"), nullptr);
+  err = poseError(crate.shape, carried, perception.world().object("crate_1").pose);
+  EXPECT_LT(err.xy, 0.03);
+  EXPECT_EQ(perception.world().objectCount(), truth.objectCount());
+}
+
+TEST(SceneTest, GoneOnlyWhenItsPlaceIsVisibleAndUnoccluded) {
+  world::World prior = tableWorld();
+  world::Object target = box("target", 0.25, 0.25, 0.25, 3.0, -0.2, 0.0);
+  ASSERT_TRUE(prior.addObject(target).ok());
+  const auto cam = testing::mastCamera(0, 0, 0);
+
+  {  // Hidden behind a large box: not detected, but not gone either.
+    world::World truth = prior;
+    ASSERT_TRUE(truth.addObject(box("blocker", 0.6, 0.8, 1.0, 2.2, -0.15, 0.0)).ok());
+    ASSERT_EQ(testing::visiblePixels(truth, cam, {}, "target"), 0);
+    Perception perception(prior, PerceptionParams());
+    Runner run(perception);
+    for (int k = 0; k < 4; ++k) run.frame(truth, cam);
+    EXPECT_TRUE(run.eventsOf(EventType::kGone).empty());
+    EXPECT_NE(perception.world().findObject("target"), nullptr);
+    // Even when it really went away behind the blocker: its place is not seen, so not gone.
+    ASSERT_TRUE(truth.removeObject("target").ok());
+    for (int k = 0; k < 4; ++k) run.frame(truth, cam);
+    EXPECT_TRUE(run.eventsOf(EventType::kGone).empty());
+    EXPECT_NE(perception.world().findObject("target"), nullptr);
+  }
+  {  // Taken away while the robot looks elsewhere: not gone (not in view).
+    world::World truth = prior;
+    ASSERT_TRUE(truth.removeObject("target").ok());
+    Perception perception(prior, PerceptionParams());
+    Runner run(perception);
+    for (int k = 0; k < 4; ++k) run.frame(truth, testing::mastCamera(0, 0, kPi));
+    EXPECT_TRUE(run.eventsOf(EventType::kGone).empty());
+    // Looking at its place: gone after gone_frames frames, and out of the world model.
+    run.frame(truth, cam);
+    EXPECT_TRUE(run.eventsOf(EventType::kGone).empty()) << "gone after a single frame";
+    run.frame(truth, cam);
+    const auto gone = run.eventsOf(EventType::kGone, "target");
+    ASSERT_EQ(gone.size(), 1u);
+    EXPECT_LT((gone[0].pose.translation() - target.pose.translation()).norm(), 1e-9);
+    EXPECT_EQ(perception.world().findObject("target"), nullptr);
+    EXPECT_EQ(perception.track("target")->state, TrackInfo::State::kGone);
+  }
+}
+
+TEST(SceneTest, UnexplainedSpaceGoesToTheOccupancyMapAndIsClearedWhenSeenFree) {
+  world::World truth = tableWorld();
+  // A thin pole (below the object size threshold) and a long low wall (above the largest
+  // object), neither in the prior.
+  ASSERT_TRUE(truth.addObject(cylinder("pole", 0.01, 0.8, 1.7, -0.3, 0.0, world::ObjectKind::kStatic)).ok());
+  ASSERT_TRUE(truth.addObject(box("long_wall", 3.0, 0.12, 0.5, 3.8, -0.5, 0.0, 0.0, world::ObjectKind::kStatic)).ok());
+  const world::World prior = tableWorld();
+  Perception perception(prior, PerceptionParams());
+  Runner run(perception);
+  const auto cam = testing::mastCamera(0, 0, 0);
+  for (int k = 0; k < 3; ++k) run.frame(truth, cam);
+  EXPECT_EQ(perception.world().objectCount(), prior.objectCount()) << "neither is an object";
+  const OccupancyMap& map = *perception.occupancy();
+  EXPECT_EQ(map.state({1.7, -0.3, 0.5}), CellState::kOccupied);
+  EXPECT_EQ(map.state({3.8, -0.5, 0.3}), CellState::kOccupied);
+  EXPECT_EQ(map.state({1.2, 0.3, 0.3}), CellState::kFree);  // seen through
+  for (const auto& v : map.occupiedVoxels()) {
+    const bool pole = (v.head<2>() - Eigen::Vector2d(1.7, -0.3)).norm() < 0.1;
+    const bool wall = std::abs(v.y() + 0.5) < 0.12 && std::abs(v.x() - 3.8) < 1.6;
+    EXPECT_TRUE(pole || wall) << "stray occupied voxel at " << v.transpose();
+  }
+
+  // The planner's collision scene reads the published map.
+  collision::Scene scene(perception.world());
+  ASSERT_TRUE(scene.setUnknownSpaceFromOctomapBinary(perception.occupancyBinary()).ok());
+  const auto probe = world::Shape::box(0.1, 0.1, 0.1);
+  const collision::Filter unknown{collision::kUnknownSpace, {}, {}};
+  EXPECT_TRUE(scene.shapeInCollision(probe, Eigen::Isometry3d(Eigen::Translation3d(1.7, -0.3, 0.5)),
+                                     unknown));
+  EXPECT_FALSE(scene.shapeInCollision(probe, Eigen::Isometry3d(Eigen::Translation3d(1.2, 0.5, 0.5)),
+                                      unknown));
+
+  // The pole is removed: its voxels are cleared by the rays that now pass through.
+  ASSERT_TRUE(truth.removeObject("pole").ok());
+  for (int k = 0; k < 4; ++k) run.frame(truth, cam);
+  EXPECT_NE(map.state({1.7, -0.3, 0.5}), CellState::kOccupied);
+  EXPECT_EQ(map.state({3.8, -0.5, 0.3}), CellState::kOccupied);
+}
+
+}  // namespace
+}  // namespace tamp::perception

@@ -405,7 +405,15 @@ PlanReply Planner::solve(const PlanRequest& req, const Termination& caller_term)
       session = owned.get();
     }
     Query q;
-    auto init = session->problemInit();
+    // This request's initial state (a cached session was created from another request's).
+    std::vector<AtomSpec> init_specs;
+    init_specs.reserve(problem.init.size());
+    for (const auto& a : problem.init) {
+      AtomSpec spec{a.predicate, {}};
+      for (const auto& t : a.args) spec.args.push_back(t.name);
+      init_specs.push_back(std::move(spec));
+    }
+    auto init = session->atomIds(init_specs);
     if (!init) return errorReply(init.error());
     q.init = std::move(*init);
     q.goal_formula = problem.goal;

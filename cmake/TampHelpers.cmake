@@ -6,7 +6,7 @@
 #   tamp_add_executable(name SOURCES ... [DEPS ...])
 #   tamp_add_test(name SOURCES ... [DEPS ...] [LABELS ...] [TIMEOUT s])
 #       A GoogleTest binary; each TEST becomes a ctest entry (discovered before running, not at
-#       build time). Tests run with TAMP_SOURCE_DIR/TAMP_SHARED_DIR/TAMP_BIN_DIR in the environment.
+#       build time). Tests get TAMP_SOURCE_DIR/TAMP_SHARED_DIR/TAMP_BIN_DIR as compile definitions.
 #   tamp_add_benchmark(name SOURCES ... [DEPS ...])   Google Benchmark or own bench tool; not a test.
 #   tamp_add_fuzzer(name SOURCES ... [DEPS ...])      libFuzzer target, only with TAMP_FUZZ (clang).
 
@@ -23,19 +23,16 @@ function(tamp_add_executable name)
   cmake_parse_arguments(E "" "" "SOURCES;DEPS" ${ARGN})
   add_executable(${name} ${E_SOURCES})
   target_link_libraries(${name} PRIVATE ${E_DEPS} tamp_warnings)
+  tamp_sanitizer_options(${name})
 endfunction()
 
-set(TAMP_TEST_ENV
-  "TAMP_SOURCE_DIR=${CMAKE_SOURCE_DIR}"
-  "TAMP_SHARED_DIR=${TAMP_SHARED_DIR}"
-  "TAMP_BIN_DIR=${CMAKE_BINARY_DIR}/bin"
-  "SKIP_DEFAULT_XML_FILE=1")
-if(TAMP_SANITIZE)
-  # Fast DDS 2.9 itself deletes its StatisticsReaderImpl through a base pointer of another size
-  # (RTPSReader::~RTPSReader, inside libfastrtps): ASan's new-delete-type-mismatch check fires in
-  # Debian's library, not in our code. Everything else stays on.
-  list(APPEND TAMP_TEST_ENV "ASAN_OPTIONS=new_delete_type_mismatch=0")
-endif()
+# Sanitizer builds link this into every executable (see the file for why).
+set(TAMP_ASAN_OPTIONS_SOURCE ${CMAKE_CURRENT_LIST_DIR}/asan_default_options.cc)
+function(tamp_sanitizer_options target)
+  if(TAMP_SANITIZE)
+    target_sources(${target} PRIVATE ${TAMP_ASAN_OPTIONS_SOURCE})
+  endif()
+endfunction()
 
 function(tamp_add_test name)
   if(NOT TAMP_BUILD_TESTS)
@@ -50,9 +47,12 @@ function(tamp_add_test name)
   target_compile_definitions(${name} PRIVATE
     TAMP_SOURCE_DIR="${CMAKE_SOURCE_DIR}" TAMP_SHARED_DIR="${TAMP_SHARED_DIR}"
     TAMP_BIN_DIR="${CMAKE_BINARY_DIR}/bin")
+  tamp_sanitizer_options(${name})
+  # Paths reach tests as compile definitions (above): gtest_discover_tests splits a multi-variable
+  # ENVIRONMENT property into separate arguments, so only one variable is set here.
   gtest_discover_tests(${name}
     DISCOVERY_MODE PRE_TEST
-    PROPERTIES ENVIRONMENT "${TAMP_TEST_ENV}" TIMEOUT ${T_TIMEOUT} LABELS "${T_LABELS}")
+    PROPERTIES ENVIRONMENT "SKIP_DEFAULT_XML_FILE=1" TIMEOUT ${T_TIMEOUT} LABELS "${T_LABELS}")
 endfunction()
 
 function(tamp_add_benchmark name)

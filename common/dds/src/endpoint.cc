@@ -115,8 +115,15 @@ bool WriterBase::waitForReaders(const Termination& until, int count) const {
 class ReaderBase::Listener : public fdds::DataReaderListener {
  public:
   explicit Listener(ReaderBase* owner) : owner_(owner) {}
-  // Runs on a Fast DDS thread that holds the reader's lock: only raise the flag.
+  // Runs on a Fast DDS thread that holds the reader's lock: raise the flag for the dispatch
+  // thread, or (inline mode) run the short callback right here.
   void on_data_available(fdds::DataReader*) override {
+    if (owner_->inline_) {
+      ++owner_->in_flight_;
+      if (owner_->active_) owner_->deliverNow();
+      --owner_->in_flight_;
+      return;
+    }
     {
       std::lock_guard lock(owner_->signal_mutex_);
       owner_->pending_ = true;
@@ -150,6 +157,19 @@ ReaderBase::ReaderBase(std::shared_ptr<Participant> p, const std::string& topic,
     throw std::runtime_error("cannot create a DDS reader on '" + topic + "' with profile '" + profile + "'");
   }
   listener_ = std::make_unique<Listener>(this);
+  inline_ = options.inline_callbacks;
+}
+
+void ReaderBase::deliverNow() {
+  try {
+    onDataAvailable();
+  } catch (const std::exception& e) {
+    countCallbackError();
+    log::get("dds")->error("reader callback on '{}' threw: {}", topic_name_, e.what());
+  } catch (...) {
+    countCallbackError();
+    log::get("dds")->error("reader callback on '{}' threw an unknown exception", topic_name_);
+  }
 }
 
 ReaderBase::~ReaderBase() {
@@ -165,6 +185,16 @@ ReaderBase::~ReaderBase() {
 }
 
 void ReaderBase::startListening() {
+  if (inline_) {
+    active_ = true;
+    ReturnCode_t r = reader_->set_listener(listener_.get(), fdds::StatusMask::data_available());
+    if (r != ReturnCode_t::RETCODE_OK) {
+      active_ = false;
+      throw std::runtime_error("cannot attach a listener on '" + topic_name_ + "': " + rcName(r));
+    }
+    deliverNow();  // what arrived before the listener; no lock of ours is held here
+    return;
+  }
   {
     std::lock_guard lock(signal_mutex_);
     pending_ = true;  // deliver what arrived before the listener (transient-local history)
@@ -178,15 +208,7 @@ void ReaderBase::startListening() {
         if (stop_) return;
         pending_ = false;
       }
-      try {
-        onDataAvailable();
-      } catch (const std::exception& e) {
-        countCallbackError();
-        log::get("dds")->error("reader callback on '{}' threw: {}", topic_name_, e.what());
-      } catch (...) {
-        countCallbackError();
-        log::get("dds")->error("reader callback on '{}' threw an unknown exception", topic_name_);
-      }
+      deliverNow();
     }
   });
   ReturnCode_t r = reader_->set_listener(listener_.get(), fdds::StatusMask::data_available());
@@ -197,7 +219,10 @@ void ReaderBase::startListening() {
 }
 
 void ReaderBase::stopListening() {
+  active_ = false;
   if (reader_ != nullptr) (void)reader_->set_listener(nullptr);
+  // Inline mode: wait for a callback still running on a Fast DDS thread.
+  while (in_flight_.load() > 0) std::this_thread::yield();
   {
     std::lock_guard lock(signal_mutex_);
     stop_ = true;

@@ -68,6 +68,11 @@ struct ReaderOptions {
   /// possible; empty: no filter.
   std::string filter;
   std::vector<std::string> filter_parameters;
+  /// Run the callback directly on Fast DDS's receive thread instead of the reader's dispatch
+  /// thread (saves a thread hop, ~50 us on a loaded 2-core VM). Only for callbacks that are short,
+  /// thread-safe (they may run on two threads at once) and never wait on anything that calls into
+  /// Fast DDS; the RPC layer uses it to route replies and queue requests.
+  bool inline_callbacks{false};
 };
 
 class WriterBase {
@@ -144,6 +149,8 @@ class ReaderBase {
   /// Called on the listener thread when data is available (derived: loop over takeNextRaw).
   virtual void onDataAvailable() = 0;
   void countCallbackError() { ++callback_errors_; }
+  /// Runs onDataAvailable(), containing and counting exceptions.
+  void deliverNow();
 
  private:
   std::shared_ptr<Participant> participant_;
@@ -156,6 +163,9 @@ class ReaderBase {
   bool pending_{false};
   bool stop_{false};
   std::thread dispatcher_;
+  bool inline_{false};
+  std::atomic<bool> active_{false};   // inline mode: callbacks allowed
+  std::atomic<int> in_flight_{0};     // inline mode: callbacks running now
   std::atomic<uint64_t> callback_errors_{0};
 };
 
@@ -191,13 +201,18 @@ class Reader : public ReaderBase {
     SampleMeta meta;
     while (takeNextRaw(&sample, meta)) {
       // A not-alive sample carries no data; report it with the instance's last known sample.
-      if (meta.alive) {
-        if (keyed_) last_[meta.instance] = sample;
-      } else {
-        auto it = last_.find(meta.instance);
-        if (it == last_.end()) continue;
-        sample = std::move(it->second);
-        last_.erase(it);
+      if (keyed_) {
+        std::lock_guard lock(last_mutex_);
+        if (meta.alive) {
+          last_[meta.instance] = sample;
+        } else {
+          auto it = last_.find(meta.instance);
+          if (it == last_.end()) continue;
+          sample = std::move(it->second);
+          last_.erase(it);
+        }
+      } else if (!meta.alive) {
+        continue;
       }
       try {
         cb_(sample, meta);
@@ -211,7 +226,8 @@ class Reader : public ReaderBase {
  private:
   Callback cb_;
   bool keyed_;
-  std::map<std::array<uint8_t, 16>, T> last_;  // listener thread only
+  std::mutex last_mutex_;
+  std::map<std::array<uint8_t, 16>, T> last_;
 };
 
 }  // namespace tamp::dds

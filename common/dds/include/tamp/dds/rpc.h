@@ -75,7 +75,8 @@ class RpcClient {
         client_id_(detail::newClientId()),
         writer_(p, TopicSpec<Req>{request_topic_.assign(service + "/request").c_str(), QosClass::kRpc}),
         reader_(p, TopicSpec<Rep>{reply_topic_.assign(service + "/reply").c_str(), QosClass::kRpc},
-                [this](const Rep& rep, const SampleMeta& meta) { onReply(rep, meta); }) {}
+                [this](const Rep& rep, const SampleMeta& meta) { onReply(rep, meta); },
+                ReaderOptions{"", "", {}, /*inline_callbacks=*/true}) {}
   RpcClient(std::shared_ptr<Participant> p, const ServiceSpec<Req, Rep>& spec, const RpcClientOptions& options = {})
       : RpcClient(std::move(p), spec.name, options, spec.max_request_bytes) {}
 
@@ -217,7 +218,8 @@ class RpcServer {
     for (int i = 0; i < options.threads; ++i) workers_.emplace_back([this](std::stop_token st) { work(st); });
     reader_ = std::make_unique<Reader<Req>>(
         p, TopicSpec<Req>{request_topic_.assign(service + "/request").c_str(), QosClass::kRpc},
-        [this](const Req& req, const SampleMeta& meta) { onRequest(req, meta); });
+        [this](const Req& req, const SampleMeta& meta) { onRequest(req, meta); },
+        ReaderOptions{"", "", {}, /*inline_callbacks=*/true});
   }
   RpcServer(std::shared_ptr<Participant> p, const ServiceSpec<Req, Rep>& spec, Handler handler,
             const RpcServerOptions& options = {})

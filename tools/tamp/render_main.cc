@@ -125,7 +125,9 @@ int main(int argc, char** argv) {
       d.paths.push_back(std::move(p));
     }
   }
-  if (tamp::Status s = tamp::render::render(d, output, opt); !s) {
+  const tamp::Status s = tamp::render::render(d, output, opt);
+  tamp::render::releaseFontCaches();
+  if (!s) {
     std::cerr << s.error().toString() << "\n";
     return tamp::cli::kExitInputError;
   }

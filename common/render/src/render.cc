@@ -8,6 +8,7 @@
 
 #include <cairo-svg.h>
 #include <cairo.h>
+#include <fontconfig/fontconfig.h>
 
 namespace tamp::render {
 
@@ -39,6 +40,11 @@ std::optional<std::string> RenderOptions::invalidReason() const {
   if (max_pixels < 16 || max_pixels > 20000) return "max_pixels must be in [16, 20000]";
   if (!(margin_m >= 0) || !std::isfinite(margin_m)) return "margin_m must be >= 0";
   return std::nullopt;
+}
+
+void releaseFontCaches() {
+  cairo_debug_reset_static_data();
+  FcFini();
 }
 
 world::Polygon2 objectOutline(const world::Object& o) {

@@ -86,6 +86,10 @@ Status renderSvg(const Drawing& drawing, const std::filesystem::path& file,
 Status render(const Drawing& drawing, const std::filesystem::path& file,
               const RenderOptions& options = {});
 
+/// Releases Cairo's and fontconfig's process-wide font caches. Call once at the end of a process
+/// that rendered (so leak checkers report only real leaks); no rendering may follow.
+void releaseFontCaches();
+
 /// The outline an object is drawn with (world xy): its upright footprint, or its bounding box.
 world::Polygon2 objectOutline(const world::Object& object);
 

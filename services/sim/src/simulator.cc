@@ -415,7 +415,10 @@ struct Simulator::Impl {
   void resweep(double rel) {
     if (!active) return;
     Active& a = *active;
-    if (a.outcome != Outcome::kSucceeded) return;  // already stopping
+    // A failed or cancelled action has stopped already; a blocked one is re-planned: the world
+    // change may block it earlier, or remove what blocked it.
+    if (a.outcome != Outcome::kSucceeded && a.outcome != Outcome::kBlocked) return;
+    a.outcome = Outcome::kSucceeded;
     a.end = a.total;
     a.blocking.clear();
     if (auto stop = sweep(a, rel)) {

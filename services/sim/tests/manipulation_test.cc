@@ -165,7 +165,7 @@ TEST(ManipulationTest, PickFailsWhenTheObjectIsNotWhereTheCommandSays) {
   for (int j = 0; j < 6; ++j) EXPECT_NEAR(sim.robotState().state.arm[j], ps.pregrasp[j], 1e-9);
 }
 
-TEST(ManipulationTest, PickFailsForAnObjectOutOfTheGripperOrTooHeavy) {
+TEST(ManipulationTest, PickFailsForAnObjectOutOfTheGripperNotGraspableOrTooHeavy) {
   {
     // The gripper closes 10 cm beside the can.
     Simulator sim(kitchen(), robotModel(), upright(), exactParams());
@@ -178,6 +178,22 @@ TEST(ManipulationTest, PickFailsForAnObjectOutOfTheGripperOrTooHeavy) {
     const StepEvents e = runToEnd(sim);
     EXPECT_EQ(e.results.at(0).outcome, Outcome::kFailed);
     EXPECT_NE(e.results[0].reason.find("m away from 'can'"), std::string::npos) << e.results[0].reason;
+    EXPECT_FALSE(sim.world().held());
+  }
+  {
+    world::World w = kitchen();
+    world::Object can = w.object("can");
+    can.graspable = false;  // e.g. glued down, or too slippery
+    ASSERT_TRUE(w.updateObject(can));
+    Simulator sim(w, robotModel(), upright(), exactParams());
+    const PickSetup ps = pickSetup(can.pose.translation());
+    moveArmTo(sim, ps.pregrasp, "to_pregrasp");
+    ActionCommand pick = armCommand("pick", ActionKind::kPick, {ps.pregrasp, ps.grasp, ps.pregrasp});
+    pick.object_id = "can";
+    ASSERT_TRUE(sim.submit(pick));
+    const StepEvents e = runToEnd(sim);
+    EXPECT_EQ(e.results.at(0).outcome, Outcome::kFailed);
+    EXPECT_NE(e.results[0].reason.find("'can' is not graspable"), std::string::npos) << e.results[0].reason;
     EXPECT_FALSE(sim.world().held());
   }
   {

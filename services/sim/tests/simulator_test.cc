@@ -242,6 +242,46 @@ TEST(SimulatorTest, ScriptedFaultsFireAtTheirTimeAndStep) {
   EXPECT_FALSE(sim.robotState().moving);
 }
 
+TEST(SimulatorTest, WorldChangesDuringAnActionReplanTheStop) {
+  world::World w = emptyRoom();
+  ASSERT_TRUE(w.addObject(box("far_crate", 0.4, 0.4, 0.4, at(5.0, 0.0, 0.2), false, true)));
+  Simulator sim(w, robotModel(), upright(), exactParams());
+  ASSERT_TRUE(sim.submit(moveBase("go", {{0, 0, 0}, {8, 0, 0}})));
+  // Blocked by the far crate (at x = 5 - 0.2 - 0.3 = 4.5); a box appears nearer on the way.
+  (void)sim.step(1.0);
+  Fault spawn;
+  spawn.id = "near";
+  spawn.type = FaultType::kSpawnObject;
+  spawn.object = box("near_box", 0.4, 0.4, 0.4, at(2.5, 0.0, 0.2));
+  ASSERT_TRUE(sim.inject(spawn));
+  StepEvents e = runToEnd(sim);
+  ASSERT_EQ(e.results.size(), 1u);
+  EXPECT_EQ(e.results[0].blocking_object_id, "near_box");
+  EXPECT_NEAR(sim.robotState().state.base.x, 2.0, 0.011);
+  // Removing what blocks a running action lets it go on to the next obstacle.
+  ASSERT_TRUE(sim.submit(moveBase("turn", {{2.0, 0, 0}, {2.0, 0, M_PI / 2}})));
+  ASSERT_EQ(runToEnd(sim).results.at(0).outcome, Outcome::kBlocked) << "the base corners hit the box";
+  Fault remove;
+  remove.id = "gone";
+  remove.type = FaultType::kRemoveObject;
+  remove.object_id = "near_box";
+  ASSERT_TRUE(sim.inject(remove));
+  (void)sim.step(0.0);
+  const double x = sim.robotState().state.base.x;
+  const double theta = sim.robotState().state.base.theta;
+  ASSERT_TRUE(sim.submit(moveBase("on", {{x, 0, theta}, {x, 0, 0}, {8, 0, 0}})));
+  Fault remove_far;
+  remove_far.id = "gone_far";
+  remove_far.type = FaultType::kRemoveObject;
+  remove_far.object_id = "far_crate";
+  (void)sim.step(2.0);
+  ASSERT_TRUE(sim.inject(remove_far));
+  e = runToEnd(sim);
+  ASSERT_EQ(e.results.size(), 1u);
+  EXPECT_EQ(e.results[0].outcome, Outcome::kSucceeded) << e.results[0].reason;
+  EXPECT_NEAR(sim.robotState().state.base.x, 8.0, 1e-9);
+}
+
 TEST(SimulatorTest, InjectedFaultsFireAtTheNextStep) {
   Simulator sim(emptyRoom(), robotModel(), upright(), exactParams());
   // A spawned object, a removal, and a failure of the next action.

@@ -77,7 +77,6 @@ void OccupancyMap::integrate(const Eigen::Vector3d& origin, const std::vector<Ei
 
 std::size_t OccupancyMap::clearSeenThrough(const RangeImage& image, double margin) {
   octomap::OcTree& tree = impl_->tree;
-  const Eigen::Vector3d origin = image.worldTSensor().translation();
   std::size_t updated = 0;
   for (auto it = impl_->hits.begin(); it != impl_->hits.end();) {
     const octomap::OcTreeNode* n = tree.search(*it);
@@ -87,8 +86,8 @@ std::size_t OccupancyMap::clearSeenThrough(const RangeImage& image, double margi
     }
     const octomap::point3d c = tree.keyToCoord(*it);
     const Eigen::Vector3d centre(c.x(), c.y(), c.z());
-    const double measured = image.nearestRange(centre);
-    if (measured > 0 && measured > (centre - origin).norm() + margin) {
+    const Eigen::Vector3d half = Eigen::Vector3d::Constant(0.5 * tree.getResolution());
+    if (image.seenThrough(centre - half, centre + half, margin)) {
       tree.updateNode(*it, false, true);
       ++updated;
     }

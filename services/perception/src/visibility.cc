@@ -63,6 +63,33 @@ double RangeImage::nearestRange(const Eigen::Vector3d& p) const {
   return std::isfinite(r) ? double(r) : -1.0;
 }
 
+bool RangeImage::seenThrough(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double margin) const {
+  if (cols_ == 0) return false;
+  const Eigen::Vector3d origin = world_T_sensor_.translation();
+  double umin = kMaxTan, umax = -kMaxTan, vmin = kMaxTan, vmax = -kMaxTan, far = 0.0;
+  for (int c = 0; c < 8; ++c) {
+    const Eigen::Vector3d corner((c & 1) ? hi.x() : lo.x(), (c & 2) ? hi.y() : lo.y(), (c & 4) ? hi.z() : lo.z());
+    const Eigen::Vector3d q = sensor_T_world_ * corner;
+    if (!(q.z() > 1e-6)) return false;
+    umin = std::min(umin, q.x() / q.z());
+    umax = std::max(umax, q.x() / q.z());
+    vmin = std::min(vmin, q.y() / q.z());
+    vmax = std::max(vmax, q.y() / q.z());
+    far = std::max(far, (corner - origin).norm());
+  }
+  const double c0 = std::floor((umin - u0_) / bin_), c1 = std::floor((umax - u0_) / bin_);
+  const double r0 = std::floor((vmin - v0_) / bin_), r1 = std::floor((vmax - v0_) / bin_);
+  if (c0 < 0 || r0 < 0 || c1 >= double(cols_) || r1 >= double(rows_)) return false;
+  const float limit = static_cast<float>(far + margin);
+  for (long r = static_cast<long>(r0); r <= static_cast<long>(r1); ++r) {
+    for (long c = static_cast<long>(c0); c <= static_cast<long>(c1); ++c) {
+      const float nearest = nearest_[static_cast<std::size_t>(r * cols_ + c)];
+      if (!std::isfinite(nearest) || nearest <= limit) return false;
+    }
+  }
+  return true;
+}
+
 std::size_t RangeImage::binsWithReturns() const {
   return static_cast<std::size_t>(std::count_if(nearest_.begin(), nearest_.end(), [](float r) { return std::isfinite(r); }));
 }

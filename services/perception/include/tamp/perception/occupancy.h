@@ -36,8 +36,8 @@ class OccupancyMap {
   /// World frame, metres.
   void integrate(const Eigen::Vector3d& origin, const std::vector<Eigen::Vector3f>& scan,
                  const std::vector<Eigen::Vector3f>& occupied);
-  /// Complements the (sparse) rays: every occupied voxel whose centre is seen through in
-  /// `image` (the nearest return in its direction lies beyond it + `margin`) gets a miss.
+  /// Complements the (sparse) rays: every occupied voxel seen through as a whole in `image`
+  /// (`RangeImage::seenThrough`: every ray across it went on beyond it + `margin`) gets a miss.
   /// Cost: O(voxels that received hits). Returns how many voxels were updated.
   std::size_t clearSeenThrough(const RangeImage& image, double margin);
   /// Marks occupied voxels inside `object` grown by `explained_margin` free (known object, not

@@ -40,6 +40,10 @@ class RangeImage {
 
   /// Nearest range (m) of the returns in the direction of world point `p`; < 0 when none.
   double nearestRange(const Eigen::Vector3d& p) const;
+  /// True when every bin the box `[lo, hi]` (world frame) projects onto has a return, all
+  /// farther than the box's farthest corner + `margin`: every ray through the box passed it.
+  /// False when a bin is empty or out of the image, or the box reaches behind the sensor.
+  bool seenThrough(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double margin) const;
   /// Tests the volume of `object` (samples `n` per axis, ignoring a band of `bottom_band` m at
   /// its bottom where the supporting surface lies) with a range margin of `margin` m.
   ObjectVisibility checkObject(const world::Object& object, double margin, int n = 5,

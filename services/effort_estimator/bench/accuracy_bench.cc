@@ -11,7 +11,8 @@
 // per-waypoint base pauses, a quadratic mass effect on the gripper; see synthetic.h): the error
 // floor is then the model's bias, not the noise.
 //
-//   tamp_effort_estimator_accuracy [--seeds N] [--noise S] [--outliers F] [--mismatch] [--out FILE]
+//   tamp_effort_estimator_accuracy [--seeds N] [--noise S] [--outliers F] [--mismatch]
+//                                  [--loss none|huber|cauchy|tukey] [--loss-scale K] [--out FILE]
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -57,6 +58,9 @@ int main(int argc, char** argv) {
   double outliers = 0.05;
   std::string out_file;
   bool mismatch = false;
+  const ee::EstimatorParams defaults;
+  ee::LossKind loss = defaults.fit.loss;
+  double loss_scale = defaults.fit.loss_scale;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string {
@@ -72,16 +76,26 @@ int main(int argc, char** argv) {
       noise = std::atof(next().c_str());
     } else if (a == "--outliers") {
       outliers = std::atof(next().c_str());
+    } else if (a == "--loss") {
+      const auto l = ee::lossKindFromString(next());
+      if (!l) {
+        std::cerr << "unknown loss\n";
+        return 30;
+      }
+      loss = *l;
+    } else if (a == "--loss-scale") {
+      loss_scale = std::atof(next().c_str());
     } else if (a == "--mismatch") {
       mismatch = true;
     } else if (a == "--out") {
       out_file = next();
     } else {
-      std::cerr << "usage: " << argv[0] << " [--seeds N] [--noise S] [--outliers F] [--mismatch] [--out FILE]\n";
+      std::cerr << "usage: " << argv[0]
+                << " [--seeds N] [--noise S] [--outliers F] [--mismatch] [--loss L] [--loss-scale K] [--out FILE]\n";
       return a == "--help" ? 0 : 30;
     }
   }
-  if (seeds < 1 || !(noise >= 0) || !(outliers >= 0 && outliers < 1)) {
+  if (seeds < 1 || !(noise >= 0) || !(outliers >= 0 && outliers < 1) || !(loss_scale > 0)) {
     std::cerr << "bad arguments\n";
     return 30;
   }
@@ -99,7 +113,7 @@ int main(int argc, char** argv) {
                     "+0.1 s/kg^2 gripper time); 'true time' is the mismatched robot's "
                     "noise-free time."
                   : " The simulator follows the model with other parameters.")
-     << "\n\n";
+     << " Fit: loss " << ee::toString(loss) << ", scale " << loss_scale << " noise stddevs.\n\n";
   md << "| kind | records | MAPE vs measured | MAPE vs true time | mean stddev / mean | 95 % interval coverage | refit time |\n";
   md << "|---|---|---|---|---|---|---|\n";
 
@@ -125,6 +139,8 @@ int main(int argc, char** argv) {
                                                    {.log_stddev = noise, .outlier_fraction = outliers, .mismatch = mismatch});
       ee::EstimatorParams params;
       params.store_directory = "";  // memory only
+      params.fit.loss = loss;
+      params.fit.loss_scale = loss_scale;
       // Deployed on the mismatched robot, the estimator knows its URDF speed limits per joint.
       if (mismatch) params.features = ee::synthetic::urdfJointScales();
       ee::EffortEstimator est(params, /*start_worker=*/false);

@@ -230,7 +230,14 @@ RefitReport EffortEstimator::refitKind(std::size_t k, const Termination& termina
   RefitReport report{kAllActionKinds[k], Status::Ok(), current.version, records.size()};
   if (records.empty()) return report;
 
-  Result<KindModel> fitted = fitModel(current, records, params_.priors[k], params_.fit, termination);
+  // Every refit starts from the prior (values and noise), not from the previous fit: the result
+  // is then a function of the record set alone (reproducible, independent of the order and the
+  // batching of records), and a poor early fit (e.g. a stall on the only loaded record of the
+  // first five, taken for a payload effect, with an inflated noise estimate that then stops the
+  // robust loss from rejecting stalls) cannot lock later fits into its basin. Fits take ~1 ms.
+  KindModel start = priorModel(params_.priors[k], params_.fit);
+  start.version = current.version;
+  Result<KindModel> fitted = fitModel(start, records, params_.priors[k], params_.fit, termination);
   {
     std::lock_guard lk(state_->mu);
     // A cancelled fit leaves its records pending for the next run; any other outcome consumes

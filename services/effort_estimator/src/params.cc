@@ -100,7 +100,7 @@ Result<EstimatorParams> parseEstimatorParams(const std::string& yaml_text, const
     if (auto l = lossKindFromString(loss)) {
       p.fit.loss = *l;
     } else {
-      r.fail("loss", "unknown loss '" + loss + "' (expected one of: none, huber, cauchy)");
+      r.fail("loss", "unknown loss '" + loss + "' (expected one of: none, huber, cauchy, tukey)");
     }
   }
   r.optional("loss_scale", p.fit.loss_scale);

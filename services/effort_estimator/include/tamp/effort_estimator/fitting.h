@@ -11,8 +11,11 @@
 /// 60 s action). The prior keeps parameters that the records do not excite (only short moves say
 /// nothing about the cruise speed) at their defaults with their prior uncertainty, so few records
 /// give sane estimates. sigma, the noise stddev of log(duration), is estimated robustly from the
-/// residuals (1.4826 * median |r|, corrected for the effective number of parameters) and pooled
+/// residuals (from the lower quartile of |r|, which tolerates up to 75 % stalls, corrected for the
+/// effective number of parameters) and pooled
 /// with `prior_noise` worth `prior_noise_weight` records; the fit is repeated until sigma settles.
+/// With a non-convex loss (Cauchy, Tukey) the first pass uses the convex Huber loss to reach the
+/// right basin from a start that may be far off (graduated non-convexity).
 /// The covariance of theta is the inverse of the Gauss-Newton Hessian at the optimum
 /// (ceres::Covariance, robustified Jacobian), i.e. the Laplace approximation of the posterior.
 ///
@@ -34,9 +37,11 @@
 
 namespace tamp::effort_estimator {
 
-/// Robust loss on the noise-normalised log residuals.
-enum class LossKind { kNone, kHuber, kCauchy };
-/// "none", "huber", "cauchy".
+/// Robust loss on the noise-normalised log residuals: none (least squares), Huber (convex,
+/// bounded influence), Cauchy (influence decays as 1/r), Tukey (biweight: influence zero beyond
+/// loss_scale, cost capped; the most aggressive against bursts of stalls).
+enum class LossKind { kNone, kHuber, kCauchy, kTukey };
+/// "none", "huber", "cauchy", "tukey".
 std::string_view toString(LossKind loss);
 std::optional<LossKind> lossKindFromString(std::string_view name);
 
@@ -57,7 +62,7 @@ struct FitOptions {
 struct FitSummary {
   bool converged{false};       ///< Ceres reported convergence in the final pass
   int iterations{0};           ///< LM iterations over all passes
-  int passes{0};               ///< noise re-estimation passes (1-3)
+  int passes{0};               ///< solver passes (noise re-estimation, Huber then Cauchy; 1-4)
   int outliers{0};             ///< records whose |log residual| exceeds 3 sigma
   double rms_log_residual{0};  ///< RMS of log(predicted / measured) over the records
   double solve_time_s{0};      ///< wall time of the whole fit, s

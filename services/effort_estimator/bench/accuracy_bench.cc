@@ -5,7 +5,7 @@
 // factors 0.5-2.0 (synthetic::trueParameters), through the same pure model functions, with
 // multiplicative log-normal noise and occasional stalls. The estimator never sees the true
 // parameters: it gets the records one by one (addRecord) and refits at 5, 20 and 100 records
-// (refitNow, warm-started from the previous fit, exactly what the online worker does).
+// (refitNow, which like the online worker starts every refit from the prior).
 //
 // With --mismatch the simulated robot does not follow the model exactly (per-joint arm limits,
 // per-waypoint base pauses, a quadratic mass effect on the gripper; see synthetic.h): the error

@@ -1,4 +1,4 @@
-// tamp_motion_planner: the motion planning service (lazy paths with blocking objects, full paths,
+// tamp_motion_planner_service: the motion planning service (lazy paths with blocking objects, full paths,
 // placements, grasps) as a DDS process.
 #include "motion_planner_node.h"
 

@@ -1,4 +1,4 @@
-// tamp_perception: the perception service (depth frames -> world model, events, occupancy).
+// tamp_perception_service: the perception service (depth frames -> world model, events, occupancy).
 #include "perception_node.h"
 
 int main(int argc, char** argv) {

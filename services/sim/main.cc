@@ -1,4 +1,4 @@
-// tamp_sim: the simulated robot and world (issue 6) behind the robot's DDS topics.
+// tamp_sim_service: the simulated robot and world (issue 6) behind the robot's DDS topics.
 #include "sim_node.h"
 
 int main(int argc, char** argv) {

@@ -134,8 +134,15 @@ int main(int argc, char** argv) {
     spec.executable = exe;
     spec.args = {"--name", s.name, "--domain", std::to_string(*dom), "--heartbeat-period",
                  std::to_string(deployment->heartbeat_period_s)};
-    for (const auto& a : s.args) {
-      spec.args.push_back(expand(expand(a, "{scenario}", scenario), "{config}", tamp::configDir().string()));
+    for (std::size_t i = 0; i < s.args.size(); ++i) {
+      // "--option {scenario}" is left out as a pair when the run has no scenario.
+      if (scenario.empty() && i + 1 < s.args.size() && s.args[i].rfind("--", 0) == 0 &&
+          s.args[i + 1] == "{scenario}") {
+        ++i;
+        continue;
+      }
+      spec.args.push_back(
+          expand(expand(s.args[i], "{scenario}", scenario), "{config}", tamp::configDir().string()));
     }
     spec.log_file = run_dir / (s.name + ".log");
     spec.restart = keep;
@@ -203,7 +210,15 @@ int main(int argc, char** argv) {
   std::printf("\n");
   std::fflush(stdout);
   // The same table `tamp status` prints, from the heartbeats.
-  std::system((bin_dir / "tamp-status").string().append(" --wait 0.6 --domain ").append(std::to_string(*dom)).c_str());
+  // A new participant must discover every service first: listen for a few heartbeat periods.
+  const double status_wait = std::max(1.5, 3.0 * deployment->heartbeat_period_s);
+  std::system((bin_dir / "tamp-status")
+                  .string()
+                  .append(" --wait ")
+                  .append(std::to_string(status_wait))
+                  .append(" --domain ")
+                  .append(std::to_string(*dom))
+                  .c_str());
 
   if (scenario.empty()) {
     std::printf("\ntamp run: no scenario given: services only.\n");

@@ -200,6 +200,14 @@ void ReaderBase::startListening() {
     pending_ = true;  // deliver what arrived before the listener (transient-local history)
     stop_ = false;
   }
+  // The listener goes on before the dispatch thread starts: a sample arriving between the first
+  // delivery and the attachment would otherwise sit unread until the next one (found by the
+  // effort estimator's node tests). Signals before the thread runs are kept in pending_.
+  ReturnCode_t r = reader_->set_listener(listener_.get(), fdds::StatusMask::data_available());
+  if (r != ReturnCode_t::RETCODE_OK) {
+    (void)reader_->set_listener(nullptr);
+    throw std::runtime_error("cannot attach a listener on '" + topic_name_ + "': " + rcName(r));
+  }
   dispatcher_ = std::thread([this] {
     while (true) {
       {
@@ -211,11 +219,6 @@ void ReaderBase::startListening() {
       deliverNow();
     }
   });
-  ReturnCode_t r = reader_->set_listener(listener_.get(), fdds::StatusMask::data_available());
-  if (r != ReturnCode_t::RETCODE_OK) {
-    stopListening();
-    throw std::runtime_error("cannot attach a listener on '" + topic_name_ + "': " + rcName(r));
-  }
 }
 
 void ReaderBase::stopListening() {

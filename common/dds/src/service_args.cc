@@ -16,6 +16,9 @@ Result<ServiceArgs> parseServiceArgs(int argc, char** argv, const std::string& d
   app.add_option("--domain", a.domain_id, "DDS domain id (default: $TAMP_DOMAIN_ID or 0)")->check(CLI::Range(0, 232));
   app.add_option("--profile", a.profile, "DDS participant profile: tamp_default, tamp_udp, tamp_shm");
   app.add_option("--config", a.config_file, "service parameters (YAML)")->check(CLI::ExistingFile);
+  app.add_option("--scenario", a.scenario_file,
+                 "scenario YAML of the run (services that need the world, robot or priors read it)")
+      ->check(CLI::ExistingFile);
   app.add_option("--log-level", a.log_level, "trace, debug, info, warn, error, off");
   app.add_option("--heartbeat-period", a.heartbeat_period_s, "seconds between heartbeats")
       ->check(CLI::Range(0.01, 60.0));

@@ -6,6 +6,7 @@
 #include "tamp/config/yaml_reader.h"
 #include "tamp/core/log.h"
 #include "tamp/core/paths.h"
+#include "tamp/world/scenario.h"
 
 namespace tamp::perception {
 
@@ -71,6 +72,12 @@ Result<std::unique_ptr<dds::ServiceNode>> PerceptionNode::create(const dds::Serv
     auto o = loadNodeOptions(args.config_file);
     if (!o) return o.error();
     options = std::move(*o);
+  }
+  if (!args.scenario_file.empty()) {
+    // The prior: the scenario's static map and declared objects (its planner view, no hidden ones).
+    auto scenario = world::loadScenario(args.scenario_file);
+    if (!scenario) return scenario.error();
+    options.prior = scenario->plannerWorld();
   }
   try {
     return std::unique_ptr<dds::ServiceNode>(std::make_unique<PerceptionNode>(args, std::move(options)));

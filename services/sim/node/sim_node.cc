@@ -167,6 +167,7 @@ Result<std::unique_ptr<dds::ServiceNode>> SimNode::create(const dds::ServiceArgs
   }
   auto params = file.empty() ? Result<SimParams>(SimParams{}) : loadSimParams(file);
   if (!params) return params.error();
+  if (!args.scenario_file.empty()) params->scenario = std::filesystem::absolute(args.scenario_file).string();
   auto setup = loadSetup(*params);
   if (!setup) return setup.error();
   try {

@@ -33,6 +33,9 @@ struct ServiceArgs {
   int domain_id{-1};        ///< -1: $TAMP_DOMAIN_ID or 0
   std::string profile;      ///< DDS participant profile; empty: tamp_default
   std::string config_file;  ///< service parameters (YAML); empty: the service's defaults
+  /// The run's scenario (YAML); empty: none. Overrides a scenario named in the service's own
+  /// parameters (the simulator's ground truth, perception's priors, the planners' robot).
+  std::string scenario_file;
   std::string log_level{"info"};
   double heartbeat_period_s{1.0};
 };

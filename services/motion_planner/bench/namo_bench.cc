@@ -15,6 +15,8 @@
 //
 // Usage: tamp_motion_planner_namo_bench [--runs 20] [--full-runs 3] [--time-limit 5]
 //          [--filter substring] [--json out.json] [--markdown out.md] [--no-baselines]
+//          [--config params.yaml]   (MotionPlannerParams for our planner, e.g.
+//                                    config/services/motion_planner.yaml; default: built-in defaults)
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -282,6 +284,7 @@ int main(int argc, char** argv) {
   double limit = 5.0;
   std::string filter, json_out, md_out;
   bool baselines = true;
+  motion_planner::MotionPlannerParams params;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string {
@@ -298,9 +301,17 @@ int main(int argc, char** argv) {
     else if (a == "--json") json_out = next();
     else if (a == "--markdown") md_out = next();
     else if (a == "--no-baselines") baselines = false;
+    else if (a == "--config") {
+      auto p = motion_planner::loadMotionPlannerParams(next(), {"node"});
+      if (!p) {
+        std::cerr << p.error().toString() << "\n";
+        return 2;
+      }
+      params = *p;
+    }
     else {
       std::cerr << "usage: " << argv[0]
-                << " [--runs N] [--full-runs N] [--time-limit s] [--filter s] [--json f] [--markdown f] [--no-baselines]\n";
+                << " [--runs N] [--full-runs N] [--time-limit s] [--filter s] [--json f] [--markdown f] [--no-baselines] [--config f]\n";
       return 2;
     }
   }
@@ -316,7 +327,7 @@ int main(int argc, char** argv) {
   for (const auto& wc : worlds) {
     std::cerr << "world " << wc.name << " (" << wc.nw.world.objectCount() << " objects, r = " << wc.nw.robot_radius
               << " m)\n";
-    motion_planner::MotionPlanner mp(collision::RobotGeometry::disc(wc.nw.robot_radius, 1.0));
+    motion_planner::MotionPlanner mp(collision::RobotGeometry::disc(wc.nw.robot_radius, 1.0), params);
     mp.setWorld(wc.nw.world);
     motion_planner::MotionRequest req;
     req.start.base = wc.nw.start;

@@ -2,7 +2,8 @@
 // frames, and detection recall + pose error against the ground truth over scenes rendered by
 // the simulator's depth camera. Prints Markdown tables (docs/benchmarks.md, "Perception").
 //
-//   tamp_perception_bench [--frames N] [--timing-only | --accuracy-only] [--scenarios DIR]
+//   tamp_perception_bench [--frames N] [--size 50k|300k|1M] [--timing-only | --accuracy-only | --scenarios-only]
+//                         [--scenarios DIR]
 //
 // Timing: a furnished room (static walls and table in the prior, 10 objects to find), frames
 // pre-rendered (not timed) from a robot turning on the spot; 3 warm-up frames, then N timed.
@@ -10,11 +11,20 @@
 // each scene is run twice, with the object classes known (sizes from the scenario's objects) and
 // without (size thresholds only). Ground truth objects count when the camera saw >= 100 pixels
 // of them in some frame; a perceived object matches a ground-truth one within 0.15 m (Hungarian).
+// Shipped scenarios (config/scenarios/*.yaml, or DIR): the truth is the scenario's world (hidden
+// objects and objects that scripted faults make appear included); the robot's own camera (URDF
+// `camera_optical_frame`, the simulator's default sensor: 320 x 240, noise on) looks from its
+// start pose and from every named location, turning on the spot (yaw -0.55, 0, +0.55 rad),
+// 3 frames per view. The prior is the static map; the held object is not counted. Matching and
+// xy error use bounding-box centres (a NAMO prism's pose origin is not its centre).
+// Diagnostics on stderr: TAMP_BENCH_VERBOSE=1 lists false and missed objects, TAMP_BENCH_PLANES=1
+// the support planes of every accuracy frame.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <filesystem>
 #include <map>
 #include <numbers>
@@ -25,6 +35,8 @@
 #include "tamp/perception/assignment.h"
 #include "tamp/perception/perception.h"
 #include "tamp/sim/depth_sensor.h"
+#include "tamp/sim/setup.h"
+#include "tamp/world/scenario.h"
 #include "test_scenes.h"
 
 namespace tp = tamp::perception;
@@ -122,6 +134,13 @@ tw::World staticMap(const tw::World& truth) {
   return w;
 }
 
+/// CPU time of the calling thread, ms.
+double threadCpuMs() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
+}
+
 // ---- timing -----------------------------------------------------------------------------------
 
 struct SizeSpec {
@@ -129,14 +148,15 @@ struct SizeSpec {
   int width, height;
 };
 
-void runTiming(int frames) {
+void runTiming(int frames, const std::string& only) {
   const tw::World truth = room();
   const tw::World prior = staticMap(truth);
   std::printf("\n### Time per cloud (ms), room scene, %d timed frames after 3 warm-up frames\n\n", frames);
-  std::printf("| cloud | points (valid / cropped / voxels) | validate | transform+crop | voxel grid | planes | static map | clustering | fitting | association+tracking | visibility | occupancy | **total p50** | total p90 | max |\n");
-  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  std::printf("| cloud | points (valid / cropped / voxels) | validate | transform+crop | voxel grid | planes | static map | clustering | fitting | association+tracking | visibility | occupancy | **total p50** | total p90 | max | CPU p50 |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   const SizeSpec sizes[] = {{"50k", 256, 196}, {"300k", 640, 480}, {"1M", 1152, 864}};
   for (const auto& s : sizes) {
+    if (!only.empty() && only != s.name) continue;
     tamp::perception::testing::Camera cam;
     cam.width = s.width;
     cam.height = s.height;
@@ -151,13 +171,17 @@ void runTiming(int frames) {
     tp::Perception perception(prior, params);
     std::map<std::string, std::vector<double>> t;
     std::vector<double> valid, cropped, voxels;
+    std::vector<double> cpu;
     for (int k = 0; k < frames + 3; ++k) {
+      const double cpu0 = threadCpuMs();
       auto r = perception.processFrame(clouds[static_cast<std::size_t>(k)]);
+      const double cpu_ms = threadCpuMs() - cpu0;
       if (!r) {
         std::fprintf(stderr, "frame failed: %s\n", r.error().toString().c_str());
         std::exit(1);
       }
       if (k < 3) continue;
+      cpu.push_back(cpu_ms);
       const auto& T = r->times;
       t["validate"].push_back(T.validate);
       t["crop"].push_back(T.transform_crop);
@@ -179,11 +203,12 @@ void runTiming(int frames) {
     for (const char* k : {"validate", "crop", "voxel", "planes", "static", "cluster", "fit", "track", "vis", "occ"}) {
       std::printf(" %.2f |", quantile(t[k], 0.5));
     }
-    std::printf(" **%.1f** | %.1f | %.1f |\n", quantile(t["total"], 0.5), quantile(t["total"], 0.9),
-                *std::max_element(t["total"].begin(), t["total"].end()));
+    std::printf(" **%.1f** | %.1f | %.1f | %.1f |\n", quantile(t["total"], 0.5), quantile(t["total"], 0.9),
+                *std::max_element(t["total"].begin(), t["total"].end()), quantile(cpu, 0.5));
     std::fflush(stdout);
   }
-  std::printf("\nStage columns are medians. The world model after the frames: objects found are checked by the accuracy part.\n");
+  std::printf("\nStage columns are medians of wall-clock time; CPU p50 is the median thread CPU time of a frame "
+              "(insensitive to other load on the machine).\n");
 }
 
 // ---- accuracy ---------------------------------------------------------------------------------
@@ -235,6 +260,12 @@ Tally runScene(const Scene& scene, bool with_classes, int frames_per_view) {
     for (int k = 0; k < frames_per_view; ++k) {
       auto r = perception.processFrame(tamp::perception::testing::render(scene.truth, v, cam, stamp, index++));
       stamp += 200'000'000;
+      if (r && std::getenv("TAMP_BENCH_PLANES") != nullptr) {
+        for (const auto& pl : r->planes) {
+          std::fprintf(stderr, "  %s frame %llu: plane '%s' h %.3f area %.2f inliers %d\n", scene.name.c_str(),
+                       static_cast<unsigned long long>(index), pl.region.c_str(), pl.height, pl.area, pl.inliers);
+        }
+      }
       if (!r) {
         std::fprintf(stderr, "%s: %s\n", scene.name.c_str(), r.error().toString().c_str());
         std::exit(1);
@@ -273,6 +304,18 @@ Tally runScene(const Scene& scene, bool with_classes, int frames_per_view) {
     if (tp::yawSymmetry(gt[i]->shape) > 0) t.yaw.push_back(e.yaw);
   }
   t.false_pos = t.perceived - t.found;
+  if (std::getenv("TAMP_BENCH_VERBOSE") != nullptr) {
+    std::vector<char> used(found.size(), 0);
+    for (auto a : assign) {
+      if (a >= 0) used[static_cast<std::size_t>(a)] = 1;
+    }
+    for (std::size_t j = 0; j < found.size(); ++j) {
+      if (used[j]) continue;
+      const auto b = found[j]->aabb();
+      std::fprintf(stderr, "  %s: false %s (%s) box (%.2f..%.2f, %.2f..%.2f, %.2f..%.2f)\n", scene.name.c_str(), found[j]->id.c_str(),
+                   found[j]->label.c_str(), b.min.x(), b.max.x(), b.min.y(), b.max.y(), b.min.z(), b.max.z());
+    }
+  }
   std::printf("| %s | %s | %zu | %d | %d / %d | %d | %.3f / %.3f / %.3f | %.1f / %.1f | %s |\n", scene.name.c_str(),
               with_classes ? "known" : "none", scene.views.size() * static_cast<std::size_t>(frames_per_view), t.truth,
               t.found, t.truth, t.false_pos, quantile(t.xy, 0.5), quantile(t.xy, 0.9),
@@ -311,24 +354,236 @@ void runAccuracy() {
   }
 }
 
+// ---- shipped scenarios ------------------------------------------------------------------------
+
+struct ScenarioTally {
+  int truth{0}, found{0}, false_pos{0}, small{0};
+  std::vector<double> xy, z, yaw;
+};
+
+/// One scenario file: prints a table row per class mode; returns false when it has no object in
+/// view (no row).
+/// Centre of an object's bounding box in the plane (boxes and cylinders: the pose's xy).
+Eigen::Vector2d centreXY(const tw::Object& o) {
+  const auto b = o.aabb();
+  return 0.5 * (b.min + b.max).head<2>();
+}
+
+bool runScenarioFile(const std::filesystem::path& file, bool with_classes, ScenarioTally& all) {
+  auto scenario = tamp::world::loadScenario(file);
+  if (!scenario) {
+    std::fprintf(stderr, "%s: %s\n", file.string().c_str(), scenario.error().toString().c_str());
+    std::exit(1);
+  }
+  auto setup = tamp::sim::setupFromScenario(*scenario);
+  if (!setup) {
+    std::fprintf(stderr, "%s: %s\n", file.string().c_str(), setup.error().toString().c_str());
+    std::exit(1);
+  }
+  tw::World truth = setup->world;
+  int appearing = 0;
+  for (const auto& f : scenario->faults) {
+    if (f.kind == tamp::world::FaultKind::kObjectAppears && f.object && truth.findObject(f.object->id) == nullptr) {
+      tw::Object o = *f.object;
+      o.hidden = false;
+      if (truth.addObject(o)) ++appearing;
+    }
+  }
+  const std::string held = truth.held() ? truth.held()->object_id : std::string();
+  // Views: the start pose and every named location, turning on the spot.
+  std::vector<tamp::robot::RobotState> views;
+  std::vector<tamp::Pose2D> bases{setup->initial.base};
+  for (const auto& l : truth.locations()) bases.push_back(l.pose);
+  for (const auto& b : bases) {
+    for (double dyaw : {0.0, -0.55, 0.55}) {
+      tamp::robot::RobotState s = setup->initial;
+      s.base = b;
+      s.base.theta += dyaw;
+      views.push_back(s);
+    }
+  }
+  tamp::sim::DepthSensorParams sensor_params;  // the simulator's default sensor (config/services/sim.yaml)
+  std::map<std::string, int> seen;
+  {
+    tamp::sim::DepthSensorParams quiet = sensor_params;
+    quiet.noise_stddev_m = quiet.noise_quadratic = quiet.dropout_probability = 0.0;
+    tamp::sim::DepthSensor sensor(quiet);
+    for (const auto& v : views) {
+      tamp::sim::GroundTruthLabels labels;
+      (void)sensor.capture(truth, setup->robot, v, 0, &labels);
+      std::map<int, int> count;
+      for (auto l : labels.pixel) {
+        if (l >= 0) ++count[l];
+      }
+      for (const auto& [l, n] : count) {
+        const std::string& id = labels.ids[static_cast<std::size_t>(l)];
+        seen[id] = std::max(seen[id], n);
+      }
+    }
+  }
+  std::vector<const tw::Object*> gt;
+  int small = 0;
+  for (const auto& o : truth.objects()) {
+    if (o.kind != tw::ObjectKind::kMovable || o.id == held) continue;
+    if (seen[o.id] >= 100) {
+      gt.push_back(&o);
+    } else if (seen[o.id] > 0) {
+      ++small;
+    }
+  }
+  if (gt.empty()) return false;
+
+  tp::PerceptionParams params;
+  if (with_classes) params.classes = tp::classesFromWorld(truth);
+  const tw::World prior = staticMap(truth);
+  tp::Perception perception(prior, params);
+  tamp::sim::DepthSensor sensor(sensor_params);
+  int64_t stamp = 1'000'000'000;
+  constexpr int kFramesPerView = 3;
+  for (const auto& v : views) {
+    for (int k = 0; k < kFramesPerView; ++k) {
+      auto r = perception.processFrame(sensor.capture(truth, setup->robot, v, stamp));
+      stamp += 500'000'000;
+      if (!r) {
+        std::fprintf(stderr, "%s: %s\n", scenario->name.c_str(), r.error().toString().c_str());
+        std::exit(1);
+      }
+    }
+  }
+  // Candidates: the counted objects plus the held one (a detection of it is not a false object).
+  std::vector<const tw::Object*> candidates = gt;
+  if (!held.empty() && truth.findObject(held) != nullptr) candidates.push_back(truth.findObject(held));
+  std::vector<const tw::Object*> found;
+  for (const auto& o : perception.world().objects()) {
+    if (prior.findObject(o.id) == nullptr) found.push_back(&o);
+  }
+  std::vector<std::vector<double>> cost(candidates.size(), std::vector<double>(found.size(), INFINITY));
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    for (std::size_t j = 0; j < found.size(); ++j) {
+      const double d = (centreXY(*candidates[i]) - centreXY(*found[j])).norm();
+      if (d <= 0.15) cost[i][j] = d;
+    }
+  }
+  const auto assign = tp::solveAssignment(cost);
+  ScenarioTally t;
+  t.truth = static_cast<int>(gt.size());
+  t.small = small;
+  int matched = 0;
+  std::string missed;
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    if (assign[i] >= 0) ++matched;
+    if (i >= gt.size()) continue;  // the held object
+    if (assign[i] < 0) {
+      missed += " " + gt[i]->id;
+      continue;
+    }
+    ++t.found;
+    const tw::Object& f = *found[static_cast<std::size_t>(assign[i])];
+    const tp::PoseError e = tp::poseError(gt[i]->shape, gt[i]->pose, f.pose);
+    t.xy.push_back((centreXY(*gt[i]) - centreXY(f)).norm());  // prisms: pose origin != centre
+    t.z.push_back(e.z);
+    if (tp::yawSymmetry(gt[i]->shape) > 0 && tp::yawSymmetry(gt[i]->shape) < 2 * kPi - 1e-9) t.yaw.push_back(e.yaw);
+  }
+  t.false_pos = static_cast<int>(found.size()) - matched;
+  if (std::getenv("TAMP_BENCH_VERBOSE") != nullptr) {  // what the false objects are
+    std::vector<char> used(found.size(), 0);
+    for (auto a : assign) {
+      if (a >= 0) used[static_cast<std::size_t>(a)] = 1;
+    }
+    for (std::size_t j = 0; j < found.size(); ++j) {
+      if (used[j]) continue;
+      const auto b = found[j]->aabb();
+      std::fprintf(stderr, "  %s: false %s (%s) at (%.2f, %.2f) box (%.2f..%.2f, %.2f..%.2f, %.2f..%.2f)\n", scenario->name.c_str(),
+                   found[j]->id.c_str(), found[j]->label.c_str(), found[j]->pose.translation().x(), found[j]->pose.translation().y(),
+                   b.min.x(), b.max.x(), b.min.y(), b.max.y(), b.min.z(), b.max.z());
+    }
+    for (std::size_t i = 0; i < gt.size(); ++i) {
+      if (assign[i] < 0) {
+        std::fprintf(stderr, "  %s: missed %s at (%.2f, %.2f), %d px\n", scenario->name.c_str(), gt[i]->id.c_str(),
+                     gt[i]->pose.translation().x(), gt[i]->pose.translation().y(), seen[gt[i]->id]);
+      }
+    }
+  }
+  std::string hidden;
+  for (const auto* o : gt) {
+    if (o->hidden) hidden += " " + o->id;
+  }
+  std::printf("| %s | %s | %zu | %d%s | %d / %d | %d | %.3f / %.3f | %.3f | %.1f / %.1f | %s |\n", scenario->name.c_str(),
+              with_classes ? "known" : "none", views.size() * kFramesPerView, t.truth,
+              (hidden.empty() && appearing == 0) ? "" : " (incl. hidden/appearing)", t.found, t.truth, t.false_pos,
+              quantile(t.xy, 0.5), t.xy.empty() ? 0.0 : *std::max_element(t.xy.begin(), t.xy.end()),
+              t.z.empty() ? 0.0 : *std::max_element(t.z.begin(), t.z.end()), quantile(t.yaw, 0.5) * 180 / kPi,
+              t.yaw.empty() ? 0.0 : *std::max_element(t.yaw.begin(), t.yaw.end()) * 180 / kPi,
+              missed.empty() ? "-" : missed.c_str());
+  std::fflush(stdout);
+  all.truth += t.truth;
+  all.found += t.found;
+  all.false_pos += t.false_pos;
+  all.small += t.small;
+  all.xy.insert(all.xy.end(), t.xy.begin(), t.xy.end());
+  all.z.insert(all.z.end(), t.z.begin(), t.z.end());
+  all.yaw.insert(all.yaw.end(), t.yaw.begin(), t.yaw.end());
+  return true;
+}
+
+void runScenarios(const std::filesystem::path& dir) {
+  std::vector<std::filesystem::path> files;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) {
+    if (e.path().extension() == ".yaml") files.push_back(e.path());
+  }
+  std::sort(files.begin(), files.end());
+  std::printf("\n### Shipped scenarios (%s): robot camera 320x240, start + every location x 3 headings, 3 frames per view\n\n",
+              dir.string().c_str());
+  std::printf("| scenario | classes | frames | movable objects in view (>= 100 px) | found | false objects | xy error p50 / max (m) | z error max (m) | yaw error p50 / max (deg) | missed |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
+  std::vector<std::string> skipped;
+  for (bool classes : {true, false}) {
+    ScenarioTally all;
+    for (const auto& f : files) {
+      if (!runScenarioFile(f, classes, all) && classes) skipped.push_back(f.stem().string());
+    }
+    std::printf("| **all** | %s | | %d | **%d / %d (%.0f %%)** | %d | %.3f / %.3f | %.3f | %.1f / %.1f | |\n", classes ? "known" : "none",
+                all.truth, all.found, all.truth, 100.0 * all.found / std::max(all.truth, 1), all.false_pos, quantile(all.xy, 0.5),
+                all.xy.empty() ? 0.0 : *std::max_element(all.xy.begin(), all.xy.end()),
+                all.z.empty() ? 0.0 : *std::max_element(all.z.begin(), all.z.end()), quantile(all.yaw, 0.5) * 180 / kPi,
+                all.yaw.empty() ? 0.0 : *std::max_element(all.yaw.begin(), all.yaw.end()) * 180 / kPi);
+    if (classes) {
+      std::printf("| | | | (%d more movable objects seen with < 100 px, not counted) | | | | | | |\n", all.small);
+    }
+  }
+  std::string list;
+  for (const auto& s : skipped) list += (list.empty() ? "" : ", ") + s;
+  std::printf("\nNo movable object in view (no row): %s.\n", list.empty() ? "none" : list.c_str());
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   int frames = 20;
-  bool timing = true, accuracy = true;
+  bool timing = true, accuracy = true, scenarios = true;
+  std::string only_size;  // "50k", "300k" or "1M": time that size only
+  std::filesystem::path scenario_dir = std::filesystem::path(TAMP_SOURCE_DIR) / "config" / "scenarios";
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--frames") && i + 1 < argc) {
       frames = std::max(1, std::atoi(argv[++i]));
+    } else if (!std::strcmp(argv[i], "--size") && i + 1 < argc) {
+      only_size = argv[++i];
     } else if (!std::strcmp(argv[i], "--timing-only")) {
-      accuracy = false;
+      accuracy = scenarios = false;
     } else if (!std::strcmp(argv[i], "--accuracy-only")) {
-      timing = false;
+      timing = scenarios = false;
+    } else if (!std::strcmp(argv[i], "--scenarios-only")) {
+      timing = accuracy = false;
+    } else if (!std::strcmp(argv[i], "--scenarios") && i + 1 < argc) {
+      scenario_dir = argv[++i];
     } else {
-      std::fprintf(stderr, "usage: %s [--frames N] [--timing-only | --accuracy-only]\n", argv[0]);
+      std::fprintf(stderr, "usage: %s [--frames N] [--size 50k|300k|1M] [--timing-only | --accuracy-only | --scenarios-only] [--scenarios DIR]\n",
+                   argv[0]);
       return 2;
     }
   }
-  if (timing) runTiming(frames);
+  if (timing) runTiming(frames, only_size);
   if (accuracy) runAccuracy();
+  if (scenarios) runScenarios(scenario_dir);
   return 0;
 }

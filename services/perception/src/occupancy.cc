@@ -17,6 +17,9 @@ struct OccupancyMap::Impl {
   OccupancyParams params;
   octomap::OcTree tree;
   octomap::KeySet hits;  // voxels that received a hit and may be occupied
+  // Inner nodes lag the leaves until updateInnerNodes(): refreshing them walks the whole tree, so
+  // it is done once per frame, not after every integrate/clear call (which set this).
+  bool inner_stale{false};
   explicit Impl(const OccupancyParams& p) : params(p), tree(p.resolution) {
     tree.setProbHit(p.prob_hit);
     tree.setProbMiss(p.prob_miss);
@@ -72,7 +75,7 @@ void OccupancyMap::integrate(const Eigen::Vector3d& origin, const std::vector<Ei
     tree.updateNode(k, true, true);
     impl_->hits.insert(k);
   }
-  tree.updateInnerOccupancy();
+  impl_->inner_stale = true;
 }
 
 std::size_t OccupancyMap::clearSeenThrough(const RangeImage& image, double margin) {
@@ -93,7 +96,7 @@ std::size_t OccupancyMap::clearSeenThrough(const RangeImage& image, double margi
     }
     ++it;
   }
-  if (updated > 0) tree.updateInnerOccupancy();
+  if (updated > 0) impl_->inner_stale = true;
   return updated;
 }
 
@@ -121,8 +124,14 @@ std::size_t OccupancyMap::clearObject(const world::Object& object) {
     tree.setNodeValue(key, tree.getClampingThresMinLog(), true);
     impl_->hits.erase(key);
   }
-  if (!explained.empty()) tree.updateInnerOccupancy();
+  if (!explained.empty()) impl_->inner_stale = true;
   return explained.size();
+}
+
+void OccupancyMap::updateInnerNodes() {
+  if (!impl_->inner_stale) return;
+  impl_->tree.updateInnerOccupancy();
+  impl_->inner_stale = false;
 }
 
 void OccupancyMap::clear() {

@@ -711,6 +711,7 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& frame, const
     for (const auto& o : I.world.objects()) {
       if (o.kind == world::ObjectKind::kMovable || I.prior.findObject(o.id) == nullptr) I.occupancy->clearObject(o);
     }
+    I.occupancy->updateInnerNodes();  // once per frame (see OccupancyMap)
   }
   result.times.occupancy = watch.millis();
 

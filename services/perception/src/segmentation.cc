@@ -51,14 +51,16 @@ class StaticIndex {
       }
     }
   }
-  bool explains(const Eigen::Vector3d& p) const {
+  /// True when `p` lies within `margin` (at most the construction's margin) of a static object.
+  bool explains(const Eigen::Vector3d& p, double margin) const {
+    margin = std::min(margin, margin_);
     auto it = grid_.find(key(cell(p.x()), cell(p.y())));
     if (it == grid_.end()) return false;
     for (int i : it->second) {
       const Aabb& b = boxes_[static_cast<std::size_t>(i)];
-      if ((p.array() < b.min.array() - margin_).any() || (p.array() > b.max.array() + margin_).any()) continue;
+      if ((p.array() < b.min.array() - margin).any() || (p.array() > b.max.array() + margin).any()) continue;
       const world::Object& o = *objects_[static_cast<std::size_t>(i)];
-      if (pointInShape(o.shape, o.pose, p, margin_)) return true;
+      if (pointInShape(o.shape, o.pose, p, margin)) return true;
     }
     return false;
   }
@@ -76,6 +78,15 @@ class StaticIndex {
 };
 
 double ms(const Stopwatch& w) { return w.millis(); }
+
+/// A support plane matching no prior region must cover at least this fraction of its inliers'
+/// convex hull (distinct voxel cells; see the plane stage of Segmenter::run).
+constexpr double kMinSupportFill = 0.25;
+
+/// Points this close to a prior static object, at `range` from the sensor, are its returns.
+double staticMargin(const PerceptionParams& P, double range) {
+  return std::max(P.clusters.static_margin, P.planes.noise_sigmas * P.sensor.stddev(range));
+}
 
 }  // namespace
 
@@ -107,7 +118,10 @@ Segmenter::Segmenter(const PerceptionParams& params, const world::World& prior) 
   }
   impl_->workspace.min.z() = std::max(impl_->workspace.min.z(), params.crop.min_z);
   impl_->workspace.max.z() = std::min(impl_->workspace.max.z(), params.crop.max_z);
-  impl_->statics = StaticIndex(prior, params.clusters.static_margin);
+  // The static map's margin grows with the range noise (as the support planes' band does): a far
+  // wall's returns scatter by several centimetres, and those would otherwise cluster into thin
+  // false objects in front of it. The index is built for the largest margin (at max_range).
+  impl_->statics = StaticIndex(prior, staticMargin(params, params.crop.max_range));
   for (const auto& r : prior.regions()) impl_->regions.push_back(r);
 }
 
@@ -257,6 +271,20 @@ Result<Segmentation> Segmenter::run(const PointCloudFrame& frame, const Terminat
       }
       // A rejected plane is an object's top: its points stay object points.
       if (region == nullptr && plane.area < P.planes.min_support_area) continue;
+      // A large plane that matches no region must be a surface: its inliers must fill a good
+      // part of their hull. A horizontal slice through walls and objects (the band of a plane
+      // at some height cuts every vertical surface) can add up to the support area but fills
+      // little of the room it spans; taking it as a support cut every object there in two.
+      if (region == nullptr) {
+        std::vector<Eigen::Vector2d> xy;
+        xy.reserve(inliers.size());
+        for (auto i : inliers) {
+          const auto& q = cloud->points[static_cast<std::size_t>(i)];
+          xy.emplace_back(q.x, q.y);
+        }
+        const double hull_area = std::abs(world::signedArea(convexHull(std::move(xy))));
+        if (plane.area < kMinSupportFill * hull_area) continue;
+      }
       if (region != nullptr) {
         plane.region = region->id;
         plane.height = region->height;
@@ -308,7 +336,8 @@ Result<Segmentation> Segmenter::run(const PointCloudFrame& frame, const Terminat
   for (std::size_t i = 0; i < cloud->size(); ++i) {
     if (removed[i]) continue;
     const auto& q = cloud->points[i];
-    if (!impl_->statics.empty() && impl_->statics.explains(Eigen::Vector3d(q.x, q.y, q.z))) {
+    const Eigen::Vector3d p(q.x, q.y, q.z);
+    if (!impl_->statics.empty() && impl_->statics.explains(p, staticMargin(P, (p - frame.world_T_sensor.translation()).norm()))) {
       ++out.static_points;
       continue;
     }

@@ -184,6 +184,40 @@ TEST(SceneTest, NoFalseObjectFromSensorNoiseOnAnEmptyFloor) {
   }
 }
 
+TEST(SceneTest, WallsOfTheStaticMapMakeNoSupportPlaneAndNoFalseObject) {
+  // A room's walls (static, in the prior) seen from its middle: the band of a horizontal plane
+  // at any height cuts all of them, and those slices once added up to a "support" that cut every
+  // object in two; the far walls' returns (several cm of noise at 4-5 m) once clustered into
+  // thin false boxes in front of them. Objects near the walls stay whole.
+  world::World truth("room");
+  ASSERT_TRUE(truth.addRegion(testing::floorRegion()).ok());
+  ASSERT_TRUE(truth.addObject(box("wall_n", 9.0, 0.1, 1.5, 1.5, 3.0, 0.0, 0.0, world::ObjectKind::kStatic)).ok());
+  ASSERT_TRUE(truth.addObject(box("wall_s", 9.0, 0.1, 1.5, 1.5, -3.0, 0.0, 0.0, world::ObjectKind::kStatic)).ok());
+  ASSERT_TRUE(truth.addObject(box("wall_e", 0.1, 6.0, 1.5, 5.0, 0.0, 0.0, 0.0, world::ObjectKind::kStatic)).ok());
+  const world::World prior = truth;
+  ASSERT_TRUE(truth.addObject(box("cabinet", 0.6, 0.5, 1.0, 4.2, 1.0, 0.0)).ok());
+  ASSERT_TRUE(truth.addObject(cylinder("post", 0.08, 0.9, 3.6, -0.4)).ok());
+  ASSERT_TRUE(truth.addObject(box("crate", 0.4, 0.4, 0.3, 2.2, -0.8, 0.3)).ok());
+  Perception perception(prior, PerceptionParams{});
+  Runner run(perception);
+  run.camera.width = 640;
+  run.camera.height = 480;
+  for (int k = 0; k < 6; ++k) {
+    const FrameResult r = run.frame(truth, testing::mastCamera(-0.5, 0.0, 0.4 * ((k % 3) - 1)));
+    for (const auto& p : r.planes) EXPECT_EQ(p.region, "floor") << "frame " << k << ": support at " << p.height;
+  }
+  ASSERT_EQ(perception.world().objectCount(), 6u) << "3 walls + 3 objects";
+  for (const char* id : {"cabinet", "post", "crate"}) {
+    const world::Object* o = truth.findObject(id);
+    int near = 0;
+    for (const auto& f : perception.world().objects()) {
+      if (prior.findObject(f.id) != nullptr) continue;
+      if ((f.pose.translation().head<2>() - o->pose.translation().head<2>()).norm() < 0.1) ++near;
+    }
+    EXPECT_EQ(near, 1) << id;
+  }
+}
+
 TEST(SceneTest, FlagsAHiddenObjectOnceItComesIntoView) {
   // A wall (in the static map) hides a box the planner does not know about.
   world::World truth("hidden");

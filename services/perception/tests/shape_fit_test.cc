@@ -81,6 +81,32 @@ TEST(ShapeFitTest, ConvexHullAndMinAreaRectOfARotatedRectangle) {
   EXPECT_NEAR(r.extents.y(), 0.2, 1e-9);
 }
 
+TEST(ShapeFitTest, ConvexHullOfManyPointsIsExact) {
+  // Large inputs are pre-filtered (Akl-Toussaint); the hull must still be exact: vertices are
+  // input points, strictly convex and counter-clockwise, and every input point is inside or on it.
+  std::mt19937 rng(7);
+  for (int shape = 0; shape < 3; ++shape) {
+    std::uniform_real_distribution<double> u(-2.0, 2.0);
+    std::vector<Eigen::Vector2d> pts;
+    for (int i = 0; i < 5000; ++i) {
+      Eigen::Vector2d p(u(rng), u(rng));
+      if (shape == 1 && p.norm() > 2.0) continue;                    // disc
+      if (shape == 2) p = Eigen::Vector2d(std::round(p.x() * 50) / 50, std::round(p.y() * 50) / 50);  // grid: collinear runs
+      pts.push_back(p);
+    }
+    const auto hull = convexHull(pts);
+    ASSERT_GE(hull.size(), 3u) << shape;
+    for (std::size_t i = 0; i < hull.size(); ++i) {
+      EXPECT_NE(std::find(pts.begin(), pts.end(), hull[i]), pts.end()) << shape;
+      const Eigen::Vector2d a = hull[i], b = hull[(i + 1) % hull.size()], c = hull[(i + 2) % hull.size()];
+      EXPECT_GT((b - a).x() * (c - a).y() - (b - a).y() * (c - a).x(), 0.0) << shape << " vertex " << i;
+      for (const auto& p : pts) {
+        ASSERT_GE((b - a).x() * (p - a).y() - (b - a).y() * (p - a).x(), -1e-12) << shape;
+      }
+    }
+  }
+}
+
 TEST(ShapeFitTest, CircleFitsOnAnArc) {
   std::mt19937 rng(7);
   std::normal_distribution<double> n(0.0, 0.002);

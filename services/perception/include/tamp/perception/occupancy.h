@@ -43,6 +43,10 @@ class OccupancyMap {
   /// Marks occupied voxels inside `object` grown by `explained_margin` free (known object, not
   /// unknown space). Returns how many.
   std::size_t clearObject(const world::Object& object);
+  /// Refreshes the inner nodes of the octree after the calls above (lazy OctoMap updates). The
+  /// leaves, and so every query of this class, are up to date without it; call it once per frame
+  /// (a walk of the whole tree), not after each update.
+  void updateInnerNodes();
   void clear();
 
   CellState state(const Eigen::Vector3d& p) const;

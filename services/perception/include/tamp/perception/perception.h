@@ -15,8 +15,10 @@
 /// 3. **Voxel grid** (PCL `VoxelGrid`): the leaf size bounds the cost of everything after.
 /// 4. **Support planes** (PCL RANSAC, `SACMODEL_PERPENDICULAR_PLANE` about world z, several
 ///    planes): the floor and table tops. A plane is a support when it matches a prior region's
-///    height or is large; a table region's polygon bounds what its plane removes.
-/// 5. **Static map**: points inside the prior's static objects (walls, tables) are theirs.
+///    height or is large and fills >= 25 % of its hull (not a slice through walls); a table
+///    region's polygon bounds what its plane removes.
+/// 5. **Static map**: points inside the prior's static objects (walls, tables), grown by a margin
+///    that follows the range noise, are theirs.
 /// 6. **Euclidean clustering** (PCL): clusters big enough are object candidates; small ones are
 ///    unexplained occupied space; single stray returns are noise.
 /// 7. **Shape fitting** (`shape_fit.h`): footprint by minimum-area rectangle and circle fit,

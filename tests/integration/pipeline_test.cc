@@ -57,7 +57,7 @@ class Inbox {
 class PipelineTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    domain_ = isolatedDomain() + 1;  // the other integration tests use isolatedDomain()
+    domain_ = isolatedDomain();  // per process: concurrent test processes have distinct pids
     scenario_file_ = configDir() / "scenarios" / "namo_corridor.yaml";
     store_dir_ = tempFile("tamp_it_effort_store");
     std::filesystem::remove_all(store_dir_);

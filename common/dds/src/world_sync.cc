@@ -178,15 +178,28 @@ Status WorldPublisher::publish(const world::World& w) {
     const world::Object* before = last_ ? last_->findObject(o.id) : nullptr;
     if (before != nullptr && *before == o) continue;
     if (Status s = objects_.write(toMsg(o, v)); !s.ok()) return s;
+    written_[o.id] = v;
   }
   if (last_) {
     for (const auto& o : last_->objects()) {
       if (w.findObject(o.id) == nullptr) {
         if (Status s = objects_.dispose(toMsg(o, v)); !s.ok()) return s;
+        written_.erase(o.id);
       }
     }
   }
-  if (Status s = meta_.write(metaToMsg(w, world_id_)); !s.ok()) return s;
+  msg::WorldMeta meta = metaToMsg(w, world_id_);
+  std::vector<std::string> ids;
+  std::vector<uint64_t> versions;
+  ids.reserve(written_.size());
+  versions.reserve(written_.size());
+  for (const auto& [id, version] : written_) {
+    ids.push_back(id);
+    versions.push_back(version);
+  }
+  meta.object_ids(std::move(ids));
+  meta.object_versions(std::move(versions));
+  if (Status s = meta_.write(meta); !s.ok()) return s;
   last_ = w;
   published_version_ = v;
   return Status::Ok();
@@ -203,9 +216,13 @@ void WorldMirror::onObject(const msg::WorldObject& m, const SampleMeta& meta) {
   {
     std::lock_guard lock(mutex_);
     if (!meta.alive) {
+      received_.erase(m.id());
+      updateCompleteLocked();
       if (world_.findObject(m.id()) == nullptr) return;
       (void)world_.removeObject(m.id());
     } else {
+      received_[m.id()] = m.version();  // received, even if it turns out malformed below
+      updateCompleteLocked();
       auto o = fromMsg(m);
       if (!o) {
         log::get("world")->warn("ignoring a malformed world object: {}", o.error().toString());
@@ -252,10 +269,31 @@ void WorldMirror::onMeta(const msg::WorldMeta& m, const SampleMeta& meta) {
       b.extend(Eigen::Vector3d(m.bounds()[2], m.bounds()[3], 2.0));
       world_.setWorkspace(b);
     }
-    published_version_ = m.version();
+    manifest_version_ = m.version();
+    manifest_.clear();
+    if (m.object_ids().size() == m.object_versions().size()) {
+      for (std::size_t i = 0; i < m.object_ids().size(); ++i) manifest_[m.object_ids()[i]] = m.object_versions()[i];
+    } else {
+      log::get("world")->warn("world meta {}: {} object ids but {} versions; manifest ignored", m.version(),
+                              m.object_ids().size(), m.object_versions().size());
+    }
+    updateCompleteLocked();
     ++changes_;
   }
   notify();
+}
+
+void WorldMirror::updateCompleteLocked() {
+  if (manifest_version_ <= published_version_) return;
+  for (const auto& [id, version] : manifest_) {
+    auto it = received_.find(id);
+    if (it == received_.end() || it->second < version) return;  // not here yet
+  }
+  for (const auto& [id, version] : received_) {
+    // An object outside the manifest is either newer (fine) or removed but not yet disposed here.
+    if (manifest_.count(id) == 0 && version <= manifest_version_) return;
+  }
+  published_version_ = manifest_version_;
 }
 
 void WorldMirror::notify() {

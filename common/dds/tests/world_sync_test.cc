@@ -113,5 +113,41 @@ TEST(WorldSyncTest, MalformedObjectMessageIsIgnored) {
   EXPECT_EQ(r.error().where.field, "objects[broken].shape");
 }
 
+// Objects and meta travel on separate topics: a meta that overtakes its objects must not make
+// the mirror claim the version (a planner would plan in the old world).
+TEST(WorldSyncTest, VersionIsHeldOnlyWhenEveryObjectOfTheManifestHasArrived) {
+  auto p = testing::makeParticipant();
+  ASSERT_TRUE(p);
+  WorldMirror mirror(p);
+  Writer<msg::WorldObject> objects(p, topics::kWorldObjects);
+  Writer<msg::WorldMeta> metas(p, topics::kWorldMeta);
+  const world::World w = sampleWorld();
+  msg::WorldMeta meta = metaToMsg(w, "world");
+  meta.version(2);
+  meta.object_ids({"can", "table"});
+  meta.object_versions({2, 1});
+  ASSERT_TRUE(metas.write(meta).ok());
+  ASSERT_TRUE(objects.write(toMsg(w.object("table"), 1)).ok());
+  ASSERT_TRUE(waitFor([&] { return mirror.snapshot().findObject("table") != nullptr; }));
+  ASSERT_TRUE(waitFor([&] { return mirror.snapshot().findLocation("near_table") != nullptr; }));
+  EXPECT_EQ(mirror.publishedVersion(), 0u) << "the can of version 2 has not arrived";
+  ASSERT_TRUE(objects.write(toMsg(w.object("can"), 1)).ok());  // an older sample of it
+  ASSERT_TRUE(waitFor([&] { return mirror.snapshot().findObject("can") != nullptr; }));
+  EXPECT_EQ(mirror.publishedVersion(), 0u) << "the can is older than the manifest says";
+  ASSERT_TRUE(objects.write(toMsg(w.object("can"), 2)).ok());
+  EXPECT_TRUE(mirror.waitForPublishedVersion(2, Termination::after(10.0)));
+  // Version 3 removes the can: held only once the removal has arrived.
+  meta.version(3);
+  meta.object_ids({"table"});
+  meta.object_versions({1});
+  ASSERT_TRUE(metas.write(meta).ok());
+  ASSERT_TRUE(waitFor([&] { return mirror.changes() >= 5; }));
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  EXPECT_EQ(mirror.publishedVersion(), 2u) << "the can is still here";
+  ASSERT_TRUE(objects.dispose(toMsg(w.object("can"), 3)).ok());
+  EXPECT_TRUE(mirror.waitForPublishedVersion(3, Termination::after(10.0)));
+  EXPECT_EQ(mirror.snapshot().findObject("can"), nullptr);
+}
+
 }  // namespace
 }  // namespace tamp::dds

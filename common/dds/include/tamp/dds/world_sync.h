@@ -44,6 +44,7 @@ class WorldPublisher {
   Writer<msg::WorldObject> objects_;
   Writer<msg::WorldMeta> meta_;
   std::optional<world::World> last_;
+  std::map<std::string, uint64_t> written_;  ///< object id -> version it was last written at
   uint64_t published_version_{0};
 };
 
@@ -54,9 +55,11 @@ class WorldMirror {
   world::World snapshot() const;
   /// Increments on every received change.
   uint64_t changes() const;
-  /// The publisher's world version of the last WorldMeta received (0: none yet).
+  /// The latest publisher's world version held completely: its WorldMeta and every object of
+  /// its manifest at (at least) the listed versions have arrived, removed objects are gone
+  /// (0: none yet). Objects of a newer version may already be in the snapshot.
   uint64_t publishedVersion() const;
-  /// Waits until a WorldMeta with version >= `version` has arrived.
+  /// Waits until publishedVersion() >= `version`.
   bool waitForPublishedVersion(uint64_t version, const Termination& until) const;
   /// Called (on a DDS thread) after each change with the new world; keep it short.
   void onChange(std::function<void(const world::World&)> cb);
@@ -65,12 +68,16 @@ class WorldMirror {
   void onObject(const msg::WorldObject& m, const SampleMeta& meta);
   void onMeta(const msg::WorldMeta& m, const SampleMeta& meta);
   void notify();
+  void updateCompleteLocked();
 
   std::string world_id_;
   mutable std::mutex mutex_;
   world::World world_;
   uint64_t changes_{0};
   uint64_t published_version_{0};
+  std::map<std::string, uint64_t> received_;  ///< object id -> version of the sample received
+  uint64_t manifest_version_{0};              ///< version of the latest WorldMeta
+  std::map<std::string, uint64_t> manifest_;  ///< its objects and their versions
   std::function<void(const world::World&)> cb_;
   Reader<msg::WorldObject> objects_;
   Reader<msg::WorldMeta> meta_;

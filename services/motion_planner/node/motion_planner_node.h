@@ -3,7 +3,8 @@
 /// The motion planning service over DDS: a thin adapter around tamp::motion_planner::MotionPlanner.
 ///
 /// - Serves `services::kMotion`, `kPlacement` and `kGrasp` (idl/motion.idl) with one RpcServer
-///   each; requests run one at a time on the planner (one scene, guarded by a mutex).
+///   each; requests run one at a time on the planner (one scene and its lazy-mode roadmap
+///   cache, guarded by a mutex; the DDS dispatch may call handlers concurrently).
 /// - Mirrors the world model (`tamp::dds::WorldMirror`, topics tamp/world/objects + meta); before
 ///   each request the planner's scene is brought to the mirror's latest world (a diff: cheap when
 ///   little changed). A request naming a `world_version` waits (at most `world_wait_s`) for it.

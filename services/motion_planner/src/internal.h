@@ -20,6 +20,7 @@
 #include "tamp/core/geometry.h"
 #include "tamp/core/termination.h"
 #include "tamp/motion_planner/motion_planner.h"
+#include "tamp/world/world.h"
 
 namespace tamp::motion_planner::detail {
 
@@ -208,15 +209,78 @@ struct EvaluatedPath {
 EvaluatedPath evaluatePath(Oracle& oracle, const og::PathGeometric& path, double resolution,
                            double max_segment);
 
-/// The effort-aware roadmap search of the design overview (LazySP over a k-NN roadmap seeded
-/// with `seed_path`). Returns the best fully evaluated path, or nothing when the budget ran out
-/// first. Fills the roadmap fields of `stats`.
-std::optional<og::PathGeometric> effortRoadmapSearch(Oracle& oracle, const ob::SpaceInformationPtr& si,
-                                                     const og::PathGeometric& seed_path,
-                                                     const LazyParams& params, double resolution,
-                                                     double seconds_per_unit,
-                                                     const Termination& termination,
-                                                     PlanningStats& stats);
+/// What the static free space of one planning group depends on (the cache key of a
+/// StaticRoadmap): the static objects that are not ignored (by pointer, else by value), the held
+/// object (its geometry and where it sits on the hold link), and the joints the group does not
+/// move (base group: arm + gripper; arm group: base pose + gripper; whole body: gripper). The
+/// robot is fixed per planner. Movables are not part of it: they are only costs.
+struct StaticWorldKey {
+  PlanningGroup group{PlanningGroup::kBase};
+  std::vector<std::shared_ptr<const world::Object>> statics;  ///< sorted by id
+  std::shared_ptr<const world::Object> held;                  ///< or null
+  Eigen::Isometry3d link_T_held{Eigen::Isometry3d::Identity()};
+  std::vector<double> fixed;
+  bool operator==(const StaticWorldKey& o) const;
+};
+
+/// A roadmap of the static free space of one group and StaticWorldKey, kept across requests
+/// (see motion_planner.h, "Roadmap cache"): nodes (uniform samples, request starts and goals,
+/// lazy KPIECE paths) are static-free; k-nearest-neighbour edges carry their static validity
+/// once evaluated (lazily, when an edge is on a candidate path), so later requests pay only for
+/// the movables along the edges they consider. Not thread-safe (the planner it belongs to is not).
+class StaticRoadmap {
+ public:
+  StaticRoadmap(ob::StateSpacePtr space, StaticWorldKey key, std::uint32_t seed, int neighbors);
+  ~StaticRoadmap();
+  StaticRoadmap(const StaticRoadmap&) = delete;
+  StaticRoadmap& operator=(const StaticRoadmap&) = delete;
+
+  const StaticWorldKey& key() const { return key_; }
+  std::size_t nodeCount() const { return nodes_.size(); }
+  std::size_t edgeCount() const { return edges_.size(); }
+  std::size_t uniformSamples() const { return uniform_; }
+
+  /// Draws uniform states of `gs`'s space (own seeded generator: deterministic) until `count`
+  /// static-free ones were added or 4 x `count` were drawn; then up to `bridge_count` bridge-test
+  /// samples (narrow passages; at most 20 x `bridge_count` attempts).
+  void addSamples(Oracle& oracle, const GroupSpace& gs, int count, const Termination& termination,
+                  int bridge_count = 0, double bridge_distance = 1.0);
+  /// Adds a static-free state (or finds the node already there) connected to its k nearest nodes.
+  int addState(const ob::State* s);
+  /// Adds a statically valid path cut every `spacing` (its edges are known valid); returns the
+  /// nodes of its first and last states.
+  std::pair<int, int> addPath(const og::PathGeometric& path, double spacing);
+
+  /// The effort-aware LazySP search (see roadmap.cc) from node `start` to any of `goals` under
+  /// the request's movables; nothing when they are not connected within the budgets
+  /// (LazyParams::roadmap_max_evaluations edge evaluations, `max_new_invalid` edges newly found
+  /// statically invalid when > 0 -- the sign of a roadmap that does not connect them --,
+  /// optimize_budget_s, `termination`). When the evaluation budget runs out, the best path
+  /// over the edges known to be statically valid is returned if they connect start and goal.
+  std::optional<og::PathGeometric> search(Oracle& oracle, const ob::SpaceInformationPtr& si, int start,
+                                          const std::vector<int>& goals, const LazyParams& params,
+                                          double resolution, double seconds_per_unit,
+                                          const Termination& termination, PlanningStats& stats,
+                                          int max_new_invalid = 0);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  ob::StateSpacePtr space_;
+  StaticWorldKey key_;
+  std::vector<ob::State*> nodes_;
+  struct Edge {
+    int a{0}, b{0};
+    double len{0.0};
+    enum Status : unsigned char { kUnknown, kValid, kInvalid } status{kUnknown};  // static validity
+  };
+  std::vector<Edge> edges_;
+  std::vector<std::vector<int>> adj_;
+  std::size_t uniform_{0};
+  int neighbors_{12};
+  void addEdge(int a, int b, bool valid);
+  int pushNode(const ob::State* s);
+};
 
 /// Effort-aware shortcutting: replaces vertices i..j by the straight segment when it is
 /// statically valid and lowers J. `attempts` random pairs (fixed-seed rng).

@@ -163,7 +163,8 @@ MotionPlanner::Impl::Impl(MotionPlannerParams p, detail::RobotBinding r)
 
 Result<MotionPlanner::Impl::AttachGuard> MotionPlanner::Impl::attach(const std::string& object_id,
                                                                    const robot::RobotState& start,
-                                                                   const std::string& field) {
+                                                                   const std::string& field,
+                                                                   Eigen::Isometry3d* link_T_object_out) {
   const world::Object* obj = world.findObject(object_id);
   if (!obj) return Error(ErrorCode::kInvalidArgument, field + ": no object '" + object_id + "' in the world");
   if (obj->kind != world::ObjectKind::kMovable) {
@@ -181,10 +182,32 @@ Result<MotionPlanner::Impl::AttachGuard> MotionPlanner::Impl::attach(const std::
     const Eigen::Isometry3d world_T_link = poses[static_cast<std::size_t>(it - links.begin())];
     link_T_object = world_T_link.inverse() * obj->pose;
   }
+  if (link_T_object_out) *link_T_object_out = link_T_object;
   if (Status s = scene.attach(object_id, robot.holdLink(), link_T_object); !s) {
     return Error(ErrorCode::kInvalidArgument, field + ": " + s.error().message);
   }
   return AttachGuard(&scene, object_id);
+}
+
+detail::StaticRoadmap* MotionPlanner::Impl::roadmapFor(detail::StaticWorldKey key, const ob::StateSpacePtr& space,
+                                                      bool& reused, std::unique_ptr<detail::StaticRoadmap>& scratch) {
+  for (auto it = roadmaps.begin(); it != roadmaps.end(); ++it) {
+    if ((*it)->key() == key) {
+      std::rotate(it, it + 1, roadmaps.end());
+      reused = true;
+      return roadmaps.back().get();
+    }
+  }
+  reused = false;
+  auto rm = std::make_unique<detail::StaticRoadmap>(space, std::move(key), params.seed, params.lazy.roadmap_neighbors);
+  const auto entries = static_cast<std::size_t>(params.lazy.roadmap_cache_entries);
+  if (entries == 0) {
+    scratch = std::move(rm);
+    return scratch.get();
+  }
+  while (roadmaps.size() >= entries) roadmaps.erase(roadmaps.begin());
+  roadmaps.push_back(std::move(rm));
+  return roadmaps.back().get();
 }
 
 double MotionPlanner::Impl::reachRadius(const robot::RobotState& s, const std::string& held) const {
@@ -294,6 +317,9 @@ void MotionPlanner::setObjectEffort(ObjectEffortFn fn) {
   if (!fn) throw std::invalid_argument("setObjectEffort: empty function");
   impl_->effort = std::move(fn);
 }
+
+void MotionPlanner::clearRoadmapCache() { impl_->roadmaps.clear(); }
+std::size_t MotionPlanner::roadmapCacheSize() const { return impl_->roadmaps.size(); }
 
 const MotionPlannerParams& MotionPlanner::params() const { return impl_->params; }
 bool MotionPlanner::hasArm() const { return impl_->robot.hasArm(); }
@@ -421,8 +447,9 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
                            : impl.world.held() ? impl.world.held()->object_id
                                                : std::string();
   Impl::AttachGuard guard;
+  Eigen::Isometry3d link_T_held = Eigen::Isometry3d::Identity();
   if (!held.empty()) {
-    auto g = impl.attach(held, req.start, req.held_object.empty() ? "world.held" : "held_object");
+    auto g = impl.attach(held, req.start, req.held_object.empty() ? "world.held" : "held_object", &link_T_held);
     if (!g) return finish(MotionStatus::kInvalidRequest, g.error().message);
     guard = std::move(*g);
   }
@@ -596,6 +623,45 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
     pdef->setGoal(goals);
   }
 
+  // ---- lazy: the cached roadmap of the static free space ----
+  const double spu = gs.secondsPerUnit(P.cost);
+  const double res_check = P.sampling.validity_resolution;
+  detail::StaticRoadmap* roadmap = nullptr;
+  std::unique_ptr<detail::StaticRoadmap> uncached;  // roadmap_cache_entries == 0
+  std::optional<og::PathGeometric> from_roadmap;
+  if (lazy && P.lazy.optimize) {
+    Stopwatch rw;
+    detail::StaticWorldKey key;
+    key.group = req.group;
+    for (const auto& o : impl.world.objects()) {
+      if (o.kind != world::ObjectKind::kStatic) continue;
+      if (std::find(ignored.begin(), ignored.end(), o.id) != ignored.end()) continue;
+      key.statics.push_back(impl.world.objectPtr(o.id));
+    }
+    if (!held.empty()) {
+      key.held = impl.world.objectPtr(held);
+      key.link_T_held = link_T_held;
+    }
+    if (req.group == PlanningGroup::kBase) key.fixed = req.start.arm;
+    if (req.group == PlanningGroup::kArm) key.fixed = {req.start.base.x, req.start.base.y, req.start.base.theta};
+    if (impl.robot.hasArm()) key.fixed.push_back(req.start.gripper);
+    roadmap = impl.roadmapFor(std::move(key), space, res.stats.roadmap_reused, uncached);
+    if (roadmap->uniformSamples() == 0 && P.lazy.roadmap_samples > 0) {
+      roadmap->addSamples(oracle, gs, P.lazy.roadmap_samples, termination, P.lazy.roadmap_bridge_samples,
+                          P.lazy.roadmap_bridge_distance);
+    }
+    // A roadmap new in this request knows no edge yet: lazy KPIECE goes first and seeds it.
+    if (req.group == PlanningGroup::kBase && P.lazy.roadmap_first && res.stats.roadmap_reused &&
+        !goal_states.empty()) {
+      const int s = roadmap->addState(start.get());
+      std::vector<int> goals;
+      for (const auto* g : goal_states) goals.push_back(roadmap->addState(g));
+      from_roadmap = roadmap->search(oracle, si, s, goals, P.lazy, res_check, spu, termination, res.stats,
+                                     P.lazy.roadmap_max_new_invalid);
+    }
+    res.stats.optimize_ms += rw.millis();
+  }
+
   // ---- search (+ infeasibility proof, interleaved) ----
   Stopwatch phase;
   const PlannerKind kind = req.group != PlanningGroup::kBase ? P.sampling.arm_planner
@@ -613,7 +679,8 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
            : collision::Filter{collision::kAllGroups, {}, ignored};
   std::size_t proof_level = 0;
   double slice = lazy ? 0.25 : 0.05;
-  bool solved = false;
+  bool solved = from_roadmap.has_value();
+  res.stats.lazy_planner_used = !solved;
   bool first = true;
   while (!solved) {
     if (proof_level < proof_cells.size() && (!lazy || !first)) {
@@ -650,12 +717,10 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
                       (proof_cells.empty() ? std::string(" (no infeasibility proof for this group)")
                                            : std::string(" (infeasibility not proven)")));
   }
-  og::PathGeometric raw = *pdef->getSolutionPath()->as<og::PathGeometric>();
+  og::PathGeometric raw = from_roadmap ? *from_roadmap : *pdef->getSolutionPath()->as<og::PathGeometric>();
   res.stats.raw_path_length = detail::reportedLength(gs, raw);
 
   og::PathGeometric final_path(si);
-  const double spu = gs.secondsPerUnit(P.cost);
-  const double res_check = P.sampling.validity_resolution;
   if (lazy) {
     phase.reset();
     detail::EvaluatedPath raw_eval = detail::evaluatePath(oracle, raw, res_check, 0.0);
@@ -663,14 +728,20 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
     res.stats.raw_cost_s = raw_cost.cost;
     for (int o : raw_cost.objects) res.stats.raw_blocking.push_back(oracle.movables()[static_cast<std::size_t>(o)].id);
     og::PathGeometric best = raw;
-    if (P.lazy.optimize && req.object_cost_scale > 0 && !raw_cost.objects.empty()) {
-      auto rm = detail::effortRoadmapSearch(oracle, si, raw, P.lazy, res_check, spu, termination, res.stats);
+    const bool improve = req.group == PlanningGroup::kBase || (req.object_cost_scale > 0 && !raw_cost.objects.empty());
+    if (roadmap && !from_roadmap && improve) {
+      // Lazy KPIECE's path (statically valid) joins the roadmap, which also grows where it is.
+      const auto [s, g] = roadmap->addPath(raw, P.lazy.path_node_spacing);
+      if (roadmap->nodeCount() < static_cast<std::size_t>(P.lazy.roadmap_max_nodes)) {
+        roadmap->addSamples(oracle, gs, P.lazy.roadmap_growth_samples, termination);
+      }
+      auto rm = roadmap->search(oracle, si, s, {g}, P.lazy, res_check, spu, termination, res.stats);
       if (rm) {
         detail::EvaluatedPath rm_eval = detail::evaluatePath(oracle, *rm, res_check, 0.0);
         if (rm_eval.cost(oracle, spu).cost < raw_cost.cost) best = *rm;
       }
     }
-    res.stats.optimize_ms = phase.millis();
+    res.stats.optimize_ms += phase.millis();
     phase.reset();
     detail::EvaluatedPath ep = detail::evaluatePath(oracle, best, res_check, P.lazy.path_node_spacing * 0.5);
     std::mt19937 rng(P.seed);

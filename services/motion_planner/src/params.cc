@@ -55,7 +55,14 @@ std::vector<Rule> rules(const MotionPlannerParams& p) {
       N("sampling", "workspace_margin", S.workspace_margin),
       I("lazy", "roadmap_samples", L.roadmap_samples, 0),
       I("lazy", "roadmap_neighbors", L.roadmap_neighbors, 2),
+      I("lazy", "roadmap_bridge_samples", L.roadmap_bridge_samples, 0),
+      P("lazy", "roadmap_bridge_distance", L.roadmap_bridge_distance),
       P("lazy", "path_node_spacing", L.path_node_spacing),
+      I("lazy", "roadmap_max_evaluations", L.roadmap_max_evaluations, 1),
+      I("lazy", "roadmap_max_new_invalid", L.roadmap_max_new_invalid, 1),
+      I("lazy", "roadmap_growth_samples", L.roadmap_growth_samples, 0),
+      I("lazy", "roadmap_max_nodes", L.roadmap_max_nodes, 1),
+      I("lazy", "roadmap_cache_entries", L.roadmap_cache_entries, 0),
       P("lazy", "optimize_budget_s", L.optimize_budget_s),
       I("lazy", "shortcut_attempts", L.shortcut_attempts, 0),
       P("lazy", "contact_resolution", L.contact_resolution),
@@ -177,7 +184,15 @@ Result<MotionPlannerParams> parseMotionPlannerParams(const std::string& yaml_tex
     s.optional("optimize", p.lazy.optimize);
     s.optional("roadmap_samples", p.lazy.roadmap_samples);
     s.optional("roadmap_neighbors", p.lazy.roadmap_neighbors);
+    s.optional("roadmap_bridge_samples", p.lazy.roadmap_bridge_samples);
+    s.optional("roadmap_bridge_distance", p.lazy.roadmap_bridge_distance);
     s.optional("path_node_spacing", p.lazy.path_node_spacing);
+    s.optional("roadmap_max_evaluations", p.lazy.roadmap_max_evaluations);
+    s.optional("roadmap_max_new_invalid", p.lazy.roadmap_max_new_invalid);
+    s.optional("roadmap_growth_samples", p.lazy.roadmap_growth_samples);
+    s.optional("roadmap_max_nodes", p.lazy.roadmap_max_nodes);
+    s.optional("roadmap_cache_entries", p.lazy.roadmap_cache_entries);
+    s.optional("roadmap_first", p.lazy.roadmap_first);
     s.optional("optimize_budget_s", p.lazy.optimize_budget_s);
     s.optional("shortcut_attempts", p.lazy.shortcut_attempts);
     s.optional("contact_resolution", p.lazy.contact_resolution);

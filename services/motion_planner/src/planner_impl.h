@@ -16,6 +16,8 @@ struct MotionPlanner::Impl {
   collision::Scene scene;
   world::World world;  // planner view
   ObjectEffortFn effort;
+  /// Cached static roadmaps (motion_planner.h, "Roadmap cache"), least recently used first.
+  std::vector<std::unique_ptr<detail::StaticRoadmap>> roadmaps;
 
   Impl(MotionPlannerParams p, detail::RobotBinding r);
 
@@ -49,7 +51,12 @@ struct MotionPlanner::Impl {
   /// Attaches `object_id` (validated by the caller) in state `start`; the world's held record is
   /// used when it names the same object. Errors name the field `field`.
   Result<AttachGuard> attach(const std::string& object_id, const robot::RobotState& start,
-                             const std::string& field);
+                             const std::string& field, Eigen::Isometry3d* link_T_object_out = nullptr);
+  /// The cached roadmap for `key` (moved to most recently used; `reused` tells whether it
+  /// existed), or a new one, evicting the least recently used beyond
+  /// LazyParams::roadmap_cache_entries; with 0 entries the new one lives in `scratch`.
+  detail::StaticRoadmap* roadmapFor(detail::StaticWorldKey key, const detail::ob::StateSpacePtr& space,
+                                    bool& reused, std::unique_ptr<detail::StaticRoadmap>& scratch);
 
   /// The robot's xy radius about its base origin in state `s`, attached objects included.
   double reachRadius(const robot::RobotState& s, const std::string& held) const;

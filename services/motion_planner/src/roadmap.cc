@@ -1,42 +1,34 @@
-// The effort-aware roadmap search of the lazy mode (see motion_planner.h, "Worth executing").
+// The cached static roadmap and the effort-aware roadmap search of the lazy mode (see
+// motion_planner.h, "Worth executing" and "Roadmap cache").
 //
-// Nodes: the lazy path's states (cut every `path_node_spacing`) plus uniform samples of the
-// static free space; edges: k nearest neighbours, and the lazy path's own segments (statically
-// valid already). Edge cost from u to v along e:
+// Nodes: uniform samples of the static free space (own seeded generator), the starts and goals of
+// earlier requests and the lazy KPIECE paths of requests the roadmap could not answer (cut every
+// `path_node_spacing`); edges: each new node to its k nearest nodes, and a lazy path's own
+// segments (statically valid already). An edge's static validity is evaluated at most once per
+// roadmap; the movables it touches are evaluated per request (they change between requests).
+// Edge cost from u to v along e:
 //   w(u, e, v) = length(e) x seconds_per_unit + sum of cost(o) over objects touched along e but
 //                not at u   (an object is paid when the path enters it)
-// which, before e is evaluated, is bounded below by using the objects touched at v instead of
-// along e. A* (admissible heuristic: distance to the goal x seconds_per_unit) finds the best
-// path under the current costs; its unevaluated edges are evaluated in order (static validity,
-// then the movables touched, densely) until one is invalid; the search repeats until a path is
-// found whose every edge is evaluated and whose cost did not rise (LazySP).
+// which, before e is evaluated in this request, is bounded below by using the objects touched at
+// v instead of along e. A* (admissible heuristic: distance to the nearest goal x
+// seconds_per_unit) finds the best path under the current costs; its unevaluated edges are
+// evaluated in order (static validity unless known, then the movables touched, densely; all of
+// them, also after an invalid one); the search repeats until a path is found whose every edge is evaluated and whose
+// cost did not rise (LazySP).
 #include <algorithm>
 #include <cmath>
 #include <iostream>  // NearestNeighborsGNATNoThreadSafety.h uses std::cout without including it
+#include <limits>
 #include <queue>
 #include <unordered_set>
 
-#include <ompl/base/StateSampler.h>
+#include <ompl/base/spaces/RealVectorStateSpace.h>
 #include <ompl/datastructures/NearestNeighborsGNATNoThreadSafety.h>
 
 #include "internal.h"
 
 namespace tamp::motion_planner::detail {
 namespace {
-
-struct Node {
-  ob::State* s{nullptr};
-  std::vector<int> touched;
-  double h{0.0};
-};
-
-struct Edge {
-  int a{0}, b{0};
-  double len{0.0};
-  enum Status : unsigned char { kUnknown, kValid, kInvalid } status{kUnknown};
-  bool static_valid{false};
-  std::vector<int> touched;  // when kValid
-};
 
 /// Sum of costs of objects in `in` but not in `minus` (both sorted).
 double enteringCost(const Oracle& oracle, const std::vector<int>& in, const std::vector<int>& minus) {
@@ -50,187 +42,313 @@ double enteringCost(const Oracle& oracle, const std::vector<int>& in, const std:
   return c;
 }
 
+bool sameObject(const std::shared_ptr<const world::Object>& a, const std::shared_ptr<const world::Object>& b) {
+  if (a == b) return true;
+  if (!a || !b) return false;
+  return *a == *b;
+}
+
 }  // namespace
 
-std::optional<og::PathGeometric> effortRoadmapSearch(Oracle& oracle, const ob::SpaceInformationPtr& si,
-                                                     const og::PathGeometric& seed_path, const LazyParams& params,
-                                                     double resolution, double seconds_per_unit,
-                                                     const Termination& termination, PlanningStats& stats) {
-  const Termination term = termination.tightened(Deadline::in(params.optimize_budget_s));
-  const auto& space = si->getStateSpace();
-  std::vector<Node> nodes;
-  std::vector<Edge> edges;
-  struct Freer {
-    std::vector<Node>& n;
-    const ob::StateSpacePtr& sp;
-    ~Freer() {
-      for (auto& x : n) sp->freeState(x.s);
-    }
-  } freer{nodes, space};
-  if (seed_path.getStateCount() < 2) return std::nullopt;
+bool StaticWorldKey::operator==(const StaticWorldKey& o) const {
+  if (group != o.group || fixed != o.fixed || statics.size() != o.statics.size()) return false;
+  if (!sameObject(held, o.held)) return false;
+  if (held && !link_T_held.matrix().isApprox(o.link_T_held.matrix(), 1e-12)) return false;
+  for (std::size_t i = 0; i < statics.size(); ++i) {
+    if (!sameObject(statics[i], o.statics[i])) return false;
+  }
+  return true;
+}
 
-  // 1. The lazy path, cut into nodes; its segments are statically valid.
+struct StaticRoadmap::Impl {
+  ompl::NearestNeighborsGNATNoThreadSafety<int> nn;
+  const ob::State* probe{nullptr};  // index -1 in `nn` queries
   std::unordered_set<std::uint64_t> edge_keys;
-  auto addEdge = [&](int a, int b, bool static_valid) {
-    if (a == b) return;
-    const std::uint64_t key = (static_cast<std::uint64_t>(std::min(a, b)) << 32) | static_cast<std::uint32_t>(std::max(a, b));
-    if (!edge_keys.insert(key).second) {
-      if (static_valid) {
-        for (auto& e : edges) {
-          if ((e.a == a && e.b == b) || (e.a == b && e.b == a)) e.static_valid = true;
-        }
+  std::mt19937 rng;
+};
+
+StaticRoadmap::StaticRoadmap(ob::StateSpacePtr space, StaticWorldKey key, std::uint32_t seed, int neighbors)
+    : impl_(std::make_unique<Impl>()), space_(std::move(space)), key_(std::move(key)), neighbors_(neighbors) {
+  impl_->rng.seed(seed);
+  impl_->nn.setDistanceFunction([this](const int& a, const int& b) {
+    const ob::State* sa = a < 0 ? impl_->probe : nodes_[static_cast<std::size_t>(a)];
+    const ob::State* sb = b < 0 ? impl_->probe : nodes_[static_cast<std::size_t>(b)];
+    return space_->distance(sa, sb);
+  });
+}
+
+StaticRoadmap::~StaticRoadmap() {
+  for (auto* s : nodes_) space_->freeState(s);
+}
+
+void StaticRoadmap::addEdge(int a, int b, bool valid) {
+  if (a == b) return;
+  const std::uint64_t key =
+      (static_cast<std::uint64_t>(std::min(a, b)) << 32) | static_cast<std::uint32_t>(std::max(a, b));
+  if (!impl_->edge_keys.insert(key).second) {
+    if (valid) {
+      for (int ei : adj_[static_cast<std::size_t>(a)]) {
+        Edge& e = edges_[static_cast<std::size_t>(ei)];
+        if (e.a == b || e.b == b) e.status = Edge::kValid;
       }
-      return;
     }
-    Edge e;
-    e.a = a;
-    e.b = b;
-    e.len = space->distance(nodes[static_cast<std::size_t>(a)].s, nodes[static_cast<std::size_t>(b)].s);
-    e.static_valid = static_valid;
-    edges.push_back(std::move(e));
+    return;
+  }
+  Edge e;
+  e.a = a;
+  e.b = b;
+  e.len = space_->distance(nodes_[static_cast<std::size_t>(a)], nodes_[static_cast<std::size_t>(b)]);
+  e.status = valid ? Edge::kValid : Edge::kUnknown;
+  const int ei = static_cast<int>(edges_.size());
+  edges_.push_back(e);
+  adj_[static_cast<std::size_t>(a)].push_back(ei);
+  adj_[static_cast<std::size_t>(b)].push_back(ei);
+}
+
+int StaticRoadmap::pushNode(const ob::State* s) {
+  std::vector<int> nbrs;
+  if (!nodes_.empty()) {
+    impl_->probe = s;
+    impl_->nn.nearestK(-1, static_cast<std::size_t>(neighbors_), nbrs);
+    impl_->probe = nullptr;
+    if (!nbrs.empty() && space_->distance(s, nodes_[static_cast<std::size_t>(nbrs.front())]) < 1e-9) {
+      return nbrs.front();
+    }
+  }
+  const int i = static_cast<int>(nodes_.size());
+  nodes_.push_back(space_->cloneState(s));
+  adj_.emplace_back();
+  impl_->nn.add(i);
+  for (int j : nbrs) addEdge(i, j, false);
+  return i;
+}
+
+int StaticRoadmap::addState(const ob::State* s) { return pushNode(s); }
+
+void StaticRoadmap::addSamples(Oracle& oracle, const GroupSpace& gs, int count, const Termination& termination,
+                               int bridge_count, double bridge_distance) {
+  ob::State* tmp = space_->allocState();
+  ob::State* other = space_->allocState();
+  ob::State* mid = space_->allocState();
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  auto& rng = impl_->rng;
+  std::vector<std::pair<double, double>> ranges;
+  if (gs.hasBase()) {
+    const Aabb& b = gs.baseBounds();
+    ranges.emplace_back(b.min.x(), b.max.x());
+    ranges.emplace_back(b.min.y(), b.max.y());
+    ranges.emplace_back(-M_PI, M_PI);
+  }
+  if (gs.movesArm()) {
+    const ob::StateSpace* arm = gs.hasBase() ? gs.space()->as<ob::CompoundStateSpace>()->getSubspace(1).get()
+                                             : gs.space().get();
+    const auto& bounds = arm->as<ob::RealVectorStateSpace>()->getBounds();
+    for (std::size_t i = 0; i < bounds.low.size(); ++i) ranges.emplace_back(bounds.low[i], bounds.high[i]);
+  }
+  std::vector<double> v(ranges.size());
+  int added = 0;
+  for (int attempt = 0; added < count && attempt < 4 * count; ++attempt) {
+    if ((attempt & 31) == 0 && termination()) break;
+    for (std::size_t i = 0; i < ranges.size(); ++i) {
+      v[i] = ranges[i].first + (ranges[i].second - ranges[i].first) * unit(rng);
+    }
+    gs.setValues(v, tmp);
+    if (!oracle.staticFree(tmp)) continue;
+    pushNode(tmp);
+    ++added;
+    ++uniform_;
+  }
+  // Bridge test (Hsu et al., ICRA 2003): two states in static collision, about
+  // `bridge_distance` apart, whose midpoint is free -- a state in a narrow passage (doors,
+  // gaps between walls), where uniform samples rarely fall.
+  std::normal_distribution<double> gauss(0.0, bridge_distance / std::sqrt(static_cast<double>(ranges.size())));
+  std::vector<double> w(ranges.size());
+  added = 0;
+  for (int attempt = 0; added < bridge_count && attempt < 20 * bridge_count; ++attempt) {
+    if ((attempt & 31) == 0 && termination()) break;
+    for (std::size_t i = 0; i < ranges.size(); ++i) {
+      v[i] = ranges[i].first + (ranges[i].second - ranges[i].first) * unit(rng);
+      w[i] = std::clamp(v[i] + gauss(rng), ranges[i].first, ranges[i].second);
+    }
+    gs.setValues(v, tmp);
+    if (oracle.staticFree(tmp)) continue;
+    gs.setValues(w, other);
+    if (oracle.staticFree(other)) continue;
+    space_->interpolate(tmp, other, 0.5, mid);
+    if (!oracle.staticFree(mid)) continue;
+    pushNode(mid);
+    ++added;
+    ++uniform_;
+  }
+  space_->freeState(mid);
+  space_->freeState(other);
+  space_->freeState(tmp);
+}
+
+std::pair<int, int> StaticRoadmap::addPath(const og::PathGeometric& path, double spacing) {
+  ob::State* s = space_->allocState();
+  int prev = pushNode(path.getState(0));
+  const int first = prev;
+  for (std::size_t i = 0; i + 1 < path.getStateCount(); ++i) {
+    const ob::State* a = path.getState(i);
+    const ob::State* b = path.getState(i + 1);
+    const int pieces = std::max(1, static_cast<int>(std::ceil(space_->distance(a, b) / spacing)));
+    for (int k = 1; k <= pieces; ++k) {
+      if (k == pieces) {
+        space_->copyState(s, b);
+      } else {
+        space_->interpolate(a, b, static_cast<double>(k) / pieces, s);
+      }
+      const int cur = pushNode(s);
+      addEdge(prev, cur, true);
+      prev = cur;
+    }
+  }
+  space_->freeState(s);
+  return {first, prev};
+}
+
+std::optional<og::PathGeometric> StaticRoadmap::search(Oracle& oracle, const ob::SpaceInformationPtr& si, int start,
+                                                       const std::vector<int>& goals, const LazyParams& params,
+                                                       double resolution, double seconds_per_unit,
+                                                       const Termination& termination, PlanningStats& stats,
+                                                       int max_new_invalid) {
+  const Termination term = termination.tightened(Deadline::in(params.optimize_budget_s));
+  const std::size_t n = nodes_.size();
+  stats.roadmap_nodes = n;
+  stats.roadmap_edges = edges_.size();
+  if (goals.empty()) return std::nullopt;
+  std::vector<char> is_goal(n, 0);
+  for (int g : goals) is_goal[static_cast<std::size_t>(g)] = 1;
+
+  // Per request: the movables touched at nodes and along edges, the heuristic (all lazily).
+  std::vector<char> have_touched(n, 0);
+  std::vector<std::vector<int>> node_touched(n);
+  auto touchedAt = [&](int i) -> const std::vector<int>& {
+    const auto u = static_cast<std::size_t>(i);
+    if (!have_touched[u]) {
+      oracle.touched(nodes_[u], node_touched[u]);
+      have_touched[u] = 1;
+    }
+    return node_touched[u];
   };
-  {
-    nodes.push_back(Node{space->cloneState(seed_path.getState(0)), {}, 0.0});
-    for (std::size_t i = 0; i + 1 < seed_path.getStateCount(); ++i) {
-      const ob::State* a = seed_path.getState(i);
-      const ob::State* b = seed_path.getState(i + 1);
-      const int pieces = std::max(1, static_cast<int>(std::ceil(space->distance(a, b) / params.path_node_spacing)));
-      for (int k = 1; k <= pieces; ++k) {
-        ob::State* s = space->allocState();
-        if (k == pieces) {
-          space->copyState(s, b);
-        } else {
-          space->interpolate(a, b, static_cast<double>(k) / pieces, s);
-        }
-        nodes.push_back(Node{s, {}, 0.0});
-        addEdge(static_cast<int>(nodes.size()) - 2, static_cast<int>(nodes.size()) - 1, true);
-      }
+  std::vector<double> h(n, -1.0);
+  auto heuristic = [&](int i) {
+    const auto u = static_cast<std::size_t>(i);
+    if (h[u] < 0) {
+      double d = std::numeric_limits<double>::infinity();
+      for (int g : goals) d = std::min(d, space_->distance(nodes_[u], nodes_[static_cast<std::size_t>(g)]));
+      h[u] = d * seconds_per_unit;
     }
-  }
-  const int start = 0;
-  const int goal = static_cast<int>(nodes.size()) - 1;
-
-  // 2. Uniform samples of the static free space.
-  {
-    auto sampler = si->allocStateSampler();
-    ob::State* tmp = space->allocState();
-    int added = 0;
-    for (int attempt = 0; added < params.roadmap_samples && attempt < 4 * params.roadmap_samples; ++attempt) {
-      if ((attempt & 31) == 0 && term()) break;
-      sampler->sampleUniform(tmp);
-      if (!oracle.staticFree(tmp)) continue;
-      nodes.push_back(Node{space->cloneState(tmp), {}, 0.0});
-      ++added;
-    }
-    space->freeState(tmp);
-  }
-  for (auto& n : nodes) {
-    oracle.touched(n.s, n.touched);
-    n.h = space->distance(n.s, nodes[static_cast<std::size_t>(goal)].s) * seconds_per_unit;
-  }
-  if (term()) return std::nullopt;
-
-  // 3. k nearest neighbours.
-  {
-    ompl::NearestNeighborsGNATNoThreadSafety<int> nn;
-    nn.setDistanceFunction([&](const int& a, const int& b) {
-      return space->distance(nodes[static_cast<std::size_t>(a)].s, nodes[static_cast<std::size_t>(b)].s);
-    });
-    std::vector<int> all(nodes.size());
-    for (std::size_t i = 0; i < nodes.size(); ++i) all[i] = static_cast<int>(i);
-    nn.add(all);
-    std::vector<int> nbrs;
-    for (int i : all) {
-      nn.nearestK(i, static_cast<std::size_t>(params.roadmap_neighbors) + 1, nbrs);
-      for (int j : nbrs) addEdge(i, j, false);
-    }
-  }
-  std::vector<std::vector<int>> adj(nodes.size());
-  for (std::size_t e = 0; e < edges.size(); ++e) {
-    adj[static_cast<std::size_t>(edges[e].a)].push_back(static_cast<int>(e));
-    adj[static_cast<std::size_t>(edges[e].b)].push_back(static_cast<int>(e));
-  }
-  stats.roadmap_nodes = nodes.size();
-  stats.roadmap_edges = edges.size();
-
-  auto weight = [&](int u, const Edge& e) {
+    return h[u];
+  };
+  std::vector<char> evaluated(edges_.size(), 0);  // in this request (movables)
+  std::vector<std::vector<int>> edge_touched(edges_.size());
+  auto weight = [&](int u, int ei) {
+    const Edge& e = edges_[static_cast<std::size_t>(ei)];
     const int v = e.a == u ? e.b : e.a;
-    const auto& objs = e.status == Edge::kValid ? e.touched : nodes[static_cast<std::size_t>(v)].touched;
-    return e.len * seconds_per_unit + enteringCost(oracle, objs, nodes[static_cast<std::size_t>(u)].touched);
+    const auto& objs = evaluated[static_cast<std::size_t>(ei)] ? edge_touched[static_cast<std::size_t>(ei)] : touchedAt(v);
+    return e.len * seconds_per_unit + enteringCost(oracle, objs, touchedAt(u));
   };
 
-  // 4. LazySP with A*.
-  std::vector<double> g(nodes.size());
-  std::vector<int> parent_edge(nodes.size());
-  std::vector<char> closed(nodes.size());
+  std::vector<double> g(n);
+  std::vector<int> parent_edge(n);
+  std::vector<char> closed(n);
   using QItem = std::pair<double, int>;
-  while (!term()) {
-    ++stats.search_iterations;
-    std::fill(g.begin(), g.end(), std::numeric_limits<double>::infinity());
-    std::fill(parent_edge.begin(), parent_edge.end(), -1);
-    std::fill(closed.begin(), closed.end(), 0);
-    std::priority_queue<QItem, std::vector<QItem>, std::greater<>> open;
-    g[start] = 0.0;
-    open.emplace(nodes[start].h, start);
-    while (!open.empty()) {
-      const auto [f, u] = open.top();
-      open.pop();
-      if (closed[static_cast<std::size_t>(u)]) continue;
-      closed[static_cast<std::size_t>(u)] = 1;
-      if (u == goal) break;
-      for (int ei : adj[static_cast<std::size_t>(u)]) {
-        const Edge& e = edges[static_cast<std::size_t>(ei)];
-        if (e.status == Edge::kInvalid) continue;
-        const int v = e.a == u ? e.b : e.a;
-        if (closed[static_cast<std::size_t>(v)]) continue;
-        const double gv = g[static_cast<std::size_t>(u)] + weight(u, e);
-        if (gv < g[static_cast<std::size_t>(v)]) {
-          g[static_cast<std::size_t>(v)] = gv;
-          parent_edge[static_cast<std::size_t>(v)] = ei;
-          open.emplace(gv + nodes[static_cast<std::size_t>(v)].h, v);
+  enum class Outcome { kFound, kDisconnected, kBudget, kUnconnected };
+  std::vector<std::pair<int, int>> route;  // (from node, edge) start -> goal
+  // LazySP; `known_only`: over the edges known to be statically valid (no static checks, only
+  // the movables along them are evaluated).
+  auto lazySp = [&](bool known_only, int max_evaluations, int invalid_cap) {
+    int evaluations = 0;
+    int new_invalid = 0;
+    while (!term()) {
+      ++stats.search_iterations;
+      std::fill(g.begin(), g.end(), std::numeric_limits<double>::infinity());
+      std::fill(parent_edge.begin(), parent_edge.end(), -1);
+      std::fill(closed.begin(), closed.end(), 0);
+      std::priority_queue<QItem, std::vector<QItem>, std::greater<>> open;
+      g[static_cast<std::size_t>(start)] = 0.0;
+      open.emplace(heuristic(start), start);
+      int reached = -1;
+      while (!open.empty()) {
+        const int u = open.top().second;
+        open.pop();
+        if (closed[static_cast<std::size_t>(u)]) continue;
+        closed[static_cast<std::size_t>(u)] = 1;
+        if (is_goal[static_cast<std::size_t>(u)]) {
+          reached = u;
+          break;
+        }
+        for (int ei : adj_[static_cast<std::size_t>(u)]) {
+          const Edge& e = edges_[static_cast<std::size_t>(ei)];
+          if (e.status == Edge::kInvalid || (known_only && e.status != Edge::kValid)) continue;
+          const int v = e.a == u ? e.b : e.a;
+          if (closed[static_cast<std::size_t>(v)]) continue;
+          const double gv = g[static_cast<std::size_t>(u)] + weight(u, ei);
+          if (gv < g[static_cast<std::size_t>(v)]) {
+            g[static_cast<std::size_t>(v)] = gv;
+            parent_edge[static_cast<std::size_t>(v)] = ei;
+            open.emplace(gv + heuristic(v), v);
+          }
         }
       }
-    }
-    if (!std::isfinite(g[static_cast<std::size_t>(goal)])) return std::nullopt;  // cannot happen: the seed path
-    std::vector<std::pair<int, int>> route;  // (from node, edge) start -> goal
-    for (int v = goal; v != start;) {
-      const int ei = parent_edge[static_cast<std::size_t>(v)];
-      const Edge& e = edges[static_cast<std::size_t>(ei)];
-      const int u = e.a == v ? e.b : e.a;
-      route.emplace_back(u, ei);
-      v = u;
-    }
-    std::reverse(route.begin(), route.end());
-    bool changed = false;
-    for (const auto& [u, ei] : route) {
-      Edge& e = edges[static_cast<std::size_t>(ei)];
-      if (e.status != Edge::kUnknown) continue;
-      if (term()) return std::nullopt;
-      const double before = weight(u, e);
-      SegmentInfo info = evaluateSegment(oracle, nodes[static_cast<std::size_t>(e.a)].s,
-                                         nodes[static_cast<std::size_t>(e.b)].s, resolution, e.static_valid);
-      ++stats.edges_evaluated;
-      if (!info.valid) {
-        e.status = Edge::kInvalid;
-        changed = true;
-        break;
+      if (reached < 0) return Outcome::kDisconnected;
+      route.clear();
+      for (int v = reached; v != start;) {
+        const int ei = parent_edge[static_cast<std::size_t>(v)];
+        const Edge& e = edges_[static_cast<std::size_t>(ei)];
+        const int u = e.a == v ? e.b : e.a;
+        route.emplace_back(u, ei);
+        v = u;
       }
-      e.status = Edge::kValid;
-      e.touched = std::move(info.touched);
-      if (weight(u, e) > before + 1e-9) changed = true;
-    }
-    if (!changed) {
-      og::PathGeometric out(si);
-      out.append(nodes[start].s);
+      std::reverse(route.begin(), route.end());
+      bool changed = false;
       for (const auto& [u, ei] : route) {
-        const Edge& e = edges[static_cast<std::size_t>(ei)];
-        out.append(nodes[static_cast<std::size_t>(e.a == u ? e.b : e.a)].s);
+        const auto eu = static_cast<std::size_t>(ei);
+        if (evaluated[eu]) continue;
+        if (term() || evaluations >= max_evaluations) return Outcome::kBudget;
+        Edge& e = edges_[eu];
+        const double before = weight(u, ei);
+        SegmentInfo info = evaluateSegment(oracle, nodes_[static_cast<std::size_t>(e.a)],
+                                           nodes_[static_cast<std::size_t>(e.b)], resolution, e.status == Edge::kValid);
+        ++evaluations;
+        ++stats.edges_evaluated;
+        if (!info.valid) {
+          // The rest of the route is evaluated too: on a new roadmap most candidates cross a
+          // wall somewhere, and one A* run per invalid edge found would dominate the time.
+          e.status = Edge::kInvalid;
+          changed = true;
+          if (invalid_cap > 0 && ++new_invalid >= invalid_cap) return Outcome::kUnconnected;
+          continue;
+        }
+        e.status = Edge::kValid;
+        evaluated[eu] = 1;
+        edge_touched[eu] = std::move(info.touched);
+        if (weight(u, ei) > before + 1e-9) changed = true;
       }
-      stats.optimize_completed = true;
-      return out;
+      if (!changed) return Outcome::kFound;
     }
+    return Outcome::kBudget;
+  };
+  Outcome outcome = lazySp(false, params.roadmap_max_evaluations, max_new_invalid);
+  if (outcome == Outcome::kFound) {
+    stats.optimize_completed = true;
+  } else if (outcome == Outcome::kBudget) {
+    // Anytime completion (evaluation budget spent, not after `max_new_invalid`: a roadmap that
+    // keeps finding walls is left to lazy KPIECE): the best path over the edges known to be
+    // statically valid (earlier requests, lazy KPIECE paths, this search); their movables are
+    // evaluated as needed.
+    outcome = lazySp(true, std::numeric_limits<int>::max(), 0);
   }
-  return std::nullopt;
+  if (outcome != Outcome::kFound) return std::nullopt;
+  og::PathGeometric out(si);
+  out.append(nodes_[static_cast<std::size_t>(start)]);
+  for (const auto& [u, ei] : route) {
+    const Edge& e = edges_[static_cast<std::size_t>(ei)];
+    out.append(nodes_[static_cast<std::size_t>(e.a == u ? e.b : e.a)]);
+  }
+  return out;
 }
 
 }  // namespace tamp::motion_planner::detail

@@ -28,10 +28,24 @@
 ///     the edges of each candidate are then evaluated (static validity and the movables touched
 ///     along them, checked densely), and the search repeats until the best candidate is fully
 ///     evaluated (LazySP: Dellin & Srinivasa, ICAPS 2016; lazy edge evaluation as in Bohlin &
-///     Kavraki's Lazy PRM, ICRA 2000). Because the raw path is in the roadmap, the result never
-///     costs more than it. Effort-aware shortcutting follows: a shortcut is taken when the
-///     static check passes and J decreases, so it never adds an object whose effort exceeds the
-///     length it saves.
+///     Kavraki's Lazy PRM, ICRA 2000). Effort-aware shortcutting follows: a shortcut is taken
+///     when the static check passes and J decreases, so it never adds an object whose effort
+///     exceeds the length it saves.
+///     *Roadmap cache*: the graph manager asks many motions against one static world while the
+///     movables change, so the roadmap is kept in the planner per planning group and static
+///     world (static objects, held object and where it is held, the joints the group does not
+///     move; see detail::StaticWorldKey) -- movables are costs, not part of it -- and grows across
+///     requests: starts and goals become nodes, edges keep their static validity once evaluated.
+///     A new roadmap draws `roadmap_samples` uniform and `roadmap_bridge_samples` bridge-test
+///     samples and is seeded with lazy KPIECE's path. Later, for the base group, the cached
+///     roadmap is searched first; lazy KPIECE runs only when the roadmap cannot connect
+///     start and goal within `roadmap_max_evaluations` edge evaluations, and its path (whose
+///     edges are valid) is then added to the roadmap with `roadmap_growth_samples` more samples
+///     and searched again, so the result never costs more than the lazy KPIECE path. Other
+///     groups run lazy KPIECE first and seed the cached roadmap with its path. A changed static
+///     world or held object selects another roadmap (LRU, `roadmap_cache_entries`). Budgets are
+///     counts, so a request's result depends on the seeds and the requests before it, not on
+///     the machine's load (a wall-clock safety cap and the request's deadline apply on top).
 ///  3. *Blocking report*: the final path is checked densely against movables; per object its id,
 ///     where contact starts and ends (waypoint index and path fraction), the swept states and
 ///     base poses while in contact, its mass and effort.
@@ -53,7 +67,8 @@
 ///
 /// **Scene**: one `collision::Scene` per planner mirrors the world (`setWorld` applies only the
 /// diff, so updates between calls are cheap); FCL is reached only through tamp::collision and
-/// OMPL only in this library's .cc files. A planner is not thread-safe: one per thread.
+/// OMPL only in this library's .cc files. A planner is not thread-safe (scene and roadmap cache
+/// are mutated by every call): one per thread, or calls serialised (the DDS node holds a mutex).
 ///
 /// **Determinism**: call `seedRandomness()` once before the first planner exists (OMPL's global
 /// seed); the library's own samplers are seeded from `MotionPlannerParams::seed`.
@@ -143,7 +158,7 @@ struct BlockingObject {
 /// Diagnostics of one call (milliseconds, counts).
 struct PlanningStats {
   double sampling_ms{0.0};      ///< lazy KPIECE (or the full-mode planner)
-  double optimize_ms{0.0};      ///< roadmap search (lazy)
+  double optimize_ms{0.0};      ///< roadmap build/growth and search (lazy)
   double shortcut_ms{0.0};
   double analysis_ms{0.0};      ///< blocking report
   double proof_ms{0.0};         ///< full mode: infeasibility grid
@@ -152,10 +167,14 @@ struct PlanningStats {
   std::size_t roadmap_edges{0};
   std::size_t edges_evaluated{0};
   int search_iterations{0};
+  /// Lazy mode: the path source's path before optimization -- lazy KPIECE's raw path, or the
+  /// cached roadmap's path when the roadmap answered the request (`lazy_planner_used` false).
   double raw_path_length{0.0};  ///< the planner's raw path (lazy: before optimization)
   std::vector<std::string> raw_blocking;  ///< movables the raw lazy path crosses
   double raw_cost_s{0.0};       ///< J of the raw lazy path
   bool optimize_completed{false};  ///< the roadmap search finished before its budget
+  bool roadmap_reused{false};   ///< lazy: the cached roadmap of this static world was reused
+  bool lazy_planner_used{false};  ///< lazy: lazy KPIECE ran (roadmap_first off, or the roadmap could not connect)
 };
 
 struct MotionResult {
@@ -211,6 +230,11 @@ class MotionPlanner {
   std::vector<std::string> groupJointNames(PlanningGroup group) const;
   /// Radius of the robot's footprint (base) around the base origin, m.
   double footprintRadius() const;
+
+  /// Drops every cached roadmap (the next lazy request builds its roadmap from scratch).
+  void clearRoadmapCache();
+  /// Number of cached roadmaps.
+  std::size_t roadmapCacheSize() const;
 
   /// Plans one motion. Never throws for bad input: a malformed request gives kInvalidRequest
   /// naming the field. Checks `termination` throughout.

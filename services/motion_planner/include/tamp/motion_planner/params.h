@@ -46,13 +46,29 @@ struct SamplingParams {
   PlannerKind arm_planner{PlannerKind::kKpiece};
 };
 
-/// Lazy mode: making the lazy path worth executing (see motion_planner.h).
+/// Lazy mode: making the lazy path worth executing (see motion_planner.h). The roadmap of the
+/// static free space is cached per planning group and static world (motion_planner.h, "Roadmap
+/// cache") and grows across requests; its budgets are counts (deterministic), with a wall-clock
+/// safety cap and the request's deadline on top.
 struct LazyParams {
   bool optimize{true};              ///< effort-aware roadmap search + shortcutting of the lazy path
-  int roadmap_samples{600};         ///< uniform samples of the static free space; >= 0
+  int roadmap_samples{600};         ///< uniform samples of the static free space in a new roadmap; >= 0
+  int roadmap_bridge_samples{200};  ///< bridge-test samples (narrow passages) in a new roadmap; >= 0
+  double roadmap_bridge_distance{0.8};  ///< typical distance of a bridge's two colliding ends (space metric); > 0
   int roadmap_neighbors{12};        ///< k of the k-nearest-neighbour connections; >= 2
-  double path_node_spacing{0.5};    ///< the lazy path is cut into roadmap nodes this far apart (space metric); > 0
-  double optimize_budget_s{0.04};   ///< time cap of the roadmap search (the request's deadline also applies); > 0
+  double path_node_spacing{0.5};    ///< a lazy KPIECE path is cut into roadmap nodes this far apart (space metric); > 0
+  int roadmap_max_evaluations{1000}; ///< edge evaluations per roadmap search before it gives up; >= 1
+  /// Roadmap-first search: it gives up (lazy KPIECE runs) after finding this many edges newly
+  /// statically invalid -- a roadmap that does not connect start and goal shows that way; >= 1
+  int roadmap_max_new_invalid{30};
+  int roadmap_growth_samples{100};  ///< uniform samples added when a request falls back to lazy KPIECE; >= 0
+  int roadmap_max_nodes{4000};      ///< no uniform samples are added beyond this many nodes; >= 1
+  int roadmap_cache_entries{4};     ///< roadmaps kept per planner (static world x group x held object), LRU; 0: none kept
+  /// Base group: search the cached roadmap first (when it existed before the request) and run
+  /// lazy KPIECE only when it cannot connect start and goal; false (and other groups, and a new
+  /// roadmap): lazy KPIECE first, its path then seeds the roadmap.
+  bool roadmap_first{true};
+  double optimize_budget_s{0.5};    ///< wall-clock cap of one roadmap search (safety net; the request's deadline also applies); > 0
   int shortcut_attempts{150};       ///< effort-aware shortcut attempts; >= 0
   double contact_resolution{0.01};  ///< dense re-check of the final path against movables, space metric; > 0
   double swept_spacing{0.05};       ///< spacing of the reported swept states, space metric; > 0

@@ -1,0 +1,161 @@
+// The roadmap cache of the lazy mode: reused across requests while only movables change, with the
+// same quality; a changed static world or held object selects another roadmap.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include "tamp/motion_planner/motion_planner.h"
+#include "test_worlds.h"
+
+namespace tamp::motion_planner {
+namespace {
+
+using testing::discClearance;
+using testing::discTouches;
+
+constexpr double kRadius = 0.3;
+
+MotionPlannerParams params() {
+  MotionPlannerParams p;
+  p.lazy.optimize_budget_s = 30.0;  // deterministic: the evaluation counts decide (see lazy_test.cc)
+  p.lazy.roadmap_max_evaluations = 1000000;
+  return p;
+}
+
+MotionRequest baseRequest(Pose2D from, Pose2D to) {
+  MotionRequest r;
+  r.group = PlanningGroup::kBase;
+  r.mode = MotionMode::kLazy;
+  r.start.base = from;
+  r.goal = MotionGoal::basePoseGoal(to);
+  return r;
+}
+
+std::vector<std::string> ids(const std::vector<BlockingObject>& b) {
+  std::vector<std::string> out;
+  for (const auto& o : b) out.push_back(o.object_id);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+class RoadmapCacheTest : public ::testing::Test {
+ protected:
+  void SetUp() override { seedRandomness(42); }
+};
+
+TEST_F(RoadmapCacheTest, ReuseGivesTheSameQualityAndMovablesDoNotInvalidate) {
+  world::World w = testing::twoDoorWorld();
+  MotionPlanner mp(collision::RobotGeometry::disc(kRadius, 1.0), params());
+  mp.setWorld(w);
+  const MotionRequest req = baseRequest({2, 0.9, 0}, {8, 0.9, 0});
+  const MotionResult cold = mp.plan(req, Termination::after(5.0));
+  ASSERT_EQ(cold.status, MotionStatus::kSolved) << cold.reason;
+  EXPECT_FALSE(cold.stats.roadmap_reused);
+  EXPECT_TRUE(cold.stats.lazy_planner_used);  // a new roadmap is seeded by lazy KPIECE
+  EXPECT_EQ(ids(cold.blocking), std::vector<std::string>{"light"});
+  EXPECT_EQ(mp.roadmapCacheSize(), 1u);
+
+  // Another query from elsewhere, then the same query again: the roadmap answers.
+  const MotionResult other = mp.plan(baseRequest({1, 3, 0}, {9, 1, 0}), Termination::after(5.0));
+  ASSERT_EQ(other.status, MotionStatus::kSolved) << other.reason;
+  EXPECT_TRUE(other.stats.roadmap_reused);
+  EXPECT_GT(discClearance(w, other.path, kRadius, 0.005, {}, /*movables=*/false), -1e-3);
+  EXPECT_EQ(discTouches(w, other.path, kRadius, 0.005), ids(other.blocking));
+  const MotionResult warm = mp.plan(req, Termination::after(5.0));
+  ASSERT_EQ(warm.status, MotionStatus::kSolved) << warm.reason;
+  EXPECT_TRUE(warm.stats.roadmap_reused);
+  EXPECT_FALSE(warm.stats.lazy_planner_used);
+  EXPECT_EQ(ids(warm.blocking), ids(cold.blocking));
+  EXPECT_EQ(discTouches(w, warm.path, kRadius, 0.005), ids(warm.blocking));
+  EXPECT_GT(discClearance(w, warm.path, kRadius, 0.005, {}, false), -1e-3);
+  EXPECT_LE(warm.cost_s, cold.cost_s * 1.05) << "cold " << cold.cost_s << " warm " << warm.cost_s;
+
+  // Movables change: the light box leaves door B. Same roadmap, and the path is now free.
+  Eigen::Isometry3d p = w.object("light").pose;
+  p.translation().x() = 8.5;
+  p.translation().y() = 3.5;
+  ASSERT_TRUE(w.setObjectPose("light", p).ok());
+  mp.setWorld(w);
+  const MotionResult moved = mp.plan(req, Termination::after(5.0));
+  ASSERT_EQ(moved.status, MotionStatus::kSolved) << moved.reason;
+  EXPECT_TRUE(moved.stats.roadmap_reused);
+  EXPECT_TRUE(moved.blocking.empty()) << moved.blocking.front().object_id;
+  EXPECT_TRUE(discTouches(w, moved.path, kRadius, 0.005).empty());
+  EXPECT_EQ(mp.roadmapCacheSize(), 1u);
+}
+
+TEST_F(RoadmapCacheTest, StaticWorldChangeInvalidates) {
+  world::World w = testing::twoDoorWorld();
+  MotionPlanner mp(collision::RobotGeometry::disc(kRadius, 1.0), params());
+  mp.setWorld(w);
+  const MotionRequest req = baseRequest({2, 0.9, 0}, {8, 0.9, 0});
+  const MotionResult first = mp.plan(req, Termination::after(5.0));
+  ASSERT_EQ(first.status, MotionStatus::kSolved) << first.reason;
+  ASSERT_EQ(ids(first.blocking), std::vector<std::string>{"light"});  // through door B
+  ASSERT_TRUE(mp.plan(req, Termination::after(5.0)).stats.roadmap_reused);
+
+  // A static wall closes door B: the cached roadmap's edges through it are no longer valid.
+  ASSERT_TRUE(w.addObject(testing::box("door_b_closed", 5.0, 3.1, 0.2, 1.0, false)).ok());
+  ASSERT_TRUE(w.removeObject("light").ok());
+  mp.setWorld(w);
+  const MotionResult closed = mp.plan(req, Termination::after(5.0));
+  ASSERT_EQ(closed.status, MotionStatus::kSolved) << closed.reason;
+  EXPECT_FALSE(closed.stats.roadmap_reused);
+  EXPECT_GT(discClearance(w, closed.path, kRadius, 0.005, {}, /*movables=*/false), -1e-3);
+  EXPECT_EQ(ids(closed.blocking), (std::vector<std::string>{"heavy_a", "heavy_b"}));
+
+  // A moved static object invalidates too.
+  world::World w2 = w;
+  Eigen::Isometry3d p = w2.object("door_b_closed").pose;
+  p.translation().x() = 1.0;
+  ASSERT_TRUE(w2.setObjectPose("door_b_closed", p).ok());
+  mp.setWorld(w2);
+  const MotionResult reopened = mp.plan(req, Termination::after(5.0));
+  ASSERT_EQ(reopened.status, MotionStatus::kSolved) << reopened.reason;
+  EXPECT_FALSE(reopened.stats.roadmap_reused);
+  EXPECT_GT(discClearance(w2, reopened.path, kRadius, 0.005, {}, false), -1e-3);
+  EXPECT_TRUE(reopened.blocking.empty());  // door B is open and free now
+
+  // Back to the first static world: its roadmap is still cached (LRU), and still right.
+  mp.setWorld(w);
+  const MotionResult again = mp.plan(req, Termination::after(5.0));
+  ASSERT_EQ(again.status, MotionStatus::kSolved) << again.reason;
+  EXPECT_TRUE(again.stats.roadmap_reused);
+  EXPECT_GT(discClearance(w, again.path, kRadius, 0.005, {}, false), -1e-3);
+
+  mp.clearRoadmapCache();
+  EXPECT_EQ(mp.roadmapCacheSize(), 0u);
+  EXPECT_FALSE(mp.plan(req, Termination::after(5.0)).stats.roadmap_reused);
+}
+
+TEST_F(RoadmapCacheTest, HeldObjectChangeInvalidates) {
+  world::World w = testing::twoDoorWorld();
+  ASSERT_TRUE(w.addObject(testing::box("parcel", 2.0, 1.35, 0.2, 0.2, true, 0.3, 1.0)).ok());
+  MotionPlanner mp(collision::RobotGeometry::disc(kRadius, 1.0), params());
+  mp.setWorld(w);
+  MotionRequest req = baseRequest({2, 0.9, 0}, {8, 0.9, 0});
+  ASSERT_TRUE(mp.plan(req, Termination::after(5.0)).ok());
+  ASSERT_TRUE(mp.plan(req, Termination::after(5.0)).stats.roadmap_reused);
+
+  req.held_object = "parcel";  // the robot carries it: its static free space is smaller
+  const MotionResult held = mp.plan(req, Termination::after(5.0));
+  ASSERT_EQ(held.status, MotionStatus::kSolved) << held.reason;
+  EXPECT_FALSE(held.stats.roadmap_reused);
+  EXPECT_EQ(std::count(held.stats.raw_blocking.begin(), held.stats.raw_blocking.end(), "parcel"), 0);
+  EXPECT_EQ(mp.roadmapCacheSize(), 2u);
+  EXPECT_TRUE(mp.plan(req, Termination::after(5.0)).stats.roadmap_reused);
+
+  // Held at another place on the robot (the start differs relative to the parcel): another roadmap.
+  MotionRequest req2 = req;
+  req2.start.base = Pose2D{2.0, 0.85, 0.0};
+  const MotionResult regrasped = mp.plan(req2, Termination::after(5.0));
+  ASSERT_EQ(regrasped.status, MotionStatus::kSolved) << regrasped.reason;
+  EXPECT_FALSE(regrasped.stats.roadmap_reused);
+
+  // Put down again: the first roadmap is still cached.
+  req.held_object.clear();
+  EXPECT_TRUE(mp.plan(req, Termination::after(5.0)).stats.roadmap_reused);
+}
+
+}  // namespace
+}  // namespace tamp::motion_planner

@@ -61,7 +61,9 @@ int main(int argc, char** argv) {
   std::string domain, problem, search = "ehc", heuristic, cost_type, plan_out, validate_plan;
   double timeout = 0.0, weight = 5.0;
   size_t memory_mb = 4096;
-  bool stats = false, no_check = false, no_fallback = false, no_agenda = false, first_improvement = false;
+  bool stats = false, no_check = false, no_fallback = false, no_agenda = false, first_improvement = false,
+       no_ff_first = false;
+  uint64_t ff_budget = 300;
   app.add_option("domain", domain, "PDDL domain file")->required();
   app.add_option("problem", problem, "PDDL problem file")->required();
   app.add_option("--search", search, "ehc (FF: hill-climbing, then best-first), gbfs, wastar, astar")
@@ -83,6 +85,10 @@ int main(int argc, char** argv) {
   app.add_flag("--no-goal-agenda", no_agenda, "ehc: pursue all goals at once (no FF goal agenda)");
   app.add_flag("--ehc-first-improvement", first_improvement,
                "ehc: continue from the first better state (FF) instead of the best sibling");
+  app.add_flag("--no-ehc-ff-first", no_ff_first,
+               "ehc: no first hill-climbing run with FF-v2.3's variant of the relaxed plan");
+  app.add_option("--ehc-ff-budget", ff_budget,
+                 "ehc: evaluations allowed to that first run per unit of the initial h (0 = no first run)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -100,6 +106,8 @@ int main(int argc, char** argv) {
   req.search.ehc_fallback = !no_fallback;
   req.search.goal_agenda = !no_agenda;
   req.search.ehc_best_sibling = !first_improvement;
+  req.search.ehc_ff_first = !no_ff_first;
+  req.search.ehc_ff_budget_per_h = ff_budget;
   if (heuristic == "ff") req.search.heuristic = sp::HeuristicKind::kFF;
   if (heuristic == "add") req.search.heuristic = sp::HeuristicKind::kAdd;
   if (heuristic == "max") req.search.heuristic = sp::HeuristicKind::kMax;
@@ -113,11 +121,12 @@ int main(int argc, char** argv) {
   if (stats) {
     std::fprintf(stderr,
                  "; status %s; parse %.4f s, ground %.4f s, search %.4f s; facts %zu, operators %zu; "
-                 "expanded %llu, evaluated %llu, initial h %lld%s\n",
+                 "expanded %llu, evaluated %llu, initial h %lld%s%s\n",
                  sp::toString(reply.status).c_str(), reply.stats.parse_seconds, reply.stats.ground_seconds,
                  reply.stats.search_seconds, reply.stats.facts, reply.stats.operators,
                  static_cast<unsigned long long>(reply.stats.expanded),
                  static_cast<unsigned long long>(reply.stats.evaluated), static_cast<long long>(reply.stats.initial_h),
+                 reply.stats.ehc_ff_failed ? "; ehc with FF-v2.3's relaxed plan failed, restarted" : "",
                  reply.stats.ehc_failed ? "; ehc failed, used gbfs" : "");
   }
   if (reply.status != sp::PlanStatus::kSolved) {

@@ -7,7 +7,430 @@ namespace tamp::symbolic_planner {
 namespace {
 
 constexpr Cost kInf = Heuristic::kDeadEnd;
+constexpr uint32_t kNone = UINT32_MAX;
 
+/// The delete relaxation of a task in flat (CSR) arrays. A relaxed operator ("rop", FF's
+/// "effect") is an operator's unconditional part or one of its conditional effects, with the
+/// effect condition added to the precondition. Built once per heuristic object.
+struct RelaxedOps {
+  std::vector<OpId> op;              ///< rop -> operator
+  std::vector<int32_t> ce;           ///< rop -> conditional effect index, -1 = unconditional part
+  std::vector<uint32_t> pre_begin, pre;
+  std::vector<uint32_t> add_begin, add;
+  std::vector<uint32_t> count;       ///< number of preconditions
+  std::vector<Cost> cost;            ///< adjusted cost of the operator
+  std::vector<uint32_t> pre_of_begin, pre_of;  ///< fact -> rops that need it
+  std::vector<uint32_t> adders_begin, adders;  ///< fact -> rops that add it (in rop order)
+  std::vector<uint32_t> no_pre;
+  /// rop -> other rops of the same operator that fire whenever it fires (their condition is a
+  /// subset of its condition; FF's "implied effects").
+  std::vector<uint32_t> implied_begin, implied;
+
+  size_t size() const { return op.size(); }
+
+  void build(const Task& task, CostType ct) {
+    const size_t nf = task.numFacts();
+    std::vector<uint32_t> pre_count(nf + 1, 0), add_count(nf + 1, 0);
+    std::vector<FactId> tmp;
+    std::vector<uint32_t> op_first(task.ops.size() + 1, 0);
+    auto addRop = [&](OpId o, int32_t c, const std::vector<FactId>& p1, const std::vector<FactId>* p2,
+                      const std::vector<FactId>& adds) {
+      if (adds.empty()) return;
+      tmp.assign(p1.begin(), p1.end());
+      if (p2) {
+        tmp.insert(tmp.end(), p2->begin(), p2->end());
+        std::sort(tmp.begin(), tmp.end());
+        tmp.erase(std::unique(tmp.begin(), tmp.end()), tmp.end());
+      }
+      op.push_back(o);
+      ce.push_back(c);
+      pre_begin.push_back(static_cast<uint32_t>(pre.size()));
+      pre.insert(pre.end(), tmp.begin(), tmp.end());
+      add_begin.push_back(static_cast<uint32_t>(add.size()));
+      add.insert(add.end(), adds.begin(), adds.end());
+      count.push_back(static_cast<uint32_t>(tmp.size()));
+      cost.push_back(adjustedCost(task.ops[o], ct, task.unit_cost));
+      for (FactId f : tmp) ++pre_count[f];
+      for (FactId f : adds) ++add_count[f];
+    };
+    for (OpId o = 0; o < task.ops.size(); ++o) {
+      const Operator& x = task.ops[o];
+      op_first[o] = static_cast<uint32_t>(op.size());
+      addRop(o, -1, x.pre, nullptr, x.add);
+      for (size_t c = 0; c < x.cond_effects.size(); ++c) {
+        addRop(o, static_cast<int32_t>(c), x.pre, &x.cond_effects[c].cond, x.cond_effects[c].add);
+      }
+    }
+    op_first[task.ops.size()] = static_cast<uint32_t>(op.size());
+    const uint32_t n = static_cast<uint32_t>(op.size());
+    pre_begin.push_back(static_cast<uint32_t>(pre.size()));
+    add_begin.push_back(static_cast<uint32_t>(add.size()));
+    // Inverted indices by counting sort: rops stay in increasing order per fact.
+    auto invert = [&](const std::vector<uint32_t>& counts, const std::vector<uint32_t>& begin,
+                      const std::vector<uint32_t>& items, std::vector<uint32_t>& out_begin,
+                      std::vector<uint32_t>& out) {
+      out_begin.assign(nf + 1, 0);
+      for (size_t f = 0; f < nf; ++f) out_begin[f + 1] = out_begin[f] + counts[f];
+      out.resize(out_begin[nf]);
+      std::vector<uint32_t> fill(out_begin.begin(), out_begin.end() - 1);
+      for (uint32_t r = 0; r < n; ++r) {
+        for (uint32_t i = begin[r]; i < begin[r + 1]; ++i) out[fill[items[i]]++] = r;
+      }
+    };
+    invert(pre_count, pre_begin, pre, pre_of_begin, pre_of);
+    invert(add_count, add_begin, add, adders_begin, adders);
+    for (uint32_t r = 0; r < n; ++r) {
+      if (count[r] == 0) no_pre.push_back(r);
+    }
+    // Implied effects: within each operator, rop j is implied by rop i when cond(j) is a subset
+    // of cond(i) (the unconditional part is implied by every conditional effect).
+    implied_begin.assign(n + 1, 0);
+    for (OpId o = 0; o < task.ops.size(); ++o) {
+      const Operator& x = task.ops[o];
+      for (uint32_t i = op_first[o]; i < op_first[o + 1]; ++i) {
+        implied_begin[i] = static_cast<uint32_t>(implied.size());
+        if (ce[i] < 0) continue;  // the unconditional part implies no conditional effect
+        const auto& ci = x.cond_effects[static_cast<size_t>(ce[i])].cond;
+        for (uint32_t j = op_first[o]; j < op_first[o + 1]; ++j) {
+          if (j == i) continue;
+          if (ce[j] < 0) {
+            implied.push_back(j);
+            continue;
+          }
+          const auto& cj = x.cond_effects[static_cast<size_t>(ce[j])].cond;
+          if (std::includes(ci.begin(), ci.end(), cj.begin(), cj.end())) implied.push_back(j);
+        }
+      }
+    }
+    implied_begin[n] = static_cast<uint32_t>(implied.size());
+  }
+};
+
+/// Goal facts of the current goal: per fact, the conjuncts it belongs to (reset-free lookups).
+class GoalIndex {
+ public:
+  void set(const Goal& goal, size_t num_facts) {
+    if (first_.size() != num_facts) first_.assign(num_facts, kNone);
+    for (const auto& [f, c] : pairs_) first_[f] = kNone;
+    pairs_.clear();
+    for (uint32_t c = 0; c < goal.conjuncts.size(); ++c) {
+      for (FactId f : goal.conjuncts[c].pos) pairs_.push_back({f, c});
+    }
+    std::sort(pairs_.begin(), pairs_.end());
+    pairs_.erase(std::unique(pairs_.begin(), pairs_.end()), pairs_.end());
+    for (uint32_t i = static_cast<uint32_t>(pairs_.size()); i-- > 0;) first_[pairs_[i].first] = i;
+    sizes_.assign(goal.conjuncts.size(), 0);
+    for (const auto& [f, c] : pairs_) ++sizes_[c];
+  }
+  bool isGoal(FactId f) const { return first_[f] != kNone; }
+  /// Calls fn(conjunct) for every conjunct that contains f.
+  template <typename Fn>
+  void forEach(FactId f, const Fn& fn) const {
+    for (uint32_t i = first_[f]; i < pairs_.size() && pairs_[i].first == f; ++i) fn(pairs_[i].second);
+  }
+  const std::vector<uint32_t>& sizes() const { return sizes_; }
+
+ private:
+  std::vector<uint32_t> first_;
+  std::vector<std::pair<FactId, uint32_t>> pairs_;
+  std::vector<uint32_t> sizes_;
+};
+
+bool holdsAll(const uint64_t* s, const std::vector<FactId>& facts) {
+  for (FactId f : facts) {
+    if (!testBit(s, f)) return false;
+  }
+  return true;
+}
+
+// -------------------------------------------------------------------------------------------------
+/// FF's own heuristic (Hoffmann & Nebel 2001, Sec. 4.3) for tasks in which every operator costs the
+/// same (h = that cost times the number of operators in the relaxed plan): a layered relaxed planning graph built breadth-first only up to the first layer that contains
+/// a goal conjunct, a relaxed plan extracted backwards layer by layer (achievers of the previous
+/// layer with the least difficulty; the adds of a selected achiever count as true at its layer
+/// and the one below; each operator counted once), and helpful actions: the applicable operators
+/// that add a layer-1 sub-goal, the relaxed plan's own first-layer actions first, or in FF-v2.3's
+/// order (`setFFStyle`). Every array is reset through the lists of what the last evaluation
+/// touched (no per-evaluation pass over all facts or operators).
+class LayeredFF : public Heuristic {
+ public:
+  LayeredFF(const Task& task, CostType ct, Cost unit) : task_(task), unit_(unit) {
+    R_.build(task, ct);
+    const size_t nf = task.numFacts(), nr = R_.size();
+    level_.assign(nf, kNone);
+    ctr_.resize(nr);
+    for (uint32_t r = 0; r < nr; ++r) ctr_[r] = {R_.count[r], R_.count[r]};
+    rop_level_.assign(nr, kNone);
+    true_a_.assign(nf, 0);
+    true_b_.assign(nf, 0);
+    goal_mark_.assign(nf, 0);
+    op_used_.assign(task.ops.size(), 0);
+    op_mark_.assign(task.ops.size(), 0);
+    facts_.reserve(nf);
+    active_.reserve(nr);
+    touched_.reserve(nr);
+  }
+
+  void setGoal(const Goal& goal) override {
+    goal_ = goal;
+    goals_.set(goal_, task_.numFacts());
+  }
+  bool computesPreferred() const override { return true; }
+  const std::vector<OpId>& preferred() const override { return preferred_; }
+  bool setFFStyle(bool on) override {
+    ff_style_ = on;
+    return true;
+  }
+
+  Cost evaluate(const uint64_t* s) override {
+    preferred_.clear();
+    if (goal_.conjuncts.empty()) return kInf;
+    if (task_.goalReached(s, goal_)) return 0;
+    const int conj = buildGraph(s);
+    if (conj < 0) return kInf;
+    return extract(s, goal_.conjuncts[static_cast<size_t>(conj)]) * unit_;
+  }
+
+ private:
+  void reset() {
+    for (FactId f : facts_) level_[f] = kNone;
+    for (uint32_t r : active_) rop_level_[r] = kNone;
+    for (uint32_t r : touched_) ctr_[r].unsat = ctr_[r].count;
+    facts_.clear();
+    active_.clear();
+    touched_.clear();
+  }
+
+  void reach(FactId f, uint32_t lvl) {
+    level_[f] = lvl;
+    facts_.push_back(f);
+    if (goals_.isGoal(f)) {
+      goals_.forEach(f, [&](uint32_t c) {
+        if (--remaining_[c] == 0 && done_ < 0) done_ = static_cast<int>(c);
+      });
+    }
+  }
+
+  /// Builds the graph up to the first layer with a complete goal conjunct; returns the conjunct
+  /// or -1 when the relaxed fixpoint is reached without one (a dead end).
+  int buildGraph(const uint64_t* s) {
+    reset();
+    remaining_ = goals_.sizes();
+    done_ = -1;
+    const size_t nf = task_.numFacts();
+    const size_t words = task_.numWords();
+    for (size_t w = 0; w < words; ++w) {
+      uint64_t word = s[w];
+      while (word) {
+        const FactId f = static_cast<FactId>(w * 64 + static_cast<size_t>(__builtin_ctzll(word)));
+        word &= word - 1;
+        if (f >= nf) break;
+        reach(f, 0);
+      }
+    }
+    size_t start_ft = 0, start_ef = 0;
+    for (uint32_t time = 0;; ++time) {
+      if (done_ >= 0) {
+        max_level_ = time;
+        return done_;
+      }
+      const size_t stop_ft = facts_.size();
+      // Raw pointers: the push_backs below would otherwise force reloads of every array.
+      Counter* const ctr = ctr_.data();
+      const uint32_t* const pre_of = R_.pre_of.data();
+      const uint32_t* const pre_of_begin = R_.pre_of_begin.data();
+      for (size_t i = start_ft; i < stop_ft; ++i) {
+        const FactId f = facts_[i];
+        for (uint32_t k = pre_of_begin[f], e = pre_of_begin[f + 1]; k < e; ++k) {
+          const uint32_t r = pre_of[k];
+          const uint32_t u = ctr[r].unsat;
+          if (u == ctr[r].count) touched_.push_back(r);
+          ctr[r].unsat = u - 1;
+          if (u == 1) active_.push_back(r);
+        }
+      }
+      if (time == 0) {
+        for (uint32_t r : R_.no_pre) active_.push_back(r);
+      }
+      const size_t stop_ef = active_.size();
+      for (size_t i = start_ef; i < stop_ef; ++i) {
+        const uint32_t r = active_[i];
+        rop_level_[r] = time;
+        for (uint32_t k = R_.add_begin[r]; k < R_.add_begin[r + 1]; ++k) {
+          const FactId g = R_.add[k];
+          if (level_[g] == kNone) reach(g, time + 1);
+        }
+      }
+      if (stop_ft == facts_.size()) return -1;  // fixpoint without the goals
+      start_ft = stop_ft;
+      start_ef = stop_ef;
+    }
+  }
+
+  void nextEpoch() {
+    if (++epoch_ == 0) {
+      std::fill(true_a_.begin(), true_a_.end(), 0);
+      std::fill(true_b_.begin(), true_b_.end(), 0);
+      std::fill(goal_mark_.begin(), goal_mark_.end(), 0);
+      std::fill(op_used_.begin(), op_used_.end(), 0);
+      std::fill(op_mark_.begin(), op_mark_.end(), 0);
+      epoch_ = 1;
+    }
+  }
+  uint64_t stamp(uint32_t t) const { return (static_cast<uint64_t>(epoch_) << 32) | t; }
+
+  void addSubgoal(FactId f) {
+    goal_mark_[f] = epoch_;
+    goals_at_[level_[f]].push_back(f);
+  }
+
+  Cost extract(const uint64_t* s, const GoalConjunct& gc) {
+    nextEpoch();
+    const uint32_t max = max_level_;
+    if (goals_at_.size() < max + 1) goals_at_.resize(max + 1);
+    for (uint32_t t = 0; t <= max; ++t) goals_at_[t].clear();
+    for (FactId f : gc.pos) {
+      if (goal_mark_[f] != epoch_) addSubgoal(f);
+    }
+    Cost h = 0;
+    plan_first_.clear();
+    for (uint32_t time = max; time > 0; --time) {
+      // goals_at_[time] does not grow while this layer is processed (sub-goals go below).
+      for (size_t i = 0; i < goals_at_[time].size(); ++i) {
+        const FactId g = goals_at_[time][i];
+        if (isTrue(g, time)) continue;  // added by an achiever selected at this layer or above
+        uint32_t best = kNone;
+        uint64_t best_d = UINT64_MAX;
+        for (uint32_t k = R_.adders_begin[g]; k < R_.adders_begin[g + 1]; ++k) {
+          const uint32_t r = R_.adders[k];
+          if (rop_level_[r] != time - 1) continue;
+          uint64_t d = 0;
+          for (uint32_t p = R_.pre_begin[r]; p < R_.pre_begin[r + 1]; ++p) d += level_[R_.pre[p]];
+          if (d < best_d) {
+            best_d = d;
+            best = r;
+          }
+        }
+        if (best == kNone) continue;  // cannot happen: g has level `time`
+        const OpId o = R_.op[best];
+        if (op_used_[o] != epoch_) {  // an operator counts once per relaxed plan
+          op_used_[o] = epoch_;
+          ++h;
+          if (time == 1) plan_first_.push_back(o);
+        }
+        for (uint32_t p = R_.pre_begin[best]; p < R_.pre_begin[best + 1]; ++p) {
+          const FactId q = R_.pre[p];
+          if (goal_mark_[q] == epoch_ || isTrue(q, time - 1)) continue;
+          addSubgoal(q);
+        }
+        markTrue(best, time);
+        for (uint32_t k = R_.implied_begin[best]; k < R_.implied_begin[best + 1]; ++k) markTrue(R_.implied[k], time);
+      }
+    }
+    collectHelpful(s);
+    return h;
+  }
+
+  bool isTrue(FactId f, uint32_t t) const { return true_a_[f] == stamp(t) || true_b_[f] == stamp(t); }
+
+  /// The add effects of an achiever selected at layer `time` count as true at `time` and
+  /// `time - 1` (FF).
+  void markTrue(uint32_t r, uint32_t time) {
+    for (uint32_t k = R_.add_begin[r]; k < R_.add_begin[r + 1]; ++k) {
+      true_a_[R_.add[k]] = stamp(time);
+      true_b_[R_.add[k]] = stamp(time - 1);
+    }
+  }
+
+  /// Helpful actions: first the relaxed plan's own layer-1 operators that are applicable (EHC
+  /// tries helpful actions in order), then every applicable operator that adds a layer-1
+  /// sub-goal (for a conditional effect: with its condition true).
+  void collectHelpful(const uint64_t* s) {
+    if (goals_at_.size() < 2) return;
+    if (ff_style_) return collectHelpfulFF(s);
+    for (OpId o : plan_first_) {
+      if (op_mark_[o] == epoch_ || !task_.applicable(s, o)) continue;
+      op_mark_[o] = epoch_;
+      preferred_.push_back(o);
+    }
+    for (FactId g : goals_at_[1]) {
+      for (OpId o : task_.achievers[g]) {
+        if (op_mark_[o] == epoch_ || !task_.applicable(s, o) || !addsIn(s, o, g)) continue;
+        op_mark_[o] = epoch_;
+        preferred_.push_back(o);
+      }
+    }
+  }
+
+  /// FF-v2.3's helpful actions: operators with an effect at layer 0 (applicable, condition true)
+  /// that adds a sub-goal of layer 1, ordered by the number of goals and sub-goals their layer-0
+  /// effects delete (fewest first); among equals, those collected last come first.
+  void collectHelpfulFF(const uint64_t* s) {
+    cand_.clear();
+    for (FactId g : goals_at_[1]) {
+      for (uint32_t k = R_.adders_begin[g]; k < R_.adders_begin[g + 1]; ++k) {
+        const uint32_t r = R_.adders[k];
+        if (rop_level_[r] != 0) continue;
+        const OpId o = R_.op[r];
+        if (op_mark_[o] == epoch_) continue;
+        op_mark_[o] = epoch_;
+        cand_.push_back({0, o});
+      }
+    }
+    for (auto& [d, o] : cand_) {
+      const Operator& op = task_.ops[o];
+      uint32_t n = 0;
+      for (FactId f : op.del) n += goal_mark_[f] == epoch_ ? 1 : 0;
+      for (const auto& ce : op.cond_effects) {
+        if (ce.del.empty() || !holdsAll(s, ce.cond)) continue;
+        for (FactId f : ce.del) n += goal_mark_[f] == epoch_ ? 1 : 0;
+      }
+      d = n;
+    }
+    std::reverse(cand_.begin(), cand_.end());
+    std::stable_sort(cand_.begin(), cand_.end(),
+                     [](const std::pair<uint32_t, OpId>& a, const std::pair<uint32_t, OpId>& b) { return a.first < b.first; });
+    for (const auto& c : cand_) preferred_.push_back(c.second);
+  }
+
+  bool addsIn(const uint64_t* s, OpId o, FactId g) const {
+    const Operator& op = task_.ops[o];
+    if (std::binary_search(op.add.begin(), op.add.end(), g)) return true;
+    for (const auto& ce : op.cond_effects) {
+      if (std::binary_search(ce.add.begin(), ce.add.end(), g) && holdsAll(s, ce.cond)) return true;
+    }
+    return false;
+  }
+
+  const Task& task_;
+  Cost unit_;  ///< the cost every operator has (h counts operators)
+  RelaxedOps R_;
+  Goal goal_;
+  GoalIndex goals_;
+  std::vector<uint32_t> remaining_;
+  int done_{-1};
+  uint32_t max_level_{0};
+  // Graph (reset through facts_/active_/touched_).
+  /// Unsatisfied preconditions of a rop next to its precondition count (one cache line).
+  struct Counter {
+    uint32_t unsat, count;
+  };
+  std::vector<Counter> ctr_;
+  std::vector<uint32_t> level_, rop_level_;
+  std::vector<FactId> facts_;
+  std::vector<uint32_t> active_, touched_;
+  // Extraction (epoch-stamped).
+  uint32_t epoch_{0};
+  std::vector<uint64_t> true_a_, true_b_;
+  std::vector<uint32_t> goal_mark_, op_mark_, op_used_;
+  std::vector<std::pair<uint32_t, OpId>> cand_;
+  bool ff_style_{false};
+  std::vector<OpId> plan_first_;
+  std::vector<std::vector<FactId>> goals_at_;
+  std::vector<OpId> preferred_;
+};
+
+// -------------------------------------------------------------------------------------------------
 /// A min-heap of (cost, fact) with reused storage.
 class FactHeap {
  public:
@@ -29,6 +452,9 @@ class FactHeap {
   std::vector<std::pair<Cost, FactId>> v_;
 };
 
+/// Cost-based relaxed exploration (generalised Dijkstra over facts, as Fast Downward's relaxation
+/// heuristics): h_max, h_add, and h_FF with a relaxed plan through the h_add best supporters (for
+/// tasks whose operators differ in cost).
 class RelaxationHeuristic : public Heuristic {
  public:
   enum class Mode { kMax, kAdd, kFF };
@@ -62,22 +488,6 @@ class RelaxationHeuristic : public Heuristic {
     }
     rop_pre_begin_.push_back(static_cast<uint32_t>(rop_pre_.size()));
     rop_add_begin_.push_back(static_cast<uint32_t>(rop_add_.size()));
-    {
-      std::vector<std::vector<uint32_t>> adders(nf);
-      for (uint32_t r = 0; r < rop_op_.size(); ++r) {
-        for (uint32_t i = rop_add_begin_[r]; i < rop_add_begin_[r + 1]; ++i) adders[rop_add_[i]].push_back(r);
-      }
-      adders_begin_.resize(nf + 1);
-      for (FactId f = 0; f < nf; ++f) {
-        adders_begin_[f] = static_cast<uint32_t>(adders_.size());
-        adders_.insert(adders_.end(), adders[f].begin(), adders[f].end());
-      }
-      adders_begin_[nf] = static_cast<uint32_t>(adders_.size());
-    }
-    // FF's own relaxed plan extraction (layers of h_max, achievers of least difficulty) when
-    // every operator counts 1; otherwise FD-style extraction through h_add supporters.
-    ff_layers_ = mode == Mode::kFF && (ct == CostType::kUnit || task.unit_cost);
-    if (ff_layers_) mode_ = Mode::kMax;
     pre_of_begin_.resize(nf + 1);
     for (FactId f = 0; f < nf; ++f) {
       pre_of_begin_[f] = static_cast<uint32_t>(pre_of_.size());
@@ -103,7 +513,7 @@ class RelaxationHeuristic : public Heuristic {
     }
   }
 
-  bool computesPreferred() const override { return mode_ == Mode::kFF || ff_layers_; }
+  bool computesPreferred() const override { return mode_ == Mode::kFF; }
   const std::vector<OpId>& preferred() const override { return preferred_; }
 
   Cost evaluate(const uint64_t* s) override {
@@ -130,7 +540,6 @@ class RelaxationHeuristic : public Heuristic {
       }
     }
     if (best == kInf) return kInf;
-    if (ff_layers_) return extractLayered(s, goal_.conjuncts[static_cast<size_t>(best_c)], best);
     if (mode_ != Mode::kFF) return best;
     return extract(s, goal_.conjuncts[static_cast<size_t>(best_c)]);
   }
@@ -192,13 +601,6 @@ class RelaxationHeuristic : public Heuristic {
     }
   }
 
-  bool ropApplicable(const uint64_t* s, uint32_t r) const {
-    for (uint32_t i = rop_pre_begin_[r]; i < rop_pre_begin_[r + 1]; ++i) {
-      if (!testBit(s, rop_pre_[i])) return false;
-    }
-    return true;
-  }
-
   Cost extract(const uint64_t* s, const GoalConjunct& gc) {
     ++mark_;
     if (mark_ == 0) {
@@ -209,7 +611,6 @@ class RelaxationHeuristic : public Heuristic {
     Cost h = 0;
     stack_.clear();
     g1_.clear();
-    plan_first_.clear();
     for (FactId f : gc.pos) stack_.push_back(f);
     while (!stack_.empty()) {
       const FactId f = stack_.back();
@@ -238,90 +639,11 @@ class RelaxationHeuristic : public Heuristic {
     return h;
   }
 
-  /// FF's extraction (Hoffmann & Nebel 2001, Sec. 4.3): sub-goals are placed at their layer; from
-  /// the top layer down, each open sub-goal gets the achiever of the previous layer with the least
-  /// difficulty (sum of its preconditions' layers); the achiever's add effects count as true at
-  /// this layer and the one below, so one action serves every sub-goal it adds.
-  Cost extractLayered(const uint64_t* s, const GoalConjunct& gc, Cost top) {
-    ++mark_;
-    if (mark_ == 0) {
-      std::fill(fact_mark_.begin(), fact_mark_.end(), 0);
-      std::fill(op_mark_.begin(), op_mark_.end(), 0);
-      mark_ = 1;
-    }
-    if (true_a_.size() != fact_mark_.size()) {
-      true_a_.assign(fact_mark_.size(), 0);
-      true_b_.assign(fact_mark_.size(), 0);
-    }
-    const size_t layers = static_cast<size_t>(top) + 1;
-    if (layer_goals_.size() < layers) layer_goals_.resize(layers);
-    for (size_t i = 0; i < layers; ++i) layer_goals_[i].clear();
-    const uint64_t base = static_cast<uint64_t>(mark_) << 32;
-    auto isTrue = [&](FactId f, Cost t) {
-      const uint64_t v = base | static_cast<uint32_t>(t);
-      return true_a_[f] == v || true_b_[f] == v;
-    };
-    auto addGoal = [&](FactId f) {
-      if (fact_mark_[f] == mark_ || testBit(s, f)) return;
-      fact_mark_[f] = mark_;
-      layer_goals_[static_cast<size_t>(fact_cost_[f])].push_back(f);
-    };
-    for (FactId f : gc.pos) addGoal(f);
-    Cost h = 0;
-    g1_.clear();
-    plan_first_.clear();
-    for (size_t i = layers - 1; i >= 1; --i) {
-      for (size_t k = 0; k < layer_goals_[i].size(); ++k) {
-        const FactId g = layer_goals_[i][k];
-        if (i == 1) g1_.push_back(g);
-        if (isTrue(g, static_cast<Cost>(i))) continue;
-        // Achiever at layer i-1 with the least difficulty.
-        uint32_t best = UINT32_MAX;
-        Cost best_d = kInf;
-        for (uint32_t a = adders_begin_[g]; a < adders_begin_[g + 1]; ++a) {
-          const uint32_t r = adders_[a];
-          if (unsat_[r] != 0 || rop_cost_[r] != static_cast<Cost>(i - 1)) continue;
-          Cost d = 0;
-          for (uint32_t p = rop_pre_begin_[r]; p < rop_pre_begin_[r + 1]; ++p) d += fact_cost_[rop_pre_[p]];
-          if (d < best_d) {
-            best_d = d;
-            best = r;
-          }
-        }
-        if (best == UINT32_MAX) continue;  // cannot happen: g has level i
-        const OpId o = rop_op_[best];
-        if (op_mark_[o] != mark_) {
-          op_mark_[o] = mark_;
-          h += 1;
-          if (i == 1) plan_first_.push_back(o);
-        }
-        for (uint32_t p = rop_pre_begin_[best]; p < rop_pre_begin_[best + 1]; ++p) {
-          const FactId q = rop_pre_[p];
-          if (fact_cost_[q] != 0 && !isTrue(q, static_cast<Cost>(i - 1))) addGoal(q);
-        }
-        for (uint32_t a = rop_add_begin_[best]; a < rop_add_begin_[best + 1]; ++a) {
-          const FactId f = rop_add_[a];
-          true_a_[f] = base | static_cast<uint32_t>(i);
-          true_b_[f] = base | static_cast<uint32_t>(i - 1);
-        }
-      }
-      if (i == 1) break;
-    }
-    collectHelpful(s);
-    return h;
-  }
-
   void collectHelpful(const uint64_t* s) {
     ++pref_mark_;
     if (pref_mark_ == 0 || pref_stamp_.size() != task_.ops.size()) {
       pref_stamp_.assign(task_.ops.size(), 0);
       pref_mark_ = 1;
-    }
-    // The relaxed plan's own first-layer actions first (EHC tries helpful actions in order).
-    for (OpId o : plan_first_) {
-      if (pref_stamp_[o] == pref_mark_ || !task_.applicable(s, o)) continue;
-      pref_stamp_[o] = pref_mark_;
-      preferred_.push_back(o);
     }
     for (FactId g : g1_) {
       for (OpId o : task_.achievers[g]) {
@@ -347,10 +669,6 @@ class RelaxationHeuristic : public Heuristic {
 
   const Task& task_;
   Mode mode_;
-  bool ff_layers_{false};
-  std::vector<uint32_t> adders_begin_, adders_;
-  std::vector<uint64_t> true_a_, true_b_;
-  std::vector<std::vector<FactId>> layer_goals_;
   Goal goal_;
   std::vector<std::vector<uint32_t>> goal_of_;
   std::vector<uint32_t> remaining_;
@@ -368,7 +686,6 @@ class RelaxationHeuristic : public Heuristic {
   std::vector<uint32_t> fact_mark_, op_mark_, pref_stamp_;
   uint32_t mark_{0}, pref_mark_{0};
   std::vector<FactId> stack_, g1_;
-  std::vector<OpId> plan_first_;
   std::vector<OpId> preferred_;
 };
 
@@ -386,11 +703,26 @@ class BlindHeuristic : public Heuristic {
   Goal goal_;
 };
 
+/// The cost every operator has under `ct` when they all have the same positive one, else 0.
+Cost uniformCost(const Task& task, CostType ct) {
+  if (ct == CostType::kUnit || task.unit_cost || task.ops.empty()) return 1;
+  const Cost c = adjustedCost(task.ops[0], ct, task.unit_cost);
+  for (const auto& op : task.ops) {
+    if (adjustedCost(op, ct, task.unit_cost) != c) return 0;
+  }
+  return c;
+}
+
 }  // namespace
 
 std::unique_ptr<Heuristic> makeHeuristic(HeuristicKind kind, const Task& task, CostType cost_type) {
   switch (kind) {
-    case HeuristicKind::kFF: return std::make_unique<RelaxationHeuristic>(task, cost_type, RelaxationHeuristic::Mode::kFF);
+    case HeuristicKind::kFF: {
+      // FF's layered graph when every operator costs the same (h scaled by that cost), the
+      // cost-based relaxed plan otherwise.
+      if (const Cost c = uniformCost(task, cost_type); c > 0) return std::make_unique<LayeredFF>(task, cost_type, c);
+      return std::make_unique<RelaxationHeuristic>(task, cost_type, RelaxationHeuristic::Mode::kFF);
+    }
     case HeuristicKind::kAdd: return std::make_unique<RelaxationHeuristic>(task, cost_type, RelaxationHeuristic::Mode::kAdd);
     case HeuristicKind::kMax: return std::make_unique<RelaxationHeuristic>(task, cost_type, RelaxationHeuristic::Mode::kMax);
     case HeuristicKind::kBlind: return std::make_unique<BlindHeuristic>(task);

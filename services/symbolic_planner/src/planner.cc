@@ -299,6 +299,7 @@ PlanReply PlanningSession::solve(const Query& q, const Termination& term) {
   reply.stats.evaluated = sr.stats.evaluated;
   reply.stats.initial_h = sr.stats.initial_h;
   reply.stats.ehc_failed = sr.stats.ehc_failed;
+  reply.stats.ehc_ff_failed = sr.stats.ehc_ff_failed;
   reply.status = fromSearch(sr.status);
   if (sr.status == SearchStatus::kSolved) {
     reply.cost = sr.cost;

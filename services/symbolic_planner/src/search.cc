@@ -92,83 +92,76 @@ class OpenList {
   uint64_t counter_{0};
 };
 
-/// FF's goal agenda (Koehler & Hoffmann 2000, approximation <=_h as in FF): goal j is ordered
-/// before goal i when, with i true and kept true, j looks unachievable: every achiever of j
-/// deletes i, or needs a precondition that only i-deleting achievers (or achievers needing a fact
-/// in i's False set) provide. Returns the goal facts in entries to be achieved incrementally.
+/// FF's goal agenda (Koehler & Hoffmann 2000; FF-v2.3 `orderings.c`, approximation <=_h): goal j
+/// is ordered before goal i when, with i true and kept true, j looks unachievable: every achiever
+/// of j deletes i, or needs a precondition that only i-deleting achievers (or achievers needing a
+/// fact of i's False set) provide. Returns the goal facts in entries to be achieved incrementally,
+/// goals of equal rank in their given order. Uses the task's effect index (no per-call tables).
 std::vector<std::vector<FactId>> goalAgenda(const Task& task, const std::vector<FactId>& goals) {
   const size_t n = goals.size();
   if (n < 2) return {goals};
-  struct Eff {
-    const std::vector<FactId>* pre;
-    const std::vector<FactId>* cond;
-    const std::vector<FactId>* add;
-    const std::vector<FactId>* del;
-    const std::vector<FactId>* del2;
+  const EffectIndex& E = task.effects;
+  auto range = [](const std::vector<uint32_t>& begin, const std::vector<uint32_t>& items, FactId f) {
+    return std::pair<const uint32_t*, const uint32_t*>(items.data() + begin[f], items.data() + begin[f + 1]);
   };
-  std::vector<Eff> effs;
-  for (const auto& op : task.ops) {
-    static const std::vector<FactId> kEmpty;
-    effs.push_back({&op.pre, &kEmpty, &op.add, &op.del, &kEmpty});
-    for (const auto& ce : op.cond_effects) effs.push_back({&op.pre, &ce.cond, &ce.add, &ce.del, &op.del});
-  }
-  const size_t nf = task.numFacts();
-  std::vector<std::vector<uint32_t>> adders(nf), users(nf), deleters(nf);
-  for (uint32_t e = 0; e < effs.size(); ++e) {
-    for (FactId f : *effs[e].add) adders[f].push_back(e);
-    for (FactId f : *effs[e].pre) users[f].push_back(e);
-    for (FactId f : *effs[e].cond) users[f].push_back(e);
-    for (FactId f : *effs[e].del) deleters[f].push_back(e);
-    for (FactId f : *effs[e].del2) deleters[f].push_back(e);
-  }
-  std::vector<char> usable(effs.size(), 1);
-  std::vector<uint32_t> del_count(nf, 0);
+  auto effPre = [&](uint32_t e, auto&& fn) {
+    const Operator& op = task.ops[E.op[e]];
+    for (FactId f : op.pre) fn(f);
+    if (E.ce[e] >= 0) {
+      for (FactId f : op.cond_effects[static_cast<size_t>(E.ce[e])].cond) fn(f);
+    }
+  };
+  auto effDel = [&](uint32_t e, auto&& fn) {
+    const Operator& op = task.ops[E.op[e]];
+    for (FactId f : op.del) fn(f);
+    if (E.ce[e] >= 0) {
+      for (FactId f : op.cond_effects[static_cast<size_t>(E.ce[e])].del) fn(f);
+    }
+  };
+  std::vector<char> usable(E.size(), 1);
+  auto anyUsableAdder = [&](FactId p) {
+    auto [b, e] = range(E.adders_begin, E.adders, p);
+    for (const uint32_t* a = b; a != e; ++a) {
+      if (usable[*a]) return true;
+    }
+    return false;
+  };
   auto possiblyAchievable = [&](FactId f) {
-    for (uint32_t e : adders[f]) {
-      if (!usable[e]) continue;
+    auto [b, e] = range(E.adders_begin, E.adders, f);
+    for (const uint32_t* a = b; a != e; ++a) {
+      if (!usable[*a]) continue;
       bool ok = true;
-      auto check = [&](const std::vector<FactId>& pre) {
-        for (FactId p : pre) {
-          bool any = false;
-          for (uint32_t a : adders[p]) {
-            if (usable[a]) {
-              any = true;
-              break;
-            }
-          }
-          if (!any) {
-            ok = false;
-            return;
-          }
-        }
-      };
-      check(*effs[e].pre);
-      if (ok) check(*effs[e].cond);
+      effPre(*a, [&](FactId p) { ok = ok && anyUsableAdder(p); });
       if (ok) return true;
     }
     return false;
   };
+  std::vector<uint32_t> del_count(task.numFacts(), 0);
+  std::vector<FactId> touched;
   std::vector<std::vector<char>> m(n, std::vector<char>(n, 0));
+  std::vector<uint32_t> excluded;
   for (size_t i = 0; i < n; ++i) {
     m[i][i] = 1;
     const FactId gi = goals[i];
     // False set: facts deleted by every achiever of gi.
-    std::vector<FactId> touched;
-    for (uint32_t e : adders[gi]) {
-      for (const auto* dl : {effs[e].del, effs[e].del2}) {
-        for (FactId f : *dl) {
-          if (del_count[f]++ == 0) touched.push_back(f);
-        }
-      }
+    auto [ab, ae] = range(E.adders_begin, E.adders, gi);
+    const size_t num_adders = static_cast<size_t>(ae - ab);
+    touched.clear();
+    for (const uint32_t* a = ab; a != ae; ++a) {
+      effDel(*a, [&](FactId f) {
+        if (del_count[f]++ == 0) touched.push_back(f);
+      });
     }
-    std::vector<uint32_t> excluded;
+    excluded.clear();
     for (FactId f : touched) {
-      if (del_count[f] == adders[gi].size()) {
-        for (uint32_t e : users[f]) excluded.push_back(e);
+      if (del_count[f] >= num_adders) {
+        auto [ub, ue] = range(E.users_begin, E.users, f);
+        excluded.insert(excluded.end(), ub, ue);
       }
       del_count[f] = 0;
     }
-    for (uint32_t e : deleters[gi]) excluded.push_back(e);
+    auto [db, de] = range(E.deleters_begin, E.deleters, gi);
+    excluded.insert(excluded.end(), db, de);
     for (uint32_t e : excluded) usable[e] = 0;
     for (size_t j = 0; j < n; ++j) {
       if (j != i && !possiblyAchievable(goals[j])) m[j][i] = 1;
@@ -389,7 +382,12 @@ class Searcher {
     bool is_new = false;
     if (task_.goalReached(reg_.get(cur), goal)) return finish(SearchStatus::kSolved, plan);
     Cost hcur = evaluate(cur);
-    if (first) stats_.initial_h = hcur;
+    if (first) {
+      stats_.initial_h = hcur;
+      if (opt_.ehc_eval_budget_per_h > 0 && hcur != Heuristic::kDeadEnd) {
+        eval_budget_ = opt_.ehc_eval_budget_per_h * static_cast<uint64_t>(std::max<Cost>(hcur, 2));
+      }
+    }
     if (hcur == Heuristic::kDeadEnd) {
       if (first && &goal == &goal_) return finish(SearchStatus::kUnsolvable);
       return fallback();
@@ -406,6 +404,7 @@ class Searcher {
       uint32_t found = kNone;
       for (size_t head = 0; head < queue.size() && found == kNone; ++head) {
         if (auto st = checkLimits()) return finish(*st);
+        if (eval_budget_ > 0 && stats_.evaluated > eval_budget_) return finish(SearchStatus::kFailed);
         const uint32_t id = queue[head];
         std::copy(reg_.get(id), reg_.get(id) + reg_.words(), buf_.begin());
         ++stats_.expanded;
@@ -612,6 +611,7 @@ class Searcher {
   uint64_t checks_{0};
   size_t open_bytes_{0};
   std::vector<uint32_t> stamp_;  // ehc: BFS iteration that reached each state
+  uint64_t eval_budget_{0};      // ehc: give up after this many evaluations (0 = unlimited)
   uint32_t iter_{0};
 };
 
@@ -675,6 +675,33 @@ SearchResult search(const Task& task, const StateBits& init, const Goal& goal, c
   if (init.size() != task.numWords()) {
     throw std::invalid_argument("search: initial state has " + std::to_string(init.size()) + " words, task needs " +
                                 std::to_string(task.numWords()));
+  }
+  if (options.algorithm == SearchAlgorithm::kEhc && options.ehc_ff_first && options.ehc_ff_budget_per_h > 0 &&
+      heuristic.setFFStyle(true)) {
+    // First run: EHC with FF-v2.3's relaxed plan, no fallback, bounded evaluations.
+    SearchOptions first = options;
+    first.ehc_fallback = false;
+    first.ehc_eval_budget_per_h = options.ehc_ff_budget_per_h;
+    SearchResult r1;
+    try {
+      Searcher s1(task, init, goal, first, heuristic, term);
+      r1 = s1.run();
+    } catch (...) {
+      heuristic.setFFStyle(false);
+      throw;
+    }
+    heuristic.setFFStyle(false);
+    if (r1.status != SearchStatus::kFailed && r1.status != SearchStatus::kOutOfMemory) return r1;
+    // Second run: the default search from the start, as if the first had not happened.
+    Searcher s2(task, init, goal, options, heuristic, term);
+    SearchResult r2 = s2.run();
+    r2.stats.ehc_ff_failed = true;
+    r2.stats.expanded += r1.stats.expanded;
+    r2.stats.generated += r1.stats.generated;
+    r2.stats.evaluated += r1.stats.evaluated;
+    r2.stats.registered_states += r1.stats.registered_states;
+    r2.stats.seconds += r1.stats.seconds;
+    return r2;
   }
   Searcher s(task, init, goal, options, heuristic, term);
   return s.run();

@@ -20,6 +20,7 @@ void Task::finalize() {
     }
     for (FactId f : op.pre) ++pre_count[f];
   }
+  buildEffectIndex();
   // Key precondition: the one whose fact has the fewest... we use a proxy for "rarely true":
   // facts that are preconditions of few operators are specific (e.g. an object's position);
   // facts shared by many operators (hand-empty) are often true.
@@ -37,6 +38,49 @@ void Task::finalize() {
     }
     ops_by_key_[key].push_back(o);
   }
+}
+
+void Task::buildEffectIndex() {
+  const size_t n = numFacts();
+  EffectIndex& e = effects;
+  e = EffectIndex{};
+  for (OpId o = 0; o < ops.size(); ++o) {
+    e.op.push_back(o);
+    e.ce.push_back(-1);
+  }
+  for (OpId o = 0; o < ops.size(); ++o) {
+    for (size_t c = 0; c < ops[o].cond_effects.size(); ++c) {
+      e.op.push_back(o);
+      e.ce.push_back(static_cast<int32_t>(c));
+    }
+  }
+  // Two passes per index: count, then fill (effects stay in increasing order per fact).
+  auto build = [&](std::vector<uint32_t>& begin, std::vector<uint32_t>& out, auto&& forEach) {
+    begin.assign(n + 1, 0);
+    for (uint32_t x = 0; x < e.size(); ++x) forEach(x, [&](FactId f) { ++begin[f + 1]; });
+    for (size_t f = 0; f < n; ++f) begin[f + 1] += begin[f];
+    out.resize(begin[n]);
+    std::vector<uint32_t> fill(begin.begin(), begin.end() - 1);
+    for (uint32_t x = 0; x < e.size(); ++x) forEach(x, [&](FactId f) { out[fill[f]++] = x; });
+  };
+  build(e.adders_begin, e.adders, [&](uint32_t x, auto&& fn) {
+    const Operator& op = ops[e.op[x]];
+    for (FactId f : e.ce[x] < 0 ? op.add : op.cond_effects[static_cast<size_t>(e.ce[x])].add) fn(f);
+  });
+  build(e.users_begin, e.users, [&](uint32_t x, auto&& fn) {
+    const Operator& op = ops[e.op[x]];
+    for (FactId f : op.pre) fn(f);
+    if (e.ce[x] >= 0) {
+      for (FactId f : op.cond_effects[static_cast<size_t>(e.ce[x])].cond) fn(f);
+    }
+  });
+  build(e.deleters_begin, e.deleters, [&](uint32_t x, auto&& fn) {
+    const Operator& op = ops[e.op[x]];
+    for (FactId f : op.del) fn(f);
+    if (e.ce[x] >= 0) {
+      for (FactId f : op.cond_effects[static_cast<size_t>(e.ce[x])].del) fn(f);
+    }
+  });
 }
 
 void Task::apply(const uint64_t* s, OpId o, uint64_t* out) const {

@@ -47,6 +47,14 @@ class Heuristic {
   /// Helpful actions of the last evaluation (empty when the heuristic does not compute them).
   virtual const std::vector<OpId>& preferred() const { return no_ops_; }
   virtual bool computesPreferred() const { return false; }
+  /// Switches the helpful actions to FF-v2.3's order (fewest deleted goals and relaxed-plan
+  /// sub-goals first; among equals, the last collected first) or back to the default order (the
+  /// relaxed plan's own first-layer actions first). Returns false (and changes nothing) when the
+  /// heuristic has no such variant.
+  virtual bool setFFStyle(bool on) {
+    (void)on;
+    return false;
+  }
 
  protected:
   std::vector<OpId> no_ops_;

@@ -81,6 +81,7 @@ struct PlanStatistics {
   uint64_t evaluated{0};
   int64_t initial_h{0};
   bool ehc_failed{false};
+  bool ehc_ff_failed{false};  ///< the first EHC run (FF-v2.3 heuristic variant) failed; see SearchOptions
 };
 
 /// A self-contained request (maps 1:1 to the plan-request message).

@@ -5,7 +5,11 @@
 /// - `kEhc`: FF's enforced hill-climbing: from the current state, a breadth-first search over
 ///   helpful actions until a state with a strictly better h_FF is found; on failure (dead end or
 ///   exhausted plateau) it falls back to complete greedy best-first search from the start
-///   (`ehc_fallback`), as FF does.
+///   (`ehc_fallback`), as FF does. With `ehc_ff_first` (the default) and a heuristic that has
+///   FF-v2.3's variant (`Heuristic::setFFStyle`), a first hill-climbing run uses that variant
+///   within a budget of evaluations (it tends to give shorter plans); when it fails or runs
+///   out of budget, the search starts again from the initial state with the default heuristic,
+///   exactly as without the first run.
 /// - `kGbfs`: eager greedy best-first search on h_FF with a second open list for successors through
 ///   helpful (preferred) operators, alternating with a boost on progress (as Fast Downward's
 ///   `eager_greedy([ff], preferred=[ff])`). Complete: it proves unsolvability by exhaustion.
@@ -50,6 +54,13 @@ struct SearchOptions {
   /// ehc: when a better state is found, evaluate the remaining successors of the same node and
   /// continue from the best (FF continues from the first).
   bool ehc_best_sibling{true};
+  /// ehc: first try hill-climbing with the heuristic's FF-v2.3 variant (see above), allowed
+  /// `ehc_ff_budget_per_h` evaluations per unit of the initial state's h (0 disables the first run).
+  bool ehc_ff_first{true};
+  uint64_t ehc_ff_budget_per_h{300};
+  /// ehc: give up (kFailed, no fallback) after this many evaluations per unit of the initial
+  /// state's h (at least 2 units; with the goal agenda, h of the first entry); 0 = unlimited.
+  uint64_t ehc_eval_budget_per_h{0};
   bool preferred_operators{true};  ///< gbfs: use the helpful-action open list
   /// ehc/gbfs: drop redundant actions from the plan found (greedy action elimination).
   bool eliminate_redundant_actions{true};
@@ -78,6 +89,9 @@ struct SearchStatistics {
   uint64_t registered_states{0};
   Cost initial_h{0};
   bool ehc_failed{false};  ///< ehc fell back to gbfs
+  /// ehc: the first run with the FF-v2.3 heuristic variant failed (or ran out of budget) and the
+  /// search started again; its evaluations are included in `evaluated`.
+  bool ehc_ff_failed{false};
   uint64_t ehc_retries{0};  ///< plateaus searched again without helpful-action pruning
   uint64_t eliminated_actions{0};  ///< removed by action elimination
   double seconds{0.0};

@@ -54,6 +54,20 @@ struct Goal {
   bool unsatisfiable() const { return conjuncts.empty(); }
 };
 
+/// Inverted indices over the *effects* of a task (effect e < ops.size() is operator e's
+/// unconditional part, the others are the conditional effects in operator order), in CSR form:
+/// `x_begin[f] .. x_begin[f + 1]` index `x` for fact f. Built by `Task::finalize()`; used by
+/// analyses over the whole task (FF's goal agenda) that would otherwise rebuild them per query.
+struct EffectIndex {
+  std::vector<OpId> op;          ///< effect -> operator
+  std::vector<int32_t> ce;       ///< effect -> conditional effect index, -1 = unconditional part
+  std::vector<uint32_t> adders_begin, adders;      ///< fact -> effects adding it
+  std::vector<uint32_t> users_begin, users;        ///< fact -> effects needing it (pre or condition)
+  std::vector<uint32_t> deleters_begin, deleters;  ///< fact -> effects deleting it (a conditional
+                                                   ///< effect also counts its operator's deletes)
+  size_t size() const { return op.size(); }
+};
+
 /// A state: one bit per fact.
 using StateBits = std::vector<uint64_t>;
 
@@ -70,11 +84,13 @@ class Task {
   std::vector<Operator> ops;
   bool unit_cost{true};                  ///< true: every operator costs 1 (no metric)
   std::vector<std::vector<OpId>> achievers;  ///< ops whose (conditional) effects add the fact
+  EffectIndex effects;                       ///< built by finalize()
 
   size_t numFacts() const { return fact_names.size(); }
   size_t numWords() const { return (fact_names.size() + 63) / 64; }
 
-  /// Rebuilds the derived tables (achievers, successor index). Call once after filling.
+  /// Rebuilds the derived tables (achievers, effect index, successor index). Call once after
+  /// filling.
   void finalize();
 
   bool applicable(const uint64_t* s, OpId op) const {
@@ -91,6 +107,7 @@ class Task {
   bool goalReached(const uint64_t* s, const Goal& g) const;
 
  private:
+  void buildEffectIndex();
   // Successor generation: each operator is indexed under its "key" precondition (the one least
   // likely to hold); operators without preconditions are always checked.
   std::vector<std::vector<OpId>> ops_by_key_;

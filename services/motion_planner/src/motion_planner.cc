@@ -629,6 +629,16 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
   detail::StaticRoadmap* roadmap = nullptr;
   std::unique_ptr<detail::StaticRoadmap> uncached;  // roadmap_cache_entries == 0
   std::optional<og::PathGeometric> from_roadmap;
+  // A new roadmap draws its samples when it is first searched (arm requests whose lazy path
+  // crosses nothing never need it). Bridge-test samples for the base group only (narrow
+  // passages of the floor plan; in joint space they would cost many attempts, unmeasured).
+  auto ensureSampled = [&] {
+    if (roadmap->uniformSamples() == 0 && P.lazy.roadmap_samples > 0) {
+      roadmap->addSamples(oracle, gs, P.lazy.roadmap_samples, termination,
+                          req.group == PlanningGroup::kBase ? P.lazy.roadmap_bridge_samples : 0,
+                          P.lazy.roadmap_bridge_distance);
+    }
+  };
   if (lazy && P.lazy.optimize) {
     Stopwatch rw;
     detail::StaticWorldKey key;
@@ -646,13 +656,10 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
     if (req.group == PlanningGroup::kArm) key.fixed = {req.start.base.x, req.start.base.y, req.start.base.theta};
     if (impl.robot.hasArm()) key.fixed.push_back(req.start.gripper);
     roadmap = impl.roadmapFor(std::move(key), space, res.stats.roadmap_reused, uncached);
-    if (roadmap->uniformSamples() == 0 && P.lazy.roadmap_samples > 0) {
-      roadmap->addSamples(oracle, gs, P.lazy.roadmap_samples, termination, P.lazy.roadmap_bridge_samples,
-                          P.lazy.roadmap_bridge_distance);
-    }
     // A roadmap new in this request knows no edge yet: lazy KPIECE goes first and seeds it.
     if (req.group == PlanningGroup::kBase && P.lazy.roadmap_first && res.stats.roadmap_reused &&
         !goal_states.empty()) {
+      ensureSampled();
       const int s = roadmap->addState(start.get());
       std::vector<int> goals;
       for (const auto* g : goal_states) goals.push_back(roadmap->addState(g));
@@ -731,6 +738,7 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
     const bool improve = req.group == PlanningGroup::kBase || (req.object_cost_scale > 0 && !raw_cost.objects.empty());
     if (roadmap && !from_roadmap && improve) {
       // Lazy KPIECE's path (statically valid) joins the roadmap, which also grows where it is.
+      ensureSampled();
       const auto [s, g] = roadmap->addPath(raw, P.lazy.path_node_spacing);
       if (roadmap->nodeCount() < static_cast<std::size_t>(P.lazy.roadmap_max_nodes)) {
         roadmap->addSamples(oracle, gs, P.lazy.roadmap_growth_samples, termination);

@@ -53,7 +53,7 @@ struct SamplingParams {
 struct LazyParams {
   bool optimize{true};              ///< effort-aware roadmap search + shortcutting of the lazy path
   int roadmap_samples{600};         ///< uniform samples of the static free space in a new roadmap; >= 0
-  int roadmap_bridge_samples{200};  ///< bridge-test samples (narrow passages) in a new roadmap; >= 0
+  int roadmap_bridge_samples{200};  ///< bridge-test samples (narrow passages) in a new base-group roadmap; >= 0
   double roadmap_bridge_distance{0.8};  ///< typical distance of a bridge's two colliding ends (space metric); > 0
   int roadmap_neighbors{12};        ///< k of the k-nearest-neighbour connections; >= 2
   double path_node_spacing{0.5};    ///< a lazy KPIECE path is cut into roadmap nodes this far apart (space metric); > 0

@@ -5,7 +5,10 @@
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
-#include <unordered_set>
+#include <algorithm>
+#include <cstdint>
+#include <utility>
+#include <vector>
 
 #include <octomap/OcTree.h>
 
@@ -13,8 +16,66 @@
 
 namespace tamp::perception {
 
+namespace {
+
+constexpr std::uint64_t kEmpty = ~std::uint64_t{0};
+constexpr std::uint64_t kTombstone = kEmpty - 1;  // keys use 48 bits: neither is a key
+
+/// Inserts `key` into an open-addressing table (size a power of 2, kEmpty = free slot); false if
+/// it was there.
+bool insertKey(std::vector<std::uint64_t>& table, std::uint64_t key) {
+  const std::size_t mask = table.size() - 1;
+  for (std::size_t i = (key * 0x9E3779B97F4A7C15ull) >> 40 & mask;; i = (i + 1) & mask) {
+    if (table[i] == key) return false;
+    if (table[i] == kEmpty) {
+      table[i] = key;
+      return true;
+    }
+  }
+}
+
+/// Replaces `key` by a tombstone (lookups go on past it; grow() drops it).
+void eraseKey(std::vector<std::uint64_t>& table, std::uint64_t key) {
+  const std::size_t mask = table.size() - 1;
+  for (std::size_t i = (key * 0x9E3779B97F4A7C15ull) >> 40 & mask;; i = (i + 1) & mask) {
+    if (table[i] == key) {
+      table[i] = kTombstone;
+      return;
+    }
+    if (table[i] == kEmpty) return;
+  }
+}
+
+bool containsKey(const std::vector<std::uint64_t>& table, std::uint64_t key) {
+  const std::size_t mask = table.size() - 1;
+  for (std::size_t i = (key * 0x9E3779B97F4A7C15ull) >> 40 & mask;; i = (i + 1) & mask) {
+    if (table[i] == key) return true;
+    if (table[i] == kEmpty) return false;
+  }
+}
+
+/// Doubles an open-addressing table.
+void grow(std::vector<std::uint64_t>& table) {
+  std::vector<std::uint64_t> bigger(2 * table.size(), kEmpty);
+  for (auto k : table) {
+    if (k != kEmpty && k != kTombstone) insertKey(bigger, k);
+  }
+  table.swap(bigger);
+}
+
+std::uint64_t packKey(const octomap::OcTreeKey& k) {
+  return std::uint64_t{k[0]} | (std::uint64_t{k[1]} << 16) | (std::uint64_t{k[2]} << 32);
+}
+
+}  // namespace
+
 struct OccupancyMap::Impl {
   OccupancyParams params;
+  octomap::KeyRay ray;  // reused across rays and frames
+  // Keys of leaves at the free clamping threshold (open-addressing set; entries and tombstones
+  // counted in clamped_used). Only a hit raises such a leaf: integrate() erases its key first.
+  std::vector<std::uint64_t> clamped_free = std::vector<std::uint64_t>(std::size_t{1} << 16, kEmpty);
+  std::size_t clamped_used{0};
   octomap::OcTree tree;
   octomap::KeySet hits;  // voxels that received a hit and may be occupied
   // Inner nodes lag the leaves until updateInnerNodes(): refreshing them walks the whole tree, so
@@ -46,32 +107,79 @@ void OccupancyMap::integrate(const Eigen::Vector3d& origin, const std::vector<Ei
   octomap::OcTree& tree = impl_->tree;
   const OccupancyParams& p = impl_->params;
   // One ray endpoint per free_space_voxel: the ray count, not the point count, sets the cost.
+  // (The first scan point of each such cell; a small open-addressing set, ~1000 cells a frame.)
   const double inv = 1.0 / std::max(p.free_space_voxel, p.resolution);
-  std::unordered_set<std::uint64_t> seen;
-  seen.reserve(scan.size() / 4 + 16);
-  octomap::Pointcloud rays;
-  rays.reserve(scan.size() / 4 + 16);
-  for (const auto& q : scan) {
-    const auto ix = static_cast<std::int64_t>(std::floor(q.x() * inv)) & 0x1FFFFF;
-    const auto iy = static_cast<std::int64_t>(std::floor(q.y() * inv)) & 0x1FFFFF;
-    const auto iz = static_cast<std::int64_t>(std::floor(q.z() * inv)) & 0x1FFFFF;
-    const std::uint64_t key = (std::uint64_t(ix) << 42) | (std::uint64_t(iy) << 21) | std::uint64_t(iz);
-    if (seen.insert(key).second) rays.push_back(q.x(), q.y(), q.z());
+  std::vector<octomap::point3d> rays;
+  {
+    std::vector<std::uint64_t> table(4096, kEmpty);
+    std::size_t used = 0;
+    for (const auto& q : scan) {
+      const auto ix = static_cast<std::int64_t>(std::floor(q.x() * inv)) & 0x1FFFFF;
+      const auto iy = static_cast<std::int64_t>(std::floor(q.y() * inv)) & 0x1FFFFF;
+      const auto iz = static_cast<std::int64_t>(std::floor(q.z() * inv)) & 0x1FFFFF;
+      const std::uint64_t key = (std::uint64_t(ix) << 42) | (std::uint64_t(iy) << 21) | std::uint64_t(iz);
+      if (insertKey(table, key)) {
+        rays.emplace_back(q.x(), q.y(), q.z());
+        if (2 * ++used > table.size()) grow(table);  // keep the load under 1/2
+      }
+    }
   }
   const octomap::point3d o(static_cast<float>(origin.x()), static_cast<float>(origin.y()),
                            static_cast<float>(origin.z()));
-  octomap::KeySet free_cells, endpoint_cells;
-  tree.computeUpdate(rays, o, free_cells, endpoint_cells, p.max_ray_range);
+  // OccupancyOcTreeBase::computeUpdate (no bounding box, serial) with open-addressing sets
+  // instead of its hash sets (octomap::KeySet): the cells of every ray except any ray's end cell.
+  // The free cells are updated in the order the rays first reach them: consecutive cells of a
+  // ray share most of their path down the tree (cache), where KeySet's order is random.
+  std::vector<octomap::OcTreeKey> free_cells;
+  free_cells.reserve(rays.size() * 64);
+  std::size_t free_size = std::size_t{1} << 12;  // load <= 1/2 for ~40 new cells a ray
+  while (free_size < rays.size() * 80) free_size *= 2;
+  std::vector<std::uint64_t> free_set(free_size, kEmpty), end_set(std::size_t{1} << 12, kEmpty);
+  std::size_t end_used = 0;
+  {
+    octomap::KeyRay& ray = impl_->ray;
+    const double maxrange = p.max_ray_range;
+    const auto addRay = [&] {
+      for (const auto& k : ray) {
+        if (!insertKey(free_set, packKey(k))) continue;
+        free_cells.push_back(k);
+        if (2 * free_cells.size() > free_set.size()) grow(free_set);
+      }
+    };
+    for (const auto& q : rays) {
+      if (maxrange < 0.0 || (q - o).norm() <= maxrange) {
+        if (tree.computeRayKeys(o, q, ray)) addRay();
+        octomap::OcTreeKey key;
+        if (tree.coordToKeyChecked(q, key) && insertKey(end_set, packKey(key)) && 2 * ++end_used > end_set.size()) grow(end_set);
+      } else {
+        const octomap::point3d direction = (q - o).normalized();
+        const octomap::point3d new_end = o + direction * static_cast<float>(maxrange);
+        if (tree.computeRayKeys(o, new_end, ray)) addRay();
+      }
+    }
+  }
 
   octomap::KeySet hit_cells;
   for (const auto& q : occupied) {
     octomap::OcTreeKey k;
     if (tree.coordToKeyChecked(octomap::point3d(q.x(), q.y(), q.z()), k)) hit_cells.insert(k);
   }
+  // A free update of a cell already clamped at free changes nothing (OcTree::updateNode returns
+  // after a search from the root); those cells are remembered and skipped without the search.
+  std::vector<std::uint64_t>& clamped = impl_->clamped_free;
+  const float clamp_min = tree.getClampingThresMinLog();
   for (const auto& k : free_cells) {
-    if (hit_cells.count(k) == 0) tree.updateNode(k, false, true);
+    const std::uint64_t packed = packKey(k);
+    if (containsKey(end_set, packed) || containsKey(clamped, packed) || hit_cells.count(k) != 0) continue;
+    const octomap::OcTreeNode* n = tree.updateNode(k, false, true);
+    if (n != nullptr && n->getLogOdds() <= clamp_min && insertKey(clamped, packed) && 2 * ++impl_->clamped_used > clamped.size()) {
+      grow(clamped);
+      impl_->clamped_used = 0;
+      for (auto c : clamped) impl_->clamped_used += c != kEmpty ? 1 : 0;
+    }
   }
   for (const auto& k : hit_cells) {
+    eraseKey(impl_->clamped_free, packKey(k));
     tree.updateNode(k, true, true);
     impl_->hits.insert(k);
   }
@@ -137,6 +245,8 @@ void OccupancyMap::updateInnerNodes() {
 void OccupancyMap::clear() {
   impl_->tree.clear();
   impl_->hits.clear();
+  std::fill(impl_->clamped_free.begin(), impl_->clamped_free.end(), kEmpty);
+  impl_->clamped_used = 0;
 }
 
 CellState OccupancyMap::state(const Eigen::Vector3d& p) const {

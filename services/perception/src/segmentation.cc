@@ -4,18 +4,21 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <optional>
 #include <stdexcept>
 #include <unordered_map>
 
 #include <pcl/console/print.h>
+#include <pcl/ModelCoefficients.h>
+#include <pcl/PointIndices.h>
 #include <pcl/filters/voxel_grid.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
-#include <pcl/sample_consensus/method_types.h>
-#include <pcl/sample_consensus/model_types.h>
+#include <pcl/sample_consensus/ransac.h>
+#include <pcl/sample_consensus/sac_model_perpendicular_plane.h>
 #include <pcl/search/kdtree.h>
 #include <pcl/segmentation/extract_clusters.h>
-#include <pcl/segmentation/sac_segmentation.h>
 
 #include "tamp/perception/shape_fit.h"
 #include "tamp/world/polygon.h"
@@ -79,6 +82,299 @@ class StaticIndex {
 
 double ms(const Stopwatch& w) { return w.millis(); }
 
+// ---- fast exact replacements of pcl::VoxelGrid, pcl::EuclideanClusterExtraction and the plane
+// model's inlier count (the three took ~45 % of a 300k frame; see docs/benchmarks.md) ------------
+
+/// Empty slot of an open-addressing set of xy cell keys (ix << 32) ^ (iy & 0xffffffff); cell
+/// (-1, -1) has this key and is counted apart.
+constexpr std::uint64_t kNoCell = ~std::uint64_t{0};
+
+/// A key and a payload, sorted by key.
+struct KeyVal {
+  std::uint64_t key;
+  std::uint32_t val;
+};
+
+/// Stable LSD radix sort of records by their `key` member (keys < 2^bits), at most 8 bits per
+/// pass (256 buckets: the scatter's write streams stay in L1).
+template <typename T>
+void radixSort(std::vector<T>& a, int bits) {
+  const std::size_t n = a.size();
+  if (n < 2 || bits <= 0) return;
+  const int passes = (bits + 7) / 8;
+  const int digit = (bits + passes - 1) / passes;
+  const std::size_t buckets = std::size_t{1} << digit;
+  std::unique_ptr<T[]> tmp(new T[n]);  // uninitialised: every element is written
+  T* src = a.data();
+  T* dst = tmp.get();
+  std::vector<std::size_t> count(buckets);
+  for (int shift = 0; shift < bits; shift += digit) {
+    std::fill(count.begin(), count.end(), 0);
+    for (std::size_t i = 0; i < n; ++i) ++count[(src[i].key >> shift) & (buckets - 1)];
+    if (count[(src[0].key >> shift) & (buckets - 1)] == n) continue;  // one bucket: no-op pass
+    std::size_t sum = 0;
+    for (auto& c : count) {
+      const std::size_t k = c;
+      c = sum;
+      sum += k;
+    }
+    for (std::size_t i = 0; i < n; ++i) dst[count[(src[i].key >> shift) & (buckets - 1)]++] = src[i];
+    std::swap(src, dst);
+  }
+  if (src != a.data()) std::copy(src, src + n, a.data());
+}
+
+int bitWidth(std::uint64_t v) {
+  int b = 0;
+  while (v != 0) {
+    ++b;
+    v >>= 1;
+  }
+  return b;
+}
+
+/// What pcl::VoxelGrid<PointXYZ> (leaf size `leaf`, defaults otherwise) outputs: the centroid of
+/// every occupied leaf, leaves in its order (ascending (z, y, x) leaf coordinates), the same leaf
+/// arithmetic (floor(coordinate * (1 / leaf)) in float). Instead of sorting every point by its
+/// leaf, points are summed per leaf as they come (a direct-mapped cache of recent leaves: the
+/// rows above in the organised frame hit the same leaves) and only those sums are radix-sorted.
+/// The grid covers leaf coordinates [first, first + count) per axis, fixed in advance.
+class LeafGrid {
+ public:
+  LeafGrid(const Eigen::Array3i& first, const Eigen::Array3i& count, float leaf, std::size_t expected)
+      : inv_(1.0f / leaf), first_(first.cast<float>()), div_(count.cast<std::int64_t>()),
+        mul1_(static_cast<std::uint64_t>(count[0])), mul2_(mul1_ * static_cast<std::uint64_t>(count[1])),
+        recent_(std::size_t{1} << kCacheBits, kNone) {
+    runs_.reserve(expected / 3 + 1);
+  }
+  /// Adds a point; false (nothing added) when its leaf is outside the grid.
+  bool add(const Eigen::Vector3f& p) {
+    const auto i0 = static_cast<std::int64_t>(static_cast<int>(std::floor(p.x() * inv_) - first_[0]));
+    const auto i1 = static_cast<std::int64_t>(static_cast<int>(std::floor(p.y() * inv_) - first_[1]));
+    const auto i2 = static_cast<std::int64_t>(static_cast<int>(std::floor(p.z() * inv_) - first_[2]));
+    if (i0 < 0 || i1 < 0 || i2 < 0 || i0 >= div_[0] || i1 >= div_[1] || i2 >= div_[2]) return false;
+    const std::uint64_t idx = static_cast<std::uint64_t>(i0) + static_cast<std::uint64_t>(i1) * mul1_ + static_cast<std::uint64_t>(i2) * mul2_;
+    std::uint32_t& slot = recent_[(idx * 0x9E3779B97F4A7C15ull) >> (64 - kCacheBits)];
+    std::uint32_t r = last_ != kNone && runs_[last_].key == idx ? last_ : slot;
+    if (r == kNone || runs_[r].key != idx) {
+      r = static_cast<std::uint32_t>(runs_.size());
+      runs_.push_back({idx, 0.0f, 0.0f, 0.0f, 0});
+    }
+    slot = last_ = r;
+    Run& run = runs_[r];
+    run.x += p.x();
+    run.y += p.y();
+    run.z += p.z();
+    ++run.n;
+    return true;
+  }
+  /// The leaves' centroids in PCL's order.
+  void centroids(Cloud& out) {
+    radixSort(runs_, bitWidth(mul2_ * static_cast<std::uint64_t>(div_[2])));
+    out.clear();
+    out.points.reserve(runs_.size() / 2 + 1);
+    for (std::size_t a = 0; a < runs_.size();) {
+      std::size_t b = a;
+      Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+      std::uint32_t n = 0;
+      for (; b < runs_.size() && runs_[b].key == runs_[a].key; ++b) {
+        sum += Eigen::Vector3f(runs_[b].x, runs_[b].y, runs_[b].z);
+        n += runs_[b].n;
+      }
+      const Eigen::Vector3f c = sum / static_cast<float>(n);
+      out.points.emplace_back(c.x(), c.y(), c.z());
+      a = b;
+    }
+    out.width = static_cast<std::uint32_t>(out.points.size());
+    out.height = 1;
+    out.is_dense = true;
+  }
+
+ private:
+  static constexpr int kCacheBits = 12;
+  static constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+  struct Run {  // points of one leaf met in a row; sorted with their sums (no gather afterwards)
+    std::uint64_t key;
+    float x, y, z;
+    std::uint32_t n;
+  };
+  float inv_;
+  Eigen::Array3f first_;
+  Eigen::Array<std::int64_t, 3, 1> div_;
+  std::uint64_t mul1_, mul2_;
+  std::vector<Run> runs_;
+  std::vector<std::uint32_t> recent_;
+  std::uint32_t last_{kNone};
+};
+
+/// Would pcl::VoxelGrid refuse points within [lo, hi] (its int32 leaf index overflows; it then
+/// passes the cloud through)?
+bool pclVoxelOverflow(const Eigen::Array3f& lo, const Eigen::Array3f& hi, float leaf) {
+  const Eigen::Array3f span = (hi - lo) * Eigen::Array3f::Constant(1.0f / leaf);
+  const auto dx = static_cast<std::int64_t>(span.x()) + 1, dy = static_cast<std::int64_t>(span.y()) + 1,
+             dz = static_cast<std::int64_t>(span.z()) + 1;
+  return dx * dy * dz > static_cast<std::int64_t>(std::numeric_limits<std::int32_t>::max());
+}
+
+/// pcl::VoxelGrid<PointXYZ> on `pts` (bounds `lo`, `hi`) with a LeafGrid over those bounds.
+void voxelFilter(const std::vector<Eigen::Vector3f>& pts, const Eigen::Array3f& lo, const Eigen::Array3f& hi, float leaf,
+                 Cloud& out) {
+  if (pts.empty() || pclVoxelOverflow(lo, hi, leaf)) {  // PCL's pass-through
+    out.clear();
+    for (const auto& p : pts) out.points.emplace_back(p.x(), p.y(), p.z());
+    out.width = static_cast<std::uint32_t>(out.points.size());
+    out.height = 1;
+    out.is_dense = true;
+    return;
+  }
+  const float inv = 1.0f / leaf;
+  Eigen::Array3i min_b, max_b;
+  for (int k = 0; k < 3; ++k) {
+    min_b[k] = static_cast<int>(std::floor(lo[k] * inv));
+    max_b[k] = static_cast<int>(std::floor(hi[k] * inv));
+  }
+  LeafGrid grid(min_b, max_b - min_b + 1, leaf, pts.size());
+  for (const auto& p : pts) grid.add(p);  // always inside
+  grid.centroids(out);
+}
+
+/// The clusters pcl::EuclideanClusterExtraction finds in `pts` (connected components of the
+/// graph joining points closer than `tolerance`, same float distance test as its FLANN radius
+/// search) with min_size..max_size points; indices ascending within a cluster, clusters by size,
+/// largest first, ties in order of their smallest index (PCL's order). Instead of a kd-tree
+/// radius search per point: a grid of cells of `tolerance` (neighbours are in the 26 adjacent
+/// cells, contiguous runs of the key-sorted points) and a union-find over point pairs.
+/// Returns nullopt where the grid's keys would overflow: the caller uses PCL.
+std::optional<std::vector<std::vector<int>>> euclideanClusters(const std::vector<Eigen::Vector3f>& pts, double tolerance,
+                                                               std::size_t min_size, std::size_t max_size) {
+  std::vector<std::vector<int>> clusters;
+  const std::size_t n = pts.size();
+  if (n == 0) return clusters;
+  const double inv = 1.0 / (tolerance * (1.0 + 1e-4));  // a pair within tolerance: cells differ by <= 1
+  Eigen::Array3d lo = pts.front().cast<double>().array(), hi = lo;
+  for (const auto& p : pts) {
+    lo = lo.min(p.cast<double>().array());
+    hi = hi.max(p.cast<double>().array());
+  }
+  const Eigen::Array3d cmin = (lo * inv).floor();
+  const Eigen::Array3d extent = (hi * inv).floor() - cmin + 3.0;  // one empty cell of padding each side
+  if (!(extent.prod() < 4e18)) return std::nullopt;
+  const auto DX = static_cast<std::uint64_t>(extent.x()), DXY = DX * static_cast<std::uint64_t>(extent.y());
+  std::vector<KeyVal> keys(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Array3d c = (pts[i].cast<double>().array() * inv).floor() - cmin + 1.0;
+    keys[i] = {static_cast<std::uint64_t>(c.x()) + static_cast<std::uint64_t>(c.y()) * DX + static_cast<std::uint64_t>(c.z()) * DXY,
+               static_cast<std::uint32_t>(i)};
+  }
+  radixSort(keys, bitWidth(DXY * static_cast<std::uint64_t>(extent.z())));
+  // Points in key order (structure of arrays) and the cells' ranges.
+  std::vector<float> xs(n), ys(n), zs(n);
+  std::vector<std::uint64_t> cell_key;
+  std::vector<std::uint32_t> cell_begin;
+  for (std::size_t s = 0; s < n; ++s) {
+    const Eigen::Vector3f& p = pts[keys[s].val];
+    xs[s] = p.x();
+    ys[s] = p.y();
+    zs[s] = p.z();
+    if (s == 0 || keys[s].key != keys[s - 1].key) {
+      cell_key.push_back(keys[s].key);
+      cell_begin.push_back(static_cast<std::uint32_t>(s));
+    }
+  }
+  const std::size_t cells = cell_key.size();
+  cell_begin.push_back(static_cast<std::uint32_t>(n));
+  std::vector<std::uint32_t> parent(n);
+  for (std::size_t s = 0; s < n; ++s) parent[s] = static_cast<std::uint32_t>(s);
+  auto find = [&](std::uint32_t x) {
+    while (parent[x] != x) {
+      parent[x] = parent[parent[x]];
+      x = parent[x];
+    }
+    return x;
+  };
+  const auto r2 = static_cast<float>(tolerance * tolerance);  // PCL: float(radius * radius), d2 < r2
+  // Forward half of the 3x3x3 neighbourhood as key ranges [first, last] of 1 to 3 cells: every
+  // pair of neighbouring cells is visited once (from the one with the smaller key).
+  const std::uint64_t rows[5][2] = {{0, 1},
+                                    {DX - 1, DX + 1},
+                                    {DXY - DX - 1, DXY - DX + 1},
+                                    {DXY - 1, DXY + 1},
+                                    {DXY + DX - 1, DXY + DX + 1}};
+  for (std::size_t ci = 0; ci < cells; ++ci) {
+    const std::uint64_t k = cell_key[ci];
+    const std::uint32_t b0 = cell_begin[ci], e0 = cell_begin[ci + 1];
+    for (const auto& row : rows) {
+      const std::uint64_t first = k + row[0], last = k + row[1];
+      std::size_t cj = static_cast<std::size_t>(std::lower_bound(cell_key.begin() + static_cast<std::ptrdiff_t>(ci), cell_key.end(), first) -
+                                                cell_key.begin());
+      for (; cj < cells && cell_key[cj] <= last; ++cj) {
+        const std::uint32_t e1 = cell_begin[cj + 1];
+        for (std::uint32_t a = b0; a < e0; ++a) {
+          const float ax = xs[a], ay = ys[a], az = zs[a];
+          for (std::uint32_t b = cj == ci ? a + 1 : cell_begin[cj]; b < e1; ++b) {
+            const float ddx = ax - xs[b], ddy = ay - ys[b], ddz = az - zs[b];
+            if (ddx * ddx + ddy * ddy + ddz * ddz < r2) {
+              const std::uint32_t ra = find(a), rb = find(b);
+              if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);
+            }
+          }
+        }
+      }
+    }
+  }
+  // Components in order of their smallest original index (PCL's seed order).
+  std::vector<std::uint32_t> root_of(n);
+  for (std::size_t s = 0; s < n; ++s) root_of[keys[s].val] = find(static_cast<std::uint32_t>(s));
+  std::vector<int> comp(n, -1);  // by root (a sorted position)
+  std::vector<std::vector<int>> all;
+  for (std::size_t i = 0; i < n; ++i) {
+    int& c = comp[root_of[i]];
+    if (c < 0) {
+      c = static_cast<int>(all.size());
+      all.emplace_back();
+    }
+    all[static_cast<std::size_t>(c)].push_back(static_cast<int>(i));
+  }
+  for (auto& c : all) {
+    if (c.size() >= min_size && c.size() <= max_size) clusters.push_back(std::move(c));
+  }
+  std::stable_sort(clusters.begin(), clusters.end(), [](const auto& a, const auto& b) { return a.size() > b.size(); });
+  return clusters;
+}
+
+/// SampleConsensusModelPerpendicularPlane with the inlier count of RANSAC's hypotheses (PCL's
+/// generic build: an indexed scalar loop, ~10 % of a frame) over a contiguous copy of the points.
+class PerpendicularPlaneModel : public pcl::SampleConsensusModelPerpendicularPlane<pcl::PointXYZ> {
+ public:
+  PerpendicularPlaneModel(const Cloud::ConstPtr& cloud, const pcl::Indices& indices)
+      : pcl::SampleConsensusModelPerpendicularPlane<pcl::PointXYZ>(cloud, indices, false) {
+    xs_.reserve(indices.size());
+    ys_.reserve(indices.size());
+    zs_.reserve(indices.size());
+    for (auto i : indices) {
+      const auto& p = (*cloud)[static_cast<std::size_t>(i)];
+      xs_.push_back(p.x);
+      ys_.push_back(p.y);
+      zs_.push_back(p.z);
+    }
+  }
+  std::size_t countWithinDistance(const Eigen::VectorXf& c, const double threshold) const override {
+    if (!isModelValid(c)) return 0;
+    const float a = c[0], b = c[1], cc = c[2], d = c[3];
+    // PCL: float |coefficients . (p, 1)| < threshold (a double): the same as <= the largest
+    // float below the threshold; the dot product summed as Eigen's SSE reduction does.
+    float t = static_cast<float>(threshold);
+    if (static_cast<double>(t) >= threshold) t = std::nextafter(t, 0.0f);
+    std::size_t count = 0;
+    const std::size_t n = xs_.size();
+    for (std::size_t i = 0; i < n; ++i) count += std::abs((a * xs_[i] + cc * zs_[i]) + (b * ys_[i] + d)) <= t ? 1 : 0;
+    return count;
+  }
+
+ private:
+  std::vector<float> xs_, ys_, zs_;
+};
+
 /// A support plane matching no prior region must cover at least this fraction of its inliers'
 /// convex hull (distinct voxel cells; see the plane stage of Segmenter::run).
 constexpr double kMinSupportFill = 0.25;
@@ -137,7 +433,9 @@ Result<Segmentation> Segmenter::run(const PointCloudFrame& frame, const Terminat
   Stopwatch watch;
 
   // ---- transform + crop ------------------------------------------------------------------------
-  auto cropped = std::make_shared<Cloud>();
+  std::vector<Eigen::Vector3f> cropped;
+  Eigen::Array3f cropped_lo = Eigen::Array3f::Constant(std::numeric_limits<float>::infinity());
+  Eigen::Array3f cropped_hi = -cropped_lo;
   {
     const Eigen::Matrix3f R = frame.world_T_sensor.linear().cast<float>();
     const Eigen::Vector3f t = frame.world_T_sensor.translation().cast<float>();
@@ -146,7 +444,7 @@ Result<Segmentation> Segmenter::run(const PointCloudFrame& frame, const Terminat
     const float r2min = static_cast<float>(P.crop.min_range * P.crop.min_range);
     const float r2max = static_cast<float>(P.crop.max_range * P.crop.max_range);
     const std::size_t n = frame.size();
-    cropped->points.reserve(n);
+    cropped.reserve(n);
     for (std::size_t i = 0; i < n; ++i) {
       const Eigen::Vector3f q(frame.xyz[3 * i], frame.xyz[3 * i + 1], frame.xyz[3 * i + 2]);
       if (!std::isfinite(q.x())) continue;  // validated: a triplet is all finite or a no-return
@@ -155,26 +453,20 @@ Result<Segmentation> Segmenter::run(const PointCloudFrame& frame, const Terminat
       if (r2 < r2min || r2 > r2max) continue;
       const Eigen::Vector3f w = R * q + t;
       if ((w.array() < lo).any() || (w.array() > hi).any()) continue;
-      cropped->points.emplace_back(w.x(), w.y(), w.z());
+      cropped.push_back(w);
+      cropped_lo = cropped_lo.min(w.array());
+      cropped_hi = cropped_hi.max(w.array());
     }
-    cropped->width = static_cast<std::uint32_t>(cropped->points.size());
-    cropped->height = 1;
-    cropped->is_dense = true;
   }
-  out.cropped_points = cropped->size();
+  out.cropped_points = cropped.size();
   out.times.transform_crop = ms(watch);
   if (term()) return stopped(term, "the voxel filter").error();
 
   // ---- voxel grid ------------------------------------------------------------------------------
   watch.reset();
   auto cloud = std::make_shared<Cloud>();
-  if (!cropped->empty()) {
-    pcl::VoxelGrid<pcl::PointXYZ> grid;
-    const float leaf = static_cast<float>(P.planes.voxel_size);
-    grid.setLeafSize(leaf, leaf, leaf);
-    grid.setInputCloud(cropped);
-    grid.filter(*cloud);
-  }
+  voxelFilter(cropped, cropped_lo, cropped_hi, static_cast<float>(P.planes.voxel_size), *cloud);
+  std::vector<Eigen::Vector3f>().swap(cropped);
   out.scan.reserve(cloud->size());
   for (const auto& p : cloud->points) out.scan.emplace_back(p.x, p.y, p.z);
   out.times.voxel = ms(watch);
@@ -187,17 +479,26 @@ Result<Segmentation> Segmenter::run(const PointCloudFrame& frame, const Terminat
     const Eigen::Vector3f origin = frame.world_T_sensor.translation().cast<float>();
     std::vector<pcl::index_t> search(cloud->size());
     for (std::size_t i = 0; i < cloud->size(); ++i) search[i] = static_cast<pcl::index_t>(i);
-    // PCL's RANSAC is seeded with a constant (SACSegmentation(random = false)): frames are
-    // reproducible.
-    pcl::SACSegmentation<pcl::PointXYZ> seg;
-    seg.setOptimizeCoefficients(true);
-    seg.setModelType(pcl::SACMODEL_PERPENDICULAR_PLANE);
-    seg.setMethodType(pcl::SAC_RANSAC);
-    seg.setAxis(Eigen::Vector3f::UnitZ());
-    seg.setEpsAngle(P.planes.max_tilt);
-    seg.setDistanceThreshold(P.planes.distance_threshold);
-    seg.setMaxIterations(P.planes.ransac_iterations);
-    seg.setInputCloud(cloud);
+    // What pcl::SACSegmentation (RANSAC, perpendicular plane, optimised coefficients) does, with
+    // the model's faster inlier count. Its RANSAC is seeded with a constant (random = false):
+    // frames are reproducible.
+    const auto segment = [&](const pcl::Indices& indices, pcl::PointIndices& inliers, pcl::ModelCoefficients& coeffs) {
+      inliers.indices.clear();
+      coeffs.values.clear();
+      auto model = std::make_shared<PerpendicularPlaneModel>(cloud, indices);
+      model->setAxis(Eigen::Vector3f::UnitZ());
+      model->setEpsAngle(P.planes.max_tilt);
+      pcl::RandomSampleConsensus<pcl::PointXYZ> sac(model, P.planes.distance_threshold);
+      sac.setProbability(0.99);
+      sac.setMaxIterations(P.planes.ransac_iterations);
+      if (!sac.computeModel(0)) return;
+      sac.getInliers(inliers.indices);
+      Eigen::VectorXf coeff(model->getModelSize()), refined(model->getModelSize());
+      sac.getModelCoefficients(coeff);
+      model->optimizeModelCoefficients(inliers.indices, coeff, refined);
+      coeffs.values.assign(refined.data(), refined.data() + refined.size());
+      model->selectWithinDistance(refined, P.planes.distance_threshold, inliers.indices);
+    };
     const double voxel_area = P.planes.voxel_size * P.planes.voxel_size;
     std::vector<std::vector<Eigen::Vector2d>> plane_xy;  // inliers' xy per accepted plane (hulls)
     for (int attempt = 0; attempt < P.planes.max_attempts; ++attempt) {
@@ -206,13 +507,12 @@ Result<Segmentation> Segmenter::run(const PointCloudFrame& frame, const Terminat
       // The model from an even subsample; inliers over every candidate point.
       const std::size_t stride =
           (search.size() + static_cast<std::size_t>(P.planes.ransac_max_points) - 1) / static_cast<std::size_t>(P.planes.ransac_max_points);
-      auto sub = std::make_shared<pcl::Indices>();
-      sub->reserve(search.size() / stride + 1);
-      for (std::size_t k = 0; k < search.size(); k += stride) sub->push_back(search[k]);
+      pcl::Indices sub;
+      sub.reserve(search.size() / stride + 1);
+      for (std::size_t k = 0; k < search.size(); k += stride) sub.push_back(search[k]);
       pcl::PointIndices sub_inliers;
       pcl::ModelCoefficients coeffs;
-      seg.setIndices(sub);
-      seg.segment(sub_inliers, coeffs);
+      segment(sub, sub_inliers, coeffs);
       if (coeffs.values.size() != 4 || static_cast<int>(sub_inliers.indices.size() * stride) < P.planes.min_points) break;
       Eigen::Vector4f c(coeffs.values[0], coeffs.values[1], coeffs.values[2], coeffs.values[3]);
       c /= c.head<3>().norm();
@@ -247,16 +547,32 @@ Result<Segmentation> Segmenter::run(const PointCloudFrame& frame, const Terminat
       {
         // Area from the distinct xy cells the inliers cover (range noise smears a surface over
         // several voxel layers, so inliers x voxel^2 would overestimate it).
-        std::vector<std::int64_t> cells;
-        cells.reserve(inliers.size());
+        // Distinct cells counted in an open-addressing set (sorting them was ~2 % of a frame).
+        std::size_t size = 1024;
+        while (size < 2 * inliers.size()) size *= 2;
+        std::vector<std::uint64_t> table(size, kNoCell);
+        std::size_t distinct = 0;
+        bool minus_one = false;  // cell (-1, -1), whose key is kNoCell
         const float inv = 1.0f / static_cast<float>(P.planes.voxel_size);
         for (auto i : inliers) {
           const auto& q = cloud->points[static_cast<std::size_t>(i)];
           const auto ix = static_cast<std::int64_t>(std::floor(q.x * inv)), iy = static_cast<std::int64_t>(std::floor(q.y * inv));
-          cells.push_back((ix << 32) ^ (iy & 0xffffffff));
+          const auto cell = static_cast<std::uint64_t>((ix << 32) ^ (iy & 0xffffffff));
+          if (cell == kNoCell) {
+            distinct += minus_one ? 0 : 1;
+            minus_one = true;
+            continue;
+          }
+          for (std::size_t h = (cell * 0x9E3779B97F4A7C15ull) >> 32 & (size - 1);; h = (h + 1) & (size - 1)) {
+            if (table[h] == cell) break;
+            if (table[h] == kNoCell) {
+              table[h] = cell;
+              ++distinct;
+              break;
+            }
+          }
         }
-        std::sort(cells.begin(), cells.end());
-        plane.area = static_cast<double>(std::unique(cells.begin(), cells.end()) - cells.begin()) * voxel_area;
+        plane.area = static_cast<double>(distinct) * voxel_area;
       }
       // Match a prior region: same height and most inliers over its polygon (tables first).
       const world::Region* region = nullptr;
@@ -331,8 +647,8 @@ Result<Segmentation> Segmenter::run(const PointCloudFrame& frame, const Terminat
 
   // ---- points of prior static objects ------------------------------------------------------------
   watch.reset();
-  auto rest = std::make_shared<Cloud>();
-  rest->points.reserve(cloud->size());
+  std::vector<Eigen::Vector3f> rest;
+  rest.reserve(cloud->size());
   for (std::size_t i = 0; i < cloud->size(); ++i) {
     if (removed[i]) continue;
     const auto& q = cloud->points[i];
@@ -341,44 +657,98 @@ Result<Segmentation> Segmenter::run(const PointCloudFrame& frame, const Terminat
       ++out.static_points;
       continue;
     }
-    rest->points.push_back(q);
+    rest.emplace_back(q.x, q.y, q.z);
   }
-  rest->width = static_cast<std::uint32_t>(rest->points.size());
-  rest->height = 1;
-  rest->is_dense = true;
   out.times.static_objects = ms(watch);
   if (term()) return stopped(term, "clustering").error();
 
   // ---- Euclidean clustering ----------------------------------------------------------------------
   watch.reset();
-  if (!rest->empty()) {
-    auto tree = std::make_shared<pcl::search::KdTree<pcl::PointXYZ>>();
-    tree->setInputCloud(rest);
-    pcl::EuclideanClusterExtraction<pcl::PointXYZ> ec;
-    ec.setClusterTolerance(P.clusters.tolerance);
-    ec.setMinClusterSize(std::max(1, std::min(P.occupancy.min_cluster_points, P.clusters.min_points)));
-    ec.setMaxClusterSize(std::numeric_limits<int>::max());
-    ec.setSearchMethod(tree);
-    ec.setInputCloud(rest);
-    std::vector<pcl::PointIndices> found;
-    ec.extract(found);
-    for (const auto& c : found) {
-      const int size = static_cast<int>(c.indices.size());
-      if (size >= P.clusters.min_points && size <= P.clusters.max_points) {
-        std::vector<Eigen::Vector3f> pts;
-        pts.reserve(c.indices.size());
-        for (auto i : c.indices) pts.push_back(rest->points[static_cast<std::size_t>(i)].getVector3fMap());
-        out.clusters.push_back(std::move(pts));
-      } else if (size >= P.occupancy.min_cluster_points) {
-        std::vector<Eigen::Vector3f> pts;
-        pts.reserve(c.indices.size());
-        for (auto i : c.indices) pts.push_back(rest->points[static_cast<std::size_t>(i)].getVector3fMap());
-        out.small_clusters.push_back(std::move(pts));
-      }
+  if (!rest.empty()) {
+    const int min_size = std::max(1, std::min(P.occupancy.min_cluster_points, P.clusters.min_points));
+    auto found = euclideanClusters(rest, P.clusters.tolerance, static_cast<std::size_t>(min_size),
+                                   std::numeric_limits<std::size_t>::max());
+    if (!found) found = detail::euclideanClustersPcl(rest, P.clusters.tolerance, min_size);  // extreme extents
+    for (const auto& c : *found) {
+      const int size = static_cast<int>(c.size());
+      const bool object = size >= P.clusters.min_points && size <= P.clusters.max_points;
+      if (!object && size < P.occupancy.min_cluster_points) continue;
+      std::vector<Eigen::Vector3f> pts;
+      pts.reserve(c.size());
+      for (auto i : c) pts.push_back(rest[static_cast<std::size_t>(i)]);
+      (object ? out.clusters : out.small_clusters).push_back(std::move(pts));
     }
   }
   out.times.clustering = ms(watch);
   return out;
 }
+
+namespace detail {
+
+namespace {
+Cloud::Ptr toCloud(const std::vector<Eigen::Vector3f>& points) {
+  auto cloud = std::make_shared<Cloud>();
+  cloud->points.reserve(points.size());
+  for (const auto& p : points) cloud->points.emplace_back(p.x(), p.y(), p.z());
+  cloud->width = static_cast<std::uint32_t>(cloud->points.size());
+  cloud->height = 1;
+  cloud->is_dense = true;
+  return cloud;
+}
+}  // namespace
+
+std::vector<Eigen::Vector3f> voxelGrid(const std::vector<Eigen::Vector3f>& points, float leaf) {
+  Eigen::Array3f lo = Eigen::Array3f::Constant(std::numeric_limits<float>::infinity()), hi = -lo;
+  for (const auto& p : points) {
+    lo = lo.min(p.array());
+    hi = hi.max(p.array());
+  }
+  Cloud out;
+  voxelFilter(points, lo, hi, leaf, out);
+  std::vector<Eigen::Vector3f> v;
+  for (const auto& p : out.points) v.emplace_back(p.x, p.y, p.z);
+  return v;
+}
+
+std::vector<Eigen::Vector3f> voxelGridPcl(const std::vector<Eigen::Vector3f>& points, float leaf) {
+  Cloud out;
+  if (!points.empty()) {
+    pcl::VoxelGrid<pcl::PointXYZ> grid;
+    grid.setLeafSize(leaf, leaf, leaf);
+    grid.setInputCloud(toCloud(points));
+    grid.filter(out);
+  }
+  std::vector<Eigen::Vector3f> v;
+  for (const auto& p : out.points) v.emplace_back(p.x, p.y, p.z);
+  return v;
+}
+
+std::vector<std::vector<int>> euclideanClusters(const std::vector<Eigen::Vector3f>& points, double tolerance,
+                                                int min_size) {
+  auto found = tamp::perception::euclideanClusters(points, tolerance, static_cast<std::size_t>(std::max(1, min_size)),
+                                                   std::numeric_limits<std::size_t>::max());
+  return found ? std::move(*found) : euclideanClustersPcl(points, tolerance, min_size);
+}
+
+std::vector<std::vector<int>> euclideanClustersPcl(const std::vector<Eigen::Vector3f>& points, double tolerance,
+                                                   int min_size) {
+  std::vector<std::vector<int>> clusters;
+  if (points.empty()) return clusters;
+  const auto input = toCloud(points);
+  auto tree = std::make_shared<pcl::search::KdTree<pcl::PointXYZ>>();
+  tree->setInputCloud(input);
+  pcl::EuclideanClusterExtraction<pcl::PointXYZ> ec;
+  ec.setClusterTolerance(tolerance);
+  ec.setMinClusterSize(std::max(1, min_size));
+  ec.setMaxClusterSize(std::numeric_limits<int>::max());
+  ec.setSearchMethod(tree);
+  ec.setInputCloud(input);
+  std::vector<pcl::PointIndices> found;
+  ec.extract(found);
+  for (auto& c : found) clusters.emplace_back(c.indices.begin(), c.indices.end());
+  return clusters;
+}
+
+}  // namespace detail
 
 }  // namespace tamp::perception

@@ -68,4 +68,21 @@ class Segmenter {
   std::unique_ptr<Impl> impl_;
 };
 
+namespace detail {
+// The segmenter's replacements of PCL stages and the PCL stages they stand for (tests check that
+// they agree; PCL stays in the .cc).
+
+/// Centroid of every occupied leaf of a `leaf`-sized voxel grid, in pcl::VoxelGrid's order.
+std::vector<Eigen::Vector3f> voxelGrid(const std::vector<Eigen::Vector3f>& points, float leaf);
+/// The same with pcl::VoxelGrid<pcl::PointXYZ>.
+std::vector<Eigen::Vector3f> voxelGridPcl(const std::vector<Eigen::Vector3f>& points, float leaf);
+/// Euclidean clusters (indices ascending; largest cluster first) of at least `min_size` points.
+std::vector<std::vector<int>> euclideanClusters(const std::vector<Eigen::Vector3f>& points, double tolerance,
+                                                int min_size);
+/// The same with pcl::EuclideanClusterExtraction (kd-tree radius search).
+std::vector<std::vector<int>> euclideanClustersPcl(const std::vector<Eigen::Vector3f>& points, double tolerance,
+                                                   int min_size);
+
+}  // namespace detail
+
 }  // namespace tamp::perception

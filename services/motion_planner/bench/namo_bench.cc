@@ -19,11 +19,18 @@
 //                  one movable displaced, then per run one more such query and the benchmark
 //                  query (movables restored), so no run repeats the query just before it;
 //      `ours-any`  those random queries themselves (warm cache, arbitrary start and goal,
-//                  movables changed; no baseline: times, success and their own crossings only).
+//                  movables changed; no baseline: times, success and their own crossings only);
+//      `ours-prep` the first query after MotionPlanner::prepare() (what the DDS node does after a
+//                  world update that changed the static world): per run the cache is cleared,
+//                  prepare() builds the roadmap (timed separately: "prepare" table) and the
+//                  benchmark query is timed alone.
+//    The warm phase calls prepare() once after clearing the cache, as the node does (unless
+//    --no-prepare: the warm phase then starts on an empty cache, the behaviour before prepare()).
 // Fixed seeds: OMPL's global seed is set once at start; runs are in a fixed order.
 //
 // Usage: tamp_motion_planner_namo_bench [--runs 20] [--full-runs 3] [--time-limit 5]
 //          [--warmup 5] [--filter substring] [--json out.json] [--markdown out.md] [--no-baselines]
+//          [--no-prepare]
 //          [--config params.yaml]   (MotionPlannerParams for our planner, e.g.
 //                                    config/services/motion_planner.yaml; default: built-in defaults)
 #include <algorithm>
@@ -293,6 +300,7 @@ int main(int argc, char** argv) {
   int runs = 20, full_runs = 3, warmup = 5;
   double limit = 5.0;
   std::string filter, json_out, md_out;
+  bool use_prepare = true;
   bool baselines = true;
   motion_planner::MotionPlannerParams params;
   for (int i = 1; i < argc; ++i) {
@@ -312,6 +320,7 @@ int main(int argc, char** argv) {
     else if (a == "--json") json_out = next();
     else if (a == "--markdown") md_out = next();
     else if (a == "--no-baselines") baselines = false;
+    else if (a == "--no-prepare") use_prepare = false;
     else if (a == "--config") {
       auto p = motion_planner::loadMotionPlannerParams(next(), {"node"});
       if (!p) {
@@ -322,16 +331,18 @@ int main(int argc, char** argv) {
     }
     else {
       std::cerr << "usage: " << argv[0]
-                << " [--runs N] [--full-runs N] [--warmup N] [--time-limit s] [--filter s] [--json f] [--markdown f] [--no-baselines] [--config f]\n";
+                << " [--runs N] [--full-runs N] [--warmup N] [--time-limit s] [--filter s] [--json f] [--markdown f] [--no-baselines] [--no-prepare] [--config f]\n";
       return 2;
     }
   }
   motion_planner::seedRandomness(42);
   ompl::msg::setLogLevel(ompl::msg::LOG_NONE);
   const auto worlds = loadWorlds(filter);
-  const std::vector<std::string> methods = {"ours", "ours-warm", "ours-any", "rrtconnect", "kpiece", "lbkpiece", "rrtc+simp"};
+  const std::vector<std::string> methods = {"ours", "ours-prep", "ours-warm", "ours-any", "rrtconnect", "kpiece", "lbkpiece", "rrtc+simp"};
   std::map<std::string, std::map<std::string, std::vector<Run>>> results;  // world -> method -> runs
   std::map<std::string, std::vector<Run>> full;                           // world -> full runs
+  std::map<std::string, std::vector<double>> prep_ms;                     // world -> prepare() times
+  std::map<std::string, motion_planner::PrepareStats> prep_last;
   nlohmann::json js;
   js["time_limit_s"] = limit;
   js["runs"] = runs;
@@ -379,9 +390,27 @@ int main(int argc, char** argv) {
       mp.clearRoadmapCache();
       record("ours", r, mp.plan(req, Termination::after(limit)));
     }
+    // First query after prepare() (the node prepares after a static-world change).
+    auto prepare = [&]() {
+      auto ps = mp.prepare(motion_planner::PlanningGroup::kBase, req.start, {}, Termination::after(limit));
+      if (!ps) {
+        std::cerr << "  prepare: " << ps.error().toString() << "\n";
+        return;
+      }
+      prep_ms[wc.name].push_back(ps->time_ms);
+      prep_last[wc.name] = *ps;
+    };
+    if (use_prepare) {
+      for (int r = 0; r < runs; ++r) {
+        mp.clearRoadmapCache();
+        prepare();
+        record("ours-prep", r, mp.plan(req, Termination::after(limit)));
+      }
+    }
     // Warm cache: random queries with one movable displaced between benchmark queries.
     {
       mp.clearRoadmapCache();
+      if (use_prepare) prepare();
       std::mt19937 rng(1234);
       const Aabb b = wc.nw.world.bounds();
       std::uniform_real_distribution<double> ux(b.min.x(), b.max.x()), uy(b.min.y(), b.max.y()),
@@ -513,6 +542,26 @@ int main(int argc, char** argv) {
     js["aggregate"][m] = {{"success", s.ok}, {"runs", s.runs}, {"median_ms", s.med_ms}, {"p95_ms", s.p95_ms},
                           {"median_crossed", s.med_cross}, {"mean_crossed", s.mean_cross}, {"total_crossed", total},
                           {"median_length", s.med_len}};
+  }
+  if (!prep_ms.empty()) {
+    md << "\nprepare() (base group, cache cleared before each; not inside any request above except `ours`'s "
+          "cold runs, which pay their own build):\n\n| world | median ms | p95 ms | max ms | nodes | edges | invalid "
+          "edges |\n|---|---|---|---|---|---|---|\n";
+    std::vector<double> all;
+    for (const auto& wc : worlds) {
+      const auto& v = prep_ms[wc.name];
+      if (v.empty()) continue;
+      all.insert(all.end(), v.begin(), v.end());
+      const auto& ps = prep_last[wc.name];
+      md << "| " << wc.name << " | " << f2(percentile(v, 0.5)) << " | " << f2(percentile(v, 0.95)) << " | "
+         << f2(percentile(v, 1.0)) << " | " << ps.roadmap_nodes << " | " << ps.roadmap_edges << " | "
+         << ps.edges_invalid << " |\n";
+      js["prepare"][wc.name] = {{"median_ms", percentile(v, 0.5)}, {"p95_ms", percentile(v, 0.95)},
+                                {"max_ms", percentile(v, 1.0)}, {"nodes", ps.roadmap_nodes},
+                                {"edges", ps.roadmap_edges}, {"invalid_edges", ps.edges_invalid}};
+    }
+    md << "| all | " << f2(percentile(all, 0.5)) << " | " << f2(percentile(all, 0.95)) << " | "
+       << f2(percentile(all, 1.0)) << " | | | |\n";
   }
   std::cout << md.str();
   if (!md_out.empty()) std::ofstream(md_out) << md.str();

@@ -46,6 +46,8 @@ Result<NodeConfig> parseNodeConfig(const std::string& yaml_text, const std::stri
   r.optional("world_id", c.world_id);
   r.optional("default_budget_s", c.default_budget_s);
   r.optional("world_wait_s", c.world_wait_s);
+  r.optional("prepare", c.prepare);
+  r.optional("prepare_budget_s", c.prepare_budget_s);
   r.check(c.robot == "mobile_manipulator" || c.robot == "disc", "robot",
           "must be 'mobile_manipulator' or 'disc', got '" + c.robot + "'");
   r.check(std::isfinite(c.disc_radius) && c.disc_radius > 0, "disc_radius", "must be positive");
@@ -53,6 +55,7 @@ Result<NodeConfig> parseNodeConfig(const std::string& yaml_text, const std::stri
   r.check(!c.world_id.empty(), "world_id", "must not be empty");
   r.check(std::isfinite(c.default_budget_s) && c.default_budget_s > 0, "default_budget_s", "must be positive");
   r.check(std::isfinite(c.world_wait_s) && c.world_wait_s >= 0, "world_wait_s", "must be >= 0");
+  r.check(std::isfinite(c.prepare_budget_s) && c.prepare_budget_s > 0, "prepare_budget_s", "must be positive");
   r.refuseUnknownKeys();
   if (!r.ok()) return r.status().error();
   if (!urdf.empty()) {
@@ -93,6 +96,7 @@ Result<std::unique_ptr<MotionPlannerNode>> MotionPlannerNode::create(const dds::
 MotionPlannerNode::MotionPlannerNode(const dds::ServiceArgs& args, NodeConfig config, MotionPlanner planner)
     : ServiceNode(args), config_(std::move(config)), planner_(std::move(planner)) {
   mirror_ = std::make_unique<dds::WorldMirror>(participant(), config_.world_id);
+  mirror_->onChange([this](const world::World&) { world_dirty_ = true; });
   motion_ = std::make_unique<dds::RpcServer<msg::MotionRequest, msg::MotionReply>>(
       participant(), dds::services::kMotion,
       [this](const msg::MotionRequest& r, const dds::RequestContext& c) { return handleMotion(r, c); });
@@ -128,6 +132,46 @@ std::pair<uint64_t, uint64_t> MotionPlannerNode::requestCounters() const {
   return {served, failed};
 }
 
+void MotionPlannerNode::spinOnce() { (void)prepareIfWorldChanged(); }
+
+void MotionPlannerNode::interruptPreparation() {
+  std::lock_guard g(stop_mutex_);
+  prepare_stop_.request_stop();
+}
+
+std::optional<PrepareStats> MotionPlannerNode::prepareIfWorldChanged() {
+  if (!config_.prepare || waiting_.load() > 0 || !world_dirty_.exchange(false)) return std::nullopt;
+  std::unique_lock lock(mutex_, std::try_to_lock);
+  if (!lock.owns_lock() || waiting_.load() > 0) {  // a request runs or waits: later
+    world_dirty_ = true;
+    return std::nullopt;
+  }
+  std::stop_token token;
+  {
+    std::lock_guard g(stop_mutex_);
+    prepare_stop_ = std::stop_source();
+    token = prepare_stop_.get_token();
+  }
+  planner_.setWorld(mirror_->snapshot());
+  robot::RobotState state;
+  if (last_base_start_) {
+    state = *last_base_start_;
+  } else if (const auto* model = planner_.robotModel()) {
+    state = model->defaultState();
+  }
+  auto r = planner_.prepare(PlanningGroup::kBase, state, {},
+                            Termination(Deadline::in(config_.prepare_budget_s), std::move(token)));
+  if (!r) {
+    nodeLog()->warn("roadmap preparation failed: {}", r.error().toString());
+    return std::nullopt;
+  }
+  if (!r->completed) world_dirty_ = true;  // interrupted: resume at the next spin
+  nodeLog()->debug("roadmap prepared in {:.1f} ms ({}, {} nodes, {} edges evaluated{})", r->time_ms,
+                   r->built ? "new" : "cached", r->roadmap_nodes, r->edges_evaluated,
+                   r->completed ? "" : ", interrupted");
+  return *r;
+}
+
 Result<Termination> MotionPlannerNode::prepare(uint64_t world_version, const dds::RequestContext& ctx) {
   Termination term = ctx.termination;
   if (term.deadline().isNever()) term = term.tightened(Deadline::in(config_.default_budget_s));
@@ -144,7 +188,10 @@ Result<Termination> MotionPlannerNode::prepare(uint64_t world_version, const dds
 }
 
 msg::MotionReply MotionPlannerNode::handleMotion(const msg::MotionRequest& req, const dds::RequestContext& ctx) {
-  std::lock_guard lock(mutex_);
+  ++waiting_;
+  interruptPreparation();
+  std::unique_lock lock(mutex_);
+  --waiting_;
   auto term = prepare(req.world_version(), ctx);
   if (!term) return errorReply<msg::MotionReply>(term.error());
   auto request = fromMsg(req, planner_);
@@ -155,6 +202,7 @@ msg::MotionReply MotionPlannerNode::handleMotion(const msg::MotionRequest& req, 
     rep.header().message(request.error().toString());
     return rep;
   }
+  if (request->group == PlanningGroup::kBase) last_base_start_ = request->start;
   const MotionResult r = planner_.plan(*request, *term);
   nodeLog()->debug("motion {} {} {}: {} in {:.1f} ms, {} blocking", ctx.request_id, toString(request->group),
                    toString(request->mode), toString(r.status), r.planning_time_s * 1e3, r.blocking.size());
@@ -165,7 +213,10 @@ msg::MotionReply MotionPlannerNode::handleMotion(const msg::MotionRequest& req, 
 
 msg::PlacementReply MotionPlannerNode::handlePlacement(const msg::PlacementRequest& req,
                                                       const dds::RequestContext& ctx) {
-  std::lock_guard lock(mutex_);
+  ++waiting_;
+  interruptPreparation();
+  std::unique_lock lock(mutex_);
+  --waiting_;
   auto term = prepare(0, ctx);
   if (!term) return errorReply<msg::PlacementReply>(term.error());
   auto request = fromMsg(req);
@@ -176,7 +227,10 @@ msg::PlacementReply MotionPlannerNode::handlePlacement(const msg::PlacementReque
 }
 
 msg::GraspReply MotionPlannerNode::handleGrasp(const msg::GraspRequest& req, const dds::RequestContext& ctx) {
-  std::lock_guard lock(mutex_);
+  ++waiting_;
+  interruptPreparation();
+  std::unique_lock lock(mutex_);
+  --waiting_;
   auto term = prepare(0, ctx);
   if (!term) return errorReply<msg::GraspReply>(term.error());
   auto request = fromMsg(req);

@@ -14,6 +14,15 @@
 ///   (NOT_FOUND, INVALID_ARGUMENT, UNSUPPORTED, TIMEOUT, UNAVAILABLE) and message.
 /// - Budget: the client's remaining budget (RequestContext) and its cancellation; a request
 ///   without budget gets `default_budget_s`.
+/// - Roadmap preparation: after a world update (mirror change) the node's own run() thread
+///   (spinOnce) brings the planner to the new world and calls MotionPlanner::prepare() for the
+///   base group, under the planner's mutex, so the first lazy request after a static-world change
+///   finds a complete roadmap. Cheap when only movables changed (the cached roadmap is reused).
+///   A request arriving meanwhile stops the preparation (kept, resumed at the next spin) rather
+///   than wait for it; `prepare_budget_s` caps one preparation.
+#include <atomic>
+#include <optional>
+#include <stop_token>
 
 #include <filesystem>
 #include <memory>
@@ -35,6 +44,8 @@ struct NodeConfig {
   std::string world_id{"world"};
   double default_budget_s{5.0};             ///< > 0
   double world_wait_s{2.0};                 ///< >= 0
+  bool prepare{true};                       ///< prepare the base group's roadmap after world updates
+  double prepare_budget_s{2.0};             ///< > 0: cap of one preparation
   MotionPlannerParams params;
 };
 
@@ -55,8 +66,15 @@ class MotionPlannerNode : public dds::ServiceNode {
   msg::PlacementReply handlePlacement(const msg::PlacementRequest& req, const dds::RequestContext& ctx);
   msg::GraspReply handleGrasp(const msg::GraspRequest& req, const dds::RequestContext& ctx);
 
+  /// What spinOnce() does: when the world changed since the last preparation (or the last one
+  /// was interrupted), brings the planner to the mirror's world and prepares the base group's
+  /// roadmap (fixed joints of the last base request, else the robot's default state). Returns
+  /// whether a preparation ran; nothing when `prepare` is off, nothing changed or a request waits.
+  std::optional<PrepareStats> prepareIfWorldChanged();
+
  protected:
   std::pair<uint64_t, uint64_t> requestCounters() const override;
+  void spinOnce() override;
 
  private:
   MotionPlannerNode(const dds::ServiceArgs& args, NodeConfig config, MotionPlanner planner);
@@ -64,9 +82,17 @@ class MotionPlannerNode : public dds::ServiceNode {
   /// Returns an error when the requested world version does not arrive in time.
   Result<Termination> prepare(uint64_t world_version, const dds::RequestContext& ctx);
 
+  /// A handler about to take `mutex_`: stops a running preparation.
+  void interruptPreparation();
+
   NodeConfig config_;
-  std::mutex mutex_;  // guards planner_
+  std::mutex mutex_;  // guards planner_ and last_base_start_
   MotionPlanner planner_;
+  std::optional<robot::RobotState> last_base_start_;
+  std::atomic<bool> world_dirty_{true};
+  std::atomic<int> waiting_{0};    // handlers waiting for mutex_
+  std::mutex stop_mutex_;          // guards prepare_stop_
+  std::stop_source prepare_stop_;
   std::unique_ptr<dds::WorldMirror> mirror_;
   std::unique_ptr<dds::RpcServer<msg::MotionRequest, msg::MotionReply>> motion_;
   std::unique_ptr<dds::RpcServer<msg::PlacementRequest, msg::PlacementReply>> placement_;

@@ -238,13 +238,21 @@ class StaticRoadmap {
   const StaticWorldKey& key() const { return key_; }
   std::size_t nodeCount() const { return nodes_.size(); }
   std::size_t edgeCount() const { return edges_.size(); }
-  std::size_t uniformSamples() const { return uniform_; }
+  std::size_t uniformSamples() const { return uniform_; }  ///< uniform + bridge-test samples
+  std::size_t plainSamples() const { return plain_; }      ///< uniform samples
+  std::size_t bridgeSamples() const { return bridges_; }   ///< bridge-test samples
+  /// The last addSamples() stopped on its termination (not on its counts).
+  bool samplingInterrupted() const { return sampling_interrupted_; }
 
   /// Draws uniform states of `gs`'s space (own seeded generator: deterministic) until `count`
   /// static-free ones were added or 4 x `count` were drawn; then up to `bridge_count` bridge-test
   /// samples (narrow passages; at most 20 x `bridge_count` attempts).
   void addSamples(Oracle& oracle, const GroupSpace& gs, int count, const Termination& termination,
                   int bridge_count = 0, double bridge_distance = 1.0);
+  /// Evaluates the static validity of every edge not known yet (at `resolution`); returns
+  /// {evaluated, invalid}; `complete` tells whether every edge is known afterwards.
+  std::pair<std::size_t, std::size_t> evaluateEdges(Oracle& oracle, double resolution,
+                                                    const Termination& termination, bool& complete);
   /// Adds a static-free state (or finds the node already there) connected to its k nearest nodes.
   int addState(const ob::State* s);
   /// Adds a statically valid path cut every `spacing` (its edges are known valid); returns the
@@ -277,6 +285,9 @@ class StaticRoadmap {
   std::vector<Edge> edges_;
   std::vector<std::vector<int>> adj_;
   std::size_t uniform_{0};
+  std::size_t plain_{0};
+  std::size_t bridges_{0};
+  bool sampling_interrupted_{false};
   int neighbors_{12};
   void addEdge(int a, int b, bool valid);
   int pushNode(const ob::State* s);

@@ -416,6 +416,90 @@ std::optional<std::string> validateRequest(const MotionRequest& r, const MotionP
 
 }  // namespace
 
+namespace {
+
+/// The cache key of the static free space of `group` (see detail::StaticWorldKey).
+detail::StaticWorldKey staticWorldKey(const MotionPlanner::Impl& impl, PlanningGroup group,
+                                      const robot::RobotState& start, const std::string& held,
+                                      const Eigen::Isometry3d& link_T_held, const std::vector<std::string>& ignored) {
+  detail::StaticWorldKey key;
+  key.group = group;
+  for (const auto& o : impl.world.objects()) {
+    if (o.kind != world::ObjectKind::kStatic) continue;
+    if (std::find(ignored.begin(), ignored.end(), o.id) != ignored.end()) continue;
+    key.statics.push_back(impl.world.objectPtr(o.id));
+  }
+  if (!held.empty()) {
+    key.held = impl.world.objectPtr(held);
+    key.link_T_held = link_T_held;
+  }
+  if (group == PlanningGroup::kBase) key.fixed = start.arm;
+  if (group == PlanningGroup::kArm) key.fixed = {start.base.x, start.base.y, start.base.theta};
+  if (impl.robot.hasArm()) key.fixed.push_back(start.gripper);
+  return key;
+}
+
+}  // namespace
+
+Result<PrepareStats> MotionPlanner::prepare(PlanningGroup group, const robot::RobotState& state,
+                                            const std::string& held_object, const Termination& termination) {
+  Impl& impl = *impl_;
+  const auto& P = impl.params;
+  Stopwatch clock;
+  PrepareStats out;
+  if (group != PlanningGroup::kBase && !impl.robot.hasArm()) {
+    return Error(ErrorCode::kInvalidArgument, "group: '" + std::string(toString(group)) + "' needs an arm");
+  }
+  if (state.arm.size() != impl.robot.armDof()) {
+    return Error(ErrorCode::kInvalidArgument, "state.arm: expected " + std::to_string(impl.robot.armDof()) +
+                                                  " values, got " + std::to_string(state.arm.size()));
+  }
+  if (!std::isfinite(state.base.x) || !std::isfinite(state.base.y) || !std::isfinite(state.base.theta)) {
+    return Error(ErrorCode::kInvalidArgument, "state.base: not finite");
+  }
+  if (!P.lazy.optimize || P.lazy.roadmap_cache_entries == 0) {  // no roadmap to keep
+    out.completed = true;
+    out.time_ms = clock.millis();
+    return out;
+  }
+  const std::string held = !held_object.empty() ? held_object
+                           : impl.world.held() ? impl.world.held()->object_id
+                                               : std::string();
+  Impl::AttachGuard guard;
+  Eigen::Isometry3d link_T_held = Eigen::Isometry3d::Identity();
+  if (!held.empty()) {
+    auto g = impl.attach(held, state, held_object.empty() ? "world.held" : "held_object", &link_T_held);
+    if (!g) return g.error();
+    guard = std::move(*g);
+  }
+  const Aabb bounds = impl.baseBounds({{state.base.x, state.base.y}});
+  detail::GroupSpace gs(impl.robot, group, state, bounds, P.sampling);
+  const double reach = group == PlanningGroup::kBase ? impl.reachRadius(state, held) : 0.0;
+  detail::Oracle oracle(impl.scene, gs, {}, {}, reach);  // static checks only
+  std::unique_ptr<detail::StaticRoadmap> uncached;
+  bool reused = false;
+  detail::StaticRoadmap* roadmap =
+      impl.roadmapFor(staticWorldKey(impl, group, state, held, link_T_held, {}), gs.space(), reused, uncached);
+  out.built = !reused;
+  // A new roadmap's samples, or the rest of an interrupted preparation's.
+  if ((roadmap->uniformSamples() == 0 || roadmap->samplingInterrupted()) && P.lazy.roadmap_samples > 0) {
+    const int bridges = group == PlanningGroup::kBase ? P.lazy.roadmap_bridge_samples : 0;
+    roadmap->addSamples(oracle, gs, std::max(0, P.lazy.roadmap_samples - static_cast<int>(roadmap->plainSamples())),
+                        termination, std::max(0, bridges - static_cast<int>(roadmap->bridgeSamples())),
+                        P.lazy.roadmap_bridge_distance);
+  }
+  bool edges_complete = false;
+  const auto [evaluated, invalid] =
+      roadmap->evaluateEdges(oracle, P.sampling.validity_resolution, termination, edges_complete);
+  out.completed = edges_complete && !roadmap->samplingInterrupted();
+  out.edges_evaluated = evaluated;
+  out.edges_invalid = invalid;
+  out.roadmap_nodes = roadmap->nodeCount();
+  out.roadmap_edges = roadmap->edgeCount();
+  out.time_ms = clock.millis();
+  return out;
+}
+
 MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& termination) {
   Impl& impl = *impl_;
   const auto& P = impl.params;
@@ -641,21 +725,8 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
   };
   if (lazy && P.lazy.optimize) {
     Stopwatch rw;
-    detail::StaticWorldKey key;
-    key.group = req.group;
-    for (const auto& o : impl.world.objects()) {
-      if (o.kind != world::ObjectKind::kStatic) continue;
-      if (std::find(ignored.begin(), ignored.end(), o.id) != ignored.end()) continue;
-      key.statics.push_back(impl.world.objectPtr(o.id));
-    }
-    if (!held.empty()) {
-      key.held = impl.world.objectPtr(held);
-      key.link_T_held = link_T_held;
-    }
-    if (req.group == PlanningGroup::kBase) key.fixed = req.start.arm;
-    if (req.group == PlanningGroup::kArm) key.fixed = {req.start.base.x, req.start.base.y, req.start.base.theta};
-    if (impl.robot.hasArm()) key.fixed.push_back(req.start.gripper);
-    roadmap = impl.roadmapFor(std::move(key), space, res.stats.roadmap_reused, uncached);
+    roadmap = impl.roadmapFor(staticWorldKey(impl, req.group, req.start, held, link_T_held, ignored), space,
+                              res.stats.roadmap_reused, uncached);
     // A roadmap new in this request knows no edge yet: lazy KPIECE goes first and seeds it.
     if (req.group == PlanningGroup::kBase && P.lazy.roadmap_first && res.stats.roadmap_reused &&
         !goal_states.empty()) {

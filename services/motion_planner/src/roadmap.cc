@@ -125,6 +125,26 @@ int StaticRoadmap::pushNode(const ob::State* s) {
 
 int StaticRoadmap::addState(const ob::State* s) { return pushNode(s); }
 
+std::pair<std::size_t, std::size_t> StaticRoadmap::evaluateEdges(Oracle& oracle, double resolution,
+                                                                 const Termination& termination, bool& complete) {
+  std::size_t evaluated = 0, invalid = 0;
+  complete = true;
+  for (Edge& e : edges_) {
+    if (e.status != Edge::kUnknown) continue;
+    if ((evaluated & 63) == 0 && termination()) {
+      complete = false;
+      break;
+    }
+    // No movables in `oracle` for this: only the static pass runs.
+    const SegmentInfo info = evaluateSegment(oracle, nodes_[static_cast<std::size_t>(e.a)],
+                                             nodes_[static_cast<std::size_t>(e.b)], resolution, false);
+    e.status = info.valid ? Edge::kValid : Edge::kInvalid;
+    ++evaluated;
+    if (!info.valid) ++invalid;
+  }
+  return {evaluated, invalid};
+}
+
 void StaticRoadmap::addSamples(Oracle& oracle, const GroupSpace& gs, int count, const Termination& termination,
                                int bridge_count, double bridge_distance) {
   ob::State* tmp = space_->allocState();
@@ -147,8 +167,12 @@ void StaticRoadmap::addSamples(Oracle& oracle, const GroupSpace& gs, int count, 
   }
   std::vector<double> v(ranges.size());
   int added = 0;
+  sampling_interrupted_ = false;
   for (int attempt = 0; added < count && attempt < 4 * count; ++attempt) {
-    if ((attempt & 31) == 0 && termination()) break;
+    if ((attempt & 31) == 0 && termination()) {
+      sampling_interrupted_ = true;
+      break;
+    }
     for (std::size_t i = 0; i < ranges.size(); ++i) {
       v[i] = ranges[i].first + (ranges[i].second - ranges[i].first) * unit(rng);
     }
@@ -157,6 +181,7 @@ void StaticRoadmap::addSamples(Oracle& oracle, const GroupSpace& gs, int count, 
     pushNode(tmp);
     ++added;
     ++uniform_;
+    ++plain_;
   }
   // Bridge test (Hsu et al., ICRA 2003): two states in static collision, about
   // `bridge_distance` apart, whose midpoint is free -- a state in a narrow passage (doors,
@@ -165,7 +190,10 @@ void StaticRoadmap::addSamples(Oracle& oracle, const GroupSpace& gs, int count, 
   std::vector<double> w(ranges.size());
   added = 0;
   for (int attempt = 0; added < bridge_count && attempt < 20 * bridge_count; ++attempt) {
-    if ((attempt & 31) == 0 && termination()) break;
+    if ((attempt & 31) == 0 && termination()) {
+      sampling_interrupted_ = true;
+      break;
+    }
     for (std::size_t i = 0; i < ranges.size(); ++i) {
       v[i] = ranges[i].first + (ranges[i].second - ranges[i].first) * unit(rng);
       w[i] = std::clamp(v[i] + gauss(rng), ranges[i].first, ranges[i].second);
@@ -179,6 +207,7 @@ void StaticRoadmap::addSamples(Oracle& oracle, const GroupSpace& gs, int count, 
     pushNode(mid);
     ++added;
     ++uniform_;
+    ++bridges_;
   }
   space_->freeState(mid);
   space_->freeState(other);

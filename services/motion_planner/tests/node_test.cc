@@ -2,7 +2,10 @@
 // requests against a world published by a WorldPublisher.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
+#include <optional>
+#include <thread>
 
 #include "motion_planner_node.h"
 #include "tamp/core/paths.h"
@@ -96,6 +99,40 @@ TEST_F(NodeTest, FullRequestIsAProvenNoPathAndFollowsWorldUpdates) {
   EXPECT_GE(testing::discClearance(world_, *path, 0.3, 0.005), 0.0);
 }
 
+// After a world update the node prepares the base group's roadmap (spinOnce calls
+// prepareIfWorldChanged; called directly here): complete afterwards, nothing to do while the world
+// stays the same, and a movable's move keeps the roadmap (only a static change rebuilds it).
+TEST_F(NodeTest, PreparesTheRoadmapAfterWorldUpdates) {
+  auto rep = motion_->call(lazyRequest(), dds::CallOptions{30.0, {}});  // the mirror has the world now
+  ASSERT_TRUE(rep.ok()) << rep.error().toString();
+  ASSERT_EQ(rep->status(), msg::MOTION_SOLVED) << rep->reason();
+  auto prep = node_->prepareIfWorldChanged();
+  ASSERT_TRUE(prep.has_value());
+  EXPECT_FALSE(prep->built);  // the request above built it
+  EXPECT_TRUE(prep->completed);
+  EXPECT_GT(prep->edges_evaluated, 0u);
+  EXPECT_FALSE(node_->prepareIfWorldChanged().has_value());  // nothing changed
+
+  Eigen::Isometry3d p = world_.object("crate").pose;
+  p.translation() = Eigen::Vector3d(2.0, 3.4, 0.4);
+  ASSERT_TRUE(world_.setObjectPose("crate", p).ok());
+  ASSERT_TRUE(publisher_->publish(world_).ok());
+  std::optional<PrepareStats> moved;
+  for (int i = 0; i < 500 && !moved; ++i) {
+    moved = node_->prepareIfWorldChanged();
+    if (!moved) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ASSERT_TRUE(moved.has_value());
+  EXPECT_FALSE(moved->built);
+  EXPECT_TRUE(moved->completed);
+  msg::MotionRequest r = lazyRequest();
+  r.start_base(dds::toMsg(Pose2D{2, 1, 0}));
+  rep = motion_->call(r, dds::CallOptions{30.0, {}});
+  ASSERT_TRUE(rep.ok()) << rep.error().toString();
+  EXPECT_EQ(rep->status(), msg::MOTION_SOLVED) << rep->reason();
+  EXPECT_TRUE(rep->blocking().empty());
+}
+
 TEST_F(NodeTest, MalformedRequestsGetInvalidRequestNamingTheField) {
   msg::MotionRequest r = lazyRequest();
   r.goal_base().x(std::nan(""));
@@ -170,6 +207,11 @@ TEST(NodeConfigTest, ShippedConfigLoadsAndBadNodeKeysAreNamed) {
   auto c = loadNodeConfig(configDir() / "services" / "motion_planner.yaml");
   ASSERT_TRUE(c.ok()) << c.error().toString();
   EXPECT_EQ(c->robot, "mobile_manipulator");
+  EXPECT_TRUE(c->prepare);
+  EXPECT_GT(c->prepare_budget_s, 0.0);
+  auto bad_budget = parseNodeConfig("node:\n  prepare_budget_s: 0\n", "n.yaml");
+  ASSERT_FALSE(bad_budget.ok());
+  EXPECT_NE(bad_budget.error().message.find("node.prepare_budget_s"), std::string::npos) << bad_budget.error().message;
   auto bad = parseNodeConfig("node:\n  robot: tank\n  colour: red\n", "n.yaml");
   ASSERT_FALSE(bad.ok());
   EXPECT_NE(bad.error().message.find("node.robot"), std::string::npos) << bad.error().message;

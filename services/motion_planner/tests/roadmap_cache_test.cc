@@ -159,3 +159,67 @@ TEST_F(RoadmapCacheTest, HeldObjectChangeInvalidates) {
 
 }  // namespace
 }  // namespace tamp::motion_planner
+
+namespace tamp::motion_planner {
+namespace {
+
+// prepare() builds the roadmap ahead of requests: the first request after it reuses it (no lazy
+// KPIECE), with the same report as a cold request; a second prepare() finds it cached and only
+// evaluates the edges the request added; an interrupted prepare() keeps what it did.
+TEST_F(RoadmapCacheTest, PrepareBuildsTheRoadmapTheNextRequestReuses) {
+  world::World w = testing::twoDoorWorld();
+  MotionPlanner mp(collision::RobotGeometry::disc(kRadius, 1.0), params());
+  mp.setWorld(w);
+  const MotionRequest req = baseRequest({2, 0.9, 0}, {8, 0.9, 0});
+
+  auto stopped = mp.prepare(PlanningGroup::kBase, req.start, {}, Termination::after(-1.0));
+  ASSERT_TRUE(stopped.ok()) << stopped.error().toString();
+  EXPECT_TRUE(stopped->built);
+  EXPECT_FALSE(stopped->completed);
+
+  // The next call completes what the interrupted one left.
+  auto prep = mp.prepare(PlanningGroup::kBase, req.start, {}, Termination::after(30.0));
+  ASSERT_TRUE(prep.ok()) << prep.error().toString();
+  EXPECT_FALSE(prep->built);
+  EXPECT_TRUE(prep->completed);
+  EXPECT_GE(prep->roadmap_nodes, static_cast<std::size_t>(mp.params().lazy.roadmap_samples));
+  EXPECT_EQ(prep->edges_evaluated, prep->roadmap_edges);  // every edge's static validity known
+  EXPECT_GT(prep->edges_invalid, 0u);                     // the walls cut some
+  EXPECT_EQ(mp.roadmapCacheSize(), 1u);
+
+  const MotionResult r = mp.plan(req, Termination::after(5.0));
+  ASSERT_EQ(r.status, MotionStatus::kSolved) << r.reason;
+  EXPECT_TRUE(r.stats.roadmap_reused);
+  EXPECT_FALSE(r.stats.lazy_planner_used);
+  EXPECT_EQ(ids(r.blocking), std::vector<std::string>{"light"});
+  EXPECT_EQ(discTouches(w, r.path, kRadius, 0.005), ids(r.blocking));
+  EXPECT_GT(discClearance(w, r.path, kRadius, 0.005, {}, /*movables=*/false), -1e-3);
+  EXPECT_EQ(mp.roadmapCacheSize(), 1u);
+
+  // Again: cached; only the request's start and goal edges are new.
+  auto again = mp.prepare(PlanningGroup::kBase, req.start, {}, Termination::after(30.0));
+  ASSERT_TRUE(again.ok());
+  EXPECT_FALSE(again->built);
+  EXPECT_TRUE(again->completed);
+  EXPECT_LE(again->edges_evaluated, 2u * static_cast<std::size_t>(mp.params().lazy.roadmap_neighbors));
+
+  // Only a movable changes: still the same roadmap.
+  Eigen::Isometry3d p = w.object("light").pose;
+  p.translation().x() = 8.5;
+  p.translation().y() = 3.5;
+  ASSERT_TRUE(w.setObjectPose("light", p).ok());
+  mp.setWorld(w);
+  auto moved = mp.prepare(PlanningGroup::kBase, req.start, {}, Termination::after(30.0));
+  ASSERT_TRUE(moved.ok());
+  EXPECT_FALSE(moved->built);
+  EXPECT_EQ(moved->edges_evaluated, 0u);
+
+  // Bad input.
+  EXPECT_FALSE(mp.prepare(PlanningGroup::kArm, req.start).ok());
+  robot::RobotState bad = req.start;
+  bad.arm = {0.1};
+  EXPECT_FALSE(mp.prepare(PlanningGroup::kBase, bad).ok());
+}
+
+}  // namespace
+}  // namespace tamp::motion_planner

@@ -191,6 +191,17 @@ struct MotionResult {
   bool ok() const { return status == MotionStatus::kSolved; }
 };
 
+/// What MotionPlanner::prepare() did.
+struct PrepareStats {
+  bool built{false};                ///< a new roadmap was created (false: the cached one was completed)
+  std::size_t roadmap_nodes{0};
+  std::size_t roadmap_edges{0};
+  std::size_t edges_evaluated{0};   ///< edges whose static validity this call evaluated
+  std::size_t edges_invalid{0};     ///< of those, statically invalid
+  bool completed{false};            ///< every edge's static validity is known (false: `termination` fired)
+  double time_ms{0.0};
+};
+
 /// Seeds OMPL's global random number generator. Call once, before any planner exists; later
 /// calls are ignored (OMPL cannot re-seed deterministically). Returns false when ignored.
 bool seedRandomness(std::uint32_t seed);
@@ -235,6 +246,16 @@ class MotionPlanner {
   void clearRoadmapCache();
   /// Number of cached roadmaps.
   std::size_t roadmapCacheSize() const;
+  /// Builds the cached roadmap of `group` for the current static world ahead of requests (e.g.
+  /// right after a world update): its uniform and bridge-test samples and the static validity of
+  /// every edge, so that a later lazy request whose fixed joints (`state`: base group: arm and
+  /// gripper; arm group: base pose and gripper) and held object match (`held_object`, or the
+  /// world's held object when empty) searches a complete roadmap instead of paying the build
+  /// (and lazy KPIECE) itself. Cheap when the roadmap exists and is complete (only edges added
+  /// by later requests are evaluated). `termination` may stop it early: what was done is kept.
+  /// Errors: kInvalidArgument (a group the robot lacks, a wrong arm size, an unknown held object).
+  Result<PrepareStats> prepare(PlanningGroup group, const robot::RobotState& state,
+                               const std::string& held_object = {}, const Termination& termination = {});
 
   /// Plans one motion. Never throws for bad input: a malformed request gives kInvalidRequest
   /// naming the field. Checks `termination` throughout.

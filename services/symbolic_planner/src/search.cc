@@ -387,6 +387,9 @@ class Searcher {
       if (opt_.ehc_eval_budget_per_h > 0 && hcur != Heuristic::kDeadEnd) {
         eval_budget_ = opt_.ehc_eval_budget_per_h * static_cast<uint64_t>(std::max<Cost>(hcur, 2));
       }
+      if (opt_.ehc_eval_budget > 0 && (eval_budget_ == 0 || opt_.ehc_eval_budget < eval_budget_)) {
+        eval_budget_ = opt_.ehc_eval_budget;
+      }
     }
     if (hcur == Heuristic::kDeadEnd) {
       if (first && &goal == &goal_) return finish(SearchStatus::kUnsolvable);
@@ -691,6 +694,38 @@ SearchResult search(const Task& task, const StateBits& init, const Goal& goal, c
       throw;
     }
     heuristic.setFFStyle(false);
+    if (r1.status == SearchStatus::kSolved && options.ehc_second_budget_per_step > 0 &&
+        options.ehc_second_budget_factor > 0 &&
+        static_cast<double>(r1.plan.size()) >=
+            options.ehc_second_trigger_ratio * static_cast<double>(std::max<Cost>(r1.stats.initial_h, 1))) {
+      // The first plan is long for its initial h: try the default EHC too (bounded, no
+      // fallback) and keep the cheaper plan.
+      SearchOptions second = options;
+      second.ehc_fallback = false;
+      second.ehc_eval_budget =
+          std::min<uint64_t>(options.ehc_second_budget_per_step * r1.plan.size(),
+                             options.ehc_second_budget_factor * std::max<uint64_t>(r1.stats.evaluated, 1));
+      Searcher s2(task, init, goal, second, heuristic, term);
+      SearchResult r2 = s2.run();
+      r1.stats.ehc_second_ran = true;
+      if (r2.status == SearchStatus::kSolved && r2.cost < r1.cost) {
+        r2.stats.ehc_second_ran = true;
+        r2.stats.ehc_second_won = true;
+        r2.stats.expanded += r1.stats.expanded;
+        r2.stats.generated += r1.stats.generated;
+        r2.stats.evaluated += r1.stats.evaluated;
+        r2.stats.registered_states += r1.stats.registered_states;
+        r2.stats.seconds += r1.stats.seconds;
+        r2.stats.initial_h = r1.stats.initial_h;
+        return r2;
+      }
+      r1.stats.expanded += r2.stats.expanded;
+      r1.stats.generated += r2.stats.generated;
+      r1.stats.evaluated += r2.stats.evaluated;
+      r1.stats.registered_states += r2.stats.registered_states;
+      r1.stats.seconds += r2.stats.seconds;
+      return r1;
+    }
     if (r1.status != SearchStatus::kFailed && r1.status != SearchStatus::kOutOfMemory) return r1;
     // Second run: the default search from the start, as if the first had not happened.
     Searcher s2(task, init, goal, options, heuristic, term);

@@ -90,6 +90,26 @@ TEST(Search, RespectsDeadlineStopTokenAndMemoryBudget) {
   EXPECT_EQ(m.status, PlanStatus::kOutOfMemory) << m.message;
 }
 
+TEST(Search, SecondEhcRunKeepsTheCheaperPlan) {
+  // blocks-20: the FF-v2.3-order run gives a 50-step plan for an initial h of 5; the default EHC,
+  // run second within its budget, a shorter one. Either way the plan is checked.
+  const auto dir = test::sharedDir() / "benchmarks/pddl/blocks";
+  PlanRequest req;
+  req.domain_text = test::readFile(dir / "domain.pddl");
+  req.problem_text = test::readFile(dir / "instance-20.pddl");
+  req.search.ehc_second_budget_per_step = 0;
+  PlanReply one = plan(req, Termination());
+  ASSERT_EQ(one.status, PlanStatus::kSolved) << one.message;
+  EXPECT_FALSE(one.stats.ehc_second_ran);
+  req.search.ehc_second_budget_per_step = 300;
+  PlanReply two = plan(req, Termination());
+  ASSERT_EQ(two.status, PlanStatus::kSolved) << two.message;
+  EXPECT_TRUE(two.stats.ehc_second_ran);
+  EXPECT_LE(two.cost, one.cost);
+  EXPECT_EQ(two.stats.ehc_second_won, two.cost < one.cost);
+  EXPECT_GT(two.stats.evaluated, one.stats.evaluated);
+}
+
 TEST(Search, OptionsAreValidated) {
   SearchOptions o;
   o.weight = 0.5;

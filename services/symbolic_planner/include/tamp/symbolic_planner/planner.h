@@ -82,6 +82,8 @@ struct PlanStatistics {
   int64_t initial_h{0};
   bool ehc_failed{false};
   bool ehc_ff_failed{false};  ///< the first EHC run (FF-v2.3 heuristic variant) failed; see SearchOptions
+  bool ehc_second_ran{false};  ///< the default EHC also ran after the first run's long plan; see SearchOptions
+  bool ehc_second_won{false};  ///< ... and its plan was the cheaper one
 };
 
 /// A self-contained request (maps 1:1 to the plan-request message).

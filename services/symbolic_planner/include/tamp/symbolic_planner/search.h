@@ -61,6 +61,17 @@ struct SearchOptions {
   /// ehc: give up (kFailed, no fallback) after this many evaluations per unit of the initial
   /// state's h (at least 2 units; with the goal agenda, h of the first entry); 0 = unlimited.
   uint64_t ehc_eval_budget_per_h{0};
+  /// ehc: give up (kFailed, no fallback) after this many evaluations in all; 0 = unlimited.
+  uint64_t ehc_eval_budget{0};
+  /// ehc with `ehc_ff_first`: when the first run's plan has at least `ehc_second_trigger_ratio`
+  /// times as many actions as the initial h (the hill-climbing wandered, typically across goal
+  /// agenda entries that undo each other, as in blocksworld), the default EHC also runs, without
+  /// fallback and allowed `ehc_second_budget_per_step` evaluations per action of the first plan,
+  /// but at most `ehc_second_budget_factor` times the first run's evaluations, and the cheaper of
+  /// the two plans is returned (the first on ties). 0 disables the second run.
+  uint64_t ehc_second_budget_per_step{300};
+  uint64_t ehc_second_budget_factor{16};
+  double ehc_second_trigger_ratio{2.0};
   bool preferred_operators{true};  ///< gbfs: use the helpful-action open list
   /// ehc/gbfs: drop redundant actions from the plan found (greedy action elimination).
   bool eliminate_redundant_actions{true};
@@ -92,6 +103,10 @@ struct SearchStatistics {
   /// ehc: the first run with the FF-v2.3 heuristic variant failed (or ran out of budget) and the
   /// search started again; its evaluations are included in `evaluated`.
   bool ehc_ff_failed{false};
+  /// ehc: the default EHC also ran after the FF-v2.3-variant run solved the task (see
+  /// `ehc_second_budget_per_step`); `ehc_second_won`: its plan was cheaper and was returned.
+  bool ehc_second_ran{false};
+  bool ehc_second_won{false};
   uint64_t ehc_retries{0};  ///< plateaus searched again without helpful-action pruning
   uint64_t eliminated_actions{0};  ///< removed by action elimination
   double seconds{0.0};

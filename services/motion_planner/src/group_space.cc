@@ -294,10 +294,25 @@ bool Oracle::allFree(const ob::State* s) {
   return !self_check_ || selfFree();
 }
 
+bool Oracle::mayTouch(const ob::State* s, int index) const {
+  if (!rigid_) return true;
+  const Pose2D p = gs_.basePose(s);
+  const Aabb& box = movables_[static_cast<std::size_t>(index)].aabb;
+  const double r = reach_radius_;
+  return !(box.max.x() < p.x - r || box.min.x() > p.x + r || box.max.y() < p.y - r || box.min.y() > p.y + r);
+}
+
 void Oracle::touched(const ob::State* s, std::vector<int>& out) {
   out.clear();
   if (movables_.empty()) return;
   ++checks_;
+  if (rigid_) {
+    // The robot's reach square at `s` against the movables' boxes: most states on a roadmap or a
+    // shortcut are far from every movable, and then the scene query is skipped.
+    bool any = false;
+    for (std::size_t i = 0; i < movables_.size() && !any; ++i) any = mayTouch(s, static_cast<int>(i));
+    if (!any) return;
+  }
   gs_.placeRobot(s, scene_);
   for (const auto& id : scene_.robotCollisions(movable_filter_)) {
     auto it = index_.find(id);
@@ -308,6 +323,7 @@ void Oracle::touched(const ob::State* s, std::vector<int>& out) {
 
 bool Oracle::touches(const ob::State* s, int index) {
   ++checks_;
+  if (!mayTouch(s, index)) return false;
   gs_.placeRobot(s, scene_);
   collision::Filter f{collision::kMovableObjects, {movables_[static_cast<std::size_t>(index)].id}, {}};
   return scene_.robotInCollision(f);

@@ -114,6 +114,7 @@ struct MovableInfo {
   double effort_s{0.0};  ///< before the request's scale
   double cost_s{0.0};    ///< effort x object_cost_scale
   Aabb aabb;             ///< world frame
+  std::shared_ptr<const world::Object> object;  ///< the world's record (roadmap movable cache); may be null
 };
 
 /// Collision queries of one request: static (+ unknown space + self) validity, full validity and
@@ -131,9 +132,15 @@ class Oracle {
   void touched(const ob::State* s, std::vector<int>& out);
   /// Whether movable `index` touches the robot at `s`.
   bool touches(const ob::State* s, int index);
+  /// False when movable `index` cannot touch the robot at `s` (its AABB is outside the reach
+  /// square about the base; rigid base groups only); true otherwise.
+  bool mayTouch(const ob::State* s, int index) const;
   /// The first colliding object (static only or all) or "self:a/b"; empty when free.
   std::string collidingObject(const ob::State* s, bool include_movables);
   const std::vector<MovableInfo>& movables() const { return movables_; }
+  /// Whether the robot moves rigidly with the base (base group with a known reach radius).
+  bool rigid() const { return rigid_; }
+  double reachRadius() const { return reach_radius_; }
   /// Movables whose AABB the robot may reach on the straight segment a-b (base groups with a
   /// rigid robot); all of them otherwise.
   void candidates(const ob::State* a, const ob::State* b, std::vector<int>& out) const;
@@ -284,6 +291,12 @@ class StaticRoadmap {
   };
   std::vector<Edge> edges_;
   std::vector<std::vector<int>> adj_;
+  /// Cross-request cache of the movables touched at nodes and along valid edges (rigid base
+  /// groups): entries are dropped when a movable near them changes (syncMovables).
+  struct MovableCache;
+  std::unique_ptr<MovableCache> mcache_;
+  /// Brings the cache to the request's movables; returns false when it cannot be used.
+  bool syncMovables(const Oracle& oracle, std::vector<int>& global_to_request);
   std::size_t uniform_{0};
   std::size_t plain_{0};
   std::size_t bridges_{0};

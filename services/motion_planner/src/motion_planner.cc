@@ -551,6 +551,7 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
     mi.effort_s = impl.effort(o);
     mi.cost_s = mi.effort_s * req.object_cost_scale;
     mi.aabb = o.aabb();
+    mi.object = impl.world.objectPtr(o.id);
     movables.push_back(std::move(mi));
   }
   const double reach = req.group == PlanningGroup::kBase ? impl.reachRadius(req.start, held) : 0.0;

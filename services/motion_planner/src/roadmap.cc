@@ -60,6 +60,21 @@ bool StaticWorldKey::operator==(const StaticWorldKey& o) const {
   return true;
 }
 
+/// Touched movables are stored by roadmap-wide movable number (`ids`), so that entries survive
+/// requests whose movable lists (ignored objects, new objects) differ.
+struct StaticRoadmap::MovableCache {
+  struct Entry {
+    bool cached{false};
+    std::vector<int> touched;  ///< roadmap movable numbers, sorted
+    double x0{0}, y0{0}, x1{0}, y1{0};  ///< xy box of the base positions (node, edge ends)
+  };
+  std::vector<Entry> nodes, edges;
+  std::unordered_map<std::string, int> ids;
+  std::vector<std::shared_ptr<const world::Object>> seen;  ///< as last present (null: absent since)
+  std::vector<Aabb> last_box;                               ///< where it was when last present
+  double reach{-1.0};
+};
+
 struct StaticRoadmap::Impl {
   ompl::NearestNeighborsGNATNoThreadSafety<int> nn;
   const ob::State* probe{nullptr};  // index -1 in `nn` queries
@@ -75,6 +90,65 @@ StaticRoadmap::StaticRoadmap(ob::StateSpacePtr space, StaticWorldKey key, std::u
     const ob::State* sb = b < 0 ? impl_->probe : nodes_[static_cast<std::size_t>(b)];
     return space_->distance(sa, sb);
   });
+}
+
+bool StaticRoadmap::syncMovables(const Oracle& oracle, std::vector<int>& g2r) {
+  if (!oracle.rigid()) return false;
+  if (!mcache_) mcache_ = std::make_unique<MovableCache>();
+  MovableCache& c = *mcache_;
+  // Changed boxes are grown by the reach radius: any request's value bounds the rigid robot's
+  // extent about the base origin (the corners of its parts' AABBs at that yaw are at least as
+  // far as any of its points, and those distances do not depend on the yaw).
+  c.reach = std::max(c.reach, oracle.reachRadius());
+  c.nodes.resize(nodes_.size());
+  c.edges.resize(edges_.size());
+  std::vector<Aabb> changed;
+  const auto& movables = oracle.movables();
+  std::vector<char> present(c.seen.size(), 0);
+  g2r.assign(c.seen.size(), -1);
+  for (std::size_t i = 0; i < movables.size(); ++i) {
+    const MovableInfo& m = movables[i];
+    auto [it, inserted] = c.ids.emplace(m.id, static_cast<int>(c.seen.size()));
+    const auto g = static_cast<std::size_t>(it->second);
+    if (inserted) {
+      c.seen.emplace_back();
+      c.last_box.emplace_back();
+      present.push_back(0);
+      g2r.push_back(-1);
+    }
+    present[g] = 1;
+    g2r[g] = static_cast<int>(i);
+    const auto& before = c.seen[g];
+    const bool same = m.object && before && (before == m.object || *before == *m.object);
+    if (!same) {
+      if (before || !inserted) changed.push_back(c.last_box[g]);  // where it was
+      changed.push_back(m.aabb);
+      c.seen[g] = m.object;
+      c.last_box[g] = m.aabb;
+    }
+  }
+  // Absent in this request (removed or ignored): entries computed now lack it, so its return
+  // counts as a change (seen = null).
+  for (std::size_t g = 0; g < c.seen.size(); ++g) {
+    if (!present[g]) c.seen[g] = nullptr;
+  }
+  if (!changed.empty()) {
+    auto drop = [&](std::vector<MovableCache::Entry>& entries) {
+      for (auto& e : entries) {
+        if (!e.cached) continue;
+        for (const Aabb& b : changed) {
+          const double r = c.reach;
+          if (b.max.x() + r < e.x0 || b.min.x() - r > e.x1 || b.max.y() + r < e.y0 || b.min.y() - r > e.y1) continue;
+          e.cached = false;
+          e.touched.clear();
+          break;
+        }
+      }
+    };
+    drop(c.nodes);
+    drop(c.edges);
+  }
+  return true;
 }
 
 StaticRoadmap::~StaticRoadmap() {
@@ -253,10 +327,43 @@ std::optional<og::PathGeometric> StaticRoadmap::search(Oracle& oracle, const ob:
   // Per request: the movables touched at nodes and along edges, the heuristic (all lazily).
   std::vector<char> have_touched(n, 0);
   std::vector<std::vector<int>> node_touched(n);
+  // Cross-request cache (rigid base groups): movable numbers <-> this request's indices.
+  std::vector<int> g2r;
+  const bool use_cache = syncMovables(oracle, g2r);
+  std::vector<int> r2g;
+  if (use_cache) {
+    r2g.assign(oracle.movables().size(), -1);
+    for (std::size_t g = 0; g < g2r.size(); ++g) {
+      if (g2r[g] >= 0) r2g[static_cast<std::size_t>(g2r[g])] = static_cast<int>(g);
+    }
+  }
+  auto fromCache = [&](const MovableCache::Entry& e, std::vector<int>& out) {
+    out.clear();
+    for (int g : e.touched) {
+      const int r = g2r[static_cast<std::size_t>(g)];
+      if (r >= 0) out.push_back(r);  // absent objects (ignored, removed) dropped
+    }
+    std::sort(out.begin(), out.end());
+  };
+  auto toCache = [&](MovableCache::Entry& e, const std::vector<int>& touched, const ob::State* a, const ob::State* b) {
+    e.touched.clear();
+    for (int r : touched) e.touched.push_back(r2g[static_cast<std::size_t>(r)]);
+    const Pose2D pa = oracle.group().basePose(a), pb = oracle.group().basePose(b);
+    e.x0 = std::min(pa.x, pb.x);
+    e.x1 = std::max(pa.x, pb.x);
+    e.y0 = std::min(pa.y, pb.y);
+    e.y1 = std::max(pa.y, pb.y);
+    e.cached = true;
+  };
   auto touchedAt = [&](int i) -> const std::vector<int>& {
     const auto u = static_cast<std::size_t>(i);
     if (!have_touched[u]) {
-      oracle.touched(nodes_[u], node_touched[u]);
+      if (use_cache && mcache_->nodes[u].cached) {
+        fromCache(mcache_->nodes[u], node_touched[u]);
+      } else {
+        oracle.touched(nodes_[u], node_touched[u]);
+        if (use_cache) toCache(mcache_->nodes[u], node_touched[u], nodes_[u], nodes_[u]);
+      }
       have_touched[u] = 1;
     }
     return node_touched[u];
@@ -336,8 +443,15 @@ std::optional<og::PathGeometric> StaticRoadmap::search(Oracle& oracle, const ob:
       for (const auto& [u, ei] : route) {
         const auto eu = static_cast<std::size_t>(ei);
         if (evaluated[eu]) continue;
-        if (term() || evaluations >= max_evaluations) return Outcome::kBudget;
         Edge& e = edges_[eu];
+        if (use_cache && e.status == Edge::kValid && mcache_->edges[eu].cached) {  // free: no budget
+          const double before = weight(u, ei);
+          fromCache(mcache_->edges[eu], edge_touched[eu]);
+          evaluated[eu] = 1;
+          if (weight(u, ei) > before + 1e-9) changed = true;
+          continue;
+        }
+        if (term() || evaluations >= max_evaluations) return Outcome::kBudget;
         const double before = weight(u, ei);
         SegmentInfo info = evaluateSegment(oracle, nodes_[static_cast<std::size_t>(e.a)],
                                            nodes_[static_cast<std::size_t>(e.b)], resolution, e.status == Edge::kValid);
@@ -354,6 +468,10 @@ std::optional<og::PathGeometric> StaticRoadmap::search(Oracle& oracle, const ob:
         e.status = Edge::kValid;
         evaluated[eu] = 1;
         edge_touched[eu] = std::move(info.touched);
+        if (use_cache) {
+          toCache(mcache_->edges[eu], edge_touched[eu], nodes_[static_cast<std::size_t>(e.a)],
+                  nodes_[static_cast<std::size_t>(e.b)]);
+        }
         if (weight(u, ei) > before + 1e-9) changed = true;
       }
       if (!changed) return Outcome::kFound;

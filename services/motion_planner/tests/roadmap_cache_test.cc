@@ -221,5 +221,41 @@ TEST_F(RoadmapCacheTest, PrepareBuildsTheRoadmapTheNextRequestReuses) {
   EXPECT_FALSE(mp.prepare(PlanningGroup::kBase, bad).ok());
 }
 
+// The movables touched along roadmap edges are cached across requests and dropped near objects
+// that moved: door A's edges learnt free while the heavy boxes were away must see them again when
+// they come back (a stale entry would send the robot through them instead of the light box).
+TEST_F(RoadmapCacheTest, MovableCacheFollowsMovedObjects) {
+  world::World w = testing::twoDoorWorld();
+  MotionPlanner mp(collision::RobotGeometry::disc(kRadius, 1.0), params());
+  mp.setWorld(w);
+  const MotionRequest req = baseRequest({2, 0.9, 0}, {8, 0.9, 0});
+  ASSERT_TRUE(mp.prepare(PlanningGroup::kBase, req.start, {}, Termination::after(30.0)).ok());
+  const MotionResult first = mp.plan(req, Termination::after(5.0));
+  ASSERT_EQ(first.status, MotionStatus::kSolved) << first.reason;
+  EXPECT_EQ(ids(first.blocking), std::vector<std::string>{"light"});
+
+  const world::World original = w;
+  auto place = [&](const std::string& id, double x, double y) {
+    Eigen::Isometry3d p = w.object(id).pose;
+    p.translation().x() = x;
+    p.translation().y() = y;
+    ASSERT_TRUE(w.setObjectPose(id, p).ok());
+  };
+  place("heavy_a", 0.8, 3.3);
+  place("heavy_b", 9.2, 3.3);
+  mp.setWorld(w);
+  const MotionResult away = mp.plan(req, Termination::after(5.0));
+  ASSERT_EQ(away.status, MotionStatus::kSolved) << away.reason;
+  EXPECT_TRUE(away.blocking.empty());  // door A is free now
+  EXPECT_FALSE(away.stats.lazy_planner_used);
+
+  mp.setWorld(original);
+  const MotionResult back = mp.plan(req, Termination::after(5.0));
+  ASSERT_EQ(back.status, MotionStatus::kSolved) << back.reason;
+  EXPECT_EQ(ids(back.blocking), std::vector<std::string>{"light"});
+  EXPECT_EQ(discTouches(original, back.path, kRadius, 0.005), ids(back.blocking));
+  EXPECT_LE(back.cost_s, first.cost_s * 1.05) << "first " << first.cost_s << " back " << back.cost_s;
+}
+
 }  // namespace
 }  // namespace tamp::motion_planner

@@ -257,5 +257,31 @@ TEST_F(RoadmapCacheTest, MovableCacheFollowsMovedObjects) {
   EXPECT_LE(back.cost_s, first.cost_s * 1.05) << "first " << first.cost_s << " back " << back.cost_s;
 }
 
+// The same on an open room, where a stale entry would show: the straight path learnt free while
+// the box was away must be seen blocked when the box returns (a detour is far cheaper than
+// moving it).
+TEST_F(RoadmapCacheTest, MovableCacheDropsEntriesWhereAnObjectReturns) {
+  world::World w = testing::openRoomWorld();
+  const world::World original = w;
+  MotionPlanner mp(collision::RobotGeometry::disc(kRadius, 1.0), params());
+  const MotionRequest req = baseRequest({2, 3, 0}, {8, 3, 0});
+  Eigen::Isometry3d p = w.object("obstacle").pose;
+  p.translation().x() = 1.0;
+  p.translation().y() = 5.2;
+  ASSERT_TRUE(w.setObjectPose("obstacle", p).ok());
+  mp.setWorld(w);
+  ASSERT_TRUE(mp.prepare(PlanningGroup::kBase, req.start, {}, Termination::after(30.0)).ok());
+  const MotionResult away = mp.plan(req, Termination::after(5.0));
+  ASSERT_EQ(away.status, MotionStatus::kSolved) << away.reason;
+  EXPECT_TRUE(away.blocking.empty());
+  EXPECT_FALSE(away.stats.lazy_planner_used);
+
+  mp.setWorld(original);
+  const MotionResult back = mp.plan(req, Termination::after(5.0));
+  ASSERT_EQ(back.status, MotionStatus::kSolved) << back.reason;
+  EXPECT_TRUE(back.blocking.empty()) << back.blocking.front().object_id;
+  EXPECT_TRUE(discTouches(original, back.path, kRadius, 0.005).empty());
+}
+
 }  // namespace
 }  // namespace tamp::motion_planner

@@ -43,7 +43,11 @@
 ///     edges are valid) is then added to the roadmap with `roadmap_growth_samples` more samples
 ///     and searched again, so the result never costs more than the lazy KPIECE path. Other
 ///     groups run lazy KPIECE first and seed the cached roadmap with its path. A changed static
-///     world or held object selects another roadmap (LRU, `roadmap_cache_entries`). Budgets are
+///     world or held object selects another roadmap (LRU, `roadmap_cache_entries`). `prepare()`
+///     builds a roadmap ahead of requests (samples and every edge's static validity), so the
+///     first request after a static-world change finds it complete (the DDS node calls it after
+///     world updates). For the base group the movables touched at nodes and along valid edges
+///     are also kept across requests and dropped only near movables that changed. Budgets are
 ///     counts, so a request's result depends on the seeds and the requests before it, not on
 ///     the machine's load (a wall-clock safety cap and the request's deadline apply on top).
 ///  3. *Blocking report*: the final path is checked densely against movables; per object its id,

@@ -35,4 +35,9 @@ endif()
 if(TAMP_SANITIZE)
   add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
   add_link_options(-fsanitize=address,undefined)
+  # Eigen switches to its own aligned allocator under ASan; the executable's instances of Eigen's
+  # inline functions then interpose on those of the (uninstrumented) PCL libraries, which free
+  # with plain free(): a false "bad-free". glibc's and ASan's malloc are 16-byte aligned, which is
+  # all Eigen needs without -march flags, so keep Eigen's allocator identical to the libraries'.
+  add_compile_definitions(EIGEN_MALLOC_ALREADY_ALIGNED=1)
 endif()

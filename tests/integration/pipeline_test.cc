@@ -9,11 +9,10 @@
 //  3. a move_base command executed by the simulator produces a result and an execution record,
 //     which the effort estimator fits: its next model snapshot counts the record.
 #include <cmath>
-#include <condition_variable>
-#include <mutex>
 
 #include <gtest/gtest.h>
 
+#include "../../common/dds/tests/test_util.h"
 #include "integration_util.h"
 #include "tamp/core/paths.h"
 #include "tamp/dds/convert.h"
@@ -25,34 +24,7 @@
 namespace tamp::integration {
 namespace {
 
-template <typename T>
-class Inbox {
- public:
-  void push(const T& v) {
-    std::lock_guard l(m_);
-    items_.push_back(v);
-    cv_.notify_all();
-  }
-  std::optional<T> waitFor(const std::function<bool(const T&)>& pred, double seconds) {
-    std::unique_lock l(m_);
-    std::optional<T> found;
-    cv_.wait_for(l, std::chrono::duration<double>(seconds), [&] {
-      for (const auto& x : items_) {
-        if (pred(x)) {
-          found = x;
-          return true;
-        }
-      }
-      return false;
-    });
-    return found;
-  }
-
- private:
-  std::mutex m_;
-  std::condition_variable cv_;
-  std::vector<T> items_;
-};
+using dds::testing::Inbox;
 
 class PipelineTest : public ::testing::Test {
  protected:

@@ -1,3 +1,4 @@
+#include "tamp/core/format.h"
 #include "tamp/effort_estimator/features.h"
 
 #include <algorithm>
@@ -21,12 +22,6 @@ bool knownKind(ActionKind k) {
 
 bool isBaseJoint(const std::string& name) {
   return std::find(kBaseJointNames.begin(), kBaseJointNames.end(), name) != kBaseJointNames.end();
-}
-
-std::string fmt(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%g", v);
-  return buf;
 }
 
 /// Common path checks: non-empty, sizes match, finite values.
@@ -53,8 +48,8 @@ Status checkPath(const JointPath& path) {
         return invalid("value of joint '" + path.joint_names[j] + "' is not finite", field);
       }
       if (std::abs(w[j]) > InputLimits::kMaxAbsPathValue) {
-        return invalid("value " + fmt(w[j]) + " of joint '" + path.joint_names[j] + "' exceeds the limit of " +
-                           fmt(InputLimits::kMaxAbsPathValue),
+        return invalid("value " + formatNumber(w[j]) + " of joint '" + path.joint_names[j] + "' exceeds the limit of " +
+                           formatNumber(InputLimits::kMaxAbsPathValue),
                        field);
       }
     }
@@ -199,7 +194,7 @@ Result<ActionFeatures> armFeatures(const ActionDescription& a, const FeatureOpti
 MoveSet::MoveSet(std::vector<double> lengths) : lengths_(std::move(lengths)) {
   for (double d : lengths_) {
     if (!std::isfinite(d) || d < 0.0) {
-      throw std::invalid_argument("MoveSet: move length must be finite and >= 0, got " + fmt(d));
+      throw std::invalid_argument("MoveSet: move length must be finite and >= 0, got " + formatNumber(d));
     }
   }
   std::sort(lengths_.begin(), lengths_.end());
@@ -220,7 +215,7 @@ std::size_t MoveSet::countBelow(double threshold) const {
 Status FeatureOptions::validate() const {
   for (const auto& [joint, scale] : joint_scales) {
     if (!(std::isfinite(scale) && scale > 0.0)) {
-      return invalid("scale of joint '" + joint + "' must be positive and finite, got " + fmt(scale),
+      return invalid("scale of joint '" + joint + "' must be positive and finite, got " + formatNumber(scale),
                      "joint_scales." + joint);
     }
   }
@@ -238,8 +233,8 @@ Result<ActionFeatures> extractFeatures(const ActionDescription& action, const Fe
   }
   if (!std::isfinite(action.object_mass_kg) || action.object_mass_kg < 0.0 ||
       action.object_mass_kg > InputLimits::kMaxObjectMassKg) {
-    return invalid("object mass must be finite and in [0, " + fmt(InputLimits::kMaxObjectMassKg) + "] kg, got " +
-                       fmt(action.object_mass_kg),
+    return invalid("object mass must be finite and in [0, " + formatNumber(InputLimits::kMaxObjectMassKg) + "] kg, got " +
+                       formatNumber(action.object_mass_kg),
                    "object_mass_kg");
   }
   const bool manipulation = action.kind == ActionKind::kPick || action.kind == ActionKind::kPlace;
@@ -251,8 +246,8 @@ Result<ActionFeatures> extractFeatures(const ActionDescription& action, const Fe
     for (auto [value, field] : {std::pair{action.approach_m, "approach_m"},
                                 std::pair{action.retreat_m, "retreat_m"}}) {
       if (!std::isfinite(value) || value < 0.0 || value > InputLimits::kMaxDistanceM) {
-        return invalid(kind_name + ": distance must be finite and in [0, " + fmt(InputLimits::kMaxDistanceM) +
-                           "] m, got " + fmt(value),
+        return invalid(kind_name + ": distance must be finite and in [0, " + formatNumber(InputLimits::kMaxDistanceM) +
+                           "] m, got " + formatNumber(value),
                        field);
       }
     }
@@ -273,8 +268,8 @@ Result<ActionFeatures> extractFeatures(const ActionDescription& action, const Fe
 Status validateFeatures(const ActionFeatures& f) {
   if (!knownKind(f.kind)) return invalid("unknown action kind " + std::to_string(static_cast<int>(f.kind)), "kind");
   if (!std::isfinite(f.object_mass_kg) || f.object_mass_kg < 0.0 || f.object_mass_kg > InputLimits::kMaxObjectMassKg) {
-    return invalid("object mass must be finite and in [0, " + fmt(InputLimits::kMaxObjectMassKg) + "] kg, got " +
-                       fmt(f.object_mass_kg),
+    return invalid("object mass must be finite and in [0, " + formatNumber(InputLimits::kMaxObjectMassKg) + "] kg, got " +
+                       formatNumber(f.object_mass_kg),
                    "object_mass_kg");
   }
   const bool manipulation = f.kind == ActionKind::kPick || f.kind == ActionKind::kPlace;
@@ -282,8 +277,8 @@ Status validateFeatures(const ActionFeatures& f) {
     if (!f.moves.empty() || !f.turns.empty()) return invalid("pick/place features have no moves", "moves");
     for (auto [value, field] : {std::pair{f.approach_m, "approach_m"}, std::pair{f.retreat_m, "retreat_m"}}) {
       if (!std::isfinite(value) || value < 0.0 || value > InputLimits::kMaxDistanceM) {
-        return invalid("distance must be finite and in [0, " + fmt(InputLimits::kMaxDistanceM) + "] m, got " +
-                           fmt(value),
+        return invalid("distance must be finite and in [0, " + formatNumber(InputLimits::kMaxDistanceM) + "] m, got " +
+                           formatNumber(value),
                        field);
       }
     }
@@ -299,7 +294,7 @@ Status validateFeatures(const ActionFeatures& f) {
   const double max_move = 2.0 * InputLimits::kMaxAbsPathValue * std::sqrt(2.0);
   for (const MoveSet* set : {&f.moves, &f.turns}) {
     if (!set->empty() && set->lengths().back() > max_move) {
-      return invalid("move of " + fmt(set->lengths().back()) + " exceeds the input limits", set == &f.moves ? "moves" : "turns");
+      return invalid("move of " + formatNumber(set->lengths().back()) + " exceeds the input limits", set == &f.moves ? "moves" : "turns");
     }
   }
   return Status::Ok();

@@ -1,3 +1,4 @@
+#include "tamp/core/format.h"
 #include "tamp/effort_estimator/fitting.h"
 
 #include <ceres/ceres.h>
@@ -17,12 +18,6 @@
 
 namespace tamp::effort_estimator {
 namespace {
-
-std::string fmt(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%g", v);
-  return buf;
-}
 
 Error invalidField(const std::string& field, const std::string& message) {
   return Error(ErrorCode::kInvalidArgument, message, SourceLocation{"", 0, 0, field});
@@ -287,16 +282,16 @@ std::optional<LossKind> lossKindFromString(std::string_view name) {
 Status FitOptions::validate() const {
   if (!lossKindFromString(toString(loss))) return invalidField("loss", "unknown loss");
   if (!(std::isfinite(loss_scale) && loss_scale > 0)) {
-    return invalidField("loss_scale", "must be positive, got " + fmt(loss_scale));
+    return invalidField("loss_scale", "must be positive, got " + formatNumber(loss_scale));
   }
   if (!(std::isfinite(prior_weight) && prior_weight >= 0)) {
-    return invalidField("prior_weight", "must be >= 0, got " + fmt(prior_weight));
+    return invalidField("prior_weight", "must be >= 0, got " + formatNumber(prior_weight));
   }
   if (!(std::isfinite(prior_noise) && prior_noise > 0 && prior_noise <= 2.0)) {
-    return invalidField("prior_noise", "must be in (0, 2], got " + fmt(prior_noise));
+    return invalidField("prior_noise", "must be in (0, 2], got " + formatNumber(prior_noise));
   }
   if (!(std::isfinite(prior_noise_weight) && prior_noise_weight >= 0)) {
-    return invalidField("prior_noise_weight", "must be >= 0, got " + fmt(prior_noise_weight));
+    return invalidField("prior_noise_weight", "must be >= 0, got " + formatNumber(prior_noise_weight));
   }
   if (max_iterations < 1) {
     return invalidField("max_iterations", "must be >= 1, got " + std::to_string(max_iterations));
@@ -324,8 +319,8 @@ Status ModelPrior::validate() const {
   for (int i = 0; i < spec.size(); ++i) {
     const auto& ps = spec.parameters[i];
     if (!(values[i] >= ps.lower && values[i] <= ps.upper)) {
-      return invalidField(k + "." + ps.name, "must be within [" + fmt(ps.lower) + ", " + fmt(ps.upper) +
-                                                 "] " + ps.unit + ", got " + fmt(values[i]));
+      return invalidField(k + "." + ps.name, "must be within [" + formatNumber(ps.lower) + ", " + formatNumber(ps.upper) +
+                                                 "] " + ps.unit + ", got " + formatNumber(values[i]));
     }
     if (!(std::isfinite(log_stddev[i]) && log_stddev[i] > 0)) {
       return invalidField(k + "." + ps.name, "prior log stddev must be positive");
@@ -356,8 +351,8 @@ Status KindModel::validate() const {
     const auto& ps = spec.parameters[i];
     // A small tolerance: values are exp(log bound) after a fit.
     if (!(std::isfinite(values[i]) && values[i] >= ps.lower * (1 - 1e-9) && values[i] <= ps.upper * (1 + 1e-9))) {
-      return invalidField(k + ".values." + ps.name, "outside [" + fmt(ps.lower) + ", " + fmt(ps.upper) + "]: " +
-                                                        fmt(values[i]));
+      return invalidField(k + ".values." + ps.name, "outside [" + formatNumber(ps.lower) + ", " + formatNumber(ps.upper) + "]: " +
+                                                        formatNumber(values[i]));
     }
   }
   if (log_covariance.size() != n * n) {
@@ -376,7 +371,7 @@ Status KindModel::validate() const {
     }
   }
   if (!(std::isfinite(noise_log_stddev) && noise_log_stddev > 0)) {
-    return invalidField(k + ".noise_log_stddev", "must be positive, got " + fmt(noise_log_stddev));
+    return invalidField(k + ".noise_log_stddev", "must be positive, got " + formatNumber(noise_log_stddev));
   }
   return Status::Ok();
 }

@@ -1,3 +1,4 @@
+#include "tamp/core/format.h"
 #include "tamp/effort_estimator/params.h"
 
 #include <algorithm>
@@ -14,12 +15,6 @@
 namespace tamp::effort_estimator {
 namespace {
 
-std::string fmt(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%g", v);
-  return buf;
-}
-
 /// One rule per scalar field: (field name, ok?, message). Shared by validate() and the loader,
 /// which attaches the YAML location of the field.
 struct Rule {
@@ -33,20 +28,20 @@ std::vector<Rule> scalarRules(const EstimatorParams& p) {
   return {
       {"refit_batch_size", p.refit_batch_size >= 1, "must be >= 1, got " + std::to_string(p.refit_batch_size)},
       {"refit_period_s", std::isfinite(p.refit_period_s) && p.refit_period_s > 0,
-       "must be positive, got " + fmt(p.refit_period_s)},
+       "must be positive, got " + formatNumber(p.refit_period_s)},
       {"refit_time_budget_s", std::isfinite(p.refit_time_budget_s) && p.refit_time_budget_s > 0,
-       "must be positive, got " + fmt(p.refit_time_budget_s)},
+       "must be positive, got " + formatNumber(p.refit_time_budget_s)},
       {"max_records_per_kind", p.max_records_per_kind >= 1,
        "must be >= 1, got " + std::to_string(p.max_records_per_kind)},
       {"max_record_duration_s", std::isfinite(p.max_record_duration_s) && p.max_record_duration_s > 0,
-       "must be positive, got " + fmt(p.max_record_duration_s)},
-      {"loss_scale", std::isfinite(f.loss_scale) && f.loss_scale > 0, "must be positive, got " + fmt(f.loss_scale)},
+       "must be positive, got " + formatNumber(p.max_record_duration_s)},
+      {"loss_scale", std::isfinite(f.loss_scale) && f.loss_scale > 0, "must be positive, got " + formatNumber(f.loss_scale)},
       {"prior_weight", std::isfinite(f.prior_weight) && f.prior_weight >= 0,
-       "must be >= 0, got " + fmt(f.prior_weight)},
+       "must be >= 0, got " + formatNumber(f.prior_weight)},
       {"prior_noise", std::isfinite(f.prior_noise) && f.prior_noise > 0 && f.prior_noise <= 2.0,
-       "must be in (0, 2] (stddev of log duration), got " + fmt(f.prior_noise)},
+       "must be in (0, 2] (stddev of log duration), got " + formatNumber(f.prior_noise)},
       {"prior_noise_weight", std::isfinite(f.prior_noise_weight) && f.prior_noise_weight >= 0,
-       "must be >= 0, got " + fmt(f.prior_noise_weight)},
+       "must be >= 0, got " + formatNumber(f.prior_noise_weight)},
       {"max_iterations", f.max_iterations >= 1, "must be >= 1, got " + std::to_string(f.max_iterations)},
   };
 }
@@ -125,7 +120,7 @@ Result<EstimatorParams> parseEstimatorParams(const std::string& yaml_text, const
       double v = prior.values[i];
       if (kr.optional(ps.name, v)) {
         if (kr.check(std::isfinite(v) && v >= ps.lower && v <= ps.upper, ps.name,
-                     "must be within [" + fmt(ps.lower) + ", " + fmt(ps.upper) + "] " + ps.unit + ", got " + fmt(v))) {
+                     "must be within [" + formatNumber(ps.lower) + ", " + formatNumber(ps.upper) + "] " + ps.unit + ", got " + formatNumber(v))) {
           prior.values[i] = v;
         }
       }
@@ -139,7 +134,7 @@ Result<EstimatorParams> parseEstimatorParams(const std::string& yaml_text, const
         const std::string joint = it->first.as<std::string>();
         double scale = 0.0;
         if (scales.required(joint, scale) &&
-            scales.check(std::isfinite(scale) && scale > 0.0, joint, "must be positive, got " + fmt(scale))) {
+            scales.check(std::isfinite(scale) && scale > 0.0, joint, "must be positive, got " + formatNumber(scale))) {
           p.features.joint_scales[joint] = scale;
         }
       }

@@ -1,3 +1,4 @@
+#include "tamp/core/format.h"
 #include "tamp/effort_estimator/records.h"
 
 #include <cmath>
@@ -7,25 +8,19 @@
 namespace tamp::effort_estimator {
 namespace {
 
-std::string fmt(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%g", v);
-  return buf;
-}
-
 Status checkScalars(double duration_s, double timestamp_s, double max_duration_s) {
   auto bad = [](std::string msg, std::string field) {
     return Error(ErrorCode::kInvalidArgument, std::move(msg), SourceLocation{"", 0, 0, std::move(field)});
   };
   if (std::isnan(duration_s)) return bad("duration is NaN", "duration_s");
   if (std::isinf(duration_s)) return bad("duration is infinite", "duration_s");
-  if (duration_s <= 0.0) return bad("duration must be positive, got " + fmt(duration_s) + " s", "duration_s");
+  if (duration_s <= 0.0) return bad("duration must be positive, got " + formatNumber(duration_s) + " s", "duration_s");
   if (duration_s > max_duration_s) {
-    return bad("duration " + fmt(duration_s) + " s exceeds the limit of " + fmt(max_duration_s) + " s",
+    return bad("duration " + formatNumber(duration_s) + " s exceeds the limit of " + formatNumber(max_duration_s) + " s",
                "duration_s");
   }
   if (!std::isfinite(timestamp_s) || timestamp_s < 0.0) {
-    return bad("timestamp must be finite and >= 0, got " + fmt(timestamp_s), "timestamp_s");
+    return bad("timestamp must be finite and >= 0, got " + formatNumber(timestamp_s), "timestamp_s");
   }
   return Status::Ok();
 }

@@ -1,4 +1,5 @@
 // MotionPlanner: request validation, the lazy and full pipelines (see motion_planner.h).
+#include "tamp/core/format.h"
 #include "tamp/motion_planner/motion_planner.h"
 
 #include <algorithm>
@@ -84,12 +85,6 @@ bool seedRandomness(std::uint32_t seed) {
 }
 
 namespace {
-
-std::string fmt(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%g", v);
-  return buf;
-}
 
 bool finite(const Pose2D& p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.theta); }
 
@@ -356,8 +351,8 @@ std::optional<std::string> validateRequest(const MotionRequest& r, const MotionP
     const auto& l = m->armLimits()[i];
     if (!std::isfinite(q)) return "start.arm[" + std::to_string(i) + "]: not finite";
     if (q < l.lower - 1e-6 || q > l.upper + 1e-6) {
-      return "start.arm[" + std::to_string(i) + "] (" + m->armJointNames()[i] + "): " + fmt(q) + " outside [" +
-             fmt(l.lower) + ", " + fmt(l.upper) + "]";
+      return "start.arm[" + std::to_string(i) + "] (" + m->armJointNames()[i] + "): " + formatNumber(q) + " outside [" +
+             formatNumber(l.lower) + ", " + formatNumber(l.upper) + "]";
     }
   }
   if (!std::isfinite(r.start.gripper)) return std::string("start.gripper: not finite");
@@ -375,8 +370,8 @@ std::optional<std::string> validateRequest(const MotionRequest& r, const MotionP
         if (i >= off) {
           const auto& l = m->armLimits()[i - off];
           if (q < l.lower - 1e-6 || q > l.upper + 1e-6) {
-            return "goal.configuration[" + std::to_string(i) + "] (" + group_names[i] + "): " + fmt(q) +
-                   " outside [" + fmt(l.lower) + ", " + fmt(l.upper) + "]";
+            return "goal.configuration[" + std::to_string(i) + "] (" + group_names[i] + "): " + formatNumber(q) +
+                   " outside [" + formatNumber(l.lower) + ", " + formatNumber(l.upper) + "]";
           }
         }
       }
@@ -409,7 +404,7 @@ std::optional<std::string> validateRequest(const MotionRequest& r, const MotionP
     }
   }
   if (!std::isfinite(r.object_cost_scale) || r.object_cost_scale < 0) {
-    return "object_cost_scale: must be finite and >= 0, got " + fmt(r.object_cost_scale);
+    return "object_cost_scale: must be finite and >= 0, got " + formatNumber(r.object_cost_scale);
   }
   return std::nullopt;
 }
@@ -775,7 +770,7 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
         return finish(MotionStatus::kNoPath,
                       std::string("no path: start and goal are in different components of the ") +
                           (lazy ? "static " : "") + "free space of the base (proven on a " +
-                          fmt(proof_cells[proof_level - 1]) + " m grid)");
+                          formatNumber(proof_cells[proof_level - 1]) + " m grid)");
       }
       if (outcome == detail::ProofOutcome::kSkipped) proof_level = proof_cells.size();
     }

@@ -1,3 +1,4 @@
+#include "tamp/core/format.h"
 #include "tamp/motion_planner/params.h"
 
 #include <cmath>
@@ -10,12 +11,6 @@
 
 namespace tamp::motion_planner {
 namespace {
-
-std::string fmt(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%g", v);
-  return buf;
-}
 
 /// One check of one field: section ("" = top level), key, ok?, message.
 struct Rule {
@@ -30,10 +25,10 @@ bool nonneg(double v) { return std::isfinite(v) && v >= 0; }
 
 std::vector<Rule> rules(const MotionPlannerParams& p) {
   const auto P = [](const std::string& s, const std::string& k, double v) {
-    return Rule{s, k, pos(v), "must be positive, got " + fmt(v)};
+    return Rule{s, k, pos(v), "must be positive, got " + formatNumber(v)};
   };
   const auto N = [](const std::string& s, const std::string& k, double v) {
-    return Rule{s, k, nonneg(v), "must be >= 0, got " + fmt(v)};
+    return Rule{s, k, nonneg(v), "must be >= 0, got " + formatNumber(v)};
   };
   const auto I = [](const std::string& s, const std::string& k, int v, int lo) {
     return Rule{s, k, v >= lo, "must be >= " + std::to_string(lo) + ", got " + std::to_string(v)};
@@ -73,10 +68,10 @@ std::vector<Rule> rules(const MotionPlannerParams& p) {
       N("cost", "retreat_distance", C.retreat_distance),
       N("cost", "transfer_distance", C.transfer_distance),
       Rule{"cost", "non_graspable_factor", std::isfinite(C.non_graspable_factor) && C.non_graspable_factor >= 1,
-           "must be >= 1, got " + fmt(C.non_graspable_factor)},
+           "must be >= 1, got " + formatNumber(C.non_graspable_factor)},
       P("proof", "cell_size", R.cell_size),
       Rule{"proof", "min_cell_size", pos(R.min_cell_size) && R.min_cell_size <= R.cell_size,
-           "must be in (0, cell_size], got " + fmt(R.min_cell_size)},
+           "must be in (0, cell_size], got " + formatNumber(R.min_cell_size)},
       I("proof", "max_cells", R.max_cells, 1),
       P("timing", "base_linear_speed", T.base_linear_speed),
       P("timing", "base_linear_accel", T.base_linear_accel),
@@ -84,13 +79,13 @@ std::vector<Rule> rules(const MotionPlannerParams& p) {
       P("timing", "base_angular_accel", T.base_angular_accel),
       P("timing", "arm_accel", T.arm_accel),
       Rule{"timing", "arm_speed_scale", pos(T.arm_speed_scale) && T.arm_speed_scale <= 1,
-           "must be in (0, 1], got " + fmt(T.arm_speed_scale)},
+           "must be in (0, 1], got " + formatNumber(T.arm_speed_scale)},
       P("timing", "sample_period", T.sample_period),
       I("placement", "max_attempts", PL.max_attempts, 1),
       N("placement", "support_margin", PL.support_margin),
       P("placement", "base_distance_min", PL.base_distance_min),
       Rule{"placement", "base_distance_max", pos(PL.base_distance_max) && PL.base_distance_max >= PL.base_distance_min,
-           "must be >= base_distance_min, got " + fmt(PL.base_distance_max)},
+           "must be >= base_distance_min, got " + formatNumber(PL.base_distance_max)},
       I("placement", "base_poses_per_placement", PL.base_poses_per_placement, 1),
       P("placement", "planar_reach", PL.planar_reach),
       N("placement", "tool_clearance", PL.tool_clearance),
@@ -98,11 +93,11 @@ std::vector<Rule> rules(const MotionPlannerParams& p) {
       N("grasp", "retreat_distance", G.retreat_distance),
       N("grasp", "finger_margin", G.finger_margin),
       Rule{"grasp", "side_height_fraction", nonneg(G.side_height_fraction) && G.side_height_fraction <= 1,
-           "must be in [0, 1], got " + fmt(G.side_height_fraction)},
+           "must be in [0, 1], got " + formatNumber(G.side_height_fraction)},
       I("grasp", "cylinder_yaw_samples", G.cylinder_yaw_samples, 1),
       P("grasp", "base_distance_min", G.base_distance_min),
       Rule{"grasp", "base_distance_max", pos(G.base_distance_max) && G.base_distance_max >= G.base_distance_min,
-           "must be >= base_distance_min, got " + fmt(G.base_distance_max)},
+           "must be >= base_distance_min, got " + formatNumber(G.base_distance_max)},
       I("grasp", "base_poses", G.base_poses, 1),
   };
 }

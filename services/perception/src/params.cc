@@ -1,3 +1,4 @@
+#include "tamp/core/format.h"
 #include "tamp/perception/params.h"
 
 #include <algorithm>
@@ -13,12 +14,6 @@
 namespace tamp::perception {
 namespace {
 
-std::string fmt(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%g", v);
-  return buf;
-}
-
 /// One rule per field: (dotted field, ok?, message). Shared by validate() and the loader, which
 /// attaches the YAML location of the field.
 struct Rule {
@@ -30,8 +25,8 @@ struct Rule {
 
 bool positive(double v) { return std::isfinite(v) && v > 0; }
 bool nonNegative(double v) { return std::isfinite(v) && v >= 0; }
-std::string mustBePositive(double v) { return "must be positive, got " + fmt(v); }
-std::string mustBeNonNegative(double v) { return "must be >= 0, got " + fmt(v); }
+std::string mustBePositive(double v) { return "must be positive, got " + formatNumber(v); }
+std::string mustBeNonNegative(double v) { return "must be >= 0, got " + formatNumber(v); }
 bool inHalfOpen01(double v) { return std::isfinite(v) && v > 0 && v <= 1; }
 
 std::vector<Rule> rules(const PerceptionParams& p) {
@@ -50,12 +45,12 @@ std::vector<Rule> rules(const PerceptionParams& p) {
       {"crop", "workspace_margin", nonNegative(c.workspace_margin), mustBeNonNegative(c.workspace_margin)},
       {"crop", "min_range", nonNegative(c.min_range), mustBeNonNegative(c.min_range)},
       {"crop", "max_range", std::isfinite(c.max_range) && c.max_range > c.min_range,
-       "must be greater than min_range (" + fmt(c.min_range) + "), got " + fmt(c.max_range)},
-      {"crop", "min_z", std::isfinite(c.min_z), "must be finite, got " + fmt(c.min_z)},
+       "must be greater than min_range (" + formatNumber(c.min_range) + "), got " + formatNumber(c.max_range)},
+      {"crop", "min_z", std::isfinite(c.min_z), "must be finite, got " + formatNumber(c.min_z)},
       {"crop", "max_z", std::isfinite(c.max_z) && c.max_z > c.min_z,
-       "must be greater than min_z (" + fmt(c.min_z) + "), got " + fmt(c.max_z)},
+       "must be greater than min_z (" + formatNumber(c.min_z) + "), got " + formatNumber(c.max_z)},
       {"planes", "voxel_size", positive(pl.voxel_size) && pl.voxel_size <= 0.5,
-       "must be in (0, 0.5] m, got " + fmt(pl.voxel_size)},
+       "must be in (0, 0.5] m, got " + formatNumber(pl.voxel_size)},
       {"planes", "max_planes", pl.max_planes >= 0, "must be >= 0, got " + std::to_string(pl.max_planes)},
       {"planes", "max_attempts", pl.max_attempts >= pl.max_planes,
        "must be >= max_planes (" + std::to_string(pl.max_planes) + "), got " + std::to_string(pl.max_attempts)},
@@ -63,42 +58,42 @@ std::vector<Rule> rules(const PerceptionParams& p) {
        "must be >= 1, got " + std::to_string(pl.ransac_iterations)},
       {"planes", "distance_threshold", positive(pl.distance_threshold), mustBePositive(pl.distance_threshold)},
       {"planes", "max_tilt", std::isfinite(pl.max_tilt) && pl.max_tilt > 0 && pl.max_tilt < 1.5,
-       "must be in (0, 1.5) rad, got " + fmt(pl.max_tilt)},
+       "must be in (0, 1.5) rad, got " + formatNumber(pl.max_tilt)},
       {"planes", "min_points", pl.min_points >= 3, "must be >= 3, got " + std::to_string(pl.min_points)},
       {"planes", "min_support_area", positive(pl.min_support_area), mustBePositive(pl.min_support_area)},
       {"planes", "region_height_tolerance", positive(pl.region_height_tolerance),
        mustBePositive(pl.region_height_tolerance)},
       {"planes", "region_margin", nonNegative(pl.region_margin), mustBeNonNegative(pl.region_margin)},
       {"clusters", "tolerance", positive(cl.tolerance) && cl.tolerance > pl.voxel_size,
-       "must be greater than planes.voxel_size (" + fmt(pl.voxel_size) + "), got " + fmt(cl.tolerance)},
+       "must be greater than planes.voxel_size (" + formatNumber(pl.voxel_size) + "), got " + formatNumber(cl.tolerance)},
       {"clusters", "min_points", cl.min_points >= 1, "must be >= 1, got " + std::to_string(cl.min_points)},
       {"clusters", "max_points", cl.max_points >= cl.min_points,
        "must be >= min_points (" + std::to_string(cl.min_points) + "), got " + std::to_string(cl.max_points)},
       {"clusters", "min_height", nonNegative(cl.min_height), mustBeNonNegative(cl.min_height)},
       {"clusters", "min_size", nonNegative(cl.min_size), mustBeNonNegative(cl.min_size)},
       {"clusters", "max_size", std::isfinite(cl.max_size) && cl.max_size > cl.min_size,
-       "must be greater than min_size (" + fmt(cl.min_size) + "), got " + fmt(cl.max_size)},
+       "must be greater than min_size (" + formatNumber(cl.min_size) + "), got " + formatNumber(cl.max_size)},
       {"clusters", "static_margin", nonNegative(cl.static_margin), mustBeNonNegative(cl.static_margin)},
       {"clusters", "cylinder_residual_ratio", inHalfOpen01(cl.cylinder_residual_ratio),
-       "must be in (0, 1], got " + fmt(cl.cylinder_residual_ratio)},
+       "must be in (0, 1], got " + formatNumber(cl.cylinder_residual_ratio)},
       {"tracking", "gate_distance", positive(t.gate_distance), mustBePositive(t.gate_distance)},
       {"tracking", "size_tolerance", nonNegative(t.size_tolerance), mustBeNonNegative(t.size_tolerance)},
       {"tracking", "height_tolerance", nonNegative(t.height_tolerance), mustBeNonNegative(t.height_tolerance)},
       {"tracking", "confirm_hits", t.confirm_hits >= 1, "must be >= 1, got " + std::to_string(t.confirm_hits)},
       {"tracking", "tentative_timeout_s", positive(t.tentative_timeout_s), mustBePositive(t.tentative_timeout_s)},
       {"tracking", "gone_frames", t.gone_frames >= 1, "must be >= 1, got " + std::to_string(t.gone_frames)},
-      {"tracking", "smoothing", inHalfOpen01(t.smoothing), "must be in (0, 1], got " + fmt(t.smoothing)},
+      {"tracking", "smoothing", inHalfOpen01(t.smoothing), "must be in (0, 1], got " + formatNumber(t.smoothing)},
       {"tracking", "snap_distance", positive(t.snap_distance), mustBePositive(t.snap_distance)},
       {"tracking", "update_distance", nonNegative(t.update_distance), mustBeNonNegative(t.update_distance)},
       {"tracking", "update_angle", nonNegative(t.update_angle), mustBeNonNegative(t.update_angle)},
       {"tracking", "move_event_distance", positive(t.move_event_distance), mustBePositive(t.move_event_distance)},
       {"tracking", "move_event_angle", positive(t.move_event_angle), mustBePositive(t.move_event_angle)},
       {"tracking", "visibility_bin", positive(t.visibility_bin) && t.visibility_bin <= 0.2,
-       "must be in (0, 0.2] (tangent units), got " + fmt(t.visibility_bin)},
+       "must be in (0, 0.2] (tangent units), got " + formatNumber(t.visibility_bin)},
       {"tracking", "visibility_margin", positive(t.visibility_margin), mustBePositive(t.visibility_margin)},
-      {"tracking", "gone_fraction", inHalfOpen01(t.gone_fraction), "must be in (0, 1], got " + fmt(t.gone_fraction)},
+      {"tracking", "gone_fraction", inHalfOpen01(t.gone_fraction), "must be in (0, 1], got " + formatNumber(t.gone_fraction)},
       {"tracking", "present_fraction", inHalfOpen01(t.present_fraction),
-       "must be in (0, 1], got " + fmt(t.present_fraction)},
+       "must be in (0, 1], got " + formatNumber(t.present_fraction)},
       {"tracking", "gone_min_samples", t.gone_min_samples >= 1,
        "must be >= 1, got " + std::to_string(t.gone_min_samples)},
       {"classify", "movable_max_extent", positive(k.movable_max_extent), mustBePositive(k.movable_max_extent)},
@@ -108,17 +103,17 @@ std::vector<Rule> rules(const PerceptionParams& p) {
       {"classify", "graspable_max_width", nonNegative(k.graspable_max_width), mustBeNonNegative(k.graspable_max_width)},
       {"classify", "graspable_max_mass", nonNegative(k.graspable_max_mass), mustBeNonNegative(k.graspable_max_mass)},
       {"occupancy", "resolution", positive(o.resolution) && o.resolution <= 1.0,
-       "must be in (0, 1] m, got " + fmt(o.resolution)},
+       "must be in (0, 1] m, got " + formatNumber(o.resolution)},
       {"occupancy", "free_space_voxel", positive(o.free_space_voxel), mustBePositive(o.free_space_voxel)},
       {"occupancy", "max_ray_range", positive(o.max_ray_range), mustBePositive(o.max_ray_range)},
       {"occupancy", "explained_margin", nonNegative(o.explained_margin), mustBeNonNegative(o.explained_margin)},
       {"occupancy", "prob_hit", std::isfinite(o.prob_hit) && o.prob_hit > 0.5 && o.prob_hit < 1,
-       "must be in (0.5, 1), got " + fmt(o.prob_hit)},
+       "must be in (0.5, 1), got " + formatNumber(o.prob_hit)},
       {"occupancy", "prob_miss", std::isfinite(o.prob_miss) && o.prob_miss > 0 && o.prob_miss < 0.5,
-       "must be in (0, 0.5), got " + fmt(o.prob_miss)},
+       "must be in (0, 0.5), got " + formatNumber(o.prob_miss)},
       {"occupancy", "occupancy_threshold",
        std::isfinite(o.occupancy_threshold) && o.occupancy_threshold >= 0.5 && o.occupancy_threshold < 1,
-       "must be in [0.5, 1), got " + fmt(o.occupancy_threshold)},
+       "must be in [0.5, 1), got " + formatNumber(o.occupancy_threshold)},
       {"occupancy", "min_cluster_points", o.min_cluster_points >= 1,
        "must be >= 1, got " + std::to_string(o.min_cluster_points)},
       {"", "max_points", p.max_points >= 1, "must be >= 1"},
@@ -140,9 +135,9 @@ std::optional<std::string> ObjectClass::invalidReason() const {
   if (label.empty()) return std::string("label must not be empty");
   if (auto why = shape.invalidReason()) return "shape: " + *why;
   if (kind == world::ObjectKind::kMovable && !(mass > 0 && std::isfinite(mass))) {
-    return "mass of a movable class must be positive, got " + fmt(mass);
+    return "mass of a movable class must be positive, got " + formatNumber(mass);
   }
-  if (!(mass >= 0) || !std::isfinite(mass)) return "mass must be >= 0, got " + fmt(mass);
+  if (!(mass >= 0) || !std::isfinite(mass)) return "mass must be >= 0, got " + formatNumber(mass);
   return std::nullopt;
 }
 

@@ -1,3 +1,4 @@
+#include "tamp/core/format.h"
 #include "tamp/sim/params.h"
 
 #include <algorithm>
@@ -11,12 +12,6 @@
 
 namespace tamp::sim {
 namespace {
-
-std::string fmt(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%g", v);
-  return buf;
-}
 
 int kindIndex(ActionKind kind) {
   const auto it = std::find(kAllActionKinds.begin(), kAllActionKinds.end(), kind);
@@ -37,31 +32,31 @@ std::vector<Rule> rules(const SimParams& p) {
   auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
   auto nonneg = [](double v) { return std::isfinite(v) && v >= 0.0; };
   return {
-      {"realtime_factor", nonneg(p.realtime_factor), "must be >= 0 (0 = as fast as possible), got " + fmt(p.realtime_factor)},
+      {"realtime_factor", nonneg(p.realtime_factor), "must be >= 0 (0 = as fast as possible), got " + formatNumber(p.realtime_factor)},
       {"state_period_s", positive(p.state_period_s) && p.state_period_s <= 10.0,
-       "must be in (0, 10] s, got " + fmt(p.state_period_s)},
-      {"cloud_period_s", nonneg(p.cloud_period_s), "must be >= 0 s, got " + fmt(p.cloud_period_s)},
+       "must be in (0, 10] s, got " + formatNumber(p.state_period_s)},
+      {"cloud_period_s", nonneg(p.cloud_period_s), "must be >= 0 s, got " + formatNumber(p.cloud_period_s)},
       {"duration_noise", nonneg(p.duration_noise) && p.duration_noise <= 1.0,
-       "must be in [0, 1] (stddev of log duration), got " + fmt(p.duration_noise)},
+       "must be in [0, 1] (stddev of log duration), got " + formatNumber(p.duration_noise)},
       {"max_step_m", positive(p.max_step_m) && p.max_step_m <= 0.5,
-       "must be in (0, 0.5] m, got " + fmt(p.max_step_m)},
+       "must be in (0, 0.5] m, got " + formatNumber(p.max_step_m)},
       {"start_tolerance.position_m", positive(p.start_tolerance.position_m),
-       "must be positive, got " + fmt(p.start_tolerance.position_m)},
+       "must be positive, got " + formatNumber(p.start_tolerance.position_m)},
       {"start_tolerance.angle_rad", positive(p.start_tolerance.angle_rad),
-       "must be positive, got " + fmt(p.start_tolerance.angle_rad)},
+       "must be positive, got " + formatNumber(p.start_tolerance.angle_rad)},
       {"grasp.position_tolerance_m", positive(p.grasp.position_tolerance_m),
-       "must be positive, got " + fmt(p.grasp.position_tolerance_m)},
+       "must be positive, got " + formatNumber(p.grasp.position_tolerance_m)},
       {"grasp.tcp_tolerance_m", nonneg(p.grasp.tcp_tolerance_m),
-       "must be >= 0, got " + fmt(p.grasp.tcp_tolerance_m)},
+       "must be >= 0, got " + formatNumber(p.grasp.tcp_tolerance_m)},
       {"grasp.max_payload_kg", positive(p.grasp.max_payload_kg),
-       "must be positive, got " + fmt(p.grasp.max_payload_kg)},
+       "must be positive, got " + formatNumber(p.grasp.max_payload_kg)},
       {"place.position_tolerance_m", positive(p.place.position_tolerance_m),
-       "must be positive, got " + fmt(p.place.position_tolerance_m)},
+       "must be positive, got " + formatNumber(p.place.position_tolerance_m)},
       {"place.angle_tolerance_rad", positive(p.place.angle_tolerance_rad),
-       "must be positive, got " + fmt(p.place.angle_tolerance_rad)},
-      {"place.max_drop_m", nonneg(p.place.max_drop_m), "must be >= 0, got " + fmt(p.place.max_drop_m)},
+       "must be positive, got " + formatNumber(p.place.angle_tolerance_rad)},
+      {"place.max_drop_m", nonneg(p.place.max_drop_m), "must be >= 0, got " + formatNumber(p.place.max_drop_m)},
       {"place.max_tilt_rad", positive(p.place.max_tilt_rad) && p.place.max_tilt_rad < std::numbers::pi / 2,
-       "must be in (0, pi/2), got " + fmt(p.place.max_tilt_rad)},
+       "must be in (0, pi/2), got " + formatNumber(p.place.max_tilt_rad)},
   };
 }
 
@@ -131,8 +126,8 @@ Status TimeParameters::validate() const {
       const auto& ps = spec.parameters[i];
       if (!(std::isfinite(v[i]) && v[i] >= ps.lower && v[i] <= ps.upper)) {
         errors.emplace_back(ErrorCode::kInvalidArgument,
-                            "must be within [" + fmt(ps.lower) + ", " + fmt(ps.upper) + "] " + ps.unit +
-                                ", got " + fmt(v[i]),
+                            "must be within [" + formatNumber(ps.lower) + ", " + formatNumber(ps.upper) + "] " + ps.unit +
+                                ", got " + formatNumber(v[i]),
                             SourceLocation{"", 0, 0, base + "." + ps.name});
       }
     }
@@ -216,7 +211,7 @@ Result<SimParams> parseSimParams(const std::string& yaml_text, const std::string
       double v = p.time_parameters.of(*kind)[i];
       if (kr.optional(ps.name, v) &&
           kr.check(std::isfinite(v) && v >= ps.lower && v <= ps.upper, ps.name,
-                   "must be within [" + fmt(ps.lower) + ", " + fmt(ps.upper) + "] " + ps.unit + ", got " + fmt(v))) {
+                   "must be within [" + formatNumber(ps.lower) + ", " + formatNumber(ps.upper) + "] " + ps.unit + ", got " + formatNumber(v))) {
         p.time_parameters.of(*kind)[i] = v;
       }
     }

@@ -1,3 +1,4 @@
+#include "tamp/core/format.h"
 #include "tamp/sim/simulator.h"
 
 #include <algorithm>
@@ -29,12 +30,6 @@ constexpr double kSupportProbe = 0.005;  // m: how far below an object its suppo
 const std::shared_ptr<spdlog::logger>& logger() {
   static const auto l = tamp::log::get("sim");
   return l;
-}
-
-std::string fmt(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%.4g", v);
-  return buf;
 }
 
 Error invalid(const std::string& field, const std::string& message) {
@@ -617,8 +612,8 @@ struct Simulator::Impl {
     if (c.object_pose) {
       const double off = (o->pose.translation() - c.object_pose->translation()).norm();
       if (off > params.grasp.position_tolerance_m) {
-        return "'" + o->id + "' is not where the command says: " + fmt(off) + " m away (tolerance " +
-               fmt(params.grasp.position_tolerance_m) + " m)";
+        return "'" + o->id + "' is not where the command says: " + formatNumber(off, 4) + " m away (tolerance " +
+               formatNumber(params.grasp.position_tolerance_m, 4) + " m)";
       }
     }
     const robot::RobotState s = toState(q);
@@ -628,20 +623,20 @@ struct Simulator::Impl {
     const Eigen::Vector3d outside =
         (box.min - local).cwiseMax(local - box.max).cwiseMax(Eigen::Vector3d::Zero());
     if (outside.norm() > params.grasp.tcp_tolerance_m) {
-      return "the gripper closes " + fmt(outside.norm()) + " m away from '" + o->id + "'";
+      return "the gripper closes " + formatNumber(outside.norm(), 4) + " m away from '" + o->id + "'";
     }
     if (has_gripper) {
       const Eigen::Vector3d across = o->pose.linear().transpose() * tool.linear().col(1);
       const double width = widthAlong(o->shape, across);
       const double opening = 2.0 * robot.gripperLimits().upper;
       if (width > opening) {
-        return "'" + o->id + "' is " + fmt(width) + " m wide across the fingers; the gripper opens " +
-               fmt(opening) + " m";
+        return "'" + o->id + "' is " + formatNumber(width, 4) + " m wide across the fingers; the gripper opens " +
+               formatNumber(opening, 4) + " m";
       }
     }
     if (o->mass > params.grasp.max_payload_kg) {
-      return "'" + o->id + "' (" + fmt(o->mass) + " kg) exceeds the payload limit of " +
-             fmt(params.grasp.max_payload_kg) + " kg";
+      return "'" + o->id + "' (" + formatNumber(o->mass, 4) + " kg) exceeds the payload limit of " +
+             formatNumber(params.grasp.max_payload_kg, 4) + " kg";
     }
     return "";
   }
@@ -684,21 +679,21 @@ struct Simulator::Impl {
     const double off = (released.translation() - target.translation()).norm();
     const double turn = Eigen::AngleAxisd(released.linear().transpose() * target.linear()).angle();
     if (s.tilt > params.place.max_tilt_rad) {
-      a.failure = "'" + o.id + "' released tilted by " + fmt(s.tilt) + " rad and toppled";
+      a.failure = "'" + o.id + "' released tilted by " + formatNumber(s.tilt, 4) + " rad and toppled";
     } else if (s.drop > params.place.max_drop_m) {
-      a.failure = "'" + o.id + "' released " + fmt(s.drop) + " m above its support and dropped";
+      a.failure = "'" + o.id + "' released " + formatNumber(s.drop, 4) + " m above its support and dropped";
     } else if (s.drop < -0.02) {
-      a.failure = "'" + o.id + "' released " + fmt(-s.drop) + " m below the support surface";
+      a.failure = "'" + o.id + "' released " + formatNumber(-s.drop, 4) + " m below the support surface";
     } else if (s.robot_link >= 0) {
       a.failure = "'" + o.id + "' came to rest on the robot ('" + s.support + "')";
     } else if (s.region.empty()) {
       a.failure = "'" + o.id + "' is not on a support region" +
                   (s.support.empty() ? std::string() : " (it rests on '" + s.support + "')");
     } else if (off > params.place.position_tolerance_m) {
-      a.failure = "'" + o.id + "' released " + fmt(off) + " m from the commanded pose (tolerance " +
-                  fmt(params.place.position_tolerance_m) + " m)";
+      a.failure = "'" + o.id + "' released " + formatNumber(off, 4) + " m from the commanded pose (tolerance " +
+                  formatNumber(params.place.position_tolerance_m, 4) + " m)";
     } else if (turn > params.place.angle_tolerance_rad) {
-      a.failure = "'" + o.id + "' released rotated by " + fmt(turn) + " rad from the commanded pose";
+      a.failure = "'" + o.id + "' released rotated by " + formatNumber(turn, 4) + " rad from the commanded pose";
     } else {
       for (const auto& other : scene.shapeCollisions(o.shape, o.pose, collision::Filter::allBut({o.id}))) {
         const auto* x = world.findObject(other);
@@ -793,11 +788,11 @@ Result<std::vector<int>> Simulator::Impl::validate(const ActionCommand& c) const
     const TrajectoryPoint& p = t.points[i];
     const std::string field = "trajectory.points[" + std::to_string(i) + "]";
     if (!std::isfinite(p.time_from_start) || p.time_from_start < 0.0) {
-      return invalid(field + ".time_from_start", "must be finite and >= 0, got " + fmt(p.time_from_start));
+      return invalid(field + ".time_from_start", "must be finite and >= 0, got " + formatNumber(p.time_from_start, 4));
     }
     if (p.time_from_start <= last_time) {
-      return invalid(field + ".time_from_start", "times must increase strictly: " + fmt(p.time_from_start) +
-                                                   " s after " + fmt(last_time) + " s");
+      return invalid(field + ".time_from_start", "times must increase strictly: " + formatNumber(p.time_from_start, 4) +
+                                                   " s after " + formatNumber(last_time, 4) + " s");
     }
     last_time = p.time_from_start;
     if (p.positions.size() != cols.size()) {
@@ -814,7 +809,7 @@ Result<std::vector<int>> Simulator::Impl::validate(const ActionCommand& c) const
       const std::string& name = t.joint_names[j];
       if (!std::isfinite(v)) return invalid(pf, name + " is not finite");
       if (std::abs(v) > effort_estimator::InputLimits::kMaxAbsPathValue) {
-        return invalid(pf, name + " = " + fmt(v) + " is implausibly large");
+        return invalid(pf, name + " = " + formatNumber(v, 4) + " is implausibly large");
       }
       if (!p.velocities.empty() && !std::isfinite(p.velocities[j])) {
         return invalid(field + ".velocities[" + std::to_string(j) + "]", name + " is not finite");
@@ -823,8 +818,8 @@ Result<std::vector<int>> Simulator::Impl::validate(const ActionCommand& c) const
       if (col >= 3) {
         const robot::JointLimits lim = col < 3 + dof ? robot.armLimits()[col - 3] : robot.gripperLimits();
         if (v < lim.lower - 1e-6 || v > lim.upper + 1e-6) {
-          return invalid(pf, name + " = " + fmt(v) + " is outside its limits [" + fmt(lim.lower) + ", " +
-                                 fmt(lim.upper) + "]");
+          return invalid(pf, name + " = " + formatNumber(v, 4) + " is outside its limits [" + formatNumber(lim.lower, 4) + ", " +
+                                 formatNumber(lim.upper, 4) + "]");
         }
       }
       if (i == 0) {
@@ -832,8 +827,8 @@ Result<std::vector<int>> Simulator::Impl::validate(const ActionCommand& c) const
         const double diff = col == 2 ? std::abs(angleDiff(v, q[col])) : std::abs(v - q[col]);
         const double tol = angular ? params.start_tolerance.angle_rad : params.start_tolerance.position_m;
         if (diff > tol) {
-          return invalid(pf, "the trajectory starts with " + name + " = " + fmt(v) + " but the robot is at " +
-                                 fmt(q[col]) + " (tolerance " + fmt(tol) + ")");
+          return invalid(pf, "the trajectory starts with " + name + " = " + formatNumber(v, 4) + " but the robot is at " +
+                                 formatNumber(q[col], 4) + " (tolerance " + formatNumber(tol, 4) + ")");
         }
       }
     }
@@ -1094,8 +1089,8 @@ Result<Active> Simulator::Impl::plan(const ActionCommand& c, const std::vector<i
   double nominal = 0.0;
   for (const Phase& p : a.phases) nominal += p.nominal;
   if (std::abs(nominal - model) > 1e-6 * std::max(1.0, model)) {
-    return Error(ErrorCode::kInternal, "sim: execution timeline (" + fmt(nominal) +
-                                           " s) disagrees with the time model (" + fmt(model) + " s)");
+    return Error(ErrorCode::kInternal, "sim: execution timeline (" + formatNumber(nominal, 4) +
+                                           " s) disagrees with the time model (" + formatNumber(model, 4) + " s)");
   }
   a.k = params.duration_noise > 0.0
             ? std::exp(params.duration_noise * std::normal_distribution<double>(0.0, 1.0)(rng))
@@ -1248,7 +1243,7 @@ Status Simulator::inject(Fault fault) {
 }
 
 StepEvents Simulator::step(double dt) {
-  if (!(dt >= 0.0) || !std::isfinite(dt)) throw std::invalid_argument("Simulator::step: dt must be >= 0, got " + fmt(dt));
+  if (!(dt >= 0.0) || !std::isfinite(dt)) throw std::invalid_argument("Simulator::step: dt must be >= 0, got " + formatNumber(dt, 4));
   Impl& m = *impl_;
   StepEvents ev;
   for (const Fault& f : std::exchange(m.injected, {})) ev.faults.push_back(m.fire(f, ev));

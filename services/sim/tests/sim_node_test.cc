@@ -17,39 +17,7 @@ namespace {
 
 using namespace tamp::sim::testing;
 
-template <typename T>
-class Inbox {
- public:
-  void push(const T& v) {
-    std::lock_guard l(m_);
-    items_.push_back(v);
-    cv_.notify_all();
-  }
-  /// Waits (bounded, so that a broken node fails instead of hanging) for an item matching `pred`.
-  std::optional<T> waitFor(const std::function<bool(const T&)>& pred, double seconds = 30.0) {
-    std::unique_lock l(m_);
-    std::optional<T> found;
-    cv_.wait_for(l, std::chrono::duration<double>(seconds), [&] {
-      for (const auto& x : items_) {
-        if (pred(x)) {
-          found = x;
-          return true;
-        }
-      }
-      return false;
-    });
-    return found;
-  }
-  std::size_t size() {
-    std::lock_guard l(m_);
-    return items_.size();
-  }
-
- private:
-  std::mutex m_;
-  std::condition_variable cv_;
-  std::vector<T> items_;
-};
+using dds::testing::Inbox;
 
 TEST(SimNodeTest, ExecutesATrajectoryCommandOverDds) {
   const int domain = dds::testing::isolatedDomain();

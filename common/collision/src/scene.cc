@@ -276,6 +276,10 @@ struct Scene::Impl {
   Options options;
   world::World world;
   std::map<std::string, std::unique_ptr<Body>, std::less<>> bodies;
+  /// The attached bodies, in id order: kept so that placing the robot and iterating its pieces
+  /// (every query) does not walk the whole object map. Refreshed by every mutation of
+  /// `bodies` or of an attachment (refreshAttached()).
+  std::vector<Body*> attached_bodies;
   fcl::DynamicAABBTreeCollisionManagerd static_mgr;
   fcl::DynamicAABBTreeCollisionManagerd movable_mgr;
   std::size_t n_static{0}, n_movable{0};
@@ -343,6 +347,14 @@ struct Scene::Impl {
     movable_mgr.registerObjects(mv);
     static_mgr.setup();
     movable_mgr.setup();
+    refreshAttached();
+  }
+
+  void refreshAttached() {
+    attached_bodies.clear();
+    for (auto& [id, b] : bodies) {
+      if (b->attached) attached_bodies.push_back(b.get());
+    }
   }
 
   void placeAttached(Body& b) {
@@ -355,9 +367,7 @@ struct Scene::Impl {
   void placeParts() {
     for (auto& p : parts)
       placeAll(p.pieces, link_poses[static_cast<size_t>(p.link)] * p.link_T_shape);
-    for (auto& [id, b] : bodies) {
-      if (b->attached) placeAttached(*b);
-    }
+    for (Body* b : attached_bodies) placeAttached(*b);
   }
 
   Resolved resolve(const Filter& f) const {
@@ -406,8 +416,7 @@ struct Scene::Impl {
         if (fn(robot.links[static_cast<size_t>(p.link)], *piece.obj)) return;
       }
     }
-    for (const auto& [id, b] : bodies) {
-      if (!b->attached) continue;
+    for (const Body* b : attached_bodies) {
       for (const auto& piece : b->pieces) {
         if (fn(b->id, *piece.obj)) return;
       }
@@ -496,6 +505,7 @@ Scene::Scene(const Scene& other) : Scene(other.impl_->options) {
       impl_->placeAttached(mine);
     }
   }
+  impl_->refreshAttached();
   if (o.octomap) {
     impl_->octomap = o.octomap;
     impl_->octree =
@@ -563,6 +573,7 @@ void Scene::syncWorld(const world::World& w) {
     }
     m.bodies[o.id] = std::move(b);
   }
+  m.refreshAttached();
 }
 
 const world::World& Scene::world() const { return impl_->world; }
@@ -611,6 +622,7 @@ void Scene::setRobot(RobotGeometry g) {
       m.registerBody(*b);
     }
   }
+  m.attached_bodies.clear();
   m.robot = std::move(g);
   m.link_poses.assign(m.robot.links.size(), Eigen::Isometry3d::Identity());
   m.placeParts();
@@ -657,6 +669,7 @@ Status Scene::attach(const std::string& object_id, const std::string& link,
   b.link = static_cast<int>(li - m.robot.links.begin());
   b.link_T_object = link_T_object;
   m.placeAttached(b);
+  m.refreshAttached();
   return Status::Ok();
 }
 
@@ -676,14 +689,13 @@ Status Scene::detach(const std::string& object_id) {
   b.attached = false;
   placeAll(b.pieces, m.world.object(object_id).pose);
   m.registerBody(b);
+  m.refreshAttached();
   return Status::Ok();
 }
 
 std::vector<std::string> Scene::attachedObjects() const {
   std::vector<std::string> out;
-  for (const auto& [id, b] : impl_->bodies) {
-    if (b->attached) out.push_back(id);
-  }
+  for (const Body* b : impl_->attached_bodies) out.push_back(b->id);
   return out;
 }
 
@@ -796,9 +808,8 @@ std::vector<std::pair<std::string, std::string>> Scene::selfCollisions() const {
     for (const auto& piece : p.pieces)
       items.push_back({m.robot.links[static_cast<size_t>(p.link)], p.link, false, piece.obj.get()});
   }
-  for (const auto& [id, b] : m.bodies) {
-    if (!b->attached) continue;
-    for (const auto& piece : b->pieces) items.push_back({id, b->link, true, piece.obj.get()});
+  for (const Body* b : m.attached_bodies) {
+    for (const auto& piece : b->pieces) items.push_back({b->id, b->link, true, piece.obj.get()});
   }
   auto allowed = [&](int a, int b) {
     if (a == b) return true;

@@ -380,21 +380,42 @@ std::optional<og::PathGeometric> StaticRoadmap::search(Oracle& oracle, const ob:
   };
   std::vector<char> evaluated(edges_.size(), 0);  // in this request (movables)
   std::vector<std::vector<int>> edge_touched(edges_.size());
+  // Weights per direction (2 * edge + (u is the edge's b)), computed once: a node's movables are
+  // fixed within a request, so only an edge's evaluation changes its two weights (forgetWeight).
+  std::vector<double> weights(2 * edges_.size(), -1.0);
   auto weight = [&](int u, int ei) {
     const Edge& e = edges_[static_cast<std::size_t>(ei)];
-    const int v = e.a == u ? e.b : e.a;
-    const auto& objs = evaluated[static_cast<std::size_t>(ei)] ? edge_touched[static_cast<std::size_t>(ei)] : touchedAt(v);
-    return e.len * seconds_per_unit + enteringCost(oracle, objs, touchedAt(u));
+    double& w = weights[2 * static_cast<std::size_t>(ei) + (e.a == u ? 0 : 1)];
+    if (w < 0) {
+      const int v = e.a == u ? e.b : e.a;
+      const auto& objs = evaluated[static_cast<std::size_t>(ei)] ? edge_touched[static_cast<std::size_t>(ei)] : touchedAt(v);
+      w = e.len * seconds_per_unit + enteringCost(oracle, objs, touchedAt(u));
+    }
+    return w;
   };
+  auto forgetWeight = [&](std::size_t ei) { weights[2 * ei] = weights[2 * ei + 1] = -1.0; };
 
   std::vector<double> g(n);
   std::vector<int> parent_edge(n);
   std::vector<char> closed(n);
+  std::vector<int> expanded;  // closed nodes of the last A* run, for the heuristic's update
+  expanded.reserve(n);
   using QItem = std::pair<double, int>;
   enum class Outcome { kFound, kDisconnected, kBudget, kUnconnected };
   std::vector<std::pair<int, int>> route;  // (from node, edge) start -> goal
   // LazySP; `known_only`: over the edges known to be statically valid (no static checks, only
   // the movables along them are evaluated).
+  bool changed = false;
+  // After an edge's evaluation: a raised weight means the route must be searched again; a
+  // lowered one (a stale cross-request cache entry) would break the learned heuristic's bound,
+  // which then starts over from the distance.
+  auto settle = [&](double before, double after) {
+    if (after > before + 1e-9) {
+      changed = true;
+    } else if (after < before - 1e-9) {
+      std::fill(h.begin(), h.end(), -1.0);
+    }
+  };
   auto lazySp = [&](bool known_only, int max_evaluations, int invalid_cap) {
     int evaluations = 0;
     int new_invalid = 0;
@@ -403,6 +424,7 @@ std::optional<og::PathGeometric> StaticRoadmap::search(Oracle& oracle, const ob:
       std::fill(g.begin(), g.end(), std::numeric_limits<double>::infinity());
       std::fill(parent_edge.begin(), parent_edge.end(), -1);
       std::fill(closed.begin(), closed.end(), 0);
+      expanded.clear();
       std::priority_queue<QItem, std::vector<QItem>, std::greater<>> open;
       g[static_cast<std::size_t>(start)] = 0.0;
       open.emplace(heuristic(start), start);
@@ -416,6 +438,7 @@ std::optional<og::PathGeometric> StaticRoadmap::search(Oracle& oracle, const ob:
           reached = u;
           break;
         }
+        expanded.push_back(u);
         for (int ei : adj_[static_cast<std::size_t>(u)]) {
           const Edge& e = edges_[static_cast<std::size_t>(ei)];
           if (e.status == Edge::kInvalid || (known_only && e.status != Edge::kValid)) continue;
@@ -430,6 +453,16 @@ std::optional<og::PathGeometric> StaticRoadmap::search(Oracle& oracle, const ob:
         }
       }
       if (reached < 0) return Outcome::kDisconnected;
+      // Adaptive A* (Koenig & Likhachev, AAMAS 2005): g(goal) - g(u) is a lower bound of u's
+      // cost to the goal under the current weights, and stays one (and consistent) because
+      // evaluating an edge only raises its weight. Later iterations then expand little more than
+      // the region where the route changed, instead of most of the roadmap each time.
+      const double g_goal = g[static_cast<std::size_t>(reached)];
+      for (int u : expanded) {
+        const auto uu = static_cast<std::size_t>(u);
+        h[uu] = std::max(h[uu], g_goal - g[uu]);
+      }
+      expanded.clear();
       route.clear();
       for (int v = reached; v != start;) {
         const int ei = parent_edge[static_cast<std::size_t>(v)];
@@ -439,7 +472,7 @@ std::optional<og::PathGeometric> StaticRoadmap::search(Oracle& oracle, const ob:
         v = u;
       }
       std::reverse(route.begin(), route.end());
-      bool changed = false;
+      changed = false;
       for (const auto& [u, ei] : route) {
         const auto eu = static_cast<std::size_t>(ei);
         if (evaluated[eu]) continue;
@@ -448,7 +481,8 @@ std::optional<og::PathGeometric> StaticRoadmap::search(Oracle& oracle, const ob:
           const double before = weight(u, ei);
           fromCache(mcache_->edges[eu], edge_touched[eu]);
           evaluated[eu] = 1;
-          if (weight(u, ei) > before + 1e-9) changed = true;
+          forgetWeight(eu);
+          settle(before, weight(u, ei));
           continue;
         }
         if (term() || evaluations >= max_evaluations) return Outcome::kBudget;
@@ -468,11 +502,12 @@ std::optional<og::PathGeometric> StaticRoadmap::search(Oracle& oracle, const ob:
         e.status = Edge::kValid;
         evaluated[eu] = 1;
         edge_touched[eu] = std::move(info.touched);
+        forgetWeight(eu);
         if (use_cache) {
           toCache(mcache_->edges[eu], edge_touched[eu], nodes_[static_cast<std::size_t>(e.a)],
                   nodes_[static_cast<std::size_t>(e.b)]);
         }
-        if (weight(u, ei) > before + 1e-9) changed = true;
+        settle(before, weight(u, ei));
       }
       if (!changed) return Outcome::kFound;
     }

@@ -75,8 +75,13 @@ struct Run {
   double length{0};
   int crossed{0};
   double mass{0};
+  double effort_s{0};  // J = xy length / base speed + effort of the crossed movables (same model for all)
   std::string status;  // full mode
 };
+
+/// The path cost our lazy mode minimises, computed by this tool the same way for every method:
+/// xy length at the planner's base speed plus the default effort of each movable crossed.
+motion_planner::CostParams g_cost;
 
 struct WorldCase {
   std::string name;
@@ -93,8 +98,12 @@ double percentile(std::vector<double> v, double p) {
   return v[lo] + (v[hi] - v[lo]) * (idx - static_cast<double>(lo));
 }
 
-/// Movables (and their mass) a disc touches along a base path, every 5 mm.
-std::pair<int, double> crossed(const world::World& w, double radius, const std::vector<Pose2D>& path) {
+/// Movables a disc touches along a base path, every 5 mm: count, total mass and total effort.
+struct Crossing {
+  int count{0};
+  double mass{0}, effort_s{0};
+};
+Crossing crossed(const world::World& w, double radius, const std::vector<Pose2D>& path) {
   collision::Scene scene(w);
   scene.setRobot(collision::RobotGeometry::disc(radius, 1.0));
   std::vector<std::string> ids;
@@ -111,10 +120,17 @@ std::pair<int, double> crossed(const world::World& w, double radius, const std::
   }
   std::sort(ids.begin(), ids.end());
   ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
-  double mass = 0;
-  for (const auto& id : ids) mass += w.object(id).mass;
-  return {static_cast<int>(ids.size()), mass};
+  Crossing c;
+  c.count = static_cast<int>(ids.size());
+  for (const auto& id : ids) {
+    c.mass += w.object(id).mass;
+    c.effort_s += motion_planner::defaultObjectEffort(w.object(id), g_cost);
+  }
+  return c;
 }
+
+/// Fills a run's length, crossings, mass and J from its poses.
+void measure(Run& run, const WorldCase& wc, const std::vector<Pose2D>& poses);
 
 double xyLength(const std::vector<Pose2D>& p) {
   double l = 0;
@@ -213,32 +229,112 @@ struct Baseline {
       }
       return out;
     };
-    auto pp = poses(path);
-    raw.length = xyLength(pp);
-    std::tie(raw.crossed, raw.mass) = crossed(wc.nw.world, wc.nw.robot_radius, pp);
+    measure(raw, wc, poses(path));
     if (simplify) {
       const auto t1 = std::chrono::steady_clock::now();
       og::PathSimplifier s(si);
       s.simplifyMax(path);
       simp.time_ms = ms + std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count();
       simp.success = true;
-      auto sp = poses(path);
-      simp.length = xyLength(sp);
-      std::tie(simp.crossed, simp.mass) = crossed(wc.nw.world, wc.nw.robot_radius, sp);
+      measure(simp, wc, poses(path));
     }
     return {raw, simp};
   }
 };
 
+void measure(Run& run, const WorldCase& wc, const std::vector<Pose2D>& poses) {
+  run.length = xyLength(poses);
+  const Crossing c = crossed(wc.nw.world, wc.nw.robot_radius, poses);
+  run.crossed = c.count;
+  run.mass = c.mass;
+  run.effort_s = run.length / g_cost.base_speed + c.effort_s;
+}
+
 struct Summary {
   int runs{0}, ok{0};
-  double med_ms{NAN}, p95_ms{NAN}, med_len{NAN}, med_cross{NAN}, mean_cross{NAN}, med_mass{NAN};
+  double med_ms{NAN}, p95_ms{NAN}, med_len{NAN}, med_cross{NAN}, mean_cross{NAN}, med_mass{NAN}, med_effort{NAN};
 };
+
+Summary summarize(const std::vector<Run>& runs);
+
+/// The per-world check against the aims (x = miss), computed from the runs.
+void writeAims(std::ostream& md, const std::vector<WorldCase>& worlds,
+               std::map<std::string, std::map<std::string, std::vector<Run>>>& results) {
+  auto has = [&](const std::string& w, const std::string& m) { return !results[w][m].empty(); };
+  if (worlds.empty() || !has(worlds.front().name, "rrtc+simp")) return;  // needs the baselines
+  auto fmt = [](double v, int digits) {
+    char b[32];
+    std::snprintf(b, sizeof(b), "%.*f", digits, v);
+    return std::string(b);
+  };
+  const std::vector<std::string> ours = {"ours", "ours-prep", "ours-warm"};
+  md << "\nAgainst the aims, per world (x = miss). Crossed: median / mean, a miss when above the best OMPL raw path "
+        "(lowest of RRTConnect, KPIECE1, LBKPIECE1, medians and means separately). Length and J: median of ours-warm "
+        "(and ours-len, objects free) over the median of RRTConnect + simplify; a length miss above 1.10. p95 in ms, a "
+        "miss at 50 or more.\n\n| world | cold crossed | prep crossed | warm crossed | best raw crossed | warm length "
+        "ratio | len length ratio | warm J ratio | cold p95 | prep p95 | warm p95 |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
+  std::map<std::string, int> misses;
+  int fewer = 0;
+  for (const auto& wc : worlds) {
+    const std::string& w = wc.name;
+    double best_med = INFINITY, best_mean = INFINITY;
+    for (const std::string m : {"rrtconnect", "kpiece", "lbkpiece"}) {
+      const Summary b = summarize(results[w][m]);
+      best_med = std::min(best_med, b.med_cross);
+      best_mean = std::min(best_mean, b.mean_cross);
+    }
+    const Summary ref = summarize(results[w]["rrtc+simp"]);
+    md << "| " << w << " |";
+    for (const auto& m : ours) {
+      if (!has(w, m)) {
+        md << " - |";
+        continue;
+      }
+      const Summary o = summarize(results[w][m]);
+      const bool miss = o.med_cross > best_med + 1e-9 || o.mean_cross > best_mean + 1e-9;
+      if (miss) ++misses[m + " crossed"];
+      if (m == "ours-warm" && (o.med_cross < best_med - 1e-9 || o.mean_cross < best_mean - 1e-9)) ++fewer;
+      md << " " << fmt(o.med_cross, 0) << " / " << fmt(o.mean_cross, 2) << (miss ? " **x**" : "") << " |";
+    }
+    md << " " << fmt(best_med, 1) << " / " << fmt(best_mean, 2) << " |";
+    for (const std::string m : {"ours-warm", "ours-len"}) {
+      if (!has(w, m)) {
+        md << " - |";
+        continue;
+      }
+      const double r = summarize(results[w][m]).med_len / ref.med_len;
+      if (r > 1.10) ++misses[m + " length"];
+      md << " " << fmt(r, 2) << (r > 1.10 ? " **x**" : "") << " |";
+    }
+    if (has(w, "ours-warm")) {
+      const double r = summarize(results[w]["ours-warm"]).med_effort / ref.med_effort;
+      if (r > 1.0 + 1e-9) ++misses["ours-warm J above rrtc+simp"];
+      md << " " << fmt(r, 2) << " |";
+    } else {
+      md << " - |";
+    }
+    for (const auto& m : ours) {
+      if (!has(w, m)) {
+        md << " - |";
+        continue;
+      }
+      const double p = summarize(results[w][m]).p95_ms;
+      if (p >= 50) ++misses[m + " p95"];
+      md << " " << fmt(p, 1) << (p >= 50 ? " **x**" : "") << " |";
+    }
+    md << "\n";
+  }
+  md << "\nWorlds (of " << worlds.size() << ") where ours-warm crosses fewer objects than the best raw path (median or "
+     << "mean): " << fewer << ". Misses:";
+  if (misses.empty()) md << " none";
+  for (const auto& [k, v] : misses) md << " " << k << " " << v << ";";
+  md << "\n";
+}
 
 Summary summarize(const std::vector<Run>& runs) {
   Summary s;
   s.runs = static_cast<int>(runs.size());
-  std::vector<double> t, l, c, m;
+  std::vector<double> t, l, c, m, e;
   for (const auto& r : runs) {
     t.push_back(r.time_ms);
     if (!r.success) continue;
@@ -246,12 +342,14 @@ Summary summarize(const std::vector<Run>& runs) {
     l.push_back(r.length);
     c.push_back(r.crossed);
     m.push_back(r.mass);
+    e.push_back(r.effort_s);
   }
   s.med_ms = percentile(t, 0.5);
   s.p95_ms = percentile(t, 0.95);
   s.med_len = percentile(l, 0.5);
   s.med_cross = percentile(c, 0.5);
   s.med_mass = percentile(m, 0.5);
+  s.med_effort = percentile(e, 0.5);
   s.mean_cross = c.empty() ? NAN : std::accumulate(c.begin(), c.end(), 0.0) / static_cast<double>(c.size());
   return s;
 }
@@ -335,10 +433,12 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
+  g_cost = params.cost;
   motion_planner::seedRandomness(42);
   ompl::msg::setLogLevel(ompl::msg::LOG_NONE);
   const auto worlds = loadWorlds(filter);
-  const std::vector<std::string> methods = {"ours", "ours-prep", "ours-warm", "ours-any", "rrtconnect", "kpiece", "lbkpiece", "rrtc+simp"};
+  const std::vector<std::string> methods = {"ours",       "ours-prep", "ours-warm", "ours-any", "ours-len",
+                                            "rrtconnect", "kpiece",    "lbkpiece",  "rrtc+simp"};
   std::map<std::string, std::map<std::string, std::vector<Run>>> results;  // world -> method -> runs
   std::map<std::string, std::vector<Run>> full;                           // world -> full runs
   std::map<std::string, std::vector<double>> prep_ms;                     // world -> prepare() times
@@ -362,16 +462,21 @@ int main(int argc, char** argv) {
       if (run.success) {
         std::vector<Pose2D> poses;
         for (const auto& w : res.path.waypoints) poses.push_back(Pose2D{w[0], w[1], w[2]});
-        run.length = xyLength(poses);
         if (method == "ours-any") {
+          run.length = xyLength(poses);
           run.crossed = static_cast<int>(res.blocking.size());
-          for (const auto& b : res.blocking) run.mass += b.mass;
+          run.effort_s = run.length / g_cost.base_speed;
+          for (const auto& b : res.blocking) {
+            run.mass += b.mass;
+            run.effort_s += b.effort_s;
+          }
         } else {
-          std::tie(run.crossed, run.mass) = crossed(wc.nw.world, wc.nw.robot_radius, poses);
+          measure(run, wc, poses);
           if (run.crossed != static_cast<int>(res.blocking.size())) ++reported_mismatch;
         }
         nlohmann::json jr{{"method", method}, {"world", wc.name}, {"run", r}, {"time_ms", run.time_ms},
                           {"length", run.length}, {"crossed", run.crossed}, {"mass", run.mass},
+                          {"effort_s", run.effort_s},
                           {"raw_crossed", res.stats.raw_blocking.size()}, {"cost_s", res.cost_s},
                           {"raw_cost_s", res.stats.raw_cost_s}, {"sampling_ms", res.stats.sampling_ms},
                           {"optimize_ms", res.stats.optimize_ms}, {"shortcut_ms", res.stats.shortcut_ms},
@@ -450,6 +555,12 @@ int main(int argc, char** argv) {
         randomQuery();
         record("ours-warm", r, mp.plan(req, Termination::after(limit)));
       }
+      // The same query with objects free (object_cost_scale 0): the shortest static-free path
+      // our roadmap search and shortcutting find, to compare lengths with RRTConnect +
+      // simplification on equal terms (both ignore the movables).
+      motion_planner::MotionRequest len_req = req;
+      len_req.object_cost_scale = 0.0;
+      for (int r = 0; r < runs; ++r) record("ours-len", r, mp.plan(len_req, Termination::after(limit)));
     }
     if (reported_mismatch > 0) std::cerr << "  WARNING: " << reported_mismatch << " runs where the report differs\n";
     if (baselines) {
@@ -527,7 +638,7 @@ int main(int argc, char** argv) {
     js["full"][wc.name] = {{"statuses", statuses}, {"median_ms", percentile(ft, 0.5)}, {"max_ms", percentile(ft, 1.0)}};
   }
   md << "\nAggregate over " << worlds.size() << " worlds:\n\n| method | success | median ms | p95 ms | median crossed | mean crossed | "
-        "total crossed | median length (m) | mean mass crossed (kg) |\n|---|---|---|---|---|---|---|---|---|\n";
+        "total crossed | median length (m) | mean mass crossed (kg) | median J (s) |\n|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& m : methods) {
     if (agg[m].empty()) continue;
     const Summary s = summarize(agg[m]);
@@ -538,11 +649,12 @@ int main(int argc, char** argv) {
     }
     md << "| " << m << " | " << s.ok << "/" << s.runs << " | " << f2(s.med_ms) << " | " << f2(s.p95_ms) << " | "
        << f1(s.med_cross) << " | " << f2(s.mean_cross) << " | " << total << " | " << f1(s.med_len) << " | "
-       << f1(mass / std::max(1, s.ok)) << " |\n";
+       << f1(mass / std::max(1, s.ok)) << " | " << f1(s.med_effort) << " |\n";
     js["aggregate"][m] = {{"success", s.ok}, {"runs", s.runs}, {"median_ms", s.med_ms}, {"p95_ms", s.p95_ms},
                           {"median_crossed", s.med_cross}, {"mean_crossed", s.mean_cross}, {"total_crossed", total},
-                          {"median_length", s.med_len}};
+                          {"median_length", s.med_len}, {"median_effort_s", s.med_effort}};
   }
+  writeAims(md, worlds, results);
   if (!prep_ms.empty()) {
     md << "\nprepare() (base group, cache cleared before each; not inside any request above except `ours`'s "
           "cold runs, which pay their own build):\n\n| world | median ms | p95 ms | max ms | nodes | edges | invalid "

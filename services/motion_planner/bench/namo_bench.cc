@@ -76,6 +76,7 @@ struct Run {
   int crossed{0};
   double mass{0};
   double effort_s{0};  // J = xy length / base speed + effort of the crossed movables (same model for all)
+  std::vector<std::string> objects;  // the movables crossed (counted by this tool)
   std::string status;  // full mode
 };
 
@@ -100,7 +101,7 @@ double percentile(std::vector<double> v, double p) {
 
 /// Movables a disc touches along a base path, every 5 mm: count, total mass and total effort.
 struct Crossing {
-  int count{0};
+  std::vector<std::string> ids;
   double mass{0}, effort_s{0};
 };
 Crossing crossed(const world::World& w, double radius, const std::vector<Pose2D>& path) {
@@ -121,11 +122,11 @@ Crossing crossed(const world::World& w, double radius, const std::vector<Pose2D>
   std::sort(ids.begin(), ids.end());
   ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
   Crossing c;
-  c.count = static_cast<int>(ids.size());
   for (const auto& id : ids) {
     c.mass += w.object(id).mass;
     c.effort_s += motion_planner::defaultObjectEffort(w.object(id), g_cost);
   }
+  c.ids = std::move(ids);
   return c;
 }
 
@@ -244,8 +245,9 @@ struct Baseline {
 
 void measure(Run& run, const WorldCase& wc, const std::vector<Pose2D>& poses) {
   run.length = xyLength(poses);
-  const Crossing c = crossed(wc.nw.world, wc.nw.robot_radius, poses);
-  run.crossed = c.count;
+  Crossing c = crossed(wc.nw.world, wc.nw.robot_radius, poses);
+  run.crossed = static_cast<int>(c.ids.size());
+  run.objects = std::move(c.ids);
   run.mass = c.mass;
   run.effort_s = run.length / g_cost.base_speed + c.effort_s;
 }
@@ -476,7 +478,7 @@ int main(int argc, char** argv) {
         }
         nlohmann::json jr{{"method", method}, {"world", wc.name}, {"run", r}, {"time_ms", run.time_ms},
                           {"length", run.length}, {"crossed", run.crossed}, {"mass", run.mass},
-                          {"effort_s", run.effort_s},
+                          {"effort_s", run.effort_s}, {"objects", run.objects},
                           {"raw_crossed", res.stats.raw_blocking.size()}, {"cost_s", res.cost_s},
                           {"raw_cost_s", res.stats.raw_cost_s}, {"sampling_ms", res.stats.sampling_ms},
                           {"optimize_ms", res.stats.optimize_ms}, {"shortcut_ms", res.stats.shortcut_ms},
@@ -570,6 +572,12 @@ int main(int argc, char** argv) {
           auto [raw, simp] = base.run(p, limit, p == "rrtconnect");
           results[wc.name][p].push_back(raw);
           if (p == "rrtconnect") results[wc.name]["rrtc+simp"].push_back(simp);
+          for (const auto& [m, run] : {std::pair<std::string, const Run&>{p, raw}, {"rrtc+simp", simp}}) {
+            if (!run.success || (m == "rrtc+simp" && p != "rrtconnect")) continue;
+            js["runs_detail"].push_back({{"method", m}, {"world", wc.name}, {"run", r}, {"time_ms", run.time_ms},
+                                         {"length", run.length}, {"crossed", run.crossed}, {"mass", run.mass},
+                                         {"effort_s", run.effort_s}, {"objects", run.objects}});
+          }
         }
       }
     }

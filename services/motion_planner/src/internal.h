@@ -262,6 +262,15 @@ class StaticRoadmap {
                                                     const Termination& termination, bool& complete);
   /// Adds a static-free state (or finds the node already there) connected to its k nearest nodes.
   int addState(const ob::State* s);
+  /// addState() for a request's start or goal: a node it creates is a *request node*, stamped
+  /// with `request` (a counter of the caller); an existing request node gets the new stamp.
+  int addRequestState(const ob::State* s, std::uint64_t request);
+  std::size_t requestNodeCount() const { return request_nodes_; }
+  /// Bounds the roadmap's growth over a long mission: when more than `max_request_nodes`
+  /// request nodes exist, the least recently used are removed (with their edges and cached
+  /// movables) until half of that many remain. Samples and lazy KPIECE path nodes are kept.
+  /// Returns the number of nodes removed. Never call during a search (indices change).
+  std::size_t pruneRequestNodes(std::size_t max_request_nodes);
   /// Adds a statically valid path cut every `spacing` (its edges are known valid); returns the
   /// nodes of its first and last states.
   std::pair<int, int> addPath(const og::PathGeometric& path, double spacing);
@@ -297,6 +306,8 @@ class StaticRoadmap {
   std::unique_ptr<MovableCache> mcache_;
   /// Brings the cache to the request's movables; returns false when it cannot be used.
   bool syncMovables(const Oracle& oracle, std::vector<int>& global_to_request);
+  std::vector<std::uint64_t> request_stamp_;  ///< per node: 0, or the last request using it
+  std::size_t request_nodes_{0};
   std::size_t uniform_{0};
   std::size_t plain_{0};
   std::size_t bridges_{0};

@@ -727,9 +727,12 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
     if (req.group == PlanningGroup::kBase && P.lazy.roadmap_first && res.stats.roadmap_reused &&
         !goal_states.empty()) {
       ensureSampled();
-      const int s = roadmap->addState(start.get());
+      res.stats.roadmap_pruned =
+          roadmap->pruneRequestNodes(static_cast<std::size_t>(P.lazy.roadmap_max_request_nodes));
+      const std::uint64_t request = ++impl.requests;
+      const int s = roadmap->addRequestState(start.get(), request);
       std::vector<int> goals;
-      for (const auto* g : goal_states) goals.push_back(roadmap->addState(g));
+      for (const auto* g : goal_states) goals.push_back(roadmap->addRequestState(g, request));
       from_roadmap = roadmap->search(oracle, si, s, goals, P.lazy, res_check, spu, termination, res.stats,
                                      P.lazy.roadmap_max_new_invalid);
     }

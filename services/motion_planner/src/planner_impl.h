@@ -18,6 +18,7 @@ struct MotionPlanner::Impl {
   ObjectEffortFn effort;
   /// Cached static roadmaps (motion_planner.h, "Roadmap cache"), least recently used first.
   std::vector<std::unique_ptr<detail::StaticRoadmap>> roadmaps;
+  std::uint64_t requests{0};  ///< roadmap-first searches so far (stamps of request nodes)
 
   Impl(MotionPlannerParams p, detail::RobotBinding r);
 

@@ -19,6 +19,7 @@
 #include <cmath>
 #include <iostream>  // NearestNeighborsGNATNoThreadSafety.h uses std::cout without including it
 #include <limits>
+#include <numeric>
 #include <queue>
 #include <unordered_set>
 
@@ -191,6 +192,7 @@ int StaticRoadmap::pushNode(const ob::State* s) {
   }
   const int i = static_cast<int>(nodes_.size());
   nodes_.push_back(space_->cloneState(s));
+  request_stamp_.push_back(0);
   adj_.emplace_back();
   impl_->nn.add(i);
   for (int j : nbrs) addEdge(i, j, false);
@@ -198,6 +200,80 @@ int StaticRoadmap::pushNode(const ob::State* s) {
 }
 
 int StaticRoadmap::addState(const ob::State* s) { return pushNode(s); }
+
+int StaticRoadmap::addRequestState(const ob::State* s, std::uint64_t request) {
+  const std::size_t before = nodes_.size();
+  const int i = pushNode(s);
+  auto& stamp = request_stamp_[static_cast<std::size_t>(i)];
+  if (nodes_.size() > before) ++request_nodes_;
+  if (nodes_.size() > before || stamp > 0) stamp = std::max<std::uint64_t>(request, 1);
+  return i;
+}
+
+std::size_t StaticRoadmap::pruneRequestNodes(std::size_t max_request_nodes) {
+  if (request_nodes_ <= max_request_nodes) return 0;
+  // The oldest request nodes go, down to half the bound (so pruning is rare).
+  std::vector<std::pair<std::uint64_t, int>> by_age;
+  for (std::size_t i = 0; i < nodes_.size(); ++i) {
+    if (request_stamp_[i] > 0) by_age.emplace_back(request_stamp_[i], static_cast<int>(i));
+  }
+  std::sort(by_age.begin(), by_age.end());
+  const std::size_t remove = by_age.size() - max_request_nodes / 2;
+  std::vector<char> drop(nodes_.size(), 0);
+  for (std::size_t k = 0; k < remove; ++k) drop[static_cast<std::size_t>(by_age[k].second)] = 1;
+
+  std::vector<int> remap(nodes_.size(), -1);
+  std::vector<ob::State*> nodes;
+  std::vector<std::uint64_t> stamps;
+  for (std::size_t i = 0; i < nodes_.size(); ++i) {
+    if (drop[i]) {
+      space_->freeState(nodes_[i]);
+      continue;
+    }
+    remap[i] = static_cast<int>(nodes.size());
+    nodes.push_back(nodes_[i]);
+    stamps.push_back(request_stamp_[i]);
+  }
+  std::vector<Edge> edges;
+  std::vector<MovableCache::Entry> edge_cache;
+  impl_->edge_keys.clear();
+  std::vector<std::vector<int>> adj(nodes.size());
+  for (std::size_t ei = 0; ei < edges_.size(); ++ei) {
+    Edge e = edges_[ei];
+    e.a = remap[static_cast<std::size_t>(e.a)];
+    e.b = remap[static_cast<std::size_t>(e.b)];
+    if (e.a < 0 || e.b < 0) continue;
+    const int ni = static_cast<int>(edges.size());
+    edges.push_back(e);
+    adj[static_cast<std::size_t>(e.a)].push_back(ni);
+    adj[static_cast<std::size_t>(e.b)].push_back(ni);
+    impl_->edge_keys.insert((static_cast<std::uint64_t>(std::min(e.a, e.b)) << 32) |
+                            static_cast<std::uint32_t>(std::max(e.a, e.b)));
+    if (mcache_ && ei < mcache_->edges.size()) {
+      edge_cache.resize(edges.size());
+      edge_cache.back() = std::move(mcache_->edges[ei]);
+    }
+  }
+  if (mcache_) {
+    std::vector<MovableCache::Entry> node_cache(nodes.size());
+    for (std::size_t i = 0; i < remap.size() && i < mcache_->nodes.size(); ++i) {
+      if (remap[i] >= 0) node_cache[static_cast<std::size_t>(remap[i])] = std::move(mcache_->nodes[i]);
+    }
+    mcache_->nodes = std::move(node_cache);
+    edge_cache.resize(edges.size());
+    mcache_->edges = std::move(edge_cache);
+  }
+  nodes_ = std::move(nodes);
+  request_stamp_ = std::move(stamps);
+  edges_ = std::move(edges);
+  adj_ = std::move(adj);
+  request_nodes_ -= remove;
+  impl_->nn.clear();
+  std::vector<int> all(nodes_.size());
+  std::iota(all.begin(), all.end(), 0);
+  impl_->nn.add(all);
+  return remove;
+}
 
 std::pair<std::size_t, std::size_t> StaticRoadmap::evaluateEdges(Oracle& oracle, double resolution,
                                                                  const Termination& termination, bool& complete) {

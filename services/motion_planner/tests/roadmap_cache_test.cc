@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <random>
 
 #include "tamp/motion_planner/motion_planner.h"
 #include "test_worlds.h"
@@ -281,6 +282,49 @@ TEST_F(RoadmapCacheTest, MovableCacheDropsEntriesWhereAnObjectReturns) {
   ASSERT_EQ(back.status, MotionStatus::kSolved) << back.reason;
   EXPECT_TRUE(back.blocking.empty()) << back.blocking.front().object_id;
   EXPECT_TRUE(discTouches(original, back.path, kRadius, 0.005).empty());
+}
+
+// A long mission asks many queries: their starts and goals join the roadmap, and the least
+// recently used are removed beyond roadmap_max_request_nodes, without breaking later searches
+// (indices, edges and the movable cache are remapped).
+TEST_F(RoadmapCacheTest, RequestNodesArePrunedAndLaterSearchesStayCorrect) {
+  world::World w = testing::twoDoorWorld();
+  MotionPlannerParams p = params();
+  p.lazy.roadmap_max_request_nodes = 10;
+  p.lazy.roadmap_growth_samples = 0;
+  MotionPlanner mp(collision::RobotGeometry::disc(kRadius, 1.0), p);
+  mp.setWorld(w);
+  const MotionRequest req = baseRequest({2, 0.9, 0}, {8, 0.9, 0});
+  const auto prep = mp.prepare(PlanningGroup::kBase, req.start, {}, Termination::after(30.0));
+  ASSERT_TRUE(prep.ok());
+  const MotionResult first = mp.plan(req, Termination::after(5.0));
+  ASSERT_EQ(first.status, MotionStatus::kSolved) << first.reason;
+
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> ux(0.6, 9.4), uy(0.6, 3.4);
+  std::size_t pruned = 0, max_nodes = 0;
+  int solved = 0, fallbacks = 0;
+  for (int i = 0; i < 40; ++i) {
+    const MotionRequest q = baseRequest({ux(rng), uy(rng), 0}, {ux(rng), uy(rng), 0});
+    const MotionResult r = mp.plan(q, Termination::after(5.0));
+    if (r.status != MotionStatus::kSolved) continue;  // a sample inside a wall or a box
+    ++solved;
+    pruned += r.stats.roadmap_pruned;
+    fallbacks += r.stats.lazy_planner_used;
+    if (!r.stats.lazy_planner_used) max_nodes = std::max(max_nodes, r.stats.roadmap_nodes);
+    EXPECT_GT(discClearance(w, r.path, kRadius, 0.005, {}, /*movables=*/false), -1e-3) << "query " << i;
+    EXPECT_EQ(discTouches(w, r.path, kRadius, 0.005), ids(r.blocking)) << "query " << i;
+  }
+  EXPECT_GE(solved, 20);
+  EXPECT_GT(pruned, 0u);
+  // Samples, the first request's path and at most 10 request nodes (+ the current request's) --
+  // lazy KPIECE fallbacks add their path's nodes, which are kept.
+  EXPECT_LE(max_nodes, first.stats.roadmap_nodes + 12 + 40 * static_cast<std::size_t>(fallbacks));
+  // The first query again, after all that pruning: same objects, no worse.
+  const MotionResult again = mp.plan(req, Termination::after(5.0));
+  ASSERT_EQ(again.status, MotionStatus::kSolved) << again.reason;
+  EXPECT_EQ(ids(again.blocking), ids(first.blocking));
+  EXPECT_LE(again.cost_s, first.cost_s * 1.05) << "first " << first.cost_s << " again " << again.cost_s;
 }
 
 }  // namespace

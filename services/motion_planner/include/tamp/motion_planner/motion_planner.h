@@ -169,6 +169,7 @@ struct PlanningStats {
   std::uint64_t validity_checks{0};
   std::size_t roadmap_nodes{0};
   std::size_t roadmap_edges{0};
+  std::size_t roadmap_pruned{0};  ///< request nodes removed from the roadmap before this search
   std::size_t edges_evaluated{0};
   int search_iterations{0};
   /// Lazy mode: the path source's path before optimization -- lazy KPIECE's raw path, or the

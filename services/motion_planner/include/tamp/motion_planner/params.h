@@ -63,6 +63,9 @@ struct LazyParams {
   int roadmap_max_new_invalid{30};
   int roadmap_growth_samples{100};  ///< uniform samples added when a request falls back to lazy KPIECE; >= 0
   int roadmap_max_nodes{4000};      ///< no uniform samples are added beyond this many nodes; >= 1
+  /// Requests' starts and goals become roadmap nodes; beyond this many the least recently used
+  /// are removed (down to half), so a long mission does not grow the roadmap without bound; >= 2
+  int roadmap_max_request_nodes{400};
   int roadmap_cache_entries{4};     ///< roadmaps kept per planner (static world x group x held object), LRU; 0: none kept
   /// Base group: search the cached roadmap first (when it existed before the request) and run
   /// lazy KPIECE only when it cannot connect start and goal; false (and other groups, and a new

@@ -271,6 +271,13 @@ class StaticRoadmap {
   /// movables) until half of that many remain. Samples and lazy KPIECE path nodes are kept.
   /// Returns the number of nodes removed. Never call during a search (indices change).
   std::size_t pruneRequestNodes(std::size_t max_request_nodes);
+  /// Movable-aware densification (rigid base groups): for each movable `objects` (request
+  /// indices into oracle.movables()) not densified yet at its current box, up to `per_object`
+  /// static-free samples with the base just outside the box (0.5-1.5 x the reach radius away,
+  /// any yaw): the gaps between movables and walls that uniform samples miss, where a route
+  /// crossing fewer or lighter objects may pass. Returns the number of nodes added.
+  int addObjectRingSamples(Oracle& oracle, const GroupSpace& gs, const std::vector<int>& objects, int per_object,
+                           const Termination& termination);
   /// Adds a statically valid path cut every `spacing` (its edges are known valid); returns the
   /// nodes of its first and last states.
   std::pair<int, int> addPath(const og::PathGeometric& path, double spacing);
@@ -307,6 +314,7 @@ class StaticRoadmap {
   /// Brings the cache to the request's movables; returns false when it cannot be used.
   bool syncMovables(const Oracle& oracle, std::vector<int>& global_to_request);
   std::vector<std::uint64_t> request_stamp_;  ///< per node: 0, or the last request using it
+  std::vector<std::pair<std::string, Aabb>> densified_;  ///< movables ring-sampled, at their box then
   std::size_t request_nodes_{0};
   std::size_t uniform_{0};
   std::size_t plain_{0};

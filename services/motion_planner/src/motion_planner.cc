@@ -719,6 +719,20 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
                           P.lazy.roadmap_bridge_distance);
     }
   };
+  // When the roadmap's best path crosses movables: samples around them, and the roadmap searched
+  // again (the result can only get cheaper: the old path is still in the roadmap).
+  auto densify = [&](og::PathGeometric& path, int s, const std::vector<int>& goals) {
+    if (P.lazy.object_ring_samples <= 0 || req.group != PlanningGroup::kBase ||
+        roadmap->nodeCount() >= static_cast<std::size_t>(P.lazy.roadmap_max_nodes)) {
+      return;
+    }
+    const detail::EvaluatedPath ev = detail::evaluatePath(oracle, path, res_check, 0.0);
+    const detail::PathCost before = ev.cost(oracle, spu);
+    if (before.objects.empty()) return;
+    if (roadmap->addObjectRingSamples(oracle, gs, before.objects, P.lazy.object_ring_samples, termination) == 0) return;
+    auto again = roadmap->search(oracle, si, s, goals, P.lazy, res_check, spu, termination, res.stats);
+    if (again && detail::evaluatePath(oracle, *again, res_check, 0.0).cost(oracle, spu).cost < before.cost) path = *again;
+  };
   if (lazy && P.lazy.optimize) {
     Stopwatch rw;
     roadmap = impl.roadmapFor(staticWorldKey(impl, req.group, req.start, held, link_T_held, ignored), space,
@@ -735,6 +749,7 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
       for (const auto* g : goal_states) goals.push_back(roadmap->addRequestState(g, request));
       from_roadmap = roadmap->search(oracle, si, s, goals, P.lazy, res_check, spu, termination, res.stats,
                                      P.lazy.roadmap_max_new_invalid);
+      if (from_roadmap) densify(*from_roadmap, s, goals);
     }
     res.stats.optimize_ms += rw.millis();
   }
@@ -814,6 +829,7 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
         roadmap->addSamples(oracle, gs, P.lazy.roadmap_growth_samples, termination);
       }
       auto rm = roadmap->search(oracle, si, s, {g}, P.lazy, res_check, spu, termination, res.stats);
+      if (rm) densify(*rm, s, {g});
       if (rm) {
         detail::EvaluatedPath rm_eval = detail::evaluatePath(oracle, *rm, res_check, 0.0);
         if (rm_eval.cost(oracle, spu).cost < raw_cost.cost) best = *rm;

@@ -58,6 +58,7 @@ std::vector<Rule> rules(const MotionPlannerParams& p) {
       I("lazy", "roadmap_growth_samples", L.roadmap_growth_samples, 0),
       I("lazy", "roadmap_max_nodes", L.roadmap_max_nodes, 1),
       I("lazy", "roadmap_max_request_nodes", L.roadmap_max_request_nodes, 2),
+      I("lazy", "object_ring_samples", L.object_ring_samples, 0),
       I("lazy", "roadmap_cache_entries", L.roadmap_cache_entries, 0),
       P("lazy", "optimize_budget_s", L.optimize_budget_s),
       I("lazy", "shortcut_attempts", L.shortcut_attempts, 0),
@@ -188,6 +189,7 @@ Result<MotionPlannerParams> parseMotionPlannerParams(const std::string& yaml_tex
     s.optional("roadmap_growth_samples", p.lazy.roadmap_growth_samples);
     s.optional("roadmap_max_nodes", p.lazy.roadmap_max_nodes);
     s.optional("roadmap_max_request_nodes", p.lazy.roadmap_max_request_nodes);
+    s.optional("object_ring_samples", p.lazy.object_ring_samples);
     s.optional("roadmap_cache_entries", p.lazy.roadmap_cache_entries);
     s.optional("roadmap_first", p.lazy.roadmap_first);
     s.optional("optimize_budget_s", p.lazy.optimize_budget_s);

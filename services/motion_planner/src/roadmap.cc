@@ -364,6 +364,59 @@ void StaticRoadmap::addSamples(Oracle& oracle, const GroupSpace& gs, int count, 
   space_->freeState(tmp);
 }
 
+int StaticRoadmap::addObjectRingSamples(Oracle& oracle, const GroupSpace& gs, const std::vector<int>& objects,
+                                        int per_object, const Termination& termination) {
+  if (!oracle.rigid() || per_object <= 0) return 0;
+  const double reach = oracle.reachRadius();
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  auto& rng = impl_->rng;
+  std::vector<double> v(3);
+  ob::State* tmp = space_->allocState();
+  int added = 0;
+  for (int o : objects) {
+    const MovableInfo& m = oracle.movables()[static_cast<std::size_t>(o)];
+    auto known = std::find_if(densified_.begin(), densified_.end(), [&](const auto& d) { return d.first == m.id; });
+    if (known != densified_.end() && known->second.min.isApprox(m.aabb.min, 1e-6) &&
+        known->second.max.isApprox(m.aabb.max, 1e-6)) {
+      continue;  // done at this box already
+    }
+    if (known == densified_.end()) {
+      densified_.emplace_back(m.id, m.aabb);
+    } else {
+      known->second = m.aabb;
+    }
+    // Points on the rectangle of the box grown by d, by perimeter length.
+    for (int k = 0, attempts = 0; k < per_object && attempts < 4 * per_object; ++attempts) {
+      if ((attempts & 15) == 0 && termination()) break;
+      const double d = reach * (0.5 + unit(rng));
+      const double x0 = m.aabb.min.x() - d, x1 = m.aabb.max.x() + d;
+      const double y0 = m.aabb.min.y() - d, y1 = m.aabb.max.y() + d;
+      const double w = x1 - x0, h = y1 - y0;
+      double t = unit(rng) * 2 * (w + h);
+      double x, y;
+      if (t < w) {
+        x = x0 + t, y = y0;
+      } else if ((t -= w) < h) {
+        x = x1, y = y0 + t;
+      } else if ((t -= h) < w) {
+        x = x1 - t, y = y1;
+      } else {
+        x = x0, y = y1 - (t - w);
+      }
+      v[0] = x;
+      v[1] = y;
+      v[2] = -M_PI + 2 * M_PI * unit(rng);
+      gs.setValues(v, tmp);
+      if (!gs.space()->satisfiesBounds(tmp) || !oracle.staticFree(tmp)) continue;
+      pushNode(tmp);
+      ++k;
+      ++added;
+    }
+  }
+  space_->freeState(tmp);
+  return added;
+}
+
 std::pair<int, int> StaticRoadmap::addPath(const og::PathGeometric& path, double spacing) {
   ob::State* s = space_->allocState();
   int prev = pushNode(path.getState(0));

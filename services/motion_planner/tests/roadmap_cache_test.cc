@@ -197,12 +197,15 @@ TEST_F(RoadmapCacheTest, PrepareBuildsTheRoadmapTheNextRequestReuses) {
   EXPECT_GT(discClearance(w, r.path, kRadius, 0.005, {}, /*movables=*/false), -1e-3);
   EXPECT_EQ(mp.roadmapCacheSize(), 1u);
 
-  // Again: cached; only the request's start and goal edges are new.
+  // Again: cached; only the edges of the request's start and goal and of the samples it added
+  // around the movables its path crossed (at most each of the 3 once) are new.
   auto again = mp.prepare(PlanningGroup::kBase, req.start, {}, Termination::after(30.0));
   ASSERT_TRUE(again.ok());
   EXPECT_FALSE(again->built);
   EXPECT_TRUE(again->completed);
-  EXPECT_LE(again->edges_evaluated, 2u * static_cast<std::size_t>(mp.params().lazy.roadmap_neighbors));
+  const auto& lazy = mp.params().lazy;
+  EXPECT_LE(again->edges_evaluated,
+            static_cast<std::size_t>((2 + 3 * lazy.object_ring_samples) * lazy.roadmap_neighbors));
 
   // Only a movable changes: still the same roadmap.
   Eigen::Isometry3d p = w.object("light").pose;
@@ -317,9 +320,11 @@ TEST_F(RoadmapCacheTest, RequestNodesArePrunedAndLaterSearchesStayCorrect) {
   }
   EXPECT_GE(solved, 20);
   EXPECT_GT(pruned, 0u);
-  // Samples, the first request's path and at most 10 request nodes (+ the current request's) --
-  // lazy KPIECE fallbacks add their path's nodes, which are kept.
-  EXPECT_LE(max_nodes, first.stats.roadmap_nodes + 12 + 40 * static_cast<std::size_t>(fallbacks));
+  // Samples, the first request's path and at most 10 request nodes (+ the current request's);
+  // kept: the samples around crossed movables (each of the 3 once: they do not move here) and the
+  // paths of lazy KPIECE fallbacks.
+  EXPECT_LE(max_nodes, first.stats.roadmap_nodes + 12 + 3 * static_cast<std::size_t>(p.lazy.object_ring_samples) +
+                           40 * static_cast<std::size_t>(fallbacks));
   // The first query again, after all that pruning: same objects, no worse.
   const MotionResult again = mp.plan(req, Termination::after(5.0));
   ASSERT_EQ(again.status, MotionStatus::kSolved) << again.reason;

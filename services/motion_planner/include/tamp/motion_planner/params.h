@@ -66,6 +66,10 @@ struct LazyParams {
   /// Requests' starts and goals become roadmap nodes; beyond this many the least recently used
   /// are removed (down to half), so a long mission does not grow the roadmap without bound; >= 2
   int roadmap_max_request_nodes{400};
+  /// Base group: when the roadmap's best path crosses movables, this many samples are added just
+  /// outside each of them (once per object pose) and the roadmap is searched again: gaps between
+  /// objects and walls that uniform samples miss; >= 0 (0: off)
+  int object_ring_samples{24};
   int roadmap_cache_entries{4};     ///< roadmaps kept per planner (static world x group x held object), LRU; 0: none kept
   /// Base group: search the cached roadmap first (when it existed before the request) and run
   /// lazy KPIECE only when it cannot connect start and goal; false (and other groups, and a new

@@ -166,9 +166,11 @@ class LayeredFF : public Heuristic {
     goal_mark_.assign(nf, 0);
     op_used_.assign(task.ops.size(), 0);
     op_mark_.assign(task.ops.size(), 0);
-    facts_.reserve(nf);
-    active_.reserve(nr);
-    touched_.reserve(nr);
+    // Each fact is reached once and each rop activated and touched once per evaluation; one
+    // spare slot for the branch-free appends below.
+    facts_.resize(nf);
+    active_.resize(nr + 1);
+    touched_.resize(nr + 1);
   }
 
   void setGoal(const Goal& goal) override {
@@ -193,32 +195,42 @@ class LayeredFF : public Heuristic {
 
  private:
   void reset() {
-    for (FactId f : facts_) level_[f] = kNone;
-    for (uint32_t r : active_) rop_level_[r] = kNone;
-    for (uint32_t r : touched_) ctr_[r].unsat = ctr_[r].count;
-    facts_.clear();
-    active_.clear();
-    touched_.clear();
-  }
-
-  void reach(FactId f, uint32_t lvl) {
-    level_[f] = lvl;
-    facts_.push_back(f);
-    if (goals_.isGoal(f)) {
-      goals_.forEach(f, [&](uint32_t c) {
-        if (--remaining_[c] == 0 && done_ < 0) done_ = static_cast<int>(c);
-      });
-    }
+    for (size_t i = 0; i < num_facts_; ++i) level_[facts_[i]] = kNone;
+    for (size_t i = 0; i < num_active_; ++i) rop_level_[active_[i]] = kNone;
+    for (size_t i = 0; i < num_touched_; ++i) ctr_[touched_[i]].unsat = ctr_[touched_[i]].count;
+    num_facts_ = num_active_ = num_touched_ = 0;
   }
 
   /// Builds the graph up to the first layer with a complete goal conjunct; returns the conjunct
-  /// or -1 when the relaxed fixpoint is reached without one (a dead end).
+  /// or -1 when the relaxed fixpoint is reached without one (a dead end). The lists are arrays
+  /// sized for the whole task, appended to through local counters; the inner loop over
+  /// precondition edges appends without branches (its two conditions are unpredictable).
   int buildGraph(const uint64_t* s) {
     reset();
     remaining_ = goals_.sizes();
-    done_ = -1;
+    int done = -1;
     const size_t nf = task_.numFacts();
     const size_t words = task_.numWords();
+    FactId* const facts = facts_.data();
+    uint32_t* const active = active_.data();
+    uint32_t* const touched = touched_.data();
+    uint32_t* const level = level_.data();
+    uint32_t* const rop_level = rop_level_.data();
+    Counter* const ctr = ctr_.data();
+    const uint32_t* const pre_of = R_.pre_of.data();
+    const uint32_t* const pre_of_begin = R_.pre_of_begin.data();
+    const uint32_t* const add = R_.add.data();
+    const uint32_t* const add_begin = R_.add_begin.data();
+    size_t nfacts = 0, nactive = 0, ntouched = 0;
+    auto reach = [&](FactId f, uint32_t lvl) {
+      level[f] = lvl;
+      facts[nfacts++] = f;
+      if (goals_.isGoal(f)) {
+        goals_.forEach(f, [&](uint32_t c) {
+          if (--remaining_[c] == 0 && done < 0) done = static_cast<int>(c);
+        });
+      }
+    };
     for (size_t w = 0; w < words; ++w) {
       uint64_t word = s[w];
       while (word) {
@@ -230,41 +242,43 @@ class LayeredFF : public Heuristic {
     }
     size_t start_ft = 0, start_ef = 0;
     for (uint32_t time = 0;; ++time) {
-      if (done_ >= 0) {
+      if (done >= 0) {
         max_level_ = time;
-        return done_;
+        break;
       }
-      const size_t stop_ft = facts_.size();
-      // Raw pointers: the push_backs below would otherwise force reloads of every array.
-      Counter* const ctr = ctr_.data();
-      const uint32_t* const pre_of = R_.pre_of.data();
-      const uint32_t* const pre_of_begin = R_.pre_of_begin.data();
+      const size_t stop_ft = nfacts;
       for (size_t i = start_ft; i < stop_ft; ++i) {
-        const FactId f = facts_[i];
+        const FactId f = facts[i];
         for (uint32_t k = pre_of_begin[f], e = pre_of_begin[f + 1]; k < e; ++k) {
           const uint32_t r = pre_of[k];
           const uint32_t u = ctr[r].unsat;
-          if (u == ctr[r].count) touched_.push_back(r);
+          touched[ntouched] = r;
+          ntouched += u == ctr[r].count;
           ctr[r].unsat = u - 1;
-          if (u == 1) active_.push_back(r);
+          active[nactive] = r;
+          nactive += u == 1;
         }
       }
       if (time == 0) {
-        for (uint32_t r : R_.no_pre) active_.push_back(r);
+        for (uint32_t r : R_.no_pre) active[nactive++] = r;
       }
-      const size_t stop_ef = active_.size();
+      const size_t stop_ef = nactive;
       for (size_t i = start_ef; i < stop_ef; ++i) {
-        const uint32_t r = active_[i];
-        rop_level_[r] = time;
-        for (uint32_t k = R_.add_begin[r]; k < R_.add_begin[r + 1]; ++k) {
-          const FactId g = R_.add[k];
-          if (level_[g] == kNone) reach(g, time + 1);
+        const uint32_t r = active[i];
+        rop_level[r] = time;
+        for (uint32_t k = add_begin[r], e = add_begin[r + 1]; k < e; ++k) {
+          const FactId g = add[k];
+          if (level[g] == kNone) reach(g, time + 1);
         }
       }
-      if (stop_ft == facts_.size()) return -1;  // fixpoint without the goals
+      if (stop_ft == nfacts) break;  // fixpoint without the goals (done < 0)
       start_ft = stop_ft;
       start_ef = stop_ef;
     }
+    num_facts_ = nfacts;
+    num_active_ = nactive;
+    num_touched_ = ntouched;
+    return done;
   }
 
   void nextEpoch() {
@@ -408,9 +422,8 @@ class LayeredFF : public Heuristic {
   Goal goal_;
   GoalIndex goals_;
   std::vector<uint32_t> remaining_;
-  int done_{-1};
   uint32_t max_level_{0};
-  // Graph (reset through facts_/active_/touched_).
+  // Graph (reset through the first num_* entries of facts_/active_/touched_).
   /// Unsatisfied preconditions of a rop next to its precondition count (one cache line).
   struct Counter {
     uint32_t unsat, count;
@@ -419,6 +432,7 @@ class LayeredFF : public Heuristic {
   std::vector<uint32_t> level_, rop_level_;
   std::vector<FactId> facts_;
   std::vector<uint32_t> active_, touched_;
+  size_t num_facts_{0}, num_active_{0}, num_touched_{0};
   // Extraction (epoch-stamped).
   uint32_t epoch_{0};
   std::vector<uint64_t> true_a_, true_b_;

@@ -10,13 +10,14 @@
 
 #include <gtest/gtest.h>
 
+#include "../../common/dds/tests/test_util.h"
 #include "tamp/core/termination.h"
 #include "tamp/process/supervisor.h"
 
 namespace tamp::integration {
 
 inline std::filesystem::path binDir() { return TAMP_BIN_DIR; }
-inline int isolatedDomain() { return 20 + static_cast<int>(::getpid() % 200); }
+using dds::testing::isolatedDomain;
 
 inline std::filesystem::path tempFile(const std::string& stem) {
   return std::filesystem::temp_directory_path() / (stem + "_" + std::to_string(::getpid()));

@@ -12,7 +12,6 @@
 
 #include <gtest/gtest.h>
 
-#include "../../common/dds/tests/test_util.h"
 #include "integration_util.h"
 #include "tamp/core/paths.h"
 #include "tamp/dds/convert.h"

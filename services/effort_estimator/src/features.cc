@@ -73,55 +73,16 @@ Result<ActionFeatures> baseFeatures(const ActionDescription& a) {
   if (ix < 0 || iy < 0 || it < 0) {
     return invalid("move_base path needs joints base_x, base_y and base_theta", "path.joint_names");
   }
-  using Tol = FeatureTolerances;
+  std::vector<Pose2D> poses;
+  poses.reserve(path.waypoints.size());
+  for (const auto& w : path.waypoints) {
+    poses.push_back(Pose2D{w[static_cast<std::size_t>(ix)], w[static_cast<std::size_t>(iy)], w[static_cast<std::size_t>(it)]});
+  }
   std::vector<double> moves;
   std::vector<double> turns;
-  double heading = path.waypoints.front()[it];
-  double run_length = 0.0;  // length of the straight run being accumulated (0 = none)
-  auto turnTo = [&](double target) {
-    const double turn = std::abs(angleDiff(target, heading));
-    if (turn > Tol::kMinTurnRad) turns.push_back(turn);
-    heading = target;
-  };
-  auto flushRun = [&]() {
-    if (run_length > 0.0) moves.push_back(run_length);
-    run_length = 0.0;
-  };
-  // Unit direction of the current run; a segment continues the run when its direction is within
-  // kCollinearRad of it (cross product test, so atan2 is only paid at the start of a run).
-  double run_ux = 0.0, run_uy = 0.0;
-  const double sin_tol = std::sin(Tol::kCollinearRad);
-  for (std::size_t i = 1; i < path.waypoints.size(); ++i) {
-    const auto& p = path.waypoints[i - 1];
-    const auto& q = path.waypoints[i];
-    const double dx = q[ix] - p[ix];
-    const double dy = q[iy] - p[iy];
-    const double d = std::sqrt(dx * dx + dy * dy);
-    if (d < Tol::kMinTranslationM) {
-      // Turn in place to this waypoint's heading (if it asks for one).
-      if (std::abs(angleDiff(q[it], heading)) > Tol::kMinTurnRad) {
-        flushRun();
-        turnTo(q[it]);
-      }
-      continue;
-    }
-    if (run_length > 0.0) {
-      const double dot = run_ux * dx + run_uy * dy;
-      const double cross = run_ux * dy - run_uy * dx;
-      if (dot > 0.0 && std::abs(cross) <= sin_tol * d) {
-        run_length += d;
-        continue;
-      }
-    }
-    flushRun();
-    const double phi = std::atan2(dy, dx);
-    turnTo(phi);
-    run_ux = dx / d;
-    run_uy = dy / d;
-    run_length = d;
+  for (const BaseStep& step : baseSteps(poses)) {
+    (step.kind == BaseStep::Kind::kDrive ? moves : turns).push_back(step.amount);
   }
-  flushRun();
-  turnTo(path.waypoints.back()[it]);
 
   ActionFeatures f;
   f.kind = ActionKind::kMoveBase;
@@ -140,31 +101,96 @@ Result<ActionFeatures> armFeatures(const ActionDescription& a, const FeatureOpti
                      "path.joint_names");
     }
   }
-  using Tol = FeatureTolerances;
-  const std::size_t n = path.joint_names.size();
-  std::vector<double> inv_scale(n, 1.0);
-  if (!options.joint_scales.empty()) {
-    for (std::size_t j = 0; j < n; ++j) {
-      const auto it = options.joint_scales.find(path.joint_names[j]);
-      if (it != options.joint_scales.end()) inv_scale[j] = 1.0 / it->second;
-    }
-  }
   std::vector<double> moves;
+  for (const ArmRun& run : armRuns(path.waypoints, path.joint_names, options)) moves.push_back(run.length);
+  ActionFeatures f;
+  f.kind = ActionKind::kMoveArm;
+  f.moves = MoveSet(std::move(moves));
+  f.object_mass_kg = a.object_mass_kg;
+  return f;
+}
+
+}  // namespace
+
+std::vector<BaseStep> baseSteps(const std::vector<Pose2D>& poses) {
+  using Tol = FeatureTolerances;
+  std::vector<BaseStep> steps;
+  if (poses.empty()) return steps;
+  double heading = poses.front().theta;
+  BaseStep run{BaseStep::Kind::kDrive, 0.0, 0.0, {}};  // the straight run being accumulated
+  auto turnTo = [&](double target) {
+    const double turn = std::abs(angleDiff(target, heading));
+    if (turn > Tol::kMinTurnRad) steps.push_back(BaseStep{BaseStep::Kind::kTurn, target, turn, {}});
+    heading = target;
+  };
+  auto flushRun = [&]() {
+    if (run.amount > 0.0) steps.push_back(std::move(run));
+    run = BaseStep{BaseStep::Kind::kDrive, 0.0, 0.0, {}};
+  };
+  // Unit direction of the current run; a segment continues the run when its direction is within
+  // kCollinearRad of it (cross product test, so atan2 is only paid at the start of a run).
+  double run_ux = 0.0, run_uy = 0.0;
+  const double sin_tol = std::sin(Tol::kCollinearRad);
+  for (std::size_t i = 1; i < poses.size(); ++i) {
+    const Pose2D& p = poses[i - 1];
+    const Pose2D& q = poses[i];
+    const double dx = q.x - p.x;
+    const double dy = q.y - p.y;
+    const double d = std::sqrt(dx * dx + dy * dy);
+    if (d < Tol::kMinTranslationM) {
+      // Turn in place to this waypoint's heading (if it asks for one).
+      if (std::abs(angleDiff(q.theta, heading)) > Tol::kMinTurnRad) {
+        flushRun();
+        turnTo(q.theta);
+      }
+      continue;
+    }
+    if (run.amount > 0.0) {
+      const double dot = run_ux * dx + run_uy * dy;
+      const double cross = run_ux * dy - run_uy * dx;
+      if (dot > 0.0 && std::abs(cross) <= sin_tol * d) {
+        run.amount += d;
+        run.points.push_back(i);
+        continue;
+      }
+    }
+    flushRun();
+    turnTo(std::atan2(dy, dx));
+    run_ux = dx / d;
+    run_uy = dy / d;
+    run.amount = d;
+    run.points = {i};
+  }
+  flushRun();
+  turnTo(poses.back().theta);
+  return steps;
+}
+
+std::vector<ArmRun> armRuns(const std::vector<std::vector<double>>& waypoints,
+                            const std::vector<std::string>& joint_names, const FeatureOptions& options) {
+  using Tol = FeatureTolerances;
+  const std::size_t n = joint_names.size();
+  std::vector<double> inv_scale(n, 1.0);
+  for (std::size_t j = 0; j < n && !options.joint_scales.empty(); ++j) {
+    const auto it = options.joint_scales.find(joint_names[j]);
+    if (it != options.joint_scales.end()) inv_scale[j] = 1.0 / it->second;
+  }
+  std::vector<ArmRun> runs;
   std::vector<double> run_delta(n, 0.0);  // joint displacement of the current straight run
   std::vector<double> last_dir;           // unit direction of the last segment (empty = none)
   std::vector<double> delta(n);
   auto flushRun = [&]() {
     double largest = 0.0;
     for (std::size_t j = 0; j < n; ++j) largest = std::max(largest, std::abs(run_delta[j]) * inv_scale[j]);
-    if (largest >= Tol::kMinJointMove) moves.push_back(largest);
+    if (largest >= Tol::kMinJointMove) runs.push_back(ArmRun{run_delta, largest});
     std::fill(run_delta.begin(), run_delta.end(), 0.0);
     last_dir.clear();
   };
-  for (std::size_t i = 1; i < path.waypoints.size(); ++i) {
+  for (std::size_t i = 1; i < waypoints.size(); ++i) {
     double largest = 0.0;
     double norm2 = 0.0;
     for (std::size_t j = 0; j < n; ++j) {
-      delta[j] = path.waypoints[i][j] - path.waypoints[i - 1][j];
+      delta[j] = waypoints[i][j] - waypoints[i - 1][j];
       largest = std::max(largest, std::abs(delta[j]));
       norm2 += delta[j] * delta[j];
     }
@@ -182,14 +208,8 @@ Result<ActionFeatures> armFeatures(const ActionDescription& a, const FeatureOpti
     }
   }
   flushRun();
-  ActionFeatures f;
-  f.kind = ActionKind::kMoveArm;
-  f.moves = MoveSet(std::move(moves));
-  f.object_mass_kg = a.object_mass_kg;
-  return f;
+  return runs;
 }
-
-}  // namespace
 
 MoveSet::MoveSet(std::vector<double> lengths) : lengths_(std::move(lengths)) {
   for (double d : lengths_) {

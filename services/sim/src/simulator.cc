@@ -892,120 +892,52 @@ Result<Active> Simulator::Impl::plan(const ActionCommand& c, const std::vector<i
     const double v = P[0], acc = P[1], w = P[2], alpha = P[3], settle = P[4], overhead = P[5];
     a.mass = heldMass();
     pause(overhead);
-    double heading = wp.front()[2];
-    double run_length = 0.0, run_ux = 0.0, run_uy = 0.0;
-    GeoPath run;
-    auto turnTo = [&](double target) {
-      const double turn = angleDiff(target, heading);
-      heading = target;
-      if (std::abs(turn) <= FeatureTolerances::kMinTurnRad) return;
+    std::vector<Pose2D> poses;
+    for (const Vec& q : wp) poses.push_back(Pose2D{q[0], q[1], q[2]});
+    for (const auto& step : effort_estimator::baseSteps(poses)) {
       GeoPath g;
-      Vec end = cur;
-      end[2] = cur[2] + angleDiff(target, cur[2]);
-      g.q = {cur, end};
-      g.u = {0.0, std::abs(end[2] - cur[2])};
-      motion(std::move(g), std::abs(turn), w, alpha);
+      if (step.kind == effort_estimator::BaseStep::Kind::kTurn) {
+        Vec end = cur;
+        end[2] = cur[2] + angleDiff(step.target_heading, cur[2]);
+        g.q = {cur, end};
+        g.u = {0.0, std::abs(end[2] - cur[2])};
+        motion(std::move(g), step.amount, w, alpha);
+      } else {
+        g.q = {cur};
+        g.u = {0.0};
+        for (std::size_t i : step.points) {
+          Vec n = g.q.back();
+          n[0] = wp[i][0];
+          n[1] = wp[i][1];
+          g.u.push_back(g.u.back() + std::hypot(n[0] - g.q.back()[0], n[1] - g.q.back()[1]));
+          g.q.push_back(n);
+        }
+        motion(std::move(g), step.amount, v, acc);
+      }
       pause(settle);
-    };
-    auto flushRun = [&]() {
-      if (run_length > 0.0) {
-        motion(std::move(run), run_length, v, acc);
-        pause(settle);
-      }
-      run = GeoPath{};
-      run_length = 0.0;
-    };
-    const double sin_tol = std::sin(FeatureTolerances::kCollinearRad);
-    auto addPoint = [&](const Vec& q) {
-      Vec s = cur;
-      if (!run.q.empty()) s = run.q.back();
-      Vec n = s;
-      n[0] = q[0];
-      n[1] = q[1];
-      run.u.push_back(run.u.back() + std::hypot(n[0] - s[0], n[1] - s[1]));
-      run.q.push_back(n);
-    };
-    for (std::size_t i = 1; i < wp.size(); ++i) {
-      const Vec& p = wp[i - 1];
-      const Vec& q = wp[i];
-      const double dx = q[0] - p[0], dy = q[1] - p[1];
-      const double d = std::sqrt(dx * dx + dy * dy);
-      if (d < FeatureTolerances::kMinTranslationM) {
-        if (std::abs(angleDiff(q[2], heading)) > FeatureTolerances::kMinTurnRad) {
-          flushRun();
-          turnTo(q[2]);
-        }
-        continue;
-      }
-      if (run_length > 0.0) {
-        const double dot = run_ux * dx + run_uy * dy;
-        const double cross = run_ux * dy - run_uy * dx;
-        if (dot > 0.0 && std::abs(cross) <= sin_tol * d) {
-          run_length += d;
-          addPoint(q);
-          continue;
-        }
-      }
-      flushRun();
-      turnTo(std::atan2(dy, dx));
-      run_ux = dx / d;
-      run_uy = dy / d;
-      run_length = d;
-      run.q = {cur};
-      run.u = {0.0};
-      addPoint(q);
     }
-    flushRun();
-    turnTo(wp.back()[2]);
     desc.path = c.trajectory.path();
   } else if (c.kind == ActionKind::kMoveArm) {
     const double f = 1.0 + P[4] * heldMass();
     const double v = P[0] / f, acc = P[1] / f, settle = P[2], overhead = P[3];
     a.mass = heldMass();
     pause(overhead);
+    // The same straight runs the effort features see (effort_estimator::armRuns), each one
+    // synchronized move followed by a settle pause.
     const std::size_t n = cols.size();
-    std::vector<double> inv_scale(n, 1.0);
-    for (std::size_t j = 0; j < n; ++j) {
-      const auto it = feature_options.joint_scales.find(c.trajectory.joint_names[j]);
-      if (it != feature_options.joint_scales.end()) inv_scale[j] = 1.0 / it->second;
+    std::vector<std::vector<double>> arm(wp.size(), std::vector<double>(n));
+    for (std::size_t i = 0; i < wp.size(); ++i) {
+      for (std::size_t j = 0; j < n; ++j) arm[i][j] = wp[i][cols[j]];
     }
-    std::vector<double> run_delta(n, 0.0), last_dir, delta(n);
-    auto flushRun = [&]() {
-      double largest = 0.0;
-      for (std::size_t j = 0; j < n; ++j) largest = std::max(largest, std::abs(run_delta[j]) * inv_scale[j]);
-      if (largest >= FeatureTolerances::kMinJointMove) {
-        GeoPath g;
-        Vec end = cur;
-        for (std::size_t j = 0; j < n; ++j) end[cols[j]] += run_delta[j];
-        g.q = {cur, end};
-        g.u = {0.0, largest};
-        motion(std::move(g), largest, v, acc);
-        pause(settle);
-      }
-      std::fill(run_delta.begin(), run_delta.end(), 0.0);
-      last_dir.clear();
-    };
-    for (std::size_t i = 1; i < wp.size(); ++i) {
-      double largest = 0.0, norm2 = 0.0;
-      for (std::size_t j = 0; j < n; ++j) {
-        delta[j] = wp[i][cols[j]] - wp[i - 1][cols[j]];
-        largest = std::max(largest, std::abs(delta[j]));
-        norm2 += delta[j] * delta[j];
-      }
-      if (largest < FeatureTolerances::kMinJointMove) continue;
-      const double norm = std::sqrt(norm2);
-      double dot = 0.0;
-      if (!last_dir.empty()) {
-        for (std::size_t j = 0; j < n; ++j) dot += last_dir[j] * delta[j] / norm;
-      }
-      if (last_dir.empty() || dot < 1.0 - FeatureTolerances::kArmCollinearCos) flushRun();
-      last_dir.resize(n);
-      for (std::size_t j = 0; j < n; ++j) {
-        run_delta[j] += delta[j];
-        last_dir[j] = delta[j] / norm;
-      }
+    for (const auto& run : effort_estimator::armRuns(arm, c.trajectory.joint_names, feature_options)) {
+      GeoPath g;
+      Vec end = cur;
+      for (std::size_t j = 0; j < n; ++j) end[cols[j]] += run.delta[j];
+      g.q = {cur, end};
+      g.u = {0.0, run.length};
+      motion(std::move(g), run.length, v, acc);
+      pause(settle);
     }
-    flushRun();
     desc.path = c.trajectory.path();
   } else {
     // Pick / place: approach to the grasp waypoint along the tool path, gripper, retreat.

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "tamp/core/error.h"
+#include "tamp/core/geometry.h"
 #include "tamp/core/trajectory.h"
 
 namespace tamp::effort_estimator {
@@ -112,6 +113,37 @@ struct FeatureOptions {
   /// Ok, or kInvalidArgument naming the joint with a bad scale.
   Status validate() const;
 };
+
+/// One step of the stop-and-turn execution of a base path (see baseSteps).
+struct BaseStep {
+  enum class Kind { kTurn, kDrive };
+  Kind kind{Kind::kTurn};
+  double target_heading{0.0};        ///< kTurn: the heading turned to (rad)
+  double amount{0.0};                ///< kTurn: |turn| (rad, > kMinTurnRad); kDrive: run length (m)
+  std::vector<std::size_t> points;   ///< kDrive: the waypoints driven through, in order
+};
+
+/// The stop-and-turn steps of a base path (`poses`: its waypoints' base poses): for each straight
+/// run of the polyline (merged per FeatureTolerances::kCollinearRad), a turn in place to the
+/// run's heading, then the drive; a waypoint without translation but with a new heading is a turn
+/// in place to it; at the end a turn to the last heading. Turns up to kMinTurnRad and
+/// translations below kMinTranslationM are not steps. The segmentation the move_base features and
+/// the simulator's base timeline share.
+std::vector<BaseStep> baseSteps(const std::vector<Pose2D>& poses);
+
+/// A straight run of an arm path: consecutive segments in one joint-space direction (within
+/// FeatureTolerances::kArmCollinearCos), executed as one synchronized move.
+struct ArmRun {
+  std::vector<double> delta;  ///< joint displacement over the run, per joint of the path
+  double length{0.0};         ///< largest scaled joint displacement (FeatureOptions::joint_scales)
+};
+
+/// The straight runs of an arm path whose waypoints are over `joint_names`: the segmentation the
+/// move_arm features (one move per run) and the simulator's arm timeline share. Segments and runs
+/// shorter than FeatureTolerances::kMinJointMove are dropped. Waypoints must all have
+/// `joint_names.size()` values (not checked here: actionFeatures() validates paths).
+std::vector<ArmRun> armRuns(const std::vector<std::vector<double>>& waypoints,
+                            const std::vector<std::string>& joint_names, const FeatureOptions& options);
 
 /// Plausibility limits of action inputs: beyond them a request is rejected (a value of 1e300 m is
 /// a corrupt message, not an action, and would overflow the models).

@@ -10,8 +10,8 @@ namespace tamp::dds {
 enum class QosClass {
   kState,      ///< RELIABLE + TRANSIENT_LOCAL, KEEP_LAST 1 per instance: world model, models, graph
   kStream,     ///< BEST_EFFORT, KEEP_LAST small: robot state, point clouds
-  kCommand,    ///< RELIABLE, VOLATILE, KEEP_LAST 64: commands and their status
-  kEvent,      ///< RELIABLE, TRANSIENT_LOCAL, KEEP_LAST 100: events and execution records
+  kCommand,    ///< RELIABLE, VOLATILE, KEEP_LAST 64: commands
+  kEvent,      ///< RELIABLE, TRANSIENT_LOCAL, KEEP_LAST 100: events, results, execution records
   kRpc,        ///< RELIABLE, VOLATILE, KEEP_LAST 64: request/reply topics
   kHeartbeat,  ///< RELIABLE + TRANSIENT_LOCAL, KEEP_LAST 1 per instance: service liveness
   kBulk,       ///< RELIABLE, VOLATILE, KEEP_LAST 2: point clouds (large, fragmented)

@@ -68,7 +68,11 @@ inline constexpr TopicSpec<msg::Heartbeat> kHeartbeat{"tamp/heartbeat", QosClass
 inline constexpr TopicSpec<msg::RobotState> kRobotState{"tamp/robot/state", QosClass::kStream};
 inline constexpr TopicSpec<msg::PointCloudFrame> kPointCloud{"tamp/sensor/cloud", QosClass::kBulk};
 inline constexpr TopicSpec<msg::TrajectoryCommand> kTrajectoryCommand{"tamp/robot/trajectory", QosClass::kCommand};
-inline constexpr TopicSpec<msg::ActionResult> kActionResult{"tamp/robot/result", QosClass::kCommand};
+// Results are events (TRANSIENT_LOCAL): a reader's match is not the writer's -- a result written
+// right after the reader saw the writer may precede the writer seeing the reader, and a VOLATILE
+// result would then be lost (SimNodeTest caught it, 2 runs in 6 at load 2). Readers filter by
+// command id.
+inline constexpr TopicSpec<msg::ActionResult> kActionResult{"tamp/robot/result", QosClass::kEvent};
 inline constexpr TopicSpec<msg::FaultInjection> kFaultInjection{"tamp/sim/fault", QosClass::kCommand};
 // World model (perception)
 inline constexpr TopicSpec<msg::WorldObject> kWorldObjects{"tamp/world/objects", QosClass::kState};
@@ -80,7 +84,7 @@ inline constexpr TopicSpec<msg::EffortModelSnapshot> kEffortModel{"tamp/effort/m
 inline constexpr TopicSpec<msg::ExecutionRecord> kExecutionRecords{"tamp/execution/record", QosClass::kEvent};
 // Execution
 inline constexpr TopicSpec<msg::ExecuteCommand> kExecuteCommand{"tamp/execute/command", QosClass::kCommand};
-inline constexpr TopicSpec<msg::ExecuteStatus> kExecuteStatus{"tamp/execute/status", QosClass::kCommand};
+inline constexpr TopicSpec<msg::ExecuteStatus> kExecuteStatus{"tamp/execute/status", QosClass::kEvent};  // as results
 inline constexpr TopicSpec<msg::FailureEvent> kFailureEvents{"tamp/execute/failure", QosClass::kEvent};
 // Mission
 inline constexpr TopicSpec<msg::MissionCommand> kMissionCommand{"tamp/mission/command", QosClass::kCommand};

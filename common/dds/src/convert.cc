@@ -186,6 +186,42 @@ Result<Trajectory> fromMsg(const msg::JointTrajectory& m, const std::string& fie
   return t;
 }
 
+msg::PointCloudFrame toMsg(const PointCloudFrame& f, std::uint64_t seq) {
+  msg::PointCloudFrame m;
+  m.header().stamp_ns(f.stamp_ns);
+  m.header().frame_id(f.sensor_id);
+  m.header().seq(seq);
+  m.sensor_id(f.sensor_id);
+  m.sensor_pose(toMsg(f.world_T_sensor));
+  m.width(f.width);
+  m.height(f.height);
+  m.points(f.xyz);
+  return m;
+}
+
+Result<PointCloudFrame> fromMsg(const msg::PointCloudFrame& m) {
+  const std::size_t values = m.points().size();
+  if (values % 3 != 0) {
+    return bad("points", "size " + std::to_string(values) + " is not a multiple of 3 (x y z triplets)");
+  }
+  const std::uint64_t n = values / 3;
+  if (m.width() != 0 && static_cast<std::uint64_t>(m.width()) * m.height() != n) {
+    return bad(m.height() == 0 ? "height" : "width", "width x height = " + std::to_string(m.width()) + " x " +
+                                                         std::to_string(m.height()) + " does not match the " +
+                                                         std::to_string(n) + " points");
+  }
+  auto pose = fromMsg(m.sensor_pose(), "sensor_pose");
+  if (!pose) return pose.error();
+  PointCloudFrame f;
+  f.sensor_id = m.sensor_id();
+  f.stamp_ns = m.header().stamp_ns();
+  f.world_T_sensor = *pose;
+  f.width = m.width();
+  f.height = m.height();
+  f.xyz = m.points();
+  return f;
+}
+
 int64_t nowNs() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
       .count();

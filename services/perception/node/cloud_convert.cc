@@ -5,19 +5,6 @@
 
 namespace tamp::perception {
 
-msg::PointCloudFrame toMsg(const PointCloudFrame& f, uint64_t seq) {
-  msg::PointCloudFrame m;
-  m.header().stamp_ns(f.stamp_ns);
-  m.header().frame_id(f.sensor_id);
-  m.header().seq(seq);
-  m.sensor_id(f.sensor_id);
-  m.sensor_pose(dds::toMsg(f.world_T_sensor));
-  m.width(f.width);
-  m.height(f.height);
-  m.points(f.xyz);
-  return m;
-}
-
 Result<PointCloudFrame> fromMsg(const msg::PointCloudFrame& m, std::size_t max_points) {
   auto bad = [](const std::string& field, const std::string& why) {
     return Error(ErrorCode::kInvalidArgument, "malformed point cloud: " + why, SourceLocation{"", 0, 0, field});
@@ -28,15 +15,10 @@ Result<PointCloudFrame> fromMsg(const msg::PointCloudFrame& m, std::size_t max_p
   if (values / 3 > max_points) {
     return bad("points", std::to_string(values / 3) + " points exceed the limit of " + std::to_string(max_points));
   }
-  auto pose = dds::fromMsg(m.sensor_pose(), "sensor_pose");
-  if (!pose) return pose.error();
-  PointCloudFrame f;
-  f.sensor_id = m.sensor_id();
-  f.stamp_ns = m.header().stamp_ns();
-  f.world_T_sensor = *pose;
-  f.width = m.width();
-  f.height = m.height();
-  f.xyz = m.points();
+  // The checks above are cheap and come before the points are copied.
+  auto frame = dds::fromMsg(m);
+  if (!frame) return frame.error();
+  PointCloudFrame f = std::move(frame).value();
   if (Status s = validateFrame(f, max_points); !s.ok()) {
     Error e = s.error();
     if (e.where.field == "xyz" || e.where.field.rfind("xyz[", 0) == 0) e.where.field.replace(0, 3, "points");

@@ -14,10 +14,10 @@
 
 namespace tamp::perception {
 
-msg::PointCloudFrame toMsg(const PointCloudFrame& frame, uint64_t seq = 0);
-/// kInvalidArgument naming the field: `points` (not a multiple of 3, empty, or more than
-/// `max_points`), `width`/`height` (do not match the points), `sensor_pose` (non-finite or zero
-/// quaternion), and whatever `validateFrame` finds.
+/// dds::fromMsg (frames are published with dds::toMsg) and perception's checks: kInvalidArgument
+/// naming the field: `points` (not a multiple of 3, empty, or more than `max_points`),
+/// `width`/`height` (do not match the points), `sensor_pose` (non-finite or zero quaternion), and
+/// whatever `validateFrame` finds.
 Result<PointCloudFrame> fromMsg(const msg::PointCloudFrame& m, std::size_t max_points);
 
 msg::WorldEvent toMsg(const WorldEvent& event, uint64_t seq);

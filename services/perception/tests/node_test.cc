@@ -8,6 +8,7 @@
 
 #include "../../../common/dds/tests/test_util.h"
 #include "cloud_convert.h"
+#include "tamp/dds/convert.h"
 #include "perception_node.h"
 #include "tamp/dds/world_sync.h"
 #include "test_scenes.h"
@@ -65,7 +66,7 @@ TEST(PerceptionNodeTest, CloudInWorldObjectsEventsAndOccupancyOut) {
   ASSERT_TRUE(waitFor([&] { return mirror.publishedVersion() > 0; }));
 
   // A malformed cloud (7 floats) is rejected and counted; the node carries on.
-  msg::PointCloudFrame bad = toMsg(testing::render(truth, testing::mastCamera(0, 0, 0), {}, 1));
+  msg::PointCloudFrame bad = dds::toMsg(testing::render(truth, testing::mastCamera(0, 0, 0), {}, 1));
   bad.points(std::vector<float>(7, 1.0f));
   ASSERT_TRUE(clouds.write(bad).ok());
   ASSERT_TRUE(waitFor([&] { return node.framesRejected() == 1; }));
@@ -73,7 +74,7 @@ TEST(PerceptionNodeTest, CloudInWorldObjectsEventsAndOccupancyOut) {
   const auto cam = testing::mastCamera(0, 0, 0);
   for (int k = 0; k < 2; ++k) {
     const auto frame = testing::render(truth, cam, {}, 1'000'000'000LL * (k + 1), static_cast<std::uint64_t>(k));
-    ASSERT_TRUE(clouds.write(toMsg(frame, static_cast<std::uint64_t>(k))).ok());
+    ASSERT_TRUE(clouds.write(dds::toMsg(frame, static_cast<std::uint64_t>(k))).ok());
     ASSERT_TRUE(waitFor([&] { return node.framesProcessed() == static_cast<std::uint64_t>(k + 1); }))
         << "processed " << node.framesProcessed() << ", rejected " << node.framesRejected();
   }
@@ -107,29 +108,29 @@ TEST(PerceptionNodeTest, CloudInWorldObjectsEventsAndOccupancyOut) {
 
 TEST(PerceptionNodeTest, ConvertsCloudsBothWaysAndNamesBadFields) {
   const auto frame = testing::render(world::World(), testing::mastCamera(0, 0, 0), {}, 42);
-  auto back = fromMsg(toMsg(frame, 3), 1'000'000);
+  auto back = fromMsg(dds::toMsg(frame, 3), 1'000'000);
   ASSERT_TRUE(back.ok()) << back.error().toString();
   EXPECT_EQ(back->stamp_ns, 42);
   EXPECT_EQ(back->width, frame.width);
   EXPECT_EQ(back->xyz.size(), frame.xyz.size());
   EXPECT_TRUE(back->world_T_sensor.isApprox(frame.world_T_sensor, 1e-9));
 
-  msg::PointCloudFrame m = toMsg(frame);
+  msg::PointCloudFrame m = dds::toMsg(frame);
   m.sensor_pose().orientation().w(std::numeric_limits<double>::quiet_NaN());
   auto r = fromMsg(m, 1'000'000);
   ASSERT_FALSE(r.ok());
   EXPECT_NE(r.error().toString().find("sensor_pose"), std::string::npos) << r.error().toString();
-  m = toMsg(frame);
+  m = dds::toMsg(frame);
   m.points().pop_back();
   r = fromMsg(m, 1'000'000);
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.error().where.field, "points");
-  m = toMsg(frame);
+  m = dds::toMsg(frame);
   m.width(m.width() + 1);
   r = fromMsg(m, 1'000'000);
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.error().where.field, "width");
-  r = fromMsg(toMsg(frame), 10);
+  r = fromMsg(dds::toMsg(frame), 10);
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.error().where.field, "points");
 }

@@ -22,38 +22,6 @@ const std::shared_ptr<spdlog::logger>& logger() {
 
 }  // namespace
 
-msg::PointCloudFrame toMsg(const PointCloudFrame& f, std::uint64_t seq) {
-  msg::PointCloudFrame m;
-  m.header().stamp_ns(f.stamp_ns);
-  m.header().frame_id(f.sensor_id);
-  m.header().seq(seq);
-  m.sensor_id(f.sensor_id);
-  m.sensor_pose(dds::toMsg(f.world_T_sensor));
-  m.width(f.width);
-  m.height(f.height);
-  m.points(f.xyz);
-  return m;
-}
-
-Result<PointCloudFrame> fromMsg(const msg::PointCloudFrame& m) {
-  PointCloudFrame f;
-  f.sensor_id = m.sensor_id();
-  f.stamp_ns = m.header().stamp_ns();
-  auto pose = dds::fromMsg(m.sensor_pose(), "sensor_pose");
-  if (!pose) return pose.error();
-  f.world_T_sensor = *pose;
-  f.width = m.width();
-  f.height = m.height();
-  const std::uint64_t n = static_cast<std::uint64_t>(f.width) * f.height * 3u;
-  if (m.points().size() != n) {
-    return bad("points", "expected " + std::to_string(n) + " values (width " + std::to_string(f.width) +
-                             " x height " + std::to_string(f.height) + " x 3), got " +
-                             std::to_string(m.points().size()));
-  }
-  f.xyz = m.points();
-  return f;
-}
-
 Result<ActionCommand> fromMsg(const msg::TrajectoryCommand& m) {
   ActionCommand c;
   c.command_id = m.command_id();
@@ -195,7 +163,7 @@ SimNode::SimNode(const dds::ServiceArgs& args, SimSetup setup, SimParams params)
     }
   };
   cb.on_cloud = [this](const PointCloudFrame& f) {
-    if (Status st = cloud_writer_->write(toMsg(f, ++cloud_seq_)); !st) {
+    if (Status st = cloud_writer_->write(dds::toMsg(f, ++cloud_seq_)); !st) {
       logger()->warn("point cloud not published: {}", st.error().toString());
     }
   };

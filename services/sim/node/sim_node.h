@@ -22,10 +22,7 @@
 namespace tamp::sim {
 
 // ---- conversions (the node's boundary; exposed for tests) ---------------------------------------
-msg::PointCloudFrame toMsg(const PointCloudFrame& f, std::uint64_t seq = 0);
-/// kInvalidArgument naming the field when the point count is not width x height x 3 or the pose
-/// is not finite.
-Result<PointCloudFrame> fromMsg(const msg::PointCloudFrame& m);
+// (point clouds: dds::toMsg / dds::fromMsg)
 /// kInvalidArgument naming the field (trajectory.*, object_target, kind).
 Result<ActionCommand> fromMsg(const msg::TrajectoryCommand& m);
 msg::ActionResult toMsg(const ActionResult& r);

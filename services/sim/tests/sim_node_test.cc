@@ -105,7 +105,7 @@ TEST(SimNodeTest, ExecutesATrajectoryCommandOverDds) {
   // A cloud after the action, from the camera, seeing the (hidden) wall ahead.
   auto cloud = clouds.waitFor([&](const msg::PointCloudFrame&) { return true; });
   ASSERT_TRUE(cloud);
-  auto frame = fromMsg(*cloud);
+  auto frame = dds::fromMsg(*cloud);
   ASSERT_TRUE(frame) << frame.error().toString();
   EXPECT_EQ(frame->width, 40u);
   EXPECT_EQ(frame->height, 30u);
@@ -130,14 +130,14 @@ TEST(SimNodeTest, ExecutesATrajectoryCommandOverDds) {
 }
 
 TEST(SimNodeTest, ConversionsRejectMalformedMessages) {
-  msg::PointCloudFrame m = toMsg(PointCloudFrame{"cam", 5, Eigen::Isometry3d::Identity(), 2, 2,
+  msg::PointCloudFrame m = dds::toMsg(PointCloudFrame{"cam", 5, Eigen::Isometry3d::Identity(), 2, 2,
                                                  std::vector<float>(12, 1.0f)});
-  auto ok = fromMsg(m);
+  auto ok = dds::fromMsg(m);
   ASSERT_TRUE(ok);
   EXPECT_EQ(ok->xyz.size(), 12u);
   EXPECT_EQ(ok->stamp_ns, 5);
   m.points().pop_back();
-  auto bad = fromMsg(m);
+  auto bad = dds::fromMsg(m);
   ASSERT_FALSE(bad);
   EXPECT_EQ(bad.error().where.field, "points");
 

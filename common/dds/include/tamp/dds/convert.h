@@ -12,8 +12,10 @@
 
 #include "tamp/core/error.h"
 #include "tamp/core/geometry.h"
+#include "tamp/core/point_cloud.h"
 #include "tamp/core/trajectory.h"
 #include "tamp/msg/common.h"
+#include "tamp/msg/robot.h"
 
 namespace tamp::dds {
 
@@ -35,6 +37,12 @@ Result<JointPath> fromMsg(const msg::JointPath& m, const std::string& field = "p
 
 msg::JointTrajectory toMsg(const Trajectory& t);
 Result<Trajectory> fromMsg(const msg::JointTrajectory& m, const std::string& field = "trajectory");
+
+msg::PointCloudFrame toMsg(const PointCloudFrame& f, std::uint64_t seq = 0);
+/// The frame's shape is checked, not its points: `points` a multiple of 3, width x height equal
+/// to the point count when `width` is set (errors name `points`, `width`/`height`), and the
+/// sensor pose (`sensor_pose.*`). Consumers add their own checks (perception: validateFrame).
+Result<PointCloudFrame> fromMsg(const msg::PointCloudFrame& m);
 
 /// Nanoseconds since the Unix epoch, now.
 int64_t nowNs();

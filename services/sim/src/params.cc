@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <numbers>
 
-#include "tamp/config/yaml_reader.h"
+#include "tamp/config/schema.h"
 #include "tamp/core/paths.h"
 #include "tamp/effort_estimator/models.h"
 
@@ -21,43 +21,47 @@ int kindIndex(ActionKind kind) {
   return static_cast<int>(it - kAllActionKinds.begin());
 }
 
-/// (field, ok, message) for every scalar rule; shared by validate() and the loader.
-struct Rule {
-  std::string field;
-  bool ok;
-  std::string message;
-};
+using config::Ends;
+using config::inRange;
+using config::nonNegative;
+using config::positive;
 
-std::vector<Rule> rules(const SimParams& p) {
-  auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
-  auto nonneg = [](double v) { return std::isfinite(v) && v >= 0.0; };
-  return {
-      {"realtime_factor", nonneg(p.realtime_factor), "must be >= 0 (0 = as fast as possible), got " + formatNumber(p.realtime_factor)},
-      {"state_period_s", positive(p.state_period_s) && p.state_period_s <= 10.0,
-       "must be in (0, 10] s, got " + formatNumber(p.state_period_s)},
-      {"cloud_period_s", nonneg(p.cloud_period_s), "must be >= 0 s, got " + formatNumber(p.cloud_period_s)},
-      {"duration_noise", nonneg(p.duration_noise) && p.duration_noise <= 1.0,
-       "must be in [0, 1] (stddev of log duration), got " + formatNumber(p.duration_noise)},
-      {"max_step_m", positive(p.max_step_m) && p.max_step_m <= 0.5,
-       "must be in (0, 0.5] m, got " + formatNumber(p.max_step_m)},
-      {"start_tolerance.position_m", positive(p.start_tolerance.position_m),
-       "must be positive, got " + formatNumber(p.start_tolerance.position_m)},
-      {"start_tolerance.angle_rad", positive(p.start_tolerance.angle_rad),
-       "must be positive, got " + formatNumber(p.start_tolerance.angle_rad)},
-      {"grasp.position_tolerance_m", positive(p.grasp.position_tolerance_m),
-       "must be positive, got " + formatNumber(p.grasp.position_tolerance_m)},
-      {"grasp.tcp_tolerance_m", nonneg(p.grasp.tcp_tolerance_m),
-       "must be >= 0, got " + formatNumber(p.grasp.tcp_tolerance_m)},
-      {"grasp.max_payload_kg", positive(p.grasp.max_payload_kg),
-       "must be positive, got " + formatNumber(p.grasp.max_payload_kg)},
-      {"place.position_tolerance_m", positive(p.place.position_tolerance_m),
-       "must be positive, got " + formatNumber(p.place.position_tolerance_m)},
-      {"place.angle_tolerance_rad", positive(p.place.angle_tolerance_rad),
-       "must be positive, got " + formatNumber(p.place.angle_tolerance_rad)},
-      {"place.max_drop_m", nonneg(p.place.max_drop_m), "must be >= 0, got " + formatNumber(p.place.max_drop_m)},
-      {"place.max_tilt_rad", positive(p.place.max_tilt_rad) && p.place.max_tilt_rad < std::numbers::pi / 2,
-       "must be in (0, pi/2), got " + formatNumber(p.place.max_tilt_rad)},
-  };
+const config::Schema<SimParams>& schema() {
+  using P = SimParams;
+  static const config::Schema<P> kSchema = [] {
+    config::Schema<P> s;
+    s.root()
+        .field("scenario", &P::scenario)
+        .field("realtime_factor", &P::realtime_factor, nonNegative("(0 = as fast as possible)"))
+        .field("state_period_s", &P::state_period_s, inRange(0, 10, Ends::kOpenClosed, "s"))
+        .field("cloud_period_s", &P::cloud_period_s, nonNegative("s"))
+        .field("duration_noise", &P::duration_noise,
+               inRange(0, 1, Ends::kClosed, "(stddev of log duration)"))
+        .convert<int>("seed", &P::seed,
+                      [](int v, std::uint64_t& out) -> std::optional<std::string> {
+                        if (v < 0) return "must be >= 0, got " + std::to_string(v);
+                        out = static_cast<std::uint64_t>(v);
+                        return std::nullopt;
+                      })
+        .field("max_step_m", &P::max_step_m, inRange(0, 0.5, Ends::kOpenClosed, "m"));
+    s.section("start_tolerance", &P::start_tolerance)
+        .field("position_m", &StartTolerance::position_m, positive())
+        .field("angle_rad", &StartTolerance::angle_rad, positive());
+    s.section("grasp", &P::grasp)
+        .field("position_tolerance_m", &GraspParams::position_tolerance_m, positive())
+        .field("tcp_tolerance_m", &GraspParams::tcp_tolerance_m, nonNegative())
+        .field("max_payload_kg", &GraspParams::max_payload_kg, positive());
+    s.section("place", &P::place)
+        .field("position_tolerance_m", &PlaceParams::position_tolerance_m, positive())
+        .field("angle_tolerance_rad", &PlaceParams::angle_tolerance_rad, positive())
+        .field("max_drop_m", &PlaceParams::max_drop_m, nonNegative())
+        .field("max_tilt_rad", &PlaceParams::max_tilt_rad,
+               config::that<double>(
+                   [](double v) { return std::isfinite(v) && v > 0 && v < std::numbers::pi / 2; },
+                   "must be in (0, pi/2)"));
+    return s;
+  }();
+  return kSchema;
 }
 
 }  // namespace
@@ -138,10 +142,7 @@ Status TimeParameters::validate() const {
 }
 
 Status SimParams::validate() const {
-  std::vector<Error> errors;
-  for (const Rule& r : rules(*this)) {
-    if (!r.ok) errors.emplace_back(ErrorCode::kInvalidArgument, r.message, SourceLocation{"", 0, 0, r.field});
-  }
+  std::vector<Error> errors = schema().errors(*this);
   if (Status s = time_parameters.validate(); !s) errors.push_back(s.error());
   if (Status s = sensor.validate(); !s) errors.push_back(s.error());
   if (errors.empty()) return Status::Ok();
@@ -158,46 +159,7 @@ Result<SimParams> parseSimParams(const std::string& yaml_text, const std::string
   if (!r.isMap()) {
     return Error(ErrorCode::kParseError, "expected a mapping of simulator parameters", SourceLocation{name});
   }
-  r.optional("scenario", p.scenario);
-  r.optional("realtime_factor", p.realtime_factor);
-  r.optional("state_period_s", p.state_period_s);
-  r.optional("cloud_period_s", p.cloud_period_s);
-  r.optional("duration_noise", p.duration_noise);
-  int seed = static_cast<int>(p.seed);
-  if (r.optional("seed", seed)) {
-    if (r.check(seed >= 0, "seed", "must be >= 0, got " + std::to_string(seed))) p.seed = static_cast<std::uint64_t>(seed);
-  }
-  r.optional("max_step_m", p.max_step_m);
-  {
-    auto c = r.child("start_tolerance", false);
-    c.optional("position_m", p.start_tolerance.position_m);
-    c.optional("angle_rad", p.start_tolerance.angle_rad);
-    if (c.isMap()) c.refuseUnknownKeys();
-  }
-  {
-    auto c = r.child("grasp", false);
-    c.optional("position_tolerance_m", p.grasp.position_tolerance_m);
-    c.optional("tcp_tolerance_m", p.grasp.tcp_tolerance_m);
-    c.optional("max_payload_kg", p.grasp.max_payload_kg);
-    if (c.isMap()) c.refuseUnknownKeys();
-  }
-  {
-    auto c = r.child("place", false);
-    c.optional("position_tolerance_m", p.place.position_tolerance_m);
-    c.optional("angle_tolerance_rad", p.place.angle_tolerance_rad);
-    c.optional("max_drop_m", p.place.max_drop_m);
-    c.optional("max_tilt_rad", p.place.max_tilt_rad);
-    if (c.isMap()) c.refuseUnknownKeys();
-  }
-  for (const Rule& rule : rules(p)) {
-    // Nested fields are reported against their parent reader's key path.
-    const auto dot = rule.field.find('.');
-    if (dot == std::string::npos) {
-      r.check(rule.ok, rule.field, rule.message);
-    } else if (!rule.ok) {
-      r.child(rule.field.substr(0, dot), false).fail(rule.field.substr(dot + 1), rule.message);
-    }
-  }
+  schema().read(r, p);
   for (auto& [kind_name, kr] : r.entries("time_parameters", false)) {
     const auto kind = actionKindFromString(kind_name);
     if (!kind) {

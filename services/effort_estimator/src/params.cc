@@ -5,45 +5,46 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <functional>
 #include <vector>
 
-#include "tamp/config/yaml_reader.h"
+#include "tamp/config/schema.h"
 #include "tamp/core/paths.h"
 #include "tamp/effort_estimator/models.h"
 
 namespace tamp::effort_estimator {
 namespace {
 
-/// One rule per scalar field: (field name, ok?, message). Shared by validate() and the loader,
-/// which attaches the YAML location of the field.
-struct Rule {
-  const char* field;
-  bool ok;
-  std::string message;
-};
+using config::atLeast;
+using config::Ends;
+using config::inRange;
+using config::nonNegative;
+using config::positive;
 
-std::vector<Rule> scalarRules(const EstimatorParams& p) {
-  const FitOptions& f = p.fit;
-  return {
-      {"refit_batch_size", p.refit_batch_size >= 1, "must be >= 1, got " + std::to_string(p.refit_batch_size)},
-      {"refit_period_s", std::isfinite(p.refit_period_s) && p.refit_period_s > 0,
-       "must be positive, got " + formatNumber(p.refit_period_s)},
-      {"refit_time_budget_s", std::isfinite(p.refit_time_budget_s) && p.refit_time_budget_s > 0,
-       "must be positive, got " + formatNumber(p.refit_time_budget_s)},
-      {"max_records_per_kind", p.max_records_per_kind >= 1,
-       "must be >= 1, got " + std::to_string(p.max_records_per_kind)},
-      {"max_record_duration_s", std::isfinite(p.max_record_duration_s) && p.max_record_duration_s > 0,
-       "must be positive, got " + formatNumber(p.max_record_duration_s)},
-      {"loss_scale", std::isfinite(f.loss_scale) && f.loss_scale > 0, "must be positive, got " + formatNumber(f.loss_scale)},
-      {"prior_weight", std::isfinite(f.prior_weight) && f.prior_weight >= 0,
-       "must be >= 0, got " + formatNumber(f.prior_weight)},
-      {"prior_noise", std::isfinite(f.prior_noise) && f.prior_noise > 0 && f.prior_noise <= 2.0,
-       "must be in (0, 2] (stddev of log duration), got " + formatNumber(f.prior_noise)},
-      {"prior_noise_weight", std::isfinite(f.prior_noise_weight) && f.prior_noise_weight >= 0,
-       "must be >= 0, got " + formatNumber(f.prior_noise_weight)},
-      {"max_iterations", f.max_iterations >= 1, "must be >= 1, got " + std::to_string(f.max_iterations)},
-  };
+/// The scalar fields; all at the top level of the file (the fit options too).
+const config::Schema<EstimatorParams>& schema() {
+  using P = EstimatorParams;
+  static const config::Schema<P> kSchema = [] {
+    config::Schema<P> s;
+    s.root()
+        .field("store_directory", &P::store_directory)
+        .field("refit_batch_size", &P::refit_batch_size, atLeast(1))
+        .field("refit_period_s", &P::refit_period_s, positive())
+        .field("refit_time_budget_s", &P::refit_time_budget_s, positive())
+        .field("max_records_per_kind", &P::max_records_per_kind, atLeast(1))
+        .field("max_record_duration_s", &P::max_record_duration_s, positive());
+    s.section("", &P::fit)
+        .convert<std::string>(
+            "loss", &FitOptions::loss,
+            config::byName<LossKind>(lossKindFromString, "loss", "none, huber, cauchy, tukey"))
+        .field("loss_scale", &FitOptions::loss_scale, positive())
+        .field("prior_weight", &FitOptions::prior_weight, nonNegative())
+        .field("prior_noise", &FitOptions::prior_noise,
+               inRange(0, 2, Ends::kOpenClosed, "(stddev of log duration)"))
+        .field("prior_noise_weight", &FitOptions::prior_noise_weight, nonNegative())
+        .field("max_iterations", &FitOptions::max_iterations, atLeast(1));
+    return s;
+  }();
+  return kSchema;
 }
 
 }  // namespace
@@ -56,10 +57,7 @@ const ModelPrior& EstimatorParams::prior(ActionKind kind) const {
 }
 
 Status EstimatorParams::validate() const {
-  std::vector<Error> errors;
-  for (const Rule& r : scalarRules(*this)) {
-    if (!r.ok) errors.emplace_back(ErrorCode::kInvalidArgument, r.message, SourceLocation{"", 0, 0, r.field});
-  }
+  std::vector<Error> errors = schema().errors(*this);
   for (std::size_t i = 0; i < priors.size(); ++i) {
     if (priors[i].kind != kAllActionKinds[i]) {
       errors.emplace_back(ErrorCode::kInvalidArgument, "priors must be in kAllActionKinds order",
@@ -84,26 +82,7 @@ Result<EstimatorParams> parseEstimatorParams(const std::string& yaml_text, const
   if (!doc) return doc.error();
   EstimatorParams p;
   config::FieldReader r(*doc);
-  r.optional("store_directory", p.store_directory);
-  r.optional("refit_batch_size", p.refit_batch_size);
-  r.optional("refit_period_s", p.refit_period_s);
-  r.optional("refit_time_budget_s", p.refit_time_budget_s);
-  r.optional("max_records_per_kind", p.max_records_per_kind);
-  r.optional("max_record_duration_s", p.max_record_duration_s);
-  std::string loss(toString(p.fit.loss));
-  if (r.optional("loss", loss)) {
-    if (auto l = lossKindFromString(loss)) {
-      p.fit.loss = *l;
-    } else {
-      r.fail("loss", "unknown loss '" + loss + "' (expected one of: none, huber, cauchy, tukey)");
-    }
-  }
-  r.optional("loss_scale", p.fit.loss_scale);
-  r.optional("prior_weight", p.fit.prior_weight);
-  r.optional("prior_noise", p.fit.prior_noise);
-  r.optional("prior_noise_weight", p.fit.prior_noise_weight);
-  r.optional("max_iterations", p.fit.max_iterations);
-  for (const Rule& rule : scalarRules(p)) r.check(rule.ok, rule.field, rule.message);
+  schema().read(r, p);
 
   for (auto& [kind_name, kr] : r.entries("defaults", false)) {
     const auto kind = actionKindFromString(kind_name);

@@ -8,28 +8,14 @@
 #include <cstring>
 #include <string>
 
+#include "fuzz_input.h"
 #include "tamp/effort_estimator/effort_estimator.h"
 
 namespace ee = tamp::effort_estimator;
 
 namespace {
 
-struct Reader {
-  const std::uint8_t* p;
-  std::size_t n;
-  std::uint8_t byte() {
-    if (n == 0) return 0;
-    --n;
-    return *p++;
-  }
-  double number() {
-    double d = 0;
-    std::uint8_t b[sizeof(double)] = {};
-    for (auto& x : b) x = byte();
-    std::memcpy(&d, b, sizeof d);
-    return d;
-  }
-};
+using Reader = tamp::fuzz::Input;
 
 ee::EffortEstimator& estimator() {
   static ee::EffortEstimator* est = [] {

@@ -10,34 +10,14 @@
 #include <filesystem>
 #include <string>
 
+#include "fuzz_input.h"
 #include "tamp/core/log.h"
 #include "tamp/sim/setup.h"
 #include "tamp/sim/simulator.h"
 
 namespace {
 
-struct Reader {
-  const std::uint8_t* p;
-  std::size_t n;
-  std::uint8_t byte() {
-    if (n == 0) return 0;
-    --n;
-    return *p++;
-  }
-  double number() {
-    double d = 0;
-    std::uint8_t b[sizeof(double)] = {};
-    for (auto& x : b) x = byte();
-    std::memcpy(&d, b, sizeof d);
-    return d;
-  }
-  /// A value near `around` most of the time, an arbitrary double sometimes.
-  double value(double around) {
-    const std::uint8_t k = byte();
-    if (k % 8 == 0) return number();
-    return around + (static_cast<int>(byte()) - 128) / 64.0;
-  }
-};
+using Reader = tamp::fuzz::Input;
 
 const tamp::robot::RobotModel& robotModel() {
   static const tamp::robot::RobotModel* m = [] {

@@ -19,6 +19,7 @@
 #include "tamp/config/yaml_reader.h"
 #include "tamp/core/paths.h"
 #include "tamp/core/trajectory.h"
+#include "tamp/core/xml_error.h"
 
 namespace tamp::robot {
 
@@ -106,22 +107,6 @@ Eigen::Isometry3d jointMotion(const Joint& j, double q) {
   return M;
 }
 
-/// "mismatched element: XMLElement name=link" from tinyxml2's error (without its own line prefix).
-std::string xmlError(const tinyxml2::XMLDocument& doc) {
-  std::string name = tinyxml2::XMLDocument::ErrorIDToName(doc.ErrorID());
-  if (name.rfind("XML_ERROR_", 0) == 0) name = name.substr(10);
-  for (char& c : name)
-    c = c == '_' ? ' ' : static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  std::string detail = doc.ErrorStr() ? doc.ErrorStr() : "";
-  const auto pos = detail.find("Line number=");
-  if (pos != std::string::npos) {
-    const auto colon = detail.find(": ", pos);
-    detail = colon == std::string::npos ? "" : detail.substr(colon + 2);
-  } else {
-    detail.clear();
-  }
-  return detail.empty() ? name : name + ": " + detail;
-}
 
 double angleOf(const Eigen::Matrix3d& R) {
   const double c = std::clamp((R.trace() - 1.0) / 2.0, -1.0, 1.0);
@@ -284,7 +269,7 @@ Result<RobotModel> RobotModel::fromUrdfString(const std::string& xml, const std:
   // 1. XML syntax, with a line number, and the line of every <link>/<joint> for later messages.
   tinyxml2::XMLDocument doc;
   if (doc.Parse(xml.c_str(), xml.size()) != tinyxml2::XML_SUCCESS) {
-    return err(ErrorCode::kParseError, "invalid XML: " + xmlError(doc), doc.ErrorLineNum());
+    return err(ErrorCode::kParseError, "invalid XML: " + xmlErrorMessage(doc), doc.ErrorLineNum());
   }
   const tinyxml2::XMLElement* robot_el = doc.RootElement();
   if (robot_el == nullptr || std::string_view(robot_el->Name()) != "robot") {

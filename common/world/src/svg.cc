@@ -9,6 +9,8 @@
 #include <tinyxml2.h>
 #include <Eigen/Geometry>
 
+#include "tamp/core/xml_error.h"
+
 namespace tamp::world::svg {
 
 namespace {
@@ -461,28 +463,12 @@ struct Walker {
   }
 };
 
-std::string xmlError(const tinyxml2::XMLDocument& doc) {
-  std::string name = tinyxml2::XMLDocument::ErrorIDToName(doc.ErrorID());
-  if (name.rfind("XML_ERROR_", 0) == 0) name = name.substr(10);
-  for (char& c : name)
-    c = c == '_' ? ' ' : static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  std::string detail = doc.ErrorStr() ? doc.ErrorStr() : "";
-  const auto pos = detail.find("Line number=");
-  if (pos != std::string::npos) {
-    const auto colon = detail.find(": ", pos);
-    detail = colon == std::string::npos ? "" : detail.substr(colon + 2);
-  } else {
-    detail.clear();
-  }
-  return detail.empty() ? name : name + ": " + detail;
-}
-
 }  // namespace
 
 Result<Document> parse(const std::string& text, const std::string& file, const Options& options) {
   tinyxml2::XMLDocument xml;
   if (xml.Parse(text.c_str(), text.size()) != tinyxml2::XML_SUCCESS) {
-    return Error(ErrorCode::kParseError, "invalid XML: " + xmlError(xml),
+    return Error(ErrorCode::kParseError, "invalid XML: " + xmlErrorMessage(xml),
                  SourceLocation{file, xml.ErrorLineNum(), 0, ""});
   }
   const tinyxml2::XMLElement* root = xml.RootElement();

@@ -28,7 +28,8 @@ struct RelaxedOps {
 
   size_t size() const { return op.size(); }
 
-  void build(const Task& task, CostType ct) {
+  /// `implied`: also the implied effects (only FF's layered extraction needs them).
+  void build(const Task& task, CostType ct, bool implied_effects = true) {
     const size_t nf = task.numFacts();
     std::vector<uint32_t> pre_count(nf + 1, 0), add_count(nf + 1, 0);
     std::vector<FactId> tmp;
@@ -82,6 +83,7 @@ struct RelaxedOps {
     for (uint32_t r = 0; r < n; ++r) {
       if (count[r] == 0) no_pre.push_back(r);
     }
+    if (!implied_effects) return;
     // Implied effects: within each operator, rop j is implied by rop i when cond(j) is a subset
     // of cond(i) (the unconditional part is implied by every conditional effect).
     implied_begin.assign(n + 1, 0);
@@ -475,44 +477,12 @@ class RelaxationHeuristic : public Heuristic {
 
   RelaxationHeuristic(const Task& task, CostType ct, Mode mode) : task_(task), mode_(mode) {
     const size_t nf = task.numFacts();
-    std::vector<std::vector<uint32_t>> pre_of(nf);
-    auto addRop = [&](OpId o, std::vector<FactId> pre, const std::vector<FactId>& add) {
-      if (add.empty()) return;
-      std::sort(pre.begin(), pre.end());
-      pre.erase(std::unique(pre.begin(), pre.end()), pre.end());
-      const uint32_t r = static_cast<uint32_t>(rop_op_.size());
-      rop_op_.push_back(o);
-      rop_pre_begin_.push_back(static_cast<uint32_t>(rop_pre_.size()));
-      rop_pre_.insert(rop_pre_.end(), pre.begin(), pre.end());
-      rop_add_begin_.push_back(static_cast<uint32_t>(rop_add_.size()));
-      rop_add_.insert(rop_add_.end(), add.begin(), add.end());
-      rop_count_.push_back(static_cast<uint32_t>(pre.size()));
-      rop_base_.push_back(adjustedCost(task.ops[o], ct, task.unit_cost));
-      for (FactId f : pre) pre_of[f].push_back(r);
-      if (pre.empty()) no_pre_.push_back(r);
-    };
-    for (OpId o = 0; o < task.ops.size(); ++o) {
-      const Operator& op = task.ops[o];
-      addRop(o, op.pre, op.add);
-      for (const auto& ce : op.cond_effects) {
-        std::vector<FactId> pre = op.pre;
-        pre.insert(pre.end(), ce.cond.begin(), ce.cond.end());
-        addRop(o, std::move(pre), ce.add);
-      }
-    }
-    rop_pre_begin_.push_back(static_cast<uint32_t>(rop_pre_.size()));
-    rop_add_begin_.push_back(static_cast<uint32_t>(rop_add_.size()));
-    pre_of_begin_.resize(nf + 1);
-    for (FactId f = 0; f < nf; ++f) {
-      pre_of_begin_[f] = static_cast<uint32_t>(pre_of_.size());
-      pre_of_.insert(pre_of_.end(), pre_of[f].begin(), pre_of[f].end());
-    }
-    pre_of_begin_[nf] = static_cast<uint32_t>(pre_of_.size());
+    R_.build(task, ct, /*implied=*/false);
     for (OpId o = 0; o < task.ops.size(); ++o) op_cost_.push_back(adjustedCost(task.ops[o], ct, task.unit_cost));
     fact_cost_.assign(nf, kInf);
     supporter_.assign(nf, UINT32_MAX);
-    unsat_.resize(rop_op_.size());
-    rop_cost_.resize(rop_op_.size());
+    unsat_.resize(R_.size());
+    rop_cost_.resize(R_.size());
     goal_stamp_.assign(nf, 0);
     fact_mark_.assign(nf, 0);
     op_mark_.assign(task.ops.size(), 0);
@@ -562,7 +532,7 @@ class RelaxationHeuristic : public Heuristic {
   void explore(const uint64_t* s) {
     const size_t nf = task_.numFacts();
     std::fill(fact_cost_.begin(), fact_cost_.end(), kInf);
-    std::copy(rop_count_.begin(), rop_count_.end(), unsat_.begin());
+    std::copy(R_.count.begin(), R_.count.end(), unsat_.begin());
     std::fill(rop_cost_.begin(), rop_cost_.end(), 0);
     heap_.clear();
     ++stamp_;
@@ -580,7 +550,7 @@ class RelaxationHeuristic : public Heuristic {
         heap_.push(0, f);
       }
     }
-    for (uint32_t r : no_pre_) fire(r, 0);
+    for (uint32_t r : R_.no_pre) fire(r, 0);
     while (!heap_.empty()) {
       auto [c, f] = heap_.pop();
       if (c > fact_cost_[f]) continue;
@@ -591,8 +561,8 @@ class RelaxationHeuristic : public Heuristic {
         if (--remaining_[gc] == 0) done = true;
       }
       if (done) break;
-      for (uint32_t i = pre_of_begin_[f]; i < pre_of_begin_[f + 1]; ++i) {
-        const uint32_t r = pre_of_[i];
+      for (uint32_t i = R_.pre_of_begin[f]; i < R_.pre_of_begin[f + 1]; ++i) {
+        const uint32_t r = R_.pre_of[i];
         if (mode_ == Mode::kMax) {
           rop_cost_[r] = std::max(rop_cost_[r], c);
         } else {
@@ -604,9 +574,9 @@ class RelaxationHeuristic : public Heuristic {
   }
 
   void fire(uint32_t r, Cost pre_cost) {
-    const Cost nc = pre_cost + rop_base_[r];
-    for (uint32_t i = rop_add_begin_[r]; i < rop_add_begin_[r + 1]; ++i) {
-      const FactId g = rop_add_[i];
+    const Cost nc = pre_cost + R_.cost[r];
+    for (uint32_t i = R_.add_begin[r]; i < R_.add_begin[r + 1]; ++i) {
+      const FactId g = R_.add[i];
       if (nc < fact_cost_[g]) {
         fact_cost_[g] = nc;
         supporter_[g] = r;
@@ -633,14 +603,14 @@ class RelaxationHeuristic : public Heuristic {
       fact_mark_[f] = mark_;
       const uint32_t r = supporter_[f];
       if (r == UINT32_MAX) continue;  // cannot happen for reached facts
-      const OpId o = rop_op_[r];
+      const OpId o = R_.op[r];
       if (op_mark_[o] != mark_) {
         op_mark_[o] = mark_;
         h += op_cost_[o];
       }
       bool first_layer = true;
-      for (uint32_t i = rop_pre_begin_[r]; i < rop_pre_begin_[r + 1]; ++i) {
-        const FactId p = rop_pre_[i];
+      for (uint32_t i = R_.pre_begin[r]; i < R_.pre_begin[r + 1]; ++i) {
+        const FactId p = R_.pre[i];
         if (!testBit(s, p)) {
           first_layer = false;
           stack_.push_back(p);
@@ -686,11 +656,8 @@ class RelaxationHeuristic : public Heuristic {
   Goal goal_;
   std::vector<std::vector<uint32_t>> goal_of_;
   std::vector<uint32_t> remaining_;
-  // Relaxed operators (CSR).
-  std::vector<OpId> rop_op_;
-  std::vector<uint32_t> rop_pre_begin_, rop_pre_, rop_add_begin_, rop_add_, rop_count_;
-  std::vector<Cost> rop_base_, op_cost_;
-  std::vector<uint32_t> pre_of_begin_, pre_of_, no_pre_;
+  RelaxedOps R_;
+  std::vector<Cost> op_cost_;
   // Per evaluation.
   std::vector<Cost> fact_cost_, rop_cost_;
   std::vector<uint32_t> supporter_, unsat_;

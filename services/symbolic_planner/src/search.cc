@@ -631,6 +631,16 @@ HeuristicKind defaultHeuristic(const SearchOptions& o) {
   return optimal ? HeuristicKind::kMax : HeuristicKind::kFF;
 }
 
+/// Adds an earlier run's effort counters to `into`: a search made of several runs reports what
+/// all of them cost.
+void addRunCosts(SearchStatistics& into, const SearchStatistics& from) {
+  into.expanded += from.expanded;
+  into.generated += from.generated;
+  into.evaluated += from.evaluated;
+  into.registered_states += from.registered_states;
+  into.seconds += from.seconds;
+}
+
 }  // namespace
 
 std::optional<SearchAlgorithm> parseSearchAlgorithm(const std::string& name) {
@@ -711,19 +721,11 @@ SearchResult search(const Task& task, const StateBits& init, const Goal& goal, c
       if (r2.status == SearchStatus::kSolved && r2.cost < r1.cost) {
         r2.stats.ehc_second_ran = true;
         r2.stats.ehc_second_won = true;
-        r2.stats.expanded += r1.stats.expanded;
-        r2.stats.generated += r1.stats.generated;
-        r2.stats.evaluated += r1.stats.evaluated;
-        r2.stats.registered_states += r1.stats.registered_states;
-        r2.stats.seconds += r1.stats.seconds;
+        addRunCosts(r2.stats, r1.stats);
         r2.stats.initial_h = r1.stats.initial_h;
         return r2;
       }
-      r1.stats.expanded += r2.stats.expanded;
-      r1.stats.generated += r2.stats.generated;
-      r1.stats.evaluated += r2.stats.evaluated;
-      r1.stats.registered_states += r2.stats.registered_states;
-      r1.stats.seconds += r2.stats.seconds;
+      addRunCosts(r1.stats, r2.stats);
       return r1;
     }
     if (r1.status != SearchStatus::kFailed && r1.status != SearchStatus::kOutOfMemory) return r1;
@@ -731,11 +733,7 @@ SearchResult search(const Task& task, const StateBits& init, const Goal& goal, c
     Searcher s2(task, init, goal, options, heuristic, term);
     SearchResult r2 = s2.run();
     r2.stats.ehc_ff_failed = true;
-    r2.stats.expanded += r1.stats.expanded;
-    r2.stats.generated += r1.stats.generated;
-    r2.stats.evaluated += r1.stats.evaluated;
-    r2.stats.registered_states += r1.stats.registered_states;
-    r2.stats.seconds += r1.stats.seconds;
+    addRunCosts(r2.stats, r1.stats);
     return r2;
   }
   Searcher s(task, init, goal, options, heuristic, term);

@@ -288,11 +288,13 @@ class StaticRoadmap {
   /// statically invalid when > 0 -- the sign of a roadmap that does not connect them --,
   /// optimize_budget_s, `termination`). When the evaluation budget runs out, the best path
   /// over the edges known to be statically valid is returned if they connect start and goal.
+  /// `route_objects`, when given, receives the movables the returned path crosses (request
+  /// indices, sorted): its edges are all evaluated by then, so this costs no check.
   std::optional<og::PathGeometric> search(Oracle& oracle, const ob::SpaceInformationPtr& si, int start,
                                           const std::vector<int>& goals, const LazyParams& params,
                                           double resolution, double seconds_per_unit,
                                           const Termination& termination, PlanningStats& stats,
-                                          int max_new_invalid = 0);
+                                          int max_new_invalid = 0, std::vector<int>* route_objects = nullptr);
 
  private:
   struct Impl;

@@ -721,17 +721,18 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
   };
   // When the roadmap's best path crosses movables: samples around them, and the roadmap searched
   // again (the result can only get cheaper: the old path is still in the roadmap).
-  auto densify = [&](og::PathGeometric& path, int s, const std::vector<int>& goals) {
-    if (P.lazy.object_ring_samples <= 0 || req.group != PlanningGroup::kBase ||
+  // `objects`: those `path` crosses, as the search reported them.
+  auto densify = [&](og::PathGeometric& path, int s, const std::vector<int>& goals, const std::vector<int>& objects) {
+    if (objects.empty() || P.lazy.object_ring_samples <= 0 || req.group != PlanningGroup::kBase ||
         roadmap->nodeCount() >= static_cast<std::size_t>(P.lazy.roadmap_max_nodes)) {
       return;
     }
-    const detail::EvaluatedPath ev = detail::evaluatePath(oracle, path, res_check, 0.0);
-    const detail::PathCost before = ev.cost(oracle, spu);
-    if (before.objects.empty()) return;
-    if (roadmap->addObjectRingSamples(oracle, gs, before.objects, P.lazy.object_ring_samples, termination) == 0) return;
+    if (roadmap->addObjectRingSamples(oracle, gs, objects, P.lazy.object_ring_samples, termination) == 0) return;
     auto again = roadmap->search(oracle, si, s, goals, P.lazy, res_check, spu, termination, res.stats);
-    if (again && detail::evaluatePath(oracle, *again, res_check, 0.0).cost(oracle, spu).cost < before.cost) path = *again;
+    auto cost = [&](const og::PathGeometric& p) {
+      return detail::evaluatePath(oracle, p, res_check, 0.0).cost(oracle, spu).cost;
+    };
+    if (again && cost(*again) < cost(path)) path = *again;
   };
   if (lazy && P.lazy.optimize) {
     Stopwatch rw;
@@ -747,9 +748,10 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
       const int s = roadmap->addRequestState(start.get(), request);
       std::vector<int> goals;
       for (const auto* g : goal_states) goals.push_back(roadmap->addRequestState(g, request));
+      std::vector<int> crossed;
       from_roadmap = roadmap->search(oracle, si, s, goals, P.lazy, res_check, spu, termination, res.stats,
-                                     P.lazy.roadmap_max_new_invalid);
-      if (from_roadmap) densify(*from_roadmap, s, goals);
+                                     P.lazy.roadmap_max_new_invalid, &crossed);
+      if (from_roadmap) densify(*from_roadmap, s, goals, crossed);
     }
     res.stats.optimize_ms += rw.millis();
   }
@@ -828,8 +830,9 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
       if (roadmap->nodeCount() < static_cast<std::size_t>(P.lazy.roadmap_max_nodes)) {
         roadmap->addSamples(oracle, gs, P.lazy.roadmap_growth_samples, termination);
       }
-      auto rm = roadmap->search(oracle, si, s, {g}, P.lazy, res_check, spu, termination, res.stats);
-      if (rm) densify(*rm, s, {g});
+      std::vector<int> crossed;
+      auto rm = roadmap->search(oracle, si, s, {g}, P.lazy, res_check, spu, termination, res.stats, 0, &crossed);
+      if (rm) densify(*rm, s, {g}, crossed);
       if (rm) {
         detail::EvaluatedPath rm_eval = detail::evaluatePath(oracle, *rm, res_check, 0.0);
         if (rm_eval.cost(oracle, spu).cost < raw_cost.cost) best = *rm;

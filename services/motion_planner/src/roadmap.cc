@@ -444,7 +444,7 @@ std::optional<og::PathGeometric> StaticRoadmap::search(Oracle& oracle, const ob:
                                                        const std::vector<int>& goals, const LazyParams& params,
                                                        double resolution, double seconds_per_unit,
                                                        const Termination& termination, PlanningStats& stats,
-                                                       int max_new_invalid) {
+                                                       int max_new_invalid, std::vector<int>* route_objects) {
   const Termination term = termination.tightened(Deadline::in(params.optimize_budget_s));
   const std::size_t n = nodes_.size();
   stats.roadmap_nodes = n;
@@ -653,6 +653,15 @@ std::optional<og::PathGeometric> StaticRoadmap::search(Oracle& oracle, const ob:
     outcome = lazySp(true, std::numeric_limits<int>::max(), 0);
   }
   if (outcome != Outcome::kFound) return std::nullopt;
+  if (route_objects) {  // every route edge is evaluated (kFound)
+    route_objects->clear();
+    for (const auto& [u, ei] : route) {
+      const auto& t = edge_touched[static_cast<std::size_t>(ei)];
+      route_objects->insert(route_objects->end(), t.begin(), t.end());
+    }
+    std::sort(route_objects->begin(), route_objects->end());
+    route_objects->erase(std::unique(route_objects->begin(), route_objects->end()), route_objects->end());
+  }
   og::PathGeometric out(si);
   out.append(nodes_[static_cast<std::size_t>(start)]);
   for (const auto& [u, ei] : route) {

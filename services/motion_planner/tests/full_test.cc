@@ -13,23 +13,15 @@ namespace {
 
 using testing::discClearance;
 
-constexpr double kRadius = 0.3;
+constexpr double kRadius = testing::kDiscRadius;
 
 class FullTest : public ::testing::Test {
  protected:
   void SetUp() override { seedRandomness(42); }
-  static MotionPlanner planner(const world::World& w, MotionPlannerParams p = {}) {
-    MotionPlanner mp(collision::RobotGeometry::disc(kRadius, 1.0), p);
-    mp.setWorld(w);
-    return mp;
+  static MotionPlanner planner(const world::World& w, const MotionPlannerParams& p = {}) {
+    return testing::discPlanner(w, p);
   }
-  static MotionRequest request(Pose2D from, Pose2D to) {
-    MotionRequest r;
-    r.mode = MotionMode::kFull;
-    r.start.base = from;
-    r.goal = MotionGoal::basePoseGoal(to);
-    return r;
-  }
+  static MotionRequest request(Pose2D from, Pose2D to) { return testing::baseRequest(from, to, MotionMode::kFull); }
 };
 
 TEST_F(FullTest, PathThroughTheOpenDoorIsCollisionFreeWhenRecheckedDensely) {

@@ -10,42 +10,19 @@
 namespace tamp::motion_planner {
 namespace {
 
+using testing::baseRequest;
+using testing::blockingIds;
 using testing::discClearance;
 using testing::discTouches;
+using testing::untimedParams;
 
-constexpr double kRadius = 0.3;
+constexpr double kRadius = testing::kDiscRadius;
 
 class LazyTest : public ::testing::Test {
  protected:
   void SetUp() override { seedRandomness(42); }
-  /// The effort-aware roadmap search is cut by a count of edge evaluations (1000 by default;
-  /// then the best path over the edges known valid is kept) and a wall-clock safety cap. Here it
-  /// gets the budget to finish (LazySP's optimum over the roadmap), so the outcome depends on the
-  /// seeds only; the NAMO benchmark measures the defaults.
-  static MotionPlannerParams untimedParams() {
-    MotionPlannerParams p;
-    p.lazy.optimize_budget_s = 30.0;
-    p.lazy.roadmap_max_evaluations = 1000000;
-    return p;
-  }
-  static MotionPlanner planner(const world::World& w, MotionPlannerParams p = untimedParams()) {
-    MotionPlanner mp(collision::RobotGeometry::disc(kRadius, 1.0), p);
-    mp.setWorld(w);
-    return mp;
-  }
-  static MotionRequest baseRequest(Pose2D from, Pose2D to, MotionMode mode = MotionMode::kLazy) {
-    MotionRequest r;
-    r.group = PlanningGroup::kBase;
-    r.mode = mode;
-    r.start.base = from;
-    r.goal = MotionGoal::basePoseGoal(to);
-    return r;
-  }
-  static std::vector<std::string> ids(const std::vector<BlockingObject>& b) {
-    std::vector<std::string> out;
-    for (const auto& o : b) out.push_back(o.object_id);
-    std::sort(out.begin(), out.end());
-    return out;
+  static MotionPlanner planner(const world::World& w, const MotionPlannerParams& p = testing::untimedParams()) {
+    return testing::discPlanner(w, p);
   }
 };
 
@@ -54,11 +31,11 @@ TEST_F(LazyTest, ReportsExactlyTheObjectThatBlocksTheDoor) {
   MotionPlanner mp = planner(w);
   const MotionResult r = mp.plan(baseRequest({2, 2, 0}, {8, 2, 0}), Termination::after(5.0));
   ASSERT_EQ(r.status, MotionStatus::kSolved) << r.reason;
-  EXPECT_EQ(ids(r.blocking), std::vector<std::string>{"crate"});
+  EXPECT_EQ(blockingIds(r.blocking), std::vector<std::string>{"crate"});
   // The path avoids static geometry (independent 2-D check, 5 mm steps) ...
   EXPECT_GT(discClearance(w, r.path, kRadius, 0.005, {}, /*movables=*/false), -1e-3);
   // ... and the independent check sees exactly the reported movables.
-  EXPECT_EQ(discTouches(w, r.path, kRadius, 0.005), ids(r.blocking));
+  EXPECT_EQ(discTouches(w, r.path, kRadius, 0.005), blockingIds(r.blocking));
   // Start and goal as requested.
   ASSERT_GE(r.path.waypoints.size(), 2u);
   EXPECT_NEAR(r.path.waypoints.front()[0], 2.0, 1e-9);
@@ -131,7 +108,7 @@ TEST_F(LazyTest, PrefersOneLightObjectOverTwoHeavyOnes) {
   MotionPlanner mp = planner(w);
   const MotionResult r = mp.plan(baseRequest({2, 0.9, 0}, {8, 0.9, 0}), Termination::after(5.0));
   ASSERT_EQ(r.status, MotionStatus::kSolved) << r.reason;
-  EXPECT_EQ(ids(r.blocking), std::vector<std::string>{"light"});
+  EXPECT_EQ(blockingIds(r.blocking), std::vector<std::string>{"light"});
   EXPECT_EQ(discTouches(w, r.path, kRadius, 0.005), std::vector<std::string>{"light"});
   // Its cost is below that of crossing both heavy objects on the straight line.
   double heavy = 0.0;
@@ -150,7 +127,7 @@ TEST_F(LazyTest, ReportMatchesIndependentCheckForAnyCostScale) {
     req.object_cost_scale = scale;
     const MotionResult r = mp.plan(req, Termination::after(5.0));
     ASSERT_EQ(r.status, MotionStatus::kSolved) << r.reason;
-    EXPECT_EQ(discTouches(w, r.path, kRadius, 0.005), ids(r.blocking)) << "scale " << scale;
+    EXPECT_EQ(discTouches(w, r.path, kRadius, 0.005), blockingIds(r.blocking)) << "scale " << scale;
     EXPECT_GT(discClearance(w, r.path, kRadius, 0.005, {}, false), -1e-3) << "scale " << scale;
   }
 }
@@ -170,7 +147,7 @@ TEST_F(LazyTest, GoalInsideAMovableIsAllowedAndReported) {
   MotionPlanner mp = planner(w);
   const MotionResult r = mp.plan(baseRequest({2, 2, 0}, {8.8, 3.4, 0}), Termination::after(5.0));
   ASSERT_EQ(r.status, MotionStatus::kSolved) << r.reason;
-  const auto got = ids(r.blocking);
+  const auto got = blockingIds(r.blocking);
   EXPECT_NE(std::find(got.begin(), got.end(), "far_box"), got.end());
   EXPECT_NEAR(r.blocking.back().exit_fraction, 1.0, 1e-9);
 }
@@ -205,7 +182,7 @@ TEST_F(LazyTest, WorldUpdatesBetweenCallsAreApplied) {
   world::World w = testing::corridorWorld(true);
   MotionPlanner mp = planner(w);
   MotionResult r = mp.plan(baseRequest({2, 2, 0}, {8, 2, 0}), Termination::after(5.0));
-  ASSERT_EQ(ids(r.blocking), std::vector<std::string>{"crate"});
+  ASSERT_EQ(blockingIds(r.blocking), std::vector<std::string>{"crate"});
   // Move the crate out of the door: the next call sees it.
   Eigen::Isometry3d p = w.object("crate").pose;
   p.translation().x() = 2.0;

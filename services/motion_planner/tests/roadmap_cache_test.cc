@@ -11,33 +11,15 @@
 namespace tamp::motion_planner {
 namespace {
 
+using testing::baseRequest;
+using testing::blockingIds;
 using testing::discClearance;
 using testing::discTouches;
 
-constexpr double kRadius = 0.3;
+constexpr double kRadius = testing::kDiscRadius;
 
-MotionPlannerParams params() {
-  MotionPlannerParams p;
-  p.lazy.optimize_budget_s = 30.0;  // deterministic: the evaluation counts decide (see lazy_test.cc)
-  p.lazy.roadmap_max_evaluations = 1000000;
-  return p;
-}
-
-MotionRequest baseRequest(Pose2D from, Pose2D to) {
-  MotionRequest r;
-  r.group = PlanningGroup::kBase;
-  r.mode = MotionMode::kLazy;
-  r.start.base = from;
-  r.goal = MotionGoal::basePoseGoal(to);
-  return r;
-}
-
-std::vector<std::string> ids(const std::vector<BlockingObject>& b) {
-  std::vector<std::string> out;
-  for (const auto& o : b) out.push_back(o.object_id);
-  std::sort(out.begin(), out.end());
-  return out;
-}
+MotionPlannerParams params() { return testing::untimedParams(); }
+MotionPlanner planner(const world::World& w, const MotionPlannerParams& p = params()) { return testing::discPlanner(w, p); }
 
 class RoadmapCacheTest : public ::testing::Test {
  protected:
@@ -46,14 +28,13 @@ class RoadmapCacheTest : public ::testing::Test {
 
 TEST_F(RoadmapCacheTest, ReuseGivesTheSameQualityAndMovablesDoNotInvalidate) {
   world::World w = testing::twoDoorWorld();
-  MotionPlanner mp(collision::RobotGeometry::disc(kRadius, 1.0), params());
-  mp.setWorld(w);
+  MotionPlanner mp = planner(w, params());
   const MotionRequest req = baseRequest({2, 0.9, 0}, {8, 0.9, 0});
   const MotionResult cold = mp.plan(req, Termination::after(5.0));
   ASSERT_EQ(cold.status, MotionStatus::kSolved) << cold.reason;
   EXPECT_FALSE(cold.stats.roadmap_reused);
   EXPECT_TRUE(cold.stats.lazy_planner_used);  // a new roadmap is seeded by lazy KPIECE
-  EXPECT_EQ(ids(cold.blocking), std::vector<std::string>{"light"});
+  EXPECT_EQ(blockingIds(cold.blocking), std::vector<std::string>{"light"});
   EXPECT_EQ(mp.roadmapCacheSize(), 1u);
 
   // Another query from elsewhere, then the same query again: the roadmap answers.
@@ -61,13 +42,13 @@ TEST_F(RoadmapCacheTest, ReuseGivesTheSameQualityAndMovablesDoNotInvalidate) {
   ASSERT_EQ(other.status, MotionStatus::kSolved) << other.reason;
   EXPECT_TRUE(other.stats.roadmap_reused);
   EXPECT_GT(discClearance(w, other.path, kRadius, 0.005, {}, /*movables=*/false), -1e-3);
-  EXPECT_EQ(discTouches(w, other.path, kRadius, 0.005), ids(other.blocking));
+  EXPECT_EQ(discTouches(w, other.path, kRadius, 0.005), blockingIds(other.blocking));
   const MotionResult warm = mp.plan(req, Termination::after(5.0));
   ASSERT_EQ(warm.status, MotionStatus::kSolved) << warm.reason;
   EXPECT_TRUE(warm.stats.roadmap_reused);
   EXPECT_FALSE(warm.stats.lazy_planner_used);
-  EXPECT_EQ(ids(warm.blocking), ids(cold.blocking));
-  EXPECT_EQ(discTouches(w, warm.path, kRadius, 0.005), ids(warm.blocking));
+  EXPECT_EQ(blockingIds(warm.blocking), blockingIds(cold.blocking));
+  EXPECT_EQ(discTouches(w, warm.path, kRadius, 0.005), blockingIds(warm.blocking));
   EXPECT_GT(discClearance(w, warm.path, kRadius, 0.005, {}, false), -1e-3);
   EXPECT_LE(warm.cost_s, cold.cost_s * 1.05) << "cold " << cold.cost_s << " warm " << warm.cost_s;
 
@@ -87,12 +68,11 @@ TEST_F(RoadmapCacheTest, ReuseGivesTheSameQualityAndMovablesDoNotInvalidate) {
 
 TEST_F(RoadmapCacheTest, StaticWorldChangeInvalidates) {
   world::World w = testing::twoDoorWorld();
-  MotionPlanner mp(collision::RobotGeometry::disc(kRadius, 1.0), params());
-  mp.setWorld(w);
+  MotionPlanner mp = planner(w, params());
   const MotionRequest req = baseRequest({2, 0.9, 0}, {8, 0.9, 0});
   const MotionResult first = mp.plan(req, Termination::after(5.0));
   ASSERT_EQ(first.status, MotionStatus::kSolved) << first.reason;
-  ASSERT_EQ(ids(first.blocking), std::vector<std::string>{"light"});  // through door B
+  ASSERT_EQ(blockingIds(first.blocking), std::vector<std::string>{"light"});  // through door B
   ASSERT_TRUE(mp.plan(req, Termination::after(5.0)).stats.roadmap_reused);
 
   // A static wall closes door B: the cached roadmap's edges through it are no longer valid.
@@ -103,7 +83,7 @@ TEST_F(RoadmapCacheTest, StaticWorldChangeInvalidates) {
   ASSERT_EQ(closed.status, MotionStatus::kSolved) << closed.reason;
   EXPECT_FALSE(closed.stats.roadmap_reused);
   EXPECT_GT(discClearance(w, closed.path, kRadius, 0.005, {}, /*movables=*/false), -1e-3);
-  EXPECT_EQ(ids(closed.blocking), (std::vector<std::string>{"heavy_a", "heavy_b"}));
+  EXPECT_EQ(blockingIds(closed.blocking), (std::vector<std::string>{"heavy_a", "heavy_b"}));
 
   // A moved static object invalidates too.
   world::World w2 = w;
@@ -132,8 +112,7 @@ TEST_F(RoadmapCacheTest, StaticWorldChangeInvalidates) {
 TEST_F(RoadmapCacheTest, HeldObjectChangeInvalidates) {
   world::World w = testing::twoDoorWorld();
   ASSERT_TRUE(w.addObject(testing::box("parcel", 2.0, 1.35, 0.2, 0.2, true, 0.3, 1.0)).ok());
-  MotionPlanner mp(collision::RobotGeometry::disc(kRadius, 1.0), params());
-  mp.setWorld(w);
+  MotionPlanner mp = planner(w, params());
   MotionRequest req = baseRequest({2, 0.9, 0}, {8, 0.9, 0});
   ASSERT_TRUE(mp.plan(req, Termination::after(5.0)).ok());
   ASSERT_TRUE(mp.plan(req, Termination::after(5.0)).stats.roadmap_reused);
@@ -169,8 +148,7 @@ namespace {
 // evaluates the edges the request added; an interrupted prepare() keeps what it did.
 TEST_F(RoadmapCacheTest, PrepareBuildsTheRoadmapTheNextRequestReuses) {
   world::World w = testing::twoDoorWorld();
-  MotionPlanner mp(collision::RobotGeometry::disc(kRadius, 1.0), params());
-  mp.setWorld(w);
+  MotionPlanner mp = planner(w, params());
   const MotionRequest req = baseRequest({2, 0.9, 0}, {8, 0.9, 0});
 
   auto stopped = mp.prepare(PlanningGroup::kBase, req.start, {}, Termination::after(-1.0));
@@ -192,8 +170,8 @@ TEST_F(RoadmapCacheTest, PrepareBuildsTheRoadmapTheNextRequestReuses) {
   ASSERT_EQ(r.status, MotionStatus::kSolved) << r.reason;
   EXPECT_TRUE(r.stats.roadmap_reused);
   EXPECT_FALSE(r.stats.lazy_planner_used);
-  EXPECT_EQ(ids(r.blocking), std::vector<std::string>{"light"});
-  EXPECT_EQ(discTouches(w, r.path, kRadius, 0.005), ids(r.blocking));
+  EXPECT_EQ(blockingIds(r.blocking), std::vector<std::string>{"light"});
+  EXPECT_EQ(discTouches(w, r.path, kRadius, 0.005), blockingIds(r.blocking));
   EXPECT_GT(discClearance(w, r.path, kRadius, 0.005, {}, /*movables=*/false), -1e-3);
   EXPECT_EQ(mp.roadmapCacheSize(), 1u);
 
@@ -230,13 +208,12 @@ TEST_F(RoadmapCacheTest, PrepareBuildsTheRoadmapTheNextRequestReuses) {
 // they come back (a stale entry would send the robot through them instead of the light box).
 TEST_F(RoadmapCacheTest, MovableCacheFollowsMovedObjects) {
   world::World w = testing::twoDoorWorld();
-  MotionPlanner mp(collision::RobotGeometry::disc(kRadius, 1.0), params());
-  mp.setWorld(w);
+  MotionPlanner mp = planner(w, params());
   const MotionRequest req = baseRequest({2, 0.9, 0}, {8, 0.9, 0});
   ASSERT_TRUE(mp.prepare(PlanningGroup::kBase, req.start, {}, Termination::after(30.0)).ok());
   const MotionResult first = mp.plan(req, Termination::after(5.0));
   ASSERT_EQ(first.status, MotionStatus::kSolved) << first.reason;
-  EXPECT_EQ(ids(first.blocking), std::vector<std::string>{"light"});
+  EXPECT_EQ(blockingIds(first.blocking), std::vector<std::string>{"light"});
 
   const world::World original = w;
   auto place = [&](const std::string& id, double x, double y) {
@@ -256,8 +233,8 @@ TEST_F(RoadmapCacheTest, MovableCacheFollowsMovedObjects) {
   mp.setWorld(original);
   const MotionResult back = mp.plan(req, Termination::after(5.0));
   ASSERT_EQ(back.status, MotionStatus::kSolved) << back.reason;
-  EXPECT_EQ(ids(back.blocking), std::vector<std::string>{"light"});
-  EXPECT_EQ(discTouches(original, back.path, kRadius, 0.005), ids(back.blocking));
+  EXPECT_EQ(blockingIds(back.blocking), std::vector<std::string>{"light"});
+  EXPECT_EQ(discTouches(original, back.path, kRadius, 0.005), blockingIds(back.blocking));
   EXPECT_LE(back.cost_s, first.cost_s * 1.05) << "first " << first.cost_s << " back " << back.cost_s;
 }
 
@@ -295,8 +272,7 @@ TEST_F(RoadmapCacheTest, RequestNodesArePrunedAndLaterSearchesStayCorrect) {
   MotionPlannerParams p = params();
   p.lazy.roadmap_max_request_nodes = 10;
   p.lazy.roadmap_growth_samples = 0;
-  MotionPlanner mp(collision::RobotGeometry::disc(kRadius, 1.0), p);
-  mp.setWorld(w);
+  MotionPlanner mp = planner(w, p);
   const MotionRequest req = baseRequest({2, 0.9, 0}, {8, 0.9, 0});
   const auto prep = mp.prepare(PlanningGroup::kBase, req.start, {}, Termination::after(30.0));
   ASSERT_TRUE(prep.ok());
@@ -316,7 +292,7 @@ TEST_F(RoadmapCacheTest, RequestNodesArePrunedAndLaterSearchesStayCorrect) {
     fallbacks += r.stats.lazy_planner_used;
     if (!r.stats.lazy_planner_used) max_nodes = std::max(max_nodes, r.stats.roadmap_nodes);
     EXPECT_GT(discClearance(w, r.path, kRadius, 0.005, {}, /*movables=*/false), -1e-3) << "query " << i;
-    EXPECT_EQ(discTouches(w, r.path, kRadius, 0.005), ids(r.blocking)) << "query " << i;
+    EXPECT_EQ(discTouches(w, r.path, kRadius, 0.005), blockingIds(r.blocking)) << "query " << i;
   }
   EXPECT_GE(solved, 20);
   EXPECT_GT(pruned, 0u);
@@ -328,7 +304,7 @@ TEST_F(RoadmapCacheTest, RequestNodesArePrunedAndLaterSearchesStayCorrect) {
   // The first query again, after all that pruning: same objects, no worse.
   const MotionResult again = mp.plan(req, Termination::after(5.0));
   ASSERT_EQ(again.status, MotionStatus::kSolved) << again.reason;
-  EXPECT_EQ(ids(again.blocking), ids(first.blocking));
+  EXPECT_EQ(blockingIds(again.blocking), blockingIds(first.blocking));
   EXPECT_LE(again.cost_s, first.cost_s * 1.05) << "first " << first.cost_s << " again " << again.cost_s;
 }
 

@@ -39,6 +39,35 @@ void room(world::World& w, double width, double height) {
 }
 }  // namespace
 
+MotionPlanner discPlanner(const world::World& w, const MotionPlannerParams& p) {
+  MotionPlanner mp(collision::RobotGeometry::disc(kDiscRadius, 1.0), p);
+  mp.setWorld(w);
+  return mp;
+}
+
+MotionPlannerParams untimedParams() {
+  MotionPlannerParams p;
+  p.lazy.optimize_budget_s = 30.0;
+  p.lazy.roadmap_max_evaluations = 1000000;
+  return p;
+}
+
+MotionRequest baseRequest(Pose2D from, Pose2D to, MotionMode mode) {
+  MotionRequest r;
+  r.group = PlanningGroup::kBase;
+  r.mode = mode;
+  r.start.base = from;
+  r.goal = MotionGoal::basePoseGoal(to);
+  return r;
+}
+
+std::vector<std::string> blockingIds(const std::vector<BlockingObject>& blocking) {
+  std::vector<std::string> out;
+  for (const auto& o : blocking) out.push_back(o.object_id);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 world::World corridorWorld(bool door_blocked) {
   world::World w("corridor");
   room(w, 10, 4);

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "tamp/core/trajectory.h"
+#include "tamp/motion_planner/motion_planner.h"
 #include "tamp/world/world.h"
 
 namespace tamp::motion_planner::testing {
@@ -25,6 +26,21 @@ world::World twoDoorWorld();
 
 /// An open 10 x 6 m room with one light movable box (`obstacle`, 0.6 x 0.6) at (5, 3).
 world::World openRoomWorld();
+
+/// The disc radius of the planar robot in these tests (m).
+inline constexpr double kDiscRadius = 0.3;
+
+/// A planner for the planar disc robot (kDiscRadius) with `w` set.
+MotionPlanner discPlanner(const world::World& w, const MotionPlannerParams& p = {});
+/// Parameters under which the effort-aware roadmap search finishes (LazySP's optimum over the
+/// roadmap): it is otherwise cut by a count of edge evaluations (1000 by default; then the best
+/// path over the edges known valid is kept) and a wall-clock safety cap. The outcome then depends
+/// on the seeds only; the NAMO benchmark measures the defaults.
+MotionPlannerParams untimedParams();
+/// A base-group request between two poses.
+MotionRequest baseRequest(Pose2D from, Pose2D to, MotionMode mode = MotionMode::kLazy);
+/// The ids of the blocking objects, sorted.
+std::vector<std::string> blockingIds(const std::vector<BlockingObject>& blocking);
 
 /// Independent check: the smallest clearance (m) of a disc of `radius` moving along the base
 /// path (base_x, base_y; interpolated every `step` m) from the boxes and box prisms of `w`

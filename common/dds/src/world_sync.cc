@@ -297,15 +297,12 @@ void WorldMirror::updateCompleteLocked() {
 }
 
 void WorldMirror::notify() {
-  std::function<void(const world::World&)> cb;
-  world::World copy;
+  std::function<void()> cb;
   {
     std::lock_guard lock(mutex_);
-    if (!cb_) return;
     cb = cb_;
-    copy = world_;
   }
-  cb(copy);
+  if (cb) cb();
 }
 
 world::World WorldMirror::snapshot() const {
@@ -331,7 +328,7 @@ bool WorldMirror::waitForPublishedVersion(uint64_t version, const Termination& u
   return true;
 }
 
-void WorldMirror::onChange(std::function<void(const world::World&)> cb) {
+void WorldMirror::onChange(std::function<void()> cb) {
   std::lock_guard lock(mutex_);
   cb_ = std::move(cb);
 }

@@ -96,7 +96,7 @@ Result<std::unique_ptr<MotionPlannerNode>> MotionPlannerNode::create(const dds::
 MotionPlannerNode::MotionPlannerNode(const dds::ServiceArgs& args, NodeConfig config, MotionPlanner planner)
     : ServiceNode(args), config_(std::move(config)), planner_(std::move(planner)) {
   mirror_ = std::make_unique<dds::WorldMirror>(participant(), config_.world_id);
-  mirror_->onChange([this](const world::World&) { world_dirty_ = true; });
+  mirror_->onChange([this] { world_dirty_ = true; });
   motion_ = std::make_unique<dds::RpcServer<msg::MotionRequest, msg::MotionReply>>(
       participant(), dds::services::kMotion,
       [this](const msg::MotionRequest& r, const dds::RequestContext& c) { return handleMotion(r, c); });

@@ -61,8 +61,9 @@ class WorldMirror {
   uint64_t publishedVersion() const;
   /// Waits until publishedVersion() >= `version`.
   bool waitForPublishedVersion(uint64_t version, const Termination& until) const;
-  /// Called (on a DDS thread) after each change with the new world; keep it short.
-  void onChange(std::function<void(const world::World&)> cb);
+  /// Called (on a DDS thread) after each change; keep it short. No world is passed: a copy per
+  /// object sample would be O(n) each; take snapshot() when the world is needed.
+  void onChange(std::function<void()> cb);
 
  private:
   void onObject(const msg::WorldObject& m, const SampleMeta& meta);
@@ -78,7 +79,7 @@ class WorldMirror {
   std::map<std::string, uint64_t> received_;  ///< object id -> version of the sample received
   uint64_t manifest_version_{0};              ///< version of the latest WorldMeta
   std::map<std::string, uint64_t> manifest_;  ///< its objects and their versions
-  std::function<void(const world::World&)> cb_;
+  std::function<void()> cb_;
   Reader<msg::WorldObject> objects_;
   Reader<msg::WorldMeta> meta_;
 };

@@ -16,6 +16,7 @@
 
 #include <sys/utsname.h>
 
+#include "tamp/core/stats.h"
 #include "tamp/dds/service_node.h"
 #include "tamp/process/supervisor.h"
 
@@ -28,11 +29,6 @@ struct Row {
   double p50, p99, mean, max;
 };
 
-double percentile(std::vector<double> v, double q) {
-  std::sort(v.begin(), v.end());
-  const size_t i = std::min(v.size() - 1, static_cast<size_t>(q * static_cast<double>(v.size() - 1) + 0.5));
-  return v[i];
-}
 
 std::string cpuModel() {
   std::ifstream in("/proc/cpuinfo");
@@ -94,7 +90,7 @@ int main(int argc, char** argv) {
         }
         if (i >= n / 10 + 10) us.push_back(t);  // after warm-up
       }
-      rows.push_back(Row{profile, bytes, n, percentile(us, 0.5), percentile(us, 0.99),
+      rows.push_back(Row{profile, bytes, n, tamp::nearestRankPercentile(us, 0.5), tamp::nearestRankPercentile(us, 0.99),
                          std::accumulate(us.begin(), us.end(), 0.0) / static_cast<double>(us.size()),
                          *std::max_element(us.begin(), us.end())});
       std::fprintf(stderr, "%-12s %8zu B  n=%d  p50 %.0f us  p99 %.0f us\n", profile.c_str(), bytes, n, rows.back().p50,

@@ -20,6 +20,7 @@
 
 #include "effort_estimator_node.h"
 #include "synthetic.h"
+#include "tamp/core/stats.h"
 #include "tamp/process/supervisor.h"
 
 using namespace tamp;  // NOLINT(google-build-using-namespace): a small benchmark tool
@@ -33,12 +34,6 @@ struct Row {
   double p50, p99, mean, server_mean;
 };
 
-double percentile(std::vector<double> v, double q) {
-  std::sort(v.begin(), v.end());
-  const size_t i =
-      std::min(v.size() - 1, static_cast<size_t>(q * static_cast<double>(v.size() - 1) + 0.5));
-  return v[i];
-}
 
 }  // namespace
 
@@ -111,7 +106,7 @@ int main(int argc, char** argv) {
       auto mean = [](const std::vector<double>& v) {
         return std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
       };
-      rows.push_back(Row{profile, batch, n, percentile(us, 0.5), percentile(us, 0.99), mean(us),
+      rows.push_back(Row{profile, batch, n, nearestRankPercentile(us, 0.5), nearestRankPercentile(us, 0.99), mean(us),
                          mean(server_us)});
       std::fprintf(stderr, "%-12s batch %3zu  n=%d  p50 %.0f us  p99 %.0f us  server %.1f us\n",
                    profile.c_str(), batch, n, rows.back().p50, rows.back().p99,

@@ -59,6 +59,7 @@
 #include <ompl/util/Console.h>
 
 #include "tamp/core/paths.h"
+#include "tamp/core/stats.h"
 #include "tamp/motion_planner/motion_planner.h"
 #include "tamp/world/namo.h"
 
@@ -90,14 +91,6 @@ struct WorldCase {
   world::NamoWorld nw;
 };
 
-double percentile(std::vector<double> v, double p) {
-  if (v.empty()) return NAN;
-  std::sort(v.begin(), v.end());
-  const double idx = p * (static_cast<double>(v.size()) - 1);
-  const auto lo = static_cast<std::size_t>(std::floor(idx));
-  const auto hi = static_cast<std::size_t>(std::ceil(idx));
-  return v[lo] + (v[hi] - v[lo]) * (idx - static_cast<double>(lo));
-}
 
 /// Movables a disc touches along a base path, every 5 mm: count, total mass and total effort.
 struct Crossing {
@@ -346,12 +339,12 @@ Summary summarize(const std::vector<Run>& runs) {
     m.push_back(r.mass);
     e.push_back(r.effort_s);
   }
-  s.med_ms = percentile(t, 0.5);
-  s.p95_ms = percentile(t, 0.95);
-  s.med_len = percentile(l, 0.5);
-  s.med_cross = percentile(c, 0.5);
-  s.med_mass = percentile(m, 0.5);
-  s.med_effort = percentile(e, 0.5);
+  s.med_ms = interpolatedPercentile(t, 0.5);
+  s.p95_ms = interpolatedPercentile(t, 0.95);
+  s.med_len = interpolatedPercentile(l, 0.5);
+  s.med_cross = interpolatedPercentile(c, 0.5);
+  s.med_mass = interpolatedPercentile(m, 0.5);
+  s.med_effort = interpolatedPercentile(e, 0.5);
   s.mean_cross = c.empty() ? NAN : std::accumulate(c.begin(), c.end(), 0.0) / static_cast<double>(c.size());
   return s;
 }
@@ -642,8 +635,8 @@ int main(int argc, char** argv) {
     }
     std::string st;
     for (const auto& [k, v] : statuses) st += (st.empty() ? "" : ", ") + k + (v > 1 ? " x" + std::to_string(v) : "");
-    md << " " << st << ", " << f2(percentile(ft, 0.5)) << " ms |\n";
-    js["full"][wc.name] = {{"statuses", statuses}, {"median_ms", percentile(ft, 0.5)}, {"max_ms", percentile(ft, 1.0)}};
+    md << " " << st << ", " << f2(interpolatedPercentile(ft, 0.5)) << " ms |\n";
+    js["full"][wc.name] = {{"statuses", statuses}, {"median_ms", interpolatedPercentile(ft, 0.5)}, {"max_ms", interpolatedPercentile(ft, 1.0)}};
   }
   md << "\nAggregate over " << worlds.size() << " worlds:\n\n| method | success | median ms | p95 ms | median crossed | mean crossed | "
         "total crossed | median length (m) | mean mass crossed (kg) | median J (s) |\n|---|---|---|---|---|---|---|---|---|---|\n";
@@ -673,15 +666,15 @@ int main(int argc, char** argv) {
       if (v.empty()) continue;
       all.insert(all.end(), v.begin(), v.end());
       const auto& ps = prep_last[wc.name];
-      md << "| " << wc.name << " | " << f2(percentile(v, 0.5)) << " | " << f2(percentile(v, 0.95)) << " | "
-         << f2(percentile(v, 1.0)) << " | " << ps.roadmap_nodes << " | " << ps.roadmap_edges << " | "
+      md << "| " << wc.name << " | " << f2(interpolatedPercentile(v, 0.5)) << " | " << f2(interpolatedPercentile(v, 0.95)) << " | "
+         << f2(interpolatedPercentile(v, 1.0)) << " | " << ps.roadmap_nodes << " | " << ps.roadmap_edges << " | "
          << ps.edges_invalid << " |\n";
-      js["prepare"][wc.name] = {{"median_ms", percentile(v, 0.5)}, {"p95_ms", percentile(v, 0.95)},
-                                {"max_ms", percentile(v, 1.0)}, {"nodes", ps.roadmap_nodes},
+      js["prepare"][wc.name] = {{"median_ms", interpolatedPercentile(v, 0.5)}, {"p95_ms", interpolatedPercentile(v, 0.95)},
+                                {"max_ms", interpolatedPercentile(v, 1.0)}, {"nodes", ps.roadmap_nodes},
                                 {"edges", ps.roadmap_edges}, {"invalid_edges", ps.edges_invalid}};
     }
-    md << "| all | " << f2(percentile(all, 0.5)) << " | " << f2(percentile(all, 0.95)) << " | "
-       << f2(percentile(all, 1.0)) << " | | | |\n";
+    md << "| all | " << f2(interpolatedPercentile(all, 0.5)) << " | " << f2(interpolatedPercentile(all, 0.95)) << " | "
+       << f2(interpolatedPercentile(all, 1.0)) << " | | | |\n";
   }
   std::cout << md.str();
   if (!md_out.empty()) std::ofstream(md_out) << md.str();

@@ -31,6 +31,7 @@
 #include <string>
 #include <vector>
 
+#include "tamp/core/stats.h"
 #include "tamp/core/termination.h"
 #include "tamp/perception/assignment.h"
 #include "tamp/perception/perception.h"
@@ -48,14 +49,8 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 
-double quantile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const double pos = q * static_cast<double>(v.size() - 1);
-  const auto i = static_cast<std::size_t>(pos);
-  const double f = pos - static_cast<double>(i);
-  return i + 1 < v.size() ? v[i] * (1 - f) + v[i + 1] * f : v[i];
-}
+/// 0 for no samples (tables print 0, not nan).
+double quantile(const std::vector<double>& v, double q) { return v.empty() ? 0.0 : tamp::interpolatedPercentile(v, q); }
 
 tw::Object staticBox(const std::string& id, double sx, double sy, double sz, double x, double y, double yaw = 0.0) {
   return box(id, sx, sy, sz, x, y, yaw, 0.0, tw::ObjectKind::kStatic);
@@ -213,6 +208,22 @@ void runTiming(int frames, const std::string& only) {
 
 // ---- accuracy ---------------------------------------------------------------------------------
 
+/// TAMP_BENCH_VERBOSE: the perceived objects no ground-truth object was assigned to.
+void printFalseObjects(const std::string& where, const std::vector<const tw::Object*>& found,
+                       const std::vector<int>& assign) {
+  std::vector<char> used(found.size(), 0);
+  for (auto a : assign) {
+    if (a >= 0) used[static_cast<std::size_t>(a)] = 1;
+  }
+  for (std::size_t j = 0; j < found.size(); ++j) {
+    if (used[j]) continue;
+    const auto b = found[j]->aabb();
+    std::fprintf(stderr, "  %s: false %s (%s) at (%.2f, %.2f) box (%.2f..%.2f, %.2f..%.2f, %.2f..%.2f)\n", where.c_str(),
+                 found[j]->id.c_str(), found[j]->label.c_str(), found[j]->pose.translation().x(),
+                 found[j]->pose.translation().y(), b.min.x(), b.max.x(), b.min.y(), b.max.y(), b.min.z(), b.max.z());
+  }
+}
+
 struct Scene {
   std::string name;
   tw::World truth;
@@ -304,18 +315,8 @@ Tally runScene(const Scene& scene, bool with_classes, int frames_per_view) {
     if (tp::yawSymmetry(gt[i]->shape) > 0) t.yaw.push_back(e.yaw);
   }
   t.false_pos = t.perceived - t.found;
-  if (std::getenv("TAMP_BENCH_VERBOSE") != nullptr) {
-    std::vector<char> used(found.size(), 0);
-    for (auto a : assign) {
-      if (a >= 0) used[static_cast<std::size_t>(a)] = 1;
-    }
-    for (std::size_t j = 0; j < found.size(); ++j) {
-      if (used[j]) continue;
-      const auto b = found[j]->aabb();
-      std::fprintf(stderr, "  %s: false %s (%s) box (%.2f..%.2f, %.2f..%.2f, %.2f..%.2f)\n", scene.name.c_str(), found[j]->id.c_str(),
-                   found[j]->label.c_str(), b.min.x(), b.max.x(), b.min.y(), b.max.y(), b.min.z(), b.max.z());
-    }
-  }
+  if (std::getenv("TAMP_BENCH_VERBOSE") != nullptr) printFalseObjects(scene.name, found, assign);
+
   std::printf("| %s | %s | %zu | %d | %d / %d | %d | %.3f / %.3f / %.3f | %.1f / %.1f | %s |\n", scene.name.c_str(),
               with_classes ? "known" : "none", scene.views.size() * static_cast<std::size_t>(frames_per_view), t.truth,
               t.found, t.truth, t.false_pos, quantile(t.xy, 0.5), quantile(t.xy, 0.9),
@@ -485,25 +486,8 @@ bool runScenarioFile(const std::filesystem::path& file, bool with_classes, Scena
     if (tp::yawSymmetry(gt[i]->shape) > 0 && tp::yawSymmetry(gt[i]->shape) < 2 * kPi - 1e-9) t.yaw.push_back(e.yaw);
   }
   t.false_pos = static_cast<int>(found.size()) - matched;
-  if (std::getenv("TAMP_BENCH_VERBOSE") != nullptr) {  // what the false objects are
-    std::vector<char> used(found.size(), 0);
-    for (auto a : assign) {
-      if (a >= 0) used[static_cast<std::size_t>(a)] = 1;
-    }
-    for (std::size_t j = 0; j < found.size(); ++j) {
-      if (used[j]) continue;
-      const auto b = found[j]->aabb();
-      std::fprintf(stderr, "  %s: false %s (%s) at (%.2f, %.2f) box (%.2f..%.2f, %.2f..%.2f, %.2f..%.2f)\n", scenario->name.c_str(),
-                   found[j]->id.c_str(), found[j]->label.c_str(), found[j]->pose.translation().x(), found[j]->pose.translation().y(),
-                   b.min.x(), b.max.x(), b.min.y(), b.max.y(), b.min.z(), b.max.z());
-    }
-    for (std::size_t i = 0; i < gt.size(); ++i) {
-      if (assign[i] < 0) {
-        std::fprintf(stderr, "  %s: missed %s at (%.2f, %.2f), %d px\n", scenario->name.c_str(), gt[i]->id.c_str(),
-                     gt[i]->pose.translation().x(), gt[i]->pose.translation().y(), seen[gt[i]->id]);
-      }
-    }
-  }
+  if (std::getenv("TAMP_BENCH_VERBOSE") != nullptr) printFalseObjects(scenario->name, found, assign);
+
   std::string hidden;
   for (const auto* o : gt) {
     if (o->hidden) hidden += " " + o->id;

@@ -138,6 +138,20 @@ class GoalIndex {
   std::vector<uint32_t> sizes_;
 };
 
+/// Calls fn(f) for every fact f < num_facts true in state `s` (`words` 64-bit words), in order.
+template <typename Fn>
+void forEachTrueFact(const uint64_t* s, size_t words, size_t num_facts, Fn&& fn) {
+  for (size_t w = 0; w < words; ++w) {
+    uint64_t word = s[w];
+    while (word) {
+      const FactId f = static_cast<FactId>(w * 64 + static_cast<size_t>(__builtin_ctzll(word)));
+      word &= word - 1;
+      if (f >= num_facts) return;
+      fn(f);
+    }
+  }
+}
+
 bool holdsAll(const uint64_t* s, const std::vector<FactId>& facts) {
   for (FactId f : facts) {
     if (!testBit(s, f)) return false;
@@ -233,15 +247,7 @@ class LayeredFF : public Heuristic {
         });
       }
     };
-    for (size_t w = 0; w < words; ++w) {
-      uint64_t word = s[w];
-      while (word) {
-        const FactId f = static_cast<FactId>(w * 64 + static_cast<size_t>(__builtin_ctzll(word)));
-        word &= word - 1;
-        if (f >= nf) break;
-        reach(f, 0);
-      }
-    }
+    forEachTrueFact(s, words, nf, [&](FactId f) { reach(f, 0); });
     size_t start_ft = 0, start_ef = 0;
     for (uint32_t time = 0;; ++time) {
       if (done >= 0) {
@@ -539,17 +545,11 @@ class RelaxationHeuristic : public Heuristic {
     remaining_.assign(goal_.conjuncts.size(), 0);
     for (uint32_t c = 0; c < goal_.conjuncts.size(); ++c) remaining_[c] = static_cast<uint32_t>(goal_.conjuncts[c].pos.size());
     const size_t words = task_.numWords();
-    for (size_t w = 0; w < words; ++w) {
-      uint64_t word = s[w];
-      while (word) {
-        const FactId f = static_cast<FactId>(w * 64 + static_cast<size_t>(__builtin_ctzll(word)));
-        word &= word - 1;
-        if (f >= nf) break;
-        fact_cost_[f] = 0;
-        supporter_[f] = UINT32_MAX;
-        heap_.push(0, f);
-      }
-    }
+    forEachTrueFact(s, words, nf, [&](FactId f) {
+      fact_cost_[f] = 0;
+      supporter_[f] = UINT32_MAX;
+      heap_.push(0, f);
+    });
     for (uint32_t r : R_.no_pre) fire(r, 0);
     while (!heap_.empty()) {
       auto [c, f] = heap_.pop();

@@ -208,6 +208,19 @@ void runTiming(int frames, const std::string& only) {
 
 // ---- accuracy ---------------------------------------------------------------------------------
 
+/// seen[id] = the most pixels object `id` covered in any view so far (ground truth: which objects
+/// are in view at all).
+void keepMostPixels(const tamp::sim::GroundTruthLabels& labels, std::map<std::string, int>& seen) {
+  std::map<int, int> count;
+  for (auto l : labels.pixel) {
+    if (l >= 0) ++count[l];
+  }
+  for (const auto& [l, n] : count) {
+    const std::string& id = labels.ids[static_cast<std::size_t>(l)];
+    seen[id] = std::max(seen[id], n);
+  }
+}
+
 /// TAMP_BENCH_VERBOSE: the perceived objects no ground-truth object was assigned to.
 void printFalseObjects(const std::string& where, const std::vector<const tw::Object*>& found,
                        const std::vector<int>& assign) {
@@ -255,14 +268,7 @@ Tally runScene(const Scene& scene, bool with_classes, int frames_per_view) {
     for (const auto& v : scene.views) {
       tamp::sim::GroundTruthLabels labels;
       (void)sensor.capture(scene.truth, v, 0, &labels);
-      std::map<int, int> count;
-      for (auto l : labels.pixel) {
-        if (l >= 0) ++count[l];
-      }
-      for (const auto& [l, n] : count) {
-        const std::string& id = labels.ids[static_cast<std::size_t>(l)];
-        seen[id] = std::max(seen[id], n);
-      }
+      keepMostPixels(labels, seen);
     }
   }
   int64_t stamp = 1'000'000'000;
@@ -412,14 +418,7 @@ bool runScenarioFile(const std::filesystem::path& file, bool with_classes, Scena
     for (const auto& v : views) {
       tamp::sim::GroundTruthLabels labels;
       (void)sensor.capture(truth, setup->robot, v, 0, &labels);
-      std::map<int, int> count;
-      for (auto l : labels.pixel) {
-        if (l >= 0) ++count[l];
-      }
-      for (const auto& [l, n] : count) {
-        const std::string& id = labels.ids[static_cast<std::size_t>(l)];
-        seen[id] = std::max(seen[id], n);
-      }
+      keepMostPixels(labels, seen);
     }
   }
   std::vector<const tw::Object*> gt;

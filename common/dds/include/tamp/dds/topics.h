@@ -81,6 +81,9 @@ inline constexpr TopicSpec<msg::OccupancyMap> kOccupancy{"tamp/world/octomap", Q
 inline constexpr TopicSpec<msg::WorldEvent> kWorldEvents{"tamp/world/events", QosClass::kEvent};
 // Effort
 inline constexpr TopicSpec<msg::EffortModelSnapshot> kEffortModel{"tamp/effort/model", QosClass::kState};
+// The robot driver's (simulator's) raw measurement of each finished action; the execution
+// monitor adds the prediction and the command it executed and forwards it on kExecutionRecords.
+inline constexpr TopicSpec<msg::ExecutionRecord> kRobotRecords{"tamp/robot/record", QosClass::kEvent};
 inline constexpr TopicSpec<msg::ExecutionRecord> kExecutionRecords{"tamp/execution/record", QosClass::kEvent};
 // Execution
 inline constexpr TopicSpec<msg::ExecuteCommand> kExecuteCommand{"tamp/execute/command", QosClass::kCommand};

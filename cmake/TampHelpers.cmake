@@ -6,7 +6,7 @@
 #   tamp_add_executable(name SOURCES ... [DEPS ...])
 #   tamp_add_test(name SOURCES ... [DEPS ...] [LABELS ...] [TIMEOUT s])
 #       A GoogleTest binary; each TEST becomes a ctest entry (discovered before running, not at
-#       build time). Tests get TAMP_SOURCE_DIR/TAMP_SHARED_DIR/TAMP_BIN_DIR as compile definitions.
+#       build time). Tests get TAMP_SOURCE_DIR/TAMP_BENCHMARKS_DIR/TAMP_BIN_DIR as compile definitions.
 #   tamp_add_benchmark(name SOURCES ... [DEPS ...])   Google Benchmark or own bench tool; not a test.
 #   tamp_add_fuzzer(name SOURCES ... [DEPS ...])      libFuzzer target, only with TAMP_FUZZ (clang).
 
@@ -45,7 +45,7 @@ function(tamp_add_test name)
   add_executable(${name} ${T_SOURCES})
   target_link_libraries(${name} PRIVATE ${T_DEPS} GTest::gtest GTest::gmock GTest::gtest_main tamp_warnings)
   target_compile_definitions(${name} PRIVATE
-    TAMP_SOURCE_DIR="${CMAKE_SOURCE_DIR}" TAMP_SHARED_DIR="${TAMP_SHARED_DIR}"
+    TAMP_SOURCE_DIR="${CMAKE_SOURCE_DIR}" TAMP_BENCHMARKS_DIR="${TAMP_BENCHMARKS_DIR}"
     TAMP_BIN_DIR="${CMAKE_BINARY_DIR}/bin")
   tamp_sanitizer_options(${name})
   # Paths reach tests as compile definitions (above): gtest_discover_tests splits a multi-variable
@@ -63,7 +63,7 @@ function(tamp_add_benchmark name)
   add_executable(${name} ${B_SOURCES})
   target_link_libraries(${name} PRIVATE ${B_DEPS} tamp_warnings)
   target_compile_definitions(${name} PRIVATE
-    TAMP_SOURCE_DIR="${CMAKE_SOURCE_DIR}" TAMP_SHARED_DIR="${TAMP_SHARED_DIR}")
+    TAMP_SOURCE_DIR="${CMAKE_SOURCE_DIR}" TAMP_BENCHMARKS_DIR="${TAMP_BENCHMARKS_DIR}")
 endfunction()
 
 # Fuzz targets share tests/fuzz/fuzz_input.h (bytes -> values).

@@ -138,7 +138,7 @@ BENCHMARK(BM_MoveOneObject);
 
 // Real NAMO worlds: disc robot of the benchmark's radius at random poses in the workspace.
 world::NamoWorld loadNamoWorld(const std::string& rel) {
-  return world::loadNamo(std::string(TAMP_SHARED_DIR) + "/benchmarks/namo/" + rel).value();
+  return world::loadNamo(std::string(TAMP_BENCHMARKS_DIR) + "/namo/" + rel).value();
 }
 
 void namoBench(benchmark::State& state, const std::string& rel) {

@@ -334,7 +334,7 @@ TEST(SceneConsistencyTest, ConvexPiecesAgreeWithMeshAndWithPlanarGeometry) {
 // polygon and no convex movable polygon (they may touch). A 1 % smaller square must be free.
 TEST(SceneNamoTest, MoghaddamStartAndGoalSquaresAreFree) {
   const std::filesystem::path dir =
-      std::filesystem::path(TAMP_SHARED_DIR) / "benchmarks/namo/moghaddam_planning_2016_benchmark";
+      std::filesystem::path(TAMP_BENCHMARKS_DIR) / "namo/moghaddam_planning_2016_benchmark";
   int worlds = 0;
   for (const auto& entry : std::filesystem::directory_iterator(dir)) {
     if (entry.path().extension() != ".svg") continue;
@@ -368,8 +368,8 @@ TEST(SceneNamoTest, MoghaddamStartAndGoalSquaresAreFree) {
 // union has the outline's area; the robot's start is free and a point inside the wall is not.
 TEST(SceneNamoTest, LargeNonConvexOutline) {
   auto loaded = world::loadNamo(
-      std::filesystem::path(TAMP_SHARED_DIR) /
-      "benchmarks/namo/s-namo_cases/05_citi_second_floor/05_citi_second_floor_omniscient.json");
+      std::filesystem::path(TAMP_BENCHMARKS_DIR) /
+      "namo/s-namo_cases/05_citi_second_floor/05_citi_second_floor_omniscient.json");
   ASSERT_TRUE(loaded.ok()) << loaded.error().toString();
   const world::Object& wall = loaded->world.object("ext_obstacle");
   ASSERT_GT(wall.shape.polygon.size(), 1000u);

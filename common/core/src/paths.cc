@@ -13,9 +13,11 @@ std::filesystem::path configDir() {
   return TAMP_DEFAULT_CONFIG_DIR;
 }
 
-std::filesystem::path sharedDir() {
-  if (const char* env = std::getenv("TAMP_SHARED_DIR"); env != nullptr && *env != '\0') return env;
-  return TAMP_DEFAULT_SHARED_DIR;
+std::filesystem::path benchmarksDir() {
+  if (const char* env = std::getenv("TAMP_BENCHMARKS_DIR"); env != nullptr && *env != '\0') {
+    return env;
+  }
+  return TAMP_DEFAULT_BENCHMARKS_DIR;
 }
 
 std::filesystem::path resolveRelativeTo(const std::filesystem::path& base_file,

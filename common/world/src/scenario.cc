@@ -37,23 +37,27 @@ std::string num(double v) {
 
 bool positive(double v) { return std::isfinite(v) && v > 0; }
 
-/// Expands ${TAMP_SHARED_DIR}/${TAMP_CONFIG_DIR} and resolves against the scenario file.
+/// Expands ${TAMP_BENCHMARKS_DIR}/${TAMP_CONFIG_DIR} and resolves against the scenario file.
+/// `${TAMP_SHARED_DIR}/benchmarks` is the older spelling of ${TAMP_BENCHMARKS_DIR} (the data
+/// used to live beside the clone) and still expands to it.
 std::optional<std::filesystem::path> expandPath(const std::string& text,
                                                 const std::string& scenario_file,
                                                 std::string& why) {
-  std::string s = text;
-  std::filesystem::path base;
+  const std::string& s = text;
   for (const auto& [var, dir] :
-       {std::pair<std::string, std::filesystem::path>{"${TAMP_SHARED_DIR}", sharedDir()},
+       {std::pair<std::string, std::filesystem::path>{"${TAMP_BENCHMARKS_DIR}", benchmarksDir()},
+        std::pair<std::string, std::filesystem::path>{"${TAMP_SHARED_DIR}/benchmarks",
+                                                      benchmarksDir()},
         std::pair<std::string, std::filesystem::path>{"${TAMP_CONFIG_DIR}", configDir()}}) {
-    if (s.rfind(var, 0) == 0) {
+    if (s.rfind(var, 0) == 0 && (s.size() == var.size() || s[var.size()] == '/')) {
       std::string rest = s.substr(var.size());
       while (!rest.empty() && rest[0] == '/') rest.erase(0, 1);
       return (dir / rest).lexically_normal();
     }
   }
   if (s.find("${") != std::string::npos) {
-    why = "unknown variable in path '" + text + "' (known: ${TAMP_SHARED_DIR}, ${TAMP_CONFIG_DIR})";
+    why = "unknown variable in path '" + text +
+          "' (known: ${TAMP_BENCHMARKS_DIR}, ${TAMP_CONFIG_DIR})";
     return std::nullopt;
   }
   if (s.empty()) {

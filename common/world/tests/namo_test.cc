@@ -9,7 +9,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path namoDir() { return fs::path(TAMP_SHARED_DIR) / "benchmarks" / "namo"; }
+fs::path namoDir() { return fs::path(TAMP_BENCHMARKS_DIR) / "namo"; }
 
 NamoWorld load(const std::string& rel, const NamoOptions& o = {}) {
   auto r = loadNamo(namoDir() / rel, o);

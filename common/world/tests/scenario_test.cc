@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "tamp/collision/scene.h"
+#include "tamp/core/paths.h"
 
 namespace tamp::world {
 namespace {
@@ -268,12 +269,36 @@ TEST(ScenarioTest, NamoScenarios) {
   EXPECT_NEAR(m.namo->robot_radius, 0.5 / std::sqrt(2.0), 1e-9);
   // A NAMO world file works as a scenario on its own.
   auto direct =
-      loadScenario(fs::path(TAMP_SHARED_DIR) /
-                   "benchmarks/namo/s-namo_cases/02_basic_with_opening/02_basic_with_opening.json");
+      loadScenario(fs::path(TAMP_BENCHMARKS_DIR) /
+                   "namo/s-namo_cases/02_basic_with_opening/02_basic_with_opening.json");
   ASSERT_TRUE(direct.ok()) << direct.error().toString();
   EXPECT_EQ(direct->name, "namo_02_basic_with_opening");
   EXPECT_NEAR(direct->namo->robot_radius, robotModel().baseRadius(), 1e-9);
   EXPECT_TRUE(direct->goal.base.has_value());
+}
+
+TEST(ScenarioTest, BenchmarkDataIsInTheRepositoryAndTheOldSpellingStillExpands) {
+  // The NAMO worlds ship in tests/data/benchmarks; ${TAMP_SHARED_DIR}/benchmarks (the folder
+  // beside the clone that held them before) is read as ${TAMP_BENCHMARKS_DIR}.
+  EXPECT_EQ(fs::weakly_canonical(benchmarksDir()),
+            fs::weakly_canonical(fs::path(TAMP_SOURCE_DIR) / "tests/data/benchmarks"));
+  auto text = readTextFile(scenarioDir() / "namo_basic.yaml");
+  ASSERT_TRUE(text.ok());
+  const std::string yaml = *text;
+  const auto at = yaml.find("${TAMP_BENCHMARKS_DIR}");
+  ASSERT_NE(at, std::string::npos);
+  std::string old = yaml;
+  old.replace(at, std::string("${TAMP_BENCHMARKS_DIR}").size(), "${TAMP_SHARED_DIR}/benchmarks");
+  auto legacy = parseScenario(old, (scenarioDir() / "legacy.yaml").string());
+  ASSERT_TRUE(legacy.ok()) << legacy.error().toString();
+  EXPECT_EQ(legacy->world.objects().size(), load("namo_basic").world.objects().size());
+  std::string other = yaml;
+  other.replace(at, std::string("${TAMP_BENCHMARKS_DIR}").size(), "${TAMP_SHARED_DIR}");
+  auto bad = parseScenario(other, (scenarioDir() / "legacy.yaml").string());
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().toString().find("unknown variable in path '${TAMP_SHARED_DIR}/namo/"),
+            std::string::npos)
+      << bad.error().toString();
 }
 
 // ---- broken scenarios: the exact error text
@@ -360,7 +385,7 @@ TEST(ScenarioErrorsTest, ExactMessages) {
   EXPECT_EQ(errorOf(replaced(kMinimal, "world:\n", "world:\n  namo: ${NOPE}/x.json\n")),
             kFile +
                 ":4:9: field 'world.namo': unknown variable in path '${NOPE}/x.json' (known: "
-                "${TAMP_SHARED_DIR}, "
+                "${TAMP_BENCHMARKS_DIR}, "
                 "${TAMP_CONFIG_DIR})");
   EXPECT_EQ(errorOf(""),
             kFile + ":1:1: a scenario is a mapping (name:, robot:, world:, goal:, ...)");

@@ -1,5 +1,5 @@
 // NAMO benchmark of the motion planner (issue 7), with the setup conventions of
-// <shared>/benchmarks/namo/REFERENCE.md so that figures are comparable:
+// tests/data/benchmarks/namo/REFERENCE.md so that figures are comparable:
 //  - worlds: every bare moghaddam_planning_2016_benchmark_NN.svg (robot square side 0.5 m, disc of
 //    its circumradius 0.354 m, yaw free, goal within 1 cm in x, y) and the JSON worlds (disc of
 //    the robot's circumradius); loaded by tamp::world::loadNamo;
@@ -350,7 +350,7 @@ Summary summarize(const std::vector<Run>& runs) {
 }
 
 std::vector<WorldCase> loadWorlds(const std::string& filter) {
-  const fs::path root = sharedDir() / "benchmarks" / "namo";
+  const fs::path root = benchmarksDir() / "namo";
   std::vector<std::pair<std::string, fs::path>> files;
   for (int n : {2, 4, 5, 7, 8, 10, 11, 13, 14, 16, 17, 19, 20, 22, 23, 25, 26, 28, 29}) {
     char name[64];

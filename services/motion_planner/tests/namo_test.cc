@@ -1,4 +1,4 @@
-// The planner on real NAMO benchmark worlds (skipped when the shared benchmark folder is absent).
+// The planner on real NAMO benchmark worlds (tests/data/benchmarks/namo, shipped in the repository).
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -10,13 +10,13 @@
 namespace tamp::motion_planner {
 namespace {
 
-std::filesystem::path namoDir() { return sharedDir() / "benchmarks" / "namo"; }
+std::filesystem::path namoDir() { return std::filesystem::path(TAMP_BENCHMARKS_DIR) / "namo"; }
 
 class NamoTest : public ::testing::Test {
  protected:
   void SetUp() override {
     seedRandomness(42);
-    if (!std::filesystem::exists(namoDir())) GTEST_SKIP() << "no NAMO worlds at " << namoDir();
+    ASSERT_TRUE(std::filesystem::exists(namoDir())) << "no NAMO worlds at " << namoDir();
   }
 };
 

@@ -6,13 +6,13 @@
 set -euo pipefail
 cd "$(dirname "$0")/../../.."
 build=${1:-build/planner}
-shared=${TAMP_SHARED_DIR:-$(cd .. && pwd)/shared}
+data=${TAMP_BENCHMARKS_DIR:-tests/data/benchmarks}
 out=docs/bench
 mkdir -p "$out"
 bench="$build/bin/tamp_symbolic_planner_ipc_bench"
 planner="$build/bin/tamp-plan"
-flock /tmp/tamp-build.lock "$bench" --planner "$planner" --set "$shared/benchmarks/pddl" \
+flock /tmp/tamp-build.lock "$bench" --planner "$planner" --set "$data/pddl" \
   --out "$out/symbolic_planner_ipc.csv" --timeout 60 > "$out/symbolic_planner_ipc_summary.md"
-flock /tmp/tamp-build.lock "$bench" --planner "$planner" --set "$shared/benchmarks/pddl-adl" \
+flock /tmp/tamp-build.lock "$bench" --planner "$planner" --set "$data/pddl-adl" \
   --out "$out/symbolic_planner_ipc_adl.csv" --timeout 60 > "$out/symbolic_planner_ipc_adl_summary.md"
 cat "$out/symbolic_planner_ipc_summary.md" "$out/symbolic_planner_ipc_adl_summary.md"

@@ -84,11 +84,10 @@ TEST_F(Cli, ExitCodes) {
   CliRun u = runCli(dom_ + " " + unsolvable);
   EXPECT_EQ(u.code, 10) << u.out;
   // 20: timeout.
-  const auto blocks = test::sharedDir() / "benchmarks/pddl/blocks";
-  if (std::filesystem::exists(blocks / "instance-80.pddl")) {
-    CliRun t = runCli((blocks / "domain.pddl").string() + " " + (blocks / "instance-80.pddl").string() + " --timeout 0.2");
-    EXPECT_EQ(t.code, 20) << t.out;
-  }
+  const auto blocks = test::benchmarksDir() / "pddl/blocks";
+  ASSERT_TRUE(std::filesystem::exists(blocks / "instance-80.pddl")) << blocks;
+  CliRun t = runCli((blocks / "domain.pddl").string() + " " + (blocks / "instance-80.pddl").string() + " --timeout 0.2");
+  EXPECT_EQ(t.code, 20) << t.out;
 }
 
 }  // namespace

@@ -33,10 +33,10 @@ class Corpus : public ::testing::TestWithParam<Case> {};
 
 TEST_P(Corpus, PlanReplaysToTheGoal) {
   const Case& c = GetParam();
-  fs::path dir = c.set == "config" ? test::sourceDir() / "config/pddl" : test::sharedDir() / "benchmarks" / c.set / c.domain;
+  fs::path dir = c.set == "config" ? test::sourceDir() / "config/pddl" : test::benchmarksDir() / c.set / c.domain;
   const fs::path dom = c.set == "config" ? dir / "mobile_manipulation.pddl" : dir / "domain.pddl";
   const fs::path prob = c.set == "config" ? dir / "problems" / (c.instance + ".pddl") : dir / (c.instance + ".pddl");
-  if (c.set != "config" && !fs::exists(prob)) GTEST_SKIP() << "benchmark file missing: " << prob;
+  ASSERT_TRUE(fs::exists(prob)) << "benchmark file missing: " << prob;
   PlanRequest req;
   req.domain_path = dom.string();
   req.problem_path = prob.string();

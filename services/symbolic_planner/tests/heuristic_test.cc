@@ -14,7 +14,7 @@ class HeuristicContract : public ::testing::TestWithParam<std::tuple<HeuristicKi
 
 TEST_P(HeuristicContract, ZeroAtGoalNonNegativeAndDeadEndsOnRandomWalks) {
   const auto [kind, ct] = GetParam();
-  const std::string dir = (test::sharedDir() / "benchmarks/pddl/gripper").string();
+  const std::string dir = (test::benchmarksDir() / "pddl/gripper").string();
   auto s = PlanningSession::fromText(test::readFile(dir + "/domain.pddl"), test::readFile(dir + "/instance-4.pddl"));
   ASSERT_TRUE(s.ok());
   Query q;

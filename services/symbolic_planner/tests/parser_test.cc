@@ -156,9 +156,9 @@ TEST(PddlParser, ParsesEveryBenchmarkAndProjectFile) {
   namespace fs = std::filesystem;
   int files = 0;
   std::vector<fs::path> dirs;
-  for (const char* set : {"benchmarks/pddl", "benchmarks/pddl-adl"}) {
-    const fs::path root = test::sharedDir() / set;
-    if (!fs::exists(root)) continue;
+  for (const char* set : {"pddl", "pddl-adl"}) {
+    const fs::path root = test::benchmarksDir() / set;
+    ASSERT_TRUE(fs::is_directory(root)) << "benchmark set missing: " << root;
     for (const auto& e : fs::directory_iterator(root)) {
       if (e.is_directory()) dirs.push_back(e.path());
     }

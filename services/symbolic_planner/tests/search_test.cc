@@ -65,7 +65,7 @@ TEST(Search, AstarIsCostOptimalAndWastarWithinItsBound) {
 }
 
 TEST(Search, RespectsDeadlineStopTokenAndMemoryBudget) {
-  const auto dir = test::sharedDir() / "benchmarks/pddl/blocks";
+  const auto dir = test::benchmarksDir() / "pddl/blocks";
   PlanRequest req;
   req.domain_text = test::readFile(dir / "domain.pddl");
   req.problem_text = test::readFile(dir / "instance-80.pddl");  // far beyond a few milliseconds
@@ -93,7 +93,7 @@ TEST(Search, RespectsDeadlineStopTokenAndMemoryBudget) {
 TEST(Search, SecondEhcRunKeepsTheCheaperPlan) {
   // blocks-20: the FF-v2.3-order run gives a 50-step plan for an initial h of 5; the default EHC,
   // run second within its budget, a shorter one. Either way the plan is checked.
-  const auto dir = test::sharedDir() / "benchmarks/pddl/blocks";
+  const auto dir = test::benchmarksDir() / "pddl/blocks";
   PlanRequest req;
   req.domain_text = test::readFile(dir / "domain.pddl");
   req.problem_text = test::readFile(dir / "instance-20.pddl");

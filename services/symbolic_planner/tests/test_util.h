@@ -17,7 +17,8 @@ inline std::string readFile(const std::filesystem::path& p) {
 }
 
 inline std::filesystem::path sourceDir() { return TAMP_SOURCE_DIR; }
-inline std::filesystem::path sharedDir() { return TAMP_SHARED_DIR; }
+/// tests/data/benchmarks of the source tree (IPC sets pddl/, pddl-adl/, ...).
+inline std::filesystem::path benchmarksDir() { return TAMP_BENCHMARKS_DIR; }
 
 /// A small ADL domain with every feature of the fragment: typing with either, constants,
 /// negative preconditions, equality, disjunction, quantifiers, conditional effects, costs.

@@ -11,8 +11,10 @@
 namespace tamp {
 
 std::filesystem::path configDir();
-/// `../shared` next to the source tree (external benchmark data), or `$TAMP_SHARED_DIR`.
-std::filesystem::path sharedDir();
+/// The benchmark data shipped in the source tree (`tests/data/benchmarks/`: IPC PDDL sets, NAMO
+/// worlds, TAMP benchmark problems; licences in its NOTICE.md), compiled in, or
+/// `$TAMP_BENCHMARKS_DIR` when set.
+std::filesystem::path benchmarksDir();
 /// `relative` resolved against the directory of `base_file` (for paths inside config files);
 /// absolute paths are returned unchanged.
 std::filesystem::path resolveRelativeTo(const std::filesystem::path& base_file,

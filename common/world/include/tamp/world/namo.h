@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Loader for the NAMO benchmark worlds of `<shared>/benchmarks/namo/` (see its README.md and
+/// Loader for the NAMO benchmark worlds of `tests/data/benchmarks/namo/` (see its README.md and
 /// REFERENCE.md) into the world model, extruded to 3-D, with the robot's start and goals.
 ///
 /// Two formats:

@@ -10,8 +10,9 @@
 /// (tamp::config::FieldReader; unknown keys are refused): ids, references between objects,
 /// regions and locations, shapes, the arm configuration against the URDF's joint limits, the held
 /// object, fault timing, PDDL atom syntax and names. Paths inside a scenario are relative to the
-/// scenario file; `${TAMP_SHARED_DIR}` and `${TAMP_CONFIG_DIR}` prefixes expand to
-/// tamp::sharedDir() / tamp::configDir().
+/// scenario file; `${TAMP_BENCHMARKS_DIR}` and `${TAMP_CONFIG_DIR}` prefixes expand to
+/// tamp::benchmarksDir() / tamp::configDir() (the older `${TAMP_SHARED_DIR}/benchmarks` is
+/// accepted for `${TAMP_BENCHMARKS_DIR}`).
 ///
 /// `toPddlProblem()` derives the PDDL problem the world implies for the mobile-manipulation
 /// domain (objects, init facts, goal): `reaches` from inverse kinematics at each location,

@@ -1,0 +1,121 @@
+#pragma once
+/// @file
+/// The symbolic abstraction of a live world for the mobile-manipulation domain
+/// (config/pddl/mobile_manipulation.pddl): PDDL objects and facts of any world state, and symbols
+/// made on the fly for sub-tasks.
+///
+/// - **Objects**: named locations, regions, one pre-grasp arm configuration `over_<region>` per
+///   region (plus the constant `stow`), movable objects as items.
+/// - **Symbols made on the fly**: a base pose (the robot's current one, or one beside a blocking
+///   object from which the arm reaches it) becomes a location; a placement sampled by the motion
+///   planner becomes a *slot*, a small region around the object's pose there, with its own
+///   `over_<slot>` configuration. Every new symbol gets its static facts (`reaches` from inverse
+///   kinematics at each location, `conf-over`).
+/// - **Facts of a state**: `robot-at` (the location symbol of the base pose), `arm-at` (the
+///   configuration symbol), `hand-empty`/`holding`, `on` (a slot whose pose the object occupies,
+///   else its region, else the region below it), `occludes` (objects in the corridor between the
+///   approach location and the object on the same support), `graspable` (movable, flagged
+///   graspable, within the robot's payload).
+/// - **Binding**: the reverse map from a symbolic state to geometry (base pose, object poses of
+///   objects in slots, the held object), so that each node of the reachability graph is a symbolic
+///   state plus its geometric binding.
+
+#include <map>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "tamp/core/geometry.h"
+#include "tamp/robot/robot_model.h"
+#include "tamp/world/world.h"
+
+namespace tamp::graph_manager {
+
+struct AbstractionParams {
+  double location_tolerance_m{0.05};    ///< a base pose this close to a location is that location
+  double location_tolerance_rad{0.15};
+  double slot_tolerance_m{0.06};        ///< an object this close to a slot's pose is on the slot
+  double slot_half_size_m{0.06};        ///< half the side of a slot's square region
+  double payload_kg{5.0};               ///< graspable objects weigh at most this
+};
+
+/// A placement made a symbol: the object `object_id` at `pose` on `parent_region`.
+struct Slot {
+  std::string id;
+  std::string object_id;
+  std::string parent_region;
+  Eigen::Isometry3d pose{Eigen::Isometry3d::Identity()};
+};
+
+/// What a symbolic state means geometrically.
+struct Binding {
+  Pose2D base;
+  std::string location;
+  std::string armconf;                                   ///< "stow" or "over_<region>"
+  std::string held;                                      ///< object id or empty
+  std::map<std::string, Eigen::Isometry3d> object_poses;  ///< objects not where the world has them
+};
+
+class Abstraction {
+ public:
+  /// `world` is the planner's view at the start (locations, regions, objects).
+  Abstraction(world::World world, robot::RobotModel robot, AbstractionParams params = {});
+
+  const world::World& world() const { return world_; }
+  const robot::RobotModel& robot() const { return robot_; }
+  const AbstractionParams& params() const { return params_; }
+  /// Replaces the world geometry (a newer world model); symbols stay.
+  void setWorld(world::World world);
+
+  /// The location symbol of `pose`: an existing one within tolerance, else a new one named
+  /// `<hint>`, `<hint>_2`, ... with its `reaches` facts.
+  std::string locationFor(const Pose2D& pose, const std::string& hint);
+  /// The location within tolerance of `pose`, or empty.
+  std::string findLocation(const Pose2D& pose) const;
+  std::optional<Pose2D> locationPose(const std::string& id) const;
+  /// A new slot for `object_id` at `pose` on `parent_region` (existing one if the same pose).
+  std::string addSlot(const std::string& object_id, const std::string& parent_region,
+                      const Eigen::Isometry3d& pose);
+  const Slot* slot(const std::string& id) const;
+  /// True when the region or slot `id` exists.
+  bool isRegion(const std::string& id) const;
+
+  static std::string armconfOver(const std::string& region) { return "over_" + region; }
+  /// The region of an `over_<region>` configuration (empty for stow or unknown).
+  std::string regionOfArmconf(const std::string& armconf) const;
+
+  /// PDDL objects ("name - type"), every symbol known so far.
+  std::vector<std::string> objects() const;
+  /// Static facts (reaches, conf-over, graspable), sorted.
+  std::vector<std::string> staticAtoms() const;
+  /// Dynamic facts of a live state: the robot at `base` (a location symbol, made if needed), the
+  /// arm at `armconf`, holding `held` (or hand-empty), objects of `world` on regions or slots.
+  std::vector<std::string> dynamicAtoms(const world::World& world, const Pose2D& base,
+                                        const std::string& armconf, const std::string& held);
+  /// The geometry of a symbolic state (dynamic atoms).
+  Binding bind(const std::vector<std::string>& atoms) const;
+  /// Whether the object is graspable for this robot (movable, flagged, within the payload).
+  bool graspable(const world::Object& o) const;
+
+ private:
+  void addReaches(const std::string& location, const Pose2D& pose);
+  void addRegionReaches(const std::string& region_symbol, const world::Region& region);
+  world::Region slotRegion(const Slot& s) const;
+
+  world::World world_;
+  robot::RobotModel robot_;
+  AbstractionParams params_;
+  std::map<std::string, Pose2D> locations_;
+  std::map<std::string, world::Region> regions_;  ///< world regions and slot regions
+  std::map<std::string, Slot> slots_;
+  std::set<std::string> reaches_;                 ///< "(reaches l c)"
+  int slot_counter_{0};
+};
+
+/// Tokens of an atom "(p a b)" -> {"p", "a", "b"}.
+std::vector<std::string> atomTokens(const std::string& atom);
+
+}  // namespace tamp::graph_manager

@@ -1,0 +1,212 @@
+#pragma once
+/// @file
+/// The graph manager: the mission loop of "Conditional Task and Motion Planning through an
+/// Effort-Based Approach" (spec/conditional-tamp-effort-based.tex, Algorithms 1-3).
+///
+/// ## Design overview
+/// 1. `start()`: the live world's symbolic state becomes the root node; `TP(s0, sG)` gives a
+///    plan, `RGraph(P)` the first reachability graph (graph.h).
+/// 2. `traverse()` (Algorithm 3): depth-first branch-and-bound on predicted effort from the
+///    robot's current node to any node where the goal holds.
+///    - An edge is priced first by an admissible lower bound (distance at a top speed); a branch
+///      whose partial cost plus that bound reaches the best complete cost c* is cut before any
+///      motion is planned for it.
+///    - Otherwise the edge is evaluated: a lazy motion in the world of the branch (objects moved
+///      by earlier edges of the branch are passed as overrides, the held object with its grasp),
+///      then its effort from the effort estimator.
+///    - A base motion whose pure static-only lazy path crosses movables is not executable as is.
+///      For each crossed object o (policy `effort`; policy `infeasible` only when the full-mode
+///      path around everything is proven not to exist): `findPossibleActions(o)` (pick and place:
+///      the object must be graspable within the payload), a base pose beside o from the grasp
+///      service, `findEffectStates(o)`: placements off the swept path from the motion planner,
+///      made slots (abstraction.h); then `TP(v, s)` and `TP(s, child)` (and on to the goal),
+///      merged with `updateRGraph`. The detour (a full-mode path) stays a parallel edge.
+///    - Arm motions towards a pre-grasp configuration are evaluated together with the pick or
+///      place that follows (their target is that manipulation's pre-grasp).
+///    - A bounded number of edge evaluations and a deadline; deterministic for a seed (the
+///      services' own seeds and the order of evaluation are fixed).
+/// 3. `runMission()`: executes the best branch edge by edge through an `Executor`, re-planning a
+///    motion whose start no longer matches the robot, and re-running `traverse()` from the
+///    robot's node after a failed or blocked action (bounded by `max_replans`).
+///
+/// The library knows nothing of DDS: the services are reached through `ServiceClients` and the
+/// robot through `Executor` (clients.h).
+
+#include <chrono>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "tamp/graph_manager/abstraction.h"
+#include "tamp/graph_manager/clients.h"
+#include "tamp/graph_manager/graph.h"
+#include "tamp/graph_manager/params.h"
+
+namespace tamp::graph_manager {
+
+/// What the mission must achieve: PDDL atoms over world ids (a base pose goal is a location).
+struct MissionGoal {
+  std::vector<std::string> atoms;
+};
+
+/// The robot as a branch of the search assumes it (the geometric context of a node).
+struct BranchContext {
+  robot::RobotState state;
+  HeldGrasp held;
+  std::map<std::string, Eigen::Isometry3d> object_poses;  ///< objects moved by the branch
+  std::optional<GraspOption> pending_grasp;   ///< chosen by the move_arm before a pick
+  std::optional<Eigen::Isometry3d> pending_place;  ///< object pose chosen before a place
+};
+
+/// One alternative at a decision point, with its predicted effort.
+struct Alternative {
+  std::string description;   ///< "move_base start goal [around]" / "remove box via slot_box_1"
+  double effort_s{kInfinity}; ///< best complete branch through it; infinite when none
+  bool cut{false};            ///< pruned: only `bound_s` is known
+  double bound_s{0.0};
+  bool chosen{false};
+};
+
+struct Decision {
+  std::string node;           ///< "n0"
+  std::string what;           ///< the question decided
+  std::vector<Alternative> alternatives;
+  int traverse{0};            ///< which Traverse made it
+};
+
+struct Counters {
+  int planner_calls{0};
+  int motion_calls{0};
+  int placement_calls{0};
+  int grasp_calls{0};
+  int effort_calls{0};
+  int evaluations{0};
+  int subtasks{0};
+};
+
+struct TraverseResult {
+  bool found{false};
+  std::vector<EdgeId> branch;  ///< from the start node to a goal node
+  double cost_s{kInfinity};
+  double stddev_s{0.0};
+  double time_s{0.0};
+  int evaluations{0};
+  std::string reason;          ///< when not found
+};
+
+struct ExecutedAction {
+  std::string command_id;
+  std::string action;
+  std::string variant;
+  double predicted_s{0.0};
+  double predicted_stddev_s{0.0};
+  double measured_s{0.0};
+  std::string outcome;
+  std::string reason;
+  JointPath path;              ///< what the robot was commanded (for the report's picture)
+};
+
+enum class MissionOutcome { kSucceeded, kFailed, kAborted, kTimeout, kInputError, kUnavailable };
+std::string_view toString(MissionOutcome o);
+
+struct MissionReport {
+  MissionOutcome status{MissionOutcome::kFailed};
+  std::string reason;
+  double executed_effort_s{0.0};
+  double predicted_effort_s{0.0};
+  double planning_time_s{0.0};
+  double planning_time_to_first_action_s{0.0};
+  int replans{0};
+  Counters counters;
+  std::vector<std::string> objects_moved;
+  std::vector<Decision> decisions;
+  std::vector<ExecutedAction> actions;
+  std::vector<std::pair<std::string, Eigen::Isometry3d>> moved_from;  ///< object, pose before
+  std::vector<std::pair<std::string, Eigen::Isometry3d>> moved_to;
+  std::string graph_dot;
+};
+
+/// Progress callbacks for a live display (all optional).
+struct MissionObserver {
+  std::function<void(const std::string& state, const std::string& message)> on_state;
+  std::function<void(const ExecutedAction&, double done_effort_s, double total_effort_s)> on_action;
+  std::function<void(const ReachabilityGraph&, const std::vector<EdgeId>& best, NodeId current)> on_graph;
+  std::function<bool()> abort_requested;
+};
+
+/// Reads the live robot and world.
+class WorldSource {
+ public:
+  virtual ~WorldSource() = default;
+  virtual world::World world() = 0;
+  virtual Observation robot() = 0;
+};
+
+class GraphManager {
+ public:
+  /// @throws std::invalid_argument when `params` is invalid.
+  GraphManager(Abstraction abstraction, std::string domain_pddl, MissionGoal goal, ServiceClients& services,
+               GraphManagerParams params);
+
+  /// Builds the root node from the live state and the first plan. Errors: kInvalidArgument (goal
+  /// names unknown symbols), kNotFound (the planner proves the goal unreachable: the message says
+  /// so), kTimeout, kUnavailable.
+  Status start(const world::World& live, const Observation& robot);
+  /// Algorithm 3 from `from` with the robot in `context`.
+  TraverseResult traverse(NodeId from, const BranchContext& context);
+  /// The whole mission: start, traverse, execute, repair.
+  MissionReport runMission(WorldSource& source, Executor& executor, const MissionObserver& observer = {});
+
+  const ReachabilityGraph& graph() const { return graph_; }
+  const Abstraction& abstraction() const { return abstraction_; }
+  const Counters& counters() const { return counters_; }
+  NodeId root() const { return root_; }
+  bool isGoal(NodeId n) const;
+  const std::vector<Decision>& decisions() const { return decisions_; }
+
+  // ---- pieces (public for tests) ----
+  /// TP from the node's state to `goal` literals; adds the plan to the graph. Returns its edges.
+  Result<std::vector<EdgeId>> planFrom(NodeId from, const std::vector<std::string>& goal, const std::string& origin);
+  /// Evaluates edge `e` in `ctx` (and `next` for arm motions into a manipulation). Returns the
+  /// edge's effort, or infinity when it cannot be executed as is.
+  double evaluate(EdgeId e, EdgeId next, const BranchContext& ctx, int depth);
+  /// The context after executing `e` (with `next`) from `ctx`.
+  BranchContext advance(EdgeId e, EdgeId next, const BranchContext& ctx) const;
+  /// The command that executes edge `e` from context `ctx`.
+  Result<EdgeCommand> command(EdgeId e, EdgeId next, const BranchContext& ctx, const std::string& command_id);
+  BranchContext contextOf(const Observation& robot) const;
+
+ private:
+  struct Search;
+  double lowerBound(const Edge& e) const;
+  void spawnSubtasks(EdgeId e, const BranchContext& ctx, int depth);
+  double evaluateBase(Edge& e, const BranchContext& ctx, int depth);
+  double evaluateArm(Edge& e, EdgeId next, const BranchContext& ctx);
+  double evaluateManipulation(Edge& e, const BranchContext& ctx);
+  std::optional<EdgeMotion> armTarget(const Edge& arm_edge, EdgeId next, const BranchContext& ctx,
+                                      std::vector<double>& target, std::string& why);
+  std::pair<double, double> price(const EffortQuery& q);
+  MotionQuery baseQuery(const Edge& e, const BranchContext& ctx) const;
+  std::vector<std::string> withStatics(const std::vector<std::string>& dynamic) const;
+  void recordDecisions(NodeId from, const std::map<EdgeId, double>& best_through, const std::vector<EdgeId>& branch,
+                       double best_cost, int traverse_index, const std::map<EdgeId, double>& cut_bounds);
+
+  Abstraction abstraction_;
+  std::string domain_;
+  MissionGoal goal_;
+  ServiceClients& services_;
+  GraphManagerParams params_;
+  ReachabilityGraph graph_;
+  NodeId root_{-1};
+  Counters counters_;
+  std::vector<Decision> decisions_;
+  int traverse_count_{0};
+  double planning_s_{0.0};
+  std::map<std::string, std::vector<GraspOption>> grasp_cache_;
+  std::map<std::string, std::vector<PlacementOption>> placement_cache_;
+};
+
+}  // namespace tamp::graph_manager

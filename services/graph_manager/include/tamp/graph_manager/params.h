@@ -1,0 +1,47 @@
+#pragma once
+/// @file
+/// Parameters of the graph manager (validated; `config/services/graph_manager.yaml`).
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "tamp/core/error.h"
+
+namespace tamp::graph_manager {
+
+/// When moving an object is considered (the paper's claim is measured by comparing the two).
+enum class Policy {
+  kEffort,      ///< revise whenever a cheaper branch exists: removal and detour are both priced
+  kInfeasible,  ///< consider moving an object only when full mode proves there is no way around
+};
+std::string_view toString(Policy p);  ///< "effort", "infeasible"
+std::optional<Policy> policyFromString(std::string_view s);
+
+struct GraphManagerParams {
+  Policy policy{Policy::kEffort};
+  std::uint32_t seed{1};
+  int max_evaluations{120};        ///< edge evaluations per Traverse (the paper's MaxAttempts); >= 1
+  double traverse_budget_s{30.0};  ///< deadline of one Traverse; > 0
+  int max_replans{4};              ///< failed executions tolerated before the mission fails; >= 0
+  int max_subtask_depth{1};        ///< nested sub-tasks (a removal inside a removal branch); >= 0
+  int max_blocking_objects{2};     ///< blocking objects of one edge given sub-tasks; >= 1
+  int placements_per_object{2};    ///< findEffectStates: sampled placements kept per object; >= 1
+  double keep_clear_margin_m{0.10};  ///< placements keep this much more than the robot's radius off the path
+  double lower_bound_base_speed{1.5};  ///< m/s, above the robot's top speed (admissible bound); > 0
+  double approach_m{0.10};         ///< pick/place: gripper approach and retreat along z (m); > 0
+  double plan_budget_s{5.0};       ///< per task-planner call; > 0
+  double motion_budget_s{8.0};     ///< per motion call; > 0
+  double execution_margin_s{30.0}; ///< execution budget = prediction + k sigma + this; > 0
+  double start_tolerance{0.02};    ///< re-plan a motion whose start is farther from the robot; > 0
+
+  /// Empty when valid; else the field and why.
+  std::optional<std::string> invalidReason() const;
+};
+
+/// Reads `config/services/graph_manager.yaml`; errors name file:line:column and the field.
+Result<GraphManagerParams> loadParams(const std::filesystem::path& file);
+Result<GraphManagerParams> parseParams(const std::string& yaml_text, const std::string& name);
+
+}  // namespace tamp::graph_manager

@@ -1,0 +1,237 @@
+#include "tamp/graph_manager/abstraction.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "tamp/world/polygon.h"
+#include "tamp/world/scenario.h"
+
+namespace tamp::graph_manager {
+
+std::vector<std::string> atomTokens(const std::string& atom) {
+  std::vector<std::string> out;
+  std::string cur;
+  for (char c : atom) {
+    if (c == '(' || c == ')' || std::isspace(static_cast<unsigned char>(c))) {
+      if (!cur.empty()) out.push_back(cur), cur.clear();
+    } else {
+      cur += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    }
+  }
+  if (!cur.empty()) out.push_back(cur);
+  return out;
+}
+
+namespace {
+double angleDiff(double a, double b) { return std::abs(std::remainder(a - b, 2 * M_PI)); }
+}  // namespace
+
+Abstraction::Abstraction(world::World world, robot::RobotModel robot, AbstractionParams params)
+    : world_(std::move(world)), robot_(std::move(robot)), params_(params) {
+  for (const auto& r : world_.regions()) regions_[r.id] = r;
+  for (const auto& l : world_.locations()) {
+    locations_[l.id] = l.pose;
+    addReaches(l.id, l.pose);
+  }
+}
+
+void Abstraction::setWorld(world::World world) { world_ = std::move(world); }
+
+void Abstraction::addReaches(const std::string& location, const Pose2D& pose) {
+  reaches_.insert("(reaches " + location + " stow)");
+  for (const auto& [id, region] : regions_) {
+    if (world::reachesRegion(robot_, pose, region)) reaches_.insert("(reaches " + location + " " + armconfOver(id) + ")");
+  }
+}
+
+void Abstraction::addRegionReaches(const std::string& region_symbol, const world::Region& region) {
+  for (const auto& [id, pose] : locations_) {
+    if (world::reachesRegion(robot_, pose, region)) reaches_.insert("(reaches " + id + " " + armconfOver(region_symbol) + ")");
+  }
+}
+
+std::string Abstraction::findLocation(const Pose2D& pose) const {
+  std::string best;
+  double best_d = params_.location_tolerance_m;
+  for (const auto& [id, p] : locations_) {
+    const double d = std::hypot(p.x - pose.x, p.y - pose.y);
+    if (d <= best_d && angleDiff(p.theta, pose.theta) <= params_.location_tolerance_rad) {
+      best_d = d;
+      best = id;
+    }
+  }
+  return best;
+}
+
+std::optional<Pose2D> Abstraction::locationPose(const std::string& id) const {
+  auto it = locations_.find(id);
+  if (it == locations_.end()) return std::nullopt;
+  return it->second;
+}
+
+std::string Abstraction::locationFor(const Pose2D& pose, const std::string& hint) {
+  if (auto existing = findLocation(pose); !existing.empty()) return existing;
+  std::string id = hint;
+  for (int k = 2; locations_.count(id) || regions_.count(id); ++k) id = hint + "_" + std::to_string(k);
+  locations_[id] = pose;
+  addReaches(id, pose);
+  return id;
+}
+
+world::Region Abstraction::slotRegion(const Slot& s) const {
+  world::Region r;
+  r.id = s.id;
+  r.label = "slot for " + s.object_id;
+  const world::Region* parent = nullptr;
+  if (auto it = regions_.find(s.parent_region); it != regions_.end()) parent = &it->second;
+  r.kind = parent ? parent->kind : world::RegionKind::kFloor;
+  r.height = parent ? parent->height : 0.0;
+  const double h = params_.slot_half_size_m;
+  const Eigen::Vector2d c = s.pose.translation().head<2>();
+  r.polygon = {c + Eigen::Vector2d(-h, -h), c + Eigen::Vector2d(h, -h), c + Eigen::Vector2d(h, h),
+               c + Eigen::Vector2d(-h, h)};
+  return r;
+}
+
+std::string Abstraction::addSlot(const std::string& object_id, const std::string& parent_region,
+                                 const Eigen::Isometry3d& pose) {
+  for (const auto& [id, s] : slots_) {
+    if (s.object_id == object_id && (s.pose.translation() - pose.translation()).norm() < 1e-3) return id;
+  }
+  Slot s;
+  s.id = "slot_" + object_id + "_" + std::to_string(++slot_counter_);
+  s.object_id = object_id;
+  s.parent_region = parent_region;
+  s.pose = pose;
+  const world::Region region = slotRegion(s);
+  regions_[s.id] = region;
+  slots_[s.id] = s;
+  addRegionReaches(s.id, region);
+  return s.id;
+}
+
+const Slot* Abstraction::slot(const std::string& id) const {
+  auto it = slots_.find(id);
+  return it == slots_.end() ? nullptr : &it->second;
+}
+
+bool Abstraction::isRegion(const std::string& id) const { return regions_.count(id) > 0; }
+
+std::string Abstraction::regionOfArmconf(const std::string& armconf) const {
+  if (armconf.rfind("over_", 0) != 0) return {};
+  const std::string r = armconf.substr(5);
+  return regions_.count(r) ? r : std::string{};
+}
+
+bool Abstraction::graspable(const world::Object& o) const {
+  return o.kind == world::ObjectKind::kMovable && o.graspable && o.mass <= params_.payload_kg;
+}
+
+std::vector<std::string> Abstraction::objects() const {
+  std::vector<std::string> out;
+  for (const auto& [id, p] : locations_) out.push_back(id + " - location");
+  for (const auto& [id, r] : regions_) {
+    out.push_back(id + " - region");
+    out.push_back(armconfOver(id) + " - armconf");
+  }
+  for (const auto& o : world_.objects()) {
+    if (o.kind == world::ObjectKind::kMovable) out.push_back(o.id + " - item");
+  }
+  return out;
+}
+
+std::vector<std::string> Abstraction::staticAtoms() const {
+  std::set<std::string> s(reaches_.begin(), reaches_.end());
+  for (const auto& [id, r] : regions_) s.insert("(conf-over " + armconfOver(id) + " " + id + ")");
+  for (const auto& o : world_.objects()) {
+    if (graspable(o)) s.insert("(graspable " + o.id + ")");
+  }
+  return {s.begin(), s.end()};
+}
+
+std::vector<std::string> Abstraction::dynamicAtoms(const world::World& w, const Pose2D& base,
+                                                   const std::string& armconf, const std::string& held) {
+  std::set<std::string> atoms;
+  atoms.insert("(robot-at " + locationFor(base, "here") + ")");
+  atoms.insert("(arm-at " + (armconf.empty() ? std::string("stow") : armconf) + ")");
+  if (held.empty())
+    atoms.insert("(hand-empty)");
+  else
+    atoms.insert("(holding " + held + ")");
+  // on: a slot the object occupies, else its region, else the region below it.
+  std::map<std::string, std::string> support;
+  for (const auto& o : w.objects()) {
+    if (o.kind != world::ObjectKind::kMovable || o.id == held) continue;
+    std::string where;
+    for (const auto& [id, s] : slots_) {
+      if (s.object_id == o.id &&
+          (s.pose.translation().head<2>() - o.pose.translation().head<2>()).norm() <= params_.slot_tolerance_m)
+        where = id;
+    }
+    if (where.empty() && !o.region.empty() && regions_.count(o.region)) where = o.region;
+    if (where.empty()) {
+      if (const world::Region* r = w.regionBelow(o.pose.translation() - Eigen::Vector3d(0, 0, o.shape.halfHeight())))
+        where = r->id;
+    }
+    if (!where.empty()) {
+      atoms.insert("(on " + o.id + " " + where + ")");
+      support[o.id] = slots_.count(where) ? slots_.at(where).parent_region : where;
+    }
+  }
+  // occludes: x in the corridor from the approach location of o's support to o (as seen by the
+  // nearest location that reaches that support).
+  for (const auto& o : w.objects()) {
+    auto so = support.find(o.id);
+    if (so == support.end()) continue;
+    const auto region_it = regions_.find(so->second);
+    if (region_it == regions_.end()) continue;
+    const Eigen::Vector2d centroid = world::areaCentroid(region_it->second.polygon);
+    const Pose2D* approach = nullptr;
+    double best = std::numeric_limits<double>::infinity();
+    for (const auto& [lid, lp] : locations_) {
+      if (!reaches_.count("(reaches " + lid + " " + armconfOver(so->second) + ")")) continue;
+      const double d = (centroid - Eigen::Vector2d(lp.x, lp.y)).norm();
+      if (d < best) best = d, approach = &lp;
+    }
+    if (!approach) continue;
+    const Eigen::Vector2d l(approach->x, approach->y);
+    const Eigen::Vector2d po = o.pose.translation().head<2>();
+    const double ro = world::circumradius(o.shape.footprint(), Eigen::Vector2d::Zero());
+    for (const auto& x : w.objects()) {
+      if (x.id == o.id) continue;
+      auto sx = support.find(x.id);
+      if (sx == support.end() || sx->second != so->second) continue;
+      const Eigen::Vector2d px = x.pose.translation().head<2>();
+      const Eigen::Vector2d d = po - l;
+      const double len = d.norm();
+      if (len <= 0) continue;
+      const double t = (px - l).dot(d) / len;
+      const double lateral = std::abs(d.x() * (px - l).y() - d.y() * (px - l).x()) / len;
+      const double rx = world::circumradius(x.shape.footprint(), Eigen::Vector2d::Zero());
+      if (t > 0 && t < len && lateral < rx + ro) atoms.insert("(occludes " + x.id + " " + o.id + ")");
+    }
+  }
+  return {atoms.begin(), atoms.end()};
+}
+
+Binding Abstraction::bind(const std::vector<std::string>& atoms) const {
+  Binding b;
+  b.armconf = "stow";
+  for (const auto& a : atoms) {
+    const auto t = atomTokens(a);
+    if (t.size() == 2 && t[0] == "robot-at") {
+      b.location = t[1];
+      if (auto p = locationPose(t[1])) b.base = *p;
+    } else if (t.size() == 2 && t[0] == "arm-at") {
+      b.armconf = t[1];
+    } else if (t.size() == 2 && t[0] == "holding") {
+      b.held = t[1];
+    } else if (t.size() == 3 && t[0] == "on") {
+      if (const Slot* s = slot(t[2]); s && s->object_id == t[1]) b.object_poses[t[1]] = s->pose;
+    }
+  }
+  return b;
+}
+
+}  // namespace tamp::graph_manager

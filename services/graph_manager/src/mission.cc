@@ -1,0 +1,191 @@
+// The mission loop: traverse, execute the best branch edge by edge, repair after failures.
+#include <chrono>
+#include <cmath>
+
+#include "tamp/core/log.h"
+#include "tamp/graph_manager/graph_manager.h"
+
+namespace tamp::graph_manager {
+namespace {
+
+
+double startDistance(const Trajectory& t, const robot::RobotState& s, ActionKind kind) {
+  if (t.empty()) return kInfinity;
+  const auto& p = t.points.front().positions;
+  if (kind == ActionKind::kMoveBase) {
+    if (p.size() < 3) return kInfinity;
+    return std::hypot(p[0] - s.base.x, p[1] - s.base.y) + std::abs(std::remainder(p[2] - s.base.theta, 2 * M_PI));
+  }
+  double d = 0.0;
+  for (std::size_t i = 0; i < std::min(p.size(), s.arm.size()); ++i) d = std::max(d, std::abs(p[i] - s.arm[i]));
+  return d;
+}
+
+}  // namespace
+
+Result<EdgeCommand> GraphManager::command(EdgeId id, EdgeId next, const BranchContext& ctx,
+                                          const std::string& command_id) {
+  const Edge& e = graph_.edge(id);
+  const EdgeMotion* m = nullptr;
+  double mean = e.effort_mean_s, sd = e.effort_stddev_s;
+  if (e.kind == ActionKind::kMoveArm) {
+    auto it = e.motion_by_next.find(next);
+    if (it != e.motion_by_next.end()) m = &it->second;
+    if (auto ef = e.effort_by_next.find(next); ef != e.effort_by_next.end()) mean = ef->second.first, sd = ef->second.second;
+  } else if (e.motion) {
+    m = &*e.motion;
+  }
+  if (!m) return Error(ErrorCode::kInternal, "edge " + e.action + " has no motion");
+  EdgeCommand c;
+  c.command_id = command_id;
+  c.edge_id = "e" + std::to_string(e.id);
+  c.action = e.action;
+  c.kind = e.kind;
+  c.trajectory = m->trajectory;
+  c.object_id = m->object_id;
+  c.region_id = m->region_id;
+  c.object_target = m->object_target;
+  c.expected_s = mean;
+  c.expected_stddev_s = sd;
+  (void)ctx;
+  return c;
+}
+
+MissionReport GraphManager::runMission(WorldSource& source, Executor& executor, const MissionObserver& observer) {
+  MissionReport report;
+  auto state = [&](const std::string& s, const std::string& msg) {
+    if (observer.on_state) observer.on_state(s, msg);
+  };
+  auto finish = [&](MissionOutcome o, const std::string& reason) {
+    report.status = o;
+    report.reason = reason;
+    report.counters = counters_;
+    report.decisions = decisions_;
+    report.planning_time_s = planning_s_;
+    report.graph_dot = graph_.toDot({}, root_);
+    state(std::string(toString(o)), reason);
+    return report;
+  };
+  Observation robot = source.robot();
+  if (!robot.valid) return finish(MissionOutcome::kUnavailable, "no robot state received");
+  state("planning", "planning from the robot's state");
+  if (Status s = start(source.world(), robot); !s) {
+    const auto code = s.error().code;
+    return finish(code == ErrorCode::kUnavailable ? MissionOutcome::kUnavailable
+                  : code == ErrorCode::kTimeout   ? MissionOutcome::kTimeout
+                  : code == ErrorCode::kInvalidArgument ? MissionOutcome::kInputError
+                                                        : MissionOutcome::kFailed,
+                  s.error().message);
+  }
+  NodeId current = root_;
+  BranchContext ctx = contextOf(robot);
+  std::vector<EdgeId> branch;
+  double branch_total = 0.0, done_effort = 0.0;
+  int failures = 0, step = 0;
+  bool first_action = true;
+  while (true) {
+    if (observer.abort_requested && observer.abort_requested()) return finish(MissionOutcome::kAborted, "aborted by the user");
+    if (isGoal(current)) break;
+    if (branch.empty()) {
+      state(failures ? "replanning" : "planning", "traverse from n" + std::to_string(current));
+      TraverseResult t = traverse(current, ctx);
+      if (!t.found) return finish(MissionOutcome::kFailed, t.reason);
+      branch = t.branch;
+      branch_total = done_effort + t.cost_s;
+      report.predicted_effort_s = branch_total;
+      if (observer.on_graph) observer.on_graph(graph_, branch, current);
+    }
+    const EdgeId id = branch.front();
+    const EdgeId next = branch.size() > 1 ? branch[1] : -1;
+    Edge& e = graph_.edge(id);
+    // The robot must be where the edge's motion starts; otherwise plan the motion again from it.
+    auto cmd = command(id, next, ctx, "m" + std::to_string(step) + "-e" + std::to_string(id));
+    if (cmd && e.kind != ActionKind::kPick && e.kind != ActionKind::kPlace &&
+        startDistance(cmd->trajectory, ctx.state, e.kind) > params_.start_tolerance) {
+      if (e.kind == ActionKind::kMoveBase) {
+        e.state = EdgeState::kUnevaluated;
+        e.motion.reset();
+      } else {
+        e.motion_by_next.erase(next);
+        e.effort_by_next.erase(next);
+      }
+      evaluate(id, next, ctx, 0);
+      cmd = command(id, next, ctx, "m" + std::to_string(step) + "-e" + std::to_string(id));
+    }
+    if (!cmd) return finish(MissionOutcome::kFailed, cmd.error().message);
+    if (first_action) {
+      report.planning_time_to_first_action_s = planning_s_;
+      first_action = false;
+    }
+    e.state = EdgeState::kExecuting;
+    state("executing", e.action);
+    const double budget = cmd->expected_s + 4 * cmd->expected_stddev_s + params_.execution_margin_s;
+    ExecutionReport rep = executor.execute(*cmd, budget);
+    ++step;
+    ExecutedAction a;
+    a.command_id = cmd->command_id;
+    a.action = e.action;
+    a.variant = std::string(toString(e.variant));
+    a.predicted_s = cmd->expected_s;
+    a.predicted_stddev_s = cmd->expected_stddev_s;
+    a.measured_s = rep.measured_s;
+    a.outcome = std::string(toString(rep.outcome));
+    a.reason = rep.reason;
+    a.path = cmd->trajectory.path();
+    report.actions.push_back(a);
+    report.executed_effort_s += rep.measured_s;
+    if (rep.outcome == ExecOutcome::kSucceeded) {
+      e.state = EdgeState::kExecuted;
+      done_effort += cmd->expected_s;
+      if (e.kind == ActionKind::kPlace && cmd->object_target) {
+        report.objects_moved.push_back(cmd->object_id);
+        if (const world::Object* o = abstraction_.world().findObject(cmd->object_id))
+          report.moved_from.emplace_back(o->id, o->pose);
+        report.moved_to.emplace_back(cmd->object_id, *cmd->object_target);
+      }
+      ctx = advance(id, next, ctx);
+      const Observation now = source.robot();
+      if (now.valid) {
+        ctx.state.base = now.robot.base;
+        if (now.robot.arm.size() == ctx.state.arm.size()) ctx.state.arm = now.robot.arm;
+      }
+      if (observer.on_action) observer.on_action(a, done_effort, branch_total);
+      current = e.to;
+      branch.erase(branch.begin());
+      continue;
+    }
+    if (rep.outcome == ExecOutcome::kUnavailable) return finish(MissionOutcome::kUnavailable, rep.reason);
+    e.state = EdgeState::kFailed;
+    e.reason = std::string(toString(rep.outcome)) + ": " + rep.reason;
+    if (observer.on_action) observer.on_action(a, done_effort, branch_total);
+    if (++failures > params_.max_replans)
+      return finish(MissionOutcome::kFailed, "gave up after " + std::to_string(failures) + " failed actions; last: " +
+                                                 e.action + " " + e.reason);
+    ++report.replans;
+    // Repair: the robot's node in the graph from what it observes now, then Traverse from it.
+    const Observation now = source.robot();
+    const world::World live = source.world();
+    abstraction_.setWorld(live);
+    ctx = contextOf(now.valid ? now : robot);
+    std::string armconf = "stow";
+    if (auto stow = abstraction_.robot().namedConfiguration("stow");
+        stow && ctx.state.arm.size() == stow->size()) {
+      double d = 0.0;
+      for (std::size_t i = 0; i < stow->size(); ++i) d = std::max(d, std::abs((*stow)[i] - ctx.state.arm[i]));
+      if (d > 0.05) armconf = graph_.node(e.from).atoms.empty() ? "stow" : abstraction_.bind(graph_.node(e.from).atoms).armconf;
+    }
+    auto atoms = abstraction_.dynamicAtoms(live, ctx.state.base, armconf, now.held_object_id);
+    graph_.node(e.from).healthy = e.from != current ? graph_.node(e.from).healthy : false;
+    current = graph_.addNode(atoms, "observed after " + e.action);
+    branch.clear();
+  }
+  report.status = MissionOutcome::kSucceeded;
+  report.counters = counters_;
+  report.decisions = decisions_;
+  report.planning_time_s = planning_s_;
+  report.graph_dot = graph_.toDot({}, current);
+  state("succeeded", "goal reached");
+  return report;
+}
+
+}  // namespace tamp::graph_manager

@@ -1,0 +1,72 @@
+#include "tamp/graph_manager/params.h"
+
+#include <vector>
+
+#include "tamp/config/schema.h"
+#include "tamp/core/paths.h"
+
+namespace tamp::graph_manager {
+
+std::string_view toString(Policy p) { return p == Policy::kEffort ? "effort" : "infeasible"; }
+
+std::optional<Policy> policyFromString(std::string_view s) {
+  if (s == "effort") return Policy::kEffort;
+  if (s == "infeasible") return Policy::kInfeasible;
+  return std::nullopt;
+}
+
+namespace {
+using config::atLeast;
+using config::positive;
+
+const config::Schema<GraphManagerParams>& schema() {
+  using P = GraphManagerParams;
+  static const config::Schema<P> kSchema = [] {
+    config::Schema<P> s;
+    s.root()
+        .convert<std::string>("policy", &P::policy,
+                              config::byName<Policy>(policyFromString, "policy", "effort, infeasible"))
+        .field("seed", &P::seed)
+        .field("max_evaluations", &P::max_evaluations, atLeast(1))
+        .field("traverse_budget_s", &P::traverse_budget_s, positive())
+        .field("max_replans", &P::max_replans, atLeast(0))
+        .field("max_subtask_depth", &P::max_subtask_depth, atLeast(0))
+        .field("max_blocking_objects", &P::max_blocking_objects, atLeast(1))
+        .field("placements_per_object", &P::placements_per_object, atLeast(1))
+        .field("keep_clear_margin_m", &P::keep_clear_margin_m, config::nonNegative("m"))
+        .field("lower_bound_base_speed", &P::lower_bound_base_speed, positive())
+        .field("approach_m", &P::approach_m, positive())
+        .field("plan_budget_s", &P::plan_budget_s, positive())
+        .field("motion_budget_s", &P::motion_budget_s, positive())
+        .field("execution_margin_s", &P::execution_margin_s, positive())
+        .field("start_tolerance", &P::start_tolerance, positive());
+    return s;
+  }();
+  return kSchema;
+}
+}  // namespace
+
+std::optional<std::string> GraphManagerParams::invalidReason() const {
+  const std::vector<Error> errors = schema().errors(*this);
+  if (errors.empty()) return std::nullopt;
+  return joinErrors(errors);
+}
+
+Result<GraphManagerParams> parseParams(const std::string& yaml_text, const std::string& name) {
+  auto doc = config::parseYaml(yaml_text, name);
+  if (!doc) return doc.error();
+  GraphManagerParams p;
+  config::FieldReader r(*doc);
+  schema().read(r, p);
+  r.refuseUnknownKeys();
+  if (!r.ok()) return r.status().error();
+  return p;
+}
+
+Result<GraphManagerParams> loadParams(const std::filesystem::path& file) {
+  auto text = readTextFile(file);
+  if (!text) return text.error();
+  return parseParams(*text, file.string());
+}
+
+}  // namespace tamp::graph_manager

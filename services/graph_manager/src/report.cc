@@ -1,0 +1,86 @@
+#include "tamp/graph_manager/report.h"
+
+#include <cmath>
+
+#include <nlohmann/json.hpp>
+
+namespace tamp::graph_manager {
+namespace {
+
+nlohmann::json number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+nlohmann::json pose(const Eigen::Isometry3d& p) {
+  const Eigen::Vector3d t = p.translation();
+  const double yaw = std::atan2(p.linear()(1, 0), p.linear()(0, 0));
+  return {{"x", t.x()}, {"y", t.y()}, {"z", t.z()}, {"yaw", yaw}};
+}
+
+}  // namespace
+
+std::string reportJson(const MissionReport& r, const std::string& scenario, const std::string& policy,
+                       std::uint32_t seed) {
+  nlohmann::json j;
+  j["schema"] = "tamp-mission-report/1";
+  j["scenario"] = scenario;
+  j["policy"] = policy;
+  j["seed"] = seed;
+  j["status"] = r.status == MissionOutcome::kSucceeded ? "succeeded"
+                : r.status == MissionOutcome::kAborted ? "aborted"
+                                                       : "failed";
+  j["outcome"] = std::string(toString(r.status));
+  j["reason"] = r.reason;
+  j["executed_effort_s"] = r.executed_effort_s;
+  j["predicted_effort_s"] = number(r.predicted_effort_s);
+  j["planning_time_s"] = r.planning_time_s;
+  j["planning_time_to_first_action_s"] = r.planning_time_to_first_action_s;
+  j["replans"] = r.replans;
+  j["planner_calls"] = r.counters.planner_calls;
+  j["motion_calls"] = r.counters.motion_calls;
+  j["placement_calls"] = r.counters.placement_calls;
+  j["grasp_calls"] = r.counters.grasp_calls;
+  j["effort_calls"] = r.counters.effort_calls;
+  j["edge_evaluations"] = r.counters.evaluations;
+  j["subtasks"] = r.counters.subtasks;
+  j["objects_moved"] = r.objects_moved;
+  nlohmann::json moved = nlohmann::json::array();
+  for (std::size_t i = 0; i < r.moved_to.size(); ++i) {
+    nlohmann::json m{{"object", r.moved_to[i].first}, {"to", pose(r.moved_to[i].second)}};
+    for (const auto& [id, p] : r.moved_from)
+      if (id == r.moved_to[i].first) m["from"] = pose(p);
+    moved.push_back(m);
+  }
+  j["moves"] = moved;
+  nlohmann::json decisions = nlohmann::json::array();
+  for (const auto& d : r.decisions) {
+    nlohmann::json alts = nlohmann::json::array();
+    for (const auto& a : d.alternatives) {
+      alts.push_back({{"alternative", a.description},
+                      {"effort_s", number(a.effort_s)},
+                      {"cut", a.cut},
+                      {"bound_s", a.cut ? number(a.bound_s) : nlohmann::json(nullptr)},
+                      {"chosen", a.chosen}});
+    }
+    decisions.push_back({{"node", d.node}, {"traverse", d.traverse}, {"what", d.what}, {"alternatives", alts}});
+  }
+  j["decisions"] = decisions;
+  nlohmann::json actions = nlohmann::json::array();
+  for (const auto& a : r.actions) {
+    nlohmann::json path = nlohmann::json::array();
+    const int ix = a.path.indexOf("base_x"), iy = a.path.indexOf("base_y");
+    if (ix >= 0 && iy >= 0)
+      for (const auto& w : a.path.waypoints) path.push_back({w[static_cast<std::size_t>(ix)], w[static_cast<std::size_t>(iy)]});
+    actions.push_back({{"command_id", a.command_id},
+                       {"action", a.action},
+                       {"variant", a.variant},
+                       {"predicted_s", number(a.predicted_s)},
+                       {"predicted_stddev_s", number(a.predicted_stddev_s)},
+                       {"measured_s", a.measured_s},
+                       {"outcome", a.outcome},
+                       {"reason", a.reason},
+                       {"base_path", path}});
+  }
+  j["actions"] = actions;
+  return j.dump(2);
+}
+
+}  // namespace tamp::graph_manager

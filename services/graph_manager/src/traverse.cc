@@ -1,0 +1,823 @@
+// Traverse (Algorithm 3): edge evaluation, sub-task spawning, branch-and-bound.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <set>
+
+#include "tamp/core/log.h"
+#include "tamp/graph_manager/graph_manager.h"
+
+namespace tamp::graph_manager {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+/// A timed trajectory through `waypoints` over `names` at a nominal speed (the robot re-times it).
+Trajectory timed(const std::vector<std::string>& names, const std::vector<std::vector<double>>& waypoints,
+                 double speed) {
+  Trajectory t;
+  t.joint_names = names;
+  double time = 0.0;
+  for (std::size_t i = 0; i < waypoints.size(); ++i) {
+    if (i > 0) {
+      double d = 0.0;
+      for (std::size_t j = 0; j < waypoints[i].size(); ++j) d = std::max(d, std::abs(waypoints[i][j] - waypoints[i - 1][j]));
+      time += std::max(0.2, d / speed);
+    }
+    t.points.push_back(TrajectoryPoint{time, waypoints[i], {}});
+  }
+  return t;
+}
+
+double maxJointDelta(const std::vector<double>& a, const std::vector<double>& b) {
+  double d = 0.0;
+  for (std::size_t i = 0; i < std::min(a.size(), b.size()); ++i) d = std::max(d, std::abs(a[i] - b[i]));
+  return d;
+}
+
+}  // namespace
+
+std::string_view toString(TaskStatus s) {
+  switch (s) {
+    case TaskStatus::kSolved: return "solved";
+    case TaskStatus::kUnsolvable: return "unsolvable";
+    case TaskStatus::kFailed: return "failed";
+    case TaskStatus::kTimeout: return "timeout";
+    case TaskStatus::kInputError: return "input error";
+    case TaskStatus::kUnavailable: return "unavailable";
+  }
+  return "?";
+}
+std::string_view toString(MotionOutcome s) {
+  switch (s) {
+    case MotionOutcome::kSolved: return "solved";
+    case MotionOutcome::kNoPath: return "no path";
+    case MotionOutcome::kStartInCollision: return "start in collision";
+    case MotionOutcome::kGoalInCollision: return "goal in collision";
+    case MotionOutcome::kTimeout: return "timeout";
+    case MotionOutcome::kInvalid: return "invalid request";
+    case MotionOutcome::kUnavailable: return "unavailable";
+  }
+  return "?";
+}
+std::string_view toString(ExecOutcome o) {
+  switch (o) {
+    case ExecOutcome::kSucceeded: return "succeeded";
+    case ExecOutcome::kFailed: return "failed";
+    case ExecOutcome::kBlocked: return "blocked";
+    case ExecOutcome::kCancelled: return "cancelled";
+    case ExecOutcome::kTimeout: return "timeout";
+    case ExecOutcome::kUnavailable: return "unavailable";
+  }
+  return "?";
+}
+std::string_view toString(MissionOutcome o) {
+  switch (o) {
+    case MissionOutcome::kSucceeded: return "succeeded";
+    case MissionOutcome::kFailed: return "failed";
+    case MissionOutcome::kAborted: return "aborted";
+    case MissionOutcome::kTimeout: return "timeout";
+    case MissionOutcome::kInputError: return "input_error";
+    case MissionOutcome::kUnavailable: return "unavailable";
+  }
+  return "?";
+}
+
+GraphManager::GraphManager(Abstraction abstraction, std::string domain_pddl, MissionGoal goal,
+                           ServiceClients& services, GraphManagerParams params)
+    : abstraction_(std::move(abstraction)),
+      domain_(std::move(domain_pddl)),
+      goal_(std::move(goal)),
+      services_(services),
+      params_(params) {
+  if (auto why = params_.invalidReason()) throw std::invalid_argument("GraphManagerParams: " + *why);
+}
+
+bool GraphManager::isGoal(NodeId n) const {
+  const auto& atoms = graph_.node(n).atoms;
+  for (const auto& g : goal_.atoms) {
+    const auto t = atomTokens(g);
+    if (!t.empty() && t[0] == "not") {
+      std::string inner = "(";
+      for (std::size_t i = 1; i < t.size(); ++i) inner += (i > 1 ? " " : "") + t[i];
+      inner += ")";
+      if (std::binary_search(atoms.begin(), atoms.end(), inner)) return false;
+    } else {
+      std::string norm = "(";
+      for (std::size_t i = 0; i < t.size(); ++i) norm += (i ? " " : "") + t[i];
+      norm += ")";
+      if (!std::binary_search(atoms.begin(), atoms.end(), norm)) return false;
+    }
+  }
+  return true;
+}
+
+std::vector<std::string> GraphManager::withStatics(const std::vector<std::string>& dynamic) const {
+  std::vector<std::string> all = abstraction_.staticAtoms();
+  all.insert(all.end(), dynamic.begin(), dynamic.end());
+  return all;
+}
+
+BranchContext GraphManager::contextOf(const Observation& robot) const {
+  BranchContext c;
+  c.state = robot.robot;
+  if (!robot.held_object_id.empty()) {
+    c.held.object_id = robot.held_object_id;
+    c.held.link = abstraction_.robot().options().tool_link;
+    if (const auto& h = abstraction_.world().held(); h && h->object_id == robot.held_object_id) {
+      c.held.link = h->link;
+      c.held.link_T_object = h->link_T_object;
+    } else if (const world::Object* o = abstraction_.world().findObject(robot.held_object_id)) {
+      c.held.link_T_object = abstraction_.robot().toolPoseInWorld(robot.robot).inverse() * o->pose;
+    }
+  }
+  return c;
+}
+
+// ---- task planning ---------------------------------------------------------------------------------
+
+Result<std::vector<EdgeId>> GraphManager::planFrom(NodeId from, const std::vector<std::string>& goal,
+                                                   const std::string& origin) {
+  TaskQuery q;
+  q.domain_pddl = domain_;
+  q.objects = abstraction_.objects();
+  q.init = withStatics(graph_.node(from).atoms);
+  q.goal = goal;
+  q.budget_s = params_.plan_budget_s;
+  ++counters_.planner_calls;
+  TaskPlan p = services_.plan(q);
+  if (p.status != TaskStatus::kSolved) {
+    const ErrorCode code = p.status == TaskStatus::kUnsolvable  ? ErrorCode::kNotFound
+                           : p.status == TaskStatus::kTimeout    ? ErrorCode::kTimeout
+                           : p.status == TaskStatus::kInputError ? ErrorCode::kInvalidArgument
+                           : p.status == TaskStatus::kUnavailable ? ErrorCode::kUnavailable
+                                                                  : ErrorCode::kInternal;
+    return Error(code, "task planner (" + std::string(toString(p.status)) + "): " + p.message);
+  }
+  if (p.states.size() != p.actions.size() + 1)
+    return Error(ErrorCode::kInternal, "task planner: the plan's states do not match its actions");
+  // The planner's states may omit atoms it found static; apply its changes to the node's atoms.
+  std::vector<std::vector<std::string>> states{graph_.node(from).atoms};
+  for (std::size_t i = 0; i < p.actions.size(); ++i) {
+    std::set<std::string> prev(p.states[i].begin(), p.states[i].end());
+    std::set<std::string> next(p.states[i + 1].begin(), p.states[i + 1].end());
+    std::set<std::string> cur(states.back().begin(), states.back().end());
+    for (const auto& a : prev)
+      if (!next.count(a)) cur.erase(a);
+    for (const auto& a : next)
+      if (!prev.count(a)) cur.insert(a);
+    states.emplace_back(cur.begin(), cur.end());
+  }
+  return graph_.addPlan(p.actions, states, origin);
+}
+
+Status GraphManager::start(const world::World& live, const Observation& robot) {
+  const auto t0 = Clock::now();
+  abstraction_.setWorld(live);
+  const std::string armconf = "stow";
+  auto atoms = abstraction_.dynamicAtoms(live, robot.robot.base, armconf, robot.held_object_id);
+  root_ = graph_.addNode(atoms, "start");
+  auto plan = planFrom(root_, goal_.atoms, "plan 0");
+  planning_s_ += since(t0);
+  if (!plan) {
+    if (plan.error().code == ErrorCode::kNotFound)
+      return Error(ErrorCode::kNotFound, "the goal is unreachable: " + plan.error().message);
+    return plan.error();
+  }
+  return Status::Ok();
+}
+
+// ---- pricing ---------------------------------------------------------------------------------------
+
+std::pair<double, double> GraphManager::price(const EffortQuery& q) {
+  ++counters_.effort_calls;
+  auto a = services_.effort({q});
+  if (a.empty() || !a[0].ok) return {kInfinity, 0.0};
+  return {a[0].mean_s, a[0].stddev_s};
+}
+
+double GraphManager::lowerBound(const Edge& e) const {
+  if (e.kind != ActionKind::kMoveBase || e.tokens.size() < 3) return 0.0;
+  const auto a = abstraction_.locationPose(e.tokens[1]);
+  const auto b = abstraction_.locationPose(e.tokens[2]);
+  if (!a || !b) return 0.0;
+  return std::hypot(a->x - b->x, a->y - b->y) / params_.lower_bound_base_speed;
+}
+
+MotionQuery GraphManager::baseQuery(const Edge& e, const BranchContext& ctx) const {
+  MotionQuery q;
+  q.group = Group::kBase;
+  q.mode = e.variant == Variant::kAround ? Mode::kFull : Mode::kLazy;
+  q.start = ctx.state;
+  if (auto to = abstraction_.locationPose(e.tokens.size() > 2 ? e.tokens[2] : "")) q.goal_base = *to;
+  q.held = ctx.held;
+  for (const auto& [id, pose] : ctx.object_poses) q.overrides.push_back(ObjectOverride{id, false, pose});
+  q.movable_cost_weight = 0.0;  // the pure static-only lazy path
+  q.budget_s = params_.motion_budget_s;
+  return q;
+}
+
+double GraphManager::evaluateBase(Edge& e, const BranchContext& ctx, int depth) {
+  const MotionQuery q = baseQuery(e, ctx);
+  ++counters_.motion_calls;
+  MotionAnswer a = services_.motion(q);
+  if (!a.ok()) {
+    e.state = EdgeState::kInfeasible;
+    e.reason = std::string(toString(a.status)) + (a.reason.empty() ? "" : ": " + a.reason);
+    if (e.variant == Variant::kAround && params_.policy == Policy::kInfeasible && a.status == MotionOutcome::kNoPath &&
+        depth < params_.max_subtask_depth + 1) {
+      // Policy `infeasible`: only a proof that there is no way around lets objects be moved.
+      for (EdgeId twin : graph_.out(e.from)) {
+        Edge& d = graph_.edge(twin);
+        if (d.to == e.to && d.action == e.action && d.variant == Variant::kDirect && d.state == EdgeState::kLazy)
+          spawnSubtasks(twin, ctx, depth);
+      }
+    }
+    return kInfinity;
+  }
+  EdgeMotion m;
+  m.lazy_path = a.path;
+  for (const auto& c : a.blocking) {
+    if (c.object_id == ctx.held.object_id) continue;
+    m.blocking.push_back(c.object_id);
+    m.crossings.push_back(c);
+  }
+  m.trajectory = a.trajectory;
+  EffortQuery eq;
+  eq.kind = ActionKind::kMoveBase;
+  eq.path = a.path;
+  if (!ctx.held.object_id.empty())
+    if (const world::Object* o = abstraction_.world().findObject(ctx.held.object_id)) eq.object_mass = o->mass;
+  const auto [mean, sd] = price(eq);
+  e.motion = m;
+  if (e.variant == Variant::kDirect && !m.blocking.empty()) {
+    // Not executable as is: the detour is a parallel edge, removals are sub-tasks.
+    e.state = EdgeState::kLazy;
+    e.effort_mean_s = kInfinity;
+    std::string objs;
+    for (const auto& b : m.blocking) objs += (objs.empty() ? "" : ", ") + b;
+    e.reason = "the lazy path crosses " + objs;
+    graph_.addVariant(e.id, Variant::kAround, e.origin);
+    if (params_.policy == Policy::kEffort && depth <= params_.max_subtask_depth) spawnSubtasks(e.id, ctx, depth);
+    return kInfinity;
+  }
+  e.state = EdgeState::kFeasible;
+  e.effort_mean_s = mean;
+  e.effort_stddev_s = sd;
+  return mean;
+}
+
+std::optional<EdgeMotion> GraphManager::armTarget(const Edge& arm_edge, EdgeId next, const BranchContext& ctx,
+                                                  std::vector<double>& target, std::string& why) {
+  const robot::RobotModel& robot = abstraction_.robot();
+  const std::string to_conf = arm_edge.tokens.size() > 3 ? arm_edge.tokens[3] : "stow";
+  EdgeMotion m;
+  if (to_conf == "stow" || next < 0) {
+    auto named = robot.namedConfiguration(to_conf == "stow" ? "stow" : "ready");
+    if (!named) {
+      why = "the robot has no named configuration '" + to_conf + "'";
+      return std::nullopt;
+    }
+    target = *named;
+    return m;
+  }
+  const Edge& f = graph_.edge(next);
+  if (f.tokens.size() < 3) {
+    why = "malformed manipulation " + f.action;
+    return std::nullopt;
+  }
+  const std::string& object = f.tokens[1];
+  const std::string& region = f.tokens[2];
+  if (f.kind == ActionKind::kPick) {
+    char key[160];
+    std::snprintf(key, sizeof key, "%s@%.3f,%.3f,%.3f", object.c_str(), ctx.state.base.x, ctx.state.base.y,
+                  ctx.state.base.theta);
+    auto it = grasp_cache_.find(key);
+    if (it == grasp_cache_.end()) {
+      GraspQuery gq;
+      gq.object_id = object;
+      gq.base = ctx.state.base;
+      ++counters_.grasp_calls;
+      auto g = services_.grasps(gq);
+      it = grasp_cache_.emplace(key, g ? *g : std::vector<GraspOption>{}).first;
+      if (!g) why = "grasps of " + object + ": " + g.error().message;
+    }
+    if (it->second.empty()) {
+      if (why.empty()) why = "no grasp of " + object + " from the base pose of " + arm_edge.tokens[1];
+      return std::nullopt;
+    }
+    m.prepared = it->second.front();
+    target = m.prepared->pregrasp;
+    return m;
+  }
+  if (f.kind == ActionKind::kPlace) {
+    if (ctx.held.object_id != object) {
+      why = "place of " + object + " while not holding it";
+      return std::nullopt;
+    }
+    Eigen::Isometry3d place = Eigen::Isometry3d::Identity();
+    if (const Slot* s = abstraction_.slot(region)) {
+      place = s->pose;
+    } else {
+      const std::string key = object + "@" + region;
+      auto it = placement_cache_.find(key);
+      if (it == placement_cache_.end()) {
+        PlacementQuery pq;
+        pq.object_id = object;
+        pq.region_id = region;
+        pq.max_placements = 4;
+        ++counters_.placement_calls;
+        auto p = services_.placements(pq);
+        it = placement_cache_.emplace(key, p ? *p : std::vector<PlacementOption>{}).first;
+        if (!p) why = "placements of " + object + " on " + region + ": " + p.error().message;
+      }
+      // The placement reachable from this base pose.
+      bool found = false;
+      for (const auto& opt : it->second) {
+        const Eigen::Isometry3d world_T_tool = opt.object_pose * ctx.held.link_T_object.inverse();
+        const Eigen::Isometry3d base_T_tool = ctx.state.base.toIsometry(0.0).inverse() * world_T_tool;
+        robot::IkOptions io;
+        io.max_attempts = 12;
+        if (robot.inverseKinematics(base_T_tool, ctx.state.arm, io).ok()) {
+          place = opt.object_pose;
+          found = true;
+          break;
+        }
+      }
+      if (!found) {
+        if (why.empty()) why = "no placement of " + object + " on " + region + " reachable from " + arm_edge.tokens[1];
+        return std::nullopt;
+      }
+    }
+    const Eigen::Isometry3d world_T_tool = place * ctx.held.link_T_object.inverse();
+    Eigen::Isometry3d pre = world_T_tool;
+    pre.translation().z() += params_.approach_m;
+    const Eigen::Isometry3d base_inv = ctx.state.base.toIsometry(0.0).inverse();
+    robot::IkOptions io;
+    io.max_attempts = 24;
+    auto pre_ik = robot.inverseKinematics(base_inv * pre, ctx.state.arm, io);
+    if (!pre_ik.ok()) {
+      why = "the arm does not reach above the place pose of " + object + " on " + region;
+      return std::nullopt;
+    }
+    auto at_ik = robot.inverseKinematics(base_inv * world_T_tool, pre_ik.q, io);
+    if (!at_ik.ok()) {
+      why = "the arm does not reach the place pose of " + object + " on " + region;
+      return std::nullopt;
+    }
+    GraspOption g;
+    g.pregrasp = pre_ik.q;
+    g.grasp = at_ik.q;
+    g.base_pose = ctx.state.base;
+    g.gripper_in_object = ctx.held.link_T_object.inverse();
+    m.prepared = g;
+    m.prepared_place = place;
+    target = pre_ik.q;
+    return m;
+  }
+  auto named = robot.namedConfiguration("ready");
+  target = named ? *named : ctx.state.arm;
+  return m;
+}
+
+double GraphManager::evaluateArm(Edge& e, EdgeId next, const BranchContext& ctx) {
+  std::vector<double> target;
+  std::string why;
+  auto m = armTarget(e, next, ctx, target, why);
+  if (!m) {
+    e.reason = why;
+    e.effort_by_next[next] = {kInfinity, 0.0};
+    return kInfinity;
+  }
+  MotionQuery q;
+  q.group = Group::kArm;
+  q.mode = Mode::kFull;
+  q.start = ctx.state;
+  q.goal_arm = target;
+  q.held = ctx.held;
+  for (const auto& [id, pose] : ctx.object_poses) q.overrides.push_back(ObjectOverride{id, false, pose});
+  q.budget_s = params_.motion_budget_s;
+  ++counters_.motion_calls;
+  MotionAnswer a = services_.motion(q);
+  if (!a.ok()) {
+    e.reason = "arm motion: " + std::string(toString(a.status)) + (a.reason.empty() ? "" : ": " + a.reason);
+    e.effort_by_next[next] = {kInfinity, 0.0};
+    return kInfinity;
+  }
+  m->trajectory = a.trajectory;
+  m->lazy_path = a.path;
+  EffortQuery eq;
+  eq.kind = ActionKind::kMoveArm;
+  eq.path = a.path;
+  if (!ctx.held.object_id.empty())
+    if (const world::Object* o = abstraction_.world().findObject(ctx.held.object_id)) eq.object_mass = o->mass;
+  const auto [mean, sd] = price(eq);
+  e.motion_by_next[next] = *m;
+  e.effort_by_next[next] = {mean, sd};
+  e.state = EdgeState::kFeasible;
+  e.effort_mean_s = std::min(e.effort_mean_s, mean);
+  e.effort_stddev_s = sd;
+  return mean;
+}
+
+double GraphManager::evaluateManipulation(Edge& e, const BranchContext& ctx) {
+  const robot::RobotModel& robot = abstraction_.robot();
+  const std::string object = e.tokens.size() > 1 ? e.tokens[1] : "";
+  const world::Object* o = abstraction_.world().findObject(object);
+  if (!o) {
+    e.state = EdgeState::kInfeasible;
+    e.reason = "unknown object " + object;
+    return kInfinity;
+  }
+  std::optional<GraspOption> g = ctx.pending_grasp;
+  if (!g) {
+    e.state = EdgeState::kInfeasible;
+    e.reason = "no prepared " + std::string(e.kind == ActionKind::kPick ? "grasp" : "placement") + " for " + object;
+    return kInfinity;
+  }
+  EdgeMotion m;
+  m.object_id = object;
+  m.region_id = e.tokens.size() > 2 ? e.tokens[2] : "";
+  m.object_mass = o->mass;
+  m.gripper_in_object = g->gripper_in_object;
+  std::vector<std::vector<double>> wps;
+  wps.push_back(ctx.state.arm);
+  if (maxJointDelta(ctx.state.arm, g->pregrasp) > 1e-6) wps.push_back(g->pregrasp);
+  wps.push_back(g->grasp);
+  wps.push_back(g->pregrasp);
+  m.trajectory = timed(robot.armJointNames(), wps, 0.5);
+  const double approach = (robot.toolPose(g->pregrasp).translation() - robot.toolPose(g->grasp).translation()).norm();
+  m.approach_m = approach;
+  m.retreat_m = approach;
+  if (e.kind == ActionKind::kPlace) {
+    if (!ctx.pending_place) {
+      e.state = EdgeState::kInfeasible;
+      e.reason = "no place pose for " + object;
+      return kInfinity;
+    }
+    m.object_target = ctx.pending_place;
+  } else {
+    m.object_target = ctx.object_poses.count(object) ? ctx.object_poses.at(object) : o->pose;
+  }
+  EffortQuery eq;
+  eq.kind = e.kind;
+  eq.object_mass = o->mass;
+  eq.approach_m = m.approach_m;
+  eq.retreat_m = m.retreat_m;
+  const auto [mean, sd] = price(eq);
+  e.motion = m;
+  e.state = std::isfinite(mean) ? EdgeState::kFeasible : EdgeState::kInfeasible;
+  e.effort_mean_s = mean;
+  e.effort_stddev_s = sd;
+  return mean;
+}
+
+double GraphManager::evaluate(EdgeId id, EdgeId next, const BranchContext& ctx, int depth) {
+  Edge& e = graph_.edge(id);
+  ++counters_.evaluations;
+  switch (e.kind) {
+    case ActionKind::kMoveBase:
+      if (e.state != EdgeState::kUnevaluated) return e.effort_mean_s;
+      return evaluateBase(e, ctx, depth);
+    case ActionKind::kMoveArm: {
+      if (auto it = e.effort_by_next.find(next); it != e.effort_by_next.end()) return it->second.first;
+      return evaluateArm(e, next, ctx);
+    }
+    case ActionKind::kPick:
+    case ActionKind::kPlace:
+      return evaluateManipulation(e, ctx);
+  }
+  return kInfinity;
+}
+
+BranchContext GraphManager::advance(EdgeId id, EdgeId next, const BranchContext& ctx) const {
+  const Edge& e = graph_.edge(id);
+  BranchContext c = ctx;
+  switch (e.kind) {
+    case ActionKind::kMoveBase:
+      if (auto to = abstraction_.locationPose(e.tokens.size() > 2 ? e.tokens[2] : "")) c.state.base = *to;
+      break;
+    case ActionKind::kMoveArm: {
+      auto it = e.motion_by_next.find(next);
+      if (it != e.motion_by_next.end()) {
+        if (!it->second.trajectory.empty()) c.state.arm = it->second.trajectory.points.back().positions;
+        c.pending_grasp = it->second.prepared;
+        c.pending_place = it->second.prepared_place;
+      }
+      break;
+    }
+    case ActionKind::kPick:
+      if (e.motion && ctx.pending_grasp) {
+        c.held.object_id = e.motion->object_id;
+        c.held.link = abstraction_.robot().options().tool_link;
+        c.held.link_T_object = ctx.pending_grasp->gripper_in_object.inverse();
+        c.state.arm = ctx.pending_grasp->pregrasp;
+        c.object_poses.erase(e.motion->object_id);
+      }
+      c.pending_grasp.reset();
+      c.pending_place.reset();
+      break;
+    case ActionKind::kPlace:
+      if (e.motion && ctx.pending_grasp && ctx.pending_place) {
+        c.object_poses[e.motion->object_id] = *ctx.pending_place;
+        c.state.arm = ctx.pending_grasp->pregrasp;
+      }
+      c.held = HeldGrasp{};
+      c.pending_grasp.reset();
+      c.pending_place.reset();
+      break;
+  }
+  return c;
+}
+
+// ---- sub-tasks (findPossibleActions, findEffectStates, TP(v, s), TP(s, child)) -----------------------
+
+void GraphManager::spawnSubtasks(EdgeId id, const BranchContext& ctx, int depth) {
+  Edge& blocked = graph_.edge(id);
+  if (blocked.subtasks_spawned || !blocked.motion) return;
+  blocked.subtasks_spawned = true;
+  const NodeId v = blocked.from;
+  const NodeId child = blocked.to;
+  const EdgeMotion motion = *blocked.motion;
+  // The robot's base poses along the blocked path: placements must keep clear of them.
+  std::vector<Pose2D> swept;
+  for (const auto& w : motion.lazy_path.waypoints) {
+    if (w.size() >= 3) swept.push_back(Pose2D{w[0], w[1], w[2]});
+  }
+  const double radius = abstraction_.robot().baseRadius() + params_.keep_clear_margin_m;
+  int objects = 0;
+  for (const auto& crossing : motion.crossings) {
+    if (objects >= params_.max_blocking_objects) break;
+    const world::Object* o = abstraction_.world().findObject(crossing.object_id);
+    if (!o || !abstraction_.graspable(*o)) continue;  // findPossibleActions: only pick and place move objects
+    ++objects;
+    // A base pose beside the object from which the arm reaches it.
+    GraspQuery gq;
+    gq.object_id = o->id;
+    ++counters_.grasp_calls;
+    auto grasps = services_.grasps(gq);
+    if (!grasps || grasps->empty()) {
+      log::get("graph_manager")->info("no grasp of {} from any base pose: only the detour remains", o->id);
+      continue;
+    }
+    const std::string near = abstraction_.locationFor(grasps->front().base_pose, "near_" + o->id);
+    // findEffectStates: placements off the swept path, in the object's region first.
+    std::vector<std::string> regions;
+    if (!o->region.empty()) regions.push_back(o->region);
+    for (const auto& r : abstraction_.world().regions())
+      if (r.id != o->region) regions.push_back(r.id);
+    std::vector<std::string> slots;
+    for (const auto& r : regions) {
+      if (static_cast<int>(slots.size()) >= params_.placements_per_object) break;
+      PlacementQuery pq;
+      pq.object_id = o->id;
+      pq.region_id = r;
+      pq.keep_clear_path = swept;
+      pq.keep_clear_radius = radius;
+      pq.max_placements = static_cast<unsigned>(params_.placements_per_object);
+      ++counters_.placement_calls;
+      auto ps = services_.placements(pq);
+      if (!ps) continue;
+      for (const auto& p : *ps) {
+        if (static_cast<int>(slots.size()) >= params_.placements_per_object) break;
+        const std::string s = abstraction_.addSlot(o->id, r, p.object_pose);
+        abstraction_.locationFor(p.base_pose, "place_" + o->id);
+        slots.push_back(s);
+      }
+    }
+    (void)near;
+    // What the blocked action achieved: the sub-task's second plan must achieve it too.
+    const auto& va = graph_.node(v).atoms;
+    const auto& ca = graph_.node(child).atoms;
+    std::vector<std::string> progress;
+    for (const auto& a : ca)
+      if (!std::binary_search(va.begin(), va.end(), a)) progress.push_back(a);
+    for (const auto& s : slots) {
+      const std::string origin = "sub-task: move " + o->id + " to " + s;
+      auto before = planFrom(v, {"(on " + o->id + " " + s + ")"}, origin);
+      if (!before) continue;
+      ++counters_.subtasks;
+      const NodeId sj = before->empty() ? v : graph_.edge(before->back()).to;
+      NodeId end = sj;
+      if (!progress.empty()) {
+        auto after = planFrom(sj, progress, origin);
+        if (!after) continue;
+        if (!after->empty()) end = graph_.edge(after->back()).to;
+      }
+      if (!isGoal(end)) (void)planFrom(end, goal_.atoms, origin);
+    }
+  }
+  (void)ctx;
+  (void)depth;
+}
+
+// ---- branch-and-bound ----------------------------------------------------------------------------------
+
+struct GraphManager::Search {
+  Search(GraphManager& g, Clock::time_point start) : gm(g), t0(start) {}
+  GraphManager& gm;
+  Clock::time_point t0;
+  double best{kInfinity};
+  double best_sd2{0.0};
+  std::vector<EdgeId> best_branch;
+  std::map<EdgeId, double> best_through;
+  std::map<EdgeId, double> cut_bound;
+  int evaluations{0};
+  bool exhausted{false};
+  std::vector<EdgeId> branch;
+  std::vector<double> branch_sd2;
+
+  bool outOfBudget() {
+    if (evaluations >= gm.params_.max_evaluations || since(t0) > gm.params_.traverse_budget_s) {
+      exhausted = true;
+      return true;
+    }
+    return false;
+  }
+
+  bool onBranch(NodeId n) const {
+    for (EdgeId e : branch)
+      if (gm.graph_.edge(e).from == n) return true;
+    return false;
+  }
+
+  double known(EdgeId id) const {
+    const Edge& e = gm.graph_.edge(id);
+    if (e.state == EdgeState::kInfeasible || e.state == EdgeState::kLazy) return kInfinity;
+    if (e.kind == ActionKind::kMoveArm) return 0.0;  // priced with the manipulation that follows
+    if (e.kind != ActionKind::kMoveBase) return 0.0;
+    return e.state == EdgeState::kUnevaluated ? e.lower_bound_s : e.effort_mean_s;
+  }
+
+  void complete(double cost) {
+    if (cost < best) {
+      best = cost;
+      best_branch = branch;
+      best_sd2 = 0.0;
+      for (double s : branch_sd2) best_sd2 += s;
+    }
+    for (EdgeId e : branch) {
+      auto [it, fresh] = best_through.emplace(e, cost);
+      if (!fresh) it->second = std::min(it->second, cost);
+    }
+  }
+
+  void dfs(NodeId v, const BranchContext& ctx, double cost, int depth) {
+    if (gm.isGoal(v)) {
+      complete(cost);
+      return;
+    }
+    std::set<EdgeId> tried;
+    while (!outOfBudget()) {
+      // The untried out-edge with the least known or bounded effort (out(v) grows with sub-tasks).
+      EdgeId pick = -1;
+      double pick_cost = kInfinity;
+      for (EdgeId e : gm.graph_.out(v)) {
+        if (tried.count(e)) continue;
+        Edge& x = gm.graph_.edge(e);
+        if (x.state == EdgeState::kUnevaluated && x.lower_bound_s == 0.0) x.lower_bound_s = gm.lowerBound(x);
+        const double k = known(e);
+        if (pick < 0 || k < pick_cost) pick = e, pick_cost = k;
+      }
+      if (pick < 0) return;
+      tried.insert(pick);
+      Edge& e = gm.graph_.edge(pick);
+      if (e.to == v || onBranch(e.to)) continue;
+      if (!std::isfinite(pick_cost)) continue;
+      if (cost + pick_cost >= best) {
+        e.cut = true;
+        cut_bound[pick] = cost + pick_cost;
+        continue;
+      }
+      if (e.kind == ActionKind::kMoveArm) {
+        expandArm(pick, ctx, cost, depth);
+        continue;
+      }
+      ++evaluations;
+      const int sub_depth = depth + (e.origin.rfind("sub-task", 0) == 0 ? 1 : 0);
+      const double c = gm.evaluate(pick, -1, ctx, sub_depth);
+      if (!std::isfinite(c)) continue;
+      if (cost + c >= best) {
+        e.cut = true;
+        cut_bound[pick] = cost + c;
+        continue;
+      }
+      branch.push_back(pick);
+      branch_sd2.push_back(e.effort_stddev_s * e.effort_stddev_s);
+      dfs(e.to, gm.advance(pick, -1, ctx), cost + c, depth);
+      branch.pop_back();
+      branch_sd2.pop_back();
+    }
+  }
+
+  /// A move_arm edge: priced per manipulation that follows it (its target is their pre-grasp).
+  void expandArm(EdgeId arm, const BranchContext& ctx, double cost, int depth) {
+    const Edge& a = gm.graph_.edge(arm);
+    std::vector<EdgeId> nexts;
+    for (EdgeId f : gm.graph_.out(a.to))
+      if (gm.graph_.edge(f).kind == ActionKind::kPick || gm.graph_.edge(f).kind == ActionKind::kPlace) nexts.push_back(f);
+    if (nexts.empty() || (a.tokens.size() > 3 && a.tokens[3] == "stow")) nexts = {-1};
+    for (EdgeId f : nexts) {
+      if (outOfBudget()) return;
+      ++evaluations;
+      const double c = gm.evaluate(arm, f, ctx, depth);
+      if (!std::isfinite(c)) continue;
+      if (cost + c >= best) {
+        gm.graph_.edge(arm).cut = true;
+        cut_bound[arm] = cost + c;
+        continue;
+      }
+      const auto sd = gm.graph_.edge(arm).effort_by_next[f].second;
+      branch.push_back(arm);
+      branch_sd2.push_back(sd * sd);
+      const BranchContext next_ctx = gm.advance(arm, f, ctx);
+      if (f < 0) {
+        dfs(a.to, next_ctx, cost + c, depth);
+      } else {
+        // Evaluate the manipulation right away (it needs the prepared grasp or placement).
+        const Edge& fe = gm.graph_.edge(f);
+        ++evaluations;
+        const double cf = gm.evaluate(f, -1, next_ctx, depth);
+        if (std::isfinite(cf) && cost + c + cf < best && !onBranch(fe.to)) {
+          branch.push_back(f);
+          branch_sd2.push_back(fe.effort_stddev_s * fe.effort_stddev_s);
+          dfs(fe.to, gm.advance(f, -1, next_ctx), cost + c + cf, depth);
+          branch.pop_back();
+          branch_sd2.pop_back();
+        }
+      }
+      branch.pop_back();
+      branch_sd2.pop_back();
+    }
+  }
+};
+
+TraverseResult GraphManager::traverse(NodeId from, const BranchContext& context) {
+  const auto t0 = Clock::now();
+  ++traverse_count_;
+  TraverseResult r;
+  if (graph_.out(from).empty() && !isGoal(from)) {
+    auto plan = planFrom(from, goal_.atoms, "plan " + std::to_string(traverse_count_));
+    if (!plan) {
+      r.reason = plan.error().message;
+      r.time_s = since(t0);
+      planning_s_ += r.time_s;
+      return r;
+    }
+  }
+  Search s(*this, t0);
+  s.dfs(from, context, 0.0, 0);
+  r.evaluations = s.evaluations;
+  r.time_s = since(t0);
+  planning_s_ += r.time_s;
+  if (s.best_branch.empty() && !isGoal(from)) {
+    std::string why;
+    for (const Edge& e : graph_.edges())
+      if (!e.reason.empty()) why += (why.empty() ? "" : "; ") + e.action + ": " + e.reason;
+    r.reason = std::string(s.exhausted ? "no branch reaches the goal within the evaluation budget"
+                                       : "no branch reaches the goal") +
+               (why.empty() ? "" : " (" + why + ")");
+    return r;
+  }
+  r.found = true;
+  r.branch = s.best_branch;
+  r.cost_s = s.best;
+  r.stddev_s = std::sqrt(s.best_sd2);
+  recordDecisions(from, s.best_through, r.branch, r.cost_s, traverse_count_, s.cut_bound);
+  return r;
+}
+
+void GraphManager::recordDecisions(NodeId from, const std::map<EdgeId, double>& best_through,
+                                   const std::vector<EdgeId>& branch, double best_cost, int traverse_index,
+                                   const std::map<EdgeId, double>& cut_bounds) {
+  (void)best_cost;
+  std::vector<NodeId> nodes{from};
+  for (EdgeId e : branch) nodes.push_back(graph_.edge(e).to);
+  for (std::size_t i = 0; i < branch.size(); ++i) {
+    const NodeId n = nodes[i];
+    std::vector<Alternative> alts;
+    for (EdgeId e : graph_.out(n)) {
+      const Edge& x = graph_.edge(e);
+      if (x.state == EdgeState::kLazy) continue;  // a placeholder: its sub-tasks and detour are the options
+      Alternative a;
+      a.description = x.action + (x.variant == Variant::kAround ? " [around]" : "") + " <" + x.origin + ">";
+      if (auto it = best_through.find(e); it != best_through.end()) a.effort_s = it->second;
+      if (auto it = cut_bounds.find(e); it != cut_bounds.end() && !std::isfinite(a.effort_s)) {
+        a.cut = true;
+        a.bound_s = it->second;
+      }
+      a.chosen = e == branch[i];
+      alts.push_back(a);
+    }
+    if (alts.size() < 2) continue;
+    Decision d;
+    d.node = "n" + std::to_string(n);
+    d.what = "how to go on from " + d.node;
+    d.alternatives = alts;
+    d.traverse = traverse_index;
+    decisions_.push_back(std::move(d));
+  }
+}
+
+}  // namespace tamp::graph_manager

@@ -1,0 +1,89 @@
+#include "tamp/graph_manager/abstraction.h"
+
+#include <algorithm>
+
+#include <gtest/gtest.h>
+
+#include "tamp/core/paths.h"
+#include "tamp/world/scenario.h"
+
+namespace tamp::graph_manager {
+namespace {
+
+bool has(const std::vector<std::string>& v, const std::string& a) { return std::find(v.begin(), v.end(), a) != v.end(); }
+
+struct Fixture {
+  world::Scenario sc;
+  robot::RobotModel robot;
+};
+
+Fixture load(const std::string& name) {
+  auto sc = world::loadScenario(configDir() / "scenarios" / (name + ".yaml"));
+  EXPECT_TRUE(sc.ok()) << (sc ? "" : sc.error().toString());
+  auto robot = robot::RobotModel::loadDescription(sc->robot.description);
+  EXPECT_TRUE(robot.ok());
+  return {*sc, *robot};
+}
+
+TEST(AbstractionTest, MatchesTheScenarioDerivedProblemAtTheStart) {
+  auto f = load("occluded_can");
+  Abstraction a(f.sc.plannerWorld(), f.robot);
+  const auto atoms = a.dynamicAtoms(f.sc.plannerWorld(), f.sc.robot.start, "stow", "");
+  auto expected = world::toPddlProblem(f.sc, f.robot);
+  ASSERT_TRUE(expected.ok());
+  std::vector<std::string> mine = a.staticAtoms();
+  mine.insert(mine.end(), atoms.begin(), atoms.end());
+  std::sort(mine.begin(), mine.end());
+  // Same facts as the scenario's problem, which the tests already check against the hand-written one.
+  for (const auto& x : expected->init) EXPECT_TRUE(has(mine, x)) << x;
+  for (const auto& x : mine) EXPECT_TRUE(has(expected->init, x)) << x;
+}
+
+TEST(AbstractionTest, ACurrentBasePoseAwayFromEveryLocationBecomesALocation) {
+  auto f = load("namo_corridor");
+  Abstraction a(f.sc.plannerWorld(), f.robot);
+  const Pose2D somewhere{2.5, 1.2, 0.3};
+  const auto atoms = a.dynamicAtoms(f.sc.plannerWorld(), somewhere, "stow", "");
+  EXPECT_TRUE(has(atoms, "(robot-at here)"));
+  EXPECT_TRUE(has(a.objects(), "here - location"));
+  EXPECT_TRUE(has(a.staticAtoms(), "(reaches here stow)"));
+  // Within tolerance of a named location: that location.
+  const auto at_start = a.dynamicAtoms(f.sc.plannerWorld(), Pose2D{1.51, 1.2, 0.0}, "stow", "");
+  EXPECT_TRUE(has(at_start, "(robot-at start)"));
+}
+
+TEST(AbstractionTest, ASlotIsARegionWithItsOwnConfigurationAndBindsTheObjectPose) {
+  auto f = load("namo_corridor");
+  Abstraction a(f.sc.plannerWorld(), f.robot);
+  Eigen::Isometry3d pose = f.sc.world.object("box").pose;
+  pose.translation() += Eigen::Vector3d(-0.4, 0.6, 0.0);
+  const std::string s = a.addSlot("box", "free_patch", pose);
+  EXPECT_EQ(a.addSlot("box", "free_patch", pose), s) << "the same pose is the same slot";
+  EXPECT_TRUE(has(a.objects(), s + " - region"));
+  EXPECT_TRUE(has(a.staticAtoms(), "(conf-over over_" + s + " " + s + ")"));
+  const Binding b = a.bind({"(on box " + s + ")", "(robot-at start)", "(hand-empty)", "(arm-at stow)"});
+  ASSERT_TRUE(b.object_poses.count("box"));
+  EXPECT_NEAR((b.object_poses.at("box").translation() - pose.translation()).norm(), 0.0, 1e-12);
+  EXPECT_EQ(b.location, "start");
+  // An object standing on the slot's pose is on the slot.
+  world::World w = f.sc.plannerWorld();
+  ASSERT_TRUE(w.setObjectPose("box", pose).ok());
+  EXPECT_TRUE(has(a.dynamicAtoms(w, f.sc.robot.start, "stow", ""), "(on box " + s + ")"));
+}
+
+TEST(AbstractionTest, HeavyObjectsAreNotGraspable) {
+  auto f = load("namo_corridor");
+  AbstractionParams p;
+  p.payload_kg = 1.0;  // the box weighs 1.5 kg
+  Abstraction a(f.sc.plannerWorld(), f.robot, p);
+  EXPECT_FALSE(has(a.staticAtoms(), "(graspable box)"));
+  Abstraction b(f.sc.plannerWorld(), f.robot);
+  EXPECT_TRUE(has(b.staticAtoms(), "(graspable box)"));
+}
+
+TEST(AbstractionTest, AtomTokensNormalise) {
+  EXPECT_EQ(atomTokens("( On  Box\tfree_patch )"), (std::vector<std::string>{"on", "box", "free_patch"}));
+}
+
+}  // namespace
+}  // namespace tamp::graph_manager

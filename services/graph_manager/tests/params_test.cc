@@ -1,0 +1,37 @@
+#include "tamp/graph_manager/params.h"
+
+#include <gtest/gtest.h>
+
+#include "tamp/core/paths.h"
+
+namespace tamp::graph_manager {
+namespace {
+
+TEST(ParamsTest, TheShippedFileLoads) {
+  auto p = loadParams(configDir() / "services" / "graph_manager.yaml");
+  ASSERT_TRUE(p.ok()) << p.error().toString();
+  EXPECT_FALSE(p->invalidReason());
+}
+
+TEST(ParamsTest, ErrorsNameLineAndField) {
+  auto p = parseParams("policy: effort\nmax_evaluations: 0\n", "gm.yaml");
+  ASSERT_FALSE(p.ok());
+  EXPECT_NE(p.error().toString().find("gm.yaml:2"), std::string::npos) << p.error().toString();
+  EXPECT_NE(p.error().toString().find("max_evaluations"), std::string::npos);
+  auto q = parseParams("policy: greedy\n", "gm.yaml");
+  ASSERT_FALSE(q.ok());
+  EXPECT_NE(q.error().toString().find("unknown policy 'greedy'"), std::string::npos) << q.error().toString();
+  auto u = parseParams("polcy: effort\n", "gm.yaml");
+  EXPECT_FALSE(u.ok());
+}
+
+TEST(ParamsTest, ValidateMatchesTheLoader) {
+  GraphManagerParams p;
+  EXPECT_FALSE(p.invalidReason());
+  p.lower_bound_base_speed = 0;
+  ASSERT_TRUE(p.invalidReason());
+  EXPECT_NE(p.invalidReason()->find("lower_bound_base_speed"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace tamp::graph_manager

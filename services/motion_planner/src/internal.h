@@ -218,13 +218,15 @@ EvaluatedPath evaluatePath(Oracle& oracle, const og::PathGeometric& path, double
 
 /// What the static free space of one planning group depends on (the cache key of a
 /// StaticRoadmap): the static objects that are not ignored (by pointer, else by value), the held
-/// object (its geometry and where it sits on the hold link), and the joints the group does not
+/// object (its id and geometry -- not its world pose: it moves with the robot -- and where it
+/// sits on which link), and the joints the group does not
 /// move (base group: arm + gripper; arm group: base pose + gripper; whole body: gripper). The
 /// robot is fixed per planner. Movables are not part of it: they are only costs.
 struct StaticWorldKey {
   PlanningGroup group{PlanningGroup::kBase};
   std::vector<std::shared_ptr<const world::Object>> statics;  ///< sorted by id
-  std::shared_ptr<const world::Object> held;                  ///< or null
+  std::shared_ptr<const world::Object> held;                  ///< or null; compared by id and shape
+  std::string held_link;
   Eigen::Isometry3d link_T_held{Eigen::Isometry3d::Identity()};
   std::vector<double> fixed;
   bool operator==(const StaticWorldKey& o) const;

@@ -88,6 +88,14 @@ namespace {
 
 bool finite(const Pose2D& p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.theta); }
 
+/// Why `p` is not a rigid transform (a non-finite value, a rotation that is not orthonormal).
+std::optional<std::string> invalidPose(const Eigen::Isometry3d& p) {
+  if (!p.matrix().allFinite()) return std::string("not finite");
+  const Eigen::Matrix3d R = p.linear();
+  if (((R * R.transpose()) - Eigen::Matrix3d::Identity()).norm() > 1e-6) return std::string("rotation is not orthonormal");
+  return std::nullopt;
+}
+
 /// Base goal with a position tolerance and a free yaw (rotation-symmetric robots).
 class AnyYawGoal : public ob::GoalSampleableRegion {
  public:
@@ -158,30 +166,43 @@ MotionPlanner::Impl::Impl(MotionPlannerParams p, detail::RobotBinding r)
 
 Result<MotionPlanner::Impl::AttachGuard> MotionPlanner::Impl::attach(const std::string& object_id,
                                                                    const robot::RobotState& start,
-                                                                   const std::string& field,
+                                                                   const std::string& field, const HeldGrasp* grasp,
+                                                                   std::string* link_out,
                                                                    Eigen::Isometry3d* link_T_object_out) {
   const world::Object* obj = world.findObject(object_id);
   if (!obj) return Error(ErrorCode::kInvalidArgument, field + ": no object '" + object_id + "' in the world");
   if (obj->kind != world::ObjectKind::kMovable) {
     return Error(ErrorCode::kInvalidArgument, field + ": object '" + object_id + "' is static and cannot be held");
   }
+  std::string link = robot.holdLink();
   Eigen::Isometry3d link_T_object;
   const auto& held = world.held();
-  if (held && held->object_id == object_id && held->link == robot.holdLink()) {
+  if (grasp) {
+    if (!grasp->link.empty()) link = grasp->link;
+    link_T_object = grasp->link_T_object;
+  } else if (held && held->object_id == object_id && held->link == robot.holdLink()) {
     link_T_object = held->link_T_object;
   } else {
-    std::vector<Eigen::Isometry3d> poses;
-    robot.linkPoses(start, poses);
-    const auto& links = robot.geometry().links;
-    const auto it = std::find(links.begin(), links.end(), robot.holdLink());
-    const Eigen::Isometry3d world_T_link = poses[static_cast<std::size_t>(it - links.begin())];
-    link_T_object = world_T_link.inverse() * obj->pose;
+    const auto world_T_link = linkPose(start, link);
+    if (!world_T_link) return Error(ErrorCode::kInvalidArgument, field + ": the robot has no link '" + link + "'");
+    link_T_object = world_T_link->inverse() * obj->pose;
   }
+  if (link_out) *link_out = link;
   if (link_T_object_out) *link_T_object_out = link_T_object;
-  if (Status s = scene.attach(object_id, robot.holdLink(), link_T_object); !s) {
+  if (Status s = scene.attach(object_id, link, link_T_object); !s) {
     return Error(ErrorCode::kInvalidArgument, field + ": " + s.error().message);
   }
   return AttachGuard(&scene, object_id);
+}
+
+std::optional<Eigen::Isometry3d> MotionPlanner::Impl::linkPose(const robot::RobotState& s,
+                                                               const std::string& link) const {
+  const auto& links = robot.geometry().links;
+  const auto it = std::find(links.begin(), links.end(), link);
+  if (it == links.end()) return std::nullopt;
+  std::vector<Eigen::Isometry3d> poses;
+  robot.linkPoses(s, poses);
+  return poses[static_cast<std::size_t>(it - links.begin())];
 }
 
 detail::StaticRoadmap* MotionPlanner::Impl::roadmapFor(detail::StaticWorldKey key, const ob::StateSpacePtr& space,
@@ -205,7 +226,8 @@ detail::StaticRoadmap* MotionPlanner::Impl::roadmapFor(detail::StaticWorldKey ke
   return roadmaps.back().get();
 }
 
-double MotionPlanner::Impl::reachRadius(const robot::RobotState& s, const std::string& held) const {
+double MotionPlanner::Impl::reachRadius(const robot::RobotState& s, const std::string& held, const std::string& link,
+                                        const Eigen::Isometry3d& link_T_held) const {
   std::vector<Eigen::Isometry3d> poses;
   robot.linkPoses(s, poses);
   double r = 0.0;
@@ -217,9 +239,9 @@ double MotionPlanner::Impl::reachRadius(const robot::RobotState& s, const std::s
   for (const auto& p : robot.geometry().parts) extend(p.shape.aabb(poses[static_cast<std::size_t>(p.link)] * p.link_T_shape));
   if (!held.empty()) {
     if (const world::Object* o = world.findObject(held)) {
-      // Its pose relative to the hold link is fixed: at the start it is where the world has it
-      // (or where the world's held record puts it).
-      extend(o->aabb());
+      // Its pose relative to the link is fixed: at the start it is where the grasp puts it.
+      const auto world_T_link = linkPose(s, link);
+      extend(world_T_link ? o->shape.aabb(*world_T_link * link_T_held) : o->aabb());
     }
   }
   return r + 1e-3;
@@ -406,8 +428,82 @@ std::optional<std::string> validateRequest(const MotionRequest& r, const MotionP
   if (!std::isfinite(r.object_cost_scale) || r.object_cost_scale < 0) {
     return "object_cost_scale: must be finite and >= 0, got " + formatNumber(r.object_cost_scale);
   }
+  if (r.held_grasp) {
+    if (r.held_object.empty()) return std::string("held_grasp: given without held_object");
+    const auto& links = impl.robot.geometry().links;
+    if (!r.held_grasp->link.empty() && std::find(links.begin(), links.end(), r.held_grasp->link) == links.end()) {
+      return "held_grasp.link: the robot has no link '" + r.held_grasp->link + "'";
+    }
+    if (auto why = invalidPose(r.held_grasp->link_T_object)) return "held_grasp.link_T_object: " + *why;
+  }
   return std::nullopt;
 }
+
+/// The planner's world with the request's object overrides applied; errors name the override.
+Result<world::World> overriddenWorld(const world::World& base, const MotionRequest& r) {
+  world::World w = base;
+  for (std::size_t i = 0; i < r.object_overrides.size(); ++i) {
+    const ObjectOverride& o = r.object_overrides[i];
+    const std::string field = "object_overrides[" + std::to_string(i) + "]";
+    if (!base.findObject(o.object_id)) {
+      return Error(ErrorCode::kInvalidArgument, field + ".object_id: no object '" + o.object_id + "' in the world");
+    }
+    for (std::size_t j = 0; j < i; ++j) {
+      if (r.object_overrides[j].object_id == o.object_id) {
+        return Error(ErrorCode::kInvalidArgument, field + ".object_id: '" + o.object_id +
+                                                      "' is overridden twice (also object_overrides[" +
+                                                      std::to_string(j) + "])");
+      }
+    }
+    if (o.removed) {
+      if (o.object_id == r.held_object) {
+        return Error(ErrorCode::kInvalidArgument, field + ".removed: '" + o.object_id + "' is the held object");
+      }
+      if (Status s = w.removeObject(o.object_id); !s) {
+        return Error(ErrorCode::kInvalidArgument, field + ": " + s.error().message);
+      }
+      continue;
+    }
+    if (auto why = invalidPose(o.pose)) return Error(ErrorCode::kInvalidArgument, field + ".pose: " + *why);
+    if (Status s = w.setObjectPose(o.object_id, o.pose); !s) {
+      return Error(ErrorCode::kInvalidArgument, field + ".pose: " + s.error().message);
+    }
+  }
+  return w;
+}
+
+/// Puts the planner's scene and world back when a request planned in a hypothetical world ends.
+class WorldRestore {
+ public:
+  WorldRestore() = default;
+  WorldRestore(MotionPlanner::Impl& impl, world::World hypothetical) : impl_(&impl), saved_(impl.world) {
+    impl.world = std::move(hypothetical);
+    impl.scene.syncWorld(impl.world);
+  }
+  WorldRestore(WorldRestore&& o) noexcept : impl_(o.impl_), saved_(std::move(o.saved_)) { o.impl_ = nullptr; }
+  WorldRestore& operator=(WorldRestore&& o) noexcept {
+    if (this != &o) {
+      restore();
+      impl_ = o.impl_;
+      saved_ = std::move(o.saved_);
+      o.impl_ = nullptr;
+    }
+    return *this;
+  }
+  WorldRestore(const WorldRestore&) = delete;
+  WorldRestore& operator=(const WorldRestore&) = delete;
+  ~WorldRestore() { restore(); }
+
+ private:
+  void restore() {
+    if (!impl_) return;
+    impl_->world = std::move(saved_);
+    impl_->scene.syncWorld(impl_->world);
+    impl_ = nullptr;
+  }
+  MotionPlanner::Impl* impl_{nullptr};
+  world::World saved_;
+};
 
 }  // namespace
 
@@ -416,7 +512,8 @@ namespace {
 /// The cache key of the static free space of `group` (see detail::StaticWorldKey).
 detail::StaticWorldKey staticWorldKey(const MotionPlanner::Impl& impl, PlanningGroup group,
                                       const robot::RobotState& start, const std::string& held,
-                                      const Eigen::Isometry3d& link_T_held, const std::vector<std::string>& ignored) {
+                                      const std::string& held_link, const Eigen::Isometry3d& link_T_held,
+                                      const std::vector<std::string>& ignored) {
   detail::StaticWorldKey key;
   key.group = group;
   for (const auto& o : impl.world.objects()) {
@@ -426,6 +523,7 @@ detail::StaticWorldKey staticWorldKey(const MotionPlanner::Impl& impl, PlanningG
   }
   if (!held.empty()) {
     key.held = impl.world.objectPtr(held);
+    key.held_link = held_link;
     key.link_T_held = link_T_held;
   }
   if (group == PlanningGroup::kBase) key.fixed = start.arm;
@@ -461,20 +559,23 @@ Result<PrepareStats> MotionPlanner::prepare(PlanningGroup group, const robot::Ro
                            : impl.world.held() ? impl.world.held()->object_id
                                                : std::string();
   Impl::AttachGuard guard;
+  std::string held_link;
   Eigen::Isometry3d link_T_held = Eigen::Isometry3d::Identity();
   if (!held.empty()) {
-    auto g = impl.attach(held, state, held_object.empty() ? "world.held" : "held_object", &link_T_held);
+    auto g = impl.attach(held, state, held_object.empty() ? "world.held" : "held_object", nullptr, &held_link,
+                         &link_T_held);
     if (!g) return g.error();
     guard = std::move(*g);
   }
   const Aabb bounds = impl.baseBounds({{state.base.x, state.base.y}});
   detail::GroupSpace gs(impl.robot, group, state, bounds, P.sampling);
-  const double reach = group == PlanningGroup::kBase ? impl.reachRadius(state, held) : 0.0;
+  const double reach = group == PlanningGroup::kBase ? impl.reachRadius(state, held, held_link, link_T_held) : 0.0;
   detail::Oracle oracle(impl.scene, gs, {}, {}, reach);  // static checks only
   std::unique_ptr<detail::StaticRoadmap> uncached;
   bool reused = false;
   detail::StaticRoadmap* roadmap =
-      impl.roadmapFor(staticWorldKey(impl, group, state, held, link_T_held, {}), gs.space(), reused, uncached);
+      impl.roadmapFor(staticWorldKey(impl, group, state, held, held_link, link_T_held, {}), gs.space(), reused,
+                      uncached);
   out.built = !reused;
   // A new roadmap's samples, or the rest of an interrupted preparation's.
   if ((roadmap->uniformSamples() == 0 || roadmap->samplingInterrupted()) && P.lazy.roadmap_samples > 0) {
@@ -509,6 +610,14 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
   };
   const std::vector<std::string> names = groupJointNames(req.group);
   if (auto why = validateRequest(req, impl, names)) return finish(MotionStatus::kInvalidRequest, *why);
+  // The request's world: the planner's with the overrides applied, restored on every return
+  // (declared before the attachment so that the held object is detached first).
+  WorldRestore restore;
+  if (!req.object_overrides.empty()) {
+    auto hypothetical = overriddenWorld(impl.world, req);
+    if (!hypothetical) return finish(MotionStatus::kInvalidRequest, hypothetical.error().message);
+    restore = WorldRestore(impl, std::move(*hypothetical));
+  }
 
   // Base bounds: the world, the start and a base goal.
   std::vector<Eigen::Vector2d> extra{{req.start.base.x, req.start.base.y}};
@@ -526,9 +635,11 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
                            : impl.world.held() ? impl.world.held()->object_id
                                                : std::string();
   Impl::AttachGuard guard;
+  std::string held_link;
   Eigen::Isometry3d link_T_held = Eigen::Isometry3d::Identity();
   if (!held.empty()) {
-    auto g = impl.attach(held, req.start, req.held_object.empty() ? "world.held" : "held_object", &link_T_held);
+    auto g = impl.attach(held, req.start, req.held_object.empty() ? "world.held" : "held_object",
+                         req.held_grasp ? &*req.held_grasp : nullptr, &held_link, &link_T_held);
     if (!g) return finish(MotionStatus::kInvalidRequest, g.error().message);
     guard = std::move(*g);
   }
@@ -549,7 +660,8 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
     mi.object = impl.world.objectPtr(o.id);
     movables.push_back(std::move(mi));
   }
-  const double reach = req.group == PlanningGroup::kBase ? impl.reachRadius(req.start, held) : 0.0;
+  const double reach =
+      req.group == PlanningGroup::kBase ? impl.reachRadius(req.start, held, held_link, link_T_held) : 0.0;
   detail::Oracle oracle(impl.scene, gs, ignored, std::move(movables), reach);
   const bool lazy = req.mode == MotionMode::kLazy;
 
@@ -736,8 +848,8 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
   };
   if (lazy && P.lazy.optimize) {
     Stopwatch rw;
-    roadmap = impl.roadmapFor(staticWorldKey(impl, req.group, req.start, held, link_T_held, ignored), space,
-                              res.stats.roadmap_reused, uncached);
+    roadmap = impl.roadmapFor(staticWorldKey(impl, req.group, req.start, held, held_link, link_T_held, ignored),
+                              space, res.stats.roadmap_reused, uncached);
     // A roadmap new in this request knows no edge yet: lazy KPIECE goes first and seeds it.
     if (req.group == PlanningGroup::kBase && P.lazy.roadmap_first && res.stats.roadmap_reused &&
         !goal_states.empty()) {

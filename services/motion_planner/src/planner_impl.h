@@ -49,18 +49,25 @@ struct MotionPlanner::Impl {
     collision::Scene* scene_{nullptr};
     std::string id_;
   };
-  /// Attaches `object_id` (validated by the caller) in state `start`; the world's held record is
-  /// used when it names the same object. Errors name the field `field`.
+  /// Attaches `object_id` (validated by the caller) in state `start`: at `grasp` when given, else
+  /// with the world's held record when it names the same object, else where the object is now
+  /// relative to the hold link. Errors name the field `field`. `link_out`/`link_T_object_out`
+  /// receive where it was attached.
   Result<AttachGuard> attach(const std::string& object_id, const robot::RobotState& start,
-                             const std::string& field, Eigen::Isometry3d* link_T_object_out = nullptr);
+                             const std::string& field, const HeldGrasp* grasp = nullptr,
+                             std::string* link_out = nullptr, Eigen::Isometry3d* link_T_object_out = nullptr);
   /// The cached roadmap for `key` (moved to most recently used; `reused` tells whether it
   /// existed), or a new one, evicting the least recently used beyond
   /// LazyParams::roadmap_cache_entries; with 0 entries the new one lives in `scratch`.
   detail::StaticRoadmap* roadmapFor(detail::StaticWorldKey key, const detail::ob::StateSpacePtr& space,
                                     bool& reused, std::unique_ptr<detail::StaticRoadmap>& scratch);
 
-  /// The robot's xy radius about its base origin in state `s`, attached objects included.
-  double reachRadius(const robot::RobotState& s, const std::string& held) const;
+  /// The robot's xy radius about its base origin in state `s`, the object `held` (or none)
+  /// included where it sits on `link` at `link_T_held`.
+  double reachRadius(const robot::RobotState& s, const std::string& held = {}, const std::string& link = {},
+                     const Eigen::Isometry3d& link_T_held = Eigen::Isometry3d::Identity()) const;
+  /// World pose of `link` (a collision geometry link) in state `s`; nothing when unknown.
+  std::optional<Eigen::Isometry3d> linkPose(const robot::RobotState& s, const std::string& link) const;
   /// Base xy bounds: the world's bounds plus `extra` points, grown by the workspace margin.
   Aabb baseBounds(const std::vector<Eigen::Vector2d>& extra) const;
   /// Timing limits of a group's joints.

@@ -53,8 +53,11 @@ bool sameObject(const std::shared_ptr<const world::Object>& a, const std::shared
 
 bool StaticWorldKey::operator==(const StaticWorldKey& o) const {
   if (group != o.group || fixed != o.fixed || statics.size() != o.statics.size()) return false;
-  if (!sameObject(held, o.held)) return false;
-  if (held && !link_T_held.matrix().isApprox(o.link_T_held.matrix(), 1e-12)) return false;
+  if (!held != !o.held) return false;
+  if (held && (held != o.held && (held->id != o.held->id || !(held->shape == o.held->shape)))) return false;
+  if (held && (held_link != o.held_link || !link_T_held.matrix().isApprox(o.link_T_held.matrix(), 1e-12))) {
+    return false;
+  }
   for (std::size_t i = 0; i < statics.size(); ++i) {
     if (!sameObject(statics[i], o.statics[i])) return false;
   }

@@ -72,7 +72,8 @@
 /// **Scene**: one `collision::Scene` per planner mirrors the world (`setWorld` applies only the
 /// diff, so updates between calls are cheap); FCL is reached only through tamp::collision and
 /// OMPL only in this library's .cc files. A planner is not thread-safe (scene and roadmap cache
-/// are mutated by every call): one per thread, or calls serialised (the DDS node holds a mutex).
+/// are mutated by every call): one per thread, or calls serialised (the DDS node keeps a small
+/// pool of planners, each used by one request at a time).
 ///
 /// **Determinism**: call `seedRandomness()` once before the first planner exists (OMPL's global
 /// seed); the library's own samplers are seeded from `MotionPlannerParams::seed`.
@@ -129,6 +130,19 @@ struct MotionGoal {
   static MotionGoal endEffectorGoal(const Eigen::Isometry3d& world_T_tool);
 };
 
+/// A hypothetical world for one request: this object moved to `pose`, or absent.
+struct ObjectOverride {
+  std::string object_id;  ///< an object of the planner's world (planner view)
+  bool removed{false};    ///< treat as absent
+  Eigen::Isometry3d pose{Eigen::Isometry3d::Identity()};  ///< world_T_object when not removed
+};
+
+/// Where a held object sits on the robot: rigidly attached to `link` at `link_T_object`.
+struct HeldGrasp {
+  std::string link;  ///< a link of the robot's collision geometry; empty: the hold (tool) link
+  Eigen::Isometry3d link_T_object{Eigen::Isometry3d::Identity()};
+};
+
 struct MotionRequest {
   PlanningGroup group{PlanningGroup::kBase};
   MotionMode mode{MotionMode::kLazy};
@@ -138,7 +152,16 @@ struct MotionRequest {
   /// the world's `held()` names it, its `link_T_object` is used; otherwise the object keeps its
   /// current pose relative to the link at the start state.
   std::string held_object;
+  /// With `held_object`: the grasp to attach it with, overriding the world's held record and
+  /// the object's pose (which then does not matter: the object moves with `link`).
+  std::optional<HeldGrasp> held_grasp;
   std::vector<std::string> ignored_objects;  ///< treated as absent (e.g. the object to pick)
+  /// The request is planned in the planner's world with these objects moved or removed (e.g.
+  /// after a sampled placement of a blocking object); the world is restored afterwards. Each id
+  /// at most once, not the held object when removed. Overriding movables keeps the cached
+  /// roadmap of the static world (movables are costs, see "Roadmap cache"); overriding a static
+  /// object selects (and may build) the roadmap of another static world.
+  std::vector<ObjectOverride> object_overrides;
   /// Lazy mode: multiplier on every object's effort in the path cost. 1 (default): the effort
   /// model as it is; 0: ignore objects (the shortest static-free path); larger values avoid
   /// objects at the price of longer detours. Must be finite and >= 0.
@@ -218,6 +241,21 @@ using ObjectEffortFn = std::function<double(const world::Object&)>;
 /// The default effort model: pick + place + transfer with the effort estimator's default time
 /// models (tamp::effort_estimator::modelSpec defaults) and `params`.
 double defaultObjectEffort(const world::Object& object, const CostParams& params);
+
+/// The parameter values of one action kind's time model (e.g. the effort estimator's fit), by
+/// name (physical units, tamp::effort_estimator::modelSpec names); names not given keep their
+/// default.
+struct TimeModelValues {
+  ActionKind kind{ActionKind::kPick};
+  std::vector<std::string> names;
+  std::vector<double> values;  ///< one per name, finite and > 0
+};
+
+/// The effort model of defaultObjectEffort with the pick, place and move_base (transfer) time
+/// models of `models` (kinds not given, and other kinds, keep the defaults). Errors
+/// (kInvalidArgument): a name unknown to the kind's model, sizes that differ, a value that is
+/// not finite and positive -- each naming `models[i]` and the parameter.
+Result<ObjectEffortFn> fittedObjectEffort(const CostParams& params, const std::vector<TimeModelValues>& models);
 
 class MotionPlanner {
  public:

@@ -6,6 +6,7 @@
 #include <map>
 #include <numeric>
 #include <set>
+#include <sstream>
 
 #include <console_bridge/console.h>
 #include <tinyxml2.h>
@@ -210,6 +211,11 @@ Result<RobotModel> RobotModel::loadDescription(const std::filesystem::path& yaml
   r.optional("tool_link", o.tool_link);
   r.optional("gripper_joint", o.gripper_joint);
   r.optional("camera_frame", o.camera_frame);
+  if (r.required("payload", o.payload) && !(std::isfinite(o.payload) && o.payload >= 0)) {
+    std::ostringstream got;
+    got << o.payload;
+    r.fail("payload", "must be a finite mass >= 0 (kg), got " + got.str());
+  }
   {
     auto g = r.child("gripper", false);
     if (r.has("gripper")) {
@@ -666,6 +672,10 @@ const std::string& RobotModel::gripperJointName() const {
 JointLimits RobotModel::gripperLimits() const {
   return impl_->gripper_joint >= 0 ? impl_->joints[static_cast<size_t>(impl_->gripper_joint)].limits
                                    : JointLimits{};
+}
+
+double RobotModel::maxGraspWidth() const {
+  return impl_->gripper_joint >= 0 ? 2.0 * std::max(0.0, gripperLimits().upper) : 0.0;
 }
 
 std::vector<std::string> RobotModel::fullJointNames() const {

@@ -308,24 +308,54 @@ TEST(RobotDescriptionTest, BrokenDescriptionsNameTheField) {
     return RobotModel::loadDescription(dir / "robot.yaml");
   };
   const std::string file = (dir / "robot.yaml").string();
-  auto r1 = write("urdf: mobile_manipulator.urdf\nnamed_configurations:\n  stow: [0, 0, 0]\n");
+  auto r1 = write(
+      "urdf: mobile_manipulator.urdf\npayload: 5\nnamed_configurations:\n  stow: [0, 0, 0]\n");
   ASSERT_FALSE(r1.ok());
   EXPECT_EQ(r1.error().toString(),
-            file + ":3:9: field 'named_configurations.stow': has 3 values, the arm has 6 joints");
-  auto r2 =
-      write("urdf: mobile_manipulator.urdf\nnamed_configurations:\n  up: [0, 0, 9, 0, 0, 0]\n");
+            file + ":4:9: field 'named_configurations.stow': has 3 values, the arm has 6 joints");
+  auto r2 = write(
+      "urdf: mobile_manipulator.urdf\npayload: 5\nnamed_configurations:\n  up: [0, 0, 9, 0, 0, "
+      "0]\n");
   ASSERT_FALSE(r2.ok());
   EXPECT_EQ(r2.error().toString(),
-            file + ":3:7: field 'named_configurations.up': is outside the joint limits");
-  auto r3 = write("urdf: mobile_manipulator.urdf\ntool: gripper_tcp\n");
+            file + ":4:7: field 'named_configurations.up': is outside the joint limits");
+  auto r3 = write("urdf: mobile_manipulator.urdf\npayload: 5\ntool: gripper_tcp\n");
   ASSERT_FALSE(r3.ok());
-  EXPECT_EQ(r3.error().toString(), file +
-                                       ":2:1: field 'tool': unknown key 'tool' (expected one of: "
-                                       "base_link, camera_frame, gripper, "
-                                       "gripper_joint, named_configurations, tool_link, urdf)");
-  auto r4 = write("urdf: missing.urdf\n");
+  EXPECT_EQ(r3.error().toString(),
+            file +
+                ":3:1: field 'tool': unknown key 'tool' (expected one of: "
+                "base_link, camera_frame, gripper, "
+                "gripper_joint, named_configurations, payload, tool_link, urdf)");
+  auto r4 = write("urdf: missing.urdf\npayload: 5\n");
   ASSERT_FALSE(r4.ok());
   EXPECT_EQ(r4.error().code, ErrorCode::kNotFound);
+  // The payload: required, a finite mass >= 0, named by file:line:column and field.
+  auto p1 = write("urdf: mobile_manipulator.urdf\n");
+  ASSERT_FALSE(p1.ok());
+  EXPECT_EQ(p1.error().toString(), file + ":1:1: field 'payload': missing required field");
+  auto p2 = write("urdf: mobile_manipulator.urdf\npayload: -2\n");
+  ASSERT_FALSE(p2.ok());
+  EXPECT_EQ(p2.error().toString(),
+            file + ":2:10: field 'payload': must be a finite mass >= 0 (kg), got -2");
+  auto p3 = write("urdf: mobile_manipulator.urdf\npayload: .inf\n");
+  ASSERT_FALSE(p3.ok());
+  EXPECT_EQ(p3.error().toString(),
+            file + ":2:10: field 'payload': must be a finite mass >= 0 (kg), got inf");
+  auto p4 = write("urdf: mobile_manipulator.urdf\npayload: heavy\n");
+  ASSERT_FALSE(p4.ok());
+  EXPECT_NE(p4.error().toString().find(file + ":2:10: field 'payload': "), std::string::npos)
+      << p4.error().toString();
+  auto p5 = write("urdf: mobile_manipulator.urdf\npayload: 0\n");
+  ASSERT_TRUE(p5.ok()) << p5.error().toString();
+  EXPECT_DOUBLE_EQ(p5->payload(), 0.0);
+}
+
+TEST(RobotDescriptionTest, PayloadAndGripperWidth) {
+  auto r = RobotModel::loadDefault();
+  ASSERT_TRUE(r.ok()) << r.error().toString();
+  EXPECT_DOUBLE_EQ(r->payload(), 25.0);
+  EXPECT_DOUBLE_EQ(r->options().payload, 25.0);
+  EXPECT_DOUBLE_EQ(r->maxGraspWidth(), 0.08);  // 2 x the finger joint's 0.04 m
 }
 
 // ---- broken URDFs ------------------------------------------------------------------------------

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <set>
 #include <sstream>
@@ -167,9 +168,53 @@ std::optional<Shape> readShape(FieldReader& r) {
   return shape;
 }
 
-/// One object entry (world.objects, world.hidden_objects, faults[i].object).
+/// m: the narrowest horizontal width of a shape, across which the fingers close (boxes: the
+/// smaller footprint side; cylinders and spheres: the diameter; prisms: the polygon's minimum
+/// width, found perpendicular to an edge of its convex hull).
+double narrowestWidth(const Shape& s) {
+  switch (s.kind) {
+    case ShapeKind::kBox:
+      return std::min(s.size.x(), s.size.y());
+    case ShapeKind::kCylinder:
+    case ShapeKind::kSphere:
+      return 2 * s.radius;
+    case ShapeKind::kPrism: {
+      const Polygon2& p = s.polygon;
+      double best = std::numeric_limits<double>::infinity();
+      for (size_t i = 0; i < p.size(); ++i) {
+        for (size_t j = i + 1; j < p.size(); ++j) {
+          const Eigen::Vector2d d = p[j] - p[i];
+          if (d.norm() < 1e-12) continue;
+          const Eigen::Vector2d n = Eigen::Vector2d(-d.y(), d.x()).normalized();
+          double lo = 0, hi = 0;
+          for (const auto& q : p) {
+            const double h = n.dot(q - p[i]);
+            lo = std::min(lo, h);
+            hi = std::max(hi, h);
+          }
+          if (lo > -1e-9 || hi < 1e-9) best = std::min(best, hi - lo);  // a hull edge
+        }
+      }
+      return std::isfinite(best) ? best : 0.0;
+    }
+  }
+  return 0.0;
+}
+
+/// The robot's limits on grasping (from its description), for the graspability rules.
+struct GraspLimits {
+  double payload{0.0};    ///< kg
+  double max_width{0.0};  ///< m
+  std::string source;     ///< the robot description file, for messages
+};
+
+/// One object entry (world.objects, world.hidden_objects, faults[i].object). Graspability
+/// (docs/scenarios.md): `graspable: false` forbids a grasp; `graspable: true` on an object
+/// heavier than the payload is an error; without the flag an object is graspable when it is
+/// movable, within the payload and no wider than the open gripper. `limits` is null when the
+/// robot description failed to load (that error is reported; the flag is then taken as given).
 std::optional<Object> readObject(FieldReader& r, const World& w, bool hidden,
-                                 bool may_omit_pose = false) {
+                                 const GraspLimits* limits, bool may_omit_pose = false) {
   Object o;
   o.hidden = hidden;
   bool ok = r.required("id", o.id);
@@ -197,7 +242,7 @@ std::optional<Object> readObject(FieldReader& r, const World& w, bool hidden,
   else
     o.shape = *shape;
   r.optional("mass", o.mass);
-  r.optional("graspable", o.graspable);
+  const bool has_graspable = r.optional("graspable", o.graspable);
   const Region* on = nullptr;
   if (r.optional("on", o.region)) {
     on = w.findRegion(o.region);
@@ -243,6 +288,18 @@ std::optional<Object> readObject(FieldReader& r, const World& w, bool hidden,
   if (o.kind == ObjectKind::kStatic && o.graspable) {
     r.fail("graspable", "a static object cannot be graspable");
     return std::nullopt;
+  }
+  if (limits != nullptr && o.kind == ObjectKind::kMovable) {
+    if (has_graspable && o.graspable && o.mass > limits->payload) {
+      r.fail("graspable", "'" + o.id + "' weighs " + num(o.mass) +
+                              " kg, more than the robot's payload of " + num(limits->payload) +
+                              " kg (" + limits->source + "); a scenario may forbid a grasp, "
+                              "never allow one above the payload");
+      return std::nullopt;
+    }
+    if (!has_graspable) {
+      o.graspable = o.mass <= limits->payload && narrowestWidth(o.shape) <= limits->max_width;
+    }
   }
   return o;
 }
@@ -411,8 +468,9 @@ void readPerception(FieldReader& r, PerceptionPriors& p) {
   }
 }
 
-NamoOptions readNamoOptions(FieldReader& w) {
+NamoOptions readNamoOptions(FieldReader& w, const GraspLimits* limits) {
   NamoOptions o;
+  if (limits != nullptr) o.max_graspable_mass = limits->payload;
   if (!w.has("namo_options")) {
     w.ignore("namo_options");
     return o;
@@ -424,7 +482,13 @@ NamoOptions readNamoOptions(FieldReader& w) {
   n.optional("wall_height", o.wall_height);
   n.optional("movable_height", o.movable_height);
   n.optional("density", o.density);
-  n.optional("max_graspable_mass", o.max_graspable_mass);
+  if (n.optional("max_graspable_mass", o.max_graspable_mass) && limits != nullptr &&
+      o.max_graspable_mass > limits->payload) {
+    n.fail("max_graspable_mass", "must not exceed the robot's payload of " +
+                                     num(limits->payload) + " kg (" + limits->source + "), got " +
+                                     num(o.max_graspable_mass));
+    o.max_graspable_mass = limits->payload;
+  }
   n.optional("bare_robot_side", o.bare_robot_side);
   n.optional("robot", o.robot);
   n.optional("curve_segments", o.curve_segments);
@@ -480,10 +544,34 @@ Result<Scenario> parseScenarioImpl(const std::string& yaml_text, const std::stri
     }
   }
 
+  // ---- robot description (first: graspability follows its payload and gripper) ----
+  std::optional<robot::RobotModel> model;
+  FieldReader rb = r.child("robot");
+  {
+    auto desc = rb.has("description") ? readPath(rb, "description", true, true)
+                                      : std::optional<std::filesystem::path>(
+                                            configDir() / "robots" / "mobile_manipulator.yaml");
+    rb.ignore("description");
+    if (desc) {
+      sc.robot.description = *desc;
+      auto m = robot::RobotModel::loadDescription(*desc);
+      if (!m)
+        rb.fail("description", m.error().toString());
+      else
+        model = std::move(m).value();
+    }
+  }
+  std::optional<GraspLimits> grasp_limits;
+  if (model) {
+    grasp_limits = GraspLimits{model->payload(), model->maxGraspWidth(),
+                               sc.robot.description.string()};
+  }
+  const GraspLimits* limits = grasp_limits ? &*grasp_limits : nullptr;
+
   // ---- world ----
   FieldReader w = r.child("world");
   if (w.has("namo")) {
-    const NamoOptions nopt = readNamoOptions(w);
+    const NamoOptions nopt = readNamoOptions(w, limits);
     if (auto path = readPath(w, "namo", true, true); path && w.ok()) {
       auto nw = loadNamo(*path, nopt);
       if (!nw) {
@@ -571,7 +659,7 @@ Result<Scenario> parseScenarioImpl(const std::string& yaml_text, const std::stri
       // The held object may omit its pose: it is computed from the grasp below.
       const bool is_held = !held_id.empty() && e.has("id") && e.node()["id"].IsScalar() &&
                            e.node()["id"].Scalar() == held_id;
-      auto o = readObject(e, sc.world, hidden, is_held);
+      auto o = readObject(e, sc.world, hidden, limits, is_held);
       if (!o) continue;
       if (Status s = sc.world.addObject(*o); !s) e.fail("id", s.error().message);
     }
@@ -579,21 +667,7 @@ Result<Scenario> parseScenarioImpl(const std::string& yaml_text, const std::stri
   w.refuseUnknownKeys();
 
   // ---- robot ----
-  std::optional<robot::RobotModel> model;
-  FieldReader rb = r.child("robot");
   {
-    auto desc = rb.has("description") ? readPath(rb, "description", true, true)
-                                      : std::optional<std::filesystem::path>(
-                                            configDir() / "robots" / "mobile_manipulator.yaml");
-    rb.ignore("description");
-    if (desc) {
-      sc.robot.description = *desc;
-      auto m = robot::RobotModel::loadDescription(*desc);
-      if (!m)
-        rb.fail("description", m.error().toString());
-      else
-        model = std::move(m).value();
-    }
     // start: a location id or a pose (then location "start" is added)
     rb.ignore("start");
     const YAML::Node st = valueOf(rb, "start");
@@ -771,7 +845,7 @@ Result<Scenario> parseScenarioImpl(const std::string& yaml_text, const std::stri
     if (fault.kind == FaultKind::kObjectAppears) {
       FieldReader o = f.child("object");
       if (o.isMap()) {
-        fault.object = readObject(o, sc.world, false);
+        fault.object = readObject(o, sc.world, false, limits);
         if (fault.object && sc.world.findObject(fault.object->id) != nullptr) {
           o.fail("id", "'" + fault.object->id + "' already exists in the world");
         }
@@ -859,6 +933,7 @@ Result<Scenario> loadScenario(const std::filesystem::path& file) {
     if (!model) return model.error();
     NamoOptions o;
     o.robot_radius = model->baseRadius();
+    o.max_graspable_mass = model->payload();
     auto nw = loadNamo(file, o);
     if (!nw) return nw.error();
     Scenario sc;

@@ -322,17 +322,153 @@ world:
 goal: {pddl: ["(holding can)"]}
 )yaml";
 
+std::string replaced(std::string s, const std::string& from, const std::string& to) {
+  const auto pos = s.find(from);
+  if (pos == std::string::npos) throw std::logic_error("no '" + from + "' in the template");
+  return s.replace(pos, from.size(), to);
+}
+
+// ---- graspability: the robot's payload and gripper opening (docs/scenarios.md)
+
+/// kMinimal with the can's entry replaced by `object` (one line of the objects list).
+std::string withObject(const std::string& object) {
+  return replaced(kMinimal,
+                  "{id: can, kind: movable, shape: {type: cylinder, radius: 0.03, height: 0.12}, "
+                  "on: table, at: [1.5, 0], mass: 0.3, graspable: true}",
+                  object);
+}
+
+bool graspableIn(const std::string& yaml, const std::string& id) {
+  auto r = parseScenario(yaml, kFile);
+  EXPECT_TRUE(r.ok()) << r.error().toString();
+  return r.ok() && r->world.object(id).graspable;
+}
+
+TEST(ScenarioGraspabilityTest, WithoutTheFlagMovableWithinPayloadAndGripperOpening) {
+  ASSERT_DOUBLE_EQ(robotModel().payload(), 25.0);
+  ASSERT_DOUBLE_EQ(robotModel().maxGraspWidth(), 0.08);
+  const std::string cyl = "{id: can, kind: movable, shape: {type: cylinder, radius: 0.03, height: "
+                          "0.12}, on: table, at: [1.5, 0], mass: ";
+  EXPECT_TRUE(graspableIn(withObject(cyl + "0.3}"), "can"));
+  EXPECT_TRUE(graspableIn(withObject(cyl + "25}"), "can"));    // at the payload
+  EXPECT_FALSE(graspableIn(withObject(cyl + "25.5}"), "can"));  // above it
+  // Width: the narrowest horizontal extent against the 0.08 m opening.
+  const std::string box = "{id: can, kind: movable, on: table, at: [1.5, 0], mass: 1, shape: ";
+  EXPECT_TRUE(graspableIn(withObject(box + "{type: box, size: [0.08, 0.5, 0.1]}}"), "can"));
+  EXPECT_TRUE(graspableIn(withObject(box + "{type: box, size: [0.5, 0.07, 0.1]}}"), "can"));
+  EXPECT_FALSE(graspableIn(withObject(box + "{type: box, size: [0.09, 0.5, 0.1]}}"), "can"));
+  EXPECT_FALSE(graspableIn(withObject(box + "{type: cylinder, radius: 0.045, height: 0.1}}"), "can"));
+  EXPECT_TRUE(graspableIn(withObject(box + "{type: sphere, radius: 0.035}}"), "can"));
+  // A prism's minimum width: a thin diagonal bar (0.05 m wide, 0.4 m long) fits, an L does not.
+  EXPECT_TRUE(graspableIn(
+      withObject(box + "{type: prism, height: 0.1, polygon: [[0, 0], [0.3, 0.3], [0.265, 0.335], "
+                       "[-0.035, 0.035]]}}"),
+      "can"));
+  EXPECT_FALSE(graspableIn(
+      withObject(box + "{type: prism, height: 0.1, polygon: [[0, 0], [0.3, 0], [0.3, 0.05], "
+                       "[0.05, 0.05], [0.05, 0.3], [0, 0.3]]}}"),
+      "can"));
+  // Static objects never are (and the goal must not hold one: use a base goal here).
+  const std::string stat = replaced(
+      withObject("{id: can, kind: static, shape: {type: box, size: [0.05, 0.05, 0.1]}, on: table, "
+                 "at: [1.5, 0]}"),
+      "goal: {pddl: [\"(holding can)\"]}", "goal: {base: start}");
+  EXPECT_FALSE(graspableIn(stat, "can"));
+}
+
+TEST(ScenarioGraspabilityTest, TheFlagMayForbidButNeverAllowAboveThePayload) {
+  const std::string wide = "{id: can, kind: movable, shape: {type: box, size: [0.5, 0.5, 0.5]}, "
+                           "on: table, at: [1.5, 0], mass: ";
+  // false forbids a grasp that the rule would allow.
+  EXPECT_FALSE(graspableIn(
+      replaced(withObject("{id: can, kind: movable, shape: {type: cylinder, radius: 0.03, height: "
+                          "0.12}, on: table, at: [1.5, 0], mass: 0.3, graspable: false}"),
+               "goal: {pddl: [\"(holding can)\"]}", "goal: {base: start}"),
+      "can"));
+  // true asserts one the gripper model cannot judge (furniture moved whole), within the payload.
+  EXPECT_TRUE(graspableIn(withObject(wide + "20, graspable: true}"), "can"));
+  // true above the payload: an error naming file, line, column and field.
+  EXPECT_EQ(errorOf(withObject(wide + "30, graspable: true}")),
+            kFile + ":7:121: field 'world.objects[0].graspable': 'can' weighs 30 kg, more than the "
+                    "robot's payload of 25 kg (" +
+                (fs::path(TAMP_SOURCE_DIR) / "config/robots/mobile_manipulator.yaml").string() +
+                "); a scenario may forbid a grasp, never allow one above the payload");
+  // ... also for hidden objects and objects that appear in a fault.
+  const std::string hidden = replaced(
+      kMinimal, "goal:",
+      "  hidden_objects:\n    - {id: crate, kind: movable, shape: {type: box, size: [0.5, 0.5, "
+      "0.5]}, on: table, at: [1.2, 0], mass: 40, graspable: true}\ngoal:");
+  EXPECT_NE(errorOf(hidden).find(
+                "field 'world.hidden_objects[0].graspable': 'crate' weighs 40 kg, more than"),
+            std::string::npos)
+      << errorOf(hidden);
+  const std::string fault =
+      std::string(kMinimal) +
+      "faults:\n  - type: object_appears\n    at_time: 1\n    object: {id: crate, kind: "
+      "movable, shape: {type: box, size: [0.5, 0.5, 0.5]}, on: table, at: [1.2, 0], mass: 40, "
+      "graspable: true}\n";
+  EXPECT_NE(errorOf(fault).find(
+                "field 'faults[0].object.graspable': 'crate' weighs 40 kg, more than"),
+            std::string::npos)
+      << errorOf(fault);
+}
+
+TEST(ScenarioGraspabilityTest, NamoMassRuleFollowsThePayload) {
+  // namo_basic's box (23.3 kg at density 45) is within the 25 kg payload.
+  const Scenario basic = load("namo_basic");
+  EXPECT_NEAR(basic.world.object("movable_box").mass, 23.26, 0.01);
+  EXPECT_TRUE(basic.world.object("movable_box").graspable);
+  // At the loader's default density (31 kg) it is above the payload, so not graspable.
+  auto text = readTextFile(scenarioDir() / "namo_basic.yaml");
+  ASSERT_TRUE(text.ok());
+  const std::string dense = replaced(*text, "density: 45.0", "density: 60.0");
+  auto heavy = parseScenario(dense, (scenarioDir() / "dense.yaml").string());
+  ASSERT_TRUE(heavy.ok()) << heavy.error().toString();
+  EXPECT_NEAR(heavy->world.object("movable_box").mass, 31.02, 0.01);
+  EXPECT_FALSE(heavy->world.object("movable_box").graspable);
+  // max_graspable_mass may lower the limit ...
+  auto lower = parseScenario(replaced(*text, "density: 45.0", "max_graspable_mass: 20"),
+                             (scenarioDir() / "lower.yaml").string());
+  ASSERT_TRUE(lower.ok()) << lower.error().toString();
+  EXPECT_FALSE(lower->world.object("movable_box").graspable);
+  // ... never raise it above the payload.
+  const std::string above = replaced(*text, "density: 45.0", "max_graspable_mass: 50");
+  auto bad = parseScenario(above, (scenarioDir() / "above.yaml").string());
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().toString().find(
+                "field 'world.namo_options.max_graspable_mass': must not exceed the robot's "
+                "payload of 25 kg"),
+            std::string::npos)
+      << bad.error().toString();
+  // Moghaddam 07 at the default density: the same 22 of 27 movables as the former fixed 25 kg.
+  const Scenario m = load("namo_moghaddam_07");
+  int movable = 0, graspable = 0;
+  for (const auto& o : m.world.objects()) {
+    if (o.kind != ObjectKind::kMovable) continue;
+    ++movable;
+    graspable += o.graspable ? 1 : 0;
+    EXPECT_EQ(o.graspable, o.mass <= 25.0) << o.id;
+  }
+  EXPECT_EQ(movable, 27);
+  EXPECT_EQ(graspable, 22);
+  // A NAMO file loaded on its own follows the default robot's payload as well.
+  auto direct = loadScenario(fs::path(TAMP_BENCHMARKS_DIR) /
+                             "namo/moghaddam_planning_2016_benchmark/01/01.json");
+  ASSERT_TRUE(direct.ok()) << direct.error().toString();
+  int direct_movable = 0;
+  for (const auto& o : direct->world.objects()) {
+    if (o.kind != ObjectKind::kMovable) continue;
+    ++direct_movable;
+    EXPECT_EQ(o.graspable, o.mass <= robotModel().payload()) << o.id << " " << o.mass;
+  }
+  EXPECT_GT(direct_movable, 0);
+}
+
 TEST(ScenarioErrorsTest, MinimalLoads) {
   auto r = parseScenario(kMinimal, kFile);
   ASSERT_TRUE(r.ok()) << r.error().toString();
   EXPECT_EQ(r->robot.arm_configuration, "stow");
   EXPECT_EQ(r->domain, fs::path(TAMP_SOURCE_DIR) / "config/pddl/mobile_manipulation.pddl");
-}
-
-std::string replaced(std::string s, const std::string& from, const std::string& to) {
-  const auto pos = s.find(from);
-  if (pos == std::string::npos) throw std::logic_error("no '" + from + "' in the template");
-  return s.replace(pos, from.size(), to);
 }
 
 TEST(ScenarioErrorsTest, ExactMessages) {

@@ -75,6 +75,9 @@ struct RobotModelOptions {
   std::string camera_frame{"camera_optical_frame"};        ///< empty: no sensor
   double gripper_open{0.04};   ///< gripper joint value when open (m per finger)
   double gripper_closed{0.0};  ///< gripper joint value when closed
+  /// kg, >= 0: the heaviest object the robot may grasp and carry (the description's required
+  /// `payload`). 0 for a model loaded from a URDF alone: it grasps nothing.
+  double payload{0.0};
   /// Named arm configurations (arm joints in chain order), e.g. "stow" (the PDDL constant).
   std::vector<std::pair<std::string, std::vector<double>>> named_configurations;
 };
@@ -153,6 +156,13 @@ class RobotModel {
   const std::vector<JointLimits>& armLimits() const;
   const std::string& gripperJointName() const;  ///< empty when no gripper
   JointLimits gripperLimits() const;
+  /// kg: the heaviest object the robot may grasp (`options().payload`). Objects above it are
+  /// never graspable (world::Object::graspable; the scenario and NAMO loaders enforce it).
+  double payload() const { return options().payload; }
+  /// m: the widest object the open gripper closes around: twice the gripper joint's upper limit
+  /// (two symmetric fingers, one following the other as a mimic joint, that meet at 0); 0
+  /// without a gripper.
+  double maxGraspWidth() const;
   /// base_x, base_y, base_theta, the arm joints, then the gripper joint (if any): the joint-name
   /// convention of JointPath / Trajectory.
   std::vector<std::string> fullJointNames() const;

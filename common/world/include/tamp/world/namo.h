@@ -24,8 +24,10 @@
 /// pillars and bare static obstacles `wall_height` (1.0 m); by type: box 0.5, chair 0.9,
 /// stool 0.45, table 0.75, sofa 0.8, cabinet 1.2, bed 0.5, other/bare movables
 /// `movable_height` (0.5 m). Mass of a movable = `density` (60 kg/m^3) x footprint area x
-/// height, clamped to [1, 150] kg; graspable iff mass <= `max_graspable_mass` (25 kg) -- the
-/// PDDL domain moves objects by pick and place only, so "graspable" means "can be moved".
+/// height, clamped to [1, 150] kg; graspable iff mass <= `max_graspable_mass` -- the robot's
+/// payload when a scenario loads the world (tamp::robot::RobotModel::payload(), 25 kg for the
+/// shipped robot) -- the PDDL domain moves objects by pick and place only, so "graspable" means
+/// "can be moved".
 /// Ids: entity names lower-cased (bare SVGs: `wall_NN`, `movable_NN` in document order, the SVG
 /// id in the label). The world also gets a `floor` region over the drawing's extent and
 /// locations `start` and one per goal (the goal's id, or `goal` for bare SVGs).
@@ -45,7 +47,9 @@ struct NamoOptions {
   double wall_height{1.0};             ///< m, walls, pillars and bare static obstacles
   double movable_height{0.5};          ///< m, movables of unknown type and bare movables
   double density{60.0};                ///< kg/m^3, mass rule for movables
-  double max_graspable_mass{25.0};     ///< kg
+  /// kg: heavier movables are not graspable. The scenario loader sets it to the robot's payload
+  /// and refuses a larger value; 25 kg (the shipped robot's payload) for direct callers.
+  double max_graspable_mass{25.0};
   double bare_robot_side{0.5};         ///< m, bare SVGs: side of the robot square
   std::optional<double> scale;         ///< m per SVG user unit; overrides every other rule
   std::optional<double> robot_radius;  ///< m: scale so the benchmark robot's circumradius

@@ -9,7 +9,10 @@
 /// Loading validates everything it can and reports every error with file, line, column and field
 /// (tamp::config::FieldReader; unknown keys are refused): ids, references between objects,
 /// regions and locations, shapes, the arm configuration against the URDF's joint limits, the held
-/// object, fault timing, PDDL atom syntax and names. Paths inside a scenario are relative to the
+/// object, fault timing, PDDL atom syntax and names, and graspability against the robot
+/// description's payload and gripper opening (a `graspable: true` above the payload is an error;
+/// without the flag an object is graspable when movable, within the payload and no wider than the
+/// open gripper; docs/scenarios.md). Paths inside a scenario are relative to the
 /// scenario file; `${TAMP_BENCHMARKS_DIR}` and `${TAMP_CONFIG_DIR}` prefixes expand to
 /// tamp::benchmarksDir() / tamp::configDir() (the older `${TAMP_SHARED_DIR}/benchmarks` is
 /// accepted for `${TAMP_BENCHMARKS_DIR}`).

@@ -1,10 +1,12 @@
-// `tamp run [SCENARIO]`: starts every service of a deployment (config/deploy/local.yaml by default)
-// as supervised processes on one DDS domain, waits until each is alive (heartbeats), checks that
-// each answers a request (echo), prints the status table, and stops them (or keeps them running
-// with --keep-running, restarting any that crash). Logs go to out/run-<time>/<service>.log.
-//
-// The mission loop (graph manager + execution monitor) that turns this into an end-to-end mission
-// is not built yet; until then this is the whole main job, and it says so.
+// `tamp run [SCENARIO] [--policy effort|infeasible] [--out DIR] [--seed N]`: the main job. Starts
+// every service of a deployment (config/deploy/local.yaml by default) as supervised processes on
+// one DDS domain, waits until each is alive (heartbeats) and answers a request (echo), then sends
+// the scenario's mission to the graph manager and follows it: one line per executed action
+// (predicted and measured seconds), a progress bar weighted by predicted effort. At the end it
+// writes report.json, graph.dot/.svg and world.png/.svg into the run's folder beside every
+// service's log, stops the services (or keeps them with --keep-running) and exits with the
+// mission's code: 0 succeeded, 10 mission failed, 20 out of time, 30 bad input, 40 a service
+// unavailable. Without a scenario it only starts and checks the services.
 #include <signal.h>
 #include <unistd.h>
 
@@ -24,6 +26,7 @@
 #include "tamp/dds/heartbeat.h"
 #include "tamp/dds/service_node.h"
 #include "tamp/process/supervisor.h"
+#include "mission_run.h"
 
 namespace fs = std::filesystem;
 
@@ -85,7 +88,15 @@ int main(int argc, char** argv) {
   int domain = -1;
   bool keep = false;
   std::string out_dir = "out";
-  app.add_option("scenario", scenario, "scenario YAML (config/scenarios/...)");
+  std::string policy = "effort";
+  unsigned seed = 0;
+  double mission_timeout = 900.0;
+  app.add_option("scenario", scenario, "scenario YAML (config/scenarios/...) or NAMO world file");
+  app.add_option("--policy", policy, "effort (revise whenever cheaper) or infeasible (move objects only when no way around)")
+      ->check(CLI::IsMember({"effort", "infeasible"}));
+  app.add_option("--seed", seed, "seed of the mission's sampling (0: the graph manager's configured seed)");
+  app.add_option("--mission-timeout", mission_timeout, "give up on the mission after this many seconds")
+      ->check(CLI::PositiveNumber);
   app.add_option("--deployment", deployment_file, "deployment file: services to start")->check(CLI::ExistingFile);
   app.add_option("--domain", domain, "DDS domain id (default: $TAMP_DOMAIN_ID or 0)")->check(CLI::Range(0, 232));
   app.add_flag("--keep-running", keep, "keep the services running (supervised) until Ctrl-C");
@@ -97,9 +108,13 @@ int main(int argc, char** argv) {
     std::cerr << "tamp run: " << deployment.error().toString() << "\n";
     return tamp::cli::kExitInputError;
   }
-  if (!scenario.empty() && !fs::exists(scenario)) {
-    std::cerr << "tamp run: scenario file does not exist: " << scenario << "\n";
-    return tamp::cli::kExitInputError;
+  if (!scenario.empty()) {
+    // A bad scenario is an input error (file, line, field), found before any service starts.
+    if (auto bad = tamp::runner::checkScenario(scenario)) {
+      std::cerr << "tamp run: " << *bad << "\n";
+      return tamp::cli::kExitInputError;
+    }
+    scenario = fs::absolute(scenario).string();
   }
   auto dom = tamp::dds::resolveDomainId(domain);
   if (!dom) {
@@ -222,10 +237,17 @@ int main(int argc, char** argv) {
 
   if (scenario.empty()) {
     std::printf("\ntamp run: no scenario given: services only.\n");
-  } else {
-    std::printf("\ntamp run: scenario %s: the mission loop (graph manager, execution monitor) is not built yet,\n"
-                "so no mission is executed; the services above are what exists today.\n",
-                scenario.c_str());
+  } else if (rc == tamp::cli::kExitOk) {
+    tamp::runner::MissionOptions mo;
+    mo.scenario = scenario;
+    mo.policy = policy;
+    mo.seed = seed;
+    mo.timeout_s = mission_timeout;
+    mo.out_dir = run_dir;
+    rc = tamp::runner::runMission(*participant, mo, [&] {
+      sup.poll();
+      return g_stop != 0;
+    });
   }
   if (keep && rc == tamp::cli::kExitOk) {
     std::printf("tamp run: services running (supervised); Ctrl-C to stop.\n");

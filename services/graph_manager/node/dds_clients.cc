@@ -1,0 +1,339 @@
+#include "dds_clients.h"
+
+#include <chrono>
+
+#include "tamp/core/log.h"
+#include "tamp/dds/convert.h"
+
+namespace tamp::graph_manager {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+dds::RpcClientOptions rpcOptions() {
+  dds::RpcClientOptions o;
+  o.attempt_timeout_s = 2.0;
+  o.max_attempts = 4;
+  return o;
+}
+
+TaskStatus fromMsg(msg::PlanStatus s) {
+  switch (s) {
+    case msg::PlanStatus::PLAN_SOLVED: return TaskStatus::kSolved;
+    case msg::PlanStatus::PLAN_UNSOLVABLE: return TaskStatus::kUnsolvable;
+    case msg::PlanStatus::PLAN_TIMEOUT: return TaskStatus::kTimeout;
+    case msg::PlanStatus::PLAN_INVALID_INPUT: return TaskStatus::kInputError;
+    default: return TaskStatus::kFailed;
+  }
+}
+
+MotionOutcome fromMsg(msg::MotionStatus s) {
+  switch (s) {
+    case msg::MotionStatus::MOTION_SOLVED: return MotionOutcome::kSolved;
+    case msg::MotionStatus::MOTION_NO_PATH: return MotionOutcome::kNoPath;
+    case msg::MotionStatus::MOTION_START_IN_COLLISION: return MotionOutcome::kStartInCollision;
+    case msg::MotionStatus::MOTION_GOAL_IN_COLLISION: return MotionOutcome::kGoalInCollision;
+    case msg::MotionStatus::MOTION_TIMEOUT: return MotionOutcome::kTimeout;
+    default: return MotionOutcome::kInvalid;
+  }
+}
+
+}  // namespace
+
+DdsServiceClients::DdsServiceClients(std::shared_ptr<dds::Participant> p, robot::RobotModel robot)
+    : robot_(std::move(robot)),
+      plan_(p, dds::services::kPlan, rpcOptions()),
+      motion_(p, dds::services::kMotion, rpcOptions()),
+      placement_(p, dds::services::kPlacement, rpcOptions()),
+      grasp_(p, dds::services::kGrasp, rpcOptions()),
+      effort_(p, dds::services::kEffort, rpcOptions()) {}
+
+TaskPlan DdsServiceClients::plan(const TaskQuery& q) {
+  const auto t0 = Clock::now();
+  msg::PlanRequest req;
+  req.domain_pddl(q.domain_pddl);
+  req.objects(q.objects);
+  req.init(q.init);
+  req.goal(q.goal);
+  req.search(msg::SearchKind::SEARCH_DEFAULT);
+  req.use_costs(true);
+  TaskPlan out;
+  auto rep = plan_.call(req, dds::CallOptions{q.budget_s, {}});
+  out.time_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  if (!rep) {
+    out.status = rep.error().code == ErrorCode::kTimeout ? TaskStatus::kTimeout : TaskStatus::kUnavailable;
+    out.message = rep.error().message;
+    return out;
+  }
+  out.status = fromMsg(rep->status());
+  out.message = rep->header().message();
+  out.actions.assign(rep->actions().begin(), rep->actions().end());
+  for (const auto& s : rep->states()) out.states.emplace_back(s.atoms().begin(), s.atoms().end());
+  return out;
+}
+
+MotionAnswer DdsServiceClients::motion(const MotionQuery& q) {
+  msg::MotionRequest req;
+  req.group(q.group == Group::kBase ? msg::PlanningGroup::GROUP_BASE : msg::PlanningGroup::GROUP_ARM);
+  req.mode(q.mode == Mode::kLazy ? msg::MotionMode::MOTION_LAZY : msg::MotionMode::MOTION_FULL);
+  req.start_base(dds::toMsg(q.start.base));
+  std::vector<std::string> names = robot_.armJointNames();
+  std::vector<double> values = q.start.arm;
+  if (!robot_.gripperJointName().empty()) {
+    names.push_back(robot_.gripperJointName());
+    values.push_back(q.start.gripper);
+  }
+  req.start_joint_names(names);
+  req.start_joint_positions(values);
+  if (q.group == Group::kBase) {
+    req.goal_type(msg::GoalType::GOAL_BASE_POSE);
+    req.goal_base(dds::toMsg(q.goal_base));
+  } else {
+    req.goal_type(msg::GoalType::GOAL_CONFIGURATION);
+    req.goal_configuration(q.goal_arm);
+  }
+  req.held_object_id(q.held.object_id);
+  if (!q.held.object_id.empty()) {
+    req.held_grasp_given(true);
+    req.held_link(q.held.link);
+    req.held_link_T_object(dds::toMsg(q.held.link_T_object));
+  }
+  req.ignored_objects(q.ignored);
+  for (const auto& o : q.overrides) {
+    msg::ObjectOverride m;
+    m.object_id(o.object_id);
+    m.removed(o.removed);
+    m.pose(dds::toMsg(o.pose));
+    req.object_overrides().push_back(m);
+  }
+  req.movable_cost_weight(q.movable_cost_weight);
+  MotionAnswer a;
+  const auto t0 = Clock::now();
+  auto rep = motion_.call(req, dds::CallOptions{q.budget_s, {}});
+  a.time_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  if (!rep) {
+    a.status = rep.error().code == ErrorCode::kTimeout ? MotionOutcome::kTimeout : MotionOutcome::kUnavailable;
+    a.reason = rep.error().message;
+    return a;
+  }
+  if (rep->header().code() != msg::StatusCode::STATUS_OK) {
+    a.status = MotionOutcome::kInvalid;
+    a.reason = rep->header().message();
+    return a;
+  }
+  a.status = fromMsg(rep->status());
+  a.reason = rep->reason();
+  a.world_version = rep->world_version();
+  a.path_length = rep->path_length();
+  if (a.ok()) {
+    auto path = dds::fromMsg(rep->path(), "path");
+    auto traj = dds::fromMsg(rep->trajectory(), "trajectory");
+    if (!path || !traj) {
+      a.status = MotionOutcome::kInvalid;
+      a.reason = !path ? path.error().message : traj.error().message;
+      return a;
+    }
+    a.path = *path;
+    a.trajectory = *traj;
+  }
+  for (const auto& b : rep->blocking()) {
+    Crossing c;
+    c.object_id = b.object_id();
+    c.enter_fraction = b.enter_fraction();
+    c.exit_fraction = b.exit_fraction();
+    c.mass = b.mass();
+    c.effort_s = b.effort_s();
+    for (const auto& p : b.swept_base()) c.swept_base.push_back(Pose2D{p.x(), p.y(), p.theta()});
+    a.blocking.push_back(std::move(c));
+  }
+  return a;
+}
+
+Result<std::vector<PlacementOption>> DdsServiceClients::placements(const PlacementQuery& q) {
+  msg::PlacementRequest req;
+  req.object_id(q.object_id);
+  req.region_id(q.region_id);
+  for (const auto& p : q.keep_clear_path) req.keep_clear_path().push_back(dds::toMsg(p));
+  req.keep_clear_radius(q.keep_clear_radius);
+  req.max_placements(q.max_placements);
+  auto rep = placement_.call(req, dds::CallOptions{q.budget_s, {}});
+  if (!rep) return rep.error();
+  if (rep->header().code() != msg::StatusCode::STATUS_OK)
+    return Error(dds::fromMsg(rep->header().code()), rep->header().message());
+  std::vector<PlacementOption> out;
+  for (const auto& p : rep->placements()) {
+    auto pose = dds::fromMsg(p.object_pose(), "object_pose");
+    if (!pose) return pose.error();
+    PlacementOption o;
+    o.object_pose = *pose;
+    o.base_pose = Pose2D{p.base_pose().x(), p.base_pose().y(), p.base_pose().theta()};
+    o.arm.assign(p.arm_configuration().begin(), p.arm_configuration().end());
+    o.clearance = p.clearance();
+    out.push_back(o);
+  }
+  return out;
+}
+
+Result<std::vector<GraspOption>> DdsServiceClients::grasps(const GraspQuery& q) {
+  msg::GraspRequest req;
+  req.object_id(q.object_id);
+  req.base_given(q.base.has_value());
+  if (q.base) req.base_pose(dds::toMsg(*q.base));
+  req.max_grasps(q.max_grasps);
+  auto rep = grasp_.call(req, dds::CallOptions{q.budget_s, {}});
+  if (!rep) return rep.error();
+  if (rep->header().code() != msg::StatusCode::STATUS_OK)
+    return Error(dds::fromMsg(rep->header().code()), rep->header().message());
+  std::vector<GraspOption> out;
+  for (const auto& g : rep->grasps()) {
+    auto pose = dds::fromMsg(g.gripper_in_object(), "gripper_in_object");
+    if (!pose) return pose.error();
+    GraspOption o;
+    o.gripper_in_object = *pose;
+    o.base_pose = Pose2D{g.base_pose().x(), g.base_pose().y(), g.base_pose().theta()};
+    o.pregrasp.assign(g.pregrasp_configuration().begin(), g.pregrasp_configuration().end());
+    o.grasp.assign(g.grasp_configuration().begin(), g.grasp_configuration().end());
+    o.top = g.type() == msg::GraspType::GRASP_TOP;
+    out.push_back(o);
+  }
+  return out;
+}
+
+std::vector<EffortAnswer> DdsServiceClients::effort(const std::vector<EffortQuery>& qs) {
+  msg::EffortRequest req;
+  for (const auto& q : qs) {
+    msg::EffortQuery m;
+    m.kind(dds::toMsg(q.kind));
+    if (!q.path.empty()) m.path(dds::toMsg(q.path));
+    m.object_mass(q.object_mass);
+    m.approach_m(q.approach_m);
+    m.retreat_m(q.retreat_m);
+    req.queries().push_back(m);
+  }
+  std::vector<EffortAnswer> out(qs.size());
+  auto rep = effort_.call(req, dds::CallOptions{5.0, {}});
+  if (!rep) {
+    for (auto& a : out) a.message = rep.error().message;
+    return out;
+  }
+  for (std::size_t i = 0; i < out.size() && i < rep->estimates().size(); ++i) {
+    const auto& e = rep->estimates()[i];
+    out[i].ok = e.code() == msg::StatusCode::STATUS_OK;
+    out[i].mean_s = e.mean_s();
+    out[i].stddev_s = e.stddev_s();
+    out[i].message = e.message();
+  }
+  return out;
+}
+
+// ---- execution ---------------------------------------------------------------------------------------
+
+DdsExecutor::DdsExecutor(std::shared_ptr<dds::Participant> p, std::string mission_id)
+    : mission_id_(std::move(mission_id)),
+      writer_(p, dds::topics::kExecuteCommand),
+      reader_(p, dds::topics::kExecuteStatus, [this](const msg::ExecuteStatus& s, const dds::SampleMeta&) { onStatus(s); }) {}
+
+void DdsExecutor::onStatus(const msg::ExecuteStatus& s) {
+  const auto st = s.state();
+  if (st == msg::ExecState::EXEC_SUCCEEDED || st == msg::ExecState::EXEC_FAILED || st == msg::ExecState::EXEC_BLOCKED ||
+      st == msg::ExecState::EXEC_CANCELLED) {
+    std::lock_guard g(mutex_);
+    final_[s.command_id()] = s;
+    cv_.notify_all();
+  }
+}
+
+ExecutionReport DdsExecutor::execute(const EdgeCommand& c, double budget_s) {
+  ExecutionReport r;
+  if (!writer_.waitForReaders(Termination::after(10.0))) {
+    r.outcome = ExecOutcome::kUnavailable;
+    r.reason = "no execution monitor on this domain";
+    return r;
+  }
+  msg::ExecuteCommand m;
+  m.command_id(c.command_id);
+  m.mission_id(mission_id_);
+  m.edge_id(c.edge_id);
+  m.pddl_action(c.action);
+  m.kind(dds::toMsg(c.kind));
+  m.trajectory(dds::toMsg(c.trajectory));
+  m.object_id(c.object_id);
+  m.region_id(c.region_id);
+  if (c.object_target) {
+    m.object_target(dds::toMsg(*c.object_target));
+    m.object_target_given(true);
+  }
+  m.expected_duration_s(c.expected_s);
+  m.expected_stddev_s(c.expected_stddev_s);
+  m.world_version(c.world_version);
+  if (Status s = writer_.write(m); !s) {
+    r.outcome = ExecOutcome::kUnavailable;
+    r.reason = s.error().message;
+    return r;
+  }
+  std::unique_lock lock(mutex_);
+  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(budget_s));
+  if (!cv_.wait_until(lock, deadline, [&] { return final_.count(c.command_id) > 0; })) {
+    lock.unlock();
+    msg::ExecuteCommand cancel = m;
+    cancel.cancel(true);
+    (void)writer_.write(cancel);
+    r.outcome = ExecOutcome::kTimeout;
+    r.reason = "no result within " + std::to_string(budget_s) + " s";
+    return r;
+  }
+  const msg::ExecuteStatus s = final_.at(c.command_id);
+  switch (s.state()) {
+    case msg::ExecState::EXEC_SUCCEEDED: r.outcome = ExecOutcome::kSucceeded; break;
+    case msg::ExecState::EXEC_BLOCKED: r.outcome = ExecOutcome::kBlocked; break;
+    case msg::ExecState::EXEC_CANCELLED: r.outcome = ExecOutcome::kCancelled; break;
+    default: r.outcome = ExecOutcome::kFailed; break;
+  }
+  r.measured_s = s.measured_duration_s() > 0 ? s.measured_duration_s() : s.elapsed_s();
+  r.reason = s.reason();
+  r.blocking_object_id = s.blocking_object_id();
+  r.held_object_id = s.held_object_id();
+  return r;
+}
+
+// ---- world ---------------------------------------------------------------------------------------------
+
+DdsWorldSource::DdsWorldSource(std::shared_ptr<dds::Participant> p, robot::RobotModel robot)
+    : robot_(std::move(robot)),
+      mirror_(p),
+      state_(p, dds::topics::kRobotState, [this](const msg::RobotState& s, const dds::SampleMeta&) {
+        std::lock_guard g(mutex_);
+        last_ = s;
+      }) {}
+
+Observation DdsWorldSource::robot() {
+  Observation o;
+  std::optional<msg::RobotState> s;
+  {
+    std::lock_guard g(mutex_);
+    s = last_;
+  }
+  if (!s) return o;
+  auto st = robot_.fromJointValues(std::vector<std::string>(s->joint_names().begin(), s->joint_names().end()),
+                                   std::vector<double>(s->joint_positions().begin(), s->joint_positions().end()),
+                                   robot_.defaultState());
+  if (!st) return o;
+  o.robot = *st;
+  o.robot.base = Pose2D{s->base().x(), s->base().y(), s->base().theta()};
+  o.held_object_id = s->held_object_id();
+  o.valid = true;
+  return o;
+}
+
+bool DdsWorldSource::waitReady(const Termination& until) {
+  while (!until()) {
+    {
+      std::lock_guard g(mutex_);
+      if (last_ && mirror_.publishedVersion() > 0) return true;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return false;
+}
+
+}  // namespace tamp::graph_manager

@@ -1,0 +1,72 @@
+#pragma once
+/// @file
+/// The graph manager's reach into the other services over DDS: `ServiceClients` over the
+/// planner, motion-planner and effort-estimator request/reply services, `Executor` over the
+/// execution monitor's command and status topics, `WorldSource` over the world model and the
+/// robot state. Every call has a deadline; failures are values.
+
+#include <condition_variable>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+
+#include "tamp/dds/participant.h"
+#include "tamp/dds/rpc.h"
+#include "tamp/dds/topics.h"
+#include "tamp/dds/world_sync.h"
+#include "tamp/graph_manager/graph_manager.h"
+
+namespace tamp::graph_manager {
+
+class DdsServiceClients : public ServiceClients {
+ public:
+  DdsServiceClients(std::shared_ptr<dds::Participant> p, robot::RobotModel robot);
+  TaskPlan plan(const TaskQuery& q) override;
+  MotionAnswer motion(const MotionQuery& q) override;
+  Result<std::vector<PlacementOption>> placements(const PlacementQuery& q) override;
+  Result<std::vector<GraspOption>> grasps(const GraspQuery& q) override;
+  std::vector<EffortAnswer> effort(const std::vector<EffortQuery>& q) override;
+
+ private:
+  robot::RobotModel robot_;
+  dds::RpcClient<msg::PlanRequest, msg::PlanReply> plan_;
+  dds::RpcClient<msg::MotionRequest, msg::MotionReply> motion_;
+  dds::RpcClient<msg::PlacementRequest, msg::PlacementReply> placement_;
+  dds::RpcClient<msg::GraspRequest, msg::GraspReply> grasp_;
+  dds::RpcClient<msg::EffortRequest, msg::EffortReply> effort_;
+};
+
+class DdsExecutor : public Executor {
+ public:
+  DdsExecutor(std::shared_ptr<dds::Participant> p, std::string mission_id);
+  ExecutionReport execute(const EdgeCommand& command, double budget_s) override;
+  void setMission(const std::string& id) { mission_id_ = id; }
+
+ private:
+  void onStatus(const msg::ExecuteStatus& s);
+  std::string mission_id_;
+  dds::Writer<msg::ExecuteCommand> writer_;
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  std::map<std::string, msg::ExecuteStatus> final_;
+  dds::Reader<msg::ExecuteStatus> reader_;
+};
+
+class DdsWorldSource : public WorldSource {
+ public:
+  DdsWorldSource(std::shared_ptr<dds::Participant> p, robot::RobotModel robot);
+  world::World world() override { return mirror_.snapshot(); }
+  Observation robot() override;
+  /// Waits until a robot state and a world model have arrived.
+  bool waitReady(const Termination& until);
+
+ private:
+  robot::RobotModel robot_;
+  dds::WorldMirror mirror_;
+  std::mutex mutex_;
+  std::optional<msg::RobotState> last_;
+  dds::Reader<msg::RobotState> state_;
+};
+
+}  // namespace tamp::graph_manager

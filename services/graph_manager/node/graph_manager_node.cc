@@ -1,0 +1,226 @@
+#include "graph_manager_node.h"
+
+#include <chrono>
+
+#include "tamp/core/log.h"
+#include "tamp/core/paths.h"
+#include "tamp/dds/convert.h"
+#include "tamp/graph_manager/report.h"
+#include "tamp/world/scenario.h"
+
+namespace tamp::graph_manager {
+namespace {
+
+const std::shared_ptr<spdlog::logger>& logger() {
+  static const auto l = tamp::log::get("graph_manager");
+  return l;
+}
+
+Policy fromMsg(msg::EffortPolicy p, Policy fallback) {
+  switch (p) {
+    case msg::EffortPolicy::POLICY_EFFORT_BASED: return Policy::kEffort;
+    case msg::EffortPolicy::POLICY_INFEASIBILITY_ONLY: return Policy::kInfeasible;
+    default: return fallback;
+  }
+}
+
+msg::MissionState stateOf(const std::string& s) {
+  if (s == "planning") return msg::MissionState::MISSION_PLANNING;
+  if (s == "executing") return msg::MissionState::MISSION_EXECUTING;
+  if (s == "replanning") return msg::MissionState::MISSION_REPLANNING;
+  if (s == "succeeded") return msg::MissionState::MISSION_SUCCEEDED;
+  if (s == "aborted") return msg::MissionState::MISSION_ABORTED;
+  return msg::MissionState::MISSION_FAILED;
+}
+
+/// The mission goal as atoms: the scenario's PDDL goal, object-in-region goals and the base goal
+/// (a location; a bare pose becomes one).
+Result<MissionGoal> goalOf(const world::Scenario& sc, const robot::RobotModel& robot, Abstraction& abs) {
+  auto problem = world::toPddlProblem(sc, robot);
+  if (!problem) return problem.error();
+  MissionGoal g;
+  g.atoms = problem->goal;
+  if (sc.goal.base && sc.goal.base_location.empty())
+    g.atoms.push_back("(robot-at " + abs.locationFor(*sc.goal.base, "goal") + ")");
+  if (g.atoms.empty()) return Error(ErrorCode::kInvalidArgument, sc.file.string() + ": goal: the scenario has no goal");
+  return g;
+}
+
+}  // namespace
+
+Result<std::unique_ptr<dds::ServiceNode>> GraphManagerNode::create(const dds::ServiceArgs& args) {
+  const std::filesystem::path file =
+      args.config_file.empty() ? configDir() / "services" / "graph_manager.yaml" : std::filesystem::path(args.config_file);
+  auto params = loadParams(file);
+  if (!params) return params.error();
+  return std::unique_ptr<dds::ServiceNode>(new GraphManagerNode(args, *params));
+}
+
+GraphManagerNode::GraphManagerNode(const dds::ServiceArgs& args, GraphManagerParams params)
+    : dds::ServiceNode(args),
+      args_(args),
+      params_(params),
+      status_(participant(), dds::topics::kMissionStatus),
+      graph_(participant(), dds::topics::kGraph) {
+  thread_ = std::jthread([this](std::stop_token st) { worker(st); });
+  commands_ = std::make_unique<dds::Reader<msg::MissionCommand>>(
+      participant(), dds::topics::kMissionCommand,
+      [this](const msg::MissionCommand& c, const dds::SampleMeta&) { onCommand(c); });
+}
+
+GraphManagerNode::~GraphManagerNode() {
+  commands_.reset();
+  abort_ = true;
+  thread_.request_stop();
+  cv_.notify_all();
+}
+
+void GraphManagerNode::onCommand(const msg::MissionCommand& c) {
+  std::lock_guard g(mutex_);
+  if (c.abort()) {
+    if (c.mission_id() == running_) abort_ = true;
+    return;
+  }
+  if (c.mission_id().empty() || seen_.count(c.mission_id())) return;  // idempotent on mission id
+  seen_.insert(c.mission_id());
+  queue_.push_back(c);
+  cv_.notify_all();
+}
+
+void GraphManagerNode::worker(std::stop_token stop) {
+  while (!stop.stop_requested()) {
+    msg::MissionCommand c;
+    {
+      std::unique_lock lock(mutex_);
+      cv_.wait(lock, stop, [&] { return !queue_.empty(); });
+      if (stop.stop_requested()) return;
+      c = queue_.front();
+      queue_.pop_front();
+      running_ = c.mission_id();
+      abort_ = false;
+    }
+    try {
+      runOne(c);
+    } catch (const std::exception& e) {
+      logger()->error("mission {}: {}", c.mission_id(), e.what());
+      publish(c.mission_id(), msg::MissionState::MISSION_FAILED, std::string("internal error: ") + e.what());
+    }
+  }
+}
+
+void GraphManagerNode::publish(const std::string& mission, msg::MissionState state, const std::string& message) {
+  current_.mission_id(mission);
+  current_.state(state);
+  current_.message(message);
+  current_.stamp_ns(dds::nowNs());
+  if (Status s = status_.write(current_); !s) logger()->warn("mission status: {}", s.error().message);
+}
+
+void GraphManagerNode::runOne(const msg::MissionCommand& c) {
+  const auto t0 = std::chrono::steady_clock::now();
+  current_ = msg::MissionStatus{};
+  const std::string id = c.mission_id();
+  auto fail = [&](MissionOutcome o, const std::string& why) {
+    MissionReport r;
+    r.status = o;
+    r.reason = why;
+    current_.report_json(reportJson(r, c.scenario_path(), "", c.seed()));
+    publish(id, msg::MissionState::MISSION_FAILED, why);
+  };
+  const std::string scenario_path = c.scenario_path().empty() ? args_.scenario_file : c.scenario_path();
+  auto sc = world::loadScenario(scenario_path);
+  if (!sc) return fail(MissionOutcome::kInputError, "bad scenario: " + sc.error().toString());
+  auto robot = robot::RobotModel::loadDescription(sc->robot.description);
+  if (!robot) return fail(MissionOutcome::kInputError, "bad robot description: " + robot.error().toString());
+  auto domain = readTextFile(sc->domain);
+  if (!domain) return fail(MissionOutcome::kInputError, "bad PDDL domain: " + domain.error().toString());
+
+  GraphManagerParams p = params_;
+  p.policy = fromMsg(c.policy(), params_.policy);
+  if (c.seed() != 0) p.seed = c.seed();
+  if (c.max_replans() > 0) p.max_replans = static_cast<int>(c.max_replans());
+
+  DdsServiceClients clients(participant(), *robot);
+  DdsExecutor executor(participant(), id);
+  DdsWorldSource source(participant(), *robot);
+  publish(id, msg::MissionState::MISSION_PLANNING, "waiting for the world model and the robot state");
+  if (!source.waitReady(Termination::after(30.0)))
+    return fail(MissionOutcome::kUnavailable, "no world model or robot state within 30 s (perception, sim running?)");
+
+  Abstraction abs(source.world(), *robot);
+  auto goal = goalOf(*sc, *robot, abs);
+  if (!goal) return fail(MissionOutcome::kInputError, "bad goal: " + goal.error().toString());
+  GraphManager gm(std::move(abs), *domain, *goal, clients, p);
+  logger()->info("mission {}: scenario {}, policy {}, goal {} atoms", id, sc->name, toString(p.policy), goal->atoms.size());
+
+  MissionObserver obs;
+  obs.on_state = [&](const std::string& s, const std::string& m) {
+    current_.elapsed_s(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    const auto st = stateOf(s);
+    if (st == msg::MissionState::MISSION_SUCCEEDED || st == msg::MissionState::MISSION_FAILED ||
+        st == msg::MissionState::MISSION_ABORTED)
+      return;  // the final status carries the report, below
+    if (s == "executing") current_.current_action(m);
+    publish(id, st, m);
+  };
+  obs.on_action = [&](const ExecutedAction& a, double done, double total) {
+    current_.last_action(a.action + (a.variant == "around" ? " [around]" : ""));
+    current_.last_predicted_s(a.predicted_s);
+    current_.last_measured_s(a.measured_s);
+    current_.last_outcome(a.outcome);
+    current_.done_predicted_s(done);
+    current_.predicted_total_s(total);
+    if (a.outcome == "succeeded") current_.actions_done(current_.actions_done() + 1);
+    publish(id, msg::MissionState::MISSION_EXECUTING, a.action + " " + a.outcome);
+  };
+  obs.on_graph = [&](const ReachabilityGraph& g, const std::vector<EdgeId>& best, NodeId node) {
+    msg::GraphSnapshot s;
+    s.mission_id(id);
+    s.version(g.version());
+    s.current_node("n" + std::to_string(node));
+    for (const Node& n : g.nodes()) {
+      msg::GraphNode m;
+      m.id("n" + std::to_string(n.id));
+      m.atoms(n.atoms);
+      m.healthy(n.healthy);
+      s.nodes().push_back(m);
+    }
+    double cost = 0.0;
+    for (const Edge& e : g.edges()) {
+      msg::GraphEdge m;
+      m.id("e" + std::to_string(e.id));
+      m.from_node("n" + std::to_string(e.from));
+      m.to_node("n" + std::to_string(e.to));
+      m.action(e.action);
+      m.kind(dds::toMsg(e.kind));
+      m.state(static_cast<msg::EdgeState>(static_cast<int>(e.state)));
+      m.effort_mean_s(std::isfinite(e.effort_mean_s) ? e.effort_mean_s : -1.0);
+      m.effort_stddev_s(e.effort_stddev_s);
+      if (e.motion) m.blocking_objects(e.motion->blocking);
+      s.edges().push_back(m);
+    }
+    for (EdgeId e : best) {
+      s.best_branch().push_back("e" + std::to_string(e));
+      cost += std::isfinite(g.edge(e).effort_mean_s) ? g.edge(e).effort_mean_s : 0.0;
+    }
+    s.best_cost_s(cost);
+    current_.actions_planned(static_cast<uint32_t>(best.size()) + current_.actions_done());
+    if (Status st = graph_.write(s); !st) logger()->warn("graph snapshot: {}", st.error().message);
+  };
+  obs.abort_requested = [&] { return abort_.load(); };
+
+  MissionReport r = gm.runMission(source, executor, obs);
+  current_.elapsed_s(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  current_.replans(static_cast<uint32_t>(r.replans));
+  current_.report_json(reportJson(r, scenario_path, std::string(toString(p.policy)), p.seed));
+  current_.graph_dot(r.graph_dot);
+  logger()->info("mission {}: {} ({}) executed {:.1f} s, predicted {:.1f} s, planning {:.2f} s", id,
+                 toString(r.status), r.reason, r.executed_effort_s, r.predicted_effort_s, r.planning_time_s);
+  publish(id,
+          r.status == MissionOutcome::kSucceeded ? msg::MissionState::MISSION_SUCCEEDED
+          : r.status == MissionOutcome::kAborted ? msg::MissionState::MISSION_ABORTED
+                                                 : msg::MissionState::MISSION_FAILED,
+          r.reason);
+}
+
+}  // namespace tamp::graph_manager

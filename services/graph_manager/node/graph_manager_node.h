@@ -1,0 +1,51 @@
+#pragma once
+/// @file
+/// The graph manager's DDS adapter: takes `MissionCommand`s (tamp/mission/command), runs each
+/// mission with the graph_manager library on its own thread, and publishes `MissionStatus`
+/// (transient-local; the final one carries the JSON report and the graph) and `GraphSnapshot`
+/// (after every Traverse). It reaches the planners, the effort estimator and the execution
+/// monitor through dds_clients.h.
+
+#include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <thread>
+
+#include "dds_clients.h"
+#include "tamp/dds/service_node.h"
+#include "tamp/graph_manager/params.h"
+
+namespace tamp::graph_manager {
+
+class GraphManagerNode : public dds::ServiceNode {
+ public:
+  /// Reads `args.config_file` (default: configDir()/services/graph_manager.yaml). Errors: bad
+  /// parameters (exit 30).
+  static Result<std::unique_ptr<dds::ServiceNode>> create(const dds::ServiceArgs& args);
+  GraphManagerNode(const dds::ServiceArgs& args, GraphManagerParams params);
+  ~GraphManagerNode() override;
+
+ private:
+  void onCommand(const msg::MissionCommand& c);
+  void worker(std::stop_token stop);
+  void runOne(const msg::MissionCommand& c);
+  void publish(const std::string& mission, msg::MissionState state, const std::string& message);
+
+  dds::ServiceArgs args_;
+  GraphManagerParams params_;
+  dds::Writer<msg::MissionStatus> status_;
+  dds::Writer<msg::GraphSnapshot> graph_;
+  std::mutex mutex_;
+  std::condition_variable_any cv_;
+  std::deque<msg::MissionCommand> queue_;
+  std::set<std::string> seen_;
+  std::atomic<bool> abort_{false};
+  std::string running_;
+  msg::MissionStatus current_;
+  std::jthread thread_;
+  std::unique_ptr<dds::Reader<msg::MissionCommand>> commands_;
+};
+
+}  // namespace tamp::graph_manager

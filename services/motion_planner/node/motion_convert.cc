@@ -84,10 +84,30 @@ Result<MotionRequest> fromMsg(const msg::MotionRequest& m, const MotionPlanner& 
     default: return bad("goal_type", "unknown value " + std::to_string(static_cast<unsigned>(m.goal_type())));
   }
   r.held_object = m.held_object_id();
+  if (m.held_grasp_given()) {
+    if (r.held_object.empty()) return bad("held_grasp_given", "true without held_object_id");
+    auto t = dds::fromMsg(m.held_link_T_object(), "held_link_T_object");
+    if (!t) return t.error();
+    r.held_grasp = HeldGrasp{m.held_link(), *t};
+  }
   r.ignored_objects.assign(m.ignored_objects().begin(), m.ignored_objects().end());
+  for (std::size_t i = 0; i < m.object_overrides().size(); ++i) {
+    const msg::ObjectOverride& o = m.object_overrides()[i];
+    const std::string field = "object_overrides[" + std::to_string(i) + "]";
+    if (o.object_id().empty()) return bad(field + ".object_id", "empty");
+    ObjectOverride ov;
+    ov.object_id = o.object_id();
+    ov.removed = o.removed();
+    if (!o.removed()) {
+      auto p = dds::fromMsg(o.pose(), field + ".pose");
+      if (!p) return p.error();
+      ov.pose = *p;
+    }
+    r.object_overrides.push_back(std::move(ov));
+  }
   const double w = m.movable_cost_weight();
   if (!std::isfinite(w) || w < 0) return bad("movable_cost_weight", "must be finite and >= 0");
-  r.object_cost_scale = w == 0 ? 1.0 : w;
+  r.object_cost_scale = w;
   return r;
 }
 
@@ -107,11 +127,31 @@ msg::MotionReply toMsg(const MotionResult& r) {
     o.exit_waypoint(static_cast<uint32_t>(b.exit_waypoint));
     for (const auto& p : b.swept_base) o.swept_base().push_back(dds::toMsg(p));
     o.mass(b.mass);
+    o.effort_s(b.effort_s);
     m.blocking().push_back(std::move(o));
   }
   m.path_length(r.path_length);
   m.planning_time_s(r.planning_time_s);
+  m.cost_s(r.cost_s);
   return m;
+}
+
+Result<std::vector<TimeModelValues>> fromMsg(const msg::EffortModelSnapshot& m) {
+  std::vector<TimeModelValues> out;
+  for (std::size_t i = 0; i < m.models().size(); ++i) {
+    const msg::ActionTimeModel& a = m.models()[i];
+    const std::string field = "models[" + std::to_string(i) + "]";
+    if (a.values().size() != a.parameter_names().size()) {
+      return bad(field + ".values", std::to_string(a.values().size()) + " values for " +
+                                        std::to_string(a.parameter_names().size()) + " parameter_names");
+    }
+    TimeModelValues v;
+    v.kind = dds::fromMsg(a.kind());
+    v.names.assign(a.parameter_names().begin(), a.parameter_names().end());
+    v.values.assign(a.values().begin(), a.values().end());
+    out.push_back(std::move(v));
+  }
+  return out;
 }
 
 Result<PlacementRequest> fromMsg(const msg::PlacementRequest& m) {

@@ -48,6 +48,7 @@ Result<NodeConfig> parseNodeConfig(const std::string& yaml_text, const std::stri
   r.optional("world_wait_s", c.world_wait_s);
   r.optional("prepare", c.prepare);
   r.optional("prepare_budget_s", c.prepare_budget_s);
+  r.optional("planners", c.planners);
   r.check(c.robot == "mobile_manipulator" || c.robot == "disc", "robot",
           "must be 'mobile_manipulator' or 'disc', got '" + c.robot + "'");
   r.check(std::isfinite(c.disc_radius) && c.disc_radius > 0, "disc_radius", "must be positive");
@@ -56,6 +57,7 @@ Result<NodeConfig> parseNodeConfig(const std::string& yaml_text, const std::stri
   r.check(std::isfinite(c.default_budget_s) && c.default_budget_s > 0, "default_budget_s", "must be positive");
   r.check(std::isfinite(c.world_wait_s) && c.world_wait_s >= 0, "world_wait_s", "must be >= 0");
   r.check(std::isfinite(c.prepare_budget_s) && c.prepare_budget_s > 0, "prepare_budget_s", "must be positive");
+  r.check(c.planners >= 1 && c.planners <= 16, "planners", "must be in [1, 16]");
   r.refuseUnknownKeys();
   if (!r.ok()) return r.status().error();
   if (!urdf.empty()) {
@@ -82,36 +84,57 @@ Result<std::unique_ptr<dds::ServiceNode>> MotionPlannerNode::create(const dds::S
 }
 
 Result<std::unique_ptr<MotionPlannerNode>> MotionPlannerNode::create(const dds::ServiceArgs& args, NodeConfig config) {
-  seedRandomness(config.params.seed);
-  if (config.robot == "disc") {
-    MotionPlanner planner(collision::RobotGeometry::disc(config.disc_radius, config.disc_height), config.params);
-    return std::unique_ptr<MotionPlannerNode>(new MotionPlannerNode(args, std::move(config), std::move(planner)));
+  if (config.planners < 1 || config.planners > 16) {
+    return Error(ErrorCode::kInvalidArgument, "node.planners: must be in [1, 16], got " + std::to_string(config.planners));
   }
-  auto model = config.urdf.empty() ? robot::RobotModel::loadDefault() : robot::RobotModel::loadFile(config.urdf);
-  if (!model) return model.error();
-  MotionPlanner planner(std::move(*model), config.params);
-  return std::unique_ptr<MotionPlannerNode>(new MotionPlannerNode(args, std::move(config), std::move(planner)));
+  seedRandomness(config.params.seed);
+  std::vector<MotionPlanner> planners;
+  if (config.robot == "disc") {
+    for (int i = 0; i < config.planners; ++i) {
+      planners.emplace_back(collision::RobotGeometry::disc(config.disc_radius, config.disc_height), config.params);
+    }
+  } else {
+    auto model = config.urdf.empty() ? robot::RobotModel::loadDefault() : robot::RobotModel::loadFile(config.urdf);
+    if (!model) return model.error();
+    for (int i = 0; i < config.planners; ++i) planners.emplace_back(*model, config.params);
+  }
+  return std::unique_ptr<MotionPlannerNode>(new MotionPlannerNode(args, std::move(config), std::move(planners)));
 }
 
-MotionPlannerNode::MotionPlannerNode(const dds::ServiceArgs& args, NodeConfig config, MotionPlanner planner)
-    : ServiceNode(args), config_(std::move(config)), planner_(std::move(planner)) {
+MotionPlannerNode::MotionPlannerNode(const dds::ServiceArgs& args, NodeConfig config, std::vector<MotionPlanner> planners)
+    : ServiceNode(args), config_(std::move(config)) {
+  for (auto& p : planners) slots_.push_back(std::make_unique<Slot>(std::move(p)));
   mirror_ = std::make_unique<dds::WorldMirror>(participant(), config_.world_id);
-  mirror_->onChange([this] { world_dirty_ = true; });
+  mirror_->onChange([this] {
+    std::lock_guard g(pool_mutex_);
+    for (auto& sl : slots_) sl->dirty = true;
+  });
+  effort_reader_ = std::make_unique<dds::Reader<msg::EffortModelSnapshot>>(
+      participant(), dds::topics::kEffortModel, [this](const msg::EffortModelSnapshot& m, const dds::SampleMeta& meta) {
+        if (!meta.alive) return;
+        if (Status st = applyEffortModel(m); !st) {
+          nodeLog()->warn("effort model v{} ignored: {}", m.version(), st.error().toString());
+        }
+      });
+  // As many workers per service as planners: concurrent requests of one service run at once.
+  dds::RpcServerOptions server;
+  server.threads = static_cast<int>(slots_.size());
   motion_ = std::make_unique<dds::RpcServer<msg::MotionRequest, msg::MotionReply>>(
       participant(), dds::services::kMotion,
-      [this](const msg::MotionRequest& r, const dds::RequestContext& c) { return handleMotion(r, c); });
+      [this](const msg::MotionRequest& r, const dds::RequestContext& c) { return handleMotion(r, c); }, server);
   placement_ = std::make_unique<dds::RpcServer<msg::PlacementRequest, msg::PlacementReply>>(
       participant(), dds::services::kPlacement,
-      [this](const msg::PlacementRequest& r, const dds::RequestContext& c) { return handlePlacement(r, c); });
+      [this](const msg::PlacementRequest& r, const dds::RequestContext& c) { return handlePlacement(r, c); }, server);
   grasp_ = std::make_unique<dds::RpcServer<msg::GraspRequest, msg::GraspReply>>(
       participant(), dds::services::kGrasp,
-      [this](const msg::GraspRequest& r, const dds::RequestContext& c) { return handleGrasp(r, c); });
+      [this](const msg::GraspRequest& r, const dds::RequestContext& c) { return handleGrasp(r, c); }, server);
 }
 
 MotionPlannerNode::~MotionPlannerNode() {
-  grasp_.reset();  // servers first: their workers use the planner and the mirror
+  grasp_.reset();  // servers first: their workers use the planners and the mirror
   placement_.reset();
   motion_.reset();
+  effort_reader_.reset();
   mirror_.reset();
 }
 
@@ -134,45 +157,128 @@ std::pair<uint64_t, uint64_t> MotionPlannerNode::requestCounters() const {
 
 void MotionPlannerNode::spinOnce() { (void)prepareIfWorldChanged(); }
 
-void MotionPlannerNode::interruptPreparation() {
-  std::lock_guard g(stop_mutex_);
-  prepare_stop_.request_stop();
+Status MotionPlannerNode::applyEffortModel(const msg::EffortModelSnapshot& snapshot) {
+  auto models = fromMsg(snapshot);
+  if (!models) return models.error();
+  // Every planner has the same cost parameters.
+  auto fn = fittedObjectEffort(slots_.front()->planner.params().cost, *models);
+  if (!fn) return fn.error();
+  std::lock_guard g(pool_mutex_);
+  effort_ = std::make_shared<const ObjectEffortFn>(std::move(*fn));
+  ++effort_version_;
+  effort_model_version_ = snapshot.version();
+  nodeLog()->debug("object efforts from effort model v{}", snapshot.version());
+  return Status::Ok();
 }
 
-std::optional<PrepareStats> MotionPlannerNode::prepareIfWorldChanged() {
-  if (!config_.prepare || waiting_.load() > 0 || !world_dirty_.exchange(false)) return std::nullopt;
-  std::unique_lock lock(mutex_, std::try_to_lock);
-  if (!lock.owns_lock() || waiting_.load() > 0) {  // a request runs or waits: later
-    world_dirty_ = true;
-    return std::nullopt;
-  }
-  std::stop_token token;
+uint64_t MotionPlannerNode::effortModelVersion() const {
+  std::lock_guard g(pool_mutex_);
+  return effort_model_version_;
+}
+
+MotionPlannerNode::Lease::~Lease() {
+  if (!node_) return;
   {
-    std::lock_guard g(stop_mutex_);
-    prepare_stop_ = std::stop_source();
-    token = prepare_stop_.get_token();
+    std::lock_guard g(node_->pool_mutex_);
+    Slot& s = *node_->slots_[index_];
+    s.busy = false;
+    s.preparing = false;
   }
-  planner_.setWorld(mirror_->snapshot());
-  robot::RobotState state;
-  if (last_base_start_) {
-    state = *last_base_start_;
-  } else if (const auto* model = planner_.robotModel()) {
-    state = model->defaultState();
-  }
-  auto r = planner_.prepare(PlanningGroup::kBase, state, {},
-                            Termination(Deadline::in(config_.prepare_budget_s), std::move(token)));
-  if (!r) {
-    nodeLog()->warn("roadmap preparation failed: {}", r.error().toString());
-    return std::nullopt;
-  }
-  if (!r->completed) world_dirty_ = true;  // interrupted: resume at the next spin
-  nodeLog()->debug("roadmap prepared in {:.1f} ms ({}, {} nodes, {} edges evaluated{})", r->time_ms,
-                   r->built ? "new" : "cached", r->roadmap_nodes, r->edges_evaluated,
-                   r->completed ? "" : ", interrupted");
-  return *r;
+  node_->pool_cv_.notify_all();
 }
 
-Result<Termination> MotionPlannerNode::prepare(uint64_t world_version, const dds::RequestContext& ctx) {
+std::optional<MotionPlannerNode::Lease> MotionPlannerNode::acquire(const Termination& term) {
+  std::unique_lock lock(pool_mutex_);
+  ++waiting_;
+  while (true) {
+    std::optional<std::size_t> clean, idle;
+    bool preparing = false;
+    for (std::size_t i = 0; i < slots_.size(); ++i) {
+      const Slot& s = *slots_[i];
+      preparing |= s.preparing;
+      if (s.busy) continue;
+      if (!idle) idle = i;
+      if (!clean && !s.dirty) clean = i;
+    }
+    // A prepared idle planner; else stop the preparation (kept, resumed later) rather than
+    // take an unprepared one; else any idle planner.
+    std::optional<std::size_t> pick = clean ? clean : preparing ? std::nullopt : idle;
+    if (pick) {
+      --waiting_;
+      slots_[*pick]->busy = true;
+      return Lease(this, *pick);
+    }
+    for (auto& s : slots_) {
+      if (s->preparing) s->prepare_stop.request_stop();
+    }
+    if (term()) {
+      --waiting_;
+      return std::nullopt;
+    }
+    pool_cv_.wait_for(lock, std::chrono::milliseconds(20));
+  }
+}
+
+uint64_t MotionPlannerNode::syncPlanner(Slot& slot) {
+  const uint64_t version = mirror_->publishedVersion();  // the snapshot holds at least this
+  slot.planner.setWorld(mirror_->snapshot());
+  std::shared_ptr<const ObjectEffortFn> effort;
+  std::uint64_t effort_version = 0;
+  {
+    std::lock_guard g(pool_mutex_);
+    effort = effort_;
+    effort_version = effort_version_;
+  }
+  if (effort && slot.effort_version != effort_version) {
+    slot.planner.setObjectEffort(*effort);
+    slot.effort_version = effort_version;
+  }
+  return version;
+}
+
+std::vector<std::optional<PrepareStats>> MotionPlannerNode::prepareIfWorldChanged() {
+  std::vector<std::optional<PrepareStats>> out(slots_.size());
+  if (!config_.prepare) return out;
+  for (std::size_t i = 0; i < slots_.size(); ++i) {
+    Slot& slot = *slots_[i];
+    std::stop_token token;
+    {
+      std::lock_guard g(pool_mutex_);
+      if (waiting_ > 0) break;  // requests first
+      if (slot.busy || !slot.dirty) continue;
+      slot.busy = true;
+      slot.preparing = true;
+      slot.dirty = false;  // a world change from now on sets it again
+      slot.prepare_stop = std::stop_source();
+      token = slot.prepare_stop.get_token();
+    }
+    Lease lease(this, i);
+    (void)syncPlanner(slot);
+    robot::RobotState state;
+    if (slot.last_base_start) {
+      state = *slot.last_base_start;
+    } else if (const auto* model = slot.planner.robotModel()) {
+      state = model->defaultState();
+    }
+    auto r = slot.planner.prepare(PlanningGroup::kBase, state, {},
+                                  Termination(Deadline::in(config_.prepare_budget_s), std::move(token)));
+    if (!r) {
+      nodeLog()->warn("roadmap preparation of planner {} failed: {}", i, r.error().toString());
+      continue;
+    }
+    if (!r->completed) {  // interrupted: resume at the next spin
+      std::lock_guard g(pool_mutex_);
+      slot.dirty = true;
+    }
+    nodeLog()->debug("planner {}: roadmap prepared in {:.1f} ms ({}, {} nodes, {} edges evaluated{})", i, r->time_ms,
+                     r->built ? "new" : "cached", r->roadmap_nodes, r->edges_evaluated,
+                     r->completed ? "" : ", interrupted");
+    out[i] = *r;
+  }
+  return out;
+}
+
+Result<Termination> MotionPlannerNode::termination(uint64_t world_version, const dds::RequestContext& ctx) {
   Termination term = ctx.termination;
   if (term.deadline().isNever()) term = term.tightened(Deadline::in(config_.default_budget_s));
   if (world_version > 0 && mirror_->publishedVersion() < world_version) {
@@ -183,59 +289,65 @@ Result<Termination> MotionPlannerNode::prepare(uint64_t world_version, const dds
                                                 ")");
     }
   }
-  planner_.setWorld(mirror_->snapshot());
   return term;
 }
 
+namespace {
+Error busy() { return Error(ErrorCode::kTimeout, "every planner stayed busy until the deadline"); }
+}  // namespace
+
 msg::MotionReply MotionPlannerNode::handleMotion(const msg::MotionRequest& req, const dds::RequestContext& ctx) {
-  ++waiting_;
-  interruptPreparation();
-  std::unique_lock lock(mutex_);
-  --waiting_;
-  auto term = prepare(req.world_version(), ctx);
+  auto term = termination(req.world_version(), ctx);
   if (!term) return errorReply<msg::MotionReply>(term.error());
-  auto request = fromMsg(req, planner_);
+  auto lease = acquire(*term);
+  if (!lease) return errorReply<msg::MotionReply>(busy());
+  Slot& slot = lease->slot();
+  const uint64_t world_version = syncPlanner(slot);
+  auto request = fromMsg(req, slot.planner);
   if (!request) {
     msg::MotionReply rep;
     rep.status(msg::MOTION_INVALID_REQUEST);
     rep.reason(request.error().toString());
     rep.header().message(request.error().toString());
+    rep.world_version(world_version);
     return rep;
   }
-  if (request->group == PlanningGroup::kBase) last_base_start_ = request->start;
-  const MotionResult r = planner_.plan(*request, *term);
-  nodeLog()->debug("motion {} {} {}: {} in {:.1f} ms, {} blocking", ctx.request_id, toString(request->group),
-                   toString(request->mode), toString(r.status), r.planning_time_s * 1e3, r.blocking.size());
+  if (request->group == PlanningGroup::kBase) slot.last_base_start = request->start;
+  const MotionResult r = slot.planner.plan(*request, *term);
+  nodeLog()->debug("motion {} on planner {}: {} {} {} in {:.1f} ms, {} blocking{}", ctx.request_id, lease->index(),
+                   toString(request->group), toString(request->mode), toString(r.status), r.planning_time_s * 1e3,
+                   r.blocking.size(), request->object_overrides.empty() ? "" : ", overrides");
   msg::MotionReply rep = toMsg(r);
+  rep.world_version(world_version);
   if (r.status != MotionStatus::kSolved) rep.header().message(r.reason);
   return rep;
 }
 
 msg::PlacementReply MotionPlannerNode::handlePlacement(const msg::PlacementRequest& req,
                                                       const dds::RequestContext& ctx) {
-  ++waiting_;
-  interruptPreparation();
-  std::unique_lock lock(mutex_);
-  --waiting_;
-  auto term = prepare(0, ctx);
+  auto term = termination(0, ctx);
   if (!term) return errorReply<msg::PlacementReply>(term.error());
+  auto lease = acquire(*term);
+  if (!lease) return errorReply<msg::PlacementReply>(busy());
+  Slot& slot = lease->slot();
+  (void)syncPlanner(slot);
   auto request = fromMsg(req);
   if (!request) return errorReply<msg::PlacementReply>(request.error());
-  auto r = planner_.samplePlacements(*request, *term);
+  auto r = slot.planner.samplePlacements(*request, *term);
   if (!r) return errorReply<msg::PlacementReply>(r.error());
   return toMsg(*r);
 }
 
 msg::GraspReply MotionPlannerNode::handleGrasp(const msg::GraspRequest& req, const dds::RequestContext& ctx) {
-  ++waiting_;
-  interruptPreparation();
-  std::unique_lock lock(mutex_);
-  --waiting_;
-  auto term = prepare(0, ctx);
+  auto term = termination(0, ctx);
   if (!term) return errorReply<msg::GraspReply>(term.error());
+  auto lease = acquire(*term);
+  if (!lease) return errorReply<msg::GraspReply>(busy());
+  Slot& slot = lease->slot();
+  (void)syncPlanner(slot);
   auto request = fromMsg(req);
   if (!request) return errorReply<msg::GraspReply>(request.error());
-  auto r = planner_.generateGrasps(*request, *term);
+  auto r = slot.planner.generateGrasps(*request, *term);
   if (!r) return errorReply<msg::GraspReply>(r.error());
   return toMsg(*r);
 }

@@ -3,31 +3,36 @@
 /// The motion planning service over DDS: a thin adapter around tamp::motion_planner::MotionPlanner.
 ///
 /// - Serves `services::kMotion`, `kPlacement` and `kGrasp` (idl/motion.idl) with one RpcServer
-///   each; requests run one at a time on the planner (one scene and its lazy-mode roadmap
-///   cache, guarded by a mutex; the DDS dispatch may call handlers concurrently).
+///   each, on a pool of `node.planners` planners (default 2): each has its own scene and lazy-mode
+///   roadmap cache, all built alike (same parameters and seeds, each prepared after world
+///   updates), and serves one request at a time, so that independent requests run concurrently.
+///   A request takes the lowest-numbered idle planner whose roadmap is prepared (else it
+///   interrupts a running preparation, else the lowest idle one), so sequential requests go to
+///   planner 0 and are as deterministic as with one planner; concurrent ones depend on which
+///   planner serves them (each planner's results depend on its seeds and its own request
+///   history). The DDS dispatch calls handlers concurrently.
 /// - Mirrors the world model (`tamp::dds::WorldMirror`, topics tamp/world/objects + meta); before
 ///   each request the planner's scene is brought to the mirror's latest world (a diff: cheap when
-///   little changed). A request naming a `world_version` waits (at most `world_wait_s`) for it.
-/// - Motion outcomes are typed in the reply (`MotionReply::status` + `reason`), including
-///   MOTION_INVALID_REQUEST for malformed requests (the reason names the IDL field); the reply
-///   header says STATUS_OK then. Placement and grasp errors use the header's status code
-///   (NOT_FOUND, INVALID_ARGUMENT, UNSUPPORTED, TIMEOUT, UNAVAILABLE) and message.
-/// - Budget: the client's remaining budget (RequestContext) and its cancellation; a request
-///   without budget gets `default_budget_s`.
-/// - Roadmap preparation: after a world update (mirror change) the node's own run() thread
-///   (spinOnce) brings the planner to the new world and calls MotionPlanner::prepare() for the
-///   base group, under the planner's mutex, so the first lazy request after a static-world change
-///   finds a complete roadmap. Cheap when only movables changed (the cached roadmap is reused).
-///   A request arriving meanwhile stops the preparation (kept, resumed at the next spin) rather
-///   than wait for it; `prepare_budget_s` caps one preparation.
+///   little changed). A request naming a `world_version` waits (at most `world_wait_s`) for it;
+///   the reply's `world_version` is the mirror's complete version when the world was taken (the
+///   world planned in is at least that version).
+/// - Hypothetical worlds: `object_overrides` move or remove objects for one request (unknown ids
+///   and non-finite poses are MOTION_INVALID_REQUEST naming `object_overrides[i]...`);
+///   `held_grasp_given` attaches `held_object_id` at `held_link` / `held_link_T_object`.
+///   `movable_cost_weight` is taken as it is: 0 = movables free (the static-only lazy path).
+/// - Object prices: the node follows the effort estimator's fitted models
+///   (`topics::kEffortModel`, transient-local): each snapshot's pick, place and move_base values
+///   replace the planners' object effort (fittedObjectEffort); `BlockingObject.effort_s` and
+///   `MotionReply.cost_s` use them. Until one arrives, the default models price objects.
 #include <atomic>
-#include <optional>
-#include <stop_token>
-
+#include <condition_variable>
 #include <filesystem>
 #include <memory>
 #include <mutex>
+#include <optional>
+#include <stop_token>
 #include <string>
+#include <vector>
 
 #include "tamp/dds/service_node.h"
 #include "tamp/dds/world_sync.h"
@@ -46,6 +51,7 @@ struct NodeConfig {
   double world_wait_s{2.0};                 ///< >= 0
   bool prepare{true};                       ///< prepare the base group's roadmap after world updates
   double prepare_budget_s{2.0};             ///< > 0: cap of one preparation
+  int planners{2};                          ///< planners in the pool (concurrent requests), 1..16
   MotionPlannerParams params;
 };
 
@@ -66,34 +72,71 @@ class MotionPlannerNode : public dds::ServiceNode {
   msg::PlacementReply handlePlacement(const msg::PlacementRequest& req, const dds::RequestContext& ctx);
   msg::GraspReply handleGrasp(const msg::GraspRequest& req, const dds::RequestContext& ctx);
 
-  /// What spinOnce() does: when the world changed since the last preparation (or the last one
-  /// was interrupted), brings the planner to the mirror's world and prepares the base group's
-  /// roadmap (fixed joints of the last base request, else the robot's default state). Returns
-  /// whether a preparation ran; nothing when `prepare` is off, nothing changed or a request waits.
-  std::optional<PrepareStats> prepareIfWorldChanged();
+  /// What spinOnce() does: for each idle planner whose world changed since its last preparation
+  /// (or whose last one was interrupted), brings it to the mirror's world and prepares the base
+  /// group's roadmap (fixed joints of its last base request, else the robot's default state).
+  /// Returns, per planner, what its preparation did (nothing for a planner not prepared: `prepare`
+  /// off, nothing changed, busy, or a request waits).
+  std::vector<std::optional<PrepareStats>> prepareIfWorldChanged();
+  /// Applies an effort model snapshot (what the kEffortModel reader does); errors name the field.
+  Status applyEffortModel(const msg::EffortModelSnapshot& snapshot);
+  /// Version of the last effort model snapshot applied (0: the default models).
+  uint64_t effortModelVersion() const;
+  std::size_t plannerCount() const { return slots_.size(); }
 
  protected:
   std::pair<uint64_t, uint64_t> requestCounters() const override;
   void spinOnce() override;
 
  private:
-  MotionPlannerNode(const dds::ServiceArgs& args, NodeConfig config, MotionPlanner planner);
-  /// The request's termination (default budget when none), and the world brought up to date.
-  /// Returns an error when the requested world version does not arrive in time.
-  Result<Termination> prepare(uint64_t world_version, const dds::RequestContext& ctx);
+  /// One planner of the pool and its bookkeeping (flags guarded by pool_mutex_).
+  struct Slot {
+    explicit Slot(MotionPlanner p) : planner(std::move(p)) {}
+    MotionPlanner planner;
+    std::optional<robot::RobotState> last_base_start;  // used only by whoever holds the slot
+    bool busy{false};       // a request or a preparation holds it
+    bool preparing{false};  // ... a preparation
+    bool dirty{true};       // the world changed since its last complete preparation
+    std::uint64_t effort_version{0};  // effort model applied to this planner
+    std::stop_source prepare_stop;
+  };
+  /// A slot held by one request (released on destruction).
+  class Lease {
+   public:
+    Lease(MotionPlannerNode* node, std::size_t index) : node_(node), index_(index) {}
+    Lease(Lease&& o) noexcept : node_(o.node_), index_(o.index_) { o.node_ = nullptr; }
+    Lease& operator=(Lease&&) = delete;
+    Lease(const Lease&) = delete;
+    Lease& operator=(const Lease&) = delete;
+    ~Lease();
+    Slot& slot() const { return *node_->slots_[index_]; }
+    std::size_t index() const { return index_; }
 
-  /// A handler about to take `mutex_`: stops a running preparation.
-  void interruptPreparation();
+   private:
+    MotionPlannerNode* node_;
+    std::size_t index_;
+  };
+
+  MotionPlannerNode(const dds::ServiceArgs& args, NodeConfig config, std::vector<MotionPlanner> planners);
+  /// The request's termination (default budget when none), after waiting for the requested
+  /// world version. Returns an error when that version does not arrive in time.
+  Result<Termination> termination(uint64_t world_version, const dds::RequestContext& ctx);
+  /// Waits for a planner (see the file comment) until `term` fires; nothing then.
+  std::optional<Lease> acquire(const Termination& term);
+  /// Brings the leased planner to the mirror's world and the current effort model; returns the
+  /// mirror's complete world version taken.
+  uint64_t syncPlanner(Slot& slot);
 
   NodeConfig config_;
-  std::mutex mutex_;  // guards planner_ and last_base_start_
-  MotionPlanner planner_;
-  std::optional<robot::RobotState> last_base_start_;
-  std::atomic<bool> world_dirty_{true};
-  std::atomic<int> waiting_{0};    // handlers waiting for mutex_
-  std::mutex stop_mutex_;          // guards prepare_stop_
-  std::stop_source prepare_stop_;
+  mutable std::mutex pool_mutex_;  // guards the slots' flags, waiting_, effort_
+  std::condition_variable pool_cv_;
+  std::vector<std::unique_ptr<Slot>> slots_;
+  int waiting_{0};  // requests waiting for a planner
+  std::shared_ptr<const ObjectEffortFn> effort_;  // null: the default models
+  std::uint64_t effort_version_{0};               // bumps per applied snapshot
+  std::uint64_t effort_model_version_{0};         // the snapshot's version
   std::unique_ptr<dds::WorldMirror> mirror_;
+  std::unique_ptr<dds::Reader<msg::EffortModelSnapshot>> effort_reader_;
   std::unique_ptr<dds::RpcServer<msg::MotionRequest, msg::MotionReply>> motion_;
   std::unique_ptr<dds::RpcServer<msg::PlacementRequest, msg::PlacementReply>> placement_;
   std::unique_ptr<dds::RpcServer<msg::GraspRequest, msg::GraspReply>> grasp_;

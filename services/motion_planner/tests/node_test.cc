@@ -2,6 +2,8 @@
 // requests against a world published by a WorldPublisher.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <optional>
@@ -31,10 +33,11 @@ class NodeTest : public ::testing::Test {
     ASSERT_TRUE(node.ok()) << node.error().toString();
     node_ = std::move(*node);
     publisher_ = std::make_unique<dds::WorldPublisher>(client_);
-    world_ = testing::corridorWorld(true);
+    world_ = initialWorld();
     ASSERT_TRUE(publisher_->publish(world_).ok());
     motion_ = std::make_unique<dds::RpcClient<msg::MotionRequest, msg::MotionReply>>(client_, dds::services::kMotion);
   }
+  virtual world::World initialWorld() const { return testing::corridorWorld(true); }
   void TearDown() override {
     motion_.reset();
     publisher_.reset();
@@ -48,6 +51,7 @@ class NodeTest : public ::testing::Test {
     r.start_base(dds::toMsg(Pose2D{2, 2, 0}));
     r.goal_type(msg::GOAL_BASE_POSE);
     r.goal_base(dds::toMsg(Pose2D{8, 2, 0}));
+    r.movable_cost_weight(1.0);  // the effort model as it is (0: movables free)
     return r;
   }
 
@@ -106,12 +110,17 @@ TEST_F(NodeTest, PreparesTheRoadmapAfterWorldUpdates) {
   auto rep = motion_->call(lazyRequest(), dds::CallOptions{30.0, {}});  // the mirror has the world now
   ASSERT_TRUE(rep.ok()) << rep.error().toString();
   ASSERT_EQ(rep->status(), msg::MOTION_SOLVED) << rep->reason();
-  auto prep = node_->prepareIfWorldChanged();
-  ASSERT_TRUE(prep.has_value());
-  EXPECT_FALSE(prep->built);  // the request above built it
+  auto preps = node_->prepareIfWorldChanged();
+  ASSERT_EQ(preps.size(), 2u);  // the default pool
+  ASSERT_TRUE(preps[0].has_value());
+  const auto& prep = preps[0];
+  EXPECT_FALSE(prep->built);  // the request above (served by planner 0) built it
   EXPECT_TRUE(prep->completed);
   EXPECT_GT(prep->edges_evaluated, 0u);
-  EXPECT_FALSE(node_->prepareIfWorldChanged().has_value());  // nothing changed
+  ASSERT_TRUE(preps[1].has_value());
+  EXPECT_TRUE(preps[1]->built);  // planner 1 had none
+  EXPECT_TRUE(preps[1]->completed);
+  for (const auto& p : node_->prepareIfWorldChanged()) EXPECT_FALSE(p.has_value());  // nothing changed
 
   Eigen::Isometry3d p = world_.object("crate").pose;
   p.translation() = Eigen::Vector3d(2.0, 3.4, 0.4);
@@ -119,7 +128,7 @@ TEST_F(NodeTest, PreparesTheRoadmapAfterWorldUpdates) {
   ASSERT_TRUE(publisher_->publish(world_).ok());
   std::optional<PrepareStats> moved;
   for (int i = 0; i < 500 && !moved; ++i) {
-    moved = node_->prepareIfWorldChanged();
+    moved = node_->prepareIfWorldChanged()[0];
     if (!moved) std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
   ASSERT_TRUE(moved.has_value());
@@ -203,12 +212,219 @@ TEST_F(NodeTest, PlacementAndGraspRequests) {
   EXPECT_EQ(g.error().code, ErrorCode::kUnsupported);
 }
 
+// movable_cost_weight as it is: 0 is the pure static-only lazy path (movables free), 1 the
+// effort model. Two doors: A (short) blocked by two heavy objects, B (a detour) by a light one.
+class TwoDoorNodeTest : public NodeTest {
+ protected:
+  world::World initialWorld() const override { return testing::twoDoorWorld(); }
+};
+
+TEST_F(TwoDoorNodeTest, MovableCostWeightZeroIgnoresMovables) {
+  msg::MotionRequest r = lazyRequest();
+  r.world_version(publisher_->publishedVersion());
+  r.start_base(dds::toMsg(Pose2D{2, 0.9, 0}));
+  r.goal_base(dds::toMsg(Pose2D{8, 0.9, 0}));
+  r.movable_cost_weight(1.0);
+  auto priced = motion_->call(r, dds::CallOptions{30.0, {}});
+  ASSERT_TRUE(priced.ok()) << priced.error().toString();
+  ASSERT_EQ(priced->status(), msg::MOTION_SOLVED) << priced->reason();
+  ASSERT_EQ(priced->blocking().size(), 1u);
+  EXPECT_EQ(priced->blocking()[0].object_id(), "light");
+  EXPECT_GT(priced->cost_s(), priced->blocking()[0].effort_s());
+
+  r.movable_cost_weight(0.0);
+  auto free = motion_->call(r, dds::CallOptions{30.0, {}});
+  ASSERT_TRUE(free.ok()) << free.error().toString();
+  ASSERT_EQ(free->status(), msg::MOTION_SOLVED) << free->reason();
+  auto path = dds::fromMsg(free->path());
+  ASSERT_TRUE(path.ok());
+  EXPECT_EQ(testing::discTouches(world_, *path, 0.3, 0.005), (std::vector<std::string>{"heavy_a", "heavy_b"}));
+  EXPECT_LT(free->path_length(), priced->path_length());
+  // J is the travel time only: no object is paid for.
+  EXPECT_NEAR(free->cost_s(), free->path_length() / MotionPlannerParams{}.cost.base_speed, 1e-6);
+  for (const auto& b : free->blocking()) EXPECT_GT(b.effort_s(), 0.0);  // still priced in the report
+}
+
+TEST_F(NodeTest, ObjectOverridesPlanInAHypotheticalWorld) {
+  msg::MotionRequest r = lazyRequest();
+  auto plain = motion_->call(r, dds::CallOptions{30.0, {}});
+  ASSERT_TRUE(plain.ok()) << plain.error().toString();
+  ASSERT_EQ(plain->status(), msg::MOTION_SOLVED) << plain->reason();
+  EXPECT_EQ(plain->world_version(), publisher_->publishedVersion());
+  ASSERT_EQ(plain->blocking().size(), 1u);
+  EXPECT_GT(plain->blocking()[0].effort_s(), 0.0);
+
+  msg::ObjectOverride o;
+  o.object_id("crate");
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translation() = Eigen::Vector3d(1.0, 3.3, 0.4);
+  o.pose(dds::toMsg(pose));
+  r.object_overrides().push_back(o);
+  auto moved = motion_->call(r, dds::CallOptions{30.0, {}});
+  ASSERT_TRUE(moved.ok()) << moved.error().toString();
+  ASSERT_EQ(moved->status(), msg::MOTION_SOLVED) << moved->reason();
+  EXPECT_TRUE(moved->blocking().empty());
+  EXPECT_LT(moved->cost_s(), plain->cost_s());
+  EXPECT_EQ(moved->world_version(), publisher_->publishedVersion());
+  world::World hypothetical = world_;
+  ASSERT_TRUE(hypothetical.setObjectPose("crate", pose).ok());
+  auto path = dds::fromMsg(moved->path());
+  ASSERT_TRUE(path.ok());
+  EXPECT_TRUE(testing::discTouches(hypothetical, *path, 0.3, 0.005).empty());
+
+  r.object_overrides()[0].object_id("ghost");
+  auto unknown = motion_->call(r, dds::CallOptions{10.0, {}});
+  ASSERT_TRUE(unknown.ok());
+  EXPECT_EQ(unknown->status(), msg::MOTION_INVALID_REQUEST);
+  EXPECT_NE(unknown->reason().find("object_overrides[0].object_id"), std::string::npos) << unknown->reason();
+  r.object_overrides()[0].object_id("crate");
+  r.object_overrides()[0].pose().position().x(std::nan(""));
+  auto nan = motion_->call(r, dds::CallOptions{10.0, {}});
+  ASSERT_TRUE(nan.ok());
+  EXPECT_EQ(nan->status(), msg::MOTION_INVALID_REQUEST);
+  EXPECT_NE(nan->reason().find("object_overrides[0].pose"), std::string::npos) << nan->reason();
+
+  // The mirror's world is unchanged: the crate blocks again.
+  auto again = motion_->call(lazyRequest(), dds::CallOptions{30.0, {}});
+  ASSERT_TRUE(again.ok());
+  ASSERT_EQ(again->blocking().size(), 1u);
+  EXPECT_EQ(again->blocking()[0].object_id(), "crate");
+}
+
+TEST_F(NodeTest, HeldGraspOnTheWire) {
+  msg::MotionRequest r = lazyRequest();
+  r.start_base(dds::toMsg(Pose2D{2, 0.5, 0}));
+  r.held_object_id("far_box");
+  r.held_grasp_given(true);
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  t.translation() = Eigen::Vector3d(0.0, -0.6, 0.0);  // into the south wall at the start
+  r.held_link_T_object(dds::toMsg(t));
+  auto rep = motion_->call(r, dds::CallOptions{30.0, {}});
+  ASSERT_TRUE(rep.ok()) << rep.error().toString();
+  EXPECT_EQ(rep->status(), msg::MOTION_START_IN_COLLISION) << rep->reason();
+  EXPECT_EQ(rep->colliding_object(), "wall_south");
+  t.translation() = Eigen::Vector3d(0.6, 0.0, 0.0);  // ahead of the robot
+  r.held_link_T_object(dds::toMsg(t));
+  rep = motion_->call(r, dds::CallOptions{30.0, {}});
+  ASSERT_TRUE(rep.ok()) << rep.error().toString();
+  EXPECT_EQ(rep->status(), msg::MOTION_SOLVED) << rep->reason();
+  r.held_object_id("");
+  rep = motion_->call(r, dds::CallOptions{10.0, {}});
+  ASSERT_TRUE(rep.ok());
+  EXPECT_EQ(rep->status(), msg::MOTION_INVALID_REQUEST);
+  EXPECT_NE(rep->reason().find("held_grasp_given"), std::string::npos) << rep->reason();
+}
+
+msg::ActionTimeModel timeModel(ActionKind kind, std::vector<std::string> names, std::vector<double> values) {
+  msg::ActionTimeModel m;
+  m.kind(dds::toMsg(kind));
+  m.parameter_names(std::move(names));
+  m.values(std::move(values));
+  m.version(1);
+  return m;
+}
+
+// The fitted models on tamp/effort/model price the objects: slower pick and place raise the
+// blocking object's effort of the same request, to what the fitted models say.
+TEST_F(NodeTest, FittedEffortModelPricesBlockingObjects) {
+  auto before = motion_->call(lazyRequest(), dds::CallOptions{30.0, {}});
+  ASSERT_TRUE(before.ok()) << before.error().toString();
+  ASSERT_EQ(before->blocking().size(), 1u);
+  const world::Object& crate = world_.object("crate");
+  EXPECT_NEAR(before->blocking()[0].effort_s(), defaultObjectEffort(crate, CostParams{}), 1e-9);
+
+  dds::Writer<msg::EffortModelSnapshot> writer(client_, dds::topics::kEffortModel);
+  msg::EffortModelSnapshot snap;
+  snap.model_id("effort_estimator");
+  snap.version(7);
+  snap.models().push_back(timeModel(ActionKind::kPick, {"gripper_time", "approach_speed"}, {6.0, 0.02}));
+  snap.models().push_back(timeModel(ActionKind::kPlace, {"gripper_time"}, {5.0}));
+  ASSERT_TRUE(writer.write(snap).ok());
+  for (int i = 0; i < 500 && node_->effortModelVersion() != 7; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ASSERT_EQ(node_->effortModelVersion(), 7u);
+  auto after = motion_->call(lazyRequest(), dds::CallOptions{30.0, {}});
+  ASSERT_TRUE(after.ok()) << after.error().toString();
+  ASSERT_EQ(after->blocking().size(), 1u);
+  auto fitted = fittedObjectEffort(CostParams{}, {{ActionKind::kPick, {"gripper_time", "approach_speed"}, {6.0, 0.02}},
+                                                  {ActionKind::kPlace, {"gripper_time"}, {5.0}}});
+  ASSERT_TRUE(fitted.ok());
+  EXPECT_GT(after->blocking()[0].effort_s(), before->blocking()[0].effort_s() + 8.0);
+  EXPECT_NEAR(after->blocking()[0].effort_s(), (*fitted)(crate), 1e-9);
+
+  // A malformed snapshot is ignored (logged): the fitted prices stay.
+  snap.version(8);
+  snap.models()[0].values().push_back(1.0);
+  ASSERT_TRUE(writer.write(snap).ok());
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  EXPECT_EQ(node_->effortModelVersion(), 7u);
+}
+
+// Two planners serve two requests at once: a long full-mode request (no proof, so it runs to its
+// budget) does not hold up a lazy one; with one planner the lazy one would wait for it.
+TEST_F(NodeTest, ConcurrentRequestsRunOnSeparatePlanners) {
+  node_.reset();
+  dds::ServiceArgs args;
+  args.name = "motion_planner_pool_test";
+  args.domain_id = domain_;
+  NodeConfig cfg;
+  cfg.robot = "disc";
+  cfg.disc_radius = 0.3;
+  cfg.params.proof.enabled = false;
+  cfg.planners = 2;
+  auto node = MotionPlannerNode::create(args, cfg);
+  ASSERT_TRUE(node.ok()) << node.error().toString();
+  node_ = std::move(*node);
+  ASSERT_EQ(node_->plannerCount(), 2u);
+  ASSERT_TRUE(motion_->call(lazyRequest(), dds::CallOptions{30.0, {}}).ok());  // world mirrored
+  // Both planners prepared alike: the same request gets the same path from either.
+  for (int i = 0; i < 100; ++i) {
+    const auto preps = node_->prepareIfWorldChanged();
+    if (std::none_of(preps.begin(), preps.end(), [](const auto& p) { return p.has_value(); })) break;
+  }
+
+  std::atomic<bool> full_done{false};
+  std::atomic<bool> lazy_done_while_full_ran{false};
+  std::thread full([&] {
+    dds::RpcClient<msg::MotionRequest, msg::MotionReply> client(client_, dds::services::kMotion);
+    msg::MotionRequest r = lazyRequest();
+    r.mode(msg::MOTION_FULL);  // the crate closes the door: no path, and no proof to say so
+    auto rep = client.call(r, dds::CallOptions{3.0, {}});  // the budget the server plans with
+    if (!rep.ok() && rep.error().code == ErrorCode::kTimeout) {  // the reply came just after
+      full_done = true;
+      return;
+    }
+    full_done = true;
+    ASSERT_TRUE(rep.ok()) << rep.error().toString();
+    EXPECT_EQ(rep->status(), msg::MOTION_TIMEOUT) << rep->reason();
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));  // the full request is running
+  std::vector<std::vector<double>> paths[2];
+  for (int k = 0; k < 2; ++k) {
+    auto rep = motion_->call(lazyRequest(), dds::CallOptions{30.0, {}});
+    ASSERT_TRUE(rep.ok()) << rep.error().toString();
+    ASSERT_EQ(rep->status(), msg::MOTION_SOLVED) << rep->reason();
+    auto path = dds::fromMsg(rep->path());
+    ASSERT_TRUE(path.ok());
+    paths[k] = path->waypoints;
+  }
+  lazy_done_while_full_ran = !full_done.load();
+  full.join();
+  EXPECT_TRUE(lazy_done_while_full_ran);
+  EXPECT_EQ(paths[0], paths[1]);  // the same planner, the same (warm) answer
+}
+
 TEST(NodeConfigTest, ShippedConfigLoadsAndBadNodeKeysAreNamed) {
   auto c = loadNodeConfig(configDir() / "services" / "motion_planner.yaml");
   ASSERT_TRUE(c.ok()) << c.error().toString();
   EXPECT_EQ(c->robot, "mobile_manipulator");
   EXPECT_TRUE(c->prepare);
   EXPECT_GT(c->prepare_budget_s, 0.0);
+  EXPECT_EQ(c->planners, 2);
+  auto bad_pool = parseNodeConfig("node:\n  planners: 0\n", "n.yaml");
+  ASSERT_FALSE(bad_pool.ok());
+  EXPECT_NE(bad_pool.error().message.find("node.planners"), std::string::npos) << bad_pool.error().message;
   auto bad_budget = parseNodeConfig("node:\n  prepare_budget_s: 0\n", "n.yaml");
   ASSERT_FALSE(bad_budget.ok());
   EXPECT_NE(bad_budget.error().message.find("node.prepare_budget_s"), std::string::npos) << bad_budget.error().message;

@@ -1,13 +1,18 @@
 // The services of the robot side as real processes on their own DDS domain: the simulator
-// (ground truth of a shipped scenario, depth camera), perception (world model from the clouds)
-// and the effort estimator (learns from the simulator's execution records). The test process is
-// the only other participant: it reads what the services publish and injects a fault.
+// (ground truth of a shipped scenario, depth camera), perception (world model from the clouds),
+// the execution monitor (validates and executes commands on the simulator against perception's
+// world model, forwards the simulator's records with the prediction) and the effort estimator
+// (learns from the forwarded execution records). The test process is the only other
+// participant: it reads what the services publish, injects a fault and sends the command a
+// graph manager would.
 //
 //  1. perception publishes a world model with every object of the scenario's planner view;
 //  2. an obstacle injected into the simulator's world in front of the robot (fault injection over
 //     DDS) is seen by the camera and reported by perception as a new object at its place;
-//  3. a move_base command executed by the simulator produces a result and an execution record,
-//     which the effort estimator fits: its next model snapshot counts the record.
+//  3. a move_base ExecuteCommand, validated by the monitor against perception's world model (the
+//     new obstacle included) and executed by the simulator, ends SUCCEEDED; the simulator's record
+//     reaches the effort estimator through the monitor with the prediction and the command id,
+//     and the estimator fits it: its next model snapshot counts the record.
 #include <cmath>
 
 #include <gtest/gtest.h>
@@ -44,6 +49,9 @@ class PipelineTest : public ::testing::Test {
                          {"--config", (configDir() / "services" / "perception.yaml").string(), "--scenario", scenario}));
     sup_.add(serviceSpec("tamp_effort_estimator_service", "effort_estimator", domain_,
                          {"--config", effort_config_.string()}));
+    sup_.add(serviceSpec("tamp_execution_monitor_service", "execution_monitor", domain_,
+                         {"--config", (configDir() / "services" / "execution_monitor.yaml").string(), "--scenario",
+                          scenario}));
     ASSERT_TRUE(sup_.startAll().ok());
     auto p = dds::Participant::create({domain_, dds::kProfileDefault, "tamp/pipeline_test", {}});
     ASSERT_TRUE(p) << p.error().toString();
@@ -88,6 +96,8 @@ TEST_F(PipelineTest, PerceptionSeesAnInjectedObstacleAndTheEstimatorLearnsFromEx
   Inbox<msg::WorldEvent> events;
   Inbox<msg::ActionResult> results;
   Inbox<msg::EffortModelSnapshot> snapshots;
+  Inbox<msg::ExecuteStatus> statuses;
+  Inbox<msg::ExecutionRecord> records;
   dds::Reader<msg::RobotState> state_reader(participant_, dds::topics::kRobotState,
                                             [&](const msg::RobotState& m, const dds::SampleMeta&) { states.push(m); });
   dds::Reader<msg::WorldEvent> event_reader(participant_, dds::topics::kWorldEvents,
@@ -97,9 +107,14 @@ TEST_F(PipelineTest, PerceptionSeesAnInjectedObstacleAndTheEstimatorLearnsFromEx
   dds::Reader<msg::EffortModelSnapshot> snapshot_reader(
       participant_, dds::topics::kEffortModel,
       [&](const msg::EffortModelSnapshot& m, const dds::SampleMeta&) { snapshots.push(m); });
+  dds::Reader<msg::ExecuteStatus> status_reader(
+      participant_, dds::topics::kExecuteStatus, [&](const msg::ExecuteStatus& m, const dds::SampleMeta&) { statuses.push(m); });
+  dds::Reader<msg::ExecutionRecord> record_reader(
+      participant_, dds::topics::kExecutionRecords,
+      [&](const msg::ExecutionRecord& m, const dds::SampleMeta&) { records.push(m); });
   dds::WorldMirror mirror(participant_);
   dds::Writer<msg::FaultInjection> faults(participant_, dds::topics::kFaultInjection);
-  dds::Writer<msg::TrajectoryCommand> commands(participant_, dds::topics::kTrajectoryCommand);
+  dds::Writer<msg::ExecuteCommand> commands(participant_, dds::topics::kExecuteCommand);
 
   // 1. The robot is where the scenario starts it; perception's world holds the planner view.
   auto start = states.waitFor([](const msg::RobotState&) { return true; }, 30.0);
@@ -147,21 +162,42 @@ TEST_F(PipelineTest, PerceptionSeesAnInjectedObstacleAndTheEstimatorLearnsFromEx
   const Aabb box = crate->aabb();
   EXPECT_NEAR(box.max.z(), 0.4, 0.05) << "its height";
 
-  // 3. A turn on the spot: a result, a record, a refit that counts it.
+  // 3. A turn on the spot through the execution monitor: a status, a result, a forwarded record,
+  //    a refit that counts it.
   Trajectory turn;
   turn.joint_names = {"base_x", "base_y", "base_theta"};
   turn.points.push_back({0.0, {start->base().x(), start->base().y(), yaw}, {}});
   turn.points.push_back({1.0, {start->base().x(), start->base().y(), yaw + 0.4}, {}});
-  msg::TrajectoryCommand cmd;
+  msg::ExecuteCommand cmd;
   cmd.command_id("it_turn");
+  cmd.mission_id("it_mission");
   cmd.kind(msg::ActionKind::ACTION_MOVE_BASE);
   cmd.trajectory(dds::toMsg(turn));
+  cmd.expected_duration_s(2.5);
+  cmd.expected_stddev_s(0.3);
+  cmd.world_version(mirror.publishedVersion());
   ASSERT_TRUE(commands.waitForReaders(Termination::after(20.0)));
   ASSERT_TRUE(commands.write(cmd));
+  auto status = statuses.waitFor(
+      [](const msg::ExecuteStatus& s) {
+        return s.command_id() == "it_turn" && s.state() != msg::ExecState::EXEC_ACCEPTED &&
+               s.state() != msg::ExecState::EXEC_RUNNING;
+      },
+      60.0);
+  ASSERT_TRUE(status) << "no final status from the execution monitor";
+  EXPECT_EQ(status->state(), msg::ExecState::EXEC_SUCCEEDED) << status->reason();
   auto done = results.waitFor([](const msg::ActionResult& r) { return r.command_id() == "it_turn"; }, 30.0);
   ASSERT_TRUE(done) << "no result for the command";
   EXPECT_EQ(done->outcome(), msg::ActionOutcome::OUTCOME_SUCCEEDED) << done->reason();
   EXPECT_GT(done->duration_s(), 0.0);
+  EXPECT_DOUBLE_EQ(status->measured_duration_s(), done->duration_s());
+  auto record = records.waitFor([](const msg::ExecutionRecord& r) { return r.record_id() == "it_turn"; }, 30.0);
+  ASSERT_TRUE(record) << "the simulator's record was not forwarded";
+  EXPECT_EQ(record->command_id(), "it_turn");
+  EXPECT_EQ(record->mission_id(), "it_mission");
+  EXPECT_DOUBLE_EQ(record->predicted_s(), 2.5);
+  EXPECT_DOUBLE_EQ(record->predicted_stddev_s(), 0.3);
+  EXPECT_DOUBLE_EQ(record->duration_s(), done->duration_s());
   auto fitted = snapshots.waitFor(
       [](const msg::EffortModelSnapshot& s) {
         for (const auto& m : s.models()) {

@@ -155,7 +155,8 @@ SimNode::SimNode(const dds::ServiceArgs& args, SimSetup setup, SimParams params)
   state_writer_ = std::make_unique<dds::Writer<msg::RobotState>>(p, dds::topics::kRobotState);
   cloud_writer_ = std::make_unique<dds::Writer<msg::PointCloudFrame>>(p, dds::topics::kPointCloud);
   result_writer_ = std::make_unique<dds::Writer<msg::ActionResult>>(p, dds::topics::kActionResult);
-  record_writer_ = std::make_unique<dds::Writer<msg::ExecutionRecord>>(p, dds::topics::kExecutionRecords);
+  // Raw measurements: the execution monitor adds the prediction and forwards them.
+  record_writer_ = std::make_unique<dds::Writer<msg::ExecutionRecord>>(p, dds::topics::kRobotRecords);
   LoopCallbacks cb;
   cb.on_state = [this](const RobotStateSample& s, std::int64_t stamp) {
     if (Status st = state_writer_->write(toMsg(s, joint_names_, robot_id_, stamp, ++state_seq_)); !st) {

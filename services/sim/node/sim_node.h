@@ -7,7 +7,8 @@
 /// Publishes: tamp/robot/state (RobotState, every `state_period_s` of simulated time),
 /// tamp/sensor/cloud (PointCloudFrame: every `cloud_period_s`, after each action), tamp/robot/result
 /// (ActionResult; a rejected command gets OUTCOME_FAILED with the reason naming the field),
-/// tamp/execution/record (ExecutionRecord, one per finished action).
+/// tamp/robot/record (ExecutionRecord, one per finished action, record_id = the command id; the
+/// execution monitor adds the prediction and forwards it on tamp/execution/record).
 ///
 /// Nothing escapes a DDS callback: malformed messages become failed results and log lines.
 

@@ -41,7 +41,7 @@ TEST(SimNodeTest, ExecutesATrajectoryCommandOverDds) {
                                     [&](const msg::ActionResult& m, const dds::SampleMeta&) { results.push(m); });
   dds::Reader<msg::RobotState> sr(p, dds::topics::kRobotState,
                                   [&](const msg::RobotState& m, const dds::SampleMeta&) { states.push(m); });
-  dds::Reader<msg::ExecutionRecord> er(p, dds::topics::kExecutionRecords,
+  dds::Reader<msg::ExecutionRecord> er(p, dds::topics::kRobotRecords,
                                        [&](const msg::ExecutionRecord& m, const dds::SampleMeta&) { records.push(m); });
   dds::Reader<msg::PointCloudFrame> cr(p, dds::topics::kPointCloud,
                                        [&](const msg::PointCloudFrame& m, const dds::SampleMeta&) { clouds.push(m); });

@@ -1,0 +1,71 @@
+#pragma once
+/// @file
+/// Parameters of the execution monitor, loaded from YAML (config/services/execution_monitor.yaml;
+/// every key optional, unknown keys refused):
+///
+///   robot_description: ""        # robot description YAML ("" = the scenario's, else the default)
+///   world_id: world              # the world model instance mirrored (tamp/world/*)
+///   start_tolerance: {position_m: 0.05, angle_rad: 0.05}  # trajectory start vs robot state
+///   path_check: {step_m: 0.02, step_rad: 0.02}             # sampling of the swept path check
+///   object_tolerance_m: 0.05     # pick: world-model object vs commanded object_target
+///   timeout: {stddevs: 3.0, margin_s: 5.0}  # overrun beyond expected + stddevs * stddev + margin
+///   input_wait_s: 2.0            # before a start: wait this long for a robot state / world
+///   version result_wait_s: 10.0          # after a cancel: wait this long for the robot's result
+///   state_wait_s: 2.0            # after a result: wait this long for a robot state written later
+///   status_period_s: 0.2         # EXEC_RUNNING progress updates
+///   forward_unmatched_records: true  # forward robot records of commands the monitor did not send
+///
+/// Units: metres, radians, seconds.
+
+#include <filesystem>
+#include <string>
+
+#include "tamp/core/error.h"
+
+namespace tamp::execution_monitor {
+
+/// How far the trajectory's first point may be from the robot's current state.
+struct StartTolerance {
+  double position_m{0.05};  ///< > 0: base position and prismatic joints (m)
+  double angle_rad{0.05};   ///< > 0: base heading and revolute joints (rad)
+};
+
+/// Resolution of the swept collision check of a trajectory: between two checked states no
+/// base point moves more than `step_m` by translation and no angle (base heading, arm joint)
+/// changes by more than `step_rad`.
+struct PathCheckParams {
+  double step_m{0.02};    ///< in (0, 1] m
+  double step_rad{0.02};  ///< in (0, 1] rad
+};
+
+/// An action overruns when its elapsed time exceeds
+/// expected_duration_s + stddevs * expected_stddev_s + margin_s.
+struct TimeoutParams {
+  double stddevs{3.0};   ///< >= 0
+  double margin_s{5.0};  ///< > 0 (s)
+};
+
+struct MonitorParams {
+  std::string robot_description;  ///< robot description YAML; "" = the scenario's or the default
+  std::string world_id{"world"};  ///< world model instance (WorldMirror)
+  StartTolerance start_tolerance;
+  PathCheckParams path_check;
+  double object_tolerance_m{0.05};  ///< > 0: pick target vs the world model's object position (m)
+  TimeoutParams timeout;
+  double input_wait_s{2.0};     ///< >= 0: wait for a robot state / the command's world version (s)
+  double result_wait_s{10.0};   ///< > 0: wait for the robot's result after a cancel (s)
+  double state_wait_s{2.0};     ///< > 0: wait for a robot state written after the result (s)
+  double status_period_s{0.2};  ///< > 0: EXEC_RUNNING updates (s)
+  bool forward_unmatched_records{true};
+
+  /// Ok, or one kInvalidArgument error naming every bad field.
+  Status validate() const;
+};
+
+/// Loads parameters from a YAML file; errors name file, line, column and field; unknown keys are
+/// refused; a relative `robot_description` is resolved against the file's directory.
+Result<MonitorParams> loadMonitorParams(const std::filesystem::path& file);
+/// Same from text; `name` is used as the file name in messages.
+Result<MonitorParams> parseMonitorParams(const std::string& yaml_text, const std::string& name);
+
+}  // namespace tamp::execution_monitor

@@ -1,0 +1,84 @@
+#pragma once
+/// @file
+/// The execution monitor's DDS adapter: maps `tamp::execution_monitor::ExecutionMonitor` onto
+/// the topics (idl/execution.idl, idl/effort.idl).
+///
+/// Subscribes: tamp/execute/command (ExecuteCommand), tamp/robot/state (RobotState),
+/// tamp/robot/result (ActionResult; by command id), tamp/robot/record (the robot's raw
+/// ExecutionRecords), the world model tamp/world/objects + tamp/world/meta (WorldMirror).
+/// Publishes: tamp/execute/status (ExecuteStatus, keyed by command id), tamp/execute/failure
+/// (FailureEvent), tamp/robot/trajectory (TrajectoryCommand: execute, or `cancel`),
+/// tamp/execution/record (ExecutionRecord with predicted_s, predicted_stddev_s, command_id,
+/// mission_id filled; once per record id).
+///
+/// Every callback takes one mutex around the library and publishes what it returns; a periodic
+/// spin (every 50 ms) feeds world model changes and ticks. Nothing escapes a callback: malformed
+/// messages become EXEC_FAILED statuses naming the field and log lines.
+///
+/// Sample stamps: robot states and results are ordered by their DDS source timestamps (both are
+/// written by the robot's process), so "a state written after the result" is well defined.
+
+#include <atomic>
+#include <chrono>
+#include <memory>
+#include <mutex>
+
+#include "tamp/dds/service_node.h"
+#include "tamp/dds/topics.h"
+#include "tamp/dds/world_sync.h"
+#include "tamp/execution_monitor/monitor.h"
+
+namespace tamp::execution_monitor {
+
+// ---- conversions (the node's boundary; exposed for tests) ---------------------------------------
+/// kInvalidArgument naming the field (kind, trajectory.*, object_target).
+Result<ExecutionCommand> fromMsg(const msg::ExecuteCommand& m);
+/// kInvalidArgument naming the field (joint_names, joint_positions).
+Result<RobotObservation> fromMsg(const msg::RobotState& m, const robot::RobotModel& robot,
+                                 std::int64_t stamp_ns);
+/// kInvalidArgument for an unknown outcome.
+Result<RobotResult> fromMsg(const msg::ActionResult& m, std::int64_t stamp_ns);
+msg::ExecuteStatus toMsg(const StatusUpdate& s);
+msg::FailureEvent toMsg(const FailureReport& f, std::uint64_t seq);
+msg::TrajectoryCommand toMsg(const RobotRequest& r);
+msg::ExecState toMsg(ExecState s);
+
+class ExecutionMonitorNode : public dds::ServiceNode {
+ public:
+  /// Parameters from --config (else configDir()/services/execution_monitor.yaml when it exists,
+  /// else the defaults); the robot from the parameters' robot_description, else the --scenario's
+  /// robot, else the default robot. Errors name file, line and field (exit 30).
+  static Result<std::unique_ptr<dds::ServiceNode>> create(const dds::ServiceArgs& args);
+  /// Throws std::invalid_argument for invalid params, std::runtime_error when DDS fails.
+  ExecutionMonitorNode(const dds::ServiceArgs& args, MonitorParams params, robot::RobotModel robot);
+  ~ExecutionMonitorNode() override;
+
+ protected:
+  void spinOnce() override;
+  double spinPeriodSeconds() const override { return 0.05; }
+
+ private:
+  double now() const;
+  void publish(const Outputs& out);
+  void onCommand(const msg::ExecuteCommand& m);
+  void onState(const msg::RobotState& m, const dds::SampleMeta& meta);
+  void onResult(const msg::ActionResult& m, const dds::SampleMeta& meta);
+  void onRecord(const msg::ExecutionRecord& m);
+
+  std::chrono::steady_clock::time_point t0_{std::chrono::steady_clock::now()};
+  std::mutex mutex_;  // guards monitor_ and the writers' ordering
+  std::unique_ptr<ExecutionMonitor> monitor_;
+  std::unique_ptr<dds::Writer<msg::ExecuteStatus>> status_writer_;
+  std::unique_ptr<dds::Writer<msg::FailureEvent>> failure_writer_;
+  std::unique_ptr<dds::Writer<msg::TrajectoryCommand>> trajectory_writer_;
+  std::unique_ptr<dds::Writer<msg::ExecutionRecord>> record_writer_;
+  std::unique_ptr<dds::WorldMirror> mirror_;
+  std::unique_ptr<dds::Reader<msg::ExecuteCommand>> command_reader_;
+  std::unique_ptr<dds::Reader<msg::RobotState>> state_reader_;
+  std::unique_ptr<dds::Reader<msg::ActionResult>> result_reader_;
+  std::unique_ptr<dds::Reader<msg::ExecutionRecord>> record_reader_;
+  std::atomic<bool> world_dirty_{true};
+  std::uint64_t failure_seq_{0};
+};
+
+}  // namespace tamp::execution_monitor

@@ -1,0 +1,159 @@
+// The checks of one command against the NAMO corridor's planner world and the project's robot:
+// malformed commands named by field, the trajectory start against the robot, the held object, a
+// pick's object, and the swept path check (blocked, allowed contacts, the remaining part only).
+#include <cmath>
+#include <numbers>
+
+#include <gtest/gtest.h>
+
+#include "tamp/execution_monitor/checks.h"
+#include "test_fixtures.h"
+
+namespace tamp::execution_monitor {
+namespace {
+
+using namespace testing;
+
+class ChecksTest : public ::testing::Test {
+ protected:
+  const robot::RobotModel& robot_ = robotModel();
+  const world::World world_ = corridor().plannerWorld();
+  const robot::RobotState start_ = corridor().startState();  // (1.5, 1.2, 0), arm stowed
+};
+
+std::string fieldOf(const Status& s) { return s ? "" : s.error().where.field; }
+
+TEST_F(ChecksTest, MalformedCommandsNameTheField) {
+  const ExecutionCommand good = moveBase("c", {{1.5, 1.2, 0}, {2.5, 1.2, 0}});
+  EXPECT_TRUE(validateCommand(good, robot_));
+
+  ExecutionCommand c = good;
+  c.trajectory.points.clear();
+  EXPECT_EQ(fieldOf(validateCommand(c, robot_)), "trajectory.points");
+
+  c = good;
+  c.trajectory.points[1].positions[0] = std::nan("");
+  EXPECT_EQ(fieldOf(validateCommand(c, robot_)), "trajectory.points[1].positions[0]");
+
+  c = good;
+  c.trajectory.joint_names[1] = "base_q";
+  const Status unknown = validateCommand(c, robot_);
+  EXPECT_EQ(fieldOf(unknown), "trajectory.joint_names[1]");
+  EXPECT_NE(unknown.error().message.find("unknown joint 'base_q'"), std::string::npos)
+      << unknown.error().message;
+
+  c = good;
+  c.trajectory.points[1].time_from_start = 0.0;
+  EXPECT_EQ(fieldOf(validateCommand(c, robot_)), "trajectory.points[1].time_from_start");
+
+  c = good;
+  c.trajectory.joint_names = {"base_x", "base_y", robot_.armJointNames().front()};
+  EXPECT_EQ(fieldOf(validateCommand(c, robot_)), "trajectory.joint_names[2]");
+
+  c = good;
+  c.command_id.clear();
+  EXPECT_EQ(fieldOf(validateCommand(c, robot_)), "command_id");
+
+  c = good;
+  c.expected_duration_s = -1.0;
+  EXPECT_EQ(fieldOf(validateCommand(c, robot_)), "expected_duration_s");
+
+  ExecutionCommand place;
+  place.command_id = "p";
+  place.kind = ActionKind::kPlace;
+  place.object_id = "box";
+  place.trajectory.joint_names = robot_.armJointNames();
+  place.trajectory.points.push_back({0.0, start_.arm, {}});
+  EXPECT_EQ(fieldOf(validateCommand(place, robot_)), "object_target");
+  place.object_id.clear();
+  EXPECT_EQ(fieldOf(validateCommand(place, robot_)), "object_id");
+}
+
+TEST_F(ChecksTest, StartMustMatchTheRobot) {
+  EXPECT_FALSE(checkStart(moveBase("c", {{1.5, 1.2, 0}, {2.5, 1.2, 0}}), start_, robot_, {}));
+  // A heading off by a full turn is the same heading.
+  EXPECT_FALSE(checkStart(moveBase("c", {{1.52, 1.2, 2 * std::numbers::pi}, {2.5, 1.2, 0}}), start_,
+                          robot_, {}));
+  auto off = checkStart(moveBase("c", {{1.8, 1.2, 0}, {2.5, 1.2, 0}}), start_, robot_, {});
+  ASSERT_TRUE(off);
+  EXPECT_EQ(off->reason.rfind("start:", 0), 0u) << off->reason;
+  EXPECT_NE(off->reason.find("base_x"), std::string::npos) << off->reason;
+  auto turned = checkStart(moveBase("c", {{1.5, 1.2, 0.2}, {2.5, 1.2, 0}}), start_, robot_, {});
+  ASSERT_TRUE(turned);
+  EXPECT_NE(turned->reason.find("base_theta"), std::string::npos) << turned->reason;
+}
+
+TEST_F(ChecksTest, HeldObjectAndPickTarget) {
+  ExecutionCommand place;
+  place.kind = ActionKind::kPlace;
+  place.object_id = "box";
+  EXPECT_FALSE(checkHeld(place, "box"));
+  auto empty = checkHeld(place, "");
+  ASSERT_TRUE(empty);
+  EXPECT_EQ(empty->reason.rfind("held object:", 0), 0u);
+  EXPECT_TRUE(checkHeld(place, "can"));
+  ExecutionCommand pick = place;
+  pick.kind = ActionKind::kPick;
+  EXPECT_FALSE(checkHeld(pick, ""));
+  EXPECT_TRUE(checkHeld(pick, "can"));
+  EXPECT_FALSE(checkHeld(moveBase("m", {{0, 0, 0}}), "box"));
+
+  EXPECT_FALSE(checkPickTarget(pick, world_, 0.05));
+  pick.object_target = world_.findObject("box")->pose;
+  EXPECT_FALSE(checkPickTarget(pick, world_, 0.05));
+  pick.object_target->translation().x() += 0.2;
+  auto moved = checkPickTarget(pick, world_, 0.05);
+  ASSERT_TRUE(moved);
+  EXPECT_EQ(moved->reason.rfind("object_target:", 0), 0u) << moved->reason;
+  pick.object_id = "ghost";
+  auto ghost = checkPickTarget(pick, world_, 0.05);
+  ASSERT_TRUE(ghost);
+  EXPECT_EQ(ghost->object_id, "ghost");
+  pick.object_id = "wall_south";
+  EXPECT_TRUE(checkPickTarget(pick, world_, 0.05));
+}
+
+TEST_F(ChecksTest, PathCheckFindsTheFirstObjectOnThePath) {
+  PathChecker checker(robot_, {});
+  checker.setWorld(world_);
+  const std::vector<std::string> none;
+  // Free floor ahead of the start.
+  const SweptPath clear = makePath(moveBase("c", {{1.5, 1.2, 0}, {3.0, 1.2, 0}}), start_, robot_);
+  EXPECT_FALSE(checker.firstContact(clear, 0.0, none));
+  // Into the box standing across the corridor's mouth.
+  const SweptPath into = makePath(moveBase("c", {{1.5, 1.2, 0}, {5.0, 1.2, 0}}), start_, robot_);
+  auto hit = checker.firstContact(into, 0.0, none);
+  ASSERT_TRUE(hit);
+  EXPECT_EQ(hit->object_id, "box");
+  EXPECT_GT(hit->fraction, 0.5);
+  EXPECT_LT(hit->fraction, 1.0);
+  // The box allowed (a pick's object): the next thing in the way is not the box.
+  auto past = checker.firstContact(into, 0.0, {"box"});
+  if (past) {
+    EXPECT_NE(past->object_id, "box");
+  }
+
+  // A crate appears 0.5 m ahead: on the path from the start, not on what is left after it.
+  checker.setWorld(withCrate(world_, "crate", 2.3, 1.2));
+  auto crate_hit = checker.firstContact(clear, 0.0, none);
+  ASSERT_TRUE(crate_hit);
+  EXPECT_EQ(crate_hit->object_id, "crate");
+  EXPECT_FALSE(checker.firstContact(clear, 0.95, {}));
+  EXPECT_FALSE(checker.firstContact(clear, 0.0, {"crate"}));
+  EXPECT_EQ(checker.contactsAt(clear.at(crate_hit->fraction)), std::vector<std::string>{"crate"});
+}
+
+TEST_F(ChecksTest, PathProjectionIsMonotone) {
+  const SweptPath p =
+      makePath(moveBase("c", {{1.5, 1.2, 0}, {2.5, 1.2, 0}, {1.5, 1.2, 0}}), start_, robot_);
+  robot::RobotState s = start_;
+  s.base.x = 2.0;
+  EXPECT_NEAR(p.project(s), 0.25, 1e-9);
+  EXPECT_NEAR(p.project(s, 0.5), 0.75, 1e-9);  // on the way back, not rewound
+  s.base.x = 2.5;
+  EXPECT_NEAR(p.project(s), 0.5, 1e-9);
+  EXPECT_NEAR(p.at(0.75).base.x, 2.0, 1e-9);
+}
+
+}  // namespace
+}  // namespace tamp::execution_monitor

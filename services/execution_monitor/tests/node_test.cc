@@ -1,0 +1,393 @@
+// The execution monitor over real DDS: the simulator (tamp_sim_service on the NAMO corridor) and
+// the monitor (tamp_execution_monitor_service) as processes on an isolated domain; the test
+// process publishes the world model (the scenario's planner world, as perception would) and the
+// graph manager's ExecuteCommands, and reads what the services publish.
+//
+//  - a straight, collision-free move_base ends SUCCEEDED with the robot's measured duration and
+//    exactly one forwarded ExecutionRecord carrying the prediction and the command id; the same
+//    command id sent again is answered, not executed (one robot result, one record);
+//  - a command whose start is not the robot's, and malformed ones, fail naming what is wrong and
+//    never reach the robot;
+//  - an object appearing on the remaining path mid-action (injected into the simulator, reported
+//    by the world model) stops the robot: BLOCKED with the object's id, FAILURE_NEW_OBSTACLE.
+#include <cmath>
+#include <condition_variable>
+#include <fstream>
+#include <functional>
+#include <mutex>
+
+#include <gtest/gtest.h>
+
+#include "../../../tests/integration/integration_util.h"
+#include "tamp/core/paths.h"
+#include "tamp/dds/convert.h"
+#include "tamp/dds/topics.h"
+#include "tamp/dds/world_sync.h"
+#include "tamp/world/scenario.h"
+
+namespace tamp::execution_monitor {
+namespace {
+
+using integration::readFile;
+using integration::serviceSpec;
+using integration::tempFile;
+
+/// Samples from a reader callback, with bounded waits for a match or a count of matches.
+template <typename T>
+class Log {
+ public:
+  void push(const T& v) {
+    std::lock_guard l(m_);
+    items_.push_back(v);
+    cv_.notify_all();
+  }
+  std::optional<T> waitFor(const std::function<bool(const T&)>& pred, double seconds = 30.0) {
+    std::unique_lock l(m_);
+    std::optional<T> found;
+    cv_.wait_for(l, std::chrono::duration<double>(seconds), [&] {
+      for (const auto& x : items_) {
+        if (pred(x)) {
+          found = x;
+          return true;
+        }
+      }
+      return false;
+    });
+    return found;
+  }
+  /// Waits until `n` samples match; returns how many match then (or at the timeout).
+  std::size_t waitCount(const std::function<bool(const T&)>& pred, std::size_t n,
+                        double seconds = 30.0) {
+    std::unique_lock l(m_);
+    std::size_t count = 0;
+    cv_.wait_for(l, std::chrono::duration<double>(seconds), [&] {
+      count = static_cast<std::size_t>(std::count_if(items_.begin(), items_.end(), pred));
+      return count >= n;
+    });
+    return count;
+  }
+  std::size_t count(const std::function<bool(const T&)>& pred) {
+    std::lock_guard l(m_);
+    return static_cast<std::size_t>(std::count_if(items_.begin(), items_.end(), pred));
+  }
+  std::optional<T> last() {
+    std::lock_guard l(m_);
+    if (items_.empty()) return std::nullopt;
+    return items_.back();
+  }
+
+ private:
+  std::mutex m_;
+  std::condition_variable cv_;
+  std::vector<T> items_;
+};
+
+bool isFinal(msg::ExecState s) {
+  return s == msg::ExecState::EXEC_SUCCEEDED || s == msg::ExecState::EXEC_FAILED ||
+         s == msg::ExecState::EXEC_BLOCKED || s == msg::ExecState::EXEC_CANCELLED;
+}
+
+class MonitorNodeTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    domain_ = integration::isolatedDomain();
+    const std::string scenario = (configDir() / "scenarios" / "namo_corridor.yaml").string();
+    sim_config_ = tempFile("tamp_em_sim.yaml");
+    {
+      std::ofstream out(sim_config_);  // no periodic clouds and a tiny camera: nobody reads them
+      out << "cloud_period_s: 0\nsensor: {width: 16, height: 12}\n";
+    }
+    monitor_config_ = tempFile("tamp_em_monitor.yaml");
+    {
+      std::ofstream out(monitor_config_);  // discovery on a loaded machine may take a while
+      out << "input_wait_s: 15\n";
+    }
+    sup_.add(serviceSpec("tamp_sim_service", "sim", domain_,
+                         {"--config", sim_config_.string(), "--scenario", scenario}));
+    sup_.add(serviceSpec("tamp_execution_monitor_service", "execution_monitor", domain_,
+                         {"--config", monitor_config_.string(), "--scenario", scenario}));
+    ASSERT_TRUE(sup_.startAll().ok());
+    auto p = dds::Participant::create(
+        {domain_, dds::kProfileDefault, "tamp/execution_monitor_test", {}});
+    ASSERT_TRUE(p) << p.error().toString();
+    participant_ = *p;
+    auto sc = world::loadScenario(scenario);
+    ASSERT_TRUE(sc) << sc.error().toString();
+    world_ = sc->plannerWorld();
+
+    statuses_ = std::make_unique<dds::Reader<msg::ExecuteStatus>>(
+        participant_, dds::topics::kExecuteStatus,
+        [this](const msg::ExecuteStatus& m, const dds::SampleMeta&) { status_log_.push(m); });
+    failures_ = std::make_unique<dds::Reader<msg::FailureEvent>>(
+        participant_, dds::topics::kFailureEvents,
+        [this](const msg::FailureEvent& m, const dds::SampleMeta&) { failure_log_.push(m); });
+    results_ = std::make_unique<dds::Reader<msg::ActionResult>>(
+        participant_, dds::topics::kActionResult,
+        [this](const msg::ActionResult& m, const dds::SampleMeta&) { result_log_.push(m); });
+    states_ = std::make_unique<dds::Reader<msg::RobotState>>(
+        participant_, dds::topics::kRobotState,
+        [this](const msg::RobotState& m, const dds::SampleMeta&) { state_log_.push(m); });
+    records_ = std::make_unique<dds::Reader<msg::ExecutionRecord>>(
+        participant_, dds::topics::kExecutionRecords,
+        [this](const msg::ExecutionRecord& m, const dds::SampleMeta&) { record_log_.push(m); });
+    robot_records_ = std::make_unique<dds::Reader<msg::ExecutionRecord>>(
+        participant_, dds::topics::kRobotRecords,
+        [this](const msg::ExecutionRecord& m, const dds::SampleMeta&) {
+          robot_record_log_.push(m);
+        });
+    publisher_ = std::make_unique<dds::WorldPublisher>(participant_);
+    ASSERT_TRUE(publisher_->publish(world_));
+    commands_ = std::make_unique<dds::Writer<msg::ExecuteCommand>>(participant_,
+                                                                   dds::topics::kExecuteCommand);
+    faults_ = std::make_unique<dds::Writer<msg::FaultInjection>>(participant_,
+                                                                 dds::topics::kFaultInjection);
+
+    // Both services up: the simulator streams its state, the monitor reads commands and its
+    // status writer has matched us.
+    ASSERT_TRUE(state_log_.waitFor([](const msg::RobotState&) { return true; }))
+        << "no robot state";
+    ASSERT_TRUE(commands_->waitForReaders(Termination::after(30.0)))
+        << "the monitor reads no commands";
+    ASSERT_TRUE(statuses_->waitForWriters(Termination::after(30.0)))
+        << "the monitor publishes no status";
+    ASSERT_TRUE(faults_->waitForReaders(Termination::after(30.0)));
+  }
+
+  void TearDown() override {
+    statuses_.reset();
+    failures_.reset();
+    results_.reset();
+    states_.reset();
+    records_.reset();
+    robot_records_.reset();
+    sup_.poll();
+    for (const auto& st : sup_.status()) {
+      if (st.phase != process::ProcessPhase::kRunning || HasFailure()) {
+        ADD_FAILURE() << st.name << " (" << st.last_exit << "):\n"
+                      << readFile(tempFile("tamp_it_" + st.name + ".log"));
+      }
+    }
+    sup_.stopAll(5.0);
+    for (const auto& st : sup_.status()) {
+      EXPECT_TRUE(st.last_exit == "exit 0" || st.last_exit.rfind("signal 15", 0) == 0)
+          << st.name << " ended with " << st.last_exit;
+    }
+    std::filesystem::remove(sim_config_);
+    std::filesystem::remove(monitor_config_);
+  }
+
+  Pose2D robotBase() {
+    auto s = state_log_.last();
+    EXPECT_TRUE(s);
+    return s ? Pose2D{s->base().x(), s->base().y(), s->base().theta()} : Pose2D{};
+  }
+
+  /// A straight move_base from `from` by `distance` m along its heading (1 s per metre).
+  msg::ExecuteCommand moveBase(const std::string& id, const Pose2D& from, double distance,
+                               double turn = 0.0) {
+    Trajectory t;
+    t.joint_names = {"base_x", "base_y", "base_theta"};
+    t.points.push_back({0.0, {from.x, from.y, from.theta}, {}});
+    t.points.push_back({std::max(1.0, distance),
+                        {from.x + distance * std::cos(from.theta),
+                         from.y + distance * std::sin(from.theta), from.theta + turn},
+                        {}});
+    msg::ExecuteCommand c;
+    c.command_id(id);
+    c.mission_id("it_mission");
+    c.edge_id("e_" + id);
+    c.pddl_action("(move-base start somewhere)");
+    c.kind(msg::ActionKind::ACTION_MOVE_BASE);
+    c.trajectory(dds::toMsg(t));
+    c.expected_duration_s(4.0);
+    c.expected_stddev_s(0.4);
+    c.world_version(publisher_->publishedVersion());
+    return c;
+  }
+
+  std::optional<msg::ExecuteStatus> finalOf(const std::string& id, double seconds = 60.0) {
+    return status_log_.waitFor(
+        [&](const msg::ExecuteStatus& s) { return s.command_id() == id && isFinal(s.state()); },
+        seconds);
+  }
+
+  /// Sends a turn on the spot and waits for its end: everything the robot did for earlier
+  /// commands has been published by then (one writer per topic, in order).
+  void barrier(const std::string& id) {
+    ASSERT_TRUE(commands_->write(moveBase(id, robotBase(), 0.0, 0.3)));
+    auto done = finalOf(id);
+    ASSERT_TRUE(done) << "no final status of the barrier";
+    ASSERT_EQ(done->state(), msg::ExecState::EXEC_SUCCEEDED) << done->reason();
+    ASSERT_TRUE(robot_record_log_.waitFor(
+        [&](const msg::ExecutionRecord& r) { return r.record_id() == id; }));
+    ASSERT_TRUE(
+        record_log_.waitFor([&](const msg::ExecutionRecord& r) { return r.record_id() == id; }));
+  }
+
+  int domain_{0};
+  std::filesystem::path sim_config_, monitor_config_;
+  process::Supervisor sup_;
+  std::shared_ptr<dds::Participant> participant_;
+  world::World world_;
+  Log<msg::ExecuteStatus> status_log_;
+  Log<msg::FailureEvent> failure_log_;
+  Log<msg::ActionResult> result_log_;
+  Log<msg::RobotState> state_log_;
+  Log<msg::ExecutionRecord> record_log_, robot_record_log_;
+  std::unique_ptr<dds::Reader<msg::ExecuteStatus>> statuses_;
+  std::unique_ptr<dds::Reader<msg::FailureEvent>> failures_;
+  std::unique_ptr<dds::Reader<msg::ActionResult>> results_;
+  std::unique_ptr<dds::Reader<msg::RobotState>> states_;
+  std::unique_ptr<dds::Reader<msg::ExecutionRecord>> records_, robot_records_;
+  std::unique_ptr<dds::WorldPublisher> publisher_;
+  std::unique_ptr<dds::Writer<msg::ExecuteCommand>> commands_;
+  std::unique_ptr<dds::Writer<msg::FaultInjection>> faults_;
+};
+
+TEST_F(MonitorNodeTest, ValidMoveSucceedsOnceAndItsRecordIsForwardedOnce) {
+  const Pose2D start = robotBase();
+  const msg::ExecuteCommand go = moveBase("em_go", start, 0.8);
+  ASSERT_TRUE(commands_->write(go));
+  auto done = finalOf("em_go");
+  ASSERT_TRUE(done) << "no final status";
+  EXPECT_EQ(done->state(), msg::ExecState::EXEC_SUCCEEDED) << done->reason();
+  EXPECT_GT(done->measured_duration_s(), 0.0);
+  EXPECT_EQ(done->held_object_id(), "");
+  EXPECT_DOUBLE_EQ(done->progress(), 1.0);
+  EXPECT_TRUE(status_log_.waitFor([](const msg::ExecuteStatus& s) {
+    return s.command_id() == "em_go" && s.state() == msg::ExecState::EXEC_RUNNING;
+  }));
+  auto result =
+      result_log_.waitFor([](const msg::ActionResult& r) { return r.command_id() == "em_go"; });
+  ASSERT_TRUE(result);
+  EXPECT_DOUBLE_EQ(done->measured_duration_s(), result->duration_s());
+  auto record =
+      record_log_.waitFor([](const msg::ExecutionRecord& r) { return r.command_id() == "em_go"; });
+  ASSERT_TRUE(record) << "no forwarded execution record";
+  EXPECT_EQ(record->record_id(), "em_go");
+  EXPECT_EQ(record->mission_id(), "it_mission");
+  EXPECT_DOUBLE_EQ(record->predicted_s(), 4.0);
+  EXPECT_DOUBLE_EQ(record->predicted_stddev_s(), 0.4);
+  EXPECT_DOUBLE_EQ(record->duration_s(), result->duration_s());
+  EXPECT_TRUE(record->success());
+  EXPECT_EQ(record->source(), "sim");
+  const Pose2D after = robotBase();
+  EXPECT_NEAR(after.x, start.x + 0.8, 0.05);
+
+  // The same command again: answered with its final status, not executed.
+  ASSERT_TRUE(commands_->write(go));
+  EXPECT_EQ(status_log_.waitCount(
+                [](const msg::ExecuteStatus& s) {
+                  return s.command_id() == "em_go" && isFinal(s.state());
+                },
+                2),
+            2u);
+  barrier("em_barrier");
+  EXPECT_EQ(result_log_.count([](const msg::ActionResult& r) { return r.command_id() == "em_go"; }),
+            1u);
+  EXPECT_EQ(robot_record_log_.count(
+                [](const msg::ExecutionRecord& r) { return r.record_id() == "em_go"; }),
+            1u);
+  EXPECT_EQ(
+      record_log_.count([](const msg::ExecutionRecord& r) { return r.record_id() == "em_go"; }),
+      1u);
+  EXPECT_EQ(status_log_.count([](const msg::ExecuteStatus& s) {
+    return s.command_id() == "em_go" && s.state() == msg::ExecState::EXEC_FAILED;
+  }),
+            0u);
+}
+
+TEST_F(MonitorNodeTest, MismatchedStartAndMalformedCommandsFailNamingTheField) {
+  Pose2D elsewhere = robotBase();
+  elsewhere.x += 1.0;
+  ASSERT_TRUE(commands_->write(moveBase("em_far", elsewhere, 0.5)));
+  auto far = finalOf("em_far");
+  ASSERT_TRUE(far);
+  EXPECT_EQ(far->state(), msg::ExecState::EXEC_FAILED);
+  EXPECT_EQ(far->reason().rfind("start:", 0), 0u) << far->reason();
+  EXPECT_NE(far->reason().find("base_x"), std::string::npos) << far->reason();
+  auto event =
+      failure_log_.waitFor([](const msg::FailureEvent& e) { return e.command_id() == "em_far"; });
+  ASSERT_TRUE(event);
+  EXPECT_EQ(event->type(), msg::FailureType::FAILURE_PRECONDITION);
+  EXPECT_EQ(event->description(), far->reason());
+
+  msg::ExecuteCommand unknown = moveBase("em_unknown_joint", robotBase(), 0.5);
+  unknown.trajectory().joint_names()[1] = "base_q";
+  msg::ExecuteCommand nan = moveBase("em_nan", robotBase(), 0.5);
+  nan.trajectory().positions()[4] = std::nan("");
+  msg::ExecuteCommand empty = moveBase("em_empty", robotBase(), 0.5);
+  empty.trajectory().times().clear();
+  empty.trajectory().positions().clear();
+  for (const auto* c : {&unknown, &nan, &empty}) ASSERT_TRUE(commands_->write(*c));
+  const std::pair<const char*, const char*> expected[] = {
+      {"em_unknown_joint", "trajectory.joint_names[1]"},
+      {"em_nan", "trajectory.positions"},
+      {"em_empty", "trajectory"}};
+  for (const auto& [id, field] : expected) {
+    auto f = finalOf(id);
+    ASSERT_TRUE(f) << id;
+    EXPECT_EQ(f->state(), msg::ExecState::EXEC_FAILED) << id;
+    EXPECT_NE(f->reason().find(field), std::string::npos) << id << ": " << f->reason();
+  }
+  barrier("em_barrier");
+  for (const char* id : {"em_far", "em_unknown_joint", "em_nan", "em_empty"}) {
+    EXPECT_EQ(result_log_.count([&](const msg::ActionResult& r) { return r.command_id() == id; }),
+              0u)
+        << id << " reached the robot";
+  }
+}
+
+TEST_F(MonitorNodeTest, ObjectAppearingOnTheRemainingPathBlocksWithItsId) {
+  const Pose2D start = robotBase();
+  ASSERT_TRUE(commands_->write(moveBase("em_blocked", start, 1.8)));
+  ASSERT_TRUE(status_log_.waitFor([](const msg::ExecuteStatus& s) {
+    return s.command_id() == "em_blocked" && s.state() == msg::ExecState::EXEC_RUNNING;
+  })) << "not started";
+  // Mid-action: once the robot has driven 0.2 m, a crate appears 1.6 m ahead of the start, in the
+  // simulator's world and in the world model (the simulator would stop before it at ~1.1 m).
+  ASSERT_TRUE(state_log_.waitFor([&](const msg::RobotState& s) {
+    return std::hypot(s.base().x() - start.x, s.base().y() - start.y) > 0.2;
+  })) << "the robot does not move";
+  const double d = 1.6;
+  const double x = start.x + d * std::cos(start.theta), y = start.y + d * std::sin(start.theta);
+  msg::FaultInjection spawn;
+  spawn.fault_id("em_spawn");
+  spawn.type(msg::FaultType::FAULT_SPAWN_OBJECT);
+  spawn.object_id("em_crate");
+  spawn.reason("crate");
+  spawn.shape().type(msg::ShapeType::SHAPE_BOX);
+  spawn.shape().dimensions({0.4, 0.4, 0.4});
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translation() = Eigen::Vector3d(x, y, 0.2);
+  spawn.pose(dds::toMsg(pose));
+  ASSERT_TRUE(faults_->write(spawn));
+  world::Object crate;
+  crate.id = "em_crate";
+  crate.label = "crate";
+  crate.kind = world::ObjectKind::kStatic;
+  crate.shape = world::Shape::box(0.4, 0.4, 0.4);
+  crate.pose = pose;
+  ASSERT_TRUE(world_.addObject(crate));
+  ASSERT_TRUE(publisher_->publish(world_));
+
+  auto done = finalOf("em_blocked");
+  ASSERT_TRUE(done);
+  EXPECT_EQ(done->state(), msg::ExecState::EXEC_BLOCKED) << done->reason();
+  EXPECT_EQ(done->blocking_object_id(), "em_crate");
+  EXPECT_GT(done->measured_duration_s(), 0.0);
+  auto event = failure_log_.waitFor(
+      [](const msg::FailureEvent& e) { return e.command_id() == "em_blocked"; });
+  ASSERT_TRUE(event);
+  EXPECT_EQ(event->type(), msg::FailureType::FAILURE_NEW_OBSTACLE) << event->description();
+  EXPECT_EQ(event->object_id(), "em_crate");
+  // The monitor stopped the robot (a cancel), before it reached the crate.
+  auto result = result_log_.waitFor(
+      [](const msg::ActionResult& r) { return r.command_id() == "em_blocked"; });
+  ASSERT_TRUE(result);
+  EXPECT_EQ(result->outcome(), msg::ActionOutcome::OUTCOME_CANCELLED) << result->reason();
+  EXPECT_LT(robotBase().x, x - 0.2 - 0.3);
+}
+
+}  // namespace
+}  // namespace tamp::execution_monitor

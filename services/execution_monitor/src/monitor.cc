@@ -89,6 +89,7 @@ struct Active {
   double started{0.0};
   SweptPath path;
   std::vector<std::string> ignore;  // allowed contacts + objects touching the robot at the start
+  std::map<std::string, Eigen::Vector3d> validated;  // objects at validation and their positions
   std::string held_at_start;
   double progress{0.0};
   double last_status{0.0};
@@ -253,6 +254,7 @@ struct ExecutionMonitor::Impl {
     a.held_at_start = state->held_object_id;
     a.ignore = allowedContacts(c, state->held_object_id);
     for (const auto& id : checker.contactsAt(state->state)) a.ignore.push_back(id);
+    for (const auto& o : world->objects()) a.validated[o.id] = o.pose.translation();
     if (auto hit = checker.firstContact(a.path, 0.0, a.ignore)) {
       const robot::RobotState at = a.path.at(hit->fraction);
       return CheckFailure{"path: the robot would touch '" + hit->object_id +
@@ -374,6 +376,14 @@ struct ExecutionMonitor::Impl {
     checker.setWorld(*world);
     std::vector<std::string> ignore = a.ignore;
     for (const auto& id : checker.contactsAt(state->state)) ignore.push_back(id);
+    // Known objects that stayed put were checked at the start: only new or moved ones count.
+    for (const auto& o : world->objects()) {
+      const auto it = a.validated.find(o.id);
+      if (it != a.validated.end() &&
+          (o.pose.translation() - it->second).norm() <= params.moved_tolerance_m) {
+        ignore.push_back(o.id);
+      }
+    }
     if (auto hit = checker.firstContact(a.path, a.progress, ignore)) {
       const robot::RobotState at = a.path.at(hit->fraction);
       stop(out, Verdict::kNewObstacle, hit->object_id,

@@ -23,6 +23,7 @@ const config::Schema<MonitorParams>& schema() {
                  return std::nullopt;
                })
         .field("object_tolerance_m", &P::object_tolerance_m, positive())
+        .field("moved_tolerance_m", &P::moved_tolerance_m, positive())
         .field("input_wait_s", &P::input_wait_s, nonNegative("s"))
         .field("result_wait_s", &P::result_wait_s, positive())
         .field("state_wait_s", &P::state_wait_s, positive())

@@ -178,6 +178,23 @@ TEST_F(MonitorTest, NewObstacleOnTheRemainingPathCancelsAndBlocks) {
   monitor_.onRobotState(observe(2.0, stamp_ += 10), now_ + 1.0);
   // Something appears behind the robot: not on what is left of the path.
   EXPECT_TRUE(monitor_.onWorld(withCrate(world_, "behind", 0.6, 1.2), 2, now_ + 1.1).empty());
+  // A known object that moved: within the tolerance it is not re-checked, beyond it, it is.
+  {
+    ExecutionMonitor m(MonitorParams{}, robotModel());
+    world::World w = withCrate(world_, "known", 3.6, 1.9);  // beside the end of the path
+    m.onWorld(w, 1, now_);
+    m.onRobotState(observe(1.5, stamp_), now_);
+    ASSERT_EQ(m.onCommand(moveBase("k", {{1.5, 1.2, 0}, {3.5, 1.2, 0}}), now_).robot.size(), 1u);
+    world::World jitter = world_;
+    ASSERT_TRUE(
+        jitter.addObject(crate("known", 3.6, 1.9 - 0.5 * MonitorParams{}.moved_tolerance_m)));
+    EXPECT_TRUE(m.onWorld(jitter, 2, now_ + 0.1).robot.empty());
+    world::World moved = world_;
+    ASSERT_TRUE(moved.addObject(crate("known", 3.6, 1.3)));  // into the path
+    const Outputs o = m.onWorld(moved, 3, now_ + 0.2);
+    ASSERT_EQ(o.robot.size(), 1u);
+    EXPECT_EQ(o.robot[0].type, RobotRequest::Type::kCancel);
+  }
   // Something appears ahead of it: cancel, then BLOCKED once the robot has stopped.
   Outputs out = monitor_.onWorld(withCrate(world_, "crate", 3.0, 1.2), 3, now_ + 1.2);
   ASSERT_EQ(out.robot.size(), 1u);

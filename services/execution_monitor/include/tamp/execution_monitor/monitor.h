@@ -27,8 +27,9 @@
 ///   the robot, are allowed contacts). A failure is a final EXEC_FAILED whose reason names what
 ///   failed, with a FailureReport kPrecondition; the robot is not commanded.
 /// - **Watching while it runs.** On every world model: the remaining path (from the robot's
-///   progress) against the world (an object on it: cancel the robot, final EXEC_BLOCKED with its
-///   id, kNewObstacle). On every robot state: progress, and the held object still held while a
+///   progress) against the objects perceived since the start or moved by more than
+///   `moved_tolerance_m` (one on it: cancel the robot, final EXEC_BLOCKED with its id,
+///   kNewObstacle). On every robot state: progress, and the held object still held while a
 ///   move_base / move_arm carries it (else cancel, EXEC_FAILED, kObjectDropped). On every tick:
 ///   an overrun beyond expected + k stddev + margin (cancel, EXEC_FAILED, kTimeout), and
 ///   EXEC_RUNNING with progress every `status_period_s`.

@@ -8,6 +8,7 @@
 ///   start_tolerance: {position_m: 0.05, angle_rad: 0.05}  # trajectory start vs robot state
 ///   path_check: {step_m: 0.02, step_rad: 0.02}             # sampling of the swept path check
 ///   object_tolerance_m: 0.05     # pick: world-model object vs commanded object_target
+///   moved_tolerance_m: 0.05      # while running: a known object counts as new when it moved more
 ///   timeout: {stddevs: 3.0, margin_s: 5.0}  # overrun beyond expected + stddevs * stddev + margin
 ///   input_wait_s: 2.0            # before a start: wait this long for a robot state / world
 ///   version result_wait_s: 10.0          # after a cancel: wait this long for the robot's result
@@ -51,6 +52,10 @@ struct MonitorParams {
   StartTolerance start_tolerance;
   PathCheckParams path_check;
   double object_tolerance_m{0.05};  ///< > 0: pick target vs the world model's object position (m)
+  /// > 0: while an action runs, only objects perceived since its start, or moved by more than
+  /// this since then (m), are checked against the remaining path (perception noise on known
+  /// objects does not stop the robot; they were checked at the start).
+  double moved_tolerance_m{0.05};
   TimeoutParams timeout;
   double input_wait_s{2.0};     ///< >= 0: wait for a robot state / the command's world version (s)
   double result_wait_s{10.0};   ///< > 0: wait for the robot's result after a cancel (s)

@@ -387,6 +387,21 @@ std::optional<PathChecker::Hit> PathChecker::firstContact(const SweptPath& path,
   return std::nullopt;
 }
 
+std::vector<std::string> PathChecker::supportsOf(const world::Object& o,
+                                                 const Eigen::Isometry3d& pose) const {
+  constexpr double kProbe = 0.005;  // m
+  std::vector<std::string> out;
+  if (!has_world_) return out;
+  const double bottom = o.shape.aabb(pose).min.z();
+  Eigen::Isometry3d probe = pose;
+  probe.translation().z() -= kProbe;
+  for (const auto& id : scene_.shapeCollisions(o.shape, probe, collision::Filter::allBut({o.id}))) {
+    const world::Object* other = scene_.world().findObject(id);
+    if (other && other->aabb().max.z() <= bottom + kProbe) out.push_back(id);
+  }
+  return out;
+}
+
 std::vector<std::string> allowedContacts(const ExecutionCommand& c, const std::string& held) {
   std::vector<std::string> out;
   if (!c.object_id.empty()) out.push_back(c.object_id);

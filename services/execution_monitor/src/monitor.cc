@@ -254,6 +254,12 @@ struct ExecutionMonitor::Impl {
     a.held_at_start = state->held_object_id;
     a.ignore = allowedContacts(c, state->held_object_id);
     for (const auto& id : checker.contactsAt(state->state)) a.ignore.push_back(id);
+    // The manipulated object's support: where it rests (pick) or will rest (place).
+    if (const world::Object* o = world->findObject(c.object_id); o && c.kind == ActionKind::kPick) {
+      for (const auto& id : checker.supportsOf(*o, o->pose)) a.ignore.push_back(id);
+    } else if (o && c.kind == ActionKind::kPlace && c.object_target) {
+      for (const auto& id : checker.supportsOf(*o, *c.object_target)) a.ignore.push_back(id);
+    }
     for (const auto& o : world->objects()) a.validated[o.id] = o.pose.translation();
     if (auto hit = checker.firstContact(a.path, 0.0, a.ignore)) {
       const robot::RobotState at = a.path.at(hit->fraction);

@@ -143,6 +143,23 @@ TEST_F(ChecksTest, PathCheckFindsTheFirstObjectOnThePath) {
   EXPECT_EQ(checker.contactsAt(clear.at(crate_hit->fraction)), std::vector<std::string>{"crate"});
 }
 
+TEST_F(ChecksTest, SupportsOfAnObjectOnATable) {
+  auto sc = world::loadScenario(configDir() / "scenarios" / "occluded_can.yaml");
+  ASSERT_TRUE(sc) << sc.error().toString();
+  const world::World w = sc->plannerWorld();
+  PathChecker checker(robot_, {});
+  checker.setWorld(w);
+  const world::Object* can = w.findObject("can");
+  ASSERT_NE(can, nullptr);
+  EXPECT_EQ(checker.supportsOf(*can, can->pose), std::vector<std::string>{"table_body"});
+  // Above the counter, 2 cm up: resting on nothing.
+  Eigen::Isometry3d above = can->pose;
+  above.translation() = Eigen::Vector3d(0.0, 1.9, 0.80 + 0.06 + 0.02);
+  EXPECT_TRUE(checker.supportsOf(*can, above).empty());
+  above.translation().z() = 0.80 + 0.06;
+  EXPECT_EQ(checker.supportsOf(*can, above), std::vector<std::string>{"counter_body"});
+}
+
 TEST_F(ChecksTest, PathProjectionIsMonotone) {
   const SweptPath p =
       makePath(moveBase("c", {{1.5, 1.2, 0}, {2.5, 1.2, 0}, {1.5, 1.2, 0}}), start_, robot_);

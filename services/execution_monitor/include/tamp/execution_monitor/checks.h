@@ -104,6 +104,12 @@ class PathChecker {
   std::optional<Hit> firstContact(const SweptPath& path, double from,
                                   const std::vector<std::string>& ignore);
 
+  /// The objects `object` would rest on at `pose`: those touching it lowered by 5 mm whose top
+  /// is not above its bottom (+ 5 mm), `object` itself excluded (sorted). A pick's or place's
+  /// support (the table) is an allowed contact of the action.
+  std::vector<std::string> supportsOf(const world::Object& object,
+                                      const Eigen::Isometry3d& pose) const;
+
  private:
   const robot::RobotModel* robot_;
   PathCheckParams params_;
@@ -112,7 +118,8 @@ class PathChecker {
   std::vector<Eigen::Isometry3d> poses_;
 };
 
-/// The contacts that are part of the task: the picked / placed object and the held object.
+/// The contacts that are part of the task: the picked / placed object and the held object (the
+/// monitor adds the object's support, see PathChecker::supportsOf).
 std::vector<std::string> allowedContacts(const ExecutionCommand& command,
                                          const std::string& held_object_id);
 

@@ -23,9 +23,10 @@
 /// - **Validation just before the start**, against the latest world model and robot state:
 ///   the command's form (`validateCommand`, on arrival), the trajectory's start
 ///   (`checkStart`), the held object (`checkHeld`), a pick's object (`checkPickTarget`) and the
-///   whole path (`PathChecker`; the picked / placed and held objects, and objects already touching
-///   the robot, are allowed contacts). A failure is a final EXEC_FAILED whose reason names what
-///   failed, with a FailureReport kPrecondition; the robot is not commanded.
+///   whole path (`PathChecker`; the picked / placed and held objects, the support the object rests
+///   or will rest on, and objects already touching the robot, are allowed contacts). A failure is a
+///   final EXEC_FAILED whose reason names what failed, with a FailureReport kPrecondition; the
+///   robot is not commanded.
 /// - **Watching while it runs.** On every world model: the remaining path (from the robot's
 ///   progress) against the objects perceived since the start or moved by more than
 ///   `moved_tolerance_m` (one on it: cancel the robot, final EXEC_BLOCKED with its id,

@@ -9,7 +9,9 @@
 //  - a command whose start is not the robot's, and malformed ones, fail naming what is wrong and
 //    never reach the robot;
 //  - an object appearing on the remaining path mid-action (injected into the simulator, reported
-//    by the world model) stops the robot: BLOCKED with the object's id, FAILURE_NEW_OBSTACLE.
+//    by the world model) stops the robot: BLOCKED with the object's id, FAILURE_NEW_OBSTACLE;
+//  - the carried object dropped during a move (an injected fault): FAILED, FAILURE_OBJECT_DROPPED;
+//  - an overrun beyond the prediction and its margin: cancelled, FAILED, FAILURE_TIMEOUT.
 #include <cmath>
 #include <condition_variable>
 #include <fstream>
@@ -91,7 +93,7 @@ class MonitorNodeTest : public ::testing::Test {
  protected:
   void SetUp() override {
     domain_ = integration::isolatedDomain();
-    const std::string scenario = (configDir() / "scenarios" / "namo_corridor.yaml").string();
+    const std::string scenario = (configDir() / "scenarios" / scenario_name_).string();
     sim_config_ = tempFile("tamp_em_sim.yaml");
     {
       std::ofstream out(sim_config_);  // no periodic clouds and a tiny camera: nobody reads them
@@ -99,8 +101,8 @@ class MonitorNodeTest : public ::testing::Test {
     }
     monitor_config_ = tempFile("tamp_em_monitor.yaml");
     {
-      std::ofstream out(monitor_config_);  // discovery on a loaded machine may take a while
-      out << "input_wait_s: 15\n";
+      std::ofstream out(monitor_config_);
+      out << monitor_yaml_;
     }
     sup_.add(serviceSpec("tamp_sim_service", "sim", domain_,
                          {"--config", sim_config_.string(), "--scenario", scenario}));
@@ -224,6 +226,9 @@ class MonitorNodeTest : public ::testing::Test {
         record_log_.waitFor([&](const msg::ExecutionRecord& r) { return r.record_id() == id; }));
   }
 
+  std::string scenario_name_{"namo_corridor.yaml"};
+  std::string monitor_yaml_{
+      "input_wait_s: 15\n"};  // discovery on a loaded machine may take a while
   int domain_{0};
   std::filesystem::path sim_config_, monitor_config_;
   process::Supervisor sup_;
@@ -387,6 +392,66 @@ TEST_F(MonitorNodeTest, ObjectAppearingOnTheRemainingPathBlocksWithItsId) {
   ASSERT_TRUE(result);
   EXPECT_EQ(result->outcome(), msg::ActionOutcome::OUTCOME_CANCELLED) << result->reason();
   EXPECT_LT(robotBase().x, x - 0.2 - 0.3);
+}
+
+/// The robot starts with a cup in the gripper (holding_start).
+class HoldingMonitorNodeTest : public MonitorNodeTest {
+ protected:
+  HoldingMonitorNodeTest() { scenario_name_ = "holding_start.yaml"; }
+};
+
+TEST_F(HoldingMonitorNodeTest, DroppingTheCarriedObjectFailsTheMove) {
+  ASSERT_TRUE(
+      state_log_.waitFor([](const msg::RobotState& s) { return s.held_object_id() == "cup"; }));
+  const Pose2D start = robotBase();
+  ASSERT_TRUE(commands_->write(moveBase("em_carry", start, 1.2)));
+  ASSERT_TRUE(state_log_.waitFor([&](const msg::RobotState& s) {
+    return std::hypot(s.base().x() - start.x, s.base().y() - start.y) > 0.2;
+  })) << "the robot does not move";
+  msg::FaultInjection drop;
+  drop.fault_id("em_drop");
+  drop.type(msg::FaultType::FAULT_DROP_HELD_OBJECT);
+  drop.reason("slipped");
+  ASSERT_TRUE(faults_->write(drop));
+  auto done = finalOf("em_carry");
+  ASSERT_TRUE(done);
+  EXPECT_EQ(done->state(), msg::ExecState::EXEC_FAILED) << done->reason();
+  EXPECT_EQ(done->reason().rfind("object dropped:", 0), 0u) << done->reason();
+  EXPECT_EQ(done->held_object_id(), "");
+  EXPECT_GT(done->measured_duration_s(), 0.0);
+  auto event =
+      failure_log_.waitFor([](const msg::FailureEvent& e) { return e.command_id() == "em_carry"; });
+  ASSERT_TRUE(event);
+  EXPECT_EQ(event->type(), msg::FailureType::FAILURE_OBJECT_DROPPED) << event->description();
+  EXPECT_EQ(event->object_id(), "cup");
+}
+
+/// A monitor that allows no more than the predicted duration + 0.5 s.
+class TightTimeoutMonitorNodeTest : public MonitorNodeTest {
+ protected:
+  TightTimeoutMonitorNodeTest() {
+    monitor_yaml_ = "input_wait_s: 15\ntimeout: {stddevs: 0, margin_s: 0.5}\n";
+  }
+};
+
+TEST_F(TightTimeoutMonitorNodeTest, AnOverrunIsCancelledAsATimeout) {
+  msg::ExecuteCommand c = moveBase("em_slow", robotBase(), 1.5);
+  c.expected_duration_s(0.5);  // the robot needs several seconds
+  c.expected_stddev_s(0.0);
+  ASSERT_TRUE(commands_->write(c));
+  auto done = finalOf("em_slow");
+  ASSERT_TRUE(done);
+  EXPECT_EQ(done->state(), msg::ExecState::EXEC_FAILED) << done->reason();
+  EXPECT_EQ(done->reason().rfind("timeout:", 0), 0u) << done->reason();
+  auto event =
+      failure_log_.waitFor([](const msg::FailureEvent& e) { return e.command_id() == "em_slow"; });
+  ASSERT_TRUE(event);
+  EXPECT_EQ(event->type(), msg::FailureType::FAILURE_TIMEOUT);
+  auto result =
+      result_log_.waitFor([](const msg::ActionResult& r) { return r.command_id() == "em_slow"; });
+  ASSERT_TRUE(result);
+  EXPECT_EQ(result->outcome(), msg::ActionOutcome::OUTCOME_CANCELLED) << result->reason();
+  EXPECT_NEAR(done->measured_duration_s(), result->duration_s(), 1e-9);
 }
 
 }  // namespace

@@ -11,6 +11,7 @@ namespace tamp::execution_monitor {
 namespace {
 
 constexpr double kAngleWeight = 0.5;  // m per rad in the path metric
+constexpr double kMaxSamplesPerSegment = 1e5;
 
 Error bad(const std::string& field, const std::string& message) {
   return Error(ErrorCode::kInvalidArgument, field + ": " + message,
@@ -103,6 +104,9 @@ std::string describe(const robot::RobotState& s) {
 
 Status validateCommand(const ExecutionCommand& c, const robot::RobotModel& robot) {
   if (c.command_id.empty()) return bad("command_id", "must not be empty");
+  if (std::find(kAllActionKinds.begin(), kAllActionKinds.end(), c.kind) == kAllActionKinds.end()) {
+    return bad("kind", "unknown action kind " + std::to_string(static_cast<int>(c.kind)));
+  }
   const Trajectory& t = c.trajectory;
   if (t.joint_names.empty()) return bad("trajectory.joint_names", "empty");
   if (t.points.empty()) return bad("trajectory.points", "empty trajectory");
@@ -167,6 +171,21 @@ Status validateCommand(const ExecutionCommand& c, const robot::RobotModel& robot
                                                  formatNumber(last_t));
     }
     last_t = p.time_from_start;
+  }
+  // Arm joints within their limits (the base joints are unbounded).
+  for (std::size_t j = 0; j < t.joint_names.size(); ++j) {
+    const auto slot = slotOf(t.joint_names[j], robot);
+    if (slot->kind != Slot::Kind::kArm) continue;
+    const robot::JointLimits& lim = robot.armLimits()[static_cast<std::size_t>(slot->arm_index)];
+    for (std::size_t i = 0; i < t.points.size(); ++i) {
+      const double v = t.points[i].positions[j];
+      if (v < lim.lower - 1e-9 || v > lim.upper + 1e-9) {
+        return bad(
+            "trajectory.points[" + std::to_string(i) + "].positions[" + std::to_string(j) + "]",
+            t.joint_names[j] + " = " + formatNumber(v, 4) + " outside its limits [" +
+                formatNumber(lim.lower, 4) + ", " + formatNumber(lim.upper, 4) + "]");
+      }
+    }
   }
   if ((c.kind == ActionKind::kPick || c.kind == ActionKind::kPlace) && c.object_id.empty()) {
     return bad("object_id", std::string(toString(c.kind)) + " needs the object");
@@ -376,7 +395,8 @@ std::optional<PathChecker::Hit> PathChecker::firstContact(const SweptPath& path,
       steps = std::max(steps, std::abs(b.arm[k] - a.arm[k]) / params_.step_rad);
     }
     steps = std::max(steps, std::abs(b.gripper - a.gripper) / params_.step_m);
-    const int n = std::max(1, static_cast<int>(std::ceil(steps)));
+    // Bounded: a segment of kilometres is checked more coarsely rather than for ever.
+    const int n = static_cast<int>(std::clamp(std::ceil(steps), 1.0, kMaxSamplesPerSegment));
     for (int i = 1; i <= n; ++i) {
       const double w = static_cast<double>(i) / n;
       const double f = path.s[j - 1] + w * (path.s[j] - path.s[j - 1]);

@@ -51,6 +51,10 @@ TEST_F(ChecksTest, MalformedCommandsNameTheField) {
   EXPECT_EQ(fieldOf(validateCommand(c, robot_)), "trajectory.joint_names[2]");
 
   c = good;
+  c.kind = static_cast<ActionKind>(7);
+  EXPECT_EQ(fieldOf(validateCommand(c, robot_)), "kind");
+
+  c = good;
   c.command_id.clear();
   EXPECT_EQ(fieldOf(validateCommand(c, robot_)), "command_id");
 
@@ -67,6 +71,14 @@ TEST_F(ChecksTest, MalformedCommandsNameTheField) {
   EXPECT_EQ(fieldOf(validateCommand(place, robot_)), "object_target");
   place.object_id.clear();
   EXPECT_EQ(fieldOf(validateCommand(place, robot_)), "object_id");
+  place.object_id = "box";
+  place.object_target = Eigen::Isometry3d::Identity();
+  EXPECT_TRUE(validateCommand(place, robot_));
+  place.trajectory.points[0].positions[1] = robot_.armLimits()[1].upper + 0.1;
+  const Status limits = validateCommand(place, robot_);
+  EXPECT_EQ(fieldOf(limits), "trajectory.points[0].positions[1]");
+  EXPECT_NE(limits.error().message.find("outside its limits"), std::string::npos)
+      << limits.error().message;
 }
 
 TEST_F(ChecksTest, StartMustMatchTheRobot) {

@@ -27,10 +27,11 @@ struct CheckFailure {
   std::string object_id;  ///< the object concerned (on the path, held, picked), or ""
 };
 
-/// Well-formedness of a command against the robot: non-empty command_id; trajectory non-empty,
-/// consistent sizes, finite values, strictly increasing times; joint names known and fitting the
-/// kind (move_base: exactly base_x, base_y, base_theta; arm kinds: arm joints and optionally the
-/// gripper joint, no base joint, no duplicates); pick / place: object_id set; place:
+/// Well-formedness of a command against the robot: non-empty command_id; a known kind; trajectory
+/// non-empty, consistent sizes, finite values, strictly increasing times; joint names known and
+/// fitting the kind (move_base: exactly base_x, base_y, base_theta; arm kinds: arm joints and
+/// optionally the gripper joint, no base joint, no duplicates); arm joints within their limits;
+/// pick / place: object_id set; place:
 /// object_target set; expected_duration_s and expected_stddev_s finite and >= 0.
 /// @return kInvalidArgument whose `where.field` and message name the field
 ///   ("trajectory.points[2].positions[1]: not finite", "trajectory.joint_names[0]: unknown joint

@@ -3,7 +3,7 @@
 // the simulator's depth camera. Prints Markdown tables (docs/benchmarks.md, "Perception").
 //
 //   tamp_perception_bench [--frames N] [--size 50k|300k|1M] [--timing-only | --accuracy-only | --scenarios-only]
-//                         [--scenarios DIR]
+//                         [--scenarios DIR] [--robot hidden|seen|filtered]
 //
 // Timing: a furnished room (static walls and table in the prior, 10 objects to find), frames
 // pre-rendered (not timed) from a robot turning on the spot; 3 warm-up frames, then N timed.
@@ -17,6 +17,10 @@
 // start pose and from every named location, turning on the spot (yaw -0.55, 0, +0.55 rad),
 // 3 frames per view. The prior is the static map; the held object is not counted. Matching and
 // xy error use bounding-box centres (a NAMO prism's pose origin is not its centre).
+// --robot: in the shipped scenarios the camera does not see the robot (`hidden`, the default and
+// the simulator's default `see_robot: false`), sees it and perception gets no robot state
+// (`seen`), or sees it and perception gets the robot's body and held object at each frame's
+// state (`filtered`, self_filter.h).
 // Diagnostics on stderr: TAMP_BENCH_VERBOSE=1 lists false and missed objects, TAMP_BENCH_PLANES=1
 // the support planes of every accuracy frame.
 #include <algorithm>
@@ -376,6 +380,9 @@ Eigen::Vector2d centreXY(const tw::Object& o) {
   return 0.5 * (b.min + b.max).head<2>();
 }
 
+enum class RobotView { kHidden, kSeen, kFiltered };
+RobotView g_robot_view = RobotView::kHidden;
+
 bool runScenarioFile(const std::filesystem::path& file, bool with_classes, ScenarioTally& all) {
   auto scenario = tamp::world::loadScenario(file);
   if (!scenario) {
@@ -410,6 +417,7 @@ bool runScenarioFile(const std::filesystem::path& file, bool with_classes, Scena
     }
   }
   tamp::sim::DepthSensorParams sensor_params;  // the simulator's default sensor (config/services/sim.yaml)
+  sensor_params.see_robot = g_robot_view != RobotView::kHidden;
   std::map<std::string, int> seen;
   {
     tamp::sim::DepthSensorParams quiet = sensor_params;
@@ -442,7 +450,9 @@ bool runScenarioFile(const std::filesystem::path& file, bool with_classes, Scena
   constexpr int kFramesPerView = 3;
   for (const auto& v : views) {
     for (int k = 0; k < kFramesPerView; ++k) {
-      auto r = perception.processFrame(sensor.capture(truth, setup->robot, v, stamp));
+      const tp::RobotBody body = tp::robotBodyAt(setup->robot, v, held, stamp);
+      auto r = perception.processFrame(sensor.capture(truth, setup->robot, v, stamp), tamp::Termination(),
+                                       g_robot_view == RobotView::kFiltered ? &body : nullptr);
       stamp += 500'000'000;
       if (!r) {
         std::fprintf(stderr, "%s: %s\n", scenario->name.c_str(), r.error().toString().c_str());
@@ -515,8 +525,11 @@ void runScenarios(const std::filesystem::path& dir) {
     if (e.path().extension() == ".yaml") files.push_back(e.path());
   }
   std::sort(files.begin(), files.end());
-  std::printf("\n### Shipped scenarios (%s): robot camera 320x240, start + every location x 3 headings, 3 frames per view\n\n",
-              dir.string().c_str());
+  const char* robot = g_robot_view == RobotView::kHidden ? "robot not rendered"
+                      : g_robot_view == RobotView::kSeen ? "robot rendered, no robot state"
+                                                         : "robot rendered, filtered by its state";
+  std::printf("\n### Shipped scenarios (%s): robot camera 320x240, start + every location x 3 headings, 3 frames per view, %s\n\n",
+              dir.string().c_str(), robot);
   std::printf("| scenario | classes | frames | movable objects in view (>= 100 px) | found | false objects | xy error p50 / max (m) | z error max (m) | yaw error p50 / max (deg) | missed |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
   std::vector<std::string> skipped;
@@ -559,8 +572,17 @@ int main(int argc, char** argv) {
       timing = accuracy = false;
     } else if (!std::strcmp(argv[i], "--scenarios") && i + 1 < argc) {
       scenario_dir = argv[++i];
+    } else if (!std::strcmp(argv[i], "--robot") && i + 1 < argc && !std::strcmp(argv[i + 1], "hidden")) {
+      g_robot_view = RobotView::kHidden;
+      ++i;
+    } else if (!std::strcmp(argv[i], "--robot") && i + 1 < argc && !std::strcmp(argv[i + 1], "seen")) {
+      g_robot_view = RobotView::kSeen;
+      ++i;
+    } else if (!std::strcmp(argv[i], "--robot") && i + 1 < argc && !std::strcmp(argv[i + 1], "filtered")) {
+      g_robot_view = RobotView::kFiltered;
+      ++i;
     } else {
-      std::fprintf(stderr, "usage: %s [--frames N] [--size 50k|300k|1M] [--timing-only | --accuracy-only | --scenarios-only] [--scenarios DIR]\n",
+      std::fprintf(stderr, "usage: %s [--frames N] [--size 50k|300k|1M] [--timing-only | --accuracy-only | --scenarios-only] [--scenarios DIR] [--robot hidden|seen|filtered]\n",
                    argv[0]);
       return 2;
     }

@@ -1,11 +1,13 @@
 #include "perception_node.h"
 
 #include <cmath>
+#include <cstdlib>
 
 #include "cloud_convert.h"
 #include "tamp/config/yaml_reader.h"
 #include "tamp/core/log.h"
 #include "tamp/core/paths.h"
+#include "tamp/dds/convert.h"
 #include "tamp/world/scenario.h"
 
 namespace tamp::perception {
@@ -23,11 +25,14 @@ Result<PerceptionNodeOptions> parseNodeOptions(const std::string& yaml_text, con
     n.optional("world_id", o.world_id);
     n.optional("occupancy_period_s", o.occupancy_period_s);
     n.optional("frame_budget_s", o.frame_budget_s);
+    n.optional("robot_state_max_age_s", o.robot_state_max_age_s);
     n.check(!o.world_id.empty(), "world_id", "must not be empty");
     n.check(std::isfinite(o.occupancy_period_s) && o.occupancy_period_s >= 0, "occupancy_period_s",
             "must be >= 0, got " + std::to_string(o.occupancy_period_s));
     n.check(std::isfinite(o.frame_budget_s) && o.frame_budget_s > 0, "frame_budget_s",
             "must be positive, got " + std::to_string(o.frame_budget_s));
+    n.check(std::isfinite(o.robot_state_max_age_s) && o.robot_state_max_age_s >= 0,
+            "robot_state_max_age_s", "must be >= 0, got " + std::to_string(o.robot_state_max_age_s));
     n.refuseUnknownKeys();
     if (!r.ok()) return r.status().error();
   }
@@ -52,6 +57,13 @@ PerceptionNode::PerceptionNode(const dds::ServiceArgs& args, PerceptionNodeOptio
     throw std::runtime_error("publishing the prior world: " + s.error().toString());
   }
   worker_ = std::jthread([this](std::stop_token st) { work(st); });
+  if (options_.robot) {
+    robot_states_ = std::make_unique<dds::Reader<msg::RobotState>>(
+        participant(), dds::topics::kRobotState,
+        [this](const msg::RobotState& m, const dds::SampleMeta& meta) {
+          if (meta.alive) onState(m);
+        });
+  }
   clouds_ = std::make_unique<dds::Reader<msg::PointCloudFrame>>(
       participant(), dds::topics::kPointCloud,
       [this](const msg::PointCloudFrame& m, const dds::SampleMeta& meta) {
@@ -61,6 +73,7 @@ PerceptionNode::PerceptionNode(const dds::ServiceArgs& args, PerceptionNodeOptio
 
 PerceptionNode::~PerceptionNode() {
   clouds_.reset();  // no more callbacks
+  robot_states_.reset();
   worker_.request_stop();
   cv_.notify_all();
   if (worker_.joinable()) worker_.join();
@@ -73,11 +86,19 @@ Result<std::unique_ptr<dds::ServiceNode>> PerceptionNode::create(const dds::Serv
     if (!o) return o.error();
     options = std::move(*o);
   }
+  std::filesystem::path description = configDir() / "robots" / "mobile_manipulator.yaml";
   if (!args.scenario_file.empty()) {
     // The prior: the scenario's static map and declared objects (its planner view, no hidden ones).
     auto scenario = world::loadScenario(args.scenario_file);
     if (!scenario) return scenario.error();
     options.prior = scenario->plannerWorld();
+    description = scenario->robot.description;
+  }
+  // The robot whose body and held object the self filter removes.
+  if (options.params.self_filter.enabled) {
+    auto robot = robot::RobotModel::loadDescription(description);
+    if (!robot) return robot.error();
+    options.robot = std::make_shared<const robot::RobotModel>(std::move(robot).value());
   }
   try {
     return std::unique_ptr<dds::ServiceNode>(std::make_unique<PerceptionNode>(args, std::move(options)));
@@ -110,6 +131,46 @@ void PerceptionNode::onCloud(const msg::PointCloudFrame& m) {
   cv_.notify_one();
 }
 
+void PerceptionNode::onState(const msg::RobotState& m) {
+  // Checked here (a malformed state must not reach forward kinematics); bad ones are counted.
+  auto fail = [&](const std::string& why) {
+    ++bad_states_;
+    log::get(name())->warn("rejected a robot state of '{}': {}", m.robot_id(), why);
+  };
+  if (m.joint_names().size() != m.joint_positions().size()) {
+    return fail("joint_positions: " + std::to_string(m.joint_positions().size()) + " values for " +
+                std::to_string(m.joint_names().size()) + " joints");
+  }
+  for (double v : m.joint_positions()) {
+    if (!std::isfinite(v)) return fail("joint_positions: not finite");
+  }
+  auto base = dds::fromMsg(m.base(), "base");
+  if (!base) return fail(base.error().toString());
+  auto s = options_.robot->fromJointValues(m.joint_names(), m.joint_positions(),
+                                           options_.robot->defaultState(*base));
+  if (!s) return fail(s.error().toString());
+  if (s->arm.size() != options_.robot->armDof()) return fail("arm: wrong number of joints");
+  ++states_;
+  std::lock_guard lock(state_mutex_);
+  states_seen_.push_back(StateSample{m.header().stamp_ns(), std::move(s).value(), m.held_object_id()});
+  while (states_seen_.size() > 64) states_seen_.pop_front();
+}
+
+std::optional<RobotBody> PerceptionNode::bodyAt(std::int64_t stamp_ns) const {
+  if (!options_.robot) return std::nullopt;
+  std::optional<StateSample> best;
+  {
+    std::lock_guard lock(state_mutex_);
+    for (const StateSample& s : states_seen_) {
+      if (!best || std::llabs(s.stamp_ns - stamp_ns) <= std::llabs(best->stamp_ns - stamp_ns)) best = s;
+    }
+  }
+  if (!best || static_cast<double>(std::llabs(best->stamp_ns - stamp_ns)) > options_.robot_state_max_age_s * 1e9) {
+    return std::nullopt;
+  }
+  return robotBodyAt(*options_.robot, best->state, best->held_object_id, best->stamp_ns);
+}
+
 void PerceptionNode::work(std::stop_token stop) {
   while (!stop.stop_requested()) {
     std::optional<PointCloudFrame> frame;
@@ -130,7 +191,10 @@ void PerceptionNode::work(std::stop_token stop) {
 }
 
 void PerceptionNode::process(const PointCloudFrame& frame) {
-  auto r = perception_->processFrame(frame, Termination::after(options_.frame_budget_s));
+  const std::optional<RobotBody> body = bodyAt(frame.stamp_ns);
+  if (options_.robot && !body) ++without_state_;
+  auto r = perception_->processFrame(frame, Termination::after(options_.frame_budget_s),
+                                     body ? &*body : nullptr);
   if (!r) {
     ++rejected_;
     log::get(name())->warn("frame from '{}' not processed: {}", frame.sensor_id, r.error().toString());

@@ -8,12 +8,18 @@
 /// - the world events (`topics::kWorldEvents`);
 /// - the OctoMap of unexplained space (`topics::kOccupancy`, the OctoMap binary stream) at most
 ///   every `occupancy_period_s`.
+/// With a robot model it also subscribes the robot state (`topics::kRobotState`: base pose,
+/// joint positions, held object id) and gives each frame the robot's body at the state nearest
+/// the frame's stamp (within `robot_state_max_age_s`), so the robot's links and held object are
+/// not reported as obstacles (`self_filter.h`). A frame with no state that close is processed
+/// unfiltered and counted (`framesWithoutState`).
 /// A malformed frame is rejected with a warning naming the field and counted; nothing escapes
 /// the DDS callback or the worker thread.
 
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
+#include <deque>
 #include <filesystem>
 #include <memory>
 #include <mutex>
@@ -33,10 +39,16 @@ struct PerceptionNodeOptions {
   std::string world_id{"world"};     ///< WorldMeta key
   double occupancy_period_s{1.0};    ///< >= 0; 0 publishes after every frame
   double frame_budget_s{0.5};        ///< deadline of one frame's processing, > 0
+  /// The robot whose body and held object are filtered out; nullptr: no filtering, the robot
+  /// state is not subscribed. `create()` loads the scenario's robot description (else the
+  /// default robot).
+  std::shared_ptr<const robot::RobotModel> robot;
+  double robot_state_max_age_s{0.5};  ///< s, >= 0: largest |frame stamp - state stamp| used
 };
 
 /// Node options from the service's YAML (`config/services/perception.yaml`): the perception
-/// parameters plus a `node:` section (`world_id`, `occupancy_period_s`, `frame_budget_s`).
+/// parameters plus a `node:` section (`world_id`, `occupancy_period_s`, `frame_budget_s`,
+/// `robot_state_max_age_s`).
 /// The prior world is not part of this file (it comes from the scenario).
 Result<PerceptionNodeOptions> loadNodeOptions(const std::filesystem::path& file);
 Result<PerceptionNodeOptions> parseNodeOptions(const std::string& yaml_text, const std::string& name);
@@ -52,6 +64,10 @@ class PerceptionNode : public dds::ServiceNode {
   std::uint64_t framesProcessed() const { return processed_.load(); }
   std::uint64_t framesRejected() const { return rejected_.load(); }
   std::uint64_t framesSkipped() const { return skipped_.load(); }
+  /// Frames processed without a robot state close enough to filter the robot's body.
+  std::uint64_t framesWithoutState() const { return without_state_.load(); }
+  /// Robot states received and accepted (malformed ones are counted as rejected requests).
+  std::uint64_t robotStates() const { return states_.load(); }
   /// A copy of the current world model (thread-safe).
   world::World worldSnapshot() const;
 
@@ -60,6 +76,9 @@ class PerceptionNode : public dds::ServiceNode {
 
  private:
   void onCloud(const msg::PointCloudFrame& m);
+  void onState(const msg::RobotState& m);
+  /// The robot's body at the state nearest `stamp_ns` within the age limit, or nullopt.
+  std::optional<RobotBody> bodyAt(std::int64_t stamp_ns) const;
   void work(std::stop_token stop);
   void process(const PointCloudFrame& frame);
 
@@ -72,10 +91,19 @@ class PerceptionNode : public dds::ServiceNode {
   std::condition_variable_any cv_;
   std::optional<PointCloudFrame> pending_;
   world::World snapshot_;
-  std::atomic<std::uint64_t> processed_{0}, rejected_{0}, skipped_{0};
+  std::atomic<std::uint64_t> processed_{0}, rejected_{0}, skipped_{0}, without_state_{0};
+  std::atomic<std::uint64_t> states_{0}, bad_states_{0};
+  struct StateSample {
+    std::int64_t stamp_ns{0};
+    robot::RobotState state;
+    std::string held_object_id;
+  };
+  mutable std::mutex state_mutex_;
+  std::deque<StateSample> states_seen_;  // newest last, bounded
   std::uint64_t event_seq_{0}, map_seq_{0};
   std::optional<Clock::time_point> last_map_;
   std::jthread worker_;
+  std::unique_ptr<dds::Reader<msg::RobotState>> robot_states_;
   std::unique_ptr<dds::Reader<msg::PointCloudFrame>> clouds_;  // last: callbacks need the rest
 };
 

@@ -131,6 +131,10 @@ const config::Schema<PerceptionParams>& schema() {
         .field("min_mass", &K::min_mass, positive())
         .field("graspable_max_width", &K::graspable_max_width, nonNegative())
         .field("graspable_max_mass", &K::graspable_max_mass, nonNegative());
+    using SF = SelfFilterParams;
+    s.section("self_filter", &P::self_filter)
+        .field("enabled", &SF::enabled)
+        .field("padding", &SF::padding, inRange(0, 0.5, Ends::kClosed, "m"));
     using O = OccupancyParams;
     s.section("occupancy", &P::occupancy)
         .field("enabled", &O::enabled)

@@ -134,6 +134,9 @@ struct Perception::Impl {
   int64_t last_stamp{std::numeric_limits<int64_t>::min()};
   int next_tentative{1};
   double floor_height{0.0};
+  // The object in the gripper (self filter): its track follows the tool link at a fixed grasp.
+  std::string held_id;
+  Eigen::Isometry3d tool_T_held{Eigen::Isometry3d::Identity()};
 
   Impl(world::World prior_world, PerceptionParams p)
       : params(std::move(p)), prior(std::move(prior_world)), world(prior), segmenter(params, prior) {}
@@ -303,6 +306,7 @@ const PerceptionParams& Perception::params() const { return impl_->params; }
 const std::vector<ObjectClass>& Perception::classes() const { return impl_->classes; }
 std::uint64_t Perception::frames() const { return impl_->frames; }
 const OccupancyMap* Perception::occupancy() const { return impl_->occupancy.get(); }
+const std::string& Perception::heldObject() const { return impl_->held_id; }
 std::string Perception::occupancyBinary() const { return impl_->occupancy ? impl_->occupancy->toBinary() : std::string(); }
 
 namespace {
@@ -356,22 +360,50 @@ Result<WorldEvent> Perception::removeObject(std::string_view id, const std::stri
 
 // ---- the frame ----------------------------------------------------------------------------------
 
-Result<FrameResult> Perception::processFrame(const PointCloudFrame& frame, const Termination& term) {
+Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const Termination& term,
+                                             const RobotBody* robot) {
   Impl& I = *impl_;
   const PerceptionParams& P = I.params;
   const TrackingParams& T = P.tracking;
   FrameResult result;
   Stopwatch total, watch;
 
-  if (Status s = validateFrame(frame, P.max_points); !s.ok()) return s.error();
-  if (frame.stamp_ns < I.last_stamp) {
+  if (Status s = validateFrame(input, P.max_points); !s.ok()) return s.error();
+  if (input.stamp_ns < I.last_stamp) {
     return Error(ErrorCode::kInvalidArgument,
-                 "frame is older than the previous one (" + std::to_string(frame.stamp_ns) + " < " +
+                 "frame is older than the previous one (" + std::to_string(input.stamp_ns) + " < " +
                      std::to_string(I.last_stamp) + " ns)",
                  SourceLocation{"", 0, 0, "stamp_ns"});
   }
   result.times.validate = watch.millis();
-  result.stats.input_points = frame.size();
+  result.stats.input_points = input.size();
+
+  // ---- the robot's own body and the held object (self_filter.h) ---------------------------------
+  // Decided here, applied to the tracks only once the frame is committed (below).
+  watch.reset();
+  const bool self_filter = robot != nullptr && P.self_filter.enabled;
+  Track* held = nullptr;
+  Eigen::Isometry3d tool_T_held = I.tool_T_held;
+  std::optional<PointCloudFrame> filtered;
+  if (self_filter) {
+    if (auto it = I.tracks.find(robot->held_object_id);
+        !robot->held_object_id.empty() && it != I.tracks.end() &&
+        it->second.state != TrackInfo::State::kTentative) {
+      held = &it->second;
+      // A new grasp: the object is where it was last tracked, now rigidly on the tool link.
+      if (I.held_id != held->id) tool_T_held = robot->world_T_tool.inverse() * held->pose;
+    }
+    world::Object held_solid;
+    if (held != nullptr) {
+      held_solid.shape = held->shape;
+      held_solid.pose = robot->world_T_tool * tool_T_held;
+    }
+    filtered = input;
+    result.stats.robot_points = removeBodyPoints(*filtered, *robot, held != nullptr ? &held_solid : nullptr,
+                                                 P.self_filter.padding);
+  }
+  const PointCloudFrame& frame = filtered ? *filtered : input;
+  result.times.self_filter = watch.millis();
 
   auto seg = I.segmenter.run(frame, term);
   if (!seg) return seg.error();
@@ -400,6 +432,25 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& frame, const
   const int64_t stamp = frame.stamp_ns;
   const Eigen::Vector3d sensor = frame.world_T_sensor.translation();
   const world::World before = I.world;
+
+  // The held object follows the gripper; a release (the state reports the gripper empty, or
+  // another object) leaves it where it was last carried, tracked as any other from then on.
+  if (self_filter) {
+    I.held_id = held != nullptr ? held->id : std::string();
+    I.tool_T_held = held != nullptr ? tool_T_held : Eigen::Isometry3d::Identity();
+  }
+  if (held != nullptr) {
+    held->pose = robot->world_T_tool * tool_T_held;
+    held->misses = 0;
+    if (held->state == TrackInfo::State::kGone) {
+      held->state = TrackInfo::State::kActive;  // the robot holds it: it is back
+      (void)I.world.addObject(I.objectOf(*held));
+    } else if (const world::Object* o = I.world.findObject(held->id)) {
+      const double dpos = (o->pose.translation() - held->pose.translation()).norm();
+      const double dang = Eigen::AngleAxisd(o->pose.linear().transpose() * held->pose.linear()).angle();
+      if (dpos > T.update_distance || dang > T.update_angle) (void)I.world.updateObject(I.objectOf(*held));
+    }
+  }
 
   // ---- shape fitting ------------------------------------------------------------------------
   watch.reset();
@@ -455,7 +506,7 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& frame, const
   std::vector<Track*> candidates;
   for (auto& [id, t] : I.tracks) {
     t.matched = false;
-    if (t.state != TrackInfo::State::kGone) candidates.push_back(&t);
+    if (t.state != TrackInfo::State::kGone && id != I.held_id) candidates.push_back(&t);
   }
   const auto& dets = result.detections;
   std::vector<std::vector<double>> cost(dets.size(), std::vector<double>(candidates.size(), kInf));
@@ -571,7 +622,7 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& frame, const
   std::optional<RangeImage> image;
   std::vector<std::string> dropped;
   for (auto& [id, t] : I.tracks) {
-    if (t.matched || t.state == TrackInfo::State::kGone) continue;
+    if (t.matched || t.state == TrackInfo::State::kGone || id == I.held_id) continue;
     if (!image) image.emplace(frame, T.visibility_bin);
     world::Object o;
     o.shape = t.shape;

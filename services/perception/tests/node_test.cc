@@ -11,6 +11,8 @@
 #include "tamp/dds/convert.h"
 #include "perception_node.h"
 #include "tamp/dds/world_sync.h"
+#include "tamp/robot/robot_model.h"
+#include "tamp/sim/depth_sensor.h"
 #include "test_scenes.h"
 
 namespace tamp::perception {
@@ -106,6 +108,71 @@ TEST(PerceptionNodeTest, CloudInWorldObjectsEventsAndOccupancyOut) {
   runner.join();
 }
 
+TEST(PerceptionNodeTest, RobotStateFiltersTheRobotsOwnArm) {
+  // The simulator's camera sees the robot's arm (see_robot); the node gets the robot state on
+  // its topic and reports no object. Without a state close to a frame the frame is unfiltered.
+  const int domain = dds::testing::isolatedDomain();
+  world::World prior("node_robot_test");
+  ASSERT_TRUE(prior.addRegion(testing::floorRegion()).ok());
+  auto model = robot::RobotModel::loadDefault();
+  ASSERT_TRUE(model.ok()) << model.error().toString();
+  robot::RobotState s = model->defaultState(Pose2D{0.0, 0.0, 0.0});
+  s.arm = *model->namedConfiguration("ready");
+
+  dds::ServiceArgs args;
+  args.name = "perception_robot_test";
+  args.domain_id = domain;
+  args.heartbeat_period_s = 0.2;
+  PerceptionNodeOptions options;
+  options.prior = prior;
+  options.robot = std::make_shared<const robot::RobotModel>(*model);
+  options.robot_state_max_age_s = 0.1;
+  PerceptionNode node(args, options);
+  std::thread runner([&] { node.run(); });
+
+  auto p = dds::testing::makeParticipant(domain);
+  ASSERT_TRUE(p);
+  dds::Writer<msg::RobotState> states(p, dds::topics::kRobotState);
+  dds::Writer<msg::PointCloudFrame> clouds(p, dds::topics::kPointCloud);
+  ASSERT_TRUE(states.waitForReaders(Termination::after(10.0)));
+  ASSERT_TRUE(clouds.waitForReaders(Termination::after(10.0)));
+  sim::DepthSensorParams cam;
+  cam.see_robot = true;
+  sim::DepthSensor sensor(cam);
+  msg::RobotState m;
+  m.robot_id(model->name());
+  m.base(dds::toMsg(s.base));
+  m.joint_names(model->fullJointNames());
+  m.joint_positions(model->toJointValues(s));
+  // A malformed state (one value short) is refused; the node carries on.
+  msg::RobotState bad = m;
+  bad.joint_positions().pop_back();
+  ASSERT_TRUE(states.write(bad).ok());
+  for (int k = 0; k < 4; ++k) {
+    const int64_t stamp = 1'000'000'000LL * (k + 1);
+    m.header().stamp_ns(stamp);
+    // The state stream is best effort (a sample written before the reader has matched the
+    // writer is lost): write it until the node has it.
+    const std::uint64_t before = node.robotStates();
+    ASSERT_TRUE(waitFor([&] {
+      if (node.robotStates() > before) return true;
+      EXPECT_TRUE(states.write(m).ok());
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      return node.robotStates() > before;
+    }));
+    ASSERT_TRUE(clouds.write(dds::toMsg(sensor.capture(prior, *model, s, stamp), k)).ok());
+    ASSERT_TRUE(waitFor([&] { return node.framesProcessed() == static_cast<std::uint64_t>(k + 1); }));
+  }
+  EXPECT_EQ(node.framesWithoutState(), 0u);
+  EXPECT_EQ(node.worldSnapshot().objects().size(), 0u) << "the arm was reported as an object";
+  // A frame 1 s after the last state is processed unfiltered (and counted).
+  ASSERT_TRUE(clouds.write(dds::toMsg(sensor.capture(prior, *model, s, 6'000'000'000LL), 9)).ok());
+  ASSERT_TRUE(waitFor([&] { return node.framesProcessed() == 5u; }));
+  EXPECT_EQ(node.framesWithoutState(), 1u);
+  node.stop();
+  runner.join();
+}
+
 TEST(PerceptionNodeTest, ConvertsCloudsBothWaysAndNamesBadFields) {
   const auto frame = testing::render(world::World(), testing::mastCamera(0, 0, 0), {}, 42);
   auto back = fromMsg(dds::toMsg(frame, 3), 1'000'000);
@@ -145,6 +212,16 @@ TEST(PerceptionNodeTest, NodeOptionsFromYaml) {
   ASSERT_FALSE(bad.ok());
   EXPECT_NE(bad.error().toString().find("node.occupancy_period_s"), std::string::npos) << bad.error().toString();
   EXPECT_NE(bad.error().toString().find("node.colour"), std::string::npos) << bad.error().toString();
+  auto age = parseNodeOptions("node: {robot_state_max_age_s: -1}\nself_filter: {padding: 0.05}\n", "n.yaml");
+  ASSERT_FALSE(age.ok());
+  EXPECT_NE(age.error().toString().find("node.robot_state_max_age_s"), std::string::npos) << age.error().toString();
+  auto pad = parseNodeOptions("self_filter: {padding: 0.05, enabled: false}\n", "n.yaml");
+  ASSERT_TRUE(pad.ok()) << pad.error().toString();
+  EXPECT_DOUBLE_EQ(pad->params.self_filter.padding, 0.05);
+  EXPECT_FALSE(pad->params.self_filter.enabled);
+  auto neg = parseNodeOptions("self_filter: {padding: -0.01}\n", "n.yaml");
+  ASSERT_FALSE(neg.ok());
+  EXPECT_NE(neg.error().toString().find("self_filter.padding"), std::string::npos) << neg.error().toString();
 }
 
 }  // namespace

@@ -140,6 +140,15 @@ struct OccupancyParams {
   int min_cluster_points{3};
 };
 
+/// The robot's own body and held object (self_filter.h): their returns are dropped before
+/// segmentation when the frame comes with the robot's state (`Perception::processFrame`).
+struct SelfFilterParams {
+  bool enabled{true};
+  /// m, >= 0: the link shapes and the held object are grown by this much (state latency, encoder
+  /// and calibration error, range noise).
+  double padding{0.03};
+};
+
 struct PerceptionParams {
   SensorNoise sensor;
   CropParams crop;
@@ -148,6 +157,7 @@ struct PerceptionParams {
   TrackingParams tracking;
   ClassifyParams classify;
   OccupancyParams occupancy;
+  SelfFilterParams self_filter;
   std::vector<ObjectClass> classes;  ///< scenario priors, any order
   std::size_t max_points{5'000'000};  ///< larger frames are rejected (field xyz)
 

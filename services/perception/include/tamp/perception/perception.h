@@ -1,8 +1,9 @@
 #pragma once
 /// @file
 /// Perception: from depth frames to the planner's world model (issue 6; the world model of the
-/// paper's loop, `spec/conditional-tamp-effort-based.tex` §"unpredictable faults": a new obstacle
-/// "perceived by sensors" triggers online replanning).
+/// paper's loop, Castaman, Tosello, Pagello, "Conditional Task and Motion Planning through an
+/// Effort-Based Approach", §"unpredictable faults": a new obstacle "perceived by sensors"
+/// triggers online replanning).
 ///
 /// ## Design overview
 /// Perception is product code: it sees only what a real robot would -- depth frames (points in
@@ -11,6 +12,14 @@
 /// prior world and adds, moves and removes objects. Per frame (`Perception::processFrame`):
 ///
 /// 1. **Validate** the frame (`validateFrame`): malformed frames are rejected naming the field.
+/// 1a. **The robot's own body** (`self_filter.h`), when the frame comes with the robot's state
+///    (`RobotBody`): returns on its links' collision shapes (forward kinematics of the state)
+///    and on the held object (attached to the tool link), grown by `self_filter.padding`, are
+///    dropped before anything else sees them -- segmentation, tracking, the visibility test and
+///    the occupancy map. The held object's track follows the gripper (its pose in the tool
+///    frame is fixed when the grasp is first reported) and is neither associated nor tested for
+///    being gone while held, so it is never reported as a new obstacle nor as gone from where it
+///    was picked; when the state reports the gripper empty again it is tracked as before.
 /// 2. **Transform and crop** to the world frame, the workspace box and the sensor's range.
 /// 3. **Voxel grid** (PCL `VoxelGrid`): the leaf size bounds the cost of everything after.
 /// 4. **Support planes** (PCL RANSAC, `SACMODEL_PERPENDICULAR_PLANE` about world z, several
@@ -43,7 +52,8 @@
 /// (services/perception/node) maps messages to frames and publishes the results.
 ///
 /// Limits: objects stand upright on a support (no tilted or stacked-on-object poses); objects
-/// in contact form one cluster; the robot's own body and a held object are not filtered out.
+/// in contact form one cluster; the robot's body is filtered only for frames given a
+/// `RobotBody`, and a held object only when it is a tracked object (its shape is known).
 
 #include <cstdint>
 #include <memory>
@@ -60,6 +70,7 @@
 #include "tamp/perception/occupancy.h"
 #include "tamp/perception/params.h"
 #include "tamp/perception/segmentation.h"
+#include "tamp/perception/self_filter.h"
 #include "tamp/perception/shape_fit.h"
 #include "tamp/world/world.h"
 
@@ -105,7 +116,7 @@ struct TrackInfo {
 
 /// Wall-clock milliseconds per stage of one frame.
 struct StageTimes {
-  double validate{0}, transform_crop{0}, voxel{0}, planes{0}, static_objects{0}, clustering{0};
+  double validate{0}, self_filter{0}, transform_crop{0}, voxel{0}, planes{0}, static_objects{0}, clustering{0};
   double fitting{0}, visibility{0}, tracking{0}, occupancy{0}, total{0};
 };
 
@@ -113,6 +124,7 @@ struct StageTimes {
 struct FrameStats {
   std::size_t input_points{0}, valid_points{0}, cropped_points{0}, voxel_points{0}, plane_points{0};
   std::size_t static_points{0}, unexplained_points{0};
+  std::size_t robot_points{0};  ///< returns on the robot's body or held object (dropped)
   int planes{0}, clusters{0}, detections{0}, matched{0}, tentative{0};
 };
 
@@ -135,10 +147,18 @@ class Perception {
   Perception(const Perception&) = delete;
   Perception& operator=(const Perception&) = delete;
 
-  /// Processes one frame. Errors: kInvalidArgument for a malformed frame (naming the field) or
-  /// a frame older than the previous one (`stamp_ns`); kTimeout/kCancelled when `term` fires
-  /// (the world model is then unchanged). Not thread-safe: one caller at a time.
-  Result<FrameResult> processFrame(const PointCloudFrame& frame, const Termination& term = Termination());
+  /// Processes one frame. `robot`: the robot's body at the frame's instant (from its state:
+  /// `robotBodyAt`); with `params().self_filter.enabled` its returns and the held object's are
+  /// dropped and the held object follows the gripper (see the overview). nullptr: no state is
+  /// known for this frame, nothing is filtered and a held object stays as it was.
+  /// Errors: kInvalidArgument for a malformed frame (naming the field) or a frame older than the
+  /// previous one (`stamp_ns`); kTimeout/kCancelled when `term` fires (the world model is then
+  /// unchanged). Not thread-safe: one caller at a time.
+  Result<FrameResult> processFrame(const PointCloudFrame& frame, const Termination& term = Termination(),
+                                   const RobotBody* robot = nullptr);
+  /// The object perception believes is in the gripper (from the last frame given a RobotBody
+  /// with the self filter on), or empty.
+  const std::string& heldObject() const;
 
   /// The current world model (prior + perceived, minus gone objects).
   const world::World& world() const;

@@ -1,0 +1,282 @@
+// The robot's own body and the held object in the robot's camera: frames rendered by the
+// simulator's depth camera with the robot visible (see_robot), perception given the robot's body
+// at each frame's state. Perception only sees frames, the prior and the body; the simulator's
+// ground truth is used for the assertions.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
+#include <stdexcept>
+
+#include "tamp/perception/perception.h"
+#include "tamp/perception/self_filter.h"
+#include "tamp/robot/robot_model.h"
+#include "tamp/sim/depth_sensor.h"
+#include "test_scenes.h"
+
+namespace tamp::perception {
+namespace {
+
+constexpr int64_t kSecond = 1'000'000'000;
+
+const robot::RobotModel& robotModel() {
+  static const robot::RobotModel m = robot::RobotModel::loadDefault().value();
+  return m;
+}
+
+/// The robot's mast camera (the URDF's camera_optical_frame), robot visible, fixed noise seed.
+sim::DepthSensor robotCamera() {
+  sim::DepthSensorParams p;
+  p.see_robot = true;
+  p.seed = 7;
+  return sim::DepthSensor(p);
+}
+
+robot::RobotState armReady(double arm_joint_1 = 0.0) {
+  robot::RobotState s = robotModel().defaultState(Pose2D{0.0, 0.0, 0.0});
+  s.arm = *robotModel().namedConfiguration("ready");
+  s.arm[0] = arm_joint_1;
+  s.gripper = robotModel().options().gripper_open;
+  return s;
+}
+
+world::World floorOnly() {
+  world::World w("self_filter_test");
+  EXPECT_TRUE(w.addRegion(testing::floorRegion()).ok());
+  return w;
+}
+
+/// Pixels of a frame whose ray first hits one of the robot's links (no noise).
+int robotPixels(const world::World& truth, const robot::RobotState& s) {
+  sim::DepthSensorParams p;
+  p.see_robot = true;
+  p.noise_stddev_m = p.noise_quadratic = p.dropout_probability = 0.0;
+  sim::DepthSensor quiet(p);
+  sim::GroundTruthLabels labels;
+  (void)quiet.capture(truth, robotModel(), s, 0, &labels);
+  int n = 0;
+  for (auto l : labels.pixel) {
+    if (l < 0) continue;
+    const std::string& id = labels.ids[static_cast<std::size_t>(l)];
+    if (robotModel().linkIndex(id) >= 0) ++n;
+  }
+  return n;
+}
+
+struct Frames {
+  std::vector<WorldEvent> events;
+  std::size_t robot_points{0};
+};
+
+/// `frames` frames of the robot standing with its arm at `s`; `filter`: pass its body.
+Frames look(Perception& p, const world::World& truth, const robot::RobotState& s, int frames,
+            bool filter, int64_t& stamp, sim::DepthSensor& camera, const std::string& held = {}) {
+  Frames run;
+  for (int k = 0; k < frames; ++k) {
+    const PointCloudFrame f = camera.capture(truth, robotModel(), s, stamp);
+    const RobotBody body = robotBodyAt(robotModel(), s, held, stamp);
+    stamp += kSecond / 5;
+    auto r = p.processFrame(f, Termination(), filter ? &body : nullptr);
+    EXPECT_TRUE(r.ok()) << r.error().toString();
+    if (!r.ok()) return run;
+    run.events.insert(run.events.end(), r->events.begin(), r->events.end());
+    run.robot_points += r->stats.robot_points;
+    if (std::getenv("TAMP_PERCEPTION_DEBUG") != nullptr) {
+      std::printf("frame: self filter %.2f ms (%zu points), total %.2f ms\n", r->times.self_filter,
+                  r->stats.robot_points, r->times.total);
+    }
+  }
+  return run;
+}
+
+int count(const std::vector<WorldEvent>& events, EventType type) {
+  return static_cast<int>(std::count_if(events.begin(), events.end(),
+                                        [&](const WorldEvent& e) { return e.type == type; }));
+}
+
+TEST(SelfFilterTest, BodyPartsFollowForwardKinematics) {
+  const robot::RobotState s = armReady(0.3);
+  const RobotBody body = robotBodyAt(robotModel(), s, "can", 42);
+  EXPECT_EQ(body.parts.size(), robotModel().collisionGeometry().parts.size());
+  EXPECT_EQ(body.held_object_id, "can");
+  EXPECT_EQ(body.stamp_ns, 42);
+  EXPECT_TRUE(body.world_T_tool.isApprox(robotModel().toolPoseInWorld(s), 1e-12));
+  std::vector<Eigen::Isometry3d> poses;
+  robotModel().linkPoses(s, poses);
+  const auto& g = robotModel().collisionGeometry();
+  for (std::size_t i = 0; i < body.parts.size(); ++i) {
+    const auto link = static_cast<std::size_t>(g.parts[i].link);
+    EXPECT_EQ(body.parts[i].owner, g.links[link]);
+    EXPECT_TRUE(body.parts[i].world_T_shape.isApprox(poses[link] * g.parts[i].link_T_shape, 1e-12));
+  }
+  robot::RobotState bad = s;
+  bad.arm.pop_back();
+  EXPECT_THROW((void)robotBodyAt(robotModel(), bad), std::invalid_argument);
+}
+
+TEST(SelfFilterTest, RemovesExactlyThePointsOnTheBodyAndTheHeldObject) {
+  // A hand-made cloud in a rotated, shifted sensor frame: points inside a box link, inside the
+  // held cylinder, within the padding of the box, and outside both.
+  RobotBody body;
+  Eigen::Isometry3d link = Eigen::Isometry3d::Identity();
+  link.translation() = Eigen::Vector3d(1.0, 0.0, 0.5);
+  link.linear() = Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  body.parts.push_back(BodyPart{"arm_link", world::Shape::box(0.2, 0.1, 0.1), link});
+  world::Object held;
+  held.id = "can";
+  held.shape = world::Shape::cylinder(0.03, 0.12);
+  held.pose = Eigen::Isometry3d::Identity();
+  held.pose.translation() = Eigen::Vector3d(1.5, 0.5, 0.8);
+  PointCloudFrame f;
+  f.world_T_sensor = testing::lookAt(Eigen::Vector3d(0, -1, 1.5), Eigen::Vector3d(1.2, 0.2, 0.6));
+  const Eigen::Isometry3d sensor_T_world = f.world_T_sensor.inverse();
+  const std::vector<Eigen::Vector3d> world_points{
+      link * Eigen::Vector3d(0.09, 0.04, 0.0),       // inside the box
+      link * Eigen::Vector3d(0.12, 0.0, 0.0),        // 2 cm beyond its face: inside the padding
+      link * Eigen::Vector3d(0.16, 0.0, 0.0),        // 6 cm beyond: kept
+      held.pose * Eigen::Vector3d(0.02, 0.0, 0.05),  // inside the held object
+      Eigen::Vector3d(3.0, 2.0, 0.0),                // the floor far away: kept
+  };
+  for (const auto& p : world_points) {
+    const Eigen::Vector3f q = (sensor_T_world * p).cast<float>();
+    f.xyz.insert(f.xyz.end(), {q.x(), q.y(), q.z()});
+  }
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  f.xyz.insert(f.xyz.end(), {nan, nan, nan});  // no return: left alone
+  f.width = static_cast<uint32_t>(f.size());
+  PointCloudFrame g = f;
+  EXPECT_EQ(removeBodyPoints(g, body, &held, 0.03), 3u);
+  EXPECT_FALSE(g.valid(0));
+  EXPECT_FALSE(g.valid(1));
+  EXPECT_TRUE(g.valid(2));
+  EXPECT_FALSE(g.valid(3));
+  EXPECT_TRUE(g.valid(4));
+  EXPECT_FALSE(g.valid(5));
+  EXPECT_EQ(g.xyz.size(), f.xyz.size());  // the layout is kept
+  g = f;
+  EXPECT_EQ(removeBodyPoints(g, body, nullptr, 0.0), 1u);  // no padding, no held object
+  EXPECT_THROW((void)removeBodyPoints(g, body, nullptr, -0.01), std::invalid_argument);
+}
+
+TEST(SelfFilterTest, TheRobotsOwnArmInViewIsNoObject) {
+  const world::World truth = floorOnly();
+  const robot::RobotState s = armReady();
+  const int pixels = robotPixels(truth, s);
+  ASSERT_GT(pixels, 2000) << "the arm must be in the camera's view";
+
+  // Filtered: nothing is reported, nothing occupied.
+  {
+    sim::DepthSensor camera = robotCamera();
+    Perception p(truth, PerceptionParams{});
+    int64_t stamp = kSecond;
+    const Frames run = look(p, truth, s, 4, true, stamp, camera);
+    if (std::getenv("TAMP_PERCEPTION_DEBUG") != nullptr) {
+      std::printf("robot pixels %d, filtered %zu points in 4 frames\n", pixels, run.robot_points);
+    }
+    EXPECT_GT(run.robot_points, 4u * 1500u);
+    EXPECT_EQ(run.events.size(), 0u);
+    EXPECT_EQ(p.world().objects().size(), 0u);
+    ASSERT_NE(p.occupancy(), nullptr);
+    EXPECT_EQ(p.occupancy()->occupiedCount(), 0u);
+  }
+  // The same frames unfiltered (no body, or the filter off): the arm becomes obstacles.
+  for (const bool off_by_param : {false, true}) {
+    sim::DepthSensor camera = robotCamera();
+    PerceptionParams params;
+    params.self_filter.enabled = !off_by_param;
+    Perception p(truth, params);
+    int64_t stamp = kSecond;
+    const Frames run = look(p, truth, s, 4, off_by_param, stamp, camera);
+    EXPECT_EQ(run.robot_points, 0u);
+    const std::size_t occupied = p.occupancy()->occupiedCount();
+    if (std::getenv("TAMP_PERCEPTION_DEBUG") != nullptr) {
+      std::printf("unfiltered (%s): %d added, %zu occupied voxels, %zu objects\n",
+                  off_by_param ? "filter off" : "no body", count(run.events, EventType::kAdded),
+                  occupied, p.world().objects().size());
+    }
+    EXPECT_GE(count(run.events, EventType::kAdded), 1) << "the unfiltered arm is an object";
+    EXPECT_GE(p.world().objects().size(), 1u);
+  }
+}
+
+TEST(SelfFilterTest, TheHeldObjectFollowsTheGripperAndIsNeverNewNorGone) {
+  // A parcel standing on a stand right between the open fingers of the arm at "ready".
+  const robot::RobotState ready = armReady();
+  const Eigen::Isometry3d tool = robotModel().toolPoseInWorld(ready);
+  const Eigen::Vector3d c = tool.translation();
+  world::World prior = floorOnly();
+  const double parcel_h = 0.10, stand_top = c.z() - parcel_h / 2;
+  ASSERT_TRUE(prior
+                  .addObject(testing::box("stand", 0.3, 0.3, stand_top, c.x() + 0.05, c.y(), 0.0,
+                                          0.0, world::ObjectKind::kStatic))
+                  .ok());
+  world::Object parcel = testing::box("parcel", 0.05, 0.05, parcel_h, c.x(), c.y(), 0.0, stand_top);
+  parcel.mass = 0.3;
+  parcel.graspable = true;
+  ASSERT_TRUE(prior.addObject(parcel).ok());
+  world::World truth = prior;
+
+  sim::DepthSensor camera = robotCamera();
+  Perception p(prior, PerceptionParams{});
+  int64_t stamp = kSecond;
+  // Before the grasp: tracked where it stands.
+  Frames run = look(p, truth, ready, 2, true, stamp, camera);
+  EXPECT_EQ(p.heldObject(), "");
+  // Grasped (the state reports it held) and carried: the arm turns by 0.5 rad at its base.
+  const Eigen::Isometry3d tool_T_parcel = tool.inverse() * parcel.pose;
+  for (double q1 : {0.0, 0.15, 0.3, 0.5}) {
+    const robot::RobotState s = armReady(q1);
+    world::Object carried = parcel;
+    carried.pose = robotModel().toolPoseInWorld(s) * tool_T_parcel;
+    ASSERT_TRUE(truth.updateObject(carried).ok());
+    const Frames r = look(p, truth, s, 2, true, stamp, camera, "parcel");
+    run.events.insert(run.events.end(), r.events.begin(), r.events.end());
+    EXPECT_EQ(p.heldObject(), "parcel");
+    // The world model follows the gripper.
+    const world::Object& seen = p.world().object("parcel");
+    EXPECT_LT((seen.pose.translation() - carried.pose.translation()).norm(), 0.03) << "q1 " << q1;
+  }
+  // Its old place, now in view and empty, does not make it gone; nothing new appeared.
+  EXPECT_EQ(count(run.events, EventType::kAdded), 0);
+  EXPECT_EQ(count(run.events, EventType::kGone), 0);
+  EXPECT_EQ(p.world().objects().size(), 2u);  // stand and parcel
+
+  // Put back on the stand and released: tracked there again, still one parcel.
+  const robot::RobotState back = armReady(0.0);
+  ASSERT_TRUE(truth.updateObject(parcel).ok());
+  (void)look(p, truth, back, 1, true, stamp, camera, "parcel");
+  run = look(p, truth, back, 3, true, stamp, camera);
+  EXPECT_EQ(p.heldObject(), "");
+  EXPECT_EQ(count(run.events, EventType::kAdded), 0);
+  EXPECT_EQ(count(run.events, EventType::kGone), 0);
+  EXPECT_LT((p.world().object("parcel").pose.translation() - parcel.pose.translation()).norm(),
+            0.03);
+
+  // Without the self filter the same carry would leave the parcel's track behind (gone from
+  // the stand) or add the carried parcel as new: the filter is what prevents it.
+  truth = prior;
+  sim::DepthSensor camera2 = robotCamera();
+  Perception unfiltered(prior, PerceptionParams{});
+  stamp = kSecond;
+  Frames bare = look(unfiltered, truth, ready, 2, false, stamp, camera2);
+  for (double q1 : {0.0, 0.15, 0.3, 0.5}) {
+    const robot::RobotState s = armReady(q1);
+    world::Object carried = parcel;
+    carried.pose = robotModel().toolPoseInWorld(s) * tool_T_parcel;
+    ASSERT_TRUE(truth.updateObject(carried).ok());
+    const Frames r = look(unfiltered, truth, s, 2, false, stamp, camera2);
+    bare.events.insert(bare.events.end(), r.events.begin(), r.events.end());
+  }
+  if (std::getenv("TAMP_PERCEPTION_DEBUG") != nullptr) {
+    std::printf("carried unfiltered: %d added, %d gone, %d moved\n",
+                count(bare.events, EventType::kAdded), count(bare.events, EventType::kGone),
+                count(bare.events, EventType::kMoved));
+  }
+  EXPECT_GT(count(bare.events, EventType::kAdded) + count(bare.events, EventType::kGone), 0);
+}
+
+}  // namespace
+}  // namespace tamp::perception

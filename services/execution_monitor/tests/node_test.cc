@@ -21,6 +21,7 @@
 #include <gtest/gtest.h>
 
 #include "../../../tests/integration/integration_util.h"
+#include "execution_monitor_node.h"
 #include "tamp/core/paths.h"
 #include "tamp/dds/convert.h"
 #include "tamp/dds/topics.h"
@@ -452,6 +453,73 @@ TEST_F(TightTimeoutMonitorNodeTest, AnOverrunIsCancelledAsATimeout) {
   ASSERT_TRUE(result);
   EXPECT_EQ(result->outcome(), msg::ActionOutcome::OUTCOME_CANCELLED) << result->reason();
   EXPECT_NEAR(done->measured_duration_s(), result->duration_s(), 1e-9);
+}
+
+TEST(MonitorConversionsTest, MalformedMessagesNameTheField) {
+  robot::RobotModel robot = [] {
+    auto r = robot::RobotModel::loadDefault();
+    EXPECT_TRUE(r);
+    return std::move(r).value();
+  }();
+  msg::ExecuteCommand c;
+  c.command_id("c");
+  c.kind(static_cast<msg::ActionKind>(9));
+  auto bad_kind = fromMsg(c);
+  ASSERT_FALSE(bad_kind);
+  EXPECT_EQ(bad_kind.error().where.field, "kind");
+  c.kind(msg::ActionKind::ACTION_PLACE);
+  c.object_target_given(true);  // a zero quaternion
+  auto bad_target = fromMsg(c);
+  ASSERT_FALSE(bad_target);
+  EXPECT_EQ(bad_target.error().where.field.rfind("object_target", 0), 0u)
+      << bad_target.error().toString();
+  c.object_target().orientation().w(1.0);
+  c.expected_duration_s(3.0);
+  c.world_version(7);
+  auto ok = fromMsg(c);
+  ASSERT_TRUE(ok) << ok.error().toString();
+  EXPECT_TRUE(ok->object_target.has_value());
+  EXPECT_EQ(ok->world_version, 7u);
+  EXPECT_DOUBLE_EQ(ok->expected_duration_s, 3.0);
+  c.object_target_given(false);
+  EXPECT_FALSE(fromMsg(c)->object_target.has_value());
+
+  msg::RobotState st;
+  st.joint_names({"base_x", "base_y"});
+  st.joint_positions({1.0});
+  auto bad_state = fromMsg(st, robot, 5);
+  ASSERT_FALSE(bad_state);
+  EXPECT_EQ(bad_state.error().where.field, "joint_positions");
+  st.joint_names(robot.fullJointNames());
+  st.joint_positions(robot.toJointValues(robot.defaultState(Pose2D{1.0, 2.0, 0.5})));
+  st.held_object_id("cup");
+  auto good_state = fromMsg(st, robot, 5);
+  ASSERT_TRUE(good_state) << good_state.error().toString();
+  EXPECT_DOUBLE_EQ(good_state->state.base.y, 2.0);
+  EXPECT_EQ(good_state->held_object_id, "cup");
+  EXPECT_EQ(good_state->stamp_ns, 5);
+
+  msg::ActionResult res;
+  res.outcome(static_cast<msg::ActionOutcome>(9));
+  EXPECT_FALSE(fromMsg(res, 0));
+
+  RobotRequest cancel;
+  cancel.type = RobotRequest::Type::kCancel;
+  cancel.command.command_id = "c";
+  const msg::TrajectoryCommand tc = toMsg(cancel);
+  EXPECT_TRUE(tc.cancel());
+  EXPECT_EQ(tc.command_id(), "c");
+  StatusUpdate su;
+  su.command_id = "c";
+  su.state = ExecState::kBlocked;
+  su.blocking_object_id = "crate";
+  su.measured_duration_s = 1.5;
+  su.held_object_id = "cup";
+  const msg::ExecuteStatus es = toMsg(su);
+  EXPECT_EQ(es.state(), msg::ExecState::EXEC_BLOCKED);
+  EXPECT_EQ(es.blocking_object_id(), "crate");
+  EXPECT_DOUBLE_EQ(es.measured_duration_s(), 1.5);
+  EXPECT_EQ(es.held_object_id(), "cup");
 }
 
 }  // namespace

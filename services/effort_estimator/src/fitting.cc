@@ -13,7 +13,7 @@
 #include <memory>
 #include <stdexcept>
 
-#include "model_math.h"
+#include "tamp/effort_model/model_math.h"
 #include "tamp/effort_estimator/models.h"
 
 namespace tamp::effort_estimator {
@@ -36,8 +36,8 @@ struct LogResidual {
     using std::log;
     std::array<T, N> p;
     for (int i = 0; i < N; ++i) p[i] = exp(theta[i]);
-    const T t = detail::duration<T>(*features, p.data());
-    if (!(detail::scalarOf(t) > 0.0)) return false;  // cannot happen with positive parameters
+    const T t = effort_model::detail::duration<T>(*features, p.data());
+    if (!(effort_model::detail::scalarOf(t) > 0.0)) return false;  // cannot happen with positive parameters
     residual[0] = (log(t) - log_duration) * inv_sigma;
     return true;
   }
@@ -202,7 +202,7 @@ Result<KindModel> fitImpl(const KindModel& start, std::span<const FeatureRecord>
     std::vector<double> abs_res(records.size());
     double sum_sq = 0.0;
     for (std::size_t i = 0; i < records.size(); ++i) {
-      residuals[i] = std::log(detail::duration<double>(records[i].features, p.data())) - log_y[i];
+      residuals[i] = std::log(effort_model::detail::duration<double>(records[i].features, p.data())) - log_y[i];
       abs_res[i] = std::abs(residuals[i]);
       sum_sq += residuals[i] * residuals[i];
     }

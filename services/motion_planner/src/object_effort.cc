@@ -3,13 +3,13 @@
 #include <cmath>
 
 #include "tamp/core/format.h"
-#include "tamp/effort_estimator/models.h"
+#include "tamp/effort_model/models.h"
 #include "tamp/motion_planner/motion_planner.h"
 
 namespace tamp::motion_planner {
 namespace {
 
-namespace ee = tamp::effort_estimator;
+namespace ee = tamp::effort_model;
 
 /// Parameter vectors (modelSpec order) of the three models an object's effort uses.
 struct EffortModels {

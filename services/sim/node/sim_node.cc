@@ -63,7 +63,7 @@ msg::ActionResult toMsg(const ActionResult& r) {
   return m;
 }
 
-msg::ExecutionRecord toMsg(const effort_estimator::ExecutionRecord& r) {
+msg::ExecutionRecord toMsg(const effort_model::ExecutionRecord& r) {
   msg::ExecutionRecord m;
   m.record_id(r.record_id);
   m.kind(dds::toMsg(r.action.kind));
@@ -173,7 +173,7 @@ SimNode::SimNode(const dds::ServiceArgs& args, SimSetup setup, SimParams params)
       logger()->error("result of '{}' not published: {}", r.command_id, st.error().toString());
     }
   };
-  cb.on_record = [this](const effort_estimator::ExecutionRecord& r) {
+  cb.on_record = [this](const effort_model::ExecutionRecord& r) {
     if (Status st = record_writer_->write(toMsg(r)); !st) {
       logger()->warn("execution record of '{}' not published: {}", r.record_id, st.error().toString());
     }

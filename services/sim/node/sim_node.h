@@ -27,7 +27,7 @@ namespace tamp::sim {
 /// kInvalidArgument naming the field (trajectory.*, object_target, kind).
 Result<ActionCommand> fromMsg(const msg::TrajectoryCommand& m);
 msg::ActionResult toMsg(const ActionResult& r);
-msg::ExecutionRecord toMsg(const effort_estimator::ExecutionRecord& r);
+msg::ExecutionRecord toMsg(const effort_model::ExecutionRecord& r);
 /// kInvalidArgument naming the field (type, object_id, shape, pose).
 Result<Fault> fromMsg(const msg::FaultInjection& m);
 msg::RobotState toMsg(const RobotStateSample& s, const std::vector<std::string>& joint_names,

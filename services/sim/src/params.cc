@@ -8,7 +8,7 @@
 
 #include "tamp/config/schema.h"
 #include "tamp/core/paths.h"
-#include "tamp/effort_estimator/models.h"
+#include "tamp/effort_model/models.h"
 
 namespace tamp::sim {
 namespace {
@@ -68,7 +68,7 @@ const config::Schema<SimParams>& schema() {
 
 TimeParameters TimeParameters::simulatedRobot() {
   TimeParameters t;
-  for (ActionKind k : kAllActionKinds) t.of(k) = effort_estimator::modelSpec(k).defaults();
+  for (ActionKind k : kAllActionKinds) t.of(k) = effort_model::modelSpec(k).defaults();
   using K = ActionKind;
   t.set(K::kMoveBase, "max_linear_speed", 0.4);
   t.set(K::kMoveBase, "max_linear_accel", 0.3);
@@ -94,7 +94,7 @@ const std::vector<double>& TimeParameters::of(ActionKind kind) const { return va
 std::vector<double>& TimeParameters::of(ActionKind kind) { return values[kindIndex(kind)]; }
 
 double TimeParameters::get(ActionKind kind, const std::string& name) const {
-  const int i = effort_estimator::modelSpec(kind).indexOf(name);
+  const int i = effort_model::modelSpec(kind).indexOf(name);
   if (i < 0 || i >= static_cast<int>(of(kind).size())) {
     throw std::invalid_argument("TimeParameters: no parameter '" + name + "' for " +
                                 std::string(toString(kind)));
@@ -103,7 +103,7 @@ double TimeParameters::get(ActionKind kind, const std::string& name) const {
 }
 
 void TimeParameters::set(ActionKind kind, const std::string& name, double value) {
-  const auto& spec = effort_estimator::modelSpec(kind);
+  const auto& spec = effort_model::modelSpec(kind);
   const int i = spec.indexOf(name);
   if (i < 0) {
     throw std::invalid_argument("TimeParameters: no parameter '" + name + "' for " +
@@ -117,7 +117,7 @@ void TimeParameters::set(ActionKind kind, const std::string& name, double value)
 Status TimeParameters::validate() const {
   std::vector<Error> errors;
   for (ActionKind k : kAllActionKinds) {
-    const auto& spec = effort_estimator::modelSpec(k);
+    const auto& spec = effort_model::modelSpec(k);
     const auto& v = of(k);
     const std::string base = "time_parameters." + std::string(toString(k));
     if (v.size() != static_cast<std::size_t>(spec.size())) {
@@ -167,7 +167,7 @@ Result<SimParams> parseSimParams(const std::string& yaml_text, const std::string
                                                      "' (expected one of: move_base, move_arm, pick, place)");
       continue;
     }
-    const auto& spec = effort_estimator::modelSpec(*kind);
+    const auto& spec = effort_model::modelSpec(*kind);
     for (int i = 0; i < spec.size(); ++i) {
       const auto& ps = spec.parameters[i];
       double v = p.time_parameters.of(*kind)[i];

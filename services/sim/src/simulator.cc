@@ -13,8 +13,8 @@
 #include "tamp/collision/scene.h"
 #include "tamp/core/geometry.h"
 #include "tamp/core/log.h"
-#include "tamp/effort_estimator/features.h"
-#include "tamp/effort_estimator/models.h"
+#include "tamp/effort_model/features.h"
+#include "tamp/effort_model/models.h"
 #include "tamp/sim/depth_sensor.h"
 #include "tamp/sim/ray_scene.h"
 
@@ -22,7 +22,7 @@ namespace tamp::sim {
 namespace {
 
 using Vec = Eigen::VectorXd;
-using effort_estimator::FeatureTolerances;
+using effort_model::FeatureTolerances;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kFloorTolerance = 1e-4;
 constexpr double kSupportProbe = 0.005;  // m: how far below an object its supports are looked for  // m below z = 0 that counts as touching the floor
@@ -36,12 +36,12 @@ Error invalid(const std::string& field, const std::string& message) {
   return Error(ErrorCode::kInvalidArgument, field + ": " + message, SourceLocation{"", 0, 0, field});
 }
 
-// ---- trapezoidal stop-to-stop profile (effort_estimator/models.h) -------------------------------
+// ---- trapezoidal stop-to-stop profile (effort_model/models.h) -------------------------------
 
 /// Distance covered after time tau of a move of length L (max speed v, max acceleration a).
 double trapPosition(double tau, double L, double v, double a) {
   if (L <= 0.0 || tau <= 0.0) return 0.0;
-  const double T = effort_estimator::trapezoidTime(L, v, a);
+  const double T = effort_model::trapezoidTime(L, v, a);
   if (tau >= T) return L;
   if (L >= v * v / a) {
     const double ta = v / a;
@@ -57,7 +57,7 @@ double trapPosition(double tau, double L, double v, double a) {
 /// Inverse of trapPosition: the time at which distance s is reached.
 double trapTimeAt(double s, double L, double v, double a) {
   if (L <= 0.0 || s <= 0.0) return 0.0;
-  const double T = effort_estimator::trapezoidTime(L, v, a);
+  const double T = effort_model::trapezoidTime(L, v, a);
   if (s >= L) return T;
   if (L >= v * v / a) {
     const double ta = v / a;
@@ -182,7 +182,7 @@ struct Simulator::Impl {
   SimParams params;
   collision::Scene scene;
   DepthSensor sensor;
-  effort_estimator::FeatureOptions feature_options;
+  effort_model::FeatureOptions feature_options;
   std::vector<std::string> full_names;
   int dof{0};
   bool has_gripper{false};
@@ -722,7 +722,7 @@ struct Simulator::Impl {
                    : a.reason;
     idle = stateAt(a, a.end);
     // Velocities are zero at rest: the state is exactly the stop state.
-    effort_estimator::ExecutionRecord rec;
+    effort_model::ExecutionRecord rec;
     rec.action.kind = a.cmd.kind;
     if (a.cmd.kind == ActionKind::kMoveBase || a.cmd.kind == ActionKind::kMoveArm) {
       rec.action.path = a.cmd.trajectory.path();
@@ -808,7 +808,7 @@ Result<std::vector<int>> Simulator::Impl::validate(const ActionCommand& c) const
       const double v = p.positions[j];
       const std::string& name = t.joint_names[j];
       if (!std::isfinite(v)) return invalid(pf, name + " is not finite");
-      if (std::abs(v) > effort_estimator::InputLimits::kMaxAbsPathValue) {
+      if (std::abs(v) > effort_model::InputLimits::kMaxAbsPathValue) {
         return invalid(pf, name + " = " + formatNumber(v, 4) + " is implausibly large");
       }
       if (!p.velocities.empty() && !std::isfinite(p.velocities[j])) {
@@ -877,7 +877,7 @@ Result<Active> Simulator::Impl::plan(const ActionCommand& c, const std::vector<i
     ph.length = length;
     ph.v = v;
     ph.a = acc;
-    ph.nominal = effort_estimator::trapezoidTime(length, v, acc);
+    ph.nominal = effort_model::trapezoidTime(length, v, acc);
     ph.start = path.q.front();
     ph.end = path.q.back();
     ph.path = std::move(path);
@@ -885,18 +885,18 @@ Result<Active> Simulator::Impl::plan(const ActionCommand& c, const std::vector<i
     a.phases.push_back(std::move(ph));
   };
 
-  effort_estimator::ActionDescription desc;
+  effort_model::ActionDescription desc;
   desc.kind = c.kind;
   if (c.kind == ActionKind::kMoveBase) {
-    // Stop-and-turn exactly as effort_estimator::extractFeatures reduces the path.
+    // Stop-and-turn exactly as effort_model::extractFeatures reduces the path.
     const double v = P[0], acc = P[1], w = P[2], alpha = P[3], settle = P[4], overhead = P[5];
     a.mass = heldMass();
     pause(overhead);
     std::vector<Pose2D> poses;
     for (const Vec& q : wp) poses.push_back(Pose2D{q[0], q[1], q[2]});
-    for (const auto& step : effort_estimator::baseSteps(poses)) {
+    for (const auto& step : effort_model::baseSteps(poses)) {
       GeoPath g;
-      if (step.kind == effort_estimator::BaseStep::Kind::kTurn) {
+      if (step.kind == effort_model::BaseStep::Kind::kTurn) {
         Vec end = cur;
         end[2] = cur[2] + angleDiff(step.target_heading, cur[2]);
         g.q = {cur, end};
@@ -922,14 +922,14 @@ Result<Active> Simulator::Impl::plan(const ActionCommand& c, const std::vector<i
     const double v = P[0] / f, acc = P[1] / f, settle = P[2], overhead = P[3];
     a.mass = heldMass();
     pause(overhead);
-    // The same straight runs the effort features see (effort_estimator::armRuns), each one
+    // The same straight runs the effort features see (effort_model::armRuns), each one
     // synchronized move followed by a settle pause.
     const std::size_t n = cols.size();
     std::vector<std::vector<double>> arm(wp.size(), std::vector<double>(n));
     for (std::size_t i = 0; i < wp.size(); ++i) {
       for (std::size_t j = 0; j < n; ++j) arm[i][j] = wp[i][cols[j]];
     }
-    for (const auto& run : effort_estimator::armRuns(arm, c.trajectory.joint_names, feature_options)) {
+    for (const auto& run : effort_model::armRuns(arm, c.trajectory.joint_names, feature_options)) {
       GeoPath g;
       Vec end = cur;
       for (std::size_t j = 0; j < n; ++j) end[cols[j]] += run.delta[j];
@@ -1015,9 +1015,9 @@ Result<Active> Simulator::Impl::plan(const ActionCommand& c, const std::vector<i
   desc.object_mass_kg = a.mass;
 
   // The timeline: nominal model times stretched by the execution noise.
-  const auto features = effort_estimator::extractFeatures(desc, feature_options);
+  const auto features = effort_model::extractFeatures(desc, feature_options);
   if (!features) return Error(ErrorCode::kInvalidArgument, features.error().message, features.error().where);
-  const double model = effort_estimator::predictDuration(*features, P);
+  const double model = effort_model::predictDuration(*features, P);
   double nominal = 0.0;
   for (const Phase& p : a.phases) nominal += p.nominal;
   if (std::abs(nominal - model) > 1e-6 * std::max(1.0, model)) {

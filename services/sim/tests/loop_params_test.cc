@@ -88,12 +88,12 @@ TEST(SimulationLoopTest, ReportsStatesResultsRecordsAndClouds) {
   Simulator sim(emptyRoom(), robotModel(), upright(), params);
   std::vector<double> state_times;
   std::vector<ActionResult> results;
-  std::vector<effort_estimator::ExecutionRecord> records;
+  std::vector<effort_model::ExecutionRecord> records;
   std::vector<std::int64_t> cloud_stamps;
   LoopCallbacks cb;
   cb.on_state = [&](const RobotStateSample& s, std::int64_t) { state_times.push_back(s.time_s); };
   cb.on_result = [&](const ActionResult& r) { results.push_back(r); };
-  cb.on_record = [&](const effort_estimator::ExecutionRecord& r) { records.push_back(r); };
+  cb.on_record = [&](const effort_model::ExecutionRecord& r) { records.push_back(r); };
   cb.on_cloud = [&](const PointCloudFrame& f) { cloud_stamps.push_back(f.stamp_ns); };
   SimulationLoop loop(sim, cb);
   // A malformed command is answered through on_result too.

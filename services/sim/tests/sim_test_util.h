@@ -6,8 +6,8 @@
 
 #include <gtest/gtest.h>
 
-#include "tamp/effort_estimator/features.h"
-#include "tamp/effort_estimator/models.h"
+#include "tamp/effort_model/features.h"
+#include "tamp/effort_model/models.h"
 #include "tamp/sim/setup.h"
 #include "tamp/sim/simulator.h"
 
@@ -98,8 +98,8 @@ inline StepEvents runToEnd(Simulator& sim, double dt = 0.05, double limit_s = 60
 
 /// Per-joint speed scales of the robot's arm (URDF velocity / fastest), computed independently
 /// of the simulator.
-inline effort_estimator::FeatureOptions urdfScales() {
-  effort_estimator::FeatureOptions o;
+inline effort_model::FeatureOptions urdfScales() {
+  effort_model::FeatureOptions o;
   const auto& lim = robotModel().armLimits();
   double fastest = 0;
   for (const auto& l : lim) fastest = std::max(fastest, l.velocity);
@@ -110,10 +110,10 @@ inline effort_estimator::FeatureOptions urdfScales() {
 }
 
 /// The time model with `params` for the action a record describes.
-inline double modelTime(const effort_estimator::ExecutionRecord& r, std::span<const double> params) {
-  auto f = effort_estimator::extractFeatures(r.action, urdfScales());
+inline double modelTime(const effort_model::ExecutionRecord& r, std::span<const double> params) {
+  auto f = effort_model::extractFeatures(r.action, urdfScales());
   if (!f) throw std::runtime_error(f.error().toString());
-  return effort_estimator::predictDuration(*f, params);
+  return effort_model::predictDuration(*f, params);
 }
 
 }  // namespace tamp::sim::testing

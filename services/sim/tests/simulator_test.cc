@@ -6,7 +6,7 @@
 
 #include "sim_test_util.h"
 #include "tamp/collision/scene.h"
-#include "tamp/effort_estimator/records.h"
+#include "tamp/effort_model/records.h"
 
 namespace tamp::sim {
 namespace {
@@ -69,7 +69,7 @@ TEST(SimulatorTest, MoveBaseTakesTheTrueModelTimeAndFollowsThePath) {
   const double hand = 0.8 + 0.35 * 5 + trap(2, 0.4, 0.3) + 2 * trap(1.5, 0.4, 0.3) + 2 * trap(M_PI / 2, 1.2, 1.0);
   EXPECT_NEAR(r.duration_s, hand, 1e-9);
   // ... and not the planner's defaults.
-  const auto defaults = effort_estimator::modelSpec(ActionKind::kMoveBase).defaults();
+  const auto defaults = effort_model::modelSpec(ActionKind::kMoveBase).defaults();
   EXPECT_GT(std::abs(modelTime(all.records[0], defaults) - r.duration_s), 0.1 * r.duration_s);
   // The robot drove along the commanded polyline, within its true speed limit, and ended there.
   EXPECT_LT(max_off_path, 1e-9);
@@ -86,7 +86,7 @@ TEST(SimulatorTest, MoveBaseTakesTheTrueModelTimeAndFollowsThePath) {
   EXPECT_EQ(rec.source, "sim");
   EXPECT_EQ(rec.record_id, "drive");
   EXPECT_EQ(rec.action.path.waypoints.size(), 4u);
-  EXPECT_TRUE(effort_estimator::toFeatureRecord(rec, 3600.0, urdfScales()));
+  EXPECT_TRUE(effort_model::toFeatureRecord(rec, 3600.0, urdfScales()));
 }
 
 TEST(SimulatorTest, MoveArmUsesTheTrueJointLimitsAndPayload) {

@@ -239,11 +239,11 @@ bool seedRandomness(std::uint32_t seed);
 using ObjectEffortFn = std::function<double(const world::Object&)>;
 
 /// The default effort model: pick + place + transfer with the effort estimator's default time
-/// models (tamp::effort_estimator::modelSpec defaults) and `params`.
+/// models (tamp::effort_model::modelSpec defaults) and `params`.
 double defaultObjectEffort(const world::Object& object, const CostParams& params);
 
 /// The parameter values of one action kind's time model (e.g. the effort estimator's fit), by
-/// name (physical units, tamp::effort_estimator::modelSpec names); names not given keep their
+/// name (physical units, tamp::effort_model::modelSpec names); names not given keep their
 /// default.
 struct TimeModelValues {
   ActionKind kind{ActionKind::kPick};

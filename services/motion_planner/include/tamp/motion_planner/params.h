@@ -84,7 +84,7 @@ struct LazyParams {
 /// The path cost that decides which movable objects a lazy path may cross:
 ///   cost [s] = path length / speed + sum over crossed objects o of scale x effort(o).
 /// effort(o) is the execution time of moving o out of the way: pick + place (the effort
-/// estimator's default time models, tamp::effort_estimator, with o's mass) + driving
+/// estimator's default time models, tamp::effort_model, with o's mass) + driving
 /// `transfer_distance` to a placement and back; objects the gripper cannot hold (not graspable)
 /// cost `non_graspable_factor` times as much (pushing, two-handed handling, ...).
 struct CostParams {

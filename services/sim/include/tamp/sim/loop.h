@@ -30,7 +30,7 @@ namespace tamp::sim {
 struct LoopCallbacks {
   std::function<void(const RobotStateSample&, std::int64_t stamp_ns)> on_state;
   std::function<void(const ActionResult&)> on_result;
-  std::function<void(const effort_estimator::ExecutionRecord&)> on_record;
+  std::function<void(const effort_model::ExecutionRecord&)> on_record;
   std::function<void(const FaultEvent&)> on_fault;
   std::function<void(const PointCloudFrame&)> on_cloud;
 };

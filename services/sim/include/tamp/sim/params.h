@@ -16,7 +16,7 @@
 ///   grasp: {position_tolerance_m: 0.03, tcp_tolerance_m: 0.02, max_payload_kg: 5.0}
 ///   place: {position_tolerance_m: 0.03, angle_tolerance_rad: 0.1, max_drop_m: 0.05,
 ///           max_tilt_rad: 0.1}
-///   time_parameters:             # per action kind, parameter names of effort_estimator/models.h
+///   time_parameters:             # per action kind, parameter names of effort_model/models.h
 ///     move_base: {max_linear_speed: 0.4, ...}
 ///   sensor: {width: 320, height: 240, ...}                 # DepthSensorParams
 ///
@@ -35,8 +35,8 @@
 namespace tamp::sim {
 
 /// The simulated robot's true time parameters: for each action kind, values in physical units in
-/// the order of `effort_estimator::modelSpec(kind).parameters`. The simulator times every action
-/// with `effort_estimator::predictDuration(features, values)` (plus noise); the planner never
+/// the order of `effort_model::modelSpec(kind).parameters`. The simulator times every action
+/// with `effort_model::predictDuration(features, values)` (plus noise); the planner never
 /// sees these values.
 struct TimeParameters {
   std::array<std::vector<double>, 4> values;  ///< indexed by `static_cast<int>(ActionKind)`

@@ -10,7 +10,7 @@
 ///   a `collision::Scene` over all of it; the planner only ever sees `plannerView()`.
 /// - **Kinematics.** The robot is the URDF `robot::RobotModel`: link poses by FK, collision
 ///   geometry from the URDF, held objects attached to the tool link.
-/// - **Time.** An action's duration is `effort_estimator::predictDuration(features, true_params)`
+/// - **Time.** An action's duration is `effort_model::predictDuration(features, true_params)`
 ///   times a log-normal factor exp(sigma * N(0, 1)) (sigma = `SimParams::duration_noise`, median
 ///   1), with the features extracted from the command exactly as the estimator does. The motion
 ///   follows the commanded path re-timed by the same physical model:
@@ -43,7 +43,7 @@
 ///   upright, on a region, near the commanded pose and not in collision.
 /// - **Faults.** Scripted faults fire at a simulated time or during an action step; injected ones
 ///   (`inject()`) fire at the next `step()`. A failed action stops the robot where it is.
-/// - **Records.** Every finished action yields an `effort_estimator::ExecutionRecord` (kind, path
+/// - **Records.** Every finished action yields an `effort_model::ExecutionRecord` (kind, path
 ///   or approach/retreat distances, true object mass, measured duration, success).
 ///
 /// Time is simulated: `step(dt)` advances it; `SimulationLoop` (loop.h) paces it against the wall
@@ -60,7 +60,7 @@
 #include "tamp/core/error.h"
 #include "tamp/core/point_cloud.h"
 #include "tamp/core/trajectory.h"
-#include "tamp/effort_estimator/records.h"
+#include "tamp/effort_model/records.h"
 #include "tamp/robot/robot_model.h"
 #include "tamp/sim/faults.h"
 #include "tamp/sim/params.h"
@@ -109,7 +109,7 @@ struct RobotStateSample {
 /// What happened during a `step()`.
 struct StepEvents {
   std::vector<ActionResult> results;
-  std::vector<effort_estimator::ExecutionRecord> records;
+  std::vector<effort_model::ExecutionRecord> records;
   std::vector<FaultEvent> faults;
   bool world_changed{false};  ///< objects moved, appeared or disappeared (not just the robot)
 };

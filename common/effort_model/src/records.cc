@@ -1,11 +1,11 @@
 #include "tamp/core/format.h"
-#include "tamp/effort_estimator/records.h"
+#include "tamp/effort_model/records.h"
 
 #include <cmath>
 #include <cstdio>
 #include <string>
 
-namespace tamp::effort_estimator {
+namespace tamp::effort_model {
 namespace {
 
 Status checkScalars(double duration_s, double timestamp_s, double max_duration_s) {
@@ -50,4 +50,4 @@ Status validateFeatureRecord(const FeatureRecord& record, double max_duration_s)
   return validateFeatures(record.features);
 }
 
-}  // namespace tamp::effort_estimator
+}  // namespace tamp::effort_model

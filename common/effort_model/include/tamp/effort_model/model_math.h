@@ -6,9 +6,9 @@
 #include <cmath>
 #include <cstddef>
 
-#include "tamp/effort_estimator/features.h"
+#include "tamp/effort_model/features.h"
 
-namespace tamp::effort_estimator::detail {
+namespace tamp::effort_model::detail {
 
 inline double scalarOf(double x) { return x; }
 template <typename J>
@@ -69,4 +69,4 @@ T duration(const ActionFeatures& f, const T* p) {
   return T(0.0);
 }
 
-}  // namespace tamp::effort_estimator::detail
+}  // namespace tamp::effort_model::detail

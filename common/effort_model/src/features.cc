@@ -1,5 +1,5 @@
 #include "tamp/core/format.h"
-#include "tamp/effort_estimator/features.h"
+#include "tamp/effort_model/features.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +9,7 @@
 
 #include "tamp/core/geometry.h"
 
-namespace tamp::effort_estimator {
+namespace tamp::effort_model {
 namespace {
 
 Error invalid(std::string message, std::string field = "") {
@@ -320,4 +320,4 @@ Status validateFeatures(const ActionFeatures& f) {
   return Status::Ok();
 }
 
-}  // namespace tamp::effort_estimator
+}  // namespace tamp::effort_model

@@ -1,4 +1,4 @@
-#include "tamp/effort_estimator/models.h"
+#include "tamp/effort_model/models.h"
 
 #include <ceres/jet.h>
 
@@ -7,9 +7,9 @@
 #include <stdexcept>
 #include <string>
 
-#include "model_math.h"
+#include "tamp/effort_model/model_math.h"
 
-namespace tamp::effort_estimator {
+namespace tamp::effort_model {
 namespace {
 
 // Defaults describe a small indoor mobile manipulator (base ~0.5 m/s, 6-7 dof arm ~1 rad/s).
@@ -125,4 +125,4 @@ double predictDurationWithLogGradient(const ActionFeatures& features, std::span<
   return t.a;
 }
 
-}  // namespace tamp::effort_estimator
+}  // namespace tamp::effort_model

@@ -116,6 +116,11 @@ const Slot* Abstraction::slot(const std::string& id) const {
   return it == slots_.end() ? nullptr : &it->second;
 }
 
+void Abstraction::addReach(const std::string& location, const std::string& armconf) {
+  if (locations_.count(location) && !regionOfArmconf(armconf).empty())
+    reaches_.insert("(reaches " + location + " " + armconf + ")");
+}
+
 bool Abstraction::isRegion(const std::string& id) const { return regions_.count(id) > 0; }
 
 std::string Abstraction::regionOfArmconf(const std::string& armconf) const {
@@ -125,7 +130,8 @@ std::string Abstraction::regionOfArmconf(const std::string& armconf) const {
 }
 
 bool Abstraction::graspable(const world::Object& o) const {
-  return o.kind == world::ObjectKind::kMovable && o.graspable && o.mass <= params_.payload_kg;
+  return o.kind == world::ObjectKind::kMovable && o.graspable && o.mass <= robot_.payload() &&
+         o.mass <= params_.payload_cap_kg;
 }
 
 std::vector<std::string> Abstraction::objects() const {

@@ -26,6 +26,7 @@ double startDistance(const Trajectory& t, const robot::RobotState& s, ActionKind
 Result<EdgeCommand> GraphManager::command(EdgeId id, EdgeId next, const BranchContext& ctx,
                                           const std::string& command_id) {
   const Edge& e = graph_.edge(id);
+  next = armKey(id, next);
   const EdgeMotion* m = nullptr;
   double mean = e.effort_mean_s, sd = e.effort_stddev_s;
   if (e.kind == ActionKind::kMoveArm) {
@@ -98,6 +99,9 @@ MissionReport GraphManager::runMission(WorldSource& source, Executor& executor, 
     const EdgeId id = branch.front();
     const EdgeId next = branch.size() > 1 ? branch[1] : -1;
     Edge& e = graph_.edge(id);
+    // A manipulation follows from the arm motion just executed (its grasp or place pose) and the
+    // arm as it is: priced again from there.
+    if (e.kind == ActionKind::kPick || e.kind == ActionKind::kPlace) evaluate(id, -1, ctx, 0);
     // The robot must be where the edge's motion starts; otherwise plan the motion again from it.
     auto cmd = command(id, next, ctx, "m" + std::to_string(step) + "-e" + std::to_string(id));
     if (cmd && e.kind != ActionKind::kPick && e.kind != ActionKind::kPlace &&
@@ -106,8 +110,8 @@ MissionReport GraphManager::runMission(WorldSource& source, Executor& executor, 
         e.state = EdgeState::kUnevaluated;
         e.motion.reset();
       } else {
-        e.motion_by_next.erase(next);
-        e.effort_by_next.erase(next);
+        e.motion_by_next.erase(armKey(id, next));
+        e.effort_by_next.erase(armKey(id, next));
       }
       evaluate(id, next, ctx, 0);
       cmd = command(id, next, ctx, "m" + std::to_string(step) + "-e" + std::to_string(id));

@@ -39,7 +39,9 @@ const config::Schema<GraphManagerParams>& schema() {
         .field("plan_budget_s", &P::plan_budget_s, positive())
         .field("motion_budget_s", &P::motion_budget_s, positive())
         .field("execution_margin_s", &P::execution_margin_s, positive())
-        .field("start_tolerance", &P::start_tolerance, positive());
+        .field("start_tolerance", &P::start_tolerance, positive())
+        .field("clear_path_stretch", &P::clear_path_stretch, config::atLeast(1.0))
+        .field("turn_first_ratio", &P::turn_first_ratio, config::atLeast(1.0));
     return s;
   }();
   return kSchema;

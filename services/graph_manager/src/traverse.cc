@@ -218,10 +218,64 @@ MotionQuery GraphManager::baseQuery(const Edge& e, const BranchContext& ctx) con
   return q;
 }
 
-double GraphManager::evaluateBase(Edge& e, const BranchContext& ctx, int depth) {
-  const MotionQuery q = baseQuery(e, ctx);
+MotionAnswer GraphManager::lazyOrFull(const MotionQuery& q) {
   ++counters_.motion_calls;
   MotionAnswer a = services_.motion(q);
+  if (a.ok() && q.mode == Mode::kLazy && !a.blocking.empty()) {
+    // The static-only path ignores movables, so it may cross one where a path of about the same
+    // length touches nothing (an object beside the way, one this branch put aside): ask for the
+    // effort-aware lazy path and take it when it is clear and hardly longer.
+    MotionQuery aware = q;
+    aware.movable_cost_weight = 1.0;
+    ++counters_.motion_calls;
+    MotionAnswer b = services_.motion(aware);
+    if (b.ok() && b.blocking.empty() && b.path_length <= params_.clear_path_stretch * a.path_length) a = std::move(b);
+  }
+  return a;
+}
+
+MotionAnswer GraphManager::planBase(const MotionQuery& q) {
+  MotionAnswer a = lazyOrFull(q);
+  // A base that starts facing away from its way (it faced the object it handled) may find only
+  // a long detour: paths interpolate the heading while driving, which a narrow passage forbids.
+  // The robot turns in place first (as it executes base motions: stop, turn, drive), so plan
+  // from the heading towards the goal when that turn is free.
+  const double dx = q.goal_base.x - q.start.base.x, dy = q.goal_base.y - q.start.base.y;
+  const double straight = std::hypot(dx, dy);
+  const double heading = std::atan2(dy, dx);
+  if (straight < 1e-3 || std::abs(std::remainder(heading - q.start.base.theta, 2 * M_PI)) < 0.3) return a;
+  if (a.ok() && a.path_length <= params_.turn_first_ratio * straight) return a;
+  MotionQuery turn = q;
+  turn.mode = Mode::kFull;
+  turn.goal_base = Pose2D{q.start.base.x, q.start.base.y, heading};
+  ++counters_.motion_calls;
+  if (!services_.motion(turn).ok()) return a;
+  MotionQuery from_turned = q;
+  from_turned.start.base.theta = heading;
+  MotionAnswer b = lazyOrFull(from_turned);
+  if (!b.ok() || (a.ok() && b.path_length >= a.path_length)) return a;
+  // Prepend the turn: the start pose, then the turned path.
+  std::vector<double> start{q.start.base.x, q.start.base.y, q.start.base.theta};
+  if (!b.path.waypoints.empty()) {
+    // Keep the heading unwrapped next to the turned start.
+    start[2] = b.path.waypoints.front()[2] - std::remainder(b.path.waypoints.front()[2] - q.start.base.theta, 2 * M_PI);
+    b.path.waypoints.insert(b.path.waypoints.begin(), start);
+  }
+  if (!b.trajectory.empty()) {
+    const double turn_s = std::abs(b.trajectory.points.front().positions[2] - start[2]) / 0.5 + 0.2;
+    for (auto& p : b.trajectory.points) p.time_from_start += turn_s;
+    TrajectoryPoint p0;
+    p0.time_from_start = 0.0;
+    p0.positions = start;
+    if (!b.trajectory.points.front().velocities.empty()) p0.velocities.assign(start.size(), 0.0);
+    b.trajectory.points.insert(b.trajectory.points.begin(), p0);
+  }
+  return b;
+}
+
+double GraphManager::evaluateBase(Edge& e, const BranchContext& ctx, int depth) {
+  const MotionQuery q = baseQuery(e, ctx);
+  MotionAnswer a = planBase(q);
   if (!a.ok()) {
     e.state = EdgeState::kInfeasible;
     e.reason = std::string(toString(a.status)) + (a.reason.empty() ? "" : ": " + a.reason);
@@ -258,6 +312,15 @@ double GraphManager::evaluateBase(Edge& e, const BranchContext& ctx, int depth) 
     std::string objs;
     for (const auto& b : m.blocking) objs += (objs.empty() ? "" : ", ") + b;
     e.reason = "the lazy path crosses " + objs;
+    {
+      const Crossing& c0 = m.crossings.front();
+      const Pose2D at = c0.swept_base.empty() ? Pose2D{} : c0.swept_base.front();
+      std::string moved;
+      for (const auto& [oid, pose] : ctx.object_poses)
+        moved += " " + oid + "@(" + std::to_string(pose.translation().x()) + "," + std::to_string(pose.translation().y()) + ")";
+      log::get("graph_manager")->debug("{}: {} from {:.2f} to {:.2f} of the path, robot at ({:.2f}, {:.2f}); moved:{}",
+                                       e.action, e.reason, c0.enter_fraction, c0.exit_fraction, at.x, at.y, moved);
+    }
     graph_.addVariant(e.id, Variant::kAround, e.origin);
     if (params_.policy == Policy::kEffort && depth <= params_.max_subtask_depth) spawnSubtasks(e.id, ctx, depth);
     return kInfinity;
@@ -265,6 +328,9 @@ double GraphManager::evaluateBase(Edge& e, const BranchContext& ctx, int depth) 
   e.state = EdgeState::kFeasible;
   e.effort_mean_s = mean;
   e.effort_stddev_s = sd;
+  log::get("graph_manager")->debug("{}{}: {:.2f} m, {} waypoints, {:.1f} s", e.action,
+                                   e.variant == Variant::kAround ? " [around]" : "", a.path_length,
+                                   a.path.waypoints.size(), mean);
   return mean;
 }
 
@@ -431,6 +497,16 @@ double GraphManager::evaluateManipulation(Edge& e, const BranchContext& ctx) {
     return kInfinity;
   }
   std::optional<GraspOption> g = ctx.pending_grasp;
+  if (!g && e.kind == ActionKind::kPick) {
+    // No move_arm prepared this pick (the arm is already over the region, e.g. after a failed
+    // pick): a grasp from where the base stands, approached from the current arm configuration.
+    GraspQuery gq;
+    gq.object_id = object;
+    gq.base = ctx.state.base;
+    ++counters_.grasp_calls;
+    auto grasps = services_.grasps(gq);
+    if (grasps && !grasps->empty()) g = grasps->front();
+  }
   if (!g) {
     e.state = EdgeState::kInfeasible;
     e.reason = "no prepared " + std::string(e.kind == ActionKind::kPick ? "grasp" : "placement") + " for " + object;
@@ -441,6 +517,7 @@ double GraphManager::evaluateManipulation(Edge& e, const BranchContext& ctx) {
   m.region_id = e.tokens.size() > 2 ? e.tokens[2] : "";
   m.object_mass = o->mass;
   m.gripper_in_object = g->gripper_in_object;
+  m.prepared = g;
   std::vector<std::vector<double>> wps;
   wps.push_back(ctx.state.arm);
   if (maxJointDelta(ctx.state.arm, g->pregrasp) > 1e-6) wps.push_back(g->pregrasp);
@@ -473,8 +550,17 @@ double GraphManager::evaluateManipulation(Edge& e, const BranchContext& ctx) {
   return mean;
 }
 
+EdgeId GraphManager::armKey(EdgeId arm, EdgeId next) const {
+  const Edge& e = graph_.edge(arm);
+  if (e.kind != ActionKind::kMoveArm || next < 0) return -1;
+  if (e.tokens.size() > 3 && e.tokens[3] == "stow") return -1;
+  const ActionKind k = graph_.edge(next).kind;
+  return k == ActionKind::kPick || k == ActionKind::kPlace ? next : -1;
+}
+
 double GraphManager::evaluate(EdgeId id, EdgeId next, const BranchContext& ctx, int depth) {
   Edge& e = graph_.edge(id);
+  next = armKey(id, next);
   ++counters_.evaluations;
   switch (e.kind) {
     case ActionKind::kMoveBase:
@@ -493,6 +579,7 @@ double GraphManager::evaluate(EdgeId id, EdgeId next, const BranchContext& ctx, 
 
 BranchContext GraphManager::advance(EdgeId id, EdgeId next, const BranchContext& ctx) const {
   const Edge& e = graph_.edge(id);
+  next = armKey(id, next);
   BranchContext c = ctx;
   switch (e.kind) {
     case ActionKind::kMoveBase:
@@ -508,11 +595,11 @@ BranchContext GraphManager::advance(EdgeId id, EdgeId next, const BranchContext&
       break;
     }
     case ActionKind::kPick:
-      if (e.motion && ctx.pending_grasp) {
+      if (e.motion && e.motion->prepared) {
         c.held.object_id = e.motion->object_id;
         c.held.link = abstraction_.robot().options().tool_link;
-        c.held.link_T_object = ctx.pending_grasp->gripper_in_object.inverse();
-        c.state.arm = ctx.pending_grasp->pregrasp;
+        c.held.link_T_object = e.motion->prepared->gripper_in_object.inverse();
+        c.state.arm = e.motion->prepared->pregrasp;
         c.object_poses.erase(e.motion->object_id);
       }
       c.pending_grasp.reset();
@@ -541,9 +628,21 @@ void GraphManager::spawnSubtasks(EdgeId id, const BranchContext& ctx, int depth)
   const NodeId child = blocked.to;
   const EdgeMotion motion = *blocked.motion;
   // The robot's base poses along the blocked path: placements must keep clear of them.
+  // (every 5 cm: the placement sampler keeps clear of poses, not of segments).
   std::vector<Pose2D> swept;
-  for (const auto& w : motion.lazy_path.waypoints) {
-    if (w.size() >= 3) swept.push_back(Pose2D{w[0], w[1], w[2]});
+  const auto& wps = motion.lazy_path.waypoints;
+  for (std::size_t i = 0; i < wps.size(); ++i) {
+    if (wps[i].size() < 3) continue;
+    if (i > 0 && wps[i - 1].size() >= 3) {
+      const double len = std::hypot(wps[i][0] - wps[i - 1][0], wps[i][1] - wps[i - 1][1]);
+      const int n = static_cast<int>(std::ceil(len / 0.05));
+      for (int k = 1; k < n; ++k) {
+        const double t = static_cast<double>(k) / n;
+        swept.push_back(Pose2D{wps[i - 1][0] + t * (wps[i][0] - wps[i - 1][0]),
+                               wps[i - 1][1] + t * (wps[i][1] - wps[i - 1][1]), wps[i][2]});
+      }
+    }
+    swept.push_back(Pose2D{wps[i][0], wps[i][1], wps[i][2]});
   }
   const double radius = abstraction_.robot().baseRadius() + params_.keep_clear_margin_m;
   int objects = 0;
@@ -552,16 +651,51 @@ void GraphManager::spawnSubtasks(EdgeId id, const BranchContext& ctx, int depth)
     const world::Object* o = abstraction_.world().findObject(crossing.object_id);
     if (!o || !abstraction_.graspable(*o)) continue;  // findPossibleActions: only pick and place move objects
     ++objects;
-    // A base pose beside the object from which the arm reaches it.
-    GraspQuery gq;
-    gq.object_id = o->id;
-    ++counters_.grasp_calls;
-    auto grasps = services_.grasps(gq);
-    if (!grasps || grasps->empty()) {
+    // A base pose beside the object from which the arm reaches it, on the side the robot comes
+    // from: back from where the lazy path first touches the object, facing it; the grasp
+    // service's own samples only when none of those reaches.
+    const Pose2D entry = crossing.swept_base.empty() ? ctx.state.base : crossing.swept_base.front();
+    const Eigen::Vector2d oc = o->pose.translation().head<2>();
+    Eigen::Vector2d away = Eigen::Vector2d(entry.x, entry.y) - oc;
+    if (away.norm() < 1e-6) away = Eigen::Vector2d(ctx.state.base.x, ctx.state.base.y) - oc;
+    if (away.norm() < 1e-6) away = Eigen::Vector2d(-1.0, 0.0);
+    away.normalize();
+    std::optional<GraspOption> chosen;
+    for (double d : {0.60, 0.70, 0.50, 0.80}) {
+      const Eigen::Vector2d b = oc + d * away;
+      GraspQuery gq;
+      gq.object_id = o->id;
+      gq.base = Pose2D{b.x(), b.y(), std::atan2(-away.y(), -away.x())};
+      ++counters_.grasp_calls;
+      auto g = services_.grasps(gq);
+      if (g && !g->empty()) {
+        chosen = g->front();
+        chosen->base_pose = *gq.base;
+        break;
+      }
+    }
+    if (!chosen) {
+      GraspQuery gq;
+      gq.object_id = o->id;
+      gq.max_grasps = 8;
+      ++counters_.grasp_calls;
+      auto g = services_.grasps(gq);
+      if (g) {
+        for (const auto& x : *g) {
+          if (!chosen || std::hypot(x.base_pose.x - entry.x, x.base_pose.y - entry.y) <
+                             std::hypot(chosen->base_pose.x - entry.x, chosen->base_pose.y - entry.y))
+            chosen = x;
+        }
+      }
+    }
+    if (!chosen) {
       log::get("graph_manager")->info("no grasp of {} from any base pose: only the detour remains", o->id);
       continue;
     }
-    const std::string near = abstraction_.locationFor(grasps->front().base_pose, "near_" + o->id);
+    const std::string near = abstraction_.locationFor(chosen->base_pose, "near_" + o->id);
+    abstraction_.addReach(near, Abstraction::armconfOver(o->region.empty() ? std::string() : o->region));
+    log::get("graph_manager")->info("sub-task for {}: contact at ({:.2f}, {:.2f}); stand at {} ({:.2f}, {:.2f})", o->id,
+                                    entry.x, entry.y, near, chosen->base_pose.x, chosen->base_pose.y);
     // findEffectStates: placements off the swept path, in the object's region first.
     std::vector<std::string> regions;
     if (!o->region.empty()) regions.push_back(o->region);
@@ -582,6 +716,9 @@ void GraphManager::spawnSubtasks(EdgeId id, const BranchContext& ctx, int depth)
       for (const auto& p : *ps) {
         if (static_cast<int>(slots.size()) >= params_.placements_per_object) break;
         const std::string s = abstraction_.addSlot(o->id, r, p.object_pose);
+        log::get("graph_manager")->info("findEffectStates({}): {} at ({:.2f}, {:.2f}) on {}, base ({:.2f}, {:.2f})", o->id, s,
+                                        p.object_pose.translation().x(), p.object_pose.translation().y(), r,
+                                        p.base_pose.x, p.base_pose.y);
         abstraction_.locationFor(p.base_pose, "place_" + o->id);
         slots.push_back(s);
       }

@@ -74,7 +74,7 @@ TEST(AbstractionTest, ASlotIsARegionWithItsOwnConfigurationAndBindsTheObjectPose
 TEST(AbstractionTest, HeavyObjectsAreNotGraspable) {
   auto f = load("namo_corridor");
   AbstractionParams p;
-  p.payload_kg = 1.0;  // the box weighs 1.5 kg
+  p.payload_cap_kg = 1.0;  // the box weighs 1.5 kg
   Abstraction a(f.sc.plannerWorld(), f.robot, p);
   EXPECT_FALSE(has(a.staticAtoms(), "(graspable box)"));
   Abstraction b(f.sc.plannerWorld(), f.robot);

@@ -177,6 +177,11 @@ msg::PlanReply toMsg(const PlanReply& r) {
   std::vector<std::string> actions;
   for (const auto& step : r.plan) actions.push_back(step.toString());
   m.actions(std::move(actions));
+  for (const auto& st : r.states) {
+    msg::PlanState ps;
+    ps.atoms(st);
+    m.states().push_back(std::move(ps));
+  }
   m.cost(static_cast<double>(r.cost));
   m.expanded(r.stats.expanded);
   m.evaluated(r.stats.evaluated);

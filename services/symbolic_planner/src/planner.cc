@@ -428,6 +428,8 @@ PlanReply Planner::solve(const PlanRequest& req, const Termination& caller_term)
       if (!v.valid) {
         reply.status = PlanStatus::kInternalError;
         reply.message = "plan checker rejected the plan: " + v.message;
+      } else {
+        reply.states = std::move(v.states);
       }
     }
     if (owned && cache_size_ > 0) {

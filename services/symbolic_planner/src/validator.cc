@@ -1,6 +1,8 @@
 // Independent plan checker over the lifted AST (deliberately naive: sets of strings, recursion).
 #include "tamp/symbolic_planner/validator.h"
 
+#include <algorithm>
+
 #include <cctype>
 #include <map>
 #include <set>
@@ -212,6 +214,17 @@ Result<std::vector<PlanStep>> parsePlan(const std::string& text, const std::stri
   return out;
 }
 
+namespace {
+/// "(p a b)" for each internal "p a b", sorted.
+std::vector<std::string> atomList(const std::set<std::string>& state) {
+  std::vector<std::string> out;
+  out.reserve(state.size());
+  for (const auto& a : state) out.push_back("(" + a + ")");
+  std::sort(out.begin(), out.end());
+  return out;
+}
+}  // namespace
+
 ValidationResult validatePlan(const pddl::Domain& domain, const pddl::Problem& problem,
                               const std::vector<PlanStep>& plan, const std::optional<std::vector<pddl::Atom>>& init,
                               const std::optional<pddl::Formula>& goal) {
@@ -220,6 +233,7 @@ ValidationResult validatePlan(const pddl::Domain& domain, const pddl::Problem& p
   std::set<std::string> state;
   Binding empty;
   for (const auto& a : init ? *init : problem.init) state.insert(ck.groundAtom(a, empty));
+  r.states.push_back(atomList(state));
   for (size_t i = 0; i < plan.size(); ++i) {
     const PlanStep& st = plan[i];
     const std::string where = "step " + std::to_string(i + 1) + " " + st.toString() + ": ";
@@ -258,6 +272,7 @@ ValidationResult validatePlan(const pddl::Domain& domain, const pddl::Problem& p
     ck.effects(*act, state, b, adds, dels);
     for (const auto& d : dels) state.erase(d);
     for (const auto& a : adds) state.insert(a);
+    r.states.push_back(atomList(state));
   }
   r.failed_step = -1;
   Binding b;

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <gtest/gtest.h>
 
 #include "tamp/symbolic_planner/validator.h"
@@ -45,6 +46,19 @@ TEST_F(Validator, AcceptsAValidPlanAndSumsItsCost) {
   ValidationResult v = validatePlan(domain_, problem_, steps(kGoodPlan));
   EXPECT_TRUE(v.valid) << v.message;
   EXPECT_DOUBLE_EQ(v.cost, 20.0);
+}
+
+TEST_F(Validator, ReportsTheStatesAlongThePlan) {
+  const auto plan = steps(kGoodPlan);
+  ValidationResult v = validatePlan(domain_, problem_, plan);
+  ASSERT_TRUE(v.valid) << v.message;
+  ASSERT_EQ(v.states.size(), plan.size() + 1);
+  auto has = [](const std::vector<std::string>& s, const std::string& a) {
+    return std::find(s.begin(), s.end(), a) != s.end();
+  };
+  EXPECT_TRUE(has(v.states.back(), "(at b1 store)"));
+  EXPECT_FALSE(has(v.states.front(), "(at b1 store)"));
+  for (const auto& s : v.states) EXPECT_TRUE(std::is_sorted(s.begin(), s.end()));
 }
 
 TEST_F(Validator, NamesTheFirstInapplicableStep) {

@@ -20,6 +20,7 @@
 ///   objects in slots, the held object), so that each node of the reachability graph is a symbolic
 ///   state plus its geometric binding.
 
+#include <limits>
 #include <map>
 #include <optional>
 #include <set>
@@ -39,7 +40,8 @@ struct AbstractionParams {
   double location_tolerance_rad{0.15};
   double slot_tolerance_m{0.06};        ///< an object this close to a slot's pose is on the slot
   double slot_half_size_m{0.06};        ///< half the side of a slot's square region
-  double payload_kg{5.0};               ///< graspable objects weigh at most this
+  /// Graspable objects weigh at most the robot's payload and at most this cap (kg).
+  double payload_cap_kg{std::numeric_limits<double>::infinity()};
 };
 
 /// A placement made a symbol: the object `object_id` at `pose` on `parent_region`.
@@ -80,6 +82,8 @@ class Abstraction {
   std::string addSlot(const std::string& object_id, const std::string& parent_region,
                       const Eigen::Isometry3d& pose);
   const Slot* slot(const std::string& id) const;
+  /// Records that from `location` the arm reaches `armconf` (proved by a grasp or IK elsewhere).
+  void addReach(const std::string& location, const std::string& armconf);
   /// True when the region or slot `id` exists.
   bool isRegion(const std::string& id) const;
 

@@ -178,12 +178,16 @@ class GraphManager {
   /// The command that executes edge `e` from context `ctx`.
   Result<EdgeCommand> command(EdgeId e, EdgeId next, const BranchContext& ctx, const std::string& command_id);
   BranchContext contextOf(const Observation& robot) const;
+  /// The key of an arm edge's motion: the manipulation `next` it prepares, or -1 (stow, none).
+  EdgeId armKey(EdgeId arm, EdgeId next) const;
 
  private:
   struct Search;
   double lowerBound(const Edge& e) const;
   void spawnSubtasks(EdgeId e, const BranchContext& ctx, int depth);
   double evaluateBase(Edge& e, const BranchContext& ctx, int depth);
+  MotionAnswer planBase(const MotionQuery& q);
+  MotionAnswer lazyOrFull(const MotionQuery& q);
   double evaluateArm(Edge& e, EdgeId next, const BranchContext& ctx);
   double evaluateManipulation(Edge& e, const BranchContext& ctx);
   std::optional<EdgeMotion> armTarget(const Edge& arm_edge, EdgeId next, const BranchContext& ctx,

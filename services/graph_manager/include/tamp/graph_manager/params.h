@@ -35,6 +35,12 @@ struct GraphManagerParams {
   double motion_budget_s{8.0};     ///< per motion call; > 0
   double execution_margin_s{30.0}; ///< execution budget = prediction + k sigma + this; > 0
   double start_tolerance{0.02};    ///< re-plan a motion whose start is farther from the robot; > 0
+  /// A lazy path crossing movables is replaced by a clear effort-aware one at most this much
+  /// longer (the objects are then beside the way, not in it); >= 1.
+  double clear_path_stretch{1.25};
+  /// A base path longer than this many times the straight line from a start facing away is
+  /// planned again after a turn in place towards the goal; >= 1.
+  double turn_first_ratio{1.5};
 
   /// Empty when valid; else the field and why.
   std::optional<std::string> invalidReason() const;

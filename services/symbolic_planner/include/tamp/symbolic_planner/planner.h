@@ -110,6 +110,9 @@ struct PlanReply {
   Cost cost{0};          ///< total-cost of the plan (its length without a metric)
   std::string message;   ///< for errors: what and where; empty on success
   PlanStatistics stats;
+  /// When solved and checked (`check_plan`): every true ground atom of each state along the
+  /// plan, from the independent replay (states[0] the initial state, states[i + 1] after step i).
+  std::vector<std::vector<std::string>> states;
 };
 
 /// A query on a session: an initial state and a goal.

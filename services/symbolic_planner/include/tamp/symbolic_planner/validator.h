@@ -37,6 +37,9 @@ struct ValidationResult {
   int failed_step{-1};        ///< 0-based index of the first inapplicable step, or -1
   std::string message;        ///< why it is invalid ("step 3 (pick a b): precondition ... is false")
   double cost{0.0};           ///< total cost (plan length without a metric)
+  /// Every true ground atom ("(on a b)", sorted) of each state the replay went through:
+  /// states[0] the initial state, states[i + 1] after step i (up to the failed step).
+  std::vector<std::vector<std::string>> states;
 };
 
 /// Replays `plan` from `init` (default: the problem's `:init`) and checks `goal` (default: the

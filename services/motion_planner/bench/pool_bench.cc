@@ -12,6 +12,7 @@
 //    time from the first request to the last reply, for `--planners` 1 and 2 (a node each).
 //
 // Usage: tamp_motion_planner_pool_bench [--world FILE.svg|json] [--queries 40] [--clients 2]
+#include <unistd.h>
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -21,7 +22,6 @@
 #include <numeric>
 #include <random>
 #include <thread>
-#include <unistd.h>
 
 #include "motion_planner_node.h"
 #include "tamp/collision/scene.h"
@@ -56,7 +56,8 @@ std::vector<Query> makeQueries(const world::World& w, double radius, int n, std:
   scene.setRobot(collision::RobotGeometry::disc(radius, 1.0));
   const Aabb b = w.bounds();
   std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> ux(b.min.x(), b.max.x()), uy(b.min.y(), b.max.y()), uth(-M_PI, M_PI);
+  std::uniform_real_distribution<double> ux(b.min.x(), b.max.x()), uy(b.min.y(), b.max.y()),
+      uth(-M_PI, M_PI);
   auto freePose = [&] {
     for (int k = 0; k < 10000; ++k) {
       Pose2D p{ux(rng), uy(rng), uth(rng)};
@@ -108,7 +109,8 @@ void warm(mp::MotionPlannerNode& node, dds::RpcClient<msg::MotionRequest, msg::M
   if (!rep) throw std::runtime_error(rep.error().toString());
   for (int i = 0; i < 200; ++i) {
     const auto preps = node.prepareIfWorldChanged();
-    if (std::none_of(preps.begin(), preps.end(), [](const auto& p) { return p.has_value(); })) break;
+    if (std::none_of(preps.begin(), preps.end(), [](const auto& p) { return p.has_value(); }))
+      break;
   }
 }
 
@@ -128,9 +130,12 @@ int main(int argc, char** argv) {
   int queries = 40, clients = 2;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i];
-    if (a == "--world") world_file = argv[i + 1];
-    else if (a == "--queries") queries = std::stoi(argv[i + 1]);
-    else if (a == "--clients") clients = std::stoi(argv[i + 1]);
+    if (a == "--world")
+      world_file = argv[i + 1];
+    else if (a == "--queries")
+      queries = std::stoi(argv[i + 1]);
+    else if (a == "--clients")
+      clients = std::stoi(argv[i + 1]);
     else {
       std::cerr << "unknown option " << a << "\n";
       return 2;
@@ -142,7 +147,8 @@ int main(int argc, char** argv) {
     return 1;
   }
   const int domain = 20 + static_cast<int>(::getpid() % 200);
-  auto participant = dds::Participant::create(dds::ParticipantOptions{domain, dds::kProfileDefault, "bench", {}});
+  auto participant =
+      dds::Participant::create(dds::ParticipantOptions{domain, dds::kProfileDefault, "bench", {}});
   if (!participant) {
     std::cerr << participant.error().toString() << "\n";
     return 1;
@@ -159,7 +165,8 @@ int main(int argc, char** argv) {
   // ---- latency with and without overrides (1 client, 2 planners) ----
   {
     auto node = makeNode(domain, 2);
-    dds::RpcClient<msg::MotionRequest, msg::MotionReply> client(*participant, dds::services::kMotion);
+    dds::RpcClient<msg::MotionRequest, msg::MotionReply> client(*participant,
+                                                                dds::services::kMotion);
     warm(*node, client, qs.front(), publisher.publishedVersion());
     std::vector<double> plain, repeat, moved, removed;
     int with_blocking = 0;
@@ -171,7 +178,8 @@ int main(int argc, char** argv) {
       if (!rep || rep->status() != msg::MOTION_SOLVED || rep->blocking().empty()) continue;
       ++with_blocking;
       t0 = nowS();
-      auto again = client.call(r, dds::CallOptions{60.0, {}});  // the control: the same request, warm
+      auto again =
+          client.call(r, dds::CallOptions{60.0, {}});  // the control: the same request, warm
       repeat.push_back((nowS() - t0) * 1e3);
       const std::string id = rep->blocking()[0].object_id();
       Eigen::Isometry3d pose = nw->world.object(id).pose;
@@ -191,7 +199,8 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "override request failed\n");
       }
     }
-    std::printf("latency (1 client, round trip; %d of %d queries cross a movable):\n", with_blocking, queries);
+    std::printf("latency (1 client, round trip; %d of %d queries cross a movable):\n",
+                with_blocking, queries);
     printStats("plain (first)", plain);
     printStats("plain (repeated)", repeat);
     printStats("override: moved 3 m", moved);
@@ -203,8 +212,8 @@ int main(int argc, char** argv) {
     auto node = makeNode(domain, planners);
     std::vector<std::unique_ptr<dds::RpcClient<msg::MotionRequest, msg::MotionReply>>> cl;
     for (int c = 0; c < clients; ++c) {
-      cl.push_back(std::make_unique<dds::RpcClient<msg::MotionRequest, msg::MotionReply>>(*participant,
-                                                                                          dds::services::kMotion));
+      cl.push_back(std::make_unique<dds::RpcClient<msg::MotionRequest, msg::MotionReply>>(
+          *participant, dds::services::kMotion));
     }
     warm(*node, *cl.front(), qs.front(), publisher.publishedVersion());
     std::atomic<int> next{0}, failed{0};
@@ -226,8 +235,10 @@ int main(int argc, char** argv) {
     const double wall = nowS() - t0;
     std::vector<double> all;
     for (const auto& l : lat) all.insert(all.end(), l.begin(), l.end());
-    std::printf("throughput, %d clients, %d planner(s): %d requests in %.2f s = %.1f req/s (%d not solved)\n", clients,
-                planners, queries, wall, queries / wall, failed.load());
+    std::printf(
+        "throughput, %d clients, %d planner(s): %d requests in %.2f s = %.1f req/s (%d not "
+        "solved)\n",
+        clients, planners, queries, wall, queries / wall, failed.load());
     printStats("round trip", all);
   }
   std::printf("load after: %s\n", loadavg().c_str());

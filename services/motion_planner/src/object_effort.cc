@@ -18,7 +18,8 @@ struct EffortModels {
   std::vector<double> move_base = ee::modelSpec(ActionKind::kMoveBase).defaults();
 };
 
-double objectEffort(const world::Object& object, const CostParams& params, const EffortModels& models) {
+double objectEffort(const world::Object& object, const CostParams& params,
+                    const EffortModels& models) {
   const double mass = std::isfinite(object.mass) && object.mass > 0 ? object.mass : 0.0;
   ee::ActionFeatures pick;
   pick.kind = ActionKind::kPick;
@@ -47,17 +48,19 @@ double defaultObjectEffort(const world::Object& object, const CostParams& params
   return objectEffort(object, params, defaults);
 }
 
-Result<ObjectEffortFn> fittedObjectEffort(const CostParams& params, const std::vector<TimeModelValues>& models) {
+Result<ObjectEffortFn> fittedObjectEffort(const CostParams& params,
+                                          const std::vector<TimeModelValues>& models) {
   EffortModels m;
   for (std::size_t i = 0; i < models.size(); ++i) {
     const TimeModelValues& tm = models[i];
     const std::string field = "models[" + std::to_string(i) + "]";
-    std::vector<double>* target = tm.kind == ActionKind::kPick    ? &m.pick
-                                  : tm.kind == ActionKind::kPlace ? &m.place
+    std::vector<double>* target = tm.kind == ActionKind::kPick       ? &m.pick
+                                  : tm.kind == ActionKind::kPlace    ? &m.place
                                   : tm.kind == ActionKind::kMoveBase ? &m.move_base
                                                                      : nullptr;
     if (tm.names.size() != tm.values.size()) {
-      return Error(ErrorCode::kInvalidArgument, field + ": " + std::to_string(tm.values.size()) + " values for " +
+      return Error(ErrorCode::kInvalidArgument, field + ": " + std::to_string(tm.values.size()) +
+                                                    " values for " +
                                                     std::to_string(tm.names.size()) + " names");
     }
     if (!target) continue;  // move_arm: not part of an object's effort
@@ -65,13 +68,15 @@ Result<ObjectEffortFn> fittedObjectEffort(const CostParams& params, const std::v
     for (std::size_t k = 0; k < tm.names.size(); ++k) {
       const int idx = spec.indexOf(tm.names[k]);
       if (idx < 0) {
-        return Error(ErrorCode::kInvalidArgument, field + ".names[" + std::to_string(k) + "]: '" + tm.names[k] +
+        return Error(ErrorCode::kInvalidArgument, field + ".names[" + std::to_string(k) + "]: '" +
+                                                      tm.names[k] +
                                                       "' is not a parameter of the model");
       }
       const double v = tm.values[k];
       if (!std::isfinite(v) || v <= 0) {
-        return Error(ErrorCode::kInvalidArgument, field + ".values[" + std::to_string(k) + "] (" + tm.names[k] +
-                                                      "): must be finite and > 0, got " + formatNumber(v));
+        return Error(ErrorCode::kInvalidArgument,
+                     field + ".values[" + std::to_string(k) + "] (" + tm.names[k] +
+                         "): must be finite and > 0, got " + formatNumber(v));
       }
       (*target)[static_cast<std::size_t>(idx)] = v;
     }

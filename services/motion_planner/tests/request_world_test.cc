@@ -114,9 +114,11 @@ TEST_F(RequestWorldTest, BadOverridesNameTheField) {
 JointPath heldCentres(const JointPath& path, const Eigen::Vector2d& offset) {
   JointPath out;
   out.joint_names = {"base_x", "base_y"};
-  const int ix = path.indexOf("base_x"), iy = path.indexOf("base_y"), it = path.indexOf("base_theta");
+  const int ix = path.indexOf("base_x"), iy = path.indexOf("base_y"),
+            it = path.indexOf("base_theta");
   auto centre = [&](const std::vector<double>& q) {
-    const double c = std::cos(q[static_cast<std::size_t>(it)]), s = std::sin(q[static_cast<std::size_t>(it)]);
+    const double c = std::cos(q[static_cast<std::size_t>(it)]),
+                 s = std::sin(q[static_cast<std::size_t>(it)]);
     return std::vector<double>{q[static_cast<std::size_t>(ix)] + c * offset.x() - s * offset.y(),
                                q[static_cast<std::size_t>(iy)] + s * offset.x() + c * offset.y()};
   };
@@ -199,10 +201,12 @@ TEST(ObjectEffortTest, FittedModelsPriceObjects) {
 
   auto bad = fittedObjectEffort(cost, {{ActionKind::kPick, {"warp_speed"}, {1.0}}});
   ASSERT_FALSE(bad.ok());
-  EXPECT_NE(bad.error().message.find("models[0].names[0]"), std::string::npos) << bad.error().message;
+  EXPECT_NE(bad.error().message.find("models[0].names[0]"), std::string::npos)
+      << bad.error().message;
   bad = fittedObjectEffort(cost, {{ActionKind::kPlace, {"gripper_time"}, {-1.0}}});
   ASSERT_FALSE(bad.ok());
-  EXPECT_NE(bad.error().message.find("models[0].values[0]"), std::string::npos) << bad.error().message;
+  EXPECT_NE(bad.error().message.find("models[0].values[0]"), std::string::npos)
+      << bad.error().message;
 }
 
 }  // namespace

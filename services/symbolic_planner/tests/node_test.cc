@@ -3,6 +3,9 @@
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <sstream>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -78,6 +81,47 @@ TEST_F(PlannerNodeTest, SolvesAndThePlanReplaysToTheGoal) {
   EXPECT_TRUE(v.valid) << v.message;
   EXPECT_DOUBLE_EQ(rep->cost(), v.cost);
   EXPECT_GT(rep->operators(), 0u);
+}
+
+// PlanReply.states over the wire: one state per step plus the initial one, each sorted, the
+// initial one holding the request's init, the last the goal, and each step changing the state
+// the way its action says (pick: holding; place: on).
+TEST_F(PlannerNodeTest, ThePlanStatesFollowTheActions) {
+  auto req = occludedCan({"(on can counter)"});
+  auto rep = client_->call(req, dds::CallOptions{30.0, {}});
+  ASSERT_TRUE(rep.ok()) << rep.error().toString();
+  ASSERT_EQ(rep->status(), msg::PLAN_SOLVED) << rep->header().message();
+  const auto& actions = rep->actions();
+  const auto& states = rep->states();
+  ASSERT_EQ(states.size(), actions.size() + 1);
+  auto has = [&](std::size_t i, const std::string& atom) {
+    const auto& a = states[i].atoms();
+    return std::find(a.begin(), a.end(), atom) != a.end();
+  };
+  for (const auto& atom : req.init()) {
+    if (atom.rfind("(=", 0) == 0) continue;  // numeric fluents are not atoms
+    EXPECT_TRUE(has(0, atom)) << atom;
+  }
+  EXPECT_FALSE(has(0, "(on can counter)"));
+  EXPECT_TRUE(has(states.size() - 1, "(on can counter)"));
+  EXPECT_FALSE(has(states.size() - 1, "(robot-at start)"));
+  for (std::size_t i = 0; i < states.size(); ++i) {
+    const auto& a = states[i].atoms();
+    EXPECT_TRUE(std::is_sorted(a.begin(), a.end())) << "state " << i;
+    for (const auto& atom : a) EXPECT_EQ(atom.rfind("(not ", 0), std::string::npos) << atom;
+    if (i == 0) continue;
+    EXPECT_NE(states[i].atoms(), states[i - 1].atoms()) << "step " << i << " " << actions[i - 1];
+    // "(pick o ...)" leaves o held, "(place o r ...)" leaves o on r.
+    std::istringstream words(actions[i - 1].substr(1, actions[i - 1].size() - 2));
+    std::string name, o, r;
+    words >> name >> o >> r;
+    if (name == "pick") {
+      EXPECT_TRUE(has(i, "(holding " + o + ")")) << actions[i - 1];
+    }
+    if (name == "place") {
+      EXPECT_TRUE(has(i, "(on " + o + " " + r + ")")) << actions[i - 1];
+    }
+  }
 }
 
 TEST_F(PlannerNodeTest, RepeatedQueriesReuseTheGrounding) {

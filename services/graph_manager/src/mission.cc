@@ -102,6 +102,14 @@ MissionReport GraphManager::runMission(WorldSource& source, Executor& executor, 
     // A manipulation follows from the arm motion just executed (its grasp or place pose) and the
     // arm as it is: priced again from there.
     if (e.kind == ActionKind::kPick || e.kind == ActionKind::kPlace) evaluate(id, -1, ctx, 0);
+    // An arm motion into a manipulation is planned again in the world as it is now: the branch
+    // priced it in a hypothetical world (objects moved by earlier edges, grasps deferred).
+    if (e.kind == ActionKind::kMoveArm && armKey(id, next) >= 0) {
+      e.motion_by_next.erase(armKey(id, next));
+      e.effort_by_next.erase(armKey(id, next));
+      if (!std::isfinite(evaluate(id, next, ctx, 0)))
+        return finish(MissionOutcome::kFailed, "cannot prepare " + graph_.edge(next).action + ": " + e.reason);
+    }
     // The robot must be where the edge's motion starts; otherwise plan the motion again from it.
     auto cmd = command(id, next, ctx, "m" + std::to_string(step) + "-e" + std::to_string(id));
     if (cmd && e.kind != ActionKind::kPick && e.kind != ActionKind::kPlace &&
@@ -123,8 +131,38 @@ MissionReport GraphManager::runMission(WorldSource& source, Executor& executor, 
     }
     e.state = EdgeState::kExecuting;
     state("executing", e.action);
-    const double budget = cmd->expected_s + 4 * cmd->expected_stddev_s + params_.execution_margin_s;
-    ExecutionReport rep = executor.execute(*cmd, budget);
+    ExecutionReport rep;
+    if (e.motion && !e.motion->transfer.empty() && (e.kind == ActionKind::kPick || e.kind == ActionKind::kPlace)) {
+      // The arm motion to the pre-grasp first, as its own move_arm.
+      EdgeCommand t = *cmd;
+      t.command_id = cmd->command_id + "-arm";
+      t.action = "(move_arm to the pre-grasp of " + e.action + ")";
+      t.kind = ActionKind::kMoveArm;
+      t.trajectory = e.motion->transfer;
+      t.object_id.clear();
+      t.region_id.clear();
+      t.object_target.reset();
+      t.expected_s = e.motion->transfer_effort_s;
+      t.expected_stddev_s = e.motion->transfer_stddev_s;
+      cmd->expected_s -= t.expected_s;
+      rep = executor.execute(t, t.expected_s + 4 * t.expected_stddev_s + params_.execution_margin_s);
+      ExecutedAction ta;
+      ta.command_id = t.command_id;
+      ta.action = t.action;
+      ta.variant = "transfer";
+      ta.predicted_s = t.expected_s;
+      ta.predicted_stddev_s = t.expected_stddev_s;
+      ta.measured_s = rep.measured_s;
+      ta.outcome = std::string(toString(rep.outcome));
+      ta.reason = rep.reason;
+      report.actions.push_back(ta);
+      report.executed_effort_s += rep.measured_s;
+      if (observer.on_action) observer.on_action(ta, done_effort, branch_total);
+    }
+    if (rep.outcome == ExecOutcome::kSucceeded || !(e.motion && !e.motion->transfer.empty())) {
+      const double budget = cmd->expected_s + 4 * cmd->expected_stddev_s + params_.execution_margin_s;
+      rep = executor.execute(*cmd, budget);
+    }
     ++step;
     ExecutedAction a;
     a.command_id = cmd->command_id;

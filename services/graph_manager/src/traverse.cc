@@ -334,13 +334,67 @@ double GraphManager::evaluateBase(Edge& e, const BranchContext& ctx, int depth) 
   return mean;
 }
 
+std::optional<std::pair<GraspOption, Eigen::Isometry3d>> GraphManager::preparePlace(
+    const std::string& object, const std::string& region, const BranchContext& ctx, std::string& why, int skip) {
+  const robot::RobotModel& robot = abstraction_.robot();
+  if (ctx.held.object_id != object) {
+    why = "place of " + object + " while not holding it";
+    return std::nullopt;
+  }
+  std::vector<Eigen::Isometry3d> candidates;
+  if (const Slot* s = abstraction_.slot(region)) {
+    candidates.push_back(s->pose);
+  } else {
+    const std::string key = object + "@" + region;
+    auto it = placement_cache_.find(key);
+    if (it == placement_cache_.end()) {
+      PlacementQuery pq;
+      pq.object_id = object;
+      pq.region_id = region;
+      pq.max_placements = 32;
+      ++counters_.placement_calls;
+      auto p = services_.placements(pq);
+      it = placement_cache_.emplace(key, p ? *p : std::vector<PlacementOption>{}).first;
+      if (!p) why = "placements of " + object + " on " + region + ": " + p.error().message;
+    }
+    for (const auto& opt : it->second) candidates.push_back(opt.object_pose);
+  }
+  // The first candidate whose place and pre-place poses the arm reaches from this base.
+  const Eigen::Isometry3d base_inv = ctx.state.base.toIsometry(0.0).inverse();
+  robot::IkOptions io;
+  io.max_attempts = 16;
+  for (const auto& place : candidates) {
+    const Eigen::Isometry3d world_T_tool = place * ctx.held.link_T_object.inverse();
+    Eigen::Isometry3d pre = world_T_tool;
+    pre.translation().z() += params_.approach_m;
+    auto pre_ik = robot.inverseKinematics(base_inv * pre, ctx.state.arm, io);
+    if (!pre_ik.ok()) continue;
+    auto at_ik = robot.inverseKinematics(base_inv * world_T_tool, pre_ik.q, io);
+    if (!at_ik.ok()) continue;
+    if (skip-- > 0) continue;
+    GraspOption g;
+    g.pregrasp = pre_ik.q;
+    g.grasp = at_ik.q;
+    g.base_pose = ctx.state.base;
+    g.gripper_in_object = ctx.held.link_T_object.inverse();
+    return std::make_pair(g, place);
+  }
+  if (why.empty())
+    why = candidates.empty() ? "no placement of " + object + " on " + region
+                             : "the arm reaches none of " + std::to_string(candidates.size()) + " placements of " +
+                                   object + " on " + region + " from this base pose";
+  return std::nullopt;
+}
+
 std::optional<EdgeMotion> GraphManager::armTarget(const Edge& arm_edge, EdgeId next, const BranchContext& ctx,
-                                                  std::vector<double>& target, std::string& why) {
+                                                  std::vector<double>& target, std::string& why, int alternative) {
   const robot::RobotModel& robot = abstraction_.robot();
   const std::string to_conf = arm_edge.tokens.size() > 3 ? arm_edge.tokens[3] : "stow";
   EdgeMotion m;
   if (to_conf == "stow" || next < 0) {
-    auto named = robot.namedConfiguration(to_conf == "stow" ? "stow" : "ready");
+    // `stow` is the base-motion configuration: folded when empty-handed, `carry` when holding.
+    const bool holding = !ctx.held.object_id.empty() && robot.namedConfiguration("carry").has_value();
+    auto named = robot.namedConfiguration(to_conf == "stow" ? (holding ? "carry" : "stow") : "ready");
     if (!named) {
       why = "the robot has no named configuration '" + to_conf + "'";
       return std::nullopt;
@@ -370,6 +424,16 @@ std::optional<EdgeMotion> GraphManager::armTarget(const Edge& arm_edge, EdgeId n
       if (!g) why = "grasps of " + object + ": " + g.error().message;
     }
     if (it->second.empty()) {
+      if (!ctx.object_poses.empty()) {
+        // Objects this branch moved may be what hides every grasp today: price the arm motion to
+        // the ready configuration and plan the grasp when the edge is about to run.
+        auto ready = robot.namedConfiguration("ready");
+        if (ready) {
+          target = *ready;
+          m.deferred = true;
+          return m;
+        }
+      }
       if (why.empty()) why = "no grasp of " + object + " from the base pose of " + arm_edge.tokens[1];
       return std::nullopt;
     }
@@ -378,68 +442,11 @@ std::optional<EdgeMotion> GraphManager::armTarget(const Edge& arm_edge, EdgeId n
     return m;
   }
   if (f.kind == ActionKind::kPlace) {
-    if (ctx.held.object_id != object) {
-      why = "place of " + object + " while not holding it";
-      return std::nullopt;
-    }
-    Eigen::Isometry3d place = Eigen::Isometry3d::Identity();
-    if (const Slot* s = abstraction_.slot(region)) {
-      place = s->pose;
-    } else {
-      const std::string key = object + "@" + region;
-      auto it = placement_cache_.find(key);
-      if (it == placement_cache_.end()) {
-        PlacementQuery pq;
-        pq.object_id = object;
-        pq.region_id = region;
-        pq.max_placements = 4;
-        ++counters_.placement_calls;
-        auto p = services_.placements(pq);
-        it = placement_cache_.emplace(key, p ? *p : std::vector<PlacementOption>{}).first;
-        if (!p) why = "placements of " + object + " on " + region + ": " + p.error().message;
-      }
-      // The placement reachable from this base pose.
-      bool found = false;
-      for (const auto& opt : it->second) {
-        const Eigen::Isometry3d world_T_tool = opt.object_pose * ctx.held.link_T_object.inverse();
-        const Eigen::Isometry3d base_T_tool = ctx.state.base.toIsometry(0.0).inverse() * world_T_tool;
-        robot::IkOptions io;
-        io.max_attempts = 12;
-        if (robot.inverseKinematics(base_T_tool, ctx.state.arm, io).ok()) {
-          place = opt.object_pose;
-          found = true;
-          break;
-        }
-      }
-      if (!found) {
-        if (why.empty()) why = "no placement of " + object + " on " + region + " reachable from " + arm_edge.tokens[1];
-        return std::nullopt;
-      }
-    }
-    const Eigen::Isometry3d world_T_tool = place * ctx.held.link_T_object.inverse();
-    Eigen::Isometry3d pre = world_T_tool;
-    pre.translation().z() += params_.approach_m;
-    const Eigen::Isometry3d base_inv = ctx.state.base.toIsometry(0.0).inverse();
-    robot::IkOptions io;
-    io.max_attempts = 24;
-    auto pre_ik = robot.inverseKinematics(base_inv * pre, ctx.state.arm, io);
-    if (!pre_ik.ok()) {
-      why = "the arm does not reach above the place pose of " + object + " on " + region;
-      return std::nullopt;
-    }
-    auto at_ik = robot.inverseKinematics(base_inv * world_T_tool, pre_ik.q, io);
-    if (!at_ik.ok()) {
-      why = "the arm does not reach the place pose of " + object + " on " + region;
-      return std::nullopt;
-    }
-    GraspOption g;
-    g.pregrasp = pre_ik.q;
-    g.grasp = at_ik.q;
-    g.base_pose = ctx.state.base;
-    g.gripper_in_object = ctx.held.link_T_object.inverse();
-    m.prepared = g;
-    m.prepared_place = place;
-    target = pre_ik.q;
+    auto prepared = preparePlace(object, region, ctx, why, alternative);
+    if (!prepared) return std::nullopt;
+    m.prepared = prepared->first;
+    m.prepared_place = prepared->second;
+    target = prepared->first.pregrasp;
     return m;
   }
   auto named = robot.namedConfiguration("ready");
@@ -448,26 +455,35 @@ std::optional<EdgeMotion> GraphManager::armTarget(const Edge& arm_edge, EdgeId n
 }
 
 double GraphManager::evaluateArm(Edge& e, EdgeId next, const BranchContext& ctx) {
-  std::vector<double> target;
-  std::string why;
-  auto m = armTarget(e, next, ctx, target, why);
-  if (!m) {
-    e.reason = why;
-    e.effort_by_next[next] = {kInfinity, 0.0};
-    return kInfinity;
-  }
-  MotionQuery q;
-  q.group = Group::kArm;
-  q.mode = Mode::kFull;
-  q.start = ctx.state;
-  q.goal_arm = target;
-  q.held = ctx.held;
-  for (const auto& [id, pose] : ctx.object_poses) q.overrides.push_back(ObjectOverride{id, false, pose});
-  q.budget_s = params_.motion_budget_s;
-  ++counters_.motion_calls;
-  MotionAnswer a = services_.motion(q);
-  if (!a.ok()) {
+  // The target follows from the manipulation after it; a target the planner finds in collision
+  // (IK does not check collisions) gives way to the next placement, a few at most.
+  std::optional<EdgeMotion> m;
+  MotionAnswer a;
+  for (int alternative = 0; alternative < 4; ++alternative) {
+    std::vector<double> target;
+    std::string why;
+    m = armTarget(e, next, ctx, target, why, alternative);
+    if (!m) {
+      if (alternative == 0 || e.reason.empty()) e.reason = why;
+      e.effort_by_next[next] = {kInfinity, 0.0};
+      return kInfinity;
+    }
+    MotionQuery q;
+    q.group = Group::kArm;
+    q.mode = Mode::kFull;
+    q.start = ctx.state;
+    q.goal_arm = target;
+    q.held = ctx.held;
+    for (const auto& [id, pose] : ctx.object_poses) q.overrides.push_back(ObjectOverride{id, false, pose});
+    q.budget_s = params_.motion_budget_s;
+    ++counters_.motion_calls;
+    a = services_.motion(q);
+    if (a.ok()) break;
     e.reason = "arm motion: " + std::string(toString(a.status)) + (a.reason.empty() ? "" : ": " + a.reason);
+    const bool place_next = next >= 0 && graph_.edge(next).kind == ActionKind::kPlace;
+    if (a.status != MotionOutcome::kGoalInCollision || !place_next) break;
+  }
+  if (!a.ok()) {
     e.effort_by_next[next] = {kInfinity, 0.0};
     return kInfinity;
   }
@@ -507,8 +523,40 @@ double GraphManager::evaluateManipulation(Edge& e, const BranchContext& ctx) {
     auto grasps = services_.grasps(gq);
     if (grasps && !grasps->empty()) g = grasps->front();
   }
+  std::optional<Eigen::Isometry3d> place_pose = ctx.pending_place;
+  if (!g && e.kind == ActionKind::kPlace && e.tokens.size() > 2) {
+    // No move_arm prepared this place (the arm is over the region already): prepare it here,
+    // with the first placement whose pre-place configuration is free (IK does not check that).
+    for (int alternative = 0; alternative < 8; ++alternative) {
+      std::string why;
+      auto prepared = preparePlace(object, e.tokens[2], ctx, why, alternative);
+      if (!prepared) {
+        if (alternative == 0) e.reason = why;
+        break;
+      }
+      MotionQuery q;
+      q.group = Group::kArm;
+      q.mode = Mode::kFull;
+      q.start = ctx.state;
+      q.goal_arm = prepared->first.pregrasp;
+      q.held = ctx.held;
+      q.budget_s = params_.motion_budget_s;
+      ++counters_.motion_calls;
+      const MotionAnswer a = services_.motion(q);
+      if (a.status == MotionOutcome::kGoalInCollision) {
+        e.reason = "every pre-place configuration tried is in collision";
+        continue;
+      }
+      g = prepared->first;
+      place_pose = prepared->second;
+      e.reason.clear();
+      break;
+    }
+  }
+  if (!g && e.kind == ActionKind::kPick && !ctx.object_poses.empty()) return priceDeferredPick(e, *o, ctx);
   if (!g) {
     e.state = EdgeState::kInfeasible;
+    if (!e.reason.empty()) return kInfinity;
     e.reason = "no prepared " + std::string(e.kind == ActionKind::kPick ? "grasp" : "placement") + " for " + object;
     return kInfinity;
   }
@@ -518,28 +566,91 @@ double GraphManager::evaluateManipulation(Edge& e, const BranchContext& ctx) {
   m.object_mass = o->mass;
   m.gripper_in_object = g->gripper_in_object;
   m.prepared = g;
-  std::vector<std::vector<double>> wps;
-  wps.push_back(ctx.state.arm);
-  if (maxJointDelta(ctx.state.arm, g->pregrasp) > 1e-6) wps.push_back(g->pregrasp);
-  wps.push_back(g->grasp);
-  wps.push_back(g->pregrasp);
-  m.trajectory = timed(robot.armJointNames(), wps, 0.5);
+  // The arm is not at the pre-grasp (no move_arm prepared this manipulation): an arm motion
+  // there first, executed as its own move_arm, then the approach, the gripper and the retreat.
+  double transfer_s = 0.0, transfer_sd = 0.0;
+  if (maxJointDelta(ctx.state.arm, g->pregrasp) > 1e-3) {
+    MotionQuery q;
+    q.group = Group::kArm;
+    q.mode = Mode::kFull;
+    q.start = ctx.state;
+    q.goal_arm = g->pregrasp;
+    q.held = ctx.held;
+    for (const auto& [id, pose] : ctx.object_poses) q.overrides.push_back(ObjectOverride{id, false, pose});
+    q.budget_s = params_.motion_budget_s;
+    ++counters_.motion_calls;
+    MotionAnswer a = services_.motion(q);
+    if (!a.ok()) {
+      e.state = EdgeState::kInfeasible;
+      e.reason = "arm motion to the pre-grasp: " + std::string(toString(a.status)) + (a.reason.empty() ? "" : ": " + a.reason);
+      return kInfinity;
+    }
+    m.transfer = a.trajectory;
+    EffortQuery tq;
+    tq.kind = ActionKind::kMoveArm;
+    tq.path = a.path;
+    if (!ctx.held.object_id.empty())
+      if (const world::Object* h = abstraction_.world().findObject(ctx.held.object_id)) tq.object_mass = h->mass;
+    std::tie(transfer_s, transfer_sd) = price(tq);
+  }
+  m.trajectory = timed(robot.armJointNames(), {g->pregrasp, g->grasp, g->pregrasp}, 0.5);
   const double approach = (robot.toolPose(g->pregrasp).translation() - robot.toolPose(g->grasp).translation()).norm();
   m.approach_m = approach;
   m.retreat_m = approach;
   if (e.kind == ActionKind::kPlace) {
-    if (!ctx.pending_place) {
+    if (!place_pose) {
       e.state = EdgeState::kInfeasible;
       e.reason = "no place pose for " + object;
       return kInfinity;
     }
-    m.object_target = ctx.pending_place;
+    m.object_target = place_pose;
   } else {
     m.object_target = ctx.object_poses.count(object) ? ctx.object_poses.at(object) : o->pose;
   }
   EffortQuery eq;
   eq.kind = e.kind;
   eq.object_mass = o->mass;
+  eq.approach_m = m.approach_m;
+  eq.retreat_m = m.retreat_m;
+  const auto [mean, sd] = price(eq);
+  m.transfer_effort_s = transfer_s;
+  m.transfer_stddev_s = transfer_sd;
+  e.motion = m;
+  e.state = std::isfinite(mean + transfer_s) ? EdgeState::kFeasible : EdgeState::kInfeasible;
+  e.effort_mean_s = mean + transfer_s;
+  e.effort_stddev_s = std::hypot(sd, transfer_sd);
+  return e.effort_mean_s;
+}
+
+double GraphManager::priceDeferredPick(Edge& e, const world::Object& o, const BranchContext& ctx) {
+  EdgeMotion m;
+  m.object_id = o.id;
+  m.region_id = e.tokens.size() > 2 ? e.tokens[2] : "";
+  m.object_mass = o.mass;
+  m.approach_m = params_.approach_m;
+  m.retreat_m = params_.approach_m;
+  m.deferred = true;
+  m.object_target = ctx.object_poses.count(o.id) ? ctx.object_poses.at(o.id) : o.pose;
+  // A nominal top grasp (tool z down through the object's centre), for the rest of the branch:
+  // the carried object's geometry and the arm's pose after the pick.
+  const robot::RobotModel& robot = abstraction_.robot();
+  GraspOption g;
+  g.gripper_in_object = Eigen::Isometry3d(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitY()));
+  g.base_pose = ctx.state.base;
+  const Eigen::Isometry3d base_inv = ctx.state.base.toIsometry(0.0).inverse();
+  const Eigen::Isometry3d at = *m.object_target * g.gripper_in_object;
+  Eigen::Isometry3d pre = at;
+  pre.translation().z() += params_.approach_m;
+  robot::IkOptions io;
+  io.max_attempts = 16;
+  auto pre_ik = robot.inverseKinematics(base_inv * pre, ctx.state.arm, io);
+  g.pregrasp = pre_ik.ok() ? pre_ik.q : ctx.state.arm;
+  g.grasp = g.pregrasp;
+  m.prepared = g;
+  m.gripper_in_object = g.gripper_in_object;
+  EffortQuery eq;
+  eq.kind = ActionKind::kPick;
+  eq.object_mass = o.mass;
   eq.approach_m = m.approach_m;
   eq.retreat_m = m.retreat_m;
   const auto [mean, sd] = price(eq);
@@ -606,9 +717,9 @@ BranchContext GraphManager::advance(EdgeId id, EdgeId next, const BranchContext&
       c.pending_place.reset();
       break;
     case ActionKind::kPlace:
-      if (e.motion && ctx.pending_grasp && ctx.pending_place) {
-        c.object_poses[e.motion->object_id] = *ctx.pending_place;
-        c.state.arm = ctx.pending_grasp->pregrasp;
+      if (e.motion && e.motion->prepared && e.motion->object_target) {
+        c.object_poses[e.motion->object_id] = *e.motion->object_target;
+        c.state.arm = e.motion->prepared->pregrasp;
       }
       c.held = HeldGrasp{};
       c.pending_grasp.reset();

@@ -55,6 +55,15 @@ struct EdgeMotion {
   /// grasp or place configuration, the grasp, the place pose).
   std::optional<GraspOption> prepared;
   std::optional<Eigen::Isometry3d> prepared_place;
+  /// Priced without a grasp: in the branch's hypothetical world (objects moved by earlier edges)
+  /// the grasp service, which sees the world as it is, found none. Planned for real when the
+  /// edge is about to run.
+  bool deferred{false};
+  /// pick/place without a move_arm before it: the arm motion to the pre-grasp, executed first
+  /// as its own move_arm; its effort is part of the edge's.
+  Trajectory transfer;
+  double transfer_effort_s{0.0};
+  double transfer_stddev_s{0.0};
 };
 
 struct Edge {

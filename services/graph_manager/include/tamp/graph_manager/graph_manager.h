@@ -190,9 +190,16 @@ class GraphManager {
   MotionAnswer lazyOrFull(const MotionQuery& q);
   double evaluateArm(Edge& e, EdgeId next, const BranchContext& ctx);
   double evaluateManipulation(Edge& e, const BranchContext& ctx);
+  double priceDeferredPick(Edge& e, const world::Object& o, const BranchContext& ctx);
   std::optional<EdgeMotion> armTarget(const Edge& arm_edge, EdgeId next, const BranchContext& ctx,
-                                      std::vector<double>& target, std::string& why);
+                                      std::vector<double>& target, std::string& why, int alternative = 0);
   std::pair<double, double> price(const EffortQuery& q);
+  /// A place of the held `object` on `region` (a slot's pose, else a sampled placement the arm
+  /// reaches from the context's base): pre-place and place configurations, the object pose.
+  std::optional<std::pair<GraspOption, Eigen::Isometry3d>> preparePlace(const std::string& object,
+                                                                       const std::string& region,
+                                                                       const BranchContext& ctx, std::string& why,
+                                                                       int skip = 0);
   MotionQuery baseQuery(const Edge& e, const BranchContext& ctx) const;
   std::vector<std::string> withStatics(const std::vector<std::string>& dynamic) const;
   void recordDecisions(NodeId from, const std::map<EdgeId, double>& best_through, const std::vector<EdgeId>& branch,

@@ -129,6 +129,8 @@ int main(int argc, char** argv) {
   fs::create_directories(run_dir);
   const fs::path bin_dir = fs::read_symlink("/proc/self/exe").parent_path();
 
+  // The simulator writes the ground truth it ends with here (tests and reports judge by it).
+  if (!scenario.empty()) setenv("TAMP_SIM_FINAL_WORLD", (fs::absolute(run_dir) / "sim_final_world.json").c_str(), 1);
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
 

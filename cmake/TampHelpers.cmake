@@ -38,7 +38,7 @@ function(tamp_add_test name)
   if(NOT TAMP_BUILD_TESTS)
     return()
   endif()
-  cmake_parse_arguments(T "" "TIMEOUT" "SOURCES;DEPS;LABELS" ${ARGN})
+  cmake_parse_arguments(T "SERIAL" "TIMEOUT" "SOURCES;DEPS;LABELS" ${ARGN})
   if(NOT T_TIMEOUT)
     set(T_TIMEOUT 300)
   endif()
@@ -50,9 +50,15 @@ function(tamp_add_test name)
   tamp_sanitizer_options(${name})
   # Paths reach tests as compile definitions (above): gtest_discover_tests splits a multi-variable
   # ENVIRONMENT property into separate arguments, so only one variable is set here.
+  # SERIAL: tests that start a whole deployment (every service, a paced simulator) run alone, so
+  # the machine's other tests do not starve its real-time parts.
+  set(serial FALSE)
+  if(T_SERIAL)
+    set(serial TRUE)
+  endif()
   gtest_discover_tests(${name}
     DISCOVERY_MODE PRE_TEST
-    PROPERTIES ENVIRONMENT "SKIP_DEFAULT_XML_FILE=1" TIMEOUT ${T_TIMEOUT} LABELS "${T_LABELS}")
+    PROPERTIES ENVIRONMENT "SKIP_DEFAULT_XML_FILE=1" TIMEOUT ${T_TIMEOUT} LABELS "${T_LABELS}" RUN_SERIAL ${serial})
 endfunction()
 
 function(tamp_add_benchmark name)

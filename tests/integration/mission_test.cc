@@ -51,7 +51,7 @@ Mission run(const std::string& scenario, const std::vector<std::string>& extra =
   const fs::path out = tempFile("tamp_mission_" + tag);
   fs::remove_all(out);
   fs::create_directories(out / "deploy" / "store");
-  const fs::path deployment = fastDeployment(out / "deploy", 3.0);
+  const fs::path deployment = fastDeployment(out / "deploy", 2.0);
   std::vector<std::string> args{(configDir() / "scenarios" / scenario).string(), "--out", out.string(), "--domain",
                                 std::to_string(isolatedDomain()), "--deployment", deployment.string()};
   args.insert(args.end(), extra.begin(), extra.end());

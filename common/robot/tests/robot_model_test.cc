@@ -269,7 +269,7 @@ TEST(RobotDescriptionTest, NamedConfigurations) {
                                             "config/robots/mobile_manipulator.yaml");
   ASSERT_TRUE(loaded.ok()) << loaded.error().toString();
   const RobotModel& r = *loaded;
-  EXPECT_EQ(r.namedConfigurationNames(), (std::vector<std::string>{"stow", "ready"}));
+  EXPECT_EQ(r.namedConfigurationNames(), (std::vector<std::string>{"stow", "ready", "carry"}));
   EXPECT_EQ(r.defaultState().arm, *r.namedConfiguration("stow"));
   EXPECT_DOUBLE_EQ(r.options().gripper_open, 0.04);
   collision::Scene scene;

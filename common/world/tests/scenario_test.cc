@@ -227,7 +227,7 @@ TEST(ScenarioTest, CorridorIsBlockedByTheBox) {
     for (const auto& id : scene.robotCollisions()) hits.insert(id);
   }
   EXPECT_EQ(hits, std::set<std::string>{"box"});
-  // Without the box the corridor is passable; the detour opening is at y in [4.6, 5.8].
+  // Without the box the corridor is passable; the detour opening is at y in [18.0, 19.8].
   World w = sc.world;
   ASSERT_TRUE(w.removeObject("box"));
   collision::Scene empty(w);
@@ -236,7 +236,7 @@ TEST(ScenarioTest, CorridorIsBlockedByTheBox) {
     robotModel().linkPoses(robotModel().defaultState({x, 1.2, 0.0}), poses);
     empty.setLinkPoses(poses);
     EXPECT_FALSE(empty.robotInCollision()) << "x = " << x;
-    robotModel().linkPoses(robotModel().defaultState({x, 5.2, 0.0}), poses);
+    robotModel().linkPoses(robotModel().defaultState({x, 18.9, 0.0}), poses);
     empty.setLinkPoses(poses);
     EXPECT_FALSE(empty.robotInCollision()) << "detour x = " << x;
   }
@@ -501,7 +501,7 @@ TEST(ScenarioErrorsTest, ExactMessages) {
   EXPECT_EQ(
       errorOf(replaced(kMinimal, "robot: {start: start}", "robot: {start: start, arm: dance}")),
       kFile +
-          ":2:28: field 'robot.arm': unknown arm configuration 'dance' (robot has: stow, ready)");
+          ":2:28: field 'robot.arm': unknown arm configuration 'dance' (robot has: stow, ready, carry)");
   EXPECT_EQ(errorOf(replaced(kMinimal, "(holding can)", "(holding table)")),
             kFile +
                 ":8:14: field 'goal.pddl': 'table' in '(holding table)' is not a movable object "

@@ -166,9 +166,9 @@ TEST_F(ChecksTest, SupportsOfAnObjectOnATable) {
   EXPECT_EQ(checker.supportsOf(*can, can->pose), std::vector<std::string>{"table_body"});
   // Above the counter, 2 cm up: resting on nothing.
   Eigen::Isometry3d above = can->pose;
-  above.translation() = Eigen::Vector3d(0.0, 1.9, 0.80 + 0.06 + 0.02);
+  above.translation() = Eigen::Vector3d(0.0, 1.9, 0.70 + 0.06 + 0.02);
   EXPECT_TRUE(checker.supportsOf(*can, above).empty());
-  above.translation().z() = 0.80 + 0.06;
+  above.translation().z() = 0.70 + 0.06;
   EXPECT_EQ(checker.supportsOf(*can, above), std::vector<std::string>{"counter_body"});
 }
 

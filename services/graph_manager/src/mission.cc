@@ -107,8 +107,26 @@ MissionReport GraphManager::runMission(WorldSource& source, Executor& executor, 
     if (e.kind == ActionKind::kMoveArm && armKey(id, next) >= 0) {
       e.motion_by_next.erase(armKey(id, next));
       e.effort_by_next.erase(armKey(id, next));
-      if (!std::isfinite(evaluate(id, next, ctx, 0)))
-        return finish(MissionOutcome::kFailed, "cannot prepare " + graph_.edge(next).action + ": " + e.reason);
+      if (!std::isfinite(evaluate(id, next, ctx, 0))) {
+        // Not preparable in the world as it is now: a failure like any other, then repair.
+        e.state = EdgeState::kFailed;
+        ExecutedAction a;
+        a.action = e.action;
+        a.outcome = "not prepared";
+        a.reason = "cannot prepare " + graph_.edge(next).action + ": " + e.reason;
+        report.actions.push_back(a);
+        if (observer.on_action) observer.on_action(a, done_effort, branch_total);
+        if (++failures > params_.max_replans)
+          return finish(MissionOutcome::kFailed, "gave up after " + std::to_string(failures) + " failures; last: " + a.reason);
+        ++report.replans;
+        // Grasps are asked again (the world model may have changed since): forget the cached ones.
+        grasp_cache_.clear();
+        e.motion_by_next.erase(armKey(id, next));
+        e.effort_by_next.erase(armKey(id, next));
+        e.state = EdgeState::kUnevaluated;
+        branch.clear();
+        continue;
+      }
     }
     // The robot must be where the edge's motion starts; otherwise plan the motion again from it.
     auto cmd = command(id, next, ctx, "m" + std::to_string(step) + "-e" + std::to_string(id));

@@ -418,6 +418,7 @@ std::optional<EdgeMotion> GraphManager::armTarget(const Edge& arm_edge, EdgeId n
       GraspQuery gq;
       gq.object_id = object;
       gq.base = ctx.state.base;
+      gq.max_grasps = 8;
       ++counters_.grasp_calls;
       auto g = services_.grasps(gq);
       it = grasp_cache_.emplace(key, g ? *g : std::vector<GraspOption>{}).first;
@@ -437,7 +438,11 @@ std::optional<EdgeMotion> GraphManager::armTarget(const Edge& arm_edge, EdgeId n
       if (why.empty()) why = "no grasp of " + object + " from the base pose of " + arm_edge.tokens[1];
       return std::nullopt;
     }
-    m.prepared = it->second.front();
+    if (alternative >= static_cast<int>(it->second.size())) {
+      why = "every grasp of " + object + " tried from " + arm_edge.tokens[1] + " is in collision";
+      return std::nullopt;
+    }
+    m.prepared = it->second[static_cast<std::size_t>(alternative)];
     target = m.prepared->pregrasp;
     return m;
   }
@@ -480,8 +485,9 @@ double GraphManager::evaluateArm(Edge& e, EdgeId next, const BranchContext& ctx)
     a = services_.motion(q);
     if (a.ok()) break;
     e.reason = "arm motion: " + std::string(toString(a.status)) + (a.reason.empty() ? "" : ": " + a.reason);
-    const bool place_next = next >= 0 && graph_.edge(next).kind == ActionKind::kPlace;
-    if (a.status != MotionOutcome::kGoalInCollision || !place_next) break;
+    const bool manipulation_next = next >= 0 && (graph_.edge(next).kind == ActionKind::kPlace ||
+                                                  graph_.edge(next).kind == ActionKind::kPick);
+    if (a.status != MotionOutcome::kGoalInCollision || !manipulation_next) break;
   }
   if (!a.ok()) {
     e.effort_by_next[next] = {kInfinity, 0.0};

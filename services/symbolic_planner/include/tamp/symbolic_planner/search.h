@@ -32,9 +32,9 @@
 
 namespace tamp::symbolic_planner {
 
-enum class SearchAlgorithm { kEhc, kGbfs, kWAstar, kAstar };
+enum class SearchAlgorithm { kEhc, kGbfs, kLazy, kWAstar, kAstar };
 
-/// Parses "ehc", "gbfs", "wastar", "astar"; nullopt otherwise.
+/// Parses "ehc", "gbfs", "lazy", "wastar", "astar"; nullopt otherwise.
 std::optional<SearchAlgorithm> parseSearchAlgorithm(const std::string& name);
 std::string toString(SearchAlgorithm a);
 
@@ -46,7 +46,9 @@ struct SearchOptions {
   /// cost+1 for ehc/gbfs on tasks with costs, the real cost for wastar/astar.
   std::optional<CostType> cost_type;
   double weight{5.0};           ///< wastar only; must be >= 1
-  bool ehc_fallback{true};      ///< ehc: complete GBFS when hill-climbing fails
+  bool ehc_fallback{true};      ///< ehc: complete best-first search when hill-climbing fails
+  /// ehc: the complete search to fall back to: kLazy (LAMA's lazy GBFS) or kGbfs (eager).
+  SearchAlgorithm fallback{SearchAlgorithm::kLazy};
   bool goal_agenda{true};       ///< ehc: FF's goal agenda (achieve ordered goal subsets in turn)
   /// ehc: when the breadth-first search over helpful actions exhausts a plateau, search it again
   /// with all applicable actions before falling back (FF gives up at once).
@@ -61,6 +63,12 @@ struct SearchOptions {
   /// ehc: give up (kFailed, no fallback) after this many evaluations per unit of the initial
   /// state's h (at least 2 units; with the goal agenda, h of the first entry); 0 = unlimited.
   uint64_t ehc_eval_budget_per_h{0};
+  /// ehc: fall back to the complete search (as on a failure) once hill-climbing has used
+  /// `ehc_fallback_budget_min + ehc_fallback_budget_per_h * h(init)` evaluations (h of the first
+  /// goal-agenda entry), so that a hill-climbing lost on plateaus leaves the time to the complete
+  /// search; 0 = unlimited (FF).
+  uint64_t ehc_fallback_budget_per_h{0};
+  uint64_t ehc_fallback_budget_min{0};
   /// ehc: give up (kFailed, no fallback) after this many evaluations in all; 0 = unlimited.
   uint64_t ehc_eval_budget{0};
   /// ehc with `ehc_ff_first`: when the first run's plan has at least `ehc_second_trigger_ratio`
@@ -72,7 +80,9 @@ struct SearchOptions {
   uint64_t ehc_second_budget_per_step{300};
   uint64_t ehc_second_budget_factor{16};
   double ehc_second_trigger_ratio{2.0};
-  bool preferred_operators{true};  ///< gbfs: use the helpful-action open list
+  bool preferred_operators{true};  ///< gbfs/lazy: use the helpful-action open list(s)
+  /// lazy: alternate h_FF with LAMA's landmark-count heuristic (landmarks.h), four queues.
+  bool landmarks{true};
   /// ehc/gbfs: drop redundant actions from the plan found (greedy action elimination).
   bool eliminate_redundant_actions{true};
   int preferred_boost{1000};    ///< gbfs: preferred-queue priority boost on progress
@@ -108,6 +118,7 @@ struct SearchStatistics {
   bool ehc_second_ran{false};
   bool ehc_second_won{false};
   uint64_t ehc_retries{0};  ///< plateaus searched again without helpful-action pruning
+  uint64_t landmarks{0};    ///< lazy: number of fact landmarks found (0: landmark count not used)
   uint64_t eliminated_actions{0};  ///< removed by action elimination
   double seconds{0.0};
 };

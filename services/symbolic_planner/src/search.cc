@@ -418,7 +418,9 @@ class Searcher {
       for (size_t head = 0; head < queue.size() && found == kNone; ++head) {
         if (auto st = checkLimits()) return finish(*st);
         if (eval_budget_ > 0 && stats_.evaluated > eval_budget_) return finish(SearchStatus::kFailed);
-        if (fallback_budget_ > 0 && stats_.evaluated > fallback_budget_) return fallback();
+        if (fallback_budget_ > 0 && stats_.evaluated + opt_.ehc_fallback_budget_spent > fallback_budget_) {
+          return fallback();
+        }
         const uint32_t id = queue[head];
         std::copy(reg_.get(id), reg_.get(id) + reg_.words(), buf_.begin());
         ++stats_.expanded;
@@ -883,8 +885,11 @@ SearchResult search(const Task& task, const StateBits& init, const Goal& goal, c
       return r1;
     }
     if (r1.status != SearchStatus::kFailed && r1.status != SearchStatus::kOutOfMemory) return r1;
-    // Second run: the default search from the start, as if the first had not happened.
-    Searcher s2(task, init, goal, options, heuristic, term);
+    // Second run: the default search from the start, as if the first had not happened (but
+    // within what is left of the hill-climbing budget).
+    SearchOptions rest = options;
+    rest.ehc_fallback_budget_spent = r1.stats.evaluated;
+    Searcher s2(task, init, goal, rest, heuristic, term);
     SearchResult r2 = s2.run();
     r2.stats.ehc_ff_failed = true;
     addRunCosts(r2.stats, r1.stats);

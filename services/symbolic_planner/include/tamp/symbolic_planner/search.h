@@ -66,9 +66,14 @@ struct SearchOptions {
   /// ehc: fall back to the complete search (as on a failure) once hill-climbing has used
   /// `ehc_fallback_budget_min + ehc_fallback_budget_per_h * h(init)` evaluations (h of the first
   /// goal-agenda entry), so that a hill-climbing lost on plateaus leaves the time to the complete
-  /// search; 0 = unlimited (FF).
-  uint64_t ehc_fallback_budget_per_h{0};
-  uint64_t ehc_fallback_budget_min{0};
+  /// search; 0 = unlimited (FF). The defaults keep every hill-climbing that succeeds on the IPC
+  /// sets of docs/benchmarks.md within budget (the largest need: maintenance-20, 138k
+  /// evaluations at h 201; tpp-24, 41k at h 8) and stop those that wander (visitall, psr-small).
+  uint64_t ehc_fallback_budget_per_h{500};
+  uint64_t ehc_fallback_budget_min{50000};
+  /// ehc: evaluations already spent towards that budget (set by `search()` for the default
+  /// hill-climbing after a failed first run with the FF-v2.3 variant, so both share one budget).
+  uint64_t ehc_fallback_budget_spent{0};
   /// ehc: give up (kFailed, no fallback) after this many evaluations in all; 0 = unlimited.
   uint64_t ehc_eval_budget{0};
   /// ehc with `ehc_ff_first`: when the first run's plan has at least `ehc_second_trigger_ratio`

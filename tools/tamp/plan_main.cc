@@ -65,7 +65,8 @@ int main(int argc, char** argv) {
        no_ff_first = false, no_landmarks = false;
   uint64_t ff_budget = 300, second_budget = 300;
   const sp::SearchOptions defaults;
-  uint64_t fallback_budget = defaults.ehc_fallback_budget_per_h, fallback_min = defaults.ehc_fallback_budget_min;
+  uint64_t fallback_budget = defaults.ehc_fallback_budget_per_h, fallback_min = defaults.ehc_fallback_budget_min,
+           fallback_max = defaults.ehc_fallback_budget_max;
   app.add_option("domain", domain, "PDDL domain file")->required();
   app.add_option("problem", problem, "PDDL problem file")->required();
   app.add_option("--search", search,
@@ -102,6 +103,7 @@ int main(int argc, char** argv) {
                  "initial h (0 = never)");
   app.add_flag("--no-landmarks", no_landmarks, "lazy: h_FF only (no landmark-count heuristic)");
   app.add_option("--ehc-fallback-min", fallback_min, "ehc: the MIN of --ehc-fallback-budget");
+  app.add_option("--ehc-fallback-max", fallback_max, "ehc: at most this many evaluations before falling back (0 = no cap)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -125,6 +127,7 @@ int main(int argc, char** argv) {
   req.search.ehc_second_budget_per_step = second_budget;
   req.search.ehc_fallback_budget_per_h = fallback_budget;
   req.search.ehc_fallback_budget_min = fallback_min;
+  req.search.ehc_fallback_budget_max = fallback_max;
   req.search.landmarks = !no_landmarks;
   if (heuristic == "ff") req.search.heuristic = sp::HeuristicKind::kFF;
   if (heuristic == "add") req.search.heuristic = sp::HeuristicKind::kAdd;

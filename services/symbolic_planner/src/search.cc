@@ -399,6 +399,7 @@ class Searcher {
       if (opt_.ehc_fallback_budget_per_h > 0 && hcur != Heuristic::kDeadEnd) {
         fallback_budget_ = opt_.ehc_fallback_budget_min +
                            opt_.ehc_fallback_budget_per_h * static_cast<uint64_t>(std::max<Cost>(hcur, 1));
+        if (opt_.ehc_fallback_budget_max > 0) fallback_budget_ = std::min(fallback_budget_, opt_.ehc_fallback_budget_max);
       }
     }
     if (hcur == Heuristic::kDeadEnd) {

@@ -58,16 +58,22 @@ int main(int argc, char** argv) {
                "Exit codes: 0 plan, 10 proven unsolvable, 11 incomplete search failed, 20 timeout,\n"
                "21 out of memory, 30 input error, 31 invalid plan (--validate), 39 internal error.",
                "tamp plan"};
-  std::string domain, problem, search = "ehc", heuristic, cost_type, plan_out, validate_plan;
+  std::string domain, problem, search = "ehc", fallback = "lazy", heuristic, cost_type, plan_out, validate_plan;
   double timeout = 0.0, weight = 5.0;
   size_t memory_mb = 4096;
   bool stats = false, no_check = false, no_fallback = false, no_agenda = false, first_improvement = false,
-       no_ff_first = false;
+       no_ff_first = false, no_landmarks = false;
   uint64_t ff_budget = 300, second_budget = 300;
+  const sp::SearchOptions defaults;
+  uint64_t fallback_budget = defaults.ehc_fallback_budget_per_h, fallback_min = defaults.ehc_fallback_budget_min,
+           fallback_max = defaults.ehc_fallback_budget_max;
   app.add_option("domain", domain, "PDDL domain file")->required();
   app.add_option("problem", problem, "PDDL problem file")->required();
-  app.add_option("--search", search, "ehc (FF: hill-climbing, then best-first), gbfs, wastar, astar")
-      ->check(CLI::IsMember({"ehc", "gbfs", "wastar", "astar"}));
+  app.add_option("--search", search,
+                 "ehc (FF: hill-climbing, then best-first), gbfs (eager), lazy (LAMA's lazy GBFS), wastar, astar")
+      ->check(CLI::IsMember({"ehc", "gbfs", "lazy", "wastar", "astar"}));
+  app.add_option("--fallback", fallback, "ehc: the complete search after hill-climbing fails: lazy (default), gbfs")
+      ->check(CLI::IsMember({"lazy", "gbfs"}));
   app.add_option("--heuristic", heuristic, "ff, add, max, blind (default: ff; max for wastar/astar)")
       ->check(CLI::IsMember({"ff", "add", "max", "blind"}));
   app.add_option("--cost-type", cost_type,
@@ -92,6 +98,12 @@ int main(int argc, char** argv) {
   app.add_option("--ehc-second-budget", second_budget,
                  "ehc: when the first run's plan has >= 2 x h(init) actions, also run the default EHC with this "
                  "many evaluations per action of that plan and keep the cheaper plan (0 = never)");
+  app.add_option("--ehc-fallback-budget", fallback_budget,
+                 "ehc: fall back to the complete search after MIN + this many evaluations per unit of the "
+                 "initial h (0 = never)");
+  app.add_flag("--no-landmarks", no_landmarks, "lazy: h_FF only (no landmark-count heuristic)");
+  app.add_option("--ehc-fallback-min", fallback_min, "ehc: the MIN of --ehc-fallback-budget");
+  app.add_option("--ehc-fallback-max", fallback_max, "ehc: at most this many evaluations before falling back (0 = no cap)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -104,6 +116,7 @@ int main(int argc, char** argv) {
   req.domain_path = domain;
   req.problem_path = problem;
   req.search.algorithm = *sp::parseSearchAlgorithm(search);
+  req.search.fallback = *sp::parseSearchAlgorithm(fallback);
   req.search.weight = weight;
   req.search.memory_limit_mb = memory_mb;
   req.search.ehc_fallback = !no_fallback;
@@ -112,6 +125,10 @@ int main(int argc, char** argv) {
   req.search.ehc_ff_first = !no_ff_first;
   req.search.ehc_ff_budget_per_h = ff_budget;
   req.search.ehc_second_budget_per_step = second_budget;
+  req.search.ehc_fallback_budget_per_h = fallback_budget;
+  req.search.ehc_fallback_budget_min = fallback_min;
+  req.search.ehc_fallback_budget_max = fallback_max;
+  req.search.landmarks = !no_landmarks;
   if (heuristic == "ff") req.search.heuristic = sp::HeuristicKind::kFF;
   if (heuristic == "add") req.search.heuristic = sp::HeuristicKind::kAdd;
   if (heuristic == "max") req.search.heuristic = sp::HeuristicKind::kMax;
@@ -138,7 +155,7 @@ int main(int argc, char** argv) {
                  reply.stats.ehc_second_won   ? "; second ehc run gave the shorter plan"
                  : reply.stats.ehc_second_ran ? "; second ehc run, first plan kept"
                                               : "",
-                 reply.stats.ehc_failed ? "; ehc failed, used gbfs" : "");
+                 reply.stats.ehc_failed ? "; ehc failed, fell back to best-first search" : "");
   }
   if (reply.status != sp::PlanStatus::kSolved) {
     std::cerr << (reply.status == sp::PlanStatus::kInputError ? "error: " : "") << reply.message << "\n";

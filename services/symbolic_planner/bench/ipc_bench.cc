@@ -11,13 +11,18 @@
 // each definition.
 //
 //   tamp_symbolic_planner_ipc_bench --planner build/planner/bin/tamp-plan
-//       --set ../shared/benchmarks/pddl --out docs/bench/symbolic_planner_ipc.csv [--timeout 60]
-//       [--domain blocks] [--label ours] [-- extra planner args]
+//       --set tests/data/benchmarks/pddl --out docs/bench/symbolic_planner_ipc.csv [--timeout 60]
+//       [--domain blocks] [--problem instance-5] [--lock /tmp/tamp-build.lock] [--label ours]
+//       [-- extra planner args]
+// A set with a manifest.csv (domain,problem,domain_file,problem_file, relative to the set, as
+// pddl-more with its per-instance domain files) is run from it; otherwise every <dir>/domain.pddl
+// with its <dir>/instance-N.pddl.
 //   tamp_symbolic_planner_ipc_bench --results docs/bench/symbolic_planner_ipc.csv
-//       --set ../shared/benchmarks/pddl      (summary of an earlier run's CSV, nothing is run)
+//       --set tests/data/benchmarks/pddl      (summary of an earlier run's CSV, nothing is run)
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
+#include <sys/file.h>
 #include <sys/resource.h>
 #include <sys/syscall.h>
 #include <sys/wait.h>
@@ -220,7 +225,7 @@ std::vector<Row> readRows(const fs::path& csv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string planner, set, out_csv, results_csv, only_domain, label = "tamp-plan";
+  std::string planner, set, out_csv, results_csv, only_domain, only_problem, lock_file, label = "tamp-plan";
   double timeout = 60;
   std::vector<std::string> extra;
   for (int i = 1; i < argc; ++i) {
@@ -238,13 +243,15 @@ int main(int argc, char** argv) {
     else if (a == "--results") results_csv = next();
     else if (a == "--timeout") timeout = std::stod(next());
     else if (a == "--domain") only_domain = next();
+    else if (a == "--problem") only_problem = next();
+    else if (a == "--lock") lock_file = next();
     else if (a == "--label") label = next();
     else if (a == "--") {
       for (++i; i < argc; ++i) extra.push_back(argv[i]);
     } else {
       std::cerr << "usage: " << argv[0]
                 << " --planner PATH --set BENCH_DIR [--out CSV] [--timeout S] [--domain D] "
-                   "[--label L] [-- ARGS]\n"
+                   "[--problem P] [--lock FILE] [--label L] [-- ARGS]\n"
                 << "       " << argv[0]
                 << " --results CSV --set BENCH_DIR [--domain D] [--label L]\n";
       return 30;
@@ -254,60 +261,121 @@ int main(int argc, char** argv) {
     std::cerr << "--set and one of --planner, --results are required\n";
     return 30;
   }
-  std::vector<fs::path> domains;
-  for (const auto& e : fs::directory_iterator(set)) {
-    if (e.is_directory() && fs::exists(e.path() / "domain.pddl")) domains.push_back(e.path());
+  // The instances: the set's manifest.csv (domain,problem,domain_file,problem_file; paths relative
+  // to the set) when there is one, else every <dir>/domain.pddl with its <dir>/instance-N.pddl.
+  struct Instance {
+    std::string domain, problem;
+    fs::path domain_file, problem_file;
+  };
+  std::vector<Instance> instances;
+  std::vector<std::string> dnames;
+  const fs::path manifest = fs::path(set) / "manifest.csv";
+  if (fs::exists(manifest)) {
+    std::ifstream in(manifest);
+    std::string line;
+    std::vector<std::string> header;
+    while (std::getline(in, line)) {
+      if (!line.empty() && line.back() == '\r') line.pop_back();
+      if (line.empty()) continue;
+      auto f = splitCsv(line);
+      if (header.empty()) {
+        header = f;
+        continue;
+      }
+      std::map<std::string, std::string> m;
+      for (size_t i = 0; i < header.size() && i < f.size(); ++i) m[header[i]] = f[i];
+      if (m["domain"].empty() || m["domain_file"].empty() || m["problem_file"].empty()) {
+        std::cerr << manifest.string() << ": bad row '" << line << "'\n";
+        return 30;
+      }
+      instances.push_back({m["domain"], m["problem"].empty() ? fs::path(m["problem_file"]).stem().string() : m["problem"],
+                           fs::path(set) / m["domain_file"], fs::path(set) / m["problem_file"]});
+    }
+  } else {
+    std::vector<fs::path> domains;
+    for (const auto& e : fs::directory_iterator(set)) {
+      if (e.is_directory() && fs::exists(e.path() / "domain.pddl")) domains.push_back(e.path());
+    }
+    std::sort(domains.begin(), domains.end());
+    for (const auto& dir : domains) {
+      std::vector<fs::path> inst;
+      for (const auto& e : fs::directory_iterator(dir)) {
+        const std::string n = e.path().filename().string();
+        if (n.rfind("instance-", 0) == 0 && e.path().extension() == ".pddl") inst.push_back(e.path());
+      }
+      std::sort(inst.begin(), inst.end(), [](const fs::path& a, const fs::path& b) { return instanceNumber(a) < instanceNumber(b); });
+      for (const auto& p : inst) instances.push_back({dir.filename().string(), p.stem().string(), dir / "domain.pddl", p});
+    }
   }
-  std::sort(domains.begin(), domains.end());
+  for (const auto& i : instances) {
+    if ((only_domain.empty() || i.domain == only_domain) &&
+        std::find(dnames.begin(), dnames.end(), i.domain) == dnames.end()) {
+      dnames.push_back(i.domain);
+    }
+  }
   std::vector<Row> rows;
   if (!results_csv.empty()) {
     for (const auto& r : readRows(results_csv)) {
       if (r.planner == label && (only_domain.empty() || r.domain == only_domain)) rows.push_back(r);
     }
   }
-  for (const auto& dir : domains) {
-    const std::string dname = dir.filename().string();
-    if (!results_csv.empty() || (!only_domain.empty() && dname != only_domain)) continue;
-    std::vector<fs::path> inst;
-    for (const auto& e : fs::directory_iterator(dir)) {
-      const std::string n = e.path().filename().string();
-      if (n.rfind("instance-", 0) == 0 && e.path().extension() == ".pddl") inst.push_back(e.path());
+  // With --lock, the lock is taken around each planner run only, so that builds can run between
+  // instances but never during one.
+  int lock_fd = -1;
+  if (!lock_file.empty()) {
+    lock_fd = open(lock_file.c_str(), O_RDWR | O_CREAT, 0666);
+    if (lock_fd < 0) {
+      std::cerr << "cannot open lock file " << lock_file << "\n";
+      return 30;
     }
-    std::sort(inst.begin(), inst.end(), [](const fs::path& a, const fs::path& b) { return instanceNumber(a) < instanceNumber(b); });
-    auto dtext = tamp::readTextFile(dir / "domain.pddl");
-    auto dom = dtext ? sp::pddl::parseDomain(*dtext, (dir / "domain.pddl").string()) : tamp::Result<sp::pddl::Domain>(dtext.error());
-    for (const auto& p : inst) {
-      std::vector<std::string> args{planner, (dir / "domain.pddl").string(), p.string(), "--no-check"};
-      args.insert(args.end(), extra.begin(), extra.end());
-      RunResult rr = runChild(args, timeout);
-      Row row;
-      row.domain = dname;
-      row.problem = p.stem().string();
-      row.planner = label;
-      row.wall_s = rr.wall_s;
-      row.cpu_s = rr.cpu_s;
-      row.peak_kb = rr.peak_kb;
-      row.exit_code = rr.exit_code;
-      if (rr.exit_code == 0 && !rr.killed && dom) {
-        auto plan = sp::parsePlan(rr.out, p.string() + ".plan");
-        auto ptext = tamp::readTextFile(p);
-        if (plan && ptext) {
-          auto prob = sp::pddl::parseProblem(*ptext, *dom, p.string());
-          if (prob) {
-            const sp::ValidationResult v = sp::validatePlan(*dom, *prob, *plan);
-            row.solved = v.valid;
-            row.plan_length = static_cast<long>(plan->size());
-            row.plan_cost = v.cost;
-            if (!v.valid) row.note = "INVALID: " + v.message;
-          }
+  }
+  std::map<std::string, tamp::Result<sp::pddl::Domain>> parsed;  // by domain file
+  for (const auto& inst : instances) {
+    if (!results_csv.empty() || (!only_domain.empty() && inst.domain != only_domain)) continue;
+    if (!only_problem.empty() && inst.problem != only_problem) continue;
+    const std::string dkey = inst.domain_file.string();
+    if (!parsed.count(dkey)) {
+      auto dtext = tamp::readTextFile(inst.domain_file);
+      parsed.emplace(dkey, dtext ? sp::pddl::parseDomain(*dtext, dkey) : tamp::Result<sp::pddl::Domain>(dtext.error()));
+    }
+    const auto& dom = parsed.at(dkey);
+    const fs::path& p = inst.problem_file;
+    std::vector<std::string> args{planner, dkey, p.string(), "--no-check"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    if (lock_fd >= 0) flock(lock_fd, LOCK_EX);
+    RunResult rr = runChild(args, timeout);
+    if (lock_fd >= 0) flock(lock_fd, LOCK_UN);
+    Row row;
+    row.domain = inst.domain;
+    row.problem = inst.problem;
+    row.planner = label;
+    row.wall_s = rr.wall_s;
+    row.cpu_s = rr.cpu_s;
+    row.peak_kb = rr.peak_kb;
+    row.exit_code = rr.exit_code;
+    if (rr.exit_code == 0 && !rr.killed && dom) {
+      auto plan = sp::parsePlan(rr.out, p.string() + ".plan");
+      auto ptext = tamp::readTextFile(p);
+      if (plan && ptext) {
+        auto prob = sp::pddl::parseProblem(*ptext, *dom, p.string());
+        if (prob) {
+          const sp::ValidationResult v = sp::validatePlan(*dom, *prob, *plan);
+          row.solved = v.valid;
+          row.plan_length = static_cast<long>(plan->size());
+          row.plan_cost = v.cost;
+          if (!v.valid) row.note = "INVALID: " + v.message;
+        } else {
+          row.note = "checker cannot parse the problem";
         }
-      } else if (rr.killed) {
-        row.note = "killed at time limit";
       }
-      std::fprintf(stderr, "%-12s %-14s exit %3d  %8.3f s  %7ld KB  len %4ld  %s\n", dname.c_str(), row.problem.c_str(),
-                   row.exit_code, row.wall_s, row.peak_kb, row.plan_length, row.note.c_str());
-      rows.push_back(row);
+    } else if (rr.killed) {
+      row.note = "killed at time limit";
+    } else if (!dom) {
+      row.note = "checker cannot parse the domain";
     }
+    std::fprintf(stderr, "%-12s %-14s exit %3d  %8.3f s  %7ld KB  len %4ld  %s\n", row.domain.c_str(),
+                 row.problem.c_str(), row.exit_code, row.wall_s, row.peak_kb, row.plan_length, row.note.c_str());
+    rows.push_back(row);
   }
   if (!out_csv.empty()) {
     std::ofstream out(out_csv);
@@ -339,10 +407,6 @@ int main(int argc, char** argv) {
       "| median cost | median peak RSS (MB) | FF-solved by us | solved by both | common-solved "
       "median wall ours / this (s) |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
-  std::vector<std::string> dnames;
-  for (const auto& d : domains) {
-    if (only_domain.empty() || d.filename() == only_domain) dnames.push_back(d.filename().string());
-  }
   for (const auto& d : dnames) {
     for (const auto& pl : planners) {
       auto it = by.find(d + "|" + pl);

@@ -1,18 +1,32 @@
 #!/usr/bin/env bash
-# Runs the IPC benchmark of issue 3 and writes the per-instance CSVs and summaries to docs/bench/.
-# One tamp-plan process per instance, 60 s limit, wall time and peak RSS of the child, every plan
-# checked by the independent lifted plan checker. Takes the shared build lock for the whole run.
-#   services/symbolic_planner/bench/run_ipc_bench.sh [BUILD_DIR]   (default build/planner, Release)
+# Runs the IPC benchmarks of issues 3 and 14 and writes the per-instance CSVs and summaries to
+# docs/bench/. One tamp-plan process per instance, wall time and peak RSS of the child, every plan
+# checked by the independent lifted plan checker. The limits are the references': 60 s for
+# pddl and pddl-adl, 30 s for pddl-more. The shared build lock is taken around each planner run
+# (--lock), so that builds can run between instances but never during one.
+#   services/symbolic_planner/bench/run_ipc_bench.sh [BUILD_DIR] [SET...]
+#   (default build/planner, Release; default sets: pddl pddl-adl pddl-more)
 set -euo pipefail
 cd "$(dirname "$0")/../../.."
 build=${1:-build/planner}
+shift || true
+sets=("$@")
+[ ${#sets[@]} -eq 0 ] && sets=(pddl pddl-adl pddl-more)
 data=${TAMP_BENCHMARKS_DIR:-tests/data/benchmarks}
 out=docs/bench
 mkdir -p "$out"
 bench="$build/bin/tamp_symbolic_planner_ipc_bench"
 planner="$build/bin/tamp-plan"
-flock /tmp/tamp-build.lock "$bench" --planner "$planner" --set "$data/pddl" \
-  --out "$out/symbolic_planner_ipc.csv" --timeout 60 > "$out/symbolic_planner_ipc_summary.md"
-flock /tmp/tamp-build.lock "$bench" --planner "$planner" --set "$data/pddl-adl" \
-  --out "$out/symbolic_planner_ipc_adl.csv" --timeout 60 > "$out/symbolic_planner_ipc_adl_summary.md"
-cat "$out/symbolic_planner_ipc_summary.md" "$out/symbolic_planner_ipc_adl_summary.md"
+for set in "${sets[@]}"; do
+  case "$set" in
+    pddl) name=symbolic_planner_ipc; limit=60 ;;
+    pddl-adl) name=symbolic_planner_ipc_adl; limit=60 ;;
+    pddl-more) name=symbolic_planner_ipc_more; limit=30 ;;
+    *) name=symbolic_planner_ipc_${set//-/_}; limit=30 ;;
+  esac
+  echo "== $set ($limit s), $(date -u +%FT%TZ), load $(cut -d' ' -f1-3 /proc/loadavg)" >&2
+  "$bench" --planner "$planner" --set "$data/$set" --out "$out/$name.csv" \
+    --timeout "$limit" --lock /tmp/tamp-build.lock > "$out/${name}_summary.md"
+  echo "== $set done, $(date -u +%FT%TZ), load $(cut -d' ' -f1-3 /proc/loadavg)" >&2
+done
+

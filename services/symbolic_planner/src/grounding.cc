@@ -198,7 +198,14 @@ struct Grounder::Impl {
   std::vector<std::vector<std::string>> obj_types;
 
   Status addObject(const pddl::TypedName& o) {
-    if (obj_index.count(o.name)) return Status::Ok();
+    if (auto it = obj_index.find(o.name); it != obj_index.end()) {
+      // Declared again (a domain constant repeated in the problem): the union of its types.
+      auto& ts = obj_types[it->second];
+      for (const auto& t : o.types) {
+        if (std::find(ts.begin(), ts.end(), t) == ts.end()) ts.push_back(t);
+      }
+      return Status::Ok();
+    }
     obj_index[o.name] = static_cast<uint32_t>(obj_names.size());
     obj_names.push_back(o.name);
     obj_types.push_back(o.types);

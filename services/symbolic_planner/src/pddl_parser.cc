@@ -39,6 +39,7 @@ class Reader {
   /// Reads every top-level expression.
   std::vector<SExpr> readAll() {
     std::vector<SExpr> out;
+    if (text_.substr(0, 3) == "\xEF\xBB\xBF") pos_ = 3;  // UTF-8 byte-order mark
     std::vector<SExpr> stack;  // open lists
     for (;;) {
       skipSpace();
@@ -131,22 +132,26 @@ bool isNumber(const std::string& s, double* out) {
   return true;
 }
 
+/// A name: letters, digits and `- _ . / @ [ ]`, starting with a letter, a digit or '_', and not a
+/// number (Fast Downward accepts names such as `1st`; FF's lexer also allows brackets).
 bool isName(const std::string& s) {
   if (s.empty()) return false;
   const unsigned char c = static_cast<unsigned char>(s[0]);
-  if (!std::isalpha(c) && c != '_') return false;
+  if (!std::isalnum(c) && c != '_') return false;
+  if (std::isdigit(c) && isNumber(s, nullptr)) return false;
   return std::all_of(s.begin(), s.end(), [](char ch) {
     const unsigned char u = static_cast<unsigned char>(ch);
-    return std::isalnum(u) || ch == '-' || ch == '_' || ch == '.' || ch == '/' || ch == '@';
+    return std::isalnum(u) || ch == '-' || ch == '_' || ch == '.' || ch == '/' || ch == '@' || ch == '[' ||
+           ch == ']';
   });
 }
 
-const std::set<std::string>& supportedRequirements() {
-  static const std::set<std::string> k = {
-      ":strips", ":typing", ":negative-preconditions", ":equality", ":disjunctive-preconditions",
-      ":existential-preconditions", ":universal-preconditions", ":quantified-preconditions",
-      ":conditional-effects", ":adl", ":action-costs", ":types" /* sloppy but harmless */};
-  return k;
+/// Adds the types of `more` not yet in `into` (an object declared more than once has every type it
+/// was declared with).
+void mergeTypes(std::vector<std::string>& into, const std::vector<std::string>& more) {
+  for (const auto& t : more) {
+    if (std::find(into.begin(), into.end(), t) == into.end()) into.push_back(t);
+  }
 }
 
 /// Shared machinery for the domain and problem interpreters.
@@ -244,7 +249,7 @@ class DomainInterpreter : public Interpreter {
       fail(def.items.size() < 2 ? def.loc : def.items[1].loc, "expected (domain NAME) after 'define'");
     }
     d_.name = expectName(def.items[1].items[1], "a domain name");
-    d_.types.push_back({"object", ""});
+    d_.types.push_back({"object", {}, Loc{}});
     std::vector<const SExpr*> actions;
     for (size_t i = 2; i < def.items.size(); ++i) {
       const SExpr& sec = expectList(def.items[i], "a domain section such as (:predicates ...)");
@@ -283,21 +288,19 @@ class DomainInterpreter : public Interpreter {
   }
 
  private:
+  /// Any requirement is accepted and recorded: requirements are not enforced (IPC files
+  /// understate and over-declare them); a construct outside the fragment is refused where it is
+  /// used.
   void requirements(const SExpr& sec) {
     for (size_t k = 1; k < sec.items.size(); ++k) {
       const std::string& req = expectSymbol(sec.items[k], "a requirement such as :strips");
-      if (req.empty() || req[0] != ':') fail(sec.items[k].loc, "expected a requirement such as :strips, got '" + req + "'");
-      if (!supportedRequirements().count(req)) {
-        fail(sec.items[k].loc, "requirement " + req +
-                                   " is not supported (supported: :strips :typing :negative-preconditions :equality "
-                                   ":disjunctive-preconditions :existential-preconditions :universal-preconditions "
-                                   ":quantified-preconditions :conditional-effects :adl :action-costs)",
-             ErrorCode::kUnsupported);
-      }
+      if (req.size() < 2 || req[0] != ':') fail(sec.items[k].loc, "expected a requirement such as :strips, got '" + req + "'");
       d_.requirements.push_back(req);
     }
   }
 
+  /// Collects every declaration `a b - p` / `a b - (either p q)` / `a b` (parent object); the
+  /// hierarchy is built in checkTypes().
   void types(const SExpr& sec) {
     size_t pending = 0;
     const auto& it = sec.items;
@@ -305,69 +308,80 @@ class DomainInterpreter : public Interpreter {
       if (!it[i].is_list && it[i].text == "-") {
         if (i + 1 >= it.size()) fail(it[i].loc, "expected a parent type after '-'");
         if (pending == 0) fail(it[i].loc, "'-' with no type names before it");
-        std::string parent;
-        if (it[i + 1].is_list) {
-          std::vector<std::string> ps = typeSpec(it[i + 1]);
-          if (ps.size() != 1) fail(it[i + 1].loc, "a type can have only one parent type (either is not allowed here)");
-          parent = ps[0];
-        } else {
-          parent = expectName(it[i + 1], "a parent type name");
+        const std::vector<std::string> parents = typeSpec(it[i + 1]);
+        for (size_t k = type_decls_.size() - pending; k < type_decls_.size(); ++k) {
+          type_decls_[k].parents = parents;
+          type_decls_[k].parent_loc = it[i + 1].loc;
         }
-        for (size_t k = d_.types.size() - pending; k < d_.types.size(); ++k) d_.types[k].parent = parent;
         pending = 0;
         ++i;
         continue;
       }
       const std::string name = expectName(it[i], "a type name");
-      if (name == "object") {  // "object" redeclared (sometimes with "- object"): ignore
-        continue;
-      }
-      d_.types.push_back({name, "object"});
-      type_locs_[name] = it[i].loc;
+      type_decls_.push_back({name, {"object"}, it[i].loc, it[i].loc});
       ++pending;
     }
   }
 
+  /// Builds the type DAG: the union of every declaration of a type (see TypeDecl), parents used
+  /// but never declared become children of "object" (FF and Fast Downward do the same), cycles
+  /// are errors. "object" may be re-declared (sometimes as "object - object"); it has no parent.
   void checkTypes() {
-    // Parents must exist; no cycles. Parents that are undeclared get declared implicitly (as FF
-    // does) only when they are "object"; anything else is an error.
-    std::set<std::string> declared;
-    for (const auto& t : d_.types) {
-      if (!declared.insert(t.name).second && t.name != "object") {
-        // duplicate declarations with the same parent are harmless; different parents are an error
-        int parents = 0;
-        std::string first;
-        for (const auto& u : d_.types) {
-          if (u.name == t.name) {
-            if (parents == 0) first = u.parent;
-            else if (u.parent != first) error(type_locs_[t.name], "type '" + t.name + "' declared with two different parents");
-            ++parents;
-          }
+    std::map<std::string, size_t> index;  // name -> position in d_.types
+    index["object"] = 0;
+    auto declare = [&](const std::string& name, Loc loc) -> TypeDecl& {
+      auto [it, inserted] = index.emplace(name, d_.types.size());
+      if (inserted) d_.types.push_back({name, {}, loc});
+      return d_.types[it->second];
+    };
+    for (const auto& td : type_decls_) {
+      if (td.name == "object") continue;
+      TypeDecl& t = declare(td.name, td.loc);
+      for (const auto& p : td.parents) {
+        if (p == td.name) {
+          error(td.parent_loc, "type '" + td.name + "' is declared as its own parent");
+          continue;
         }
+        t.parents.push_back(p);
       }
     }
-    // Deduplicate.
-    std::vector<TypeDecl> uniq;
-    std::set<std::string> seen;
+    for (const auto& td : type_decls_) {
+      for (const auto& p : td.parents) {
+        if (!index.count(p)) declare(p, td.parent_loc).parents.push_back("object");
+      }
+    }
     for (auto& t : d_.types) {
-      if (seen.insert(t.name).second) uniq.push_back(t);
-    }
-    d_.types = std::move(uniq);
-    for (const auto& t : d_.types) {
-      if (!t.parent.empty() && !declared.count(t.parent)) {
-        error(type_locs_[t.name], "type '" + t.name + "' has undeclared parent type '" + t.parent + "'");
+      std::sort(t.parents.begin(), t.parents.end());
+      t.parents.erase(std::unique(t.parents.begin(), t.parents.end()), t.parents.end());
+      if (t.parents.size() > 1) {
+        t.parents.erase(std::remove(t.parents.begin(), t.parents.end(), std::string("object")), t.parents.end());
       }
+      if (t.name != "object" && t.parents.empty()) t.parents.push_back("object");
     }
     if (!errors_.empty()) return;
-    for (const auto& t : d_.types) {
-      std::string cur = t.name;
-      for (size_t steps = 0; !cur.empty(); ++steps) {
-        if (steps > d_.types.size()) {
-          error(type_locs_[t.name], "type '" + t.name + "' is part of a cycle in the type hierarchy");
-          break;
+    // Cycle check: depth-first search over the parent edges (0 = new, 1 = on the stack, 2 = done).
+    std::vector<int> color(d_.types.size(), 0);
+    for (size_t root = 0; root < d_.types.size(); ++root) {
+      if (color[root]) continue;
+      std::vector<std::pair<size_t, size_t>> stack{{root, 0}};  // type, next parent
+      color[root] = 1;
+      while (!stack.empty()) {
+        auto& [t, next] = stack.back();
+        if (next == d_.types[t].parents.size()) {
+          color[t] = 2;
+          stack.pop_back();
+          continue;
         }
-        const TypeDecl* td = d_.findType(cur);
-        cur = td ? td->parent : "";
+        const size_t p = index.at(d_.types[t].parents[next++]);
+        if (color[p] == 1) {
+          error(d_.types[p].loc, "type '" + d_.types[p].name + "' is part of a cycle in the type hierarchy (" +
+                                     d_.types[t].name + " - " + d_.types[p].name + ")");
+          return;
+        }
+        if (color[p] == 0) {
+          color[p] = 1;
+          stack.push_back({p, 0});
+        }
       }
     }
   }
@@ -382,11 +396,19 @@ class DomainInterpreter : public Interpreter {
 
   void checkDuplicates() {
     checkTypeNames(d_.constants);
-    std::set<std::string> names;
-    for (const auto& c : d_.constants) {
-      if (!names.insert(c.name).second) error(c.loc, "constant '" + c.name + "' is declared twice");
-      constants_.insert(c.name);
+    // A constant declared twice has the union of its types (as an object declared twice).
+    std::vector<TypedName> merged;
+    std::map<std::string, size_t> at;
+    for (auto& c : d_.constants) {
+      auto [it, inserted] = at.emplace(c.name, merged.size());
+      if (inserted) {
+        merged.push_back(std::move(c));
+      } else {
+        mergeTypes(merged[it->second].types, c.types);
+      }
+      constants_.insert(it->first);
     }
+    d_.constants = std::move(merged);
     std::set<std::string> preds;
     for (const auto& p : d_.predicates) {
       if (!preds.insert(p.name).second) error(p.loc, "predicate '" + p.name + "' is declared twice");
@@ -620,9 +642,15 @@ class DomainInterpreter : public Interpreter {
     return a;
   }
 
+  struct TypeDeclaration {
+    std::string name;
+    std::vector<std::string> parents;
+    Loc loc, parent_loc;
+  };
+
   Domain& d_;
   std::set<std::string> constants_;
-  std::map<std::string, Loc> type_locs_;
+  std::vector<TypeDeclaration> type_decls_;  // every declaration, in file order
 };
 
 // ------------------------------------------------------------------------------------------------
@@ -657,10 +685,7 @@ class ProblemInterpreter : public Interpreter {
           error(sec.items[1].loc, "problem is for domain '" + p_.domain_name + "', but the domain is '" + d_.name + "'");
         }
       } else if (kw == ":requirements") {
-        for (size_t k = 1; k < sec.items.size(); ++k) {
-          const std::string& req = expectSymbol(sec.items[k], "a requirement");
-          if (!supportedRequirements().count(req)) fail(sec.items[k].loc, "requirement " + req + " is not supported", ErrorCode::kUnsupported);
-        }
+        for (size_t k = 1; k < sec.items.size(); ++k) expectSymbol(sec.items[k], "a requirement");
       } else if (kw == ":objects") {
         std::vector<TypedName> objs = typedList(sec.items, 1, false);
         for (auto& o : objs) {
@@ -669,8 +694,19 @@ class ProblemInterpreter : public Interpreter {
           }
           auto [it, inserted] = objects_.emplace(o.name, o.types);
           if (!inserted) {
-            // Repeating a domain constant in :objects is common; same types are harmless.
-            if (it->second != o.types) error(o.loc, "object '" + o.name + "' is declared twice with different types");
+            // Declared before: a domain constant repeated in :objects (pathways) or an object
+            // listed twice. It has the union of its types; a constant re-declared with a new
+            // type becomes a problem object entry with all of them.
+            mergeTypes(it->second, o.types);
+            auto po = std::find_if(p_.objects.begin(), p_.objects.end(), [&](const TypedName& x) { return x.name == o.name; });
+            if (po != p_.objects.end()) {
+              po->types = it->second;
+            } else if (const auto c = std::find_if(d_.constants.begin(), d_.constants.end(),
+                                                   [&](const TypedName& x) { return x.name == o.name; });
+                       c != d_.constants.end() && c->types != it->second) {
+              o.types = it->second;
+              p_.objects.push_back(std::move(o));
+            }
             continue;
           }
           p_.objects.push_back(std::move(o));
@@ -745,6 +781,8 @@ class ProblemInterpreter : public Interpreter {
       f.atom.args = {objectTerm(l.items[1], &scope), objectTerm(l.items[2], &scope)};
     } else if (head == "preference") {
       fail(l.loc, "preferences are not supported", ErrorCode::kUnsupported);
+    } else if (head == "<" || head == ">" || head == "<=" || head == ">=") {
+      fail(l.loc, "numeric conditions ('" + head + "') are not supported", ErrorCode::kUnsupported);
     } else {
       f.kind = FormulaKind::kAtom;
       f.atom = groundAtom(l, &scope);
@@ -894,12 +932,18 @@ const TypeDecl* Domain::findType(std::string_view n) const {
   return nullptr;
 }
 bool Domain::isSubtype(std::string_view type, std::string_view ancestor) const {
-  std::string_view cur = type;
-  for (size_t steps = 0; steps <= types.size() && !cur.empty(); ++steps) {
+  if (type == ancestor) return true;
+  if (ancestor == "object") return findType(type) != nullptr;
+  // Depth-first over the parents; the hierarchy is acyclic (checked by the parser), and the
+  // step bound keeps a hand-built cyclic Domain from looping.
+  std::vector<std::string_view> stack{type};
+  for (size_t steps = 0; !stack.empty() && steps <= types.size() * types.size() + 1; ++steps) {
+    const std::string_view cur = stack.back();
+    stack.pop_back();
     if (cur == ancestor) return true;
     const TypeDecl* t = findType(cur);
-    if (!t) return false;
-    cur = t->parent;
+    if (!t) continue;
+    for (const auto& p : t->parents) stack.push_back(p);
   }
   return false;
 }

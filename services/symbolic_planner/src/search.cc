@@ -1,5 +1,9 @@
 #include "tamp/symbolic_planner/search.h"
 
+#include <memory>
+
+#include "tamp/symbolic_planner/landmarks.h"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -255,11 +259,13 @@ class Searcher {
       switch (opt_.algorithm) {
         case SearchAlgorithm::kEhc: r = ehc(); break;
         case SearchAlgorithm::kGbfs: r = gbfs(); break;
+        case SearchAlgorithm::kLazy: r = lazy(); break;
         case SearchAlgorithm::kWAstar: r = astar(opt_.weight); break;
         case SearchAlgorithm::kAstar: r = astar(1.0); break;
       }
     }
-    const bool satisficing = opt_.algorithm == SearchAlgorithm::kEhc || opt_.algorithm == SearchAlgorithm::kGbfs;
+    const bool satisficing = opt_.algorithm == SearchAlgorithm::kEhc || opt_.algorithm == SearchAlgorithm::kGbfs ||
+                             opt_.algorithm == SearchAlgorithm::kLazy;
     if (r.status == SearchStatus::kSolved && satisficing && opt_.eliminate_redundant_actions) {
       const size_t before = r.plan.size();
       r.plan = eliminateRedundantActions(task_, init_, goal_, std::move(r.plan), term_);
@@ -390,6 +396,11 @@ class Searcher {
       if (opt_.ehc_eval_budget > 0 && (eval_budget_ == 0 || opt_.ehc_eval_budget < eval_budget_)) {
         eval_budget_ = opt_.ehc_eval_budget;
       }
+      if (opt_.ehc_fallback_budget_per_h > 0 && hcur != Heuristic::kDeadEnd) {
+        fallback_budget_ = opt_.ehc_fallback_budget_min +
+                           opt_.ehc_fallback_budget_per_h * static_cast<uint64_t>(std::max<Cost>(hcur, 1));
+        if (opt_.ehc_fallback_budget_max > 0) fallback_budget_ = std::min(fallback_budget_, opt_.ehc_fallback_budget_max);
+      }
     }
     if (hcur == Heuristic::kDeadEnd) {
       if (first && &goal == &goal_) return finish(SearchStatus::kUnsolvable);
@@ -408,6 +419,9 @@ class Searcher {
       for (size_t head = 0; head < queue.size() && found == kNone; ++head) {
         if (auto st = checkLimits()) return finish(*st);
         if (eval_budget_ > 0 && stats_.evaluated > eval_budget_) return finish(SearchStatus::kFailed);
+        if (fallback_budget_ > 0 && stats_.evaluated + opt_.ehc_fallback_budget_spent > fallback_budget_) {
+          return fallback();
+        }
         const uint32_t id = queue[head];
         std::copy(reg_.get(id), reg_.get(id) + reg_.words(), buf_.begin());
         ++stats_.expanded;
@@ -469,15 +483,155 @@ class Searcher {
     stats_.ehc_failed = true;
     if (!opt_.ehc_fallback) return finish(SearchStatus::kFailed);
     h_.setGoal(goal_);
-    return gbfs();
+    return opt_.fallback == SearchAlgorithm::kGbfs ? gbfs() : lazy();
+  }
+
+  void resetRegistry() {
+    reg_ = StateRegistry(task_.numWords());
+    parent_.clear(); op_.clear(); g_.clear(); h_cache_.clear(); pref_begin_.clear(); pref_count_.clear(); flag_.clear();
+    pref_pool_.clear();
+  }
+
+  // --- lazy greedy best-first search (LAMA) ----------------------------------------------------
+  // Open entries are (parent, operator) keyed by the parent's h; a state is generated and
+  // evaluated only when its entry is popped (deferred evaluation, Richter & Helmert 2009). Two
+  // queues, all successors and preferred successors (reached by a helpful action of the parent),
+  // alternate by priority; each improvement of the best h boosts the preferred queue.
+  struct LazyEntry {
+    Cost key;
+    uint64_t order;
+    uint32_t parent;
+    OpId op;
+  };
+  struct LazyCmp {
+    bool operator()(const LazyEntry& a, const LazyEntry& b) const {
+      return a.key != b.key ? a.key > b.key : a.order > b.order;
+    }
+  };
+  class LazyOpen {
+   public:
+    void push(Cost k, uint32_t parent, OpId op) {
+      v_.push_back({k, counter_++, parent, op});
+      std::push_heap(v_.begin(), v_.end(), LazyCmp{});
+    }
+    LazyEntry pop() {
+      std::pop_heap(v_.begin(), v_.end(), LazyCmp{});
+      LazyEntry e = v_.back();
+      v_.pop_back();
+      return e;
+    }
+    bool empty() const { return v_.empty(); }
+    size_t bytes() const { return v_.capacity() * sizeof(LazyEntry); }
+
+   private:
+    std::vector<LazyEntry> v_;
+    uint64_t counter_{0};
+  };
+
+  SearchResult lazy() {
+    resetRegistry();
+    bool is_new = false;
+    const uint32_t root = registerState(init_.data(), &is_new);
+    if (task_.goalReached(reg_.get(root), goal_)) return finish(SearchStatus::kSolved);
+    const Cost h0 = evaluate(root);
+    if (stats_.initial_h == 0) stats_.initial_h = h0;
+    if (h0 == Heuristic::kDeadEnd) return finish(SearchStatus::kUnsolvable);
+    const bool use_pref = opt_.preferred_operators && h_.computesPreferred();
+    // LAMA's second heuristic: landmark count, with its own accepted-landmark set per state.
+    std::unique_ptr<LandmarkCounter> lm;
+    if (opt_.landmarks) {
+      lm = std::make_unique<LandmarkCounter>(task_, init_, goal_);
+      if (!lm->enabled()) lm.reset();
+    }
+    const size_t lw = lm ? lm->words() : 0;
+    std::vector<uint64_t> accepted;  // lw words per registered state
+    std::vector<Cost> hlm;           // per registered state
+    std::vector<uint64_t> acc_tmp(lw);
+    if (lm) {
+      accepted.resize(lw);
+      lm->initialAccepted(reg_.get(root), accepted.data());
+      hlm.push_back(lm->value(reg_.get(root), accepted.data()));
+      stats_.landmarks = lm->numLandmarks();
+    }
+    // Lists: 0 h_FF, 1 h_FF preferred, 2 landmarks, 3 landmarks preferred.
+    LazyOpen lists[4];
+    int64_t prio[4] = {0, 0, 0, 0};
+    const bool active[4] = {true, use_pref, lm != nullptr, lm != nullptr && use_pref};
+    std::vector<uint32_t> pref_mark(task_.ops.size(), 0);
+    uint32_t mark = 0;
+    std::vector<OpId> ops, lm_pref;
+    auto expand = [&](uint32_t id) {
+      ++stats_.expanded;
+      ++mark;
+      for (uint32_t i = 0; i < pref_count_[id]; ++i) pref_mark[pref_pool_[pref_begin_[id] + i]] = mark;
+      if (lm && use_pref) {
+        lm_pref.clear();
+        lm->preferred(reg_.get(id), accepted.data() + static_cast<size_t>(id) * lw, lm_pref);
+        for (OpId o : lm_pref) pref_mark[o] = mark;
+      }
+      ops.clear();
+      task_.applicableOps(reg_.get(id), ops);
+      const Cost hf = h_cache_[id];
+      const Cost hl = lm ? hlm[id] : 0;
+      for (OpId o : ops) {
+        ++stats_.generated;
+        const bool pref = use_pref && pref_mark[o] == mark;
+        lists[0].push(hf, id, o);
+        if (pref) lists[1].push(hf, id, o);
+        if (lm) {
+          lists[2].push(hl, id, o);
+          if (pref) lists[3].push(hl, id, o);
+        }
+      }
+    };
+    expand(root);
+    Cost best_ff = h0, best_lm = lm ? hlm[root] : 0;
+    for (;;) {
+      if (auto st = checkLimits()) return finish(*st);
+      open_bytes_ = lists[0].bytes() + lists[1].bytes() + lists[2].bytes() + lists[3].bytes() + accepted.capacity() * 8 +
+                    hlm.capacity() * 8;
+      int pick = -1;
+      for (int i = 0; i < 4; ++i) {
+        if (active[i] && !lists[i].empty() && (pick < 0 || prio[i] < prio[pick])) pick = i;
+      }
+      if (pick < 0) return finish(SearchStatus::kUnsolvable);
+      ++prio[pick];
+      const LazyEntry e = lists[pick].pop();
+      std::copy(reg_.get(e.parent), reg_.get(e.parent) + reg_.words(), buf_.begin());
+      task_.apply(buf_.data(), e.op, succ_.data());
+      const uint32_t sid = registerState(succ_.data(), &is_new);
+      if (!is_new) continue;  // evaluated (and expanded) before: closed
+      parent_[sid] = e.parent;
+      op_[sid] = e.op;
+      if (task_.goalReached(succ_.data(), goal_)) return finish(SearchStatus::kSolved, path(sid, kNone));
+      if (lm) {
+        lm->progress(accepted.data() + static_cast<size_t>(e.parent) * lw, succ_.data(), acc_tmp.data());
+        accepted.insert(accepted.end(), acc_tmp.begin(), acc_tmp.end());
+        hlm.push_back(lm->value(succ_.data(), acc_tmp.data()));
+      }
+      const Cost h = evaluate(sid);
+      if (h == Heuristic::kDeadEnd) continue;
+      bool progress = false;
+      if (h < best_ff) {
+        best_ff = h;
+        progress = true;
+      }
+      if (lm && hlm[sid] < best_lm) {
+        best_lm = hlm[sid];
+        progress = true;
+      }
+      if (progress) {
+        prio[1] -= opt_.preferred_boost;
+        prio[3] -= opt_.preferred_boost;
+      }
+      expand(sid);
+    }
   }
 
   // --- greedy best-first search ----------------------------------------------------------------
   SearchResult gbfs() {
     // A fresh registry: EHC's parent links are not valid for GBFS paths.
-    reg_ = StateRegistry(task_.numWords());
-    parent_.clear(); op_.clear(); g_.clear(); h_cache_.clear(); pref_begin_.clear(); pref_count_.clear(); flag_.clear();
-    pref_pool_.clear();
+    resetRegistry();
     bool is_new = false;
     const uint32_t root = registerState(init_.data(), &is_new);
     if (task_.goalReached(reg_.get(root), goal_)) return finish(SearchStatus::kSolved);
@@ -615,6 +769,7 @@ class Searcher {
   size_t open_bytes_{0};
   std::vector<uint32_t> stamp_;  // ehc: BFS iteration that reached each state
   uint64_t eval_budget_{0};      // ehc: give up after this many evaluations (0 = unlimited)
+  uint64_t fallback_budget_{0};  // ehc: fall back after this many evaluations (0 = unlimited)
   uint32_t iter_{0};
 };
 
@@ -646,6 +801,7 @@ void addRunCosts(SearchStatistics& into, const SearchStatistics& from) {
 std::optional<SearchAlgorithm> parseSearchAlgorithm(const std::string& name) {
   if (name == "ehc") return SearchAlgorithm::kEhc;
   if (name == "gbfs") return SearchAlgorithm::kGbfs;
+  if (name == "lazy") return SearchAlgorithm::kLazy;
   if (name == "wastar") return SearchAlgorithm::kWAstar;
   if (name == "astar") return SearchAlgorithm::kAstar;
   return std::nullopt;
@@ -655,6 +811,7 @@ std::string toString(SearchAlgorithm a) {
   switch (a) {
     case SearchAlgorithm::kEhc: return "ehc";
     case SearchAlgorithm::kGbfs: return "gbfs";
+    case SearchAlgorithm::kLazy: return "lazy";
     case SearchAlgorithm::kWAstar: return "wastar";
     case SearchAlgorithm::kAstar: return "astar";
   }
@@ -729,8 +886,11 @@ SearchResult search(const Task& task, const StateBits& init, const Goal& goal, c
       return r1;
     }
     if (r1.status != SearchStatus::kFailed && r1.status != SearchStatus::kOutOfMemory) return r1;
-    // Second run: the default search from the start, as if the first had not happened.
-    Searcher s2(task, init, goal, options, heuristic, term);
+    // Second run: the default search from the start, as if the first had not happened (but
+    // within what is left of the hill-climbing budget).
+    SearchOptions rest = options;
+    rest.ehc_fallback_budget_spent = r1.stats.evaluated;
+    Searcher s2(task, init, goal, rest, heuristic, term);
     SearchResult r2 = s2.run();
     r2.stats.ehc_ff_failed = true;
     addRunCosts(r2.stats, r1.stats);

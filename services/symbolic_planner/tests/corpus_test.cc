@@ -33,7 +33,9 @@ class Corpus : public ::testing::TestWithParam<Case> {};
 
 TEST_P(Corpus, PlanReplaysToTheGoal) {
   const Case& c = GetParam();
-  fs::path dir = c.set == "config" ? test::sourceDir() / "config/pddl" : test::benchmarksDir() / c.set / c.domain;
+  fs::path dir = c.set == "config" ? test::sourceDir() / "config/pddl"
+                 : c.set == "repo" ? test::sourceDir() / "services/symbolic_planner/tests/data/ipc" / c.domain
+                                   : test::benchmarksDir() / c.set / c.domain;
   const fs::path dom = c.set == "config" ? dir / "mobile_manipulation.pddl" : dir / "domain.pddl";
   const fs::path prob = c.set == "config" ? dir / "problems" / (c.instance + ".pddl") : dir / (c.instance + ".pddl");
   ASSERT_TRUE(fs::exists(prob)) << "benchmark file missing: " << prob;
@@ -83,6 +85,20 @@ std::vector<Case> cases() {
     for (int n : inst) out.push_back({"pddl-adl", d, "instance-" + std::to_string(n), SearchAlgorithm::kEhc});
   }
   out.push_back({"pddl-adl", "elevators", "instance-2", SearchAlgorithm::kWAstar});
+  // The IPC files in the repository (tests/data/ipc): parser corner cases, each solved with the
+  // default search and with the lazy search (LAMA's configuration).
+  for (const char* d : {"pathways", "psr-small", "schedule", "mystery", "philosophers"}) {
+    const std::string inst = std::string(d) == "pathways" ? "instance-6" : std::string(d) == "psr-small" ? "instance-10"
+                             : std::string(d) == "schedule" ? "instance-30" : std::string(d) == "mystery" ? "instance-6"
+                                                                                                         : "instance-10";
+    out.push_back({"repo", d, inst, SearchAlgorithm::kEhc});
+    out.push_back({"repo", d, inst, SearchAlgorithm::kLazy});
+  }
+  // The lazy search on the first two instances of some STRIPS domains.
+  for (const char* d : {"blocks", "logistics", "satellite"}) {
+    const std::string i = std::string(d) == "blocks" ? "instance-5" : std::string(d) == "logistics" ? "instance-4" : "instance-2";
+    out.push_back({"pddl", d, i, SearchAlgorithm::kLazy});
+  }
   return out;
 }
 

@@ -9,11 +9,26 @@
 /// and `:action-costs` (`(increase (total-cost) N)` or `(increase (total-cost) (f args))` with `f`
 /// a static function defined in `:init`; `(:metric minimize (total-cost))`).
 ///
-/// Refused by name: `:derived-predicates`, `:durative-actions`, `:numeric-fluents`/`:fluents`,
-/// `:timed-initial-literals`, `:preferences`, `:constraints`, `:object-fluents`, and the
-/// corresponding constructs. Names are case-insensitive (stored lower-case). Requirements are
-/// not enforced against the constructs used (real IPC files declare them sloppily), but a
-/// declared requirement outside the fragment is an error.
+/// Refused by name, where the construct is used: `:derived` axioms, durative actions, numeric
+/// conditions and effects other than `(increase (total-cost) ...)`, timed initial literals,
+/// preferences, `:constraints`, object-valued functions.
+///
+/// Accepted as FF and Fast Downward accept them (each has a parser test):
+/// - `:requirements` missing, understated or over-declared: requirements are never enforced
+///   against the constructs used, and any requirement name is accepted; a construct outside the
+///   fragment is refused where it occurs, whatever was declared (real IPC files declare sloppily).
+/// - types declared more than once or with several parents, `(either ...)` as a parent, parents
+///   used but never declared (see `TypeDecl` for the semantics: the union of the declarations);
+/// - `(either t1 t2 ...)` wherever a type may stand (`:types` parents, `:constants`, `:objects`,
+///   parameters, predicate and function arguments, `forall`/`exists` variables);
+/// - domain constants used in the problem, and re-declared in the problem's `:objects` (pathways);
+///   an object declared more than once (in the domain and the problem, or twice in one list)
+///   has the union of its declared types;
+/// - `;` comments, any case, any whitespace (CR, tabs, form feeds) between any two tokens, and a
+///   UTF-8 byte-order mark at the start of a file.
+///
+/// Names are case-insensitive (stored lower-case); they may start with a digit (as in Fast
+/// Downward) but not be a number.
 ///
 /// Every error names the file, line and column and what was expected. The parser never crashes
 /// or recurses without bound on malformed input (nesting depth is limited).
@@ -100,9 +115,22 @@ struct PredicateDecl {
   Loc loc;
 };
 
+/// A declared type and its direct parents.
+///
+/// Semantics of several parents (a type declared more than once, `t - object` on one line and
+/// `t - u` on another, or `t - (either u v)`): **the union of the declarations**. Every
+/// declaration `t - u` states that every object of type `t` is also of type `u`, so an object of
+/// type `t` belongs to every parent and to all their ancestors (the types form a DAG, not a tree).
+/// This is the reading that loses no declaration: choosing one parent (first or last) would make
+/// objects of `t` invisible to the parameters typed with the other parent, and a domain that
+/// declares both means them to be usable there. FF, which accepts such domains, likewise keeps
+/// every declaration. `object` is the implicit root; it is dropped from `parents` when a type has
+/// another parent (it is implied). A parent used but never declared is declared implicitly under
+/// `object`, as FF and Fast Downward do.
 struct TypeDecl {
   std::string name;
-  std::string parent;  ///< "object" for top-level types; empty only for "object" itself
+  std::vector<std::string> parents;  ///< direct parents, sorted; empty only for "object" itself
+  Loc loc;                           ///< first declaration
 };
 
 struct Domain {
@@ -118,7 +146,7 @@ struct Domain {
   const PredicateDecl* findPredicate(std::string_view name) const;
   const PredicateDecl* findFunction(std::string_view name) const;
   const TypeDecl* findType(std::string_view name) const;
-  /// True when `type` equals `ancestor` or descends from it.
+  /// True when `type` equals `ancestor` or descends from it through any chain of parents.
   bool isSubtype(std::string_view type, std::string_view ancestor) const;
 };
 

@@ -2,10 +2,13 @@
 /// @file
 /// Forward state-space searches over a grounded `Task`.
 ///
-/// - `kEhc`: FF's enforced hill-climbing: from the current state, a breadth-first search over
-///   helpful actions until a state with a strictly better h_FF is found; on failure (dead end or
-///   exhausted plateau) it falls back to complete greedy best-first search from the start
-///   (`ehc_fallback`), as FF does. With `ehc_ff_first` (the default) and a heuristic that has
+/// - `kEhc` (the default): FF's enforced hill-climbing: from the current state, a breadth-first
+///   search over helpful actions until a state with a strictly better h_FF is found; on failure
+///   (dead end or exhausted plateau), or once it has used its evaluation budget
+///   (`ehc_fallback_budget_*`, so that a hill-climbing lost on plateaus leaves the time to the
+///   complete search), it falls back to a complete best-first search from the start
+///   (`ehc_fallback`, `fallback`: LAMA's lazy search by default, FF's own order: hill-climbing
+///   first, then best-first). With `ehc_ff_first` (the default) and a heuristic that has
 ///   FF-v2.3's variant (`Heuristic::setFFStyle`), a first hill-climbing run uses that variant
 ///   within a budget of evaluations (it tends to give shorter plans); when it fails or runs
 ///   out of budget, the search starts again from the initial state with the default heuristic,
@@ -13,6 +16,11 @@
 /// - `kGbfs`: eager greedy best-first search on h_FF with a second open list for successors through
 ///   helpful (preferred) operators, alternating with a boost on progress (as Fast Downward's
 ///   `eager_greedy([ff], preferred=[ff])`). Complete: it proves unsolvability by exhaustion.
+/// - `kLazy`: LAMA's first iteration (Richter & Westphal 2010; Fast Downward's `lama-first`):
+///   lazy greedy best-first search (successors are evaluated when popped, keyed by the parent's
+///   value) alternating over four queues, h_FF and the landmark count (landmarks.h), each with all
+///   successors and with the preferred ones (helpful actions of h_FF and landmark achievers),
+///   the preferred queues boosted by 1000 on every improvement of either heuristic. Complete.
 /// - `kWAstar` / `kAstar`: (weighted) A* with re-opening on f = g + w*h; with the admissible
 ///   h_max (the default for these) A* returns cost-optimal plans and weighted A* plans within a
 ///   factor `weight` of optimal.
@@ -32,9 +40,9 @@
 
 namespace tamp::symbolic_planner {
 
-enum class SearchAlgorithm { kEhc, kGbfs, kWAstar, kAstar };
+enum class SearchAlgorithm { kEhc, kGbfs, kLazy, kWAstar, kAstar };
 
-/// Parses "ehc", "gbfs", "wastar", "astar"; nullopt otherwise.
+/// Parses "ehc", "gbfs", "lazy", "wastar", "astar"; nullopt otherwise.
 std::optional<SearchAlgorithm> parseSearchAlgorithm(const std::string& name);
 std::string toString(SearchAlgorithm a);
 
@@ -46,7 +54,9 @@ struct SearchOptions {
   /// cost+1 for ehc/gbfs on tasks with costs, the real cost for wastar/astar.
   std::optional<CostType> cost_type;
   double weight{5.0};           ///< wastar only; must be >= 1
-  bool ehc_fallback{true};      ///< ehc: complete GBFS when hill-climbing fails
+  bool ehc_fallback{true};      ///< ehc: complete best-first search when hill-climbing fails
+  /// ehc: the complete search to fall back to: kLazy (LAMA's lazy GBFS) or kGbfs (eager).
+  SearchAlgorithm fallback{SearchAlgorithm::kLazy};
   bool goal_agenda{true};       ///< ehc: FF's goal agenda (achieve ordered goal subsets in turn)
   /// ehc: when the breadth-first search over helpful actions exhausts a plateau, search it again
   /// with all applicable actions before falling back (FF gives up at once).
@@ -61,6 +71,20 @@ struct SearchOptions {
   /// ehc: give up (kFailed, no fallback) after this many evaluations per unit of the initial
   /// state's h (at least 2 units; with the goal agenda, h of the first entry); 0 = unlimited.
   uint64_t ehc_eval_budget_per_h{0};
+  /// ehc: fall back to the complete search (as on a failure) once hill-climbing has used
+  /// `ehc_fallback_budget_min + ehc_fallback_budget_per_h * h(init)` evaluations (h of the first
+  /// goal-agenda entry), so that a hill-climbing lost on plateaus leaves the time to the complete
+  /// search, but never more than `ehc_fallback_budget_max`; 0 = unlimited (FF). The defaults keep
+  /// every hill-climbing that succeeds on the IPC sets of docs/benchmarks.md within budget (the
+  /// largest need: maintenance-20, 138k evaluations at h 201; tpp-24, 41k at h 8) and stop those
+  /// that wander (psr-small; visitall, whose h of 300-2500 made the uncapped budget cost most
+  /// of the time limit).
+  uint64_t ehc_fallback_budget_per_h{500};
+  uint64_t ehc_fallback_budget_min{50000};
+  uint64_t ehc_fallback_budget_max{200000};
+  /// ehc: evaluations already spent towards that budget (set by `search()` for the default
+  /// hill-climbing after a failed first run with the FF-v2.3 variant, so both share one budget).
+  uint64_t ehc_fallback_budget_spent{0};
   /// ehc: give up (kFailed, no fallback) after this many evaluations in all; 0 = unlimited.
   uint64_t ehc_eval_budget{0};
   /// ehc with `ehc_ff_first`: when the first run's plan has at least `ehc_second_trigger_ratio`
@@ -72,10 +96,12 @@ struct SearchOptions {
   uint64_t ehc_second_budget_per_step{300};
   uint64_t ehc_second_budget_factor{16};
   double ehc_second_trigger_ratio{2.0};
-  bool preferred_operators{true};  ///< gbfs: use the helpful-action open list
-  /// ehc/gbfs: drop redundant actions from the plan found (greedy action elimination).
+  bool preferred_operators{true};  ///< gbfs/lazy: use the helpful-action open list(s)
+  /// lazy: alternate h_FF with LAMA's landmark-count heuristic (landmarks.h), four queues.
+  bool landmarks{true};
+  /// ehc/gbfs/lazy: drop redundant actions from the plan found (greedy action elimination).
   bool eliminate_redundant_actions{true};
-  int preferred_boost{1000};    ///< gbfs: preferred-queue priority boost on progress
+  int preferred_boost{1000};    ///< gbfs/lazy: preferred-queue priority boost on progress
   size_t memory_limit_mb{4096};  ///< search data (states + nodes); 0 = unlimited
 
   /// @throws std::invalid_argument naming the bad field (weight < 1, ...).
@@ -99,7 +125,7 @@ struct SearchStatistics {
   uint64_t reopened{0};
   uint64_t registered_states{0};
   Cost initial_h{0};
-  bool ehc_failed{false};  ///< ehc fell back to gbfs
+  bool ehc_failed{false};  ///< ehc fell back to the complete search (failure or budget)
   /// ehc: the first run with the FF-v2.3 heuristic variant failed (or ran out of budget) and the
   /// search started again; its evaluations are included in `evaluated`.
   bool ehc_ff_failed{false};
@@ -108,6 +134,7 @@ struct SearchStatistics {
   bool ehc_second_ran{false};
   bool ehc_second_won{false};
   uint64_t ehc_retries{0};  ///< plateaus searched again without helpful-action pruning
+  uint64_t landmarks{0};    ///< lazy: number of fact landmarks found (0: landmark count not used)
   uint64_t eliminated_actions{0};  ///< removed by action elimination
   double seconds{0.0};
 };

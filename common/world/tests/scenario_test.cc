@@ -227,7 +227,7 @@ TEST(ScenarioTest, CorridorIsBlockedByTheBox) {
     for (const auto& id : scene.robotCollisions()) hits.insert(id);
   }
   EXPECT_EQ(hits, std::set<std::string>{"box"});
-  // Without the box the corridor is passable; the detour opening is at y in [18.0, 19.8].
+  // Without the box the corridor is passable; the detour opening is at y in [18.0, 20.8].
   World w = sc.world;
   ASSERT_TRUE(w.removeObject("box"));
   collision::Scene empty(w);

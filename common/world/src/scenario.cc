@@ -39,16 +39,12 @@ std::string num(double v) {
 bool positive(double v) { return std::isfinite(v) && v > 0; }
 
 /// Expands ${TAMP_BENCHMARKS_DIR}/${TAMP_CONFIG_DIR} and resolves against the scenario file.
-/// `${TAMP_SHARED_DIR}/benchmarks` is the older spelling of ${TAMP_BENCHMARKS_DIR} (the data
-/// used to live beside the clone) and still expands to it.
 std::optional<std::filesystem::path> expandPath(const std::string& text,
                                                 const std::string& scenario_file,
                                                 std::string& why) {
   const std::string& s = text;
   for (const auto& [var, dir] :
        {std::pair<std::string, std::filesystem::path>{"${TAMP_BENCHMARKS_DIR}", benchmarksDir()},
-        std::pair<std::string, std::filesystem::path>{"${TAMP_SHARED_DIR}/benchmarks",
-                                                      benchmarksDir()},
         std::pair<std::string, std::filesystem::path>{"${TAMP_CONFIG_DIR}", configDir()}}) {
     if (s.rfind(var, 0) == 0 && (s.size() == var.size() || s[var.size()] == '/')) {
       std::string rest = s.substr(var.size());
@@ -970,6 +966,19 @@ Result<Scenario> loadScenario(const std::filesystem::path& file) {
 // ---- PDDL
 // -------------------------------------------------------------------------------------------
 
+bool occludes(const Object& x, const Object& o, const Eigen::Vector2d& approach) {
+  const Eigen::Vector2d po = o.pose.translation().head<2>();
+  const Eigen::Vector2d px = x.pose.translation().head<2>();
+  const Eigen::Vector2d d = po - approach;
+  const double len = d.norm();
+  if (len <= 0) return false;
+  const double t = (px - approach).dot(d) / len;  // along the approach
+  const double lateral = std::abs(d.x() * (px - approach).y() - d.y() * (px - approach).x()) / len;
+  const double ro = circumradius(o.shape.footprint(), Eigen::Vector2d::Zero());
+  const double rx = circumradius(x.shape.footprint(), Eigen::Vector2d::Zero());
+  return t > 0 && t < len && lateral < rx + ro;
+}
+
 bool reachesRegion(const robot::RobotModel& robot, const Pose2D& base, const Region& region) {
   const Eigen::Vector2d b(base.x, base.y);
   const Eigen::Vector2d ahead =
@@ -1082,21 +1091,11 @@ Result<PddlProblem> toPddlProblem(const Scenario& sc, const robot::RobotModel& r
     auto ap = approach.find(o.region);
     if (ap == approach.end()) continue;
     const Eigen::Vector2d l(ap->second->pose.x, ap->second->pose.y);
-    const Eigen::Vector2d po = o.pose.translation().head<2>();
-    const double ro = circumradius(o.shape.footprint(), Eigen::Vector2d::Zero());
     for (const auto& x : w.objects()) {
       if (&x == &o || x.kind != ObjectKind::kMovable || x.region != o.region ||
           (held && held->object_id == x.id))
         continue;
-      const Eigen::Vector2d px = x.pose.translation().head<2>();
-      const Eigen::Vector2d d = po - l;
-      const double len = d.norm();
-      if (len <= 0) continue;
-      const double t = (px - l).dot(d) / len;  // along the approach
-      const double lateral = std::abs(d.x() * (px - l).y() - d.y() * (px - l).x()) / len;
-      const double rx = circumradius(x.shape.footprint(), Eigen::Vector2d::Zero());
-      if (t > 0 && t < len && lateral < rx + ro)
-        init.insert("(occludes " + x.id + " " + o.id + ")");
+      if (occludes(x, o, l)) init.insert("(occludes " + x.id + " " + o.id + ")");
     }
   }
   for (const auto& a : sc.pddl_init) {

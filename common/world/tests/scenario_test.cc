@@ -277,9 +277,8 @@ TEST(ScenarioTest, NamoScenarios) {
   EXPECT_TRUE(direct->goal.base.has_value());
 }
 
-TEST(ScenarioTest, BenchmarkDataIsInTheRepositoryAndTheOldSpellingStillExpands) {
-  // The NAMO worlds ship in tests/data/benchmarks; ${TAMP_SHARED_DIR}/benchmarks (the folder
-  // beside the clone that held them before) is read as ${TAMP_BENCHMARKS_DIR}.
+TEST(ScenarioTest, BenchmarkDataIsInTheRepositoryAndNoOtherVariableExpands) {
+  // The NAMO worlds ship in tests/data/benchmarks; nothing beside the clone is read.
   EXPECT_EQ(fs::weakly_canonical(benchmarksDir()),
             fs::weakly_canonical(fs::path(TAMP_SOURCE_DIR) / "tests/data/benchmarks"));
   auto text = readTextFile(scenarioDir() / "namo_basic.yaml");
@@ -287,18 +286,14 @@ TEST(ScenarioTest, BenchmarkDataIsInTheRepositoryAndTheOldSpellingStillExpands) 
   const std::string yaml = *text;
   const auto at = yaml.find("${TAMP_BENCHMARKS_DIR}");
   ASSERT_NE(at, std::string::npos);
-  std::string old = yaml;
-  old.replace(at, std::string("${TAMP_BENCHMARKS_DIR}").size(), "${TAMP_SHARED_DIR}/benchmarks");
-  auto legacy = parseScenario(old, (scenarioDir() / "legacy.yaml").string());
-  ASSERT_TRUE(legacy.ok()) << legacy.error().toString();
-  EXPECT_EQ(legacy->world.objects().size(), load("namo_basic").world.objects().size());
-  std::string other = yaml;
-  other.replace(at, std::string("${TAMP_BENCHMARKS_DIR}").size(), "${TAMP_SHARED_DIR}");
-  auto bad = parseScenario(other, (scenarioDir() / "legacy.yaml").string());
-  ASSERT_FALSE(bad.ok());
-  EXPECT_NE(bad.error().toString().find("unknown variable in path '${TAMP_SHARED_DIR}/namo/"),
-            std::string::npos)
-      << bad.error().toString();
+  for (const std::string var : {"${TAMP_SHARED_DIR}/benchmarks", "${HOME}"}) {
+    std::string other = yaml;
+    other.replace(at, std::string("${TAMP_BENCHMARKS_DIR}").size(), var);
+    auto bad = parseScenario(other, (scenarioDir() / "other.yaml").string());
+    ASSERT_FALSE(bad.ok()) << var;
+    EXPECT_NE(bad.error().toString().find("unknown variable in path '" + var), std::string::npos)
+        << bad.error().toString();
+  }
 }
 
 // ---- broken scenarios: the exact error text

@@ -150,6 +150,17 @@ void GraphManagerNode::runOne(const msg::MissionCommand& c) {
   Abstraction abs(source.world(), *robot);
   auto goal = goalOf(*sc, *robot, abs);
   if (!goal) return fail(MissionOutcome::kInputError, "bad goal: " + goal.error().toString());
+  if (!c.goal().empty()) {
+    // The command's own goal replaces the scenario's (atoms over the world's ids; the planner
+    // refuses unknown names, which fails the mission as an input error).
+    goal->atoms.clear();
+    for (std::size_t i = 0; i < c.goal().size(); ++i) {
+      const std::string& a = c.goal()[i];
+      if (atomTokens(a).empty() || a.find('(') == std::string::npos)
+        return fail(MissionOutcome::kInputError, "goal[" + std::to_string(i) + "]: not a PDDL atom: '" + a + "'");
+      goal->atoms.push_back(a);
+    }
+  }
   GraphManager gm(std::move(abs), *domain, *goal, clients, p);
   logger()->info("mission {}: scenario {}, policy {}, goal {} atoms", id, sc->name, toString(p.policy), goal->atoms.size());
 

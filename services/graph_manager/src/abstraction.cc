@@ -202,20 +202,11 @@ std::vector<std::string> Abstraction::dynamicAtoms(const world::World& w, const 
     }
     if (!approach) continue;
     const Eigen::Vector2d l(approach->x, approach->y);
-    const Eigen::Vector2d po = o.pose.translation().head<2>();
-    const double ro = world::circumradius(o.shape.footprint(), Eigen::Vector2d::Zero());
     for (const auto& x : w.objects()) {
       if (x.id == o.id) continue;
       auto sx = support.find(x.id);
       if (sx == support.end() || sx->second != so->second) continue;
-      const Eigen::Vector2d px = x.pose.translation().head<2>();
-      const Eigen::Vector2d d = po - l;
-      const double len = d.norm();
-      if (len <= 0) continue;
-      const double t = (px - l).dot(d) / len;
-      const double lateral = std::abs(d.x() * (px - l).y() - d.y() * (px - l).x()) / len;
-      const double rx = world::circumradius(x.shape.footprint(), Eigen::Vector2d::Zero());
-      if (t > 0 && t < len && lateral < rx + ro) atoms.insert("(occludes " + x.id + " " + o.id + ")");
+      if (world::occludes(x, o, l)) atoms.insert("(occludes " + x.id + " " + o.id + ")");
     }
   }
   return {atoms.begin(), atoms.end()};

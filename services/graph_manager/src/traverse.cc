@@ -197,6 +197,28 @@ std::pair<double, double> GraphManager::price(const EffortQuery& q) {
   return {a[0].mean_s, a[0].stddev_s};
 }
 
+std::pair<double, double> GraphManager::pricePath(ActionKind kind, const JointPath& path, const BranchContext& ctx) {
+  EffortQuery q;
+  q.kind = kind;
+  q.path = path;
+  if (!ctx.held.object_id.empty())
+    if (const world::Object* o = abstraction_.world().findObject(ctx.held.object_id)) q.object_mass = o->mass;
+  return price(q);
+}
+
+MotionAnswer GraphManager::armMotion(const BranchContext& ctx, const std::vector<double>& target) {
+  MotionQuery q;
+  q.group = Group::kArm;
+  q.mode = Mode::kFull;
+  q.start = ctx.state;
+  q.goal_arm = target;
+  q.held = ctx.held;
+  for (const auto& [id, pose] : ctx.object_poses) q.overrides.push_back(ObjectOverride{id, false, pose});
+  q.budget_s = params_.motion_budget_s;
+  ++counters_.motion_calls;
+  return services_.motion(q);
+}
+
 double GraphManager::lowerBound(const Edge& e) const {
   if (e.kind != ActionKind::kMoveBase || e.tokens.size() < 3) return 0.0;
   const auto a = abstraction_.locationPose(e.tokens[1]);
@@ -298,12 +320,7 @@ double GraphManager::evaluateBase(Edge& e, const BranchContext& ctx, int depth) 
     m.crossings.push_back(c);
   }
   m.trajectory = a.trajectory;
-  EffortQuery eq;
-  eq.kind = ActionKind::kMoveBase;
-  eq.path = a.path;
-  if (!ctx.held.object_id.empty())
-    if (const world::Object* o = abstraction_.world().findObject(ctx.held.object_id)) eq.object_mass = o->mass;
-  const auto [mean, sd] = price(eq);
+  const auto [mean, sd] = pricePath(ActionKind::kMoveBase, a.path, ctx);
   e.motion = m;
   if (e.variant == Variant::kDirect && !m.blocking.empty()) {
     // Not executable as is: the detour is a parallel edge, removals are sub-tasks.
@@ -473,16 +490,7 @@ double GraphManager::evaluateArm(Edge& e, EdgeId next, const BranchContext& ctx)
       e.effort_by_next[next] = {kInfinity, 0.0};
       return kInfinity;
     }
-    MotionQuery q;
-    q.group = Group::kArm;
-    q.mode = Mode::kFull;
-    q.start = ctx.state;
-    q.goal_arm = target;
-    q.held = ctx.held;
-    for (const auto& [id, pose] : ctx.object_poses) q.overrides.push_back(ObjectOverride{id, false, pose});
-    q.budget_s = params_.motion_budget_s;
-    ++counters_.motion_calls;
-    a = services_.motion(q);
+    a = armMotion(ctx, target);
     if (a.ok()) break;
     e.reason = "arm motion: " + std::string(toString(a.status)) + (a.reason.empty() ? "" : ": " + a.reason);
     const bool manipulation_next = next >= 0 && (graph_.edge(next).kind == ActionKind::kPlace ||
@@ -495,12 +503,7 @@ double GraphManager::evaluateArm(Edge& e, EdgeId next, const BranchContext& ctx)
   }
   m->trajectory = a.trajectory;
   m->lazy_path = a.path;
-  EffortQuery eq;
-  eq.kind = ActionKind::kMoveArm;
-  eq.path = a.path;
-  if (!ctx.held.object_id.empty())
-    if (const world::Object* o = abstraction_.world().findObject(ctx.held.object_id)) eq.object_mass = o->mass;
-  const auto [mean, sd] = price(eq);
+  const auto [mean, sd] = pricePath(ActionKind::kMoveArm, a.path, ctx);
   e.motion_by_next[next] = *m;
   e.effort_by_next[next] = {mean, sd};
   e.state = EdgeState::kFeasible;
@@ -540,15 +543,7 @@ double GraphManager::evaluateManipulation(Edge& e, const BranchContext& ctx) {
         if (alternative == 0) e.reason = why;
         break;
       }
-      MotionQuery q;
-      q.group = Group::kArm;
-      q.mode = Mode::kFull;
-      q.start = ctx.state;
-      q.goal_arm = prepared->first.pregrasp;
-      q.held = ctx.held;
-      q.budget_s = params_.motion_budget_s;
-      ++counters_.motion_calls;
-      const MotionAnswer a = services_.motion(q);
+      const MotionAnswer a = armMotion(ctx, prepared->first.pregrasp);
       if (a.status == MotionOutcome::kGoalInCollision) {
         e.reason = "every pre-place configuration tried is in collision";
         continue;
@@ -576,28 +571,14 @@ double GraphManager::evaluateManipulation(Edge& e, const BranchContext& ctx) {
   // there first, executed as its own move_arm, then the approach, the gripper and the retreat.
   double transfer_s = 0.0, transfer_sd = 0.0;
   if (maxJointDelta(ctx.state.arm, g->pregrasp) > 1e-3) {
-    MotionQuery q;
-    q.group = Group::kArm;
-    q.mode = Mode::kFull;
-    q.start = ctx.state;
-    q.goal_arm = g->pregrasp;
-    q.held = ctx.held;
-    for (const auto& [id, pose] : ctx.object_poses) q.overrides.push_back(ObjectOverride{id, false, pose});
-    q.budget_s = params_.motion_budget_s;
-    ++counters_.motion_calls;
-    MotionAnswer a = services_.motion(q);
+    MotionAnswer a = armMotion(ctx, g->pregrasp);
     if (!a.ok()) {
       e.state = EdgeState::kInfeasible;
       e.reason = "arm motion to the pre-grasp: " + std::string(toString(a.status)) + (a.reason.empty() ? "" : ": " + a.reason);
       return kInfinity;
     }
     m.transfer = a.trajectory;
-    EffortQuery tq;
-    tq.kind = ActionKind::kMoveArm;
-    tq.path = a.path;
-    if (!ctx.held.object_id.empty())
-      if (const world::Object* h = abstraction_.world().findObject(ctx.held.object_id)) tq.object_mass = h->mass;
-    std::tie(transfer_s, transfer_sd) = price(tq);
+    std::tie(transfer_s, transfer_sd) = pricePath(ActionKind::kMoveArm, a.path, ctx);
   }
   m.trajectory = timed(robot.armJointNames(), {g->pregrasp, g->grasp, g->pregrasp}, 0.5);
   const double approach = (robot.toolPose(g->pregrasp).translation() - robot.toolPose(g->grasp).translation()).norm();

@@ -14,8 +14,7 @@
 /// without the flag an object is graspable when movable, within the payload and no wider than the
 /// open gripper; docs/scenarios.md). Paths inside a scenario are relative to the
 /// scenario file; `${TAMP_BENCHMARKS_DIR}` and `${TAMP_CONFIG_DIR}` prefixes expand to
-/// tamp::benchmarksDir() / tamp::configDir() (the older `${TAMP_SHARED_DIR}/benchmarks` is
-/// accepted for `${TAMP_BENCHMARKS_DIR}`).
+/// tamp::benchmarksDir() / tamp::configDir(); any other `${...}` is an error.
 ///
 /// `toPddlProblem()` derives the PDDL problem the world implies for the mobile-manipulation
 /// domain (objects, init facts, goal): `reaches` from inverse kinematics at each location,
@@ -147,6 +146,11 @@ struct PddlProblem {
 /// The PDDL problem the scenario's planner world implies (see the file comment). `robot` must be
 /// the scenario's robot model. Errors: kInvalidArgument when a goal atom names an unknown object.
 Result<PddlProblem> toPddlProblem(const Scenario& scenario, const robot::RobotModel& robot);
+
+/// True when `x` stands in the corridor from `approach` (a base position, world xy) to `o`:
+/// ahead of the approach, short of `o`, and laterally closer than the sum of their footprints'
+/// circumradii. The basis of the `occludes` facts.
+bool occludes(const Object& x, const Object& o, const Eigen::Vector2d& approach);
 
 /// True when the arm, with the base at `base`, reaches a top-down grasp 0.10 m above some point of
 /// `region` (the point 0.55 m ahead of the base if inside the region, else the region's point

@@ -194,6 +194,10 @@ class GraphManager {
   std::optional<EdgeMotion> armTarget(const Edge& arm_edge, EdgeId next, const BranchContext& ctx,
                                       std::vector<double>& target, std::string& why, int alternative = 0);
   std::pair<double, double> price(const EffortQuery& q);
+  /// Effort of a base or arm path in the branch's context (the held object's mass).
+  std::pair<double, double> pricePath(ActionKind kind, const JointPath& path, const BranchContext& ctx);
+  /// A collision-free arm motion from the context's state to `target` in the branch's world.
+  MotionAnswer armMotion(const BranchContext& ctx, const std::vector<double>& target);
   /// A place of the held `object` on `region` (a slot's pose, else a sampled placement the arm
   /// reaches from the context's base): pre-place and place configurations, the object pose.
   std::optional<std::pair<GraspOption, Eigen::Isometry3d>> preparePlace(const std::string& object,

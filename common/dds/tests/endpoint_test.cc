@@ -119,6 +119,38 @@ TEST(EndpointTest, TransientLocalStateReachesLateJoinerAndDisposeIsReported) {
   EXPECT_EQ(alive.count("can"), 0u);
 }
 
+TEST(EndpointTest, KeyedCommandsAndEventsAreNotLimitedToTenInstances) {
+  // One instance per command id: a mission sends far more than Fast DDS's default 10, and the
+  // 11th write once blocked until TIMEOUT. Every class whose topics are keyed per command.
+  auto p = makeParticipant();
+  ASSERT_TRUE(p);
+  Reader<msg::ExecuteCommand> commands(p, topics::kExecuteCommand);
+  Reader<msg::ExecuteStatus> statuses(p, topics::kExecuteStatus);
+  Writer<msg::ExecuteCommand> command_writer(p, topics::kExecuteCommand);
+  Writer<msg::ExecuteStatus> status_writer(p, topics::kExecuteStatus);
+  ASSERT_TRUE(command_writer.waitForReaders(Termination::after(5.0)));
+  ASSERT_TRUE(status_writer.waitForReaders(Termination::after(5.0)));
+  constexpr int kCommands = 40;
+  for (int i = 0; i < kCommands; ++i) {
+    msg::ExecuteCommand c;
+    c.command_id("m" + std::to_string(i));
+    ASSERT_TRUE(command_writer.write(c).ok()) << "command " << i;
+    msg::ExecuteStatus st;
+    st.command_id(c.command_id());
+    ASSERT_TRUE(status_writer.write(st).ok()) << "status " << i;
+  }
+  int got_commands = 0, got_statuses = 0;
+  const Deadline d = Deadline::in(10.0);
+  while ((got_commands < kCommands || got_statuses < kCommands) && !d.expired()) {
+    bool any = false;
+    while (commands.takeNext()) ++got_commands, any = true;
+    while (statuses.takeNext()) ++got_statuses, any = true;
+    if (!any) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  EXPECT_EQ(got_commands, kCommands);
+  EXPECT_EQ(got_statuses, kCommands);
+}
+
 TEST(EndpointTest, ThrowingCallbackIsContainedAndCounted) {
   auto p = makeParticipant();
   ASSERT_TRUE(p);

@@ -155,7 +155,10 @@ std::vector<BaseStep> baseSteps(const std::vector<Pose2D>& poses) {
       }
     }
     flushRun();
-    turnTo(std::atan2(dy, dx));
+    // Forwards or backwards, whichever turns less.
+    const double forwards = std::atan2(dy, dx);
+    const double backwards = std::remainder(forwards + M_PI, 2.0 * M_PI);
+    turnTo(std::abs(angleDiff(backwards, heading)) < std::abs(angleDiff(forwards, heading)) ? backwards : forwards);
     run_ux = dx / d;
     run_uy = dy / d;
     run.amount = d;

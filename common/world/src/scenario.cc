@@ -966,7 +966,7 @@ Result<Scenario> loadScenario(const std::filesystem::path& file) {
 // ---- PDDL
 // -------------------------------------------------------------------------------------------
 
-bool occludes(const Object& x, const Object& o, const Eigen::Vector2d& approach) {
+bool occludes(const Object& x, const Object& o, const Eigen::Vector2d& approach, double margin) {
   const Eigen::Vector2d po = o.pose.translation().head<2>();
   const Eigen::Vector2d px = x.pose.translation().head<2>();
   const Eigen::Vector2d d = po - approach;
@@ -976,7 +976,9 @@ bool occludes(const Object& x, const Object& o, const Eigen::Vector2d& approach)
   const double lateral = std::abs(d.x() * (px - approach).y() - d.y() * (px - approach).x()) / len;
   const double ro = circumradius(o.shape.footprint(), Eigen::Vector2d::Zero());
   const double rx = circumradius(x.shape.footprint(), Eigen::Vector2d::Zero());
-  return t > 0 && t < len && lateral < rx + ro;
+  const bool in_corridor = t > 0 && t < len && lateral < rx + ro + margin;
+  const bool crowding = margin > 0 && (px - po).norm() < rx + ro + margin;  // in the grasp's room
+  return in_corridor || crowding;
 }
 
 bool reachesRegion(const robot::RobotModel& robot, const Pose2D& base, const Region& region) {

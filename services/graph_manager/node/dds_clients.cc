@@ -38,6 +38,14 @@ MotionOutcome fromMsg(msg::MotionStatus s) {
   }
 }
 
+msg::ObjectOverride toMsg(const ObjectOverride& o) {
+  msg::ObjectOverride m;
+  m.object_id(o.object_id);
+  m.removed(o.removed);
+  m.pose(dds::toMsg(o.pose));
+  return m;
+}
+
 }  // namespace
 
 DdsServiceClients::DdsServiceClients(std::shared_ptr<dds::Participant> p, robot::RobotModel robot)
@@ -99,13 +107,7 @@ MotionAnswer DdsServiceClients::motion(const MotionQuery& q) {
     req.held_link_T_object(dds::toMsg(q.held.link_T_object));
   }
   req.ignored_objects(q.ignored);
-  for (const auto& o : q.overrides) {
-    msg::ObjectOverride m;
-    m.object_id(o.object_id);
-    m.removed(o.removed);
-    m.pose(dds::toMsg(o.pose));
-    req.object_overrides().push_back(m);
-  }
+  for (const auto& o : q.overrides) req.object_overrides().push_back(toMsg(o));
   req.movable_cost_weight(q.movable_cost_weight);
   MotionAnswer a;
   const auto t0 = Clock::now();
@@ -156,6 +158,16 @@ Result<std::vector<PlacementOption>> DdsServiceClients::placements(const Placeme
   for (const auto& p : q.keep_clear_path) req.keep_clear_path().push_back(dds::toMsg(p));
   req.keep_clear_radius(q.keep_clear_radius);
   req.max_placements(q.max_placements);
+  if (q.base) {
+    req.base_given(true);
+    req.base_pose(dds::toMsg(*q.base));
+  }
+  if (q.object_T_tool) {
+    req.held_grasp_given(true);
+    req.held_object_T_tool(dds::toMsg(*q.object_T_tool));
+  }
+  req.approach(q.approach_m);
+  for (const auto& o : q.overrides) req.object_overrides().push_back(toMsg(o));
   auto rep = placement_.call(req, dds::CallOptions{q.budget_s, {}});
   if (!rep) return rep.error();
   if (rep->header().code() != msg::StatusCode::STATUS_OK)
@@ -168,6 +180,7 @@ Result<std::vector<PlacementOption>> DdsServiceClients::placements(const Placeme
     o.object_pose = *pose;
     o.base_pose = Pose2D{p.base_pose().x(), p.base_pose().y(), p.base_pose().theta()};
     o.arm.assign(p.arm_configuration().begin(), p.arm_configuration().end());
+    o.pre_arm.assign(p.pre_arm_configuration().begin(), p.pre_arm_configuration().end());
     o.clearance = p.clearance();
     out.push_back(o);
   }
@@ -180,6 +193,7 @@ Result<std::vector<GraspOption>> DdsServiceClients::grasps(const GraspQuery& q) 
   req.base_given(q.base.has_value());
   if (q.base) req.base_pose(dds::toMsg(*q.base));
   req.max_grasps(q.max_grasps);
+  for (const auto& o : q.overrides) req.object_overrides().push_back(toMsg(o));
   auto rep = grasp_.call(req, dds::CallOptions{q.budget_s, {}});
   if (!rep) return rep.error();
   if (rep->header().code() != msg::StatusCode::STATUS_OK)

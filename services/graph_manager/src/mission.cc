@@ -101,30 +101,49 @@ MissionReport GraphManager::runMission(WorldSource& source, Executor& executor, 
     Edge& e = graph_.edge(id);
     // A manipulation follows from the arm motion just executed (its grasp or place pose) and the
     // arm as it is: priced again from there.
-    if (e.kind == ActionKind::kPick || e.kind == ActionKind::kPlace) evaluate(id, -1, ctx, 0);
+    // Not preparable in the world as it is now: a failure like any other, then repair (grasps
+    // and placements are asked again: the world model may have changed since).
+    auto notPrepared = [&](const std::string& what) {
+      e.state = EdgeState::kFailed;
+      ExecutedAction a;
+      a.action = e.action;
+      a.outcome = "not prepared";
+      a.reason = "cannot prepare " + what + ": " + e.reason;
+      report.actions.push_back(a);
+      if (observer.on_action) observer.on_action(a, done_effort, branch_total);
+      if (++failures > params_.max_replans) return false;
+      ++report.replans;
+      grasp_cache_.clear();
+      placement_cache_.clear();
+      if (e.kind == ActionKind::kMoveArm) {
+        e.motion_by_next.erase(armKey(id, next));
+        e.effort_by_next.erase(armKey(id, next));
+      } else {
+        e.motion.reset();
+      }
+      e.state = EdgeState::kUnevaluated;
+      branch.clear();
+      return true;
+    };
+    if (e.kind == ActionKind::kPick || e.kind == ActionKind::kPlace) {
+      // A manipulation is never sent deferred: its grasp is planned now or it is a failure.
+      if (!std::isfinite(evaluate(id, -1, ctx, 0)) || !e.motion || e.motion->deferred || e.motion->trajectory.empty()) {
+        if (e.reason.empty()) e.reason = "no grasp or placement in the world as it is now";
+        if (!notPrepared(e.action))
+          return finish(MissionOutcome::kFailed, "gave up after " + std::to_string(failures) + " failures; last: " +
+                                                     report.actions.back().reason);
+        continue;
+      }
+    }
     // An arm motion into a manipulation is planned again in the world as it is now: the branch
     // priced it in a hypothetical world (objects moved by earlier edges, grasps deferred).
     if (e.kind == ActionKind::kMoveArm && armKey(id, next) >= 0) {
       e.motion_by_next.erase(armKey(id, next));
       e.effort_by_next.erase(armKey(id, next));
       if (!std::isfinite(evaluate(id, next, ctx, 0))) {
-        // Not preparable in the world as it is now: a failure like any other, then repair.
-        e.state = EdgeState::kFailed;
-        ExecutedAction a;
-        a.action = e.action;
-        a.outcome = "not prepared";
-        a.reason = "cannot prepare " + graph_.edge(next).action + ": " + e.reason;
-        report.actions.push_back(a);
-        if (observer.on_action) observer.on_action(a, done_effort, branch_total);
-        if (++failures > params_.max_replans)
-          return finish(MissionOutcome::kFailed, "gave up after " + std::to_string(failures) + " failures; last: " + a.reason);
-        ++report.replans;
-        // Grasps are asked again (the world model may have changed since): forget the cached ones.
-        grasp_cache_.clear();
-        e.motion_by_next.erase(armKey(id, next));
-        e.effort_by_next.erase(armKey(id, next));
-        e.state = EdgeState::kUnevaluated;
-        branch.clear();
+        if (!notPrepared(graph_.edge(next).action))
+          return finish(MissionOutcome::kFailed, "gave up after " + std::to_string(failures) + " failures; last: " +
+                                                     report.actions.back().reason);
         continue;
       }
     }

@@ -6,6 +6,7 @@
 
 #include "tamp/core/log.h"
 #include "tamp/graph_manager/graph_manager.h"
+#include "tamp/world/scenario.h"
 
 namespace tamp::graph_manager {
 namespace {
@@ -213,7 +214,7 @@ MotionAnswer GraphManager::armMotion(const BranchContext& ctx, const std::vector
   q.start = ctx.state;
   q.goal_arm = target;
   q.held = ctx.held;
-  for (const auto& [id, pose] : ctx.object_poses) q.overrides.push_back(ObjectOverride{id, false, pose});
+  q.overrides = overridesOf(ctx);
   q.budget_s = params_.motion_budget_s;
   ++counters_.motion_calls;
   return services_.motion(q);
@@ -234,7 +235,7 @@ MotionQuery GraphManager::baseQuery(const Edge& e, const BranchContext& ctx) con
   q.start = ctx.state;
   if (auto to = abstraction_.locationPose(e.tokens.size() > 2 ? e.tokens[2] : "")) q.goal_base = *to;
   q.held = ctx.held;
-  for (const auto& [id, pose] : ctx.object_poses) q.overrides.push_back(ObjectOverride{id, false, pose});
+  q.overrides = overridesOf(ctx);
   q.movable_cost_weight = 0.0;  // the pure static-only lazy path
   q.budget_s = params_.motion_budget_s;
   return q;
@@ -351,55 +352,118 @@ double GraphManager::evaluateBase(Edge& e, const BranchContext& ctx, int depth) 
   return mean;
 }
 
+bool GraphManager::occludesFromBase(const std::string& object, const std::string& region,
+                                    const Eigen::Isometry3d& pose, const BranchContext& ctx) const {
+  const world::Object* x = abstraction_.world().findObject(object);
+  if (!x) return false;
+  world::Object placed = *x;
+  placed.pose = pose;
+  const Eigen::Vector2d approach(ctx.state.base.x, ctx.state.base.y);
+  for (const auto& o : abstraction_.world().objects()) {
+    if (o.id == object || o.kind != world::ObjectKind::kMovable) continue;
+    world::Object there = o;
+    if (auto it = ctx.object_poses.find(o.id); it != ctx.object_poses.end()) there.pose = it->second;
+    const world::Region* below = abstraction_.world().regionBelow(
+        there.pose.translation() - Eigen::Vector3d(0, 0, there.shape.halfHeight()));
+    if (!below || below->id != region) continue;  // only objects on the same support
+    // The room a top grasp of the other object needs: the gripper's opening and a finger's width.
+    const double margin = abstraction_.robot().gripperLimits().upper + 0.02;
+    if (world::occludes(placed, there, approach, margin)) return true;
+  }
+  return false;
+}
+
+std::vector<ObjectOverride> GraphManager::overridesOf(const BranchContext& ctx, const std::string& except) {
+  std::vector<ObjectOverride> out;
+  for (const auto& [id, pose] : ctx.object_poses) {
+    if (id != except) out.push_back(ObjectOverride{id, false, pose});
+  }
+  return out;
+}
+
+std::string GraphManager::worldKey(const BranchContext& ctx) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "%.3f,%.3f,%.3f", ctx.state.base.x, ctx.state.base.y, ctx.state.base.theta);
+  std::string k = buf;
+  for (const auto& [id, pose] : ctx.object_poses) {
+    std::snprintf(buf, sizeof buf, "|%.3f,%.3f,%.3f", pose.translation().x(), pose.translation().y(),
+                  pose.translation().z());
+    k += id + buf;
+  }
+  return k;
+}
+
 std::optional<std::pair<GraspOption, Eigen::Isometry3d>> GraphManager::preparePlace(
     const std::string& object, const std::string& region, const BranchContext& ctx, std::string& why, int skip) {
-  const robot::RobotModel& robot = abstraction_.robot();
   if (ctx.held.object_id != object) {
     why = "place of " + object + " while not holding it";
     return std::nullopt;
   }
-  std::vector<Eigen::Isometry3d> candidates;
-  if (const Slot* s = abstraction_.slot(region)) {
-    candidates.push_back(s->pose);
-  } else {
-    const std::string key = object + "@" + region;
-    auto it = placement_cache_.find(key);
-    if (it == placement_cache_.end()) {
-      PlacementQuery pq;
-      pq.object_id = object;
-      pq.region_id = region;
-      pq.max_placements = 32;
-      ++counters_.placement_calls;
-      auto p = services_.placements(pq);
-      it = placement_cache_.emplace(key, p ? *p : std::vector<PlacementOption>{}).first;
-      if (!p) why = "placements of " + object + " on " + region + ": " + p.error().message;
-    }
-    for (const auto& opt : it->second) candidates.push_back(opt.object_pose);
-  }
-  // The first candidate whose place and pre-place poses the arm reaches from this base.
+  const Slot* slot = abstraction_.slot(region);
+  if (!slot) return sampledPlace(object, region, ctx, why, skip);
+  // A slot is one pose: the arm reaches it and the pre-place pose above it, or not.
+  const robot::RobotModel& robot = abstraction_.robot();
   const Eigen::Isometry3d base_inv = ctx.state.base.toIsometry(0.0).inverse();
   robot::IkOptions io;
   io.max_attempts = 16;
-  for (const auto& place : candidates) {
-    const Eigen::Isometry3d world_T_tool = place * ctx.held.link_T_object.inverse();
-    Eigen::Isometry3d pre = world_T_tool;
-    pre.translation().z() += params_.approach_m;
-    auto pre_ik = robot.inverseKinematics(base_inv * pre, ctx.state.arm, io);
-    if (!pre_ik.ok()) continue;
-    auto at_ik = robot.inverseKinematics(base_inv * world_T_tool, pre_ik.q, io);
-    if (!at_ik.ok()) continue;
-    if (skip-- > 0) continue;
+  const Eigen::Isometry3d world_T_tool = slot->pose * ctx.held.link_T_object.inverse();
+  Eigen::Isometry3d pre = world_T_tool;
+  pre.translation().z() += params_.approach_m;
+  auto pre_ik = robot.inverseKinematics(base_inv * pre, ctx.state.arm, io);
+  auto at_ik = pre_ik.ok() ? robot.inverseKinematics(base_inv * world_T_tool, pre_ik.q, io) : pre_ik;
+  if (!pre_ik.ok() || !at_ik.ok() || skip > 0) {
+    why = "the arm does not reach slot " + region + " for " + object + " from this base pose";
+    return std::nullopt;
+  }
+  GraspOption g;
+  g.pregrasp = pre_ik.q;
+  g.grasp = at_ik.q;
+  g.base_pose = ctx.state.base;
+  g.gripper_in_object = ctx.held.link_T_object.inverse();
+  return std::make_pair(g, slot->pose);
+}
+
+std::optional<std::pair<GraspOption, Eigen::Isometry3d>> GraphManager::sampledPlace(
+    const std::string& object, const std::string& region, const BranchContext& ctx, std::string& why, int skip) {
+  // Placements the arm reaches from where the base stands, with the object held as it is and
+  // collision-free place and pre-place configurations (the motion planner checks them), in the
+  // branch's world. Asked once per base pose and world.
+  const std::string k = object + "@" + region + "@" + worldKey(ctx);
+  auto it = placement_cache_.find(k);
+  if (it == placement_cache_.end()) {
+    PlacementQuery pq;
+    pq.object_id = object;
+    pq.region_id = region;
+    pq.max_placements = 16;
+    pq.base = ctx.state.base;
+    pq.object_T_tool = ctx.held.link_T_object.inverse();
+    pq.approach_m = params_.approach_m;
+    pq.overrides = overridesOf(ctx, object);
+    ++counters_.placement_calls;
+    auto p = services_.placements(pq);
+    if (!p) why = "placements of " + object + " on " + region + ": " + p.error().message;
+    std::vector<PlacementOption> kept = p ? *p : std::vector<PlacementOption>{};
+    // A place does not bring back occlusion: from where the arm works, the placed object must
+    // stand in front of no other object (the domain's place adds no `occludes`).
+    kept.erase(std::remove_if(kept.begin(), kept.end(),
+                              [&](const PlacementOption& o) { return occludesFromBase(object, region, o.object_pose, ctx); }),
+               kept.end());
+    if (p && !p->empty() && kept.empty())
+      why = "every placement of " + object + " on " + region + " reachable from this base pose hides another object";
+    it = placement_cache_.emplace(k, std::move(kept)).first;
+  }
+  if (skip < static_cast<int>(it->second.size())) {
+    const PlacementOption& opt = it->second[static_cast<std::size_t>(skip)];
     GraspOption g;
-    g.pregrasp = pre_ik.q;
-    g.grasp = at_ik.q;
+    g.pregrasp = opt.pre_arm;
+    g.grasp = opt.arm;
     g.base_pose = ctx.state.base;
     g.gripper_in_object = ctx.held.link_T_object.inverse();
-    return std::make_pair(g, place);
+    return std::make_pair(g, opt.object_pose);
   }
   if (why.empty())
-    why = candidates.empty() ? "no placement of " + object + " on " + region
-                             : "the arm reaches none of " + std::to_string(candidates.size()) + " placements of " +
-                                   object + " on " + region + " from this base pose";
+    why = it->second.empty() ? "the arm reaches no free placement of " + object + " on " + region + " from this base pose"
+                             : "every placement of " + object + " on " + region + " tried from this base pose failed";
   return std::nullopt;
 }
 
@@ -427,15 +491,14 @@ std::optional<EdgeMotion> GraphManager::armTarget(const Edge& arm_edge, EdgeId n
   const std::string& object = f.tokens[1];
   const std::string& region = f.tokens[2];
   if (f.kind == ActionKind::kPick) {
-    char key[160];
-    std::snprintf(key, sizeof key, "%s@%.3f,%.3f,%.3f", object.c_str(), ctx.state.base.x, ctx.state.base.y,
-                  ctx.state.base.theta);
+    const std::string key = object + "@" + worldKey(ctx);
     auto it = grasp_cache_.find(key);
     if (it == grasp_cache_.end()) {
       GraspQuery gq;
       gq.object_id = object;
       gq.base = ctx.state.base;
       gq.max_grasps = 8;
+      gq.overrides = overridesOf(ctx, object);
       ++counters_.grasp_calls;
       auto g = services_.grasps(gq);
       it = grasp_cache_.emplace(key, g ? *g : std::vector<GraspOption>{}).first;
@@ -528,6 +591,7 @@ double GraphManager::evaluateManipulation(Edge& e, const BranchContext& ctx) {
     GraspQuery gq;
     gq.object_id = object;
     gq.base = ctx.state.base;
+    gq.overrides = overridesOf(ctx, object);
     ++counters_.grasp_calls;
     auto grasps = services_.grasps(gq);
     if (grasps && !grasps->empty()) g = grasps->front();

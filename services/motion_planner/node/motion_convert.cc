@@ -18,6 +18,25 @@ bool allFinite(const std::vector<double>& v) {
   return true;
 }
 
+Result<std::vector<ObjectOverride>> overridesFromMsg(const std::vector<msg::ObjectOverride>& in) {
+  std::vector<ObjectOverride> out;
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    const msg::ObjectOverride& o = in[i];
+    const std::string field = "object_overrides[" + std::to_string(i) + "]";
+    if (o.object_id().empty()) return bad(field + ".object_id", "empty");
+    ObjectOverride ov;
+    ov.object_id = o.object_id();
+    ov.removed = o.removed();
+    if (!o.removed()) {
+      auto p = dds::fromMsg(o.pose(), field + ".pose");
+      if (!p) return p.error();
+      ov.pose = *p;
+    }
+    out.push_back(std::move(ov));
+  }
+  return out;
+}
+
 }  // namespace
 
 msg::MotionStatus toMsg(MotionStatus s) {
@@ -91,20 +110,9 @@ Result<MotionRequest> fromMsg(const msg::MotionRequest& m, const MotionPlanner& 
     r.held_grasp = HeldGrasp{m.held_link(), *t};
   }
   r.ignored_objects.assign(m.ignored_objects().begin(), m.ignored_objects().end());
-  for (std::size_t i = 0; i < m.object_overrides().size(); ++i) {
-    const msg::ObjectOverride& o = m.object_overrides()[i];
-    const std::string field = "object_overrides[" + std::to_string(i) + "]";
-    if (o.object_id().empty()) return bad(field + ".object_id", "empty");
-    ObjectOverride ov;
-    ov.object_id = o.object_id();
-    ov.removed = o.removed();
-    if (!o.removed()) {
-      auto p = dds::fromMsg(o.pose(), field + ".pose");
-      if (!p) return p.error();
-      ov.pose = *p;
-    }
-    r.object_overrides.push_back(std::move(ov));
-  }
+  auto overrides = overridesFromMsg(m.object_overrides());
+  if (!overrides) return overrides.error();
+  r.object_overrides = std::move(*overrides);
   const double w = m.movable_cost_weight();
   if (!std::isfinite(w) || w < 0) return bad("movable_cost_weight", "must be finite and >= 0");
   r.object_cost_scale = w;
@@ -170,6 +178,22 @@ Result<PlacementRequest> fromMsg(const msg::PlacementRequest& m) {
   }
   r.keep_clear_radius = m.keep_clear_radius();
   r.max_placements = m.max_placements() == 0 ? 8u : std::min<std::uint32_t>(m.max_placements(), 256u);
+  if (m.base_given()) {
+    auto b = dds::fromMsg(m.base_pose(), "base_pose");
+    if (!b) return b.error();
+    r.base = *b;
+  }
+  if (m.held_grasp_given()) {
+    if (!m.base_given()) return bad("held_grasp_given", "true without base_given");
+    auto t = dds::fromMsg(m.held_object_T_tool(), "held_object_T_tool");
+    if (!t) return t.error();
+    r.held_object_T_tool = *t;
+  }
+  if (!std::isfinite(m.approach()) || m.approach() < 0) return bad("approach", "must be finite and >= 0");
+  r.approach = m.approach();
+  auto overrides = overridesFromMsg(m.object_overrides());
+  if (!overrides) return overrides.error();
+  r.object_overrides = std::move(*overrides);
   return r;
 }
 
@@ -180,6 +204,7 @@ msg::PlacementReply toMsg(const std::vector<Placement>& placements) {
     o.object_pose(dds::toMsg(p.object_pose));
     o.base_pose(dds::toMsg(p.base_pose));
     o.arm_configuration(p.arm_configuration);
+    o.pre_arm_configuration(p.pre_arm_configuration);
     o.clearance(p.clearance);
     m.placements().push_back(std::move(o));
   }
@@ -196,6 +221,9 @@ Result<GraspRequest> fromMsg(const msg::GraspRequest& m) {
     r.base_pose = *p;
   }
   r.max_grasps = m.max_grasps() == 0 ? 8u : std::min<std::uint32_t>(m.max_grasps(), 64u);
+  auto overrides = overridesFromMsg(m.object_overrides());
+  if (!overrides) return overrides.error();
+  r.object_overrides = std::move(*overrides);
   return r;
 }
 

@@ -96,6 +96,17 @@ Result<std::vector<Grasp>> MotionPlanner::generateGrasps(const GraspRequest& req
     }
   }
   if (req.max_grasps == 0) return Error(ErrorCode::kInvalidArgument, "max_grasps: must be >= 1");
+  // The request's world: the planner's with the overrides applied; the scene goes back after.
+  auto hypothetical = overriddenWorld(impl.world, req.object_overrides, req.object_id);
+  if (!hypothetical) return hypothetical.error();
+  struct Restore {
+    MotionPlanner::Impl& impl;
+    ~Restore() { impl.scene.syncWorld(impl.world); }
+  } restore{impl};
+  if (!req.object_overrides.empty()) {
+    impl.scene.syncWorld(*hypothetical);
+    obj = hypothetical->findObject(req.object_id);
+  }
 
   const double max_open = m->gripperLimits().upper;
   const auto cands = graspCandidates(obj->shape, P, max_open);

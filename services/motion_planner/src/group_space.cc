@@ -7,6 +7,7 @@
 #include <ompl/base/ProjectionEvaluator.h>
 #include <ompl/base/spaces/RealVectorStateSpace.h>
 #include <ompl/base/spaces/SE2StateSpace.h>
+#include <ompl/base/spaces/SO2StateSpace.h>
 
 #include "internal.h"
 
@@ -20,6 +21,81 @@ double segmentDistance(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const
   const double t = l2 > 0 ? std::clamp((p - a).dot(ab) / l2, 0.0, 1.0) : 0.0;
   return (a + t * ab - p).norm();
 }
+
+/// SE(2) as the base really moves: stop and turn. A motion from a to b turns in place at a to the
+/// heading of the segment (or its reverse, whichever is nearer), drives straight to b, and turns in place there to b's yaw;
+/// a motion without translation is a turn in place. Interpolation follows those three pieces, so
+/// every motion check, roadmap edge and path validation checks what the robot will sweep
+/// (docs/sim.md, effort_model::baseSteps), not a holonomic slide with the yaw blended in.
+class TurnDriveTurnSpace : public ob::SE2StateSpace {
+ public:
+  /// `turn_radius`: m per rad of turn for segment lengths (the robot's circumradius: the arc its
+  /// farthest point sweeps).
+  explicit TurnDriveTurnSpace(double turn_radius) : turn_radius_(std::max(turn_radius, 1e-3)) {}
+
+  void interpolate(const ob::State* from, const ob::State* to, double t, ob::State* state) const override {
+    const Pieces p = pieces(from, to);
+    const auto* a = from->as<StateType>();
+    const auto* b = to->as<StateType>();
+    auto* o = state->as<StateType>();
+    const double l1 = std::abs(p.turn1) * turn_radius_, l3 = std::abs(p.turn2) * turn_radius_;
+    const double total = l1 + p.drive + l3;
+    if (total <= 0.0) {
+      copyState(state, from);
+      return;
+    }
+    const double at = std::clamp(t, 0.0, 1.0) * total;
+    if (at <= l1) {
+      o->setXY(a->getX(), a->getY());
+      o->setYaw(a->getYaw() + (l1 > 0 ? p.turn1 * at / l1 : 0.0));
+    } else if (at <= l1 + p.drive) {
+      const double f = p.drive > 0 ? (at - l1) / p.drive : 1.0;
+      o->setXY(a->getX() + f * (b->getX() - a->getX()), a->getY() + f * (b->getY() - a->getY()));
+      o->setYaw(p.heading);
+    } else {
+      o->setXY(b->getX(), b->getY());
+      o->setYaw(p.heading + (l3 > 0 ? p.turn2 * (at - l1 - p.drive) / l3 : 0.0));
+    }
+    getSubspace(1)->enforceBounds(o->as<ob::SO2StateSpace::StateType>(1));
+  }
+
+  unsigned int validSegmentCount(const ob::State* s1, const ob::State* s2) const override {
+    const Pieces p = pieces(s1, s2);
+    const double total = (std::abs(p.turn1) + std::abs(p.turn2)) * turn_radius_ + p.drive;
+    return longestValidSegmentCountFactor_ *
+           static_cast<unsigned int>(std::max(1.0, std::ceil(total / longestValidSegment_)));
+  }
+
+ private:
+  struct Pieces {
+    double turn1{0.0};  // rad, signed
+    double drive{0.0};  // m
+    double turn2{0.0};  // rad, signed
+    double heading{0.0};
+  };
+  static double wrap(double a) { return std::remainder(a, 2.0 * M_PI); }
+  static Pieces pieces(const ob::State* from, const ob::State* to) {
+    const auto* a = from->as<StateType>();
+    const auto* b = to->as<StateType>();
+    Pieces p;
+    const double dx = b->getX() - a->getX(), dy = b->getY() - a->getY();
+    p.drive = std::hypot(dx, dy);
+    if (p.drive < 1e-6) {
+      p.drive = 0.0;
+      p.heading = a->getYaw();
+      p.turn1 = wrap(b->getYaw() - a->getYaw());
+      return p;
+    }
+    // Forwards or backwards, whichever turns less at the start (as effort_model::baseSteps).
+    p.heading = std::atan2(dy, dx);
+    if (std::abs(wrap(p.heading + M_PI - a->getYaw())) < std::abs(wrap(p.heading - a->getYaw())))
+      p.heading = wrap(p.heading + M_PI);
+    p.turn1 = wrap(p.heading - a->getYaw());
+    p.turn2 = wrap(b->getYaw() - p.heading);
+    return p;
+  }
+  double turn_radius_;
+};
 
 /// KPIECE projection of the base: (x, y) of the SE(2) state (itself or the first component).
 class BaseXYProjection : public ob::ProjectionEvaluator {
@@ -125,7 +201,8 @@ GroupSpace::GroupSpace(const RobotBinding& robot, PlanningGroup group, const rob
   }
   std::shared_ptr<ob::SE2StateSpace> se2;
   if (group != PlanningGroup::kArm) {
-    se2 = std::make_shared<ob::SE2StateSpace>();
+    se2 = params.base_turn_in_place ? std::make_shared<TurnDriveTurnSpace>(robot.footprintRadius())
+                                    : std::make_shared<ob::SE2StateSpace>();
     ob::RealVectorBounds b(2);
     b.setLow(0, base_bounds.min.x());
     b.setLow(1, base_bounds.min.y());

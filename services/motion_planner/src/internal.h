@@ -354,4 +354,11 @@ double reportedLength(const GroupSpace& gs, const og::PathGeometric& path);
 /// Group joint values along the path (yaw unwrapped).
 JointPath toJointPath(const GroupSpace& gs, const og::PathGeometric& path);
 
+/// A stop-and-turn base path made to say what the robot will do: each inner waypoint takes the
+/// heading the robot drives the next segment with (forwards or backwards, whichever turns less
+/// from the heading it arrives with), so the turns the motions were checked with are the turns
+/// executed (effort_model::baseSteps). Kept only when every changed motion is still valid
+/// (`si`'s motion validator); returns whether the path changed. Base group paths only.
+bool alignBaseHeadings(const ob::SpaceInformationPtr& si, og::PathGeometric& path);
+
 }  // namespace tamp::motion_planner::detail

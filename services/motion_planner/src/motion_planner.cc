@@ -439,24 +439,27 @@ std::optional<std::string> validateRequest(const MotionRequest& r, const MotionP
   return std::nullopt;
 }
 
+}  // namespace
+
 /// The planner's world with the request's object overrides applied; errors name the override.
-Result<world::World> overriddenWorld(const world::World& base, const MotionRequest& r) {
+Result<world::World> overriddenWorld(const world::World& base, const std::vector<ObjectOverride>& overrides,
+                                     const std::string& held_object) {
   world::World w = base;
-  for (std::size_t i = 0; i < r.object_overrides.size(); ++i) {
-    const ObjectOverride& o = r.object_overrides[i];
+  for (std::size_t i = 0; i < overrides.size(); ++i) {
+    const ObjectOverride& o = overrides[i];
     const std::string field = "object_overrides[" + std::to_string(i) + "]";
     if (!base.findObject(o.object_id)) {
       return Error(ErrorCode::kInvalidArgument, field + ".object_id: no object '" + o.object_id + "' in the world");
     }
     for (std::size_t j = 0; j < i; ++j) {
-      if (r.object_overrides[j].object_id == o.object_id) {
+      if (overrides[j].object_id == o.object_id) {
         return Error(ErrorCode::kInvalidArgument, field + ".object_id: '" + o.object_id +
                                                       "' is overridden twice (also object_overrides[" +
                                                       std::to_string(j) + "])");
       }
     }
     if (o.removed) {
-      if (o.object_id == r.held_object) {
+      if (o.object_id == held_object) {
         return Error(ErrorCode::kInvalidArgument, field + ".removed: '" + o.object_id + "' is the held object");
       }
       if (Status s = w.removeObject(o.object_id); !s) {
@@ -471,6 +474,8 @@ Result<world::World> overriddenWorld(const world::World& base, const MotionReque
   }
   return w;
 }
+
+namespace {
 
 /// Puts the planner's scene and world back when a request planned in a hypothetical world ends.
 class WorldRestore {
@@ -614,7 +619,7 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
   // (declared before the attachment so that the held object is detached first).
   WorldRestore restore;
   if (!req.object_overrides.empty()) {
-    auto hypothetical = overriddenWorld(impl.world, req);
+    auto hypothetical = overriddenWorld(impl.world, req.object_overrides, req.held_object);
     if (!hypothetical) return finish(MotionStatus::kInvalidRequest, hypothetical.error().message);
     restore = WorldRestore(impl, std::move(*hypothetical));
   }
@@ -957,6 +962,7 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
     detail::effortShortcut(oracle, ep, P.lazy.shortcut_attempts, res_check, spu, rng, termination);
     res.cost_s = ep.cost(oracle, spu).cost;
     final_path = ep.path;
+    if (req.group == PlanningGroup::kBase && P.sampling.base_turn_in_place) detail::alignBaseHeadings(si, final_path);
     res.stats.shortcut_ms = phase.millis();
     phase.reset();
     res.blocking = detail::blockingReport(oracle, final_path, P.lazy.contact_resolution, P.lazy.swept_spacing);
@@ -972,6 +978,7 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
       if (!better) break;
     }
     simplifier.collapseCloseVertices(final_path);
+    if (req.group == PlanningGroup::kBase && P.sampling.base_turn_in_place) detail::alignBaseHeadings(si, final_path);
     res.stats.shortcut_ms = phase.millis();
   }
   res.stats.validity_checks = oracle.checks();

@@ -33,6 +33,7 @@ const config::Schema<MotionPlannerParams>& schema() {
     using S = SamplingParams;
     s.section("sampling", &P::sampling)
         .field("validity_resolution", &S::validity_resolution, positive())
+        .field("base_turn_in_place", &S::base_turn_in_place)
         .field("kpiece_cell_size", &S::kpiece_cell_size, positive())
         .field("arm_cell_size", &S::arm_cell_size, positive())
         .field("range", &S::range, nonNegative())

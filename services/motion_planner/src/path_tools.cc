@@ -4,6 +4,8 @@
 #include <deque>
 #include <map>
 
+#include <ompl/base/spaces/SE2StateSpace.h>
+
 #include "internal.h"
 
 namespace tamp::motion_planner::detail {
@@ -325,6 +327,37 @@ JointPath toJointPath(const GroupSpace& gs, const og::PathGeometric& path) {
     jp.waypoints.push_back(std::move(v));
   }
   return jp;
+}
+
+bool alignBaseHeadings(const ob::SpaceInformationPtr& si, og::PathGeometric& path) {
+  if (path.getStateCount() < 3) return false;
+  auto wrap = [](double a) { return std::remainder(a, 2.0 * M_PI); };
+  og::PathGeometric aligned(path);
+  auto* first = aligned.getState(0)->as<ob::SE2StateSpace::StateType>();
+  double heading = first->getYaw();
+  bool changed = false;
+  for (std::size_t i = 1; i + 1 < aligned.getStateCount(); ++i) {
+    auto* s = aligned.getState(i)->as<ob::SE2StateSpace::StateType>();
+    const auto* n = aligned.getState(i + 1)->as<ob::SE2StateSpace::StateType>();
+    const double dx = n->getX() - s->getX(), dy = n->getY() - s->getY();
+    if (std::hypot(dx, dy) < 1e-6) {
+      heading = s->getYaw();  // a turn in place is its own heading
+      continue;
+    }
+    double h = std::atan2(dy, dx);
+    if (std::abs(wrap(h + M_PI - heading)) < std::abs(wrap(h - heading))) h = wrap(h + M_PI);
+    if (std::abs(wrap(h - s->getYaw())) > 1e-9) {
+      s->setYaw(h);
+      changed = true;
+    }
+    heading = h;
+  }
+  if (!changed) return false;
+  for (std::size_t i = 0; i + 1 < aligned.getStateCount(); ++i) {
+    if (!si->checkMotion(aligned.getState(i), aligned.getState(i + 1))) return false;
+  }
+  path = aligned;
+  return true;
 }
 
 }  // namespace tamp::motion_planner::detail

@@ -53,6 +53,40 @@ bool insideWithMargin(const world::Polygon2& inner, const world::Polygon2& outer
   return true;
 }
 
+/// The placement at `pose` as reached from the request's base: the arm takes the tool to the
+/// held grasp's pose there (or a top grasp of the object) and, with a held grasp, to the
+/// pre-place pose `approach` above it, both with collision-free IK. None when it cannot.
+std::optional<Placement> placeFromBase(MotionPlanner::Impl& impl, const PlacementRequest& req,
+                                       const Eigen::Isometry3d& pose, const collision::Filter& others,
+                                       std::uint32_t salt, const Termination& termination) {
+  const robot::RobotModel* m = impl.robot.model();
+  const world::Object* obj = impl.world.findObject(req.object_id);
+  std::vector<Eigen::Isometry3d> tool_in_object;
+  if (req.held_object_T_tool) {
+    tool_in_object.push_back(*req.held_object_T_tool);
+  } else {
+    for (const auto& c : graspCandidates(obj->shape, impl.params.grasp, m->gripperLimits().upper)) {
+      if (c.type == GraspType::kTop) tool_in_object.push_back(c.object_T_tool);
+    }
+  }
+  for (const auto& t : tool_in_object) {
+    const Eigen::Isometry3d at = pose * t;
+    Eigen::Isometry3d pre = at;
+    pre.translation().z() += req.approach;
+    auto q_pre = solveIk(impl, *req.base, pre, m->defaultState().arm, others, 0.0, salt * 131 + 1, 24, termination);
+    if (!q_pre) continue;
+    auto q_at = solveIk(impl, *req.base, at, *q_pre, others, 0.0, salt * 131 + 2, 24, termination);
+    if (!q_at) continue;
+    Placement pl;
+    pl.object_pose = pose;
+    pl.base_pose = *req.base;
+    pl.arm_configuration = *q_at;
+    pl.pre_arm_configuration = *q_pre;
+    return pl;
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 Result<std::vector<Placement>> MotionPlanner::samplePlacements(const PlacementRequest& req,
@@ -75,6 +109,21 @@ Result<std::vector<Placement>> MotionPlanner::samplePlacements(const PlacementRe
       return Error(ErrorCode::kInvalidArgument, "keep_clear_path[" + std::to_string(i) + "]: not finite");
     }
   }
+  if (req.base && (!std::isfinite(req.base->x) || !std::isfinite(req.base->y) || !std::isfinite(req.base->theta))) {
+    return Error(ErrorCode::kInvalidArgument, "base: not finite");
+  }
+  if (req.held_object_T_tool && !req.base) {
+    return Error(ErrorCode::kInvalidArgument, "held_object_T_tool: given without base");
+  }
+  if (req.held_object_T_tool && !req.held_object_T_tool->matrix().allFinite()) {
+    return Error(ErrorCode::kInvalidArgument, "held_object_T_tool: not finite");
+  }
+  if (!std::isfinite(req.approach) || req.approach < 0) {
+    return Error(ErrorCode::kInvalidArgument, "approach: must be finite and >= 0");
+  }
+  if (req.base && !impl.robot.model()) {
+    return Error(ErrorCode::kInvalidArgument, "base: the robot has no arm to place from a given base pose");
+  }
   for (std::size_t i = 0; i < req.keep_clear_states.size(); ++i) {
     const auto& s = req.keep_clear_states[i];
     if (s.arm.size() != impl.robot.armDof()) {
@@ -90,6 +139,13 @@ Result<std::vector<Placement>> MotionPlanner::samplePlacements(const PlacementRe
   const world::Polygon2 local = obj->shape.footprint(24);
   Aabb rb;
   for (const auto& v : region->polygon) rb.extend(Eigen::Vector3d(v.x(), v.y(), 0));
+  if (req.base) {
+    // From a given base, only the part of the region within the arm's reach.
+    const double r = P.base_distance_max;
+    rb.min = rb.min.cwiseMax(Eigen::Vector3d(req.base->x - r, req.base->y - r, 0));
+    rb.max = rb.max.cwiseMin(Eigen::Vector3d(req.base->x + r, req.base->y + r, 0));
+    if ((rb.max - rb.min).head<2>().minCoeff() < 0) return std::vector<Placement>{};
+  }
   const std::uint64_t seed = req.seed != 0 ? req.seed
                                            : impl.params.seed ^ std::hash<std::string>{}(req.object_id + "@" + req.region_id);
   std::mt19937_64 rng(seed);
@@ -101,12 +157,14 @@ Result<std::vector<Placement>> MotionPlanner::samplePlacements(const PlacementRe
   const robot::RobotModel* m = impl.robot.model();
   const auto tops = m ? graspCandidates(obj->shape, impl.params.grasp, m->gripperLimits().upper)
                       : std::vector<GraspCandidate>{};
-  const world::World original = impl.world;
-  struct Restore {  // the scene goes back to the world as it is
+  auto hypothetical = overriddenWorld(impl.world, req.object_overrides, req.object_id);
+  if (!hypothetical) return hypothetical.error();
+  const world::World original = std::move(*hypothetical);
+  struct Restore {  // the scene goes back to the planner's world
     Impl& impl;
-    const world::World& w;
-    ~Restore() { impl.scene.syncWorld(w); }
-  } restore{impl, original};
+    ~Restore() { impl.scene.syncWorld(impl.world); }
+  } restore{impl};
+  impl.scene.syncWorld(original);
 
   std::vector<Placement> out;
   std::vector<Eigen::Isometry3d> poses;
@@ -117,6 +175,7 @@ Result<std::vector<Placement>> MotionPlanner::samplePlacements(const PlacementRe
       break;
     }
     const double x = ux(rng), y = uy(rng), yaw = uyaw(rng);
+    if (req.base && std::hypot(x - req.base->x, y - req.base->y) > P.base_distance_max) continue;
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
     pose.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
     pose.translation() = Eigen::Vector3d(x, y, region->height + obj->shape.halfHeight());
@@ -155,9 +214,13 @@ Result<std::vector<Placement>> MotionPlanner::samplePlacements(const PlacementRe
     }
     if (!clear) continue;
     std::optional<Placement> found;
+    if (req.base) {
+      found = placeFromBase(impl, req, pose, others, static_cast<std::uint32_t>(attempt), termination);
+      if (!found) continue;
+    }
     const double dmin = m ? P.base_distance_min : impl.robot.footprintRadius() + 0.01;
     const double dmax = m ? P.base_distance_max : std::max(dmin, P.planar_reach);
-    for (int k = 0; k < P.base_poses_per_placement && !found; ++k) {
+    for (int k = 0; k < P.base_poses_per_placement && !found && !req.base; ++k) {
       const double d = dmin + (dmax - dmin) * u01(rng);
       const double a = 2 * M_PI * u01(rng);
       const Pose2D base{x + d * std::cos(a), y + d * std::sin(a), wrapAngle(a + M_PI)};

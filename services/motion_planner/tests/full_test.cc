@@ -159,7 +159,10 @@ TEST_F(FullTest, HeldObjectCollidesAsPartOfTheRobot) {
   world::Object bar = testing::box("bar", 2.0, 2.75, 0.1, 0.8, true, 0.2, 1.0);
   bar.pose.translation().z() = 0.6;
   ASSERT_TRUE(w.addObject(bar).ok());
-  MotionPlanner mp = planner(w);
+  // A holonomic base (it slides sideways through the door; a stop-and-turn base cannot).
+  MotionPlannerParams p;
+  p.sampling.base_turn_in_place = false;
+  MotionPlanner mp = planner(w, p);
   MotionRequest req = request({2, 2, 0}, {8, 2, 0});
   req.held_object = "bar";
   const MotionResult r = mp.plan(req, Termination::after(10.0));

@@ -142,7 +142,10 @@ TEST_F(RequestWorldTest, HeldObjectIsAttachedAtTheGivenGrasp) {
   world::World w = testing::corridorWorld(false);
   // A 0.3 m parcel, in the world far away in a corner: only the grasp decides where it is.
   ASSERT_TRUE(w.addObject(testing::box("parcel", 9.5, 0.5, 0.3, 0.3, true, 0.3, 2.0)).ok());
-  MotionPlanner mp = testing::discPlanner(w, testing::untimedParams());
+  // A holonomic base (it slides sideways through the door; a stop-and-turn base cannot).
+  MotionPlannerParams p = testing::untimedParams();
+  p.sampling.base_turn_in_place = false;
+  MotionPlanner mp = testing::discPlanner(w, p);
   MotionRequest req = baseRequest({2, 2, 0}, {8, 2, 0});
   req.held_object = "parcel";
   // Beside the robot: robot and parcel are 1.05 m wide across its heading, wider than the 1 m

@@ -21,6 +21,27 @@
 namespace tamp::sim {
 namespace {
 
+/// The rotation (rad) from `a` to `b` up to the shape's symmetries about its own z axis: a
+/// cylinder looks the same turned by any angle, a box turned by pi (pi/2 with a square
+/// footprint). A box placed "rotated by pi" is placed where it was commanded.
+double symmetricTurn(const world::Shape& shape, const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
+  const Eigen::Matrix3d rel = a.linear().transpose() * b.linear();
+  if (shape.kind == world::ShapeKind::kCylinder) {
+    // Only the tilt of the z axis counts.
+    return std::acos(std::clamp(rel(2, 2), -1.0, 1.0));
+  }
+  double best = Eigen::AngleAxisd(rel).angle();
+  if (shape.kind == world::ShapeKind::kBox) {
+    const bool square = std::abs(shape.size.x() - shape.size.y()) < 1e-9;
+    for (int k = 1; k < 4; ++k) {
+      if (!square && k % 2 == 1) continue;
+      const Eigen::Matrix3d z = Eigen::AngleAxisd(k * M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+      best = std::min(best, Eigen::AngleAxisd(Eigen::Matrix3d(rel * z)).angle());
+    }
+  }
+  return best;
+}
+
 using Vec = Eigen::VectorXd;
 using effort_model::FeatureTolerances;
 constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -677,7 +698,7 @@ struct Simulator::Impl {
     ev.world_changed = true;
     const Eigen::Isometry3d& target = *c.object_pose;
     const double off = (released.translation() - target.translation()).norm();
-    const double turn = Eigen::AngleAxisd(released.linear().transpose() * target.linear()).angle();
+    const double turn = symmetricTurn(o.shape, released, target);
     if (s.tilt > params.place.max_tilt_rad) {
       a.failure = "'" + o.id + "' released tilted by " + formatNumber(s.tilt, 4) + " rad and toppled";
     } else if (s.drop > params.place.max_drop_m) {

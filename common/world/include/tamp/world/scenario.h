@@ -149,8 +149,10 @@ Result<PddlProblem> toPddlProblem(const Scenario& scenario, const robot::RobotMo
 
 /// True when `x` stands in the corridor from `approach` (a base position, world xy) to `o`:
 /// ahead of the approach, short of `o`, and laterally closer than the sum of their footprints'
-/// circumradii. The basis of the `occludes` facts.
-bool occludes(const Object& x, const Object& o, const Eigen::Vector2d& approach);
+/// circumradii (plus `margin`, m >= 0: the room a grasp of `o` needs beside it; with a margin, also
+/// any `x` nearer `o` than their circumradii plus the margin). The basis of the `occludes` facts
+/// (margin 0).
+bool occludes(const Object& x, const Object& o, const Eigen::Vector2d& approach, double margin = 0.0);
 
 /// True when the arm, with the base at `base`, reaches a top-down grasp 0.10 m above some point of
 /// `region` (the point 0.55 m ahead of the base if inside the region, else the region's point

@@ -107,12 +107,17 @@ struct PlacementQuery {
   double keep_clear_radius{0.0};
   unsigned max_placements{4};
   double budget_s{3.0};
+  std::optional<Pose2D> base;                      ///< place from here (none: base poses are sampled)
+  std::optional<Eigen::Isometry3d> object_T_tool;  ///< with base: the grasp the object is held with
+  double approach_m{0.0};                          ///< pre-place height above the place pose
+  std::vector<ObjectOverride> overrides;           ///< the branch's hypothetical world
 };
 
 struct PlacementOption {
   Eigen::Isometry3d object_pose{Eigen::Isometry3d::Identity()};
   Pose2D base_pose;
-  std::vector<double> arm;
+  std::vector<double> arm;      ///< at the place pose (top grasp when not held)
+  std::vector<double> pre_arm;  ///< with a held grasp: at the pre-place pose, collision-free
   double clearance{0.0};
 };
 
@@ -121,6 +126,7 @@ struct GraspQuery {
   std::optional<Pose2D> base;  ///< none: the service samples base poses
   unsigned max_grasps{4};
   double budget_s{3.0};
+  std::vector<ObjectOverride> overrides;  ///< the branch's hypothetical world
 };
 
 struct GraspOption {

@@ -204,6 +204,20 @@ class GraphManager {
                                                                        const std::string& region,
                                                                        const BranchContext& ctx, std::string& why,
                                                                        int skip = 0);
+  /// preparePlace on a region: the `skip`-th placement the motion planner found reachable,
+  /// with collision-free configurations, from the context's base in the branch's world.
+  std::optional<std::pair<GraspOption, Eigen::Isometry3d>> sampledPlace(const std::string& object,
+                                                                       const std::string& region,
+                                                                       const BranchContext& ctx, std::string& why,
+                                                                       int skip);
+  /// True when `object` at `pose` would stand in front of another movable object on `region` as seen from
+  /// the context's base (world::occludes), the others where the branch has them.
+  bool occludesFromBase(const std::string& object, const std::string& region, const Eigen::Isometry3d& pose,
+                        const BranchContext& ctx) const;
+  /// The branch's moved objects as overrides of the live world (`except` left out).
+  static std::vector<ObjectOverride> overridesOf(const BranchContext& ctx, const std::string& except = {});
+  /// A cache key for queries in the branch's world from its base pose.
+  static std::string worldKey(const BranchContext& ctx);
   MotionQuery baseQuery(const Edge& e, const BranchContext& ctx) const;
   std::vector<std::string> withStatics(const std::vector<std::string>& dynamic) const;
   void recordDecisions(NodeId from, const std::map<EdgeId, double>& best_through, const std::vector<EdgeId>& branch,

@@ -29,6 +29,7 @@
 #include <Eigen/Geometry>
 
 #include "tamp/core/geometry.h"
+#include "tamp/motion_planner/object_override.h"
 
 namespace tamp::motion_planner {
 
@@ -40,6 +41,7 @@ struct GraspRequest {
   std::optional<Pose2D> base_pose;  ///< the robot's base pose, or none: sample base poses
   std::vector<double> start_arm;    ///< IK seed (arm joints); empty: the arm's zero configuration
   std::uint32_t max_grasps{8};      ///< >= 1
+  std::vector<ObjectOverride> object_overrides;  ///< plan in this hypothetical world; each id at most once
 };
 
 struct Grasp {

@@ -130,13 +130,6 @@ struct MotionGoal {
   static MotionGoal endEffectorGoal(const Eigen::Isometry3d& world_T_tool);
 };
 
-/// A hypothetical world for one request: this object moved to `pose`, or absent.
-struct ObjectOverride {
-  std::string object_id;  ///< an object of the planner's world (planner view)
-  bool removed{false};    ///< treat as absent
-  Eigen::Isometry3d pose{Eigen::Isometry3d::Identity()};  ///< world_T_object when not removed
-};
-
 /// Where a held object sits on the robot: rigidly attached to `link` at `link_T_object`.
 struct HeldGrasp {
   std::string link;  ///< a link of the robot's collision geometry; empty: the hold (tool) link

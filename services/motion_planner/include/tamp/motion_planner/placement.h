@@ -14,14 +14,23 @@
 /// *reachable* when a base pose `base_distance_min..max` from it, facing it, is collision-free
 /// (with the object at the new pose) and the arm reaches a top grasp of it there with a
 /// collision-free IK solution; for a planar robot (no arm) a free base pose within `planar_reach`.
+///
+/// *Placing a held object from where the robot stands* (`base` and `held_object_T_tool` given):
+/// no base pose is sampled; a placement is reachable when the arm reaches the tool pose
+/// `object_pose * held_object_T_tool` and the pre-place pose `approach` above it from `base`,
+/// both with collision-free IK (the other objects and the robot itself). The reply then carries
+/// both configurations, so the graph manager never proposes a pre-place the arm cannot take.
+/// `object_overrides` plan the request in a hypothetical world (as for motion requests).
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <Eigen/Geometry>
 
 #include "tamp/core/geometry.h"
+#include "tamp/motion_planner/object_override.h"
 #include "tamp/robot/robot_model.h"
 
 namespace tamp::motion_planner {
@@ -34,12 +43,18 @@ struct PlacementRequest {
   std::vector<robot::RobotState> keep_clear_states;  ///< robot states to keep clear of (may be empty)
   std::uint32_t max_placements{8};          ///< >= 1
   std::uint64_t seed{0};                    ///< 0: the planner's seed (results are reproducible either way)
+  std::optional<Pose2D> base;               ///< place from this base pose (none: sample base poses)
+  /// With `base`: the object is held with this grasp (tool frame in the object frame).
+  std::optional<Eigen::Isometry3d> held_object_T_tool;
+  double approach{0.0};                     ///< m >= 0, height of the pre-place pose above the place pose
+  std::vector<ObjectOverride> object_overrides;  ///< each id at most once
 };
 
 struct Placement {
   Eigen::Isometry3d object_pose{Eigen::Isometry3d::Identity()};  ///< world frame
   Pose2D base_pose;                   ///< a base pose from which the robot reaches it
   std::vector<double> arm_configuration;  ///< arm joints at the top grasp (empty for planar robots)
+  std::vector<double> pre_arm_configuration;  ///< with a held grasp: arm joints at the pre-place pose
   double clearance{0.0};              ///< m, distance of the placed object to the nearest other object
   double transfer_distance{0.0};      ///< m, from the object's current position (xy)
 };

@@ -1,0 +1,19 @@
+#pragma once
+/// @file
+/// A hypothetical world for one request (motion, placement, grasp): objects of the planner's
+/// world moved or absent, applied to a copy of the world and undone when the request ends.
+
+#include <string>
+
+#include <Eigen/Geometry>
+
+namespace tamp::motion_planner {
+
+/// A hypothetical world for one request: this object moved to `pose`, or absent.
+struct ObjectOverride {
+  std::string object_id;  ///< an object of the planner's world (planner view)
+  bool removed{false};    ///< treat as absent
+  Eigen::Isometry3d pose{Eigen::Isometry3d::Identity()};  ///< world_T_object when not removed
+};
+
+}  // namespace tamp::motion_planner

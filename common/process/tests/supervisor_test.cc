@@ -15,6 +15,21 @@
 namespace tamp::process {
 namespace {
 
+ProcessSpec makeSpec(std::string name, std::filesystem::path exe, std::vector<std::string> args,
+                     std::map<std::string, std::string> env, std::filesystem::path log, bool restart, int max_restarts,
+                     double backoff_s) {
+  ProcessSpec p;
+  p.name = std::move(name);
+  p.executable = std::move(exe);
+  p.args = std::move(args);
+  p.env = std::move(env);
+  p.log_file = std::move(log);
+  p.restart = restart;
+  p.max_restarts = max_restarts;
+  p.restart_backoff_s = backoff_s;
+  return p;
+}
+
 bool waitUntil(Supervisor& s, const std::function<bool()>& pred, double seconds = 10.0) {
   const Deadline d = Deadline::in(seconds);
   while (!d.expired()) {
@@ -26,7 +41,7 @@ bool waitUntil(Supervisor& s, const std::function<bool()>& pred, double seconds 
 }
 
 TEST(SupervisorTest, MissingExecutableIsNamed) {
-  auto r = spawn(ProcessSpec{"x", "/nonexistent/bin/svc", {}, {}, {}, true, 5, 0.5});
+  auto r = spawn(makeSpec("x", "/nonexistent/bin/svc", {}, {}, {}, true, 5, 0.5));
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.error().code, ErrorCode::kNotFound);
   EXPECT_NE(r.error().toString().find("/nonexistent/bin/svc"), std::string::npos);
@@ -34,7 +49,7 @@ TEST(SupervisorTest, MissingExecutableIsNamed) {
 
 TEST(SupervisorTest, CleanExitIsNotRestarted) {
   Supervisor s;
-  s.add(ProcessSpec{"true", "/bin/true", {}, {}, {}, true, 5, 0.01});
+  s.add(makeSpec("true", "/bin/true", {}, {}, {}, true, 5, 0.01));
   ASSERT_TRUE(s.startAll().ok());
   ASSERT_TRUE(waitUntil(s, [&] { return s.status("true")->phase == ProcessPhase::kExited; }));
   EXPECT_EQ(s.status("true")->restarts, 0);
@@ -43,7 +58,7 @@ TEST(SupervisorTest, CleanExitIsNotRestarted) {
 
 TEST(SupervisorTest, KilledProcessIsRestartedUntilTheLimit) {
   Supervisor s;
-  s.add(ProcessSpec{"sleeper", "/bin/sleep", {"30"}, {}, {}, true, 2, 0.01});
+  s.add(makeSpec("sleeper", "/bin/sleep", {"30"}, {}, {}, true, 2, 0.01));
   ASSERT_TRUE(s.startAll().ok());
   const pid_t first = s.status("sleeper")->pid;
   ASSERT_GT(first, 0);
@@ -65,8 +80,8 @@ TEST(SupervisorTest, KilledProcessIsRestartedUntilTheLimit) {
 TEST(SupervisorTest, StopAllTerminatesAndEscalates) {
   Supervisor s;
   // A process that ignores SIGTERM must be killed after the grace period.
-  s.add(ProcessSpec{"stubborn", "/bin/sh", {"-c", "trap '' TERM; sleep 30"}, {}, {}, true, 5, 0.01});
-  s.add(ProcessSpec{"polite", "/bin/sleep", {"30"}, {}, {}, true, 5, 0.01});
+  s.add(makeSpec("stubborn", "/bin/sh", {"-c", "trap '' TERM; sleep 30"}, {}, {}, true, 5, 0.01));
+  s.add(makeSpec("polite", "/bin/sleep", {"30"}, {}, {}, true, 5, 0.01));
   ASSERT_TRUE(s.startAll().ok());
   std::this_thread::sleep_for(std::chrono::milliseconds(100));
   s.stopAll(0.3);
@@ -79,8 +94,8 @@ TEST(SupervisorTest, EnvironmentAndLogFile) {
   const auto log = std::filesystem::temp_directory_path() / ("tamp_sup_" + std::to_string(::getpid()) + ".log");
   std::filesystem::remove(log);
   Supervisor s;
-  s.add(ProcessSpec{"env", "/bin/sh", {"-c", "echo domain=$TAMP_DOMAIN_ID"}, {{"TAMP_DOMAIN_ID", "77"}}, log, false,
-                    0, 0.1});
+  s.add(makeSpec("env", "/bin/sh", {"-c", "echo domain=$TAMP_DOMAIN_ID"}, {{"TAMP_DOMAIN_ID", "77"}}, log, false,
+                    0, 0.1));
   ASSERT_TRUE(s.startAll().ok());
   ASSERT_TRUE(waitUntil(s, [&] { return s.status("env")->phase == ProcessPhase::kExited; }));
   std::ifstream in(log);
@@ -104,7 +119,7 @@ TEST(SupervisorTest, ChildDoesNotInheritDescriptors) {
   const auto log = std::filesystem::temp_directory_path() / ("tamp_sup_fdlog_" + std::to_string(::getpid()));
   std::filesystem::remove(log);
   Supervisor s;
-  s.add(ProcessSpec{"fds", "/bin/sh", {"-c", "ls /proc/self/fd | wc -l"}, {}, log, false, 0, 0.1});
+  s.add(makeSpec("fds", "/bin/sh", {"-c", "ls /proc/self/fd | wc -l"}, {}, log, false, 0, 0.1));
   ASSERT_TRUE(s.startAll().ok());
   const Deadline d = Deadline::in(10.0);
   while (!d.expired() && s.status("fds")->phase != ProcessPhase::kExited) {
@@ -130,7 +145,7 @@ TEST(SupervisorTest, ChildDiesWithItsParent) {
   ASSERT_GE(helper, 0);
   if (helper == 0) {
     Supervisor inner;
-    inner.add(ProcessSpec{"sleeper", "/bin/sleep", {"60"}, {}, {}, false, 0, 0.1});
+    inner.add(makeSpec("sleeper", "/bin/sleep", {"60"}, {}, {}, false, 0, 0.1));
     if (!inner.startAll().ok()) _exit(1);
     std::ofstream(pidfile) << inner.status("sleeper")->pid;
     ::pause();

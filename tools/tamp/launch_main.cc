@@ -147,7 +147,7 @@ int main(int argc, char** argv) {
   std::fflush(stdout);
   launcher.stop(grace_s);
   for (const auto& st : launcher.supervisor().status()) {
-    if (st.last_exit != "exit 0" && st.last_exit.rfind("signal 15", 0) != 0) {
+    if (st.last_exit != "exit 0" && st.last_exit.rfind("signal 15", 0) != 0 && st.last_exit.rfind("stopped", 0) != 0) {
       std::printf("tamp launch: %s ended with %s\n", st.name.c_str(), st.last_exit.c_str());
     }
   }

@@ -205,6 +205,7 @@ int main(int argc, char** argv) {
 
   if (scenario.empty()) {
     std::printf("\ntamp run: no scenario given: services only.\n");
+    std::fflush(stdout);
   } else if (rc == tamp::cli::kExitOk) {
     tamp::runner::MissionOptions mo;
     mo.scenario = scenario;
@@ -219,6 +220,7 @@ int main(int argc, char** argv) {
   }
   if (keep && rc == tamp::cli::kExitOk) {
     std::printf("tamp run: services running (supervised); Ctrl-C to stop.\n");
+    std::fflush(stdout);
     while (!g_stop) {
       launcher.poll();
       std::this_thread::sleep_for(std::chrono::milliseconds(100));

@@ -156,7 +156,17 @@ Result<pid_t> spawn(const ProcessSpec& spec) {
   }
   // Also from the parent, so that the group exists as soon as spawn() returns (no race with a
   // signal sent right away); EACCES after the child's exec (or its setsid) is harmless.
-  if (!detach) setpgid(pid, pid);
+  if (!detach) {
+    setpgid(pid, pid);
+  } else {
+    // A session leader cannot be made a group leader by us (its setsid would fail): wait until
+    // the child's own setsid() made the group, so a signal to -pid right away reaches it.
+    for (int i = 0; i < 2000; ++i) {
+      const pid_t group = getpgid(pid);
+      if (group == pid || group < 0) break;
+      std::this_thread::sleep_for(std::chrono::microseconds(500));
+    }
+  }
   if (log_fd >= 0) close(log_fd);
   return pid;
 }
@@ -250,11 +260,11 @@ void Supervisor::onExit(Child& c, const std::string& how, int exit_code, bool cl
                                   c.spec.restart_backoff_s * std::pow(2.0, std::min(c.st.consecutive_restarts, 30)));
   c.st.phase = ProcessPhase::kBackoff;
   c.restart_at = std::chrono::steady_clock::now() + seconds(backoff);
-  log::get("supervisor")->warn("{} died ({}); restarting in {:.1f} s", c.spec.name, how, backoff);
+  log::get("supervisor")->warn("{} died ({}); restarting in {:.2f} s", c.spec.name, how, backoff);
   emit(ProcessEventKind::kRestartScheduled, c, how, backoff);
 }
 
-bool Supervisor::reap(Child& c, bool block) {
+bool Supervisor::reap(Child& c, bool block, const std::string& cause) {
   if (c.st.phase != ProcessPhase::kRunning || c.st.pid <= 0) return false;
   if (c.st.adopted) {
     // Not our child: its exit status went to whoever reaps orphans. Poll for its disappearance.
@@ -265,13 +275,14 @@ bool Supervisor::reap(Child& c, bool block) {
       }
     }
     if (processRunning(c.st.pid)) return false;
-    onExit(c, "ended (adopted process: exit status unknown)", -1, false);
+    onExit(c, !cause.empty() ? cause : c.stopping ? "stopped (adopted: exit status unknown)" : "ended (adopted: exit status unknown)",
+           -1, c.stopping);
     return true;
   }
   int wstatus = 0;
   if (waitpid(c.st.pid, &wstatus, block ? 0 : WNOHANG) != c.st.pid) return false;
   const int code = WIFEXITED(wstatus) ? WEXITSTATUS(wstatus) : 128 + WTERMSIG(wstatus);
-  onExit(c, describeExit(wstatus), code, WIFEXITED(wstatus) && WEXITSTATUS(wstatus) == 0);
+  onExit(c, cause.empty() ? describeExit(wstatus) : cause, code, WIFEXITED(wstatus) && WEXITSTATUS(wstatus) == 0);
   return true;
 }
 
@@ -303,10 +314,8 @@ bool Supervisor::declareDead(const std::string& name, const std::string& reason)
     log::get("supervisor")->warn("{} (pid {}) declared dead: {}; SIGKILL", name, c.st.pid, reason);
     emit(ProcessEventKind::kKilled, c, reason);
     kill(-c.st.pid, SIGKILL);  // also ends a stopped (SIGSTOP) process
-    if (!reap(c, true)) return false;
-    // The exit was "signal 9" because we sent it; the cause is what the caller saw.
-    c.st.last_exit = reason;
-    return true;
+    // The exit is "signal 9" because we sent it; the cause is what the caller saw.
+    return reap(c, true, "killed: " + reason);
   }
   return false;
 }

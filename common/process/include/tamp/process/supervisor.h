@@ -136,7 +136,8 @@ class Supervisor {
   };
   void onExit(Child& c, const std::string& how, int exit_code, bool clean);
   /// True (and the exit handled) when the child ended.
-  bool reap(Child& c, bool block);
+  /// `cause`: what ended it when we know better than its exit status (declareDead).
+  bool reap(Child& c, bool block, const std::string& cause = {});
   void emit(ProcessEventKind kind, const Child& c, std::string detail = {}, double backoff_s = 0) const;
   void checkUnique(const std::string& name) const;
   std::vector<Child> children_;

@@ -127,6 +127,15 @@ process::ProcessSpec Launcher::specOf(const deploy::ServiceSpec& s) const {
 }
 
 Status Launcher::start() {
+  // DDS first: a failure here must not touch the run folder of services we could have adopted.
+  dds::ParticipantOptions po;
+  po.domain_id = o_.domain;
+  if (!o_.profile.empty()) po.profile = o_.profile;
+  po.name = "tamp/launch/" + o_.host;
+  auto p = dds::Participant::create(po, o_.run_id);
+  if (!p) return p.error();
+  participant_ = *p;
+  monitor_ = std::make_unique<dds::HeartbeatMonitor>(participant_);
   std::error_code ec;
   fs::create_directories(o_.run_dir, ec);
   if (ec) return Error(ErrorCode::kIo, "cannot create the run folder: " + ec.message(), SourceLocation{o_.run_dir.string()});
@@ -146,14 +155,6 @@ Status Launcher::start() {
   (void)!write(lock_fd_, me.data(), me.size());
   touchLease();
 
-  dds::ParticipantOptions po;
-  po.domain_id = o_.domain;
-  if (!o_.profile.empty()) po.profile = o_.profile;
-  po.name = "tamp/launch/" + o_.host;
-  auto p = dds::Participant::create(po, o_.run_id);
-  if (!p) return p.error();
-  participant_ = *p;
-  monitor_ = std::make_unique<dds::HeartbeatMonitor>(participant_);
 
   note("launch_started", "pid " + std::to_string(::getpid()) + ", domain " + std::to_string(o_.domain) +
                              ", deployment " + o_.deployment.file);

@@ -113,6 +113,10 @@ int main(int argc, char** argv) {
   tamp::deploy::Deployment local = *deployment;
   std::vector<std::string> started, optional_names;
   for (auto& s : local.services) {
+    // The host's environment goes with each of its services (the service's own entries last).
+    std::vector<std::string> env = deployment->host(s.host)->env;
+    env.insert(env.end(), s.env.begin(), s.env.end());
+    s.env = std::move(env);
     s.host = tamp::deploy::kLocalHost;
     started.push_back(s.name);
     if (s.optional) optional_names.push_back(s.name);

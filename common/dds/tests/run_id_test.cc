@@ -22,7 +22,7 @@ TEST(RunIdTest, ValidationAndEnvironment) {
   ::unsetenv("TAMP_RUN_ID");
   EXPECT_EQ(resolveRunId("").value(), "");
   EXPECT_EQ(resolveRunId("run-20261201-1200.a_b").value(), "run-20261201-1200.a_b");
-  for (const std::string bad : {"a b", "a/b", "tamp*", std::string(65, 'x')}) {
+  for (const std::string& bad : std::vector<std::string>{"a b", "a/b", "tamp*", std::string(65, 'x')}) {
     auto r = resolveRunId(bad);
     ASSERT_FALSE(r.ok()) << bad;
     EXPECT_THAT(r.error().toString(), HasSubstr("--run-id must be 1-64 characters of [A-Za-z0-9_.-], got '" + bad + "'"));

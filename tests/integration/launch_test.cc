@@ -23,7 +23,8 @@ namespace {
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
-bool waitUntil(const std::function<bool()>& pred, double seconds, process::Supervisor* sup = nullptr) {
+bool waitUntil(const std::function<bool()>& pred, double seconds,
+               process::Supervisor* sup = nullptr) {
   const Deadline d = Deadline::in(seconds);
   while (!d.expired()) {
     if (sup != nullptr) sup->poll();
@@ -58,8 +59,9 @@ class LaunchTest : public ::testing::Test {
     for (const auto& pid : recordedPids()) ::kill(-pid, SIGKILL);
     if (HasFailure()) {
       for (const auto& e : fs::recursive_directory_iterator(dir_)) {
-        if (e.is_regular_file() && (e.path().extension() == ".log" || e.path().extension() == ".jsonl" ||
-                                    e.path().extension() == ".out"))
+        if (e.is_regular_file() &&
+            (e.path().extension() == ".log" || e.path().extension() == ".jsonl" ||
+             e.path().extension() == ".out"))
           std::cerr << "---- " << e.path() << "\n" << readFile(e.path()) << "\n";
       }
     }
@@ -69,26 +71,32 @@ class LaunchTest : public ::testing::Test {
   /// A deployment of echo nodes (heartbeat 0.2 s: dead after 5 silent periods).
   fs::path deployment(const std::vector<std::string>& services, const std::string& extra = "",
                       const std::string& name = "deploy.yaml") {
-    std::string text = "heartbeat_period_s: 0.2\nliveness_periods: 5\nstartup_timeout_s: 20\n"
-                       "restart: {max_restarts: 5, backoff_s: 0.2, backoff_max_s: 1}\n" + extra + "services:\n";
+    std::string text =
+        "heartbeat_period_s: 0.2\nliveness_periods: 5\nstartup_timeout_s: 20\n"
+        "restart: {max_restarts: 5, backoff_s: 0.2, backoff_max_s: 1}\n" +
+        extra + "services:\n";
     for (const auto& s : services) text += "  - {name: " + s + ", executable: tamp_echo_node}\n";
     std::ofstream(dir_ / name) << text;
     return dir_ / name;
   }
   fs::path runDir() const { return dir_ / "out" / run_id_ / "local"; }
 
-  /// Starts `tamp-launch` (as a child of the test's supervisor) and waits until every service is alive.
+  /// Starts `tamp-launch` (as a child of the test's supervisor) and waits until every service is
+  /// alive.
   void launch(const fs::path& file, const std::string& tag = "launch") {
     process::ProcessSpec s;
     s.name = tag;
     s.executable = binDir() / "tamp-launch";
-    s.args = {file.string(), "--run-id", run_id_, "--domain", std::to_string(domain_), "--out", (dir_ / "out").string(),
-              "--grace", "3"};
+    s.args = {
+        file.string(),           "--run-id", run_id_, "--domain", std::to_string(domain_), "--out",
+        (dir_ / "out").string(), "--grace",  "3"};
     s.log_file = dir_ / (tag + ".out");
     s.restart = false;
     sup_.add(s);
     ASSERT_TRUE(sup_.startAll().ok());
-    ASSERT_TRUE(waitUntil([&] { return readFile(s.log_file).find("services alive") != std::string::npos; }, 60.0, &sup_))
+    ASSERT_TRUE(
+        waitUntil([&] { return readFile(s.log_file).find("services alive") != std::string::npos; },
+                  60.0, &sup_))
         << readFile(s.log_file);
   }
   std::map<std::string, pid_t> pids() const {
@@ -104,16 +112,20 @@ class LaunchTest : public ::testing::Test {
     return out;
   }
   /// The first event of `service` named `event` after index `from`, if any.
-  std::optional<nlohmann::json> event(const std::string& service, const std::string& name, std::size_t from = 0) const {
+  std::optional<nlohmann::json> event(const std::string& service, const std::string& name,
+                                      std::size_t from = 0) const {
     const auto all = readEvents(runDir() / "events.jsonl");
     for (std::size_t i = from; i < all.size(); ++i) {
-      if (all[i].value("service", "") == service && all[i].value("event", "") == name) return all[i];
+      if (all[i].value("service", "") == service && all[i].value("event", "") == name)
+        return all[i];
     }
     return std::nullopt;
   }
-  std::pair<int, std::string> status(const fs::path& file, const std::string& run_id, double wait_s = 5.0) {
-    return runCommand(binDir() / "tamp-status", {"--deployment", file.string(), "--run-id", run_id, "--domain",
-                                                 std::to_string(domain_), "--wait", std::to_string(wait_s), "--json"});
+  std::pair<int, std::string> status(const fs::path& file, const std::string& run_id,
+                                     double wait_s = 5.0) {
+    return runCommand(binDir() / "tamp-status",
+                      {"--deployment", file.string(), "--run-id", run_id, "--domain",
+                       std::to_string(domain_), "--wait", std::to_string(wait_s), "--json"});
   }
 
   fs::path dir_;
@@ -170,16 +182,18 @@ TEST_F(LaunchTest, FrozenServiceIsDetectedByHeartbeatAndRestarted) {
 TEST_F(LaunchTest, StatusFailsAndNamesTheMissingServices) {
   launch(deployment({"alpha", "beta"}));
   // The same run expected with two more services, one of them optional.
-  std::ofstream(dir_ / "more.yaml") << readFile(dir_ / "deploy.yaml")
-                                    << "  - {name: gamma, executable: tamp_echo_node}\n"
-                                       "  - {name: delta, executable: tamp_echo_node, optional: true}\n";
+  std::ofstream(dir_ / "more.yaml")
+      << readFile(dir_ / "deploy.yaml")
+      << "  - {name: gamma, executable: tamp_echo_node}\n"
+         "  - {name: delta, executable: tamp_echo_node, optional: true}\n";
   auto [rc, out] = status(dir_ / "more.yaml", run_id_, 3.0);
   EXPECT_EQ(rc, 40) << out;
   auto j = nlohmann::json::parse(out.substr(out.find('{')));
   EXPECT_EQ(j["missing"], nlohmann::json::array({"gamma"}));
   EXPECT_EQ(j["missing_optional"], nlohmann::json::array({"delta"}));
-  auto [rc_text, text] = runCommand(binDir() / "tamp-status", {"--deployment", (dir_ / "more.yaml").string(), "--run-id",
-                                                               run_id_, "--domain", std::to_string(domain_), "--wait", "3"});
+  auto [rc_text, text] = runCommand(
+      binDir() / "tamp-status", {"--deployment", (dir_ / "more.yaml").string(), "--run-id", run_id_,
+                                 "--domain", std::to_string(domain_), "--wait", "3"});
   EXPECT_EQ(rc_text, 40);
   EXPECT_THAT(text, HasSubstr("MISSING: gamma"));
   EXPECT_THAT(text, HasSubstr("MISSING (optional): delta"));
@@ -196,7 +210,8 @@ TEST_F(LaunchTest, SignalStopsEveryServiceCleanly) {
   launch(deployment({"alpha", "beta"}));
   const auto before = pids();
   ASSERT_TRUE(sup_.signal("launch", SIGTERM));
-  ASSERT_TRUE(waitUntil([&] { return sup_.status("launch")->phase == process::ProcessPhase::kExited; }, 30.0, &sup_));
+  ASSERT_TRUE(waitUntil(
+      [&] { return sup_.status("launch")->phase == process::ProcessPhase::kExited; }, 30.0, &sup_));
   EXPECT_EQ(sup_.status("launch")->last_exit, "exit 0");
   for (const auto& [name, pid] : before) EXPECT_FALSE(process::processRunning(pid)) << name;
   EXPECT_FALSE(fs::exists(runDir() / "launch.pids"));
@@ -209,8 +224,10 @@ TEST_F(LaunchTest, KilledSupervisorLeavesServicesThatTheNextOneAdopts) {
   launch(file, "first");
   const auto before = pids();
   ASSERT_TRUE(sup_.signal("first", SIGKILL));
-  ASSERT_TRUE(waitUntil([&] { return sup_.status("first")->phase == process::ProcessPhase::kExited; }, 10.0, &sup_));
-  for (const auto& [name, pid] : before) EXPECT_TRUE(process::processRunning(pid)) << name << " died with its supervisor";
+  ASSERT_TRUE(waitUntil(
+      [&] { return sup_.status("first")->phase == process::ProcessPhase::kExited; }, 10.0, &sup_));
+  for (const auto& [name, pid] : before)
+    EXPECT_TRUE(process::processRunning(pid)) << name << " died with its supervisor";
   const std::size_t mark = readEvents(runDir() / "events.jsonl").size();
   launch(file, "second");
   EXPECT_THAT(readFile(dir_ / "second.out"), HasSubstr("2 services (2 adopted)"));
@@ -218,16 +235,19 @@ TEST_F(LaunchTest, KilledSupervisorLeavesServicesThatTheNextOneAdopts) {
   ASSERT_TRUE(event("alpha", "adopted", mark));
   EXPECT_FALSE(event("alpha", "started", mark));
   // A second supervisor of the same run and host is refused, and leaves the services alone.
-  auto [rc, out] = runCommand(binDir() / "tamp-launch", {file.string(), "--run-id", run_id_, "--domain",
-                                                         std::to_string(domain_), "--out", (dir_ / "out").string()});
+  auto [rc, out] = runCommand(binDir() / "tamp-launch",
+                              {file.string(), "--run-id", run_id_, "--domain",
+                               std::to_string(domain_), "--out", (dir_ / "out").string()});
   EXPECT_EQ(rc, 40);
   EXPECT_THAT(out, HasSubstr("another tamp launch"));
   EXPECT_EQ(pids(), before);
   // The adopter restarts an adopted service that dies, and stops them all on a signal.
   ASSERT_EQ(::kill(before.at("alpha"), SIGKILL), 0);
-  ASSERT_TRUE(waitUntil([&] { return event("alpha", "restarted", mark).has_value(); }, 30.0, &sup_));
+  ASSERT_TRUE(
+      waitUntil([&] { return event("alpha", "restarted", mark).has_value(); }, 30.0, &sup_));
   ASSERT_TRUE(sup_.signal("second", SIGTERM));
-  ASSERT_TRUE(waitUntil([&] { return sup_.status("second")->phase == process::ProcessPhase::kExited; }, 30.0, &sup_));
+  ASSERT_TRUE(waitUntil(
+      [&] { return sup_.status("second")->phase == process::ProcessPhase::kExited; }, 30.0, &sup_));
   EXPECT_EQ(sup_.status("second")->last_exit, "exit 0");
   EXPECT_FALSE(process::processRunning(before.at("beta")));
 }
@@ -236,9 +256,11 @@ TEST_F(LaunchTest, OrphansStopByThemselvesWhenNoSupervisorComes) {
   launch(deployment({"alpha"}, "orphan_timeout_s: 2\n"));
   const pid_t pid = pids().at("alpha");
   ASSERT_TRUE(sup_.signal("launch", SIGKILL));
-  ASSERT_TRUE(waitUntil([&] { return sup_.status("launch")->phase == process::ProcessPhase::kExited; }, 10.0, &sup_));
+  ASSERT_TRUE(waitUntil(
+      [&] { return sup_.status("launch")->phase == process::ProcessPhase::kExited; }, 10.0, &sup_));
   EXPECT_TRUE(process::processRunning(pid));
-  ASSERT_TRUE(waitUntil([&] { return !process::processRunning(pid); }, 30.0)) << "orphan still running";
+  ASSERT_TRUE(waitUntil([&] { return !process::processRunning(pid); }, 30.0))
+      << "orphan still running";
   EXPECT_THAT(readFile(runDir() / "alpha.log"), HasSubstr("no supervisor renewed"));
 }
 
@@ -247,9 +269,12 @@ TEST_F(LaunchTest, BadDeploymentsAreInputErrorsNamingFileLineAndField) {
   std::ofstream(dir_ / "typo.yaml") << "services:\n  - {name: a, executable: tamp_echo_node}\n"
                                        "  - {name: b, executable: tamp_echo_nod, optional: true}\n";
   for (const char* tool : {"tamp-launch", "tamp-run"}) {
-    std::vector<std::string> args = {"--domain", std::to_string(domain_), "--out", (dir_ / "out").string()};
-    if (std::string(tool) == "tamp-launch") args.insert(args.begin(), (dir_ / "typo.yaml").string());
-    else args.insert(args.end(), {"--deployment", (dir_ / "typo.yaml").string()});
+    std::vector<std::string> args = {"--domain", std::to_string(domain_), "--out",
+                                     (dir_ / "out").string()};
+    if (std::string(tool) == "tamp-launch")
+      args.insert(args.begin(), (dir_ / "typo.yaml").string());
+    else
+      args.insert(args.end(), {"--deployment", (dir_ / "typo.yaml").string()});
     auto [rc, out] = runCommand(binDir() / tool, args);
     EXPECT_EQ(rc, 30) << tool << ": " << out;
     EXPECT_THAT(out, HasSubstr((dir_ / "typo.yaml").string() + ":3:"));
@@ -261,8 +286,10 @@ TEST_F(LaunchTest, BadDeploymentsAreInputErrorsNamingFileLineAndField) {
   std::ofstream(dir_ / "bad.yaml") << "services:\n  - {name: a, executabel: tamp_echo_node}\n";
   for (const char* tool : {"tamp-launch", "tamp-status", "tamp-run"}) {
     std::vector<std::string> args = {"--domain", std::to_string(domain_)};
-    if (std::string(tool) == "tamp-launch") args.insert(args.begin(), (dir_ / "bad.yaml").string());
-    else args.insert(args.end(), {"--deployment", (dir_ / "bad.yaml").string()});
+    if (std::string(tool) == "tamp-launch")
+      args.insert(args.begin(), (dir_ / "bad.yaml").string());
+    else
+      args.insert(args.end(), {"--deployment", (dir_ / "bad.yaml").string()});
     auto [rc, out] = runCommand(binDir() / tool, args);
     EXPECT_EQ(rc, 30) << tool << ": " << out;
     EXPECT_THAT(out, HasSubstr("bad.yaml:2:"));
@@ -272,18 +299,21 @@ TEST_F(LaunchTest, BadDeploymentsAreInputErrorsNamingFileLineAndField) {
   std::ofstream(dir_ / "two.yaml") << "hosts: {robot: , desk: }\nservices:\n"
                                       "  - {name: a, host: robot, executable: tamp_echo_node}\n"
                                       "  - {name: b, host: desk, executable: tamp_echo_node}\n";
-  auto [rc_host, out_host] = runCommand(binDir() / "tamp-launch", {(dir_ / "two.yaml").string(), "--host", "robto"});
+  auto [rc_host, out_host] =
+      runCommand(binDir() / "tamp-launch", {(dir_ / "two.yaml").string(), "--host", "robto"});
   EXPECT_EQ(rc_host, 30);
   EXPECT_THAT(out_host, HasSubstr("no host 'robto' (hosts: robot desk)"));
   auto [rc_which, out_which] = runCommand(binDir() / "tamp-launch", {(dir_ / "two.yaml").string()});
   EXPECT_EQ(rc_which, 30);
   EXPECT_THAT(out_which, HasSubstr("choose one with --host"));
   ::unsetenv("TAMP_RUN_ID");
-  auto [rc_id, out_id] = runCommand(binDir() / "tamp-launch", {(dir_ / "two.yaml").string(), "--host", "robot"});
+  auto [rc_id, out_id] =
+      runCommand(binDir() / "tamp-launch", {(dir_ / "two.yaml").string(), "--host", "robot"});
   EXPECT_EQ(rc_id, 30);
   EXPECT_THAT(out_id, HasSubstr("give every host the same --run-id"));
   auto [rc_bad_id, out_bad_id] =
-      runCommand(binDir() / "tamp-launch", {(dir_ / "two.yaml").string(), "--host", "robot", "--run-id", "a b"});
+      runCommand(binDir() / "tamp-launch",
+                 {(dir_ / "two.yaml").string(), "--host", "robot", "--run-id", "a b"});
   EXPECT_EQ(rc_bad_id, 30);
   EXPECT_THAT(out_bad_id, HasSubstr("--run-id must be 1-64 characters"));
 }
@@ -296,8 +326,8 @@ TEST_F(LaunchTest, ConcurrentRunsOnOneDomainDoNotSeeEachOther) {
     process::ProcessSpec s;
     s.name = tag;
     s.executable = binDir() / "tamp-run";
-    s.args = {"--deployment", file.string(), "--domain", std::to_string(domain_), "--out", (dir_ / tag).string(),
-              "--keep-running"};
+    s.args = {"--deployment", file.string(),         "--domain",      std::to_string(domain_),
+              "--out",        (dir_ / tag).string(), "--keep-running"};
     s.log_file = dir_ / (tag + ".out");
     s.restart = false;
     sup_.add(s);
@@ -306,8 +336,12 @@ TEST_F(LaunchTest, ConcurrentRunsOnOneDomainDoNotSeeEachOther) {
   startRun("run_b");
   ASSERT_TRUE(sup_.startAll().ok());
   for (const char* tag : {"run_a", "run_b"}) {
-    ASSERT_TRUE(waitUntil([&] { return readFile(dir_ / (std::string(tag) + ".out")).find("Ctrl-C to stop") != std::string::npos; },
-                          120.0, &sup_))
+    ASSERT_TRUE(waitUntil(
+        [&] {
+          return readFile(dir_ / (std::string(tag) + ".out")).find("Ctrl-C to stop") !=
+                 std::string::npos;
+        },
+        120.0, &sup_))
         << readFile(dir_ / (std::string(tag) + ".out"));
   }
   std::map<std::string, std::string> ids;
@@ -336,14 +370,18 @@ TEST_F(LaunchTest, ConcurrentRunsOnOneDomainDoNotSeeEachOther) {
   for (const char* tag : {"run_a", "run_b"}) {
     const std::string out = readFile(dir_ / (std::string(tag) + ".out"));
     for (const auto& [name, pid] : own[tag]) {
-      EXPECT_TRUE(std::regex_search(out, std::regex(name + " +" + std::to_string(pid) + " +[0-9]+us +ok"))) << out;
+      EXPECT_TRUE(
+          std::regex_search(out, std::regex(name + " +" + std::to_string(pid) + " +[0-9]+us +ok")))
+          << out;
     }
   }
   for (const char* tag : {"run_a", "run_b"}) ASSERT_TRUE(sup_.signal(tag, SIGINT));
-  ASSERT_TRUE(waitUntil([&] {
-    return sup_.status("run_a")->phase == process::ProcessPhase::kExited &&
-           sup_.status("run_b")->phase == process::ProcessPhase::kExited;
-  }, 30.0, &sup_));
+  ASSERT_TRUE(waitUntil(
+      [&] {
+        return sup_.status("run_a")->phase == process::ProcessPhase::kExited &&
+               sup_.status("run_b")->phase == process::ProcessPhase::kExited;
+      },
+      30.0, &sup_));
   EXPECT_EQ(sup_.status("run_a")->last_exit, "exit 0");
   EXPECT_EQ(sup_.status("run_b")->last_exit, "exit 0");
 }

@@ -40,13 +40,19 @@ int main(int argc, char** argv) {
   app.add_option("deployment", file, "deployment file (config/deploy/*.yaml)")->required();
   app.add_option("--host", host, "host of the deployment to start (default: its only host)");
   app.add_option("--run-id", run_id,
-                 "run id shared by every host of the run (default: $TAMP_RUN_ID; generated for a one-host deployment)");
-  app.add_option("--domain", domain, "DDS domain id (default: $TAMP_DOMAIN_ID or 0)")->check(CLI::Range(0, 232));
-  app.add_option("--profile", profile, "DDS participant profile of the services (tamp_default, tamp_udp, tamp_shm)");
-  app.add_option("--scenario", scenario, "scenario of the run (for services whose args name {scenario})")
+                 "run id shared by every host of the run (default: $TAMP_RUN_ID; generated for a "
+                 "one-host deployment)");
+  app.add_option("--domain", domain, "DDS domain id (default: $TAMP_DOMAIN_ID or 0)")
+      ->check(CLI::Range(0, 232));
+  app.add_option("--profile", profile,
+                 "DDS participant profile of the services (tamp_default, tamp_udp, tamp_shm)");
+  app.add_option("--scenario", scenario,
+                 "scenario of the run (for services whose args name {scenario})")
       ->check(CLI::ExistingFile);
-  app.add_option("--out", out_dir, "root of the run folders: logs and events go to OUT/RUN_ID/HOST");
-  app.add_option("--grace", grace_s, "seconds a service has to stop on SIGTERM before SIGKILL")->check(CLI::Range(0.0, 600.0));
+  app.add_option("--out", out_dir,
+                 "root of the run folders: logs and events go to OUT/RUN_ID/HOST");
+  app.add_option("--grace", grace_s, "seconds a service has to stop on SIGTERM before SIGKILL")
+      ->check(CLI::Range(0.0, 600.0));
   CLI11_PARSE(app, argc, argv);
 
   auto deployment = tamp::deploy::loadDeployment(file);
@@ -56,7 +62,8 @@ int main(int argc, char** argv) {
   }
   if (host.empty()) {
     if (deployment->hosts.size() != 1) {
-      std::cerr << "tamp launch: " << file << " has " << deployment->hosts.size() << " hosts; choose one with --host:";
+      std::cerr << "tamp launch: " << file << " has " << deployment->hosts.size()
+                << " hosts; choose one with --host:";
       for (const auto& h : deployment->hosts) std::cerr << " " << h.name;
       std::cerr << "\n";
       return tamp::cli::kExitInputError;
@@ -111,9 +118,11 @@ int main(int argc, char** argv) {
     std::cerr << "tamp launch: " << s.error().toString() << "\n";
     return tamp::cli::kExitServiceError;
   }
-  std::printf("tamp launch: run %s, host %s, DDS domain %d, %zu services (%zu adopted); logs and events in %s\n",
-              run_id.c_str(), host.c_str(), *dom, launcher.services().size(), launcher.adopted().size(),
-              o.run_dir.c_str());
+  std::printf(
+      "tamp launch: run %s, host %s, DDS domain %d, %zu services (%zu adopted); logs and events in "
+      "%s\n",
+      run_id.c_str(), host.c_str(), *dom, launcher.services().size(), launcher.adopted().size(),
+      o.run_dir.c_str());
   std::fflush(stdout);
 
   bool announced = false;
@@ -122,9 +131,11 @@ int main(int argc, char** argv) {
     launcher.poll();
     const auto statuses = launcher.supervisor().status();
     bool all_failed = !statuses.empty();
-    for (const auto& st : statuses) all_failed = all_failed && st.phase == tamp::process::ProcessPhase::kFailed;
+    for (const auto& st : statuses)
+      all_failed = all_failed && st.phase == tamp::process::ProcessPhase::kFailed;
     if (all_failed) {
-      std::fprintf(stderr, "tamp launch: every service gave up (see %s)\n", launcher.eventsFile().c_str());
+      std::fprintf(stderr, "tamp launch: every service gave up (see %s)\n",
+                   launcher.eventsFile().c_str());
       rc = tamp::cli::kExitServiceError;
       break;
     }
@@ -132,7 +143,8 @@ int main(int argc, char** argv) {
       const auto beats = launcher.monitor().services();
       std::size_t alive = 0;
       for (const auto& st : statuses) {
-        for (const auto& b : beats) alive += (b.alive && b.name == st.name && b.pid == static_cast<uint32_t>(st.pid)) ? 1 : 0;
+        for (const auto& b : beats)
+          alive += (b.alive && b.name == st.name && b.pid == static_cast<uint32_t>(st.pid)) ? 1 : 0;
       }
       if (alive == statuses.size()) {
         std::printf("tamp launch: all %zu services alive\n", alive);
@@ -147,7 +159,8 @@ int main(int argc, char** argv) {
   std::fflush(stdout);
   launcher.stop(grace_s);
   for (const auto& st : launcher.supervisor().status()) {
-    if (st.last_exit != "exit 0" && st.last_exit.rfind("signal 15", 0) != 0 && st.last_exit.rfind("stopped", 0) != 0) {
+    if (st.last_exit != "exit 0" && st.last_exit.rfind("signal 15", 0) != 0 &&
+        st.last_exit.rfind("stopped", 0) != 0) {
       std::printf("tamp launch: %s ended with %s\n", st.name.c_str(), st.last_exit.c_str());
     }
   }

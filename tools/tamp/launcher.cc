@@ -27,7 +27,8 @@ namespace {
 std::string utcNow() {
   const auto now = std::chrono::system_clock::now();
   const std::time_t t = std::chrono::system_clock::to_time_t(now);
-  const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(now.time_since_epoch()).count() % 1000;
+  const auto ms =
+      std::chrono::duration_cast<std::chrono::milliseconds>(now.time_since_epoch()).count() % 1000;
   std::tm tm{};
   gmtime_r(&t, &tm);
   char buf[40];
@@ -72,7 +73,8 @@ std::string makeRunId(const std::string& prefix) {
   std::strftime(stamp, sizeof(stamp), "%Y%m%d-%H%M%S", &tm);
   std::random_device rd;
   char suffix[8];
-  std::snprintf(suffix, sizeof(suffix), "%04x", static_cast<unsigned>((rd() ^ static_cast<unsigned>(::getpid())) & 0xffff));
+  std::snprintf(suffix, sizeof(suffix), "%04x",
+                static_cast<unsigned>((rd() ^ static_cast<unsigned>(::getpid())) & 0xffff));
   return prefix + "-" + stamp + "-" + suffix;
 }
 
@@ -97,16 +99,22 @@ process::ProcessSpec Launcher::specOf(const deploy::ServiceSpec& s) const {
   process::ProcessSpec spec;
   spec.name = s.name;
   spec.executable = deploy::resolveExecutable(s, o_.bin_dir);
-  spec.args = {"--name", s.name, "--domain", std::to_string(o_.domain), "--heartbeat-period",
+  spec.args = {"--name",
+               s.name,
+               "--domain",
+               std::to_string(o_.domain),
+               "--heartbeat-period",
                std::to_string(d.heartbeat_period_s)};
   if (!o_.run_id.empty()) spec.args.insert(spec.args.end(), {"--run-id", o_.run_id});
   if (!o_.profile.empty()) spec.args.insert(spec.args.end(), {"--profile", o_.profile});
   if (o_.detach && d.orphan_timeout_s > 0) {
-    spec.args.insert(spec.args.end(), {"--supervisor-lease", (o_.run_dir / "supervisor.lease").string(),
-                                       "--orphan-timeout", std::to_string(d.orphan_timeout_s)});
+    spec.args.insert(spec.args.end(),
+                     {"--supervisor-lease", (o_.run_dir / "supervisor.lease").string(),
+                      "--orphan-timeout", std::to_string(d.orphan_timeout_s)});
   }
-  const auto extra = deploy::expandArgs(
-      s, deploy::Placeholders{o_.scenario, o_.config_dir.string(), o_.run_dir.string(), o_.run_id, o_.host});
+  const auto extra =
+      deploy::expandArgs(s, deploy::Placeholders{o_.scenario, o_.config_dir.string(),
+                                                 o_.run_dir.string(), o_.run_id, o_.host});
   spec.args.insert(spec.args.end(), extra.begin(), extra.end());
   auto addEnv = [&](const std::vector<std::string>& env) {
     for (const auto& kv : env) {
@@ -138,15 +146,17 @@ Status Launcher::start() {
   monitor_ = std::make_unique<dds::HeartbeatMonitor>(participant_);
   std::error_code ec;
   fs::create_directories(o_.run_dir, ec);
-  if (ec) return Error(ErrorCode::kIo, "cannot create the run folder: " + ec.message(), SourceLocation{o_.run_dir.string()});
+  if (ec)
+    return Error(ErrorCode::kIo, "cannot create the run folder: " + ec.message(),
+                 SourceLocation{o_.run_dir.string()});
   const fs::path lock = o_.run_dir / "launch.lock";
   lock_fd_ = ::open(lock.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
   if (lock_fd_ < 0 || flock(lock_fd_, LOCK_EX | LOCK_NB) != 0) {
     std::string holder;
     std::ifstream(lock) >> holder;
     return Error(ErrorCode::kUnavailable,
-                 "another tamp launch (pid " + (holder.empty() ? std::string("?") : holder) + ") supervises host '" +
-                     o_.host + "' of this run",
+                 "another tamp launch (pid " + (holder.empty() ? std::string("?") : holder) +
+                     ") supervises host '" + o_.host + "' of this run",
                  SourceLocation{lock.string()});
   }
   owns_run_dir_ = true;
@@ -155,9 +165,8 @@ Status Launcher::start() {
   (void)!write(lock_fd_, me.data(), me.size());
   touchLease();
 
-
-  note("launch_started", "pid " + std::to_string(::getpid()) + ", domain " + std::to_string(o_.domain) +
-                             ", deployment " + o_.deployment.file);
+  note("launch_started", "pid " + std::to_string(::getpid()) + ", domain " +
+                             std::to_string(o_.domain) + ", deployment " + o_.deployment.file);
   // Services recorded by an earlier supervisor of this run and host: adopt the ones still running
   // as they were started, replace the ones started otherwise (rebuilt binary, edited deployment).
   std::map<std::string, nlohmann::json> recorded;
@@ -176,8 +185,8 @@ Status Launcher::start() {
     if (it != recorded.end()) {
       const pid_t pid = it->second.value("pid", -1);
       const auto start_time = process::processStartTime(pid);
-      const bool same_process =
-          start_time && process::processRunning(pid) && *start_time == it->second.value("start_time", 0ULL);
+      const bool same_process = start_time && process::processRunning(pid) &&
+                                *start_time == it->second.value("start_time", 0ULL);
       if (same_process) {
         std::error_code e2;
         const fs::path exe = fs::read_symlink("/proc/" + std::to_string(pid) + "/exe", e2);
@@ -188,7 +197,8 @@ Status Launcher::start() {
           adopted_.push_back(s->name);
           continue;
         }
-        writeEvent(s->name, "replaced", pid, 0, 0, "started differently by an earlier supervisor: stopped");
+        writeEvent(s->name, "replaced", pid, 0, 0,
+                   "started differently by an earlier supervisor: stopped");
         kill(-pid, SIGTERM);
         kill(-pid, SIGCONT);
         const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(5);
@@ -228,7 +238,8 @@ void Launcher::checkLiveness() {
     if (seen == nullptr) {
       if (since_start > o_.deployment.startup_timeout_s) {
         char why[160];
-        std::snprintf(why, sizeof(why), "no heartbeat within startup_timeout_s (%.1f s) of its start",
+        std::snprintf(why, sizeof(why),
+                      "no heartbeat within startup_timeout_s (%.1f s) of its start",
                       o_.deployment.startup_timeout_s);
         (void)sup_.declareDead(st.name, why);
       }
@@ -255,7 +266,8 @@ void Launcher::stop(double grace_s) {
 
 void Launcher::touchLease() {
   const auto now = std::chrono::steady_clock::now();
-  if (now - lease_touched_ < std::chrono::duration<double>(o_.deployment.heartbeat_period_s)) return;
+  if (now - lease_touched_ < std::chrono::duration<double>(o_.deployment.heartbeat_period_s))
+    return;
   lease_touched_ = now;
   const fs::path lease = o_.run_dir / "supervisor.lease";
   std::error_code ec;
@@ -270,11 +282,17 @@ void Launcher::writePidFile() {
     if (st.phase != process::ProcessPhase::kRunning || st.pid <= 0) continue;
     const auto t = process::processStartTime(st.pid);
     const process::ProcessSpec* spec = sup_.spec(st.name);
-    services.push_back({{"name", st.name}, {"pid", st.pid}, {"start_time", t.value_or(0)},
-                        {"command", spec ? commandLine(*spec) : ""}, {"restarts", st.restarts}});
+    services.push_back({{"name", st.name},
+                        {"pid", st.pid},
+                        {"start_time", t.value_or(0)},
+                        {"command", spec ? commandLine(*spec) : ""},
+                        {"restarts", st.restarts}});
   }
-  nlohmann::json j{{"run_id", o_.run_id}, {"host", o_.host}, {"domain", o_.domain},
-                   {"supervisor_pid", ::getpid()}, {"services", services}};
+  nlohmann::json j{{"run_id", o_.run_id},
+                   {"host", o_.host},
+                   {"domain", o_.domain},
+                   {"supervisor_pid", ::getpid()},
+                   {"services", services}};
   writeAtomically(o_.run_dir / "launch.pids", j.dump(2) + "\n");
 }
 
@@ -287,10 +305,11 @@ void Launcher::logEvent(const process::ProcessEvent& e) {
   writeEvent(e.name, process::toString(e.kind), e.pid, e.restarts, e.backoff_s, e.detail);
 }
 
-void Launcher::writeEvent(const std::string& service, const std::string& event, pid_t pid, int restarts,
-                          double backoff_s, const std::string& detail) {
-  nlohmann::json j{{"time", utcNow()}, {"run_id", o_.run_id}, {"host", o_.host}, {"service", service},
-                   {"event", event},   {"pid", pid},          {"restarts", restarts}};
+void Launcher::writeEvent(const std::string& service, const std::string& event, pid_t pid,
+                          int restarts, double backoff_s, const std::string& detail) {
+  nlohmann::json j{{"time", utcNow()},    {"run_id", o_.run_id}, {"host", o_.host},
+                   {"service", service},  {"event", event},      {"pid", pid},
+                   {"restarts", restarts}};
   if (backoff_s > 0) j["backoff_s"] = backoff_s;
   if (!detail.empty()) j["detail"] = detail;
   // One write() per line with O_APPEND: lines of concurrent writers do not interleave.

@@ -38,18 +38,18 @@ namespace tamp::launch {
 
 struct LaunchOptions {
   deploy::Deployment deployment;
-  std::string host;      ///< a host of the deployment
-  std::string run_id;    ///< every service gets --run-id; may be empty (no run: default partition)
+  std::string host;    ///< a host of the deployment
+  std::string run_id;  ///< every service gets --run-id; may be empty (no run: default partition)
   int domain{0};
-  std::string profile;   ///< DDS participant profile for the services (empty: their default)
+  std::string profile;  ///< DDS participant profile for the services (empty: their default)
   std::filesystem::path run_dir;  ///< created if missing
-  std::string scenario;  ///< absolute path or empty
+  std::string scenario;           ///< absolute path or empty
   std::filesystem::path bin_dir;
   std::filesystem::path config_dir;
-  bool detach{true};     ///< services outlive the supervisor (tamp launch); attached for tamp run
-  bool restart{true};    ///< restart dead services (those with `restart: true`)
-  bool liveness{true};   ///< kill services whose heartbeats stop (only with restart)
-  bool adopt{true};      ///< adopt the services of launch.pids that still run
+  bool detach{true};    ///< services outlive the supervisor (tamp launch); attached for tamp run
+  bool restart{true};   ///< restart dead services (those with `restart: true`)
+  bool liveness{true};  ///< kill services whose heartbeats stop (only with restart)
+  bool adopt{true};     ///< adopt the services of launch.pids that still run
 };
 
 /// Generates a run id: "<prefix>-YYYYmmdd-HHMMSS-<4 hex>" (unique enough for concurrent runs).
@@ -78,7 +78,9 @@ class Launcher {
   process::Supervisor& supervisor() { return sup_; }
   const LaunchOptions& options() const { return o_; }
   std::filesystem::path eventsFile() const { return o_.run_dir / "events.jsonl"; }
-  std::filesystem::path logFile(const std::string& service) const { return o_.run_dir / (service + ".log"); }
+  std::filesystem::path logFile(const std::string& service) const {
+    return o_.run_dir / (service + ".log");
+  }
   /// Services adopted from an earlier supervisor at start().
   const std::vector<std::string>& adopted() const { return adopted_; }
   /// The participant watching heartbeats (in the run's partition).
@@ -90,8 +92,8 @@ class Launcher {
  private:
   process::ProcessSpec specOf(const deploy::ServiceSpec& s) const;
   void logEvent(const process::ProcessEvent& e);
-  void writeEvent(const std::string& service, const std::string& event, pid_t pid, int restarts, double backoff_s,
-                  const std::string& detail);
+  void writeEvent(const std::string& service, const std::string& event, pid_t pid, int restarts,
+                  double backoff_s, const std::string& detail);
   void writePidFile();
   void touchLease();
   void checkLiveness();

@@ -13,7 +13,8 @@ namespace {
 using ::testing::HasSubstr;
 
 std::shared_ptr<Participant> inRun(const std::string& run_id) {
-  auto p = Participant::create(ParticipantOptions{testing::isolatedDomain(), kProfileDefault, "run_test", {}}, run_id);
+  auto p = Participant::create(
+      ParticipantOptions{testing::isolatedDomain(), kProfileDefault, "run_test", {}}, run_id);
   if (!p) ADD_FAILURE() << p.error().toString();
   return p ? *p : nullptr;
 }
@@ -22,17 +23,21 @@ TEST(RunIdTest, ValidationAndEnvironment) {
   ::unsetenv("TAMP_RUN_ID");
   EXPECT_EQ(resolveRunId("").value(), "");
   EXPECT_EQ(resolveRunId("run-20261201-1200.a_b").value(), "run-20261201-1200.a_b");
-  for (const std::string& bad : std::vector<std::string>{"a b", "a/b", "tamp*", std::string(65, 'x')}) {
+  for (const std::string& bad :
+       std::vector<std::string>{"a b", "a/b", "tamp*", std::string(65, 'x')}) {
     auto r = resolveRunId(bad);
     ASSERT_FALSE(r.ok()) << bad;
-    EXPECT_THAT(r.error().toString(), HasSubstr("--run-id must be 1-64 characters of [A-Za-z0-9_.-], got '" + bad + "'"));
+    EXPECT_THAT(r.error().toString(),
+                HasSubstr("--run-id must be 1-64 characters of [A-Za-z0-9_.-], got '" + bad + "'"));
   }
   ::setenv("TAMP_RUN_ID", "from-env", 1);
   EXPECT_EQ(resolveRunId("").value(), "from-env");
   EXPECT_EQ(resolveRunId("flag").value(), "flag");
   ::setenv("TAMP_RUN_ID", "bad id", 1);
   EXPECT_THAT(resolveRunId("").error().toString(), HasSubstr("TAMP_RUN_ID must be"));
-  EXPECT_FALSE(Participant::create(ParticipantOptions{testing::isolatedDomain(), kProfileDefault, "x", {}}).ok());
+  EXPECT_FALSE(
+      Participant::create(ParticipantOptions{testing::isolatedDomain(), kProfileDefault, "x", {}})
+          .ok());
   ::unsetenv("TAMP_RUN_ID");
   EXPECT_EQ(runPartition(""), "");
   EXPECT_EQ(runPartition("r1"), "tamp.run.r1");

@@ -54,7 +54,8 @@ std::vector<const ServiceSpec*> Deployment::servicesOn(const std::string& host_n
 Result<Deployment> loadDeployment(const fs::path& file) {
   std::error_code ec;
   if (!fs::is_regular_file(file, ec)) {
-    return Error(ErrorCode::kNotFound, "deployment file does not exist", SourceLocation{file.string()});
+    return Error(ErrorCode::kNotFound, "deployment file does not exist",
+                 SourceLocation{file.string()});
   }
   auto doc = config::loadYamlFile(file);
   if (!doc) return doc.error();
@@ -62,14 +63,16 @@ Result<Deployment> loadDeployment(const fs::path& file) {
   Deployment d;
   d.file = file.string();
   if (!r.isMap()) {
-    return Error(ErrorCode::kInvalidArgument, "a deployment must be a mapping with a 'services' list",
+    return Error(ErrorCode::kInvalidArgument,
+                 "a deployment must be a mapping with a 'services' list",
                  SourceLocation{file.string(), 1});
   }
   r.optional("heartbeat_period_s", d.heartbeat_period_s);
   r.optional("liveness_periods", d.liveness_periods);
   r.optional("startup_timeout_s", d.startup_timeout_s);
   r.optional("orphan_timeout_s", d.orphan_timeout_s);
-  r.check(d.heartbeat_period_s > 0 && d.heartbeat_period_s <= 10, "heartbeat_period_s", "must be in (0, 10]");
+  r.check(d.heartbeat_period_s > 0 && d.heartbeat_period_s <= 10, "heartbeat_period_s",
+          "must be in (0, 10]");
   r.check(d.liveness_periods >= 2, "liveness_periods", "must be at least 2");
   r.check(d.startup_timeout_s > 0, "startup_timeout_s", "must be positive");
   r.check(d.orphan_timeout_s >= 0, "orphan_timeout_s", "must not be negative (0: never)");
@@ -81,7 +84,8 @@ Result<Deployment> loadDeployment(const fs::path& file) {
     rr.optional("stable_after_s", d.restart.stable_after_s);
     rr.check(d.restart.max_restarts >= 0, "max_restarts", "must not be negative");
     rr.check(d.restart.backoff_s > 0, "backoff_s", "must be positive");
-    rr.check(d.restart.backoff_max_s >= d.restart.backoff_s, "backoff_max_s", "must be at least backoff_s");
+    rr.check(d.restart.backoff_max_s >= d.restart.backoff_s, "backoff_max_s",
+             "must be at least backoff_s");
     rr.check(d.restart.stable_after_s > 0, "stable_after_s", "must be positive");
     rr.refuseUnknownKeys();
   }
@@ -96,7 +100,8 @@ Result<Deployment> loadDeployment(const fs::path& file) {
         checkEnv(h, host.env);
         h.refuseUnknownKeys();
       }  // else: null (no settings), or the reader recorded "expected a mapping"
-      r.check(!name.empty() && name.find('/') == std::string::npos, "hosts", "bad host name '" + name + "'");
+      r.check(!name.empty() && name.find('/') == std::string::npos, "hosts",
+              "bad host name '" + name + "'");
       d.hosts.push_back(std::move(host));
     }
     r.check(!d.hosts.empty(), "hosts", "must name at least one host");
@@ -116,20 +121,26 @@ Result<Deployment> loadDeployment(const fs::path& file) {
     checkEnv(s, e.env);
     if (has_hosts) {
       if (s.required("host", e.host)) {
-        s.check(d.host(e.host) != nullptr, "host", "unknown host '" + e.host + "' (hosts: " + listOf(d.hosts) + ")");
+        s.check(d.host(e.host) != nullptr, "host",
+                "unknown host '" + e.host + "' (hosts: " + listOf(d.hosts) + ")");
       }
     } else {
       if (s.optional("host", e.host)) {
         s.check(e.host == kLocalHost, "host",
-                "host '" + e.host + "' is not declared: add a 'hosts' mapping (without one every service is on 'local')");
+                "host '" + e.host +
+                    "' is not declared: add a 'hosts' mapping (without one every service is on "
+                    "'local')");
       }
       e.host = kLocalHost;
     }
-    s.check(!names.count(e.name) || e.name.empty(), "name", "duplicate service name '" + e.name + "'");
+    s.check(!names.count(e.name) || e.name.empty(), "name",
+            "duplicate service name '" + e.name + "'");
     const bool safe_name = !e.name.empty() && std::all_of(e.name.begin(), e.name.end(), [](char c) {
       return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_' || c == '-';
     });
-    if (s.has("name")) s.check(safe_name, "name", "must be [A-Za-z0-9_-]+ (it names log files), got '" + e.name + "'");
+    if (s.has("name"))
+      s.check(safe_name, "name",
+              "must be [A-Za-z0-9_-]+ (it names log files), got '" + e.name + "'");
     if (s.has("executable")) s.check(!e.executable.empty(), "executable", "must not be empty");
     s.refuseUnknownKeys();
     names.insert(e.name);
@@ -167,7 +178,8 @@ std::vector<std::string> expandArgs(const ServiceSpec& service, const Placeholde
   std::vector<std::string> out;
   const auto& a = service.args;
   for (std::size_t i = 0; i < a.size(); ++i) {
-    if (v.scenario.empty() && i + 1 < a.size() && a[i].rfind("--", 0) == 0 && a[i + 1] == "{scenario}") {
+    if (v.scenario.empty() && i + 1 < a.size() && a[i].rfind("--", 0) == 0 &&
+        a[i + 1] == "{scenario}") {
       ++i;
       continue;
     }

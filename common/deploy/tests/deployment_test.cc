@@ -66,9 +66,11 @@ TEST_F(DeploymentTest, ShippedTwoHostDeploymentSplitsRobotAndWorkstation) {
     for (const auto* s : d->servicesOn(host)) out.push_back(s->name);
     return out;
   };
-  EXPECT_THAT(names("robot"), ::testing::UnorderedElementsAre("sim", "perception", "execution_monitor"));
-  EXPECT_THAT(names("workstation"), ::testing::IsSupersetOf({"graph_manager", "symbolic_planner", "motion_planner",
-                                                             "effort_estimator"}));
+  EXPECT_THAT(names("robot"),
+              ::testing::UnorderedElementsAre("sim", "perception", "execution_monitor"));
+  EXPECT_THAT(names("workstation"),
+              ::testing::IsSupersetOf(
+                  {"graph_manager", "symbolic_planner", "motion_planner", "effort_estimator"}));
   EXPECT_EQ(d->servicesOn("").size(), d->services.size());
   EXPECT_EQ(d->host("nowhere"), nullptr);
 }
@@ -100,13 +102,15 @@ services:
 TEST_F(DeploymentTest, ScenarioPairIsDroppedWithoutAScenario) {
   ServiceSpec s;
   s.args = {"--config", "{config}/x.yaml", "--scenario", "{scenario}", "--v"};
-  EXPECT_EQ(expandArgs(s, Placeholders{"", "/cfg", "", "", ""}), (std::vector<std::string>{"--config", "/cfg/x.yaml", "--v"}));
+  EXPECT_EQ(expandArgs(s, Placeholders{"", "/cfg", "", "", ""}),
+            (std::vector<std::string>{"--config", "/cfg/x.yaml", "--v"}));
   EXPECT_EQ(expandArgs(s, Placeholders{"/s.yaml", "/cfg", "", "", ""}),
             (std::vector<std::string>{"--config", "/cfg/x.yaml", "--scenario", "/s.yaml", "--v"}));
 }
 
 TEST_F(DeploymentTest, MissingExecutableNamesFileLineAndField) {
-  const fs::path f = write("services:\n  - name: a\n    executable: svc_a\n  - name: b\n    executable: svc_typo\n");
+  const fs::path f = write(
+      "services:\n  - name: a\n    executable: svc_a\n  - name: b\n    executable: svc_typo\n");
   auto d = loadDeployment(f);
   ASSERT_TRUE(d.ok()) << d.error().toString();
   Status s = checkExecutables(*d, dir_ / "bin");
@@ -117,7 +121,8 @@ TEST_F(DeploymentTest, MissingExecutableNamesFileLineAndField) {
   EXPECT_THAT(msg, HasSubstr((dir_ / "bin" / "svc_typo").string()));
   EXPECT_THAT(msg, ::testing::Not(HasSubstr("svc_a")));
   // An optional service is no excuse for a missing executable.
-  auto opt = loadDeployment(write("services:\n  - {name: b, executable: /no/such/svc, optional: true}\n"));
+  auto opt =
+      loadDeployment(write("services:\n  - {name: b, executable: /no/such/svc, optional: true}\n"));
   ASSERT_TRUE(opt.ok());
   EXPECT_THAT(checkExecutables(*opt, dir_ / "bin").error().toString(), HasSubstr("/no/such/svc"));
 }
@@ -135,7 +140,8 @@ services:
 }
 
 TEST_F(DeploymentTest, BadFilesNameTheFieldAndLine) {
-  EXPECT_THAT(errorOf("services:\n  - name: a\n"), HasSubstr(":2:5: field 'services[0].executable': missing required field"));
+  EXPECT_THAT(errorOf("services:\n  - name: a\n"),
+              HasSubstr(":2:5: field 'services[0].executable': missing required field"));
   EXPECT_THAT(errorOf("services:\n  - {name: a, executable: x}\n  - {name: a, executable: y}\n"),
               HasSubstr(":3:12: field 'services[1].name': duplicate service name 'a'"));
   EXPECT_THAT(errorOf("hosts: {robot: }\nservices:\n  - {name: a, executable: x}\n"),
@@ -150,12 +156,16 @@ TEST_F(DeploymentTest, BadFilesNameTheFieldAndLine) {
               HasSubstr(":1:21: field 'heartbeat_period_s': must be in (0, 10]"));
   EXPECT_THAT(errorOf("liveness_periods: 1\nservices:\n  - {name: a, executable: x}\n"),
               HasSubstr("field 'liveness_periods': must be at least 2"));
-  EXPECT_THAT(errorOf("restart: {backoff_s: 2, backoff_max_s: 1}\nservices:\n  - {name: a, executable: x}\n"),
-              HasSubstr("field 'restart.backoff_max_s': must be at least backoff_s"));
+  EXPECT_THAT(
+      errorOf(
+          "restart: {backoff_s: 2, backoff_max_s: 1}\nservices:\n  - {name: a, executable: x}\n"),
+      HasSubstr("field 'restart.backoff_max_s': must be at least backoff_s"));
   EXPECT_THAT(errorOf("services:\n  - {name: a, executable: x, env: [NOEQUALS]}\n"),
               HasSubstr("field 'services[0].env': entry 0 must be KEY=value, got 'NOEQUALS'"));
-  EXPECT_THAT(errorOf("services:\n  - {name: a/b, executable: x}\n"), HasSubstr("field 'services[0].name': must be"));
-  EXPECT_THAT(errorOf("services: []\n"), HasSubstr("field 'services': must list at least one service"));
+  EXPECT_THAT(errorOf("services:\n  - {name: a/b, executable: x}\n"),
+              HasSubstr("field 'services[0].name': must be"));
+  EXPECT_THAT(errorOf("services: []\n"),
+              HasSubstr("field 'services': must list at least one service"));
   EXPECT_THAT(errorOf("services:\n  - {name: a, executable: x, optional: maybe}\n"),
               HasSubstr("field 'services[0].optional'"));
   EXPECT_THAT(errorOf("just a string\n"), HasSubstr(":1: a deployment must be a mapping"));

@@ -5,22 +5,22 @@
 /// starts one host's services, `tamp run` all of them on this machine, `tamp status --deployment
 /// FILE` checks that every expected service is alive.
 ///
-///   heartbeat_period_s: 0.5      # every service's heartbeat period
-///   liveness_periods: 6          # heartbeats a service may miss before it counts as dead
-///   startup_timeout_s: 30        # from start to first heartbeat
-///   orphan_timeout_s: 60         # a launched service outlives a dead supervisor this long (0: always)
+///   heartbeat_period_s: 0.5   # every service's heartbeat period
+///   liveness_periods: 6       # heartbeats a service may miss before it counts as dead
+///   startup_timeout_s: 30     # from start to first heartbeat
+///   orphan_timeout_s: 60      # a launched service outlives a dead supervisor so long (0: always)
 ///   restart: {max_restarts: 5, backoff_s: 0.5, backoff_max_s: 8, stable_after_s: 30}
-///   hosts:                       # optional; without it every service is on host "local"
+///   hosts:                    # optional; without it every service is on host "local"
 ///     robot: {env: ["KEY=value"], description: "..."}
 ///     workstation: {}
 ///   services:
-///     - name: sim                       # unique in the file
-///       host: robot                     # required when `hosts` is given
-///       executable: tamp_sim_service    # a name in the build's bin/ directory, or an absolute path
+///     - name: sim                     # unique in the file
+///       host: robot                   # required when `hosts` is given
+///       executable: tamp_sim_service  # a name in the build's bin/ directory, or absolute
 ///       args: [--config, "{config}/services/sim.yaml", --scenario, "{scenario}"]
 ///       env: ["KEY=value"]
-///       optional: false                 # the run may go on without it
-///       restart: true                   # restarted when it dies (tamp launch)
+///       optional: false               # the run may go on without it
+///       restart: true                 # restarted when it dies (tamp launch)
 ///
 /// Placeholders in args: {config} (config/ directory), {scenario} (the run's scenario; an
 /// "--option {scenario}" pair is dropped without one), {run_dir}, {run_id}, {host}. Every error
@@ -65,7 +65,7 @@ struct Deployment {
   double startup_timeout_s{30.0};  ///< > 0
   double orphan_timeout_s{60.0};   ///< >= 0; 0: launched services never stop by themselves
   RestartPolicy restart;
-  std::vector<HostSpec> hosts;     ///< at least one ("local" when the file names none)
+  std::vector<HostSpec> hosts;  ///< at least one ("local" when the file names none)
   std::vector<ServiceSpec> services;
 
   const HostSpec* host(const std::string& name) const;
@@ -83,7 +83,8 @@ inline constexpr const char* kLocalHost = "local";
 Result<Deployment> loadDeployment(const std::filesystem::path& file);
 
 /// Where a service's executable is: absolute as written, else `bin_dir / executable`.
-std::filesystem::path resolveExecutable(const ServiceSpec& service, const std::filesystem::path& bin_dir);
+std::filesystem::path resolveExecutable(const ServiceSpec& service,
+                                        const std::filesystem::path& bin_dir);
 
 /// Every service of `host` (all hosts when empty) has an executable file; errors (kNotFound) name
 /// the deployment file, the line and the field of each missing one, and the path looked for.

@@ -265,6 +265,7 @@ void Launcher::stop(double grace_s) {
 }
 
 void Launcher::touchLease() {
+  if (!o_.detach) return;  // attached services die with us: no lease to renew
   const auto now = std::chrono::steady_clock::now();
   if (now - lease_touched_ < std::chrono::duration<double>(o_.deployment.heartbeat_period_s))
     return;

@@ -18,6 +18,8 @@ int main(int argc, char** argv) {
   app.add_option("service", service, "service name, e.g. symbolic_planner")->required();
   app.add_option("--domain", domain, "DDS domain id (default: $TAMP_DOMAIN_ID or 0)")->check(CLI::Range(0, 232));
   app.add_option("--profile", profile, "DDS participant profile");
+  std::string run_id;
+  app.add_option("--run-id", run_id, "run the service belongs to (default: $TAMP_RUN_ID or none)");
   app.add_option("-c,--count", count, "number of round trips")->check(CLI::Range(1, 1000000));
   app.add_option("-s,--size", size, "payload bytes")->check(CLI::Range(0, 16 << 20));
   app.add_option("--timeout", timeout, "seconds per call")->check(CLI::Range(0.01, 3600.0));
@@ -27,7 +29,7 @@ int main(int argc, char** argv) {
   po.domain_id = domain;
   po.name = "tamp/ping";
   if (!profile.empty()) po.profile = profile;
-  auto participant = tamp::dds::Participant::create(po);
+  auto participant = tamp::dds::Participant::create(po, run_id);
   if (!participant) {
     std::cerr << "tamp ping: " << participant.error().toString() << "\n";
     return tamp::cli::kExitServiceError;

@@ -7,6 +7,10 @@
 // service's log, stops the services (or keeps them with --keep-running) and exits with the
 // mission's code: 0 succeeded, 10 mission failed, 20 out of time, 30 bad input, 40 a service
 // unavailable. Without a scenario it only starts and checks the services.
+//
+// Each run has its own run id (printed; the run folder is OUT/RUN_ID): every service gets it and
+// talks only to services of the same run, so two `tamp run`s on one DDS domain do not mix. With
+// --keep-running a service that dies or freezes is restarted (events.jsonl in the run folder).
 #include <signal.h>
 #include <unistd.h>
 
@@ -21,7 +25,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cli_common.h"
-#include "tamp/config/yaml_reader.h"
+#include "launcher.h"
 #include "tamp/core/paths.h"
 #include "tamp/dds/heartbeat.h"
 #include "tamp/dds/service_node.h"
@@ -31,50 +35,6 @@
 namespace fs = std::filesystem;
 
 namespace {
-
-struct ServiceEntry {
-  std::string name;
-  std::string executable;
-  std::vector<std::string> args;
-  bool optional{false};
-};
-
-struct Deployment {
-  double heartbeat_period_s{0.5};
-  double startup_timeout_s{30.0};
-  std::vector<ServiceEntry> services;
-};
-
-tamp::Result<Deployment> loadDeployment(const fs::path& file) {
-  auto doc = tamp::config::loadYamlFile(file);
-  if (!doc) return doc.error();
-  tamp::config::FieldReader r(*doc);
-  Deployment d;
-  r.optional("heartbeat_period_s", d.heartbeat_period_s);
-  r.optional("startup_timeout_s", d.startup_timeout_s);
-  r.check(d.heartbeat_period_s > 0 && d.heartbeat_period_s <= 10, "heartbeat_period_s", "must be in (0, 10]");
-  r.check(d.startup_timeout_s > 0, "startup_timeout_s", "must be positive");
-  for (auto& s : r.sequence("services")) {
-    ServiceEntry e;
-    s.required("name", e.name);
-    s.required("executable", e.executable);
-    s.optional("args", e.args);
-    s.optional("optional", e.optional);
-    s.refuseUnknownKeys();
-    for (const auto& other : d.services) {
-      s.check(other.name != e.name, "name", "duplicate service name '" + e.name + "'");
-    }
-    d.services.push_back(std::move(e));
-  }
-  r.refuseUnknownKeys();
-  if (!r.ok()) return r.status().error();
-  return d;
-}
-
-std::string expand(std::string s, const std::string& key, const std::string& value) {
-  for (size_t pos; (pos = s.find(key)) != std::string::npos;) s.replace(pos, key.size(), value);
-  return s;
-}
 
 volatile sig_atomic_t g_stop = 0;
 void onSignal(int) { g_stop = 1; }
@@ -97,15 +57,24 @@ int main(int argc, char** argv) {
   app.add_option("--seed", seed, "seed of the mission's sampling (0: the graph manager's configured seed)");
   app.add_option("--mission-timeout", mission_timeout, "give up on the mission after this many seconds")
       ->check(CLI::PositiveNumber);
-  app.add_option("--deployment", deployment_file, "deployment file: services to start")->check(CLI::ExistingFile);
+  app.add_option("--deployment", deployment_file, "deployment file: services to start (every host's, here)");
   app.add_option("--domain", domain, "DDS domain id (default: $TAMP_DOMAIN_ID or 0)")->check(CLI::Range(0, 232));
   app.add_flag("--keep-running", keep, "keep the services running (supervised) until Ctrl-C");
-  app.add_option("--out", out_dir, "directory for run logs and reports");
+  app.add_option("--out", out_dir, "directory for run folders (OUT/RUN_ID: logs, events, reports)");
+  std::string explicit_run_id;
+  app.add_option("--run-id", explicit_run_id, "run id (default: generated, run-YYYYmmdd-HHMMSS-xxxx)");
   CLI11_PARSE(app, argc, argv);
 
-  auto deployment = loadDeployment(deployment_file);
+  auto deployment = tamp::deploy::loadDeployment(deployment_file);
   if (!deployment) {
     std::cerr << "tamp run: " << deployment.error().toString() << "\n";
+    return tamp::cli::kExitInputError;
+  }
+  const fs::path bin_dir = fs::read_symlink("/proc/self/exe").parent_path();
+  // A deployment naming an executable that does not exist is an input error (file, line, field),
+  // optional service or not: a typo must not become a silently smaller run.
+  if (tamp::Status s = tamp::deploy::checkExecutables(*deployment, bin_dir); !s.ok()) {
+    std::cerr << "tamp run: " << s.error().toString() << "\n";
     return tamp::cli::kExitInputError;
   }
   if (!scenario.empty()) {
@@ -122,63 +91,61 @@ int main(int argc, char** argv) {
     return tamp::cli::kExitInputError;
   }
 
-  char stamp[32];
-  const std::time_t now = std::time(nullptr);
-  std::strftime(stamp, sizeof(stamp), "%Y%m%d-%H%M%S", std::localtime(&now));
-  const fs::path run_dir = fs::path(out_dir) / (std::string("run-") + stamp);
+  std::string run_id = tamp::launch::makeRunId("run");
+  if (!explicit_run_id.empty()) {
+    auto rid = tamp::dds::resolveRunId(explicit_run_id);
+    if (!rid) {
+      std::cerr << "tamp run: " << rid.error().toString() << "\n";
+      return tamp::cli::kExitInputError;
+    }
+    run_id = *rid;
+  }
+  const fs::path run_dir = fs::absolute(fs::path(out_dir) / run_id);
   fs::create_directories(run_dir);
-  const fs::path bin_dir = fs::read_symlink("/proc/self/exe").parent_path();
 
   // The simulator writes the ground truth it ends with here (tests and reports judge by it).
-  if (!scenario.empty()) setenv("TAMP_SIM_FINAL_WORLD", (fs::absolute(run_dir) / "sim_final_world.json").c_str(), 1);
+  if (!scenario.empty()) setenv("TAMP_SIM_FINAL_WORLD", (run_dir / "sim_final_world.json").c_str(), 1);
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
 
-  tamp::process::Supervisor sup;
-  std::vector<std::string> started, skipped;
-  for (const auto& s : deployment->services) {
-    const fs::path exe = bin_dir / s.executable;
-    if (access(exe.c_str(), X_OK) != 0) {
-      if (s.optional) {
-        skipped.push_back(s.name);
-        continue;
-      }
-      std::cerr << "tamp run: service '" << s.name << "' needs " << exe << ", which is not built\n";
-      return tamp::cli::kExitInputError;
-    }
-    tamp::process::ProcessSpec spec;
-    spec.name = s.name;
-    spec.executable = exe;
-    spec.args = {"--name", s.name, "--domain", std::to_string(*dom), "--heartbeat-period",
-                 std::to_string(deployment->heartbeat_period_s)};
-    for (std::size_t i = 0; i < s.args.size(); ++i) {
-      // "--option {scenario}" is left out as a pair when the run has no scenario.
-      if (scenario.empty() && i + 1 < s.args.size() && s.args[i].rfind("--", 0) == 0 &&
-          s.args[i + 1] == "{scenario}") {
-        ++i;
-        continue;
-      }
-      spec.args.push_back(
-          expand(expand(s.args[i], "{scenario}", scenario), "{config}", tamp::configDir().string()));
-    }
-    spec.log_file = run_dir / (s.name + ".log");
-    spec.restart = keep;
-    sup.add(spec);
+  // Every service of every host of the deployment, on this machine, attached to this process
+  // (they die with it); restarted on death or freeze only when they are to keep running.
+  tamp::deploy::Deployment local = *deployment;
+  std::vector<std::string> started, optional_names;
+  for (auto& s : local.services) {
+    // The host's environment goes with each of its services (the service's own entries last).
+    std::vector<std::string> env = deployment->host(s.host)->env;
+    env.insert(env.end(), s.env.begin(), s.env.end());
+    s.env = std::move(env);
+    s.host = tamp::deploy::kLocalHost;
     started.push_back(s.name);
+    if (s.optional) optional_names.push_back(s.name);
   }
-  std::printf("tamp run: DDS domain %d, deployment %s, logs in %s\n", *dom, deployment_file.c_str(), run_dir.c_str());
-  if (!skipped.empty()) {
-    std::printf("tamp run: not built yet, skipped:");
-    for (const auto& s : skipped) std::printf(" %s", s.c_str());
-    std::printf("\n");
-  }
-  if (auto st = sup.startAll(); !st.ok()) {
+  local.hosts = {tamp::deploy::HostSpec{tamp::deploy::kLocalHost, "this machine", {}}};
+  tamp::launch::LaunchOptions lo;
+  lo.deployment = local;
+  lo.host = tamp::deploy::kLocalHost;
+  lo.run_id = run_id;
+  lo.domain = *dom;
+  lo.run_dir = run_dir;
+  lo.scenario = scenario;
+  lo.bin_dir = bin_dir;
+  lo.config_dir = tamp::configDir();
+  lo.detach = false;
+  lo.restart = keep;
+  lo.liveness = keep;
+  lo.adopt = false;
+  tamp::launch::Launcher launcher(lo);
+  tamp::process::Supervisor& sup = launcher.supervisor();
+  std::printf("tamp run: run %s, DDS domain %d, deployment %s, logs in %s\n", run_id.c_str(), *dom,
+              deployment_file.c_str(), run_dir.c_str());
+  if (auto st = launcher.start(); !st.ok()) {
     std::cerr << "tamp run: " << st.error().toString() << "\n";
-    sup.stopAll();
+    launcher.stop();
     return tamp::cli::kExitServiceError;
   }
 
-  auto participant = tamp::dds::Participant::create({*dom, tamp::dds::kProfileDefault, "tamp/run", {}});
+  auto participant = tamp::dds::Participant::create({*dom, tamp::dds::kProfileDefault, "tamp/run", {}}, run_id);
   if (!participant) {
     std::cerr << "tamp run: " << participant.error().toString() << "\n";
     return tamp::cli::kExitServiceError;
@@ -188,7 +155,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> not_alive;
   for (const auto& name : started) {
     while (!monitor.waitFor(name, 1, startup.tightened(tamp::Deadline::in(0.1)))) {
-      sup.poll();
+      launcher.poll();
       auto st = sup.status(name);
       if (startup() || g_stop || (st && st->phase != tamp::process::ProcessPhase::kRunning &&
                                    st->phase != tamp::process::ProcessPhase::kBackoff)) {
@@ -203,11 +170,12 @@ int main(int argc, char** argv) {
   for (const auto& name : started) {
     auto st = sup.status(name);
     const bool alive = std::find(not_alive.begin(), not_alive.end(), name) == not_alive.end();
+    const bool optional = std::find(optional_names.begin(), optional_names.end(), name) != optional_names.end();
     if (!alive) {
-      std::printf("%-20s %8s %10s  NOT ALIVE (%s; see %s)\n", name.c_str(), "-", "-",
+      std::printf("%-20s %8s %10s  NOT ALIVE (%s; see %s)%s\n", name.c_str(), "-", "-",
                   st ? (st->last_exit.empty() ? "no heartbeat" : st->last_exit.c_str()) : "?",
-                  (run_dir / (name + ".log")).c_str());
-      rc = tamp::cli::kExitServiceError;
+                  (run_dir / (name + ".log")).c_str(), optional ? " -- optional, going on" : "");
+      if (!optional) rc = tamp::cli::kExitServiceError;
       continue;
     }
     tamp::dds::RpcClient<tamp::msg::EchoRequest, tamp::msg::EchoReply> echo(*participant,
@@ -219,7 +187,7 @@ int main(int argc, char** argv) {
     if (!rep) {
       std::printf("%-20s %8d %10s  NO REPLY: %s\n", name.c_str(), st ? st->pid : -1, "-",
                   rep.error().toString().c_str());
-      rc = tamp::cli::kExitServiceError;
+      if (!optional) rc = tamp::cli::kExitServiceError;
       continue;
     }
     std::printf("%-20s %8u %8.0fus  ok\n", name.c_str(), rep->pid(), sw.seconds() * 1e6);
@@ -235,10 +203,13 @@ int main(int argc, char** argv) {
                   .append(std::to_string(status_wait))
                   .append(" --domain ")
                   .append(std::to_string(*dom))
+                  .append(" --run-id ")
+                  .append(run_id)
                   .c_str());
 
   if (scenario.empty()) {
     std::printf("\ntamp run: no scenario given: services only.\n");
+    std::fflush(stdout);
   } else if (rc == tamp::cli::kExitOk) {
     tamp::runner::MissionOptions mo;
     mo.scenario = scenario;
@@ -247,18 +218,19 @@ int main(int argc, char** argv) {
     mo.timeout_s = mission_timeout;
     mo.out_dir = run_dir;
     rc = tamp::runner::runMission(*participant, mo, [&] {
-      sup.poll();
+      launcher.poll();
       return g_stop != 0;
     });
   }
   if (keep && rc == tamp::cli::kExitOk) {
     std::printf("tamp run: services running (supervised); Ctrl-C to stop.\n");
+    std::fflush(stdout);
     while (!g_stop) {
-      sup.poll();
+      launcher.poll();
       std::this_thread::sleep_for(std::chrono::milliseconds(100));
     }
   }
-  sup.stopAll(5.0);
+  launcher.stop(5.0);
   for (const auto& st : sup.status()) {
     if (st.last_exit != "exit 0" && st.last_exit.rfind("signal 15", 0) != 0) {
       std::printf("tamp run: %s ended with %s\n", st.name.c_str(), st.last_exit.c_str());

@@ -1,5 +1,7 @@
 #include "tamp/dds/participant.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cstdlib>
 #include <set>
 #include <sstream>
@@ -65,9 +67,37 @@ Result<int> resolveDomainId(int flag_value) {
   return id;
 }
 
+Result<std::string> resolveRunId(const std::string& flag_value) {
+  std::string id = flag_value;
+  std::string origin = "--run-id";
+  if (id.empty()) {
+    const char* env = std::getenv("TAMP_RUN_ID");
+    if (env == nullptr || *env == '\0') return std::string();
+    id = env;
+    origin = "TAMP_RUN_ID";
+  }
+  const bool valid_chars = std::all_of(id.begin(), id.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_' || c == '-' || c == '.';
+  });
+  if (id.size() > 64 || !valid_chars) {
+    return Error(ErrorCode::kInvalidArgument,
+                 origin + " must be 1-64 characters of [A-Za-z0-9_.-], got '" + id + "'");
+  }
+  return id;
+}
+
+std::string runPartition(const std::string& run_id) { return run_id.empty() ? std::string() : "tamp.run." + run_id; }
+
 Result<std::shared_ptr<Participant>> Participant::create(const ParticipantOptions& options) {
+  return create(options, std::string());
+}
+
+Result<std::shared_ptr<Participant>> Participant::create(const ParticipantOptions& options,
+                                                         const std::string& run_id_flag) {
   auto domain = resolveDomainId(options.domain_id);
   if (!domain) return domain.error();
+  auto run_id = resolveRunId(run_id_flag);
+  if (!run_id) return run_id.error();
 
   std::filesystem::path file = options.profiles_file;
   if (file.empty()) {
@@ -96,8 +126,16 @@ Result<std::shared_ptr<Participant>> Participant::create(const ParticipantOption
     return Error(ErrorCode::kInternal, "Fast DDS could not create a participant on domain " +
                                            std::to_string(*domain) + " with profile '" + profile + "'");
   }
-  p->publisher_ = p->participant_->create_publisher(fdds::PUBLISHER_QOS_DEFAULT);
-  p->subscriber_ = p->participant_->create_subscriber(fdds::SUBSCRIBER_QOS_DEFAULT);
+  p->run_id_ = *run_id;
+  // Isolation of runs: every writer and reader of this participant lives in its run's partition.
+  fdds::PublisherQos pub_qos = fdds::PUBLISHER_QOS_DEFAULT;
+  fdds::SubscriberQos sub_qos = fdds::SUBSCRIBER_QOS_DEFAULT;
+  if (!p->run_id_.empty()) {
+    pub_qos.partition().push_back(runPartition(p->run_id_).c_str());
+    sub_qos.partition().push_back(runPartition(p->run_id_).c_str());
+  }
+  p->publisher_ = p->participant_->create_publisher(pub_qos);
+  p->subscriber_ = p->participant_->create_subscriber(sub_qos);
   if (p->publisher_ == nullptr || p->subscriber_ == nullptr) {
     return Error(ErrorCode::kInternal, "Fast DDS could not create a publisher/subscriber");
   }

@@ -22,6 +22,11 @@ Result<ServiceArgs> parseServiceArgs(int argc, char** argv, const std::string& d
   app.add_option("--log-level", a.log_level, "trace, debug, info, warn, error, off");
   app.add_option("--heartbeat-period", a.heartbeat_period_s, "seconds between heartbeats")
       ->check(CLI::Range(0.01, 60.0));
+  app.add_option("--run-id", a.run_id, "run this service belongs to (DDS partition; default: $TAMP_RUN_ID or none)");
+  app.add_option("--supervisor-lease", a.supervisor_lease,
+                 "file the supervisor touches; stop when it is older than --orphan-timeout");
+  app.add_option("--orphan-timeout", a.orphan_timeout_s, "seconds without a supervisor before stopping (0: never)")
+      ->check(CLI::Range(0.0, 1e6));
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp&) {
@@ -31,6 +36,9 @@ Result<ServiceArgs> parseServiceArgs(int argc, char** argv, const std::string& d
     return Error(ErrorCode::kInvalidArgument, e.what());
   }
   if (a.name.empty()) return Error(ErrorCode::kInvalidArgument, "--name must not be empty");
+  auto run_id = resolveRunId(a.run_id);
+  if (!run_id) return run_id.error();
+  a.run_id = *run_id;
   return a;
 }
 

@@ -4,6 +4,7 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <filesystem>
 #include <iostream>
 #include <thread>
 
@@ -35,12 +36,13 @@ msg::EchoReply echoHandler(const msg::EchoRequest& req, const RequestContext& ct
   return rep;
 }
 
-ServiceNode::ServiceNode(const ServiceArgs& args) : name_(args.name) {
+ServiceNode::ServiceNode(const ServiceArgs& args)
+    : name_(args.name), supervisor_lease_(args.supervisor_lease), orphan_timeout_s_(args.orphan_timeout_s) {
   ParticipantOptions po;
   po.domain_id = args.domain_id;
   if (!args.profile.empty()) po.profile = args.profile;
   po.name = "tamp/" + args.name;
-  auto p = Participant::create(po);
+  auto p = Participant::create(po, args.run_id);
   if (!p) throw std::runtime_error(p.error().toString());
   participant_ = *p;
   heartbeat_ = std::make_unique<HeartbeatPublisher>(participant_, name_, args.heartbeat_period_s);
@@ -57,13 +59,29 @@ std::pair<uint64_t, uint64_t> ServiceNode::requestCounters() const {
   return {echo_ ? echo_->served() : 0, echo_ ? echo_->failed() + echo_->rejected() : 0};
 }
 
+bool ServiceNode::orphaned() const {
+  if (supervisor_lease_.empty() || orphan_timeout_s_ <= 0) return false;
+  std::error_code ec;
+  const auto touched = std::filesystem::last_write_time(supervisor_lease_, ec);
+  // A lease that vanished counts as expired: the run's folder was removed.
+  if (ec) return true;
+  const double age = std::chrono::duration<double>(std::filesystem::file_time_type::clock::now() - touched).count();
+  return age > orphan_timeout_s_;
+}
+
 int ServiceNode::run() {
   heartbeat_->setState(msg::SERVICE_READY);
-  log::get(name_)->info("{} ready on DDS domain {} (profile {})", name_, participant_->domainId(),
-                        participant_->profile());
+  log::get(name_)->info("{} ready on DDS domain {} (profile {}{})", name_, participant_->domainId(),
+                        participant_->profile(), runId().empty() ? std::string() : ", run " + runId());
   std::unique_lock lock(mutex_);
   while (!stop_) {
     lock.unlock();
+    if (orphaned()) {
+      log::get(name_)->warn("{}: no supervisor renewed {} for {:.1f} s: stopping", name_, supervisor_lease_,
+                            orphan_timeout_s_);
+      lock.lock();
+      break;
+    }
     try {
       spinOnce();
     } catch (const std::exception& e) {

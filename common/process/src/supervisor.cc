@@ -7,7 +7,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstring>
+#include <fstream>
+#include <sstream>
 #include <thread>
 
 #include "tamp/core/log.h"
@@ -23,6 +26,61 @@ std::string describeExit(int wstatus) {
     return "signal " + std::to_string(s) + " (" + strsignal(s) + ")";
   }
   return "status " + std::to_string(wstatus);
+}
+
+const char* toString(ProcessPhase phase) {
+  switch (phase) {
+    case ProcessPhase::kNotStarted: return "not started";
+    case ProcessPhase::kRunning: return "running";
+    case ProcessPhase::kBackoff: return "backoff";
+    case ProcessPhase::kExited: return "exited";
+    case ProcessPhase::kFailed: return "failed";
+  }
+  return "?";
+}
+
+const char* toString(ProcessEventKind kind) {
+  switch (kind) {
+    case ProcessEventKind::kStarted: return "started";
+    case ProcessEventKind::kStartFailed: return "start_failed";
+    case ProcessEventKind::kAdopted: return "adopted";
+    case ProcessEventKind::kExited: return "exited";
+    case ProcessEventKind::kKilled: return "killed";
+    case ProcessEventKind::kRestartScheduled: return "restart_scheduled";
+    case ProcessEventKind::kRestarted: return "restarted";
+    case ProcessEventKind::kGaveUp: return "gave_up";
+  }
+  return "?";
+}
+
+namespace {
+/// /proc/<pid>/stat: "pid (comm) state ppid ... starttime(22) ..."; comm may hold spaces/parens.
+bool readStat(pid_t pid, char& state, unsigned long long& start_time) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/stat");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto close = text.rfind(')');
+  if (close == std::string::npos) return false;
+  std::istringstream rest(text.substr(close + 1));
+  std::string field;
+  rest >> state;
+  for (int i = 4; i <= 21 && rest >> field; ++i) {
+  }
+  return static_cast<bool>(rest >> start_time);
+}
+}  // namespace
+
+std::optional<unsigned long long> processStartTime(pid_t pid) {
+  char state = 0;
+  unsigned long long t = 0;
+  if (pid <= 0 || !readStat(pid, state, t)) return std::nullopt;
+  return t;
+}
+
+bool processRunning(pid_t pid) {
+  char state = 0;
+  unsigned long long t = 0;
+  if (pid <= 0 || !readStat(pid, state, t)) return false;
+  return state != 'Z' && state != 'X';
 }
 
 Result<pid_t> spawn(const ProcessSpec& spec) {
@@ -63,19 +121,27 @@ Result<pid_t> spawn(const ProcessSpec& spec) {
     if (log_fd >= 0) close(log_fd);
     return Error(ErrorCode::kIo, std::string("fork: ") + std::strerror(e));
   }
+  const bool detach = spec.detach;
   if (pid == 0) {
     // Child. Its own process group (signals reach its helpers; a terminal's Ctrl-C goes to the
-    // supervisor, which stops children in order), default signal handling, and it dies with the
-    // process that started it, so a crashed test or supervisor leaves no service behind.
-    setpgid(0, 0);
+    // supervisor, which stops children in order), default signal handling, and -- attached -- it
+    // dies with the process that started it, so a crashed test or `tamp run` leaves no service
+    // behind. Detached, it leads its own session and outlives the supervisor.
+    if (detach) {
+      setsid();
+    } else {
+      setpgid(0, 0);
+    }
     struct sigaction dfl {};
     dfl.sa_handler = SIG_DFL;
     for (int sig = 1; sig < NSIG; ++sig) sigaction(sig, &dfl, nullptr);
     sigset_t none;
     sigemptyset(&none);
     sigprocmask(SIG_SETMASK, &none, nullptr);
-    prctl(PR_SET_PDEATHSIG, SIGTERM);
-    if (getppid() != parent) _exit(127);  // the parent died before prctl took effect
+    if (!detach) {
+      prctl(PR_SET_PDEATHSIG, SIGTERM);
+      if (getppid() != parent) _exit(127);  // the parent died before prctl took effect
+    }
     if (log_fd >= 0) {
       dup2(log_fd, STDOUT_FILENO);
       dup2(log_fd, STDERR_FILENO);
@@ -89,22 +155,66 @@ Result<pid_t> spawn(const ProcessSpec& spec) {
     _exit(e == ENOENT ? 127 : 126);  // seen by the supervisor as "exit 127/126"
   }
   // Also from the parent, so that the group exists as soon as spawn() returns (no race with a
-  // signal sent right away); EACCES after the child's exec is harmless.
-  setpgid(pid, pid);
+  // signal sent right away); EACCES after the child's exec (or its setsid) is harmless.
+  if (!detach) {
+    setpgid(pid, pid);
+  } else {
+    // A session leader cannot be made a group leader by us (its setsid would fail): wait until
+    // the child's own setsid() made the group, so a signal to -pid right away reaches it.
+    for (int i = 0; i < 2000; ++i) {
+      const pid_t group = getpgid(pid);
+      if (group == pid || group < 0) break;
+      std::this_thread::sleep_for(std::chrono::microseconds(500));
+    }
+  }
   if (log_fd >= 0) close(log_fd);
   return pid;
 }
 
 Supervisor::~Supervisor() { stopAll(); }
 
+namespace {
+std::chrono::steady_clock::duration seconds(double s) {
+  return std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(s));
+}
+}  // namespace
+
+void Supervisor::emit(ProcessEventKind kind, const Child& c, std::string detail, double backoff_s) const {
+  if (!handler_) return;
+  ProcessEvent e;
+  e.kind = kind;
+  e.name = c.spec.name;
+  e.pid = c.st.pid;
+  e.restarts = c.st.restarts;
+  e.backoff_s = backoff_s;
+  e.detail = std::move(detail);
+  handler_(e);
+}
+
+void Supervisor::checkUnique(const std::string& name) const {
+  for (const auto& c : children_) require(c.spec.name != name, "duplicate process name '" + name + "'");
+}
+
 void Supervisor::add(ProcessSpec spec) {
-  for (const auto& c : children_) {
-    require(c.spec.name != spec.name, "duplicate process name '" + spec.name + "'");
-  }
+  checkUnique(spec.name);
   Child c;
   c.st.name = spec.name;
   c.spec = std::move(spec);
   children_.push_back(std::move(c));
+}
+
+void Supervisor::adopt(ProcessSpec spec, pid_t pid) {
+  checkUnique(spec.name);
+  require(pid > 0, "adopt: bad pid " + std::to_string(pid) + " for '" + spec.name + "'");
+  Child c;
+  c.st.name = spec.name;
+  c.st.pid = pid;
+  c.st.phase = ProcessPhase::kRunning;
+  c.st.adopted = true;
+  c.st.started = std::chrono::steady_clock::now();
+  c.spec = std::move(spec);
+  children_.push_back(std::move(c));
+  emit(ProcessEventKind::kAdopted, children_.back());
 }
 
 Status Supervisor::startAll() {
@@ -115,76 +225,116 @@ Status Supervisor::startAll() {
     if (!pid) {
       c.st.phase = ProcessPhase::kFailed;
       c.st.last_exit = pid.error().toString();
+      emit(ProcessEventKind::kStartFailed, c, c.st.last_exit);
       if (first.ok()) first = pid.error();
       continue;
     }
     c.st.pid = *pid;
     c.st.phase = ProcessPhase::kRunning;
+    c.st.started = std::chrono::steady_clock::now();
+    emit(ProcessEventKind::kStarted, c);
   }
   return first;
 }
 
-void Supervisor::onExit(Child& c, int wstatus) {
-  c.st.last_exit = describeExit(wstatus);
-  c.st.last_exit_code = WIFEXITED(wstatus) ? WEXITSTATUS(wstatus) : 128 + WTERMSIG(wstatus);
+void Supervisor::onExit(Child& c, const std::string& how, int exit_code, bool clean) {
+  c.st.last_exit = how;
+  c.st.last_exit_code = exit_code;
+  emit(ProcessEventKind::kExited, c, how);
   c.st.pid = -1;
-  const bool clean = WIFEXITED(wstatus) && WEXITSTATUS(wstatus) == 0;
+  c.st.adopted = false;
   if (c.stopping || clean || !c.spec.restart) {
     c.st.phase = ProcessPhase::kExited;
     return;
   }
-  if (c.st.restarts >= c.spec.max_restarts) {
+  const double ran_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - c.st.started).count();
+  if (ran_s >= c.spec.stable_after_s) c.st.consecutive_restarts = 0;
+  if (c.st.consecutive_restarts >= c.spec.max_restarts) {
     c.st.phase = ProcessPhase::kFailed;
-    log::get("supervisor")->error("{} died ({}) and reached its restart limit ({})", c.spec.name, c.st.last_exit,
+    log::get("supervisor")->error("{} died ({}) and reached its restart limit ({})", c.spec.name, how,
                                   c.spec.max_restarts);
+    emit(ProcessEventKind::kGaveUp, c, how + "; " + std::to_string(c.spec.max_restarts) + " consecutive restarts");
     return;
   }
-  const double backoff = std::min(8.0, c.spec.restart_backoff_s * (1 << std::min(c.st.restarts, 4)));
+  const double backoff = std::min(c.spec.restart_backoff_max_s,
+                                  c.spec.restart_backoff_s * std::pow(2.0, std::min(c.st.consecutive_restarts, 30)));
   c.st.phase = ProcessPhase::kBackoff;
-  c.restart_at = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                                        std::chrono::duration<double>(backoff));
-  log::get("supervisor")->warn("{} died ({}); restarting in {:.1f} s", c.spec.name, c.st.last_exit, backoff);
+  c.restart_at = std::chrono::steady_clock::now() + seconds(backoff);
+  log::get("supervisor")->warn("{} died ({}); restarting in {:.2f} s", c.spec.name, how, backoff);
+  emit(ProcessEventKind::kRestartScheduled, c, how, backoff);
+}
+
+bool Supervisor::reap(Child& c, bool block, const std::string& cause) {
+  if (c.st.phase != ProcessPhase::kRunning || c.st.pid <= 0) return false;
+  if (c.st.adopted) {
+    // Not our child: its exit status went to whoever reaps orphans. Poll for its disappearance.
+    if (block) {
+      const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+      while (processRunning(c.st.pid) && std::chrono::steady_clock::now() < end) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      }
+    }
+    if (processRunning(c.st.pid)) return false;
+    onExit(c, !cause.empty() ? cause : c.stopping ? "stopped (adopted: exit status unknown)" : "ended (adopted: exit status unknown)",
+           -1, c.stopping);
+    return true;
+  }
+  int wstatus = 0;
+  if (waitpid(c.st.pid, &wstatus, block ? 0 : WNOHANG) != c.st.pid) return false;
+  const int code = WIFEXITED(wstatus) ? WEXITSTATUS(wstatus) : 128 + WTERMSIG(wstatus);
+  onExit(c, cause.empty() ? describeExit(wstatus) : cause, code, WIFEXITED(wstatus) && WEXITSTATUS(wstatus) == 0);
+  return true;
 }
 
 void Supervisor::poll() {
   for (auto& c : children_) {
-    if (c.st.phase == ProcessPhase::kRunning && c.st.pid > 0) {
-      int wstatus = 0;
-      if (waitpid(c.st.pid, &wstatus, WNOHANG) == c.st.pid) onExit(c, wstatus);
-    }
+    (void)reap(c, false);
     if (c.st.phase == ProcessPhase::kBackoff && std::chrono::steady_clock::now() >= c.restart_at) {
       auto pid = spawn(c.spec);
       ++c.st.restarts;
+      ++c.st.consecutive_restarts;
       if (!pid) {
         c.st.phase = ProcessPhase::kFailed;
         c.st.last_exit = pid.error().toString();
+        emit(ProcessEventKind::kStartFailed, c, c.st.last_exit);
       } else {
         c.st.pid = *pid;
         c.st.phase = ProcessPhase::kRunning;
+        c.st.started = std::chrono::steady_clock::now();
         log::get("supervisor")->info("{} restarted (pid {}, restart {})", c.spec.name, *pid, c.st.restarts);
+        emit(ProcessEventKind::kRestarted, c, "after " + c.st.last_exit);
       }
     }
   }
+}
+
+bool Supervisor::declareDead(const std::string& name, const std::string& reason) {
+  for (auto& c : children_) {
+    if (c.spec.name != name || c.st.phase != ProcessPhase::kRunning || c.st.pid <= 0) continue;
+    log::get("supervisor")->warn("{} (pid {}) declared dead: {}; SIGKILL", name, c.st.pid, reason);
+    emit(ProcessEventKind::kKilled, c, reason);
+    kill(-c.st.pid, SIGKILL);  // also ends a stopped (SIGSTOP) process
+    // The exit is "signal 9" because we sent it; the cause is what the caller saw.
+    return reap(c, true, "killed: " + reason);
+  }
+  return false;
 }
 
 void Supervisor::stopAll(double grace_s) {
   for (auto& c : children_) {
     c.stopping = true;
     if (c.st.phase == ProcessPhase::kBackoff) c.st.phase = ProcessPhase::kExited;
-    if (c.st.phase == ProcessPhase::kRunning && c.st.pid > 0) kill(-c.st.pid, SIGTERM);
+    if (c.st.phase == ProcessPhase::kRunning && c.st.pid > 0) {
+      kill(-c.st.pid, SIGTERM);
+      kill(-c.st.pid, SIGCONT);  // a stopped process handles SIGTERM only once continued
+    }
   }
-  const auto end = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                                          std::chrono::duration<double>(grace_s));
+  const auto end = std::chrono::steady_clock::now() + seconds(grace_s);
   while (true) {
     bool any = false;
     for (auto& c : children_) {
       if (c.st.phase != ProcessPhase::kRunning || c.st.pid <= 0) continue;
-      int wstatus = 0;
-      if (waitpid(c.st.pid, &wstatus, WNOHANG) == c.st.pid) {
-        onExit(c, wstatus);
-      } else {
-        any = true;
-      }
+      if (!reap(c, false)) any = true;
     }
     if (!any) break;
     if (std::chrono::steady_clock::now() >= end) {
@@ -192,9 +342,7 @@ void Supervisor::stopAll(double grace_s) {
         if (c.st.phase == ProcessPhase::kRunning && c.st.pid > 0) {
           log::get("supervisor")->warn("{} did not stop within {:.1f} s: SIGKILL", c.spec.name, grace_s);
           kill(-c.st.pid, SIGKILL);
-          int wstatus = 0;
-          waitpid(c.st.pid, &wstatus, 0);
-          onExit(c, wstatus);
+          (void)reap(c, true);
         }
       }
       break;
@@ -202,6 +350,8 @@ void Supervisor::stopAll(double grace_s) {
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
 }
+
+void Supervisor::release() { children_.clear(); }
 
 bool Supervisor::signal(const std::string& name, int sig) {
   for (auto& c : children_) {
@@ -223,6 +373,13 @@ std::optional<ProcessStatus> Supervisor::status(const std::string& name) const {
     if (c.spec.name == name) return c.st;
   }
   return std::nullopt;
+}
+
+const ProcessSpec* Supervisor::spec(const std::string& name) const {
+  for (const auto& c : children_) {
+    if (c.spec.name == name) return &c.spec;
+  }
+  return nullptr;
 }
 
 }  // namespace tamp::process

@@ -42,12 +42,25 @@ struct ParticipantOptions {
 /// offending value when it is not an integer in [0, 232].
 Result<int> resolveDomainId(int flag_value);
 
+/// The run id a process belongs to: `flag_value` when not empty, else $TAMP_RUN_ID, else "" (no
+/// run: the default partition). A run id is 1-64 characters of [A-Za-z0-9_.-]; the error names
+/// the offending value otherwise.
+Result<std::string> resolveRunId(const std::string& flag_value);
+
+/// The DDS partition of a run: "tamp.run.<run_id>", or "" (the default partition) for no run.
+/// Every publisher and subscriber of a participant is in its run's partition, so two runs on one
+/// domain never match each other's endpoints (and a run never matches a process of no run).
+std::string runPartition(const std::string& run_id);
+
 class Participant : public std::enable_shared_from_this<Participant> {
  public:
   /// Loads the XML profiles (once per process and file) and creates the participant.
   /// Errors: kNotFound/kParseError for the profiles file, kInvalidArgument for a bad domain id or
   /// unknown profile, kInternal when Fast DDS refuses.
   static Result<std::shared_ptr<Participant>> create(const ParticipantOptions& options = {});
+  /// As create(options), in the partition of `run_id` (see resolveRunId: "" means $TAMP_RUN_ID
+  /// or no run). Errors: those of create(), kInvalidArgument for a malformed run id.
+  static Result<std::shared_ptr<Participant>> create(const ParticipantOptions& options, const std::string& run_id);
   ~Participant();
   Participant(const Participant&) = delete;
   Participant& operator=(const Participant&) = delete;
@@ -55,6 +68,8 @@ class Participant : public std::enable_shared_from_this<Participant> {
   int domainId() const { return domain_id_; }
   const std::string& name() const { return name_; }
   const std::string& profile() const { return profile_; }
+  /// The run this participant belongs to ("" for none).
+  const std::string& runId() const { return run_id_; }
   /// This participant's GUID prefix as hex, unique per process and domain.
   std::string guid() const;
 
@@ -77,6 +92,7 @@ class Participant : public std::enable_shared_from_this<Participant> {
   int domain_id_{0};
   std::string name_;
   std::string profile_;
+  std::string run_id_;
 };
 
 }  // namespace tamp::dds

@@ -9,7 +9,7 @@
 ///     }
 ///
 /// `serviceMain` blocks SIGINT/SIGTERM before any thread exists, parses the standard arguments
-/// (--domain, --profile, --config, --name, --log-level), builds the node, runs it until a signal
+/// (--domain, --profile, --config, --name, --log-level, --run-id, ...), builds the node, runs it until a signal
 /// or stop(), and returns an exit code (0 clean stop, 30 bad arguments/config, 40 DDS failure).
 ///
 /// A `ServiceNode` owns the participant, publishes heartbeats and answers echo requests on
@@ -38,6 +38,14 @@ struct ServiceArgs {
   std::string scenario_file;
   std::string log_level{"info"};
   double heartbeat_period_s{1.0};
+  /// The run this service belongs to (its DDS partition, see runPartition()); empty: $TAMP_RUN_ID,
+  /// else no run.
+  std::string run_id;
+  /// A file its supervisor (`tamp launch`) touches every heartbeat period; empty: none. When its
+  /// modification time is older than `orphan_timeout_s` the service stops by itself (exit 0), so a
+  /// service whose supervisor was killed and not restarted does not run forever.
+  std::string supervisor_lease;
+  double orphan_timeout_s{0.0};  ///< > 0 with supervisor_lease; seconds
 };
 
 /// Parses the standard arguments. Returns an error for bad arguments; `--help` prints usage and
@@ -58,6 +66,7 @@ class ServiceNode {
   void stop();
 
   const std::string& name() const { return name_; }
+  const std::string& runId() const { return participant_->runId(); }
   const std::shared_ptr<Participant>& participant() const { return participant_; }
   HeartbeatPublisher& heartbeat() { return *heartbeat_; }
 
@@ -77,6 +86,10 @@ class ServiceNode {
   std::shared_ptr<Participant> participant_;
   std::unique_ptr<HeartbeatPublisher> heartbeat_;
   std::unique_ptr<RpcServer<msg::EchoRequest, msg::EchoReply>> echo_;
+  /// True when the supervisor's lease (ServiceArgs::supervisor_lease) expired.
+  bool orphaned() const;
+  std::string supervisor_lease_;
+  double orphan_timeout_s_{0.0};
   std::mutex mutex_;
   std::condition_variable cv_;
   bool stop_{false};

@@ -1,0 +1,106 @@
+#pragma once
+/// @file
+/// A deployment description (config/deploy/*.yaml): the hosts of an installation, the services
+/// each runs and their parameters, and how they are supervised. `tamp launch FILE --host NAME`
+/// starts one host's services, `tamp run` all of them on this machine, `tamp status --deployment
+/// FILE` checks that every expected service is alive.
+///
+///   heartbeat_period_s: 0.5   # every service's heartbeat period
+///   liveness_periods: 6       # heartbeats a service may miss before it counts as dead
+///   startup_timeout_s: 30     # from start to first heartbeat
+///   orphan_timeout_s: 60      # a launched service outlives a dead supervisor so long (0: always)
+///   restart: {max_restarts: 5, backoff_s: 0.5, backoff_max_s: 8, stable_after_s: 30}
+///   hosts:                    # optional; without it every service is on host "local"
+///     robot: {env: ["KEY=value"], description: "..."}
+///     workstation: {}
+///   services:
+///     - name: sim                     # unique in the file
+///       host: robot                   # required when `hosts` is given
+///       executable: tamp_sim_service  # a name in the build's bin/ directory, or absolute
+///       args: [--config, "{config}/services/sim.yaml", --scenario, "{scenario}"]
+///       env: ["KEY=value"]
+///       optional: false               # the run may go on without it
+///       restart: true                 # restarted when it dies (tamp launch)
+///
+/// Placeholders in args: {config} (config/ directory), {scenario} (the run's scenario; an
+/// "--option {scenario}" pair is dropped without one), {run_dir}, {run_id}, {host}. Every error
+/// names the file, line and field.
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "tamp/core/error.h"
+
+namespace tamp::deploy {
+
+struct HostSpec {
+  std::string name;
+  std::string description;
+  std::vector<std::string> env;  ///< "KEY=value", for every service of the host
+};
+
+struct ServiceSpec {
+  std::string name;
+  std::string host;        ///< a HostSpec name
+  std::string executable;  ///< as written: a file name in the bin directory or an absolute path
+  std::vector<std::string> args;
+  std::vector<std::string> env;  ///< "KEY=value", after the host's
+  bool optional{false};
+  bool restart{true};
+  SourceLocation executable_at;  ///< where `executable` is written (for errors)
+};
+
+struct RestartPolicy {
+  int max_restarts{5};          ///< consecutive restarts before giving up; >= 0
+  double backoff_s{0.5};        ///< first back-off, doubled per consecutive restart; > 0
+  double backoff_max_s{8.0};    ///< >= backoff_s
+  double stable_after_s{30.0};  ///< a service that ran this long restarts from backoff_s again
+};
+
+struct Deployment {
+  std::string file;
+  double heartbeat_period_s{0.5};  ///< (0, 10]
+  int liveness_periods{6};         ///< >= 2
+  double startup_timeout_s{30.0};  ///< > 0
+  double orphan_timeout_s{60.0};   ///< >= 0; 0: launched services never stop by themselves
+  RestartPolicy restart;
+  std::vector<HostSpec> hosts;  ///< at least one ("local" when the file names none)
+  std::vector<ServiceSpec> services;
+
+  const HostSpec* host(const std::string& name) const;
+  /// The services of `host` (every service when `host` is empty), in file order.
+  std::vector<const ServiceSpec*> servicesOn(const std::string& host) const;
+  /// Seconds without a heartbeat after which a running service counts as dead.
+  double livenessTimeout() const { return heartbeat_period_s * liveness_periods; }
+};
+
+/// The implicit host of a file without `hosts`.
+inline constexpr const char* kLocalHost = "local";
+
+/// Reads and validates a deployment file. Every problem found is reported (one error listing
+/// them), each as "file:line:col: field 'services[2].host': ...".
+Result<Deployment> loadDeployment(const std::filesystem::path& file);
+
+/// Where a service's executable is: absolute as written, else `bin_dir / executable`.
+std::filesystem::path resolveExecutable(const ServiceSpec& service,
+                                        const std::filesystem::path& bin_dir);
+
+/// Every service of `host` (all hosts when empty) has an executable file; errors (kNotFound) name
+/// the deployment file, the line and the field of each missing one, and the path looked for.
+Status checkExecutables(const Deployment& deployment, const std::filesystem::path& bin_dir,
+                        const std::string& host = {});
+
+/// Values of the placeholders in a service's args.
+struct Placeholders {
+  std::string scenario;  ///< empty: no scenario ("--option {scenario}" pairs are dropped)
+  std::string config_dir;
+  std::string run_dir;
+  std::string run_id;
+  std::string host;
+};
+
+/// The service's args with placeholders replaced.
+std::vector<std::string> expandArgs(const ServiceSpec& service, const Placeholders& values);
+
+}  // namespace tamp::deploy

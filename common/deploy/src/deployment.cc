@@ -1,0 +1,197 @@
+#include "tamp/deploy/deployment.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <set>
+
+#include "tamp/config/yaml_reader.h"
+
+namespace fs = std::filesystem;
+
+namespace tamp::deploy {
+namespace {
+
+void checkEnv(config::FieldReader& r, const std::vector<std::string>& env) {
+  for (std::size_t i = 0; i < env.size(); ++i) {
+    const auto eq = env[i].find('=');
+    r.check(eq != std::string::npos && eq > 0, "env",
+            "entry " + std::to_string(i) + " must be KEY=value, got '" + env[i] + "'");
+  }
+}
+
+std::string listOf(const std::vector<HostSpec>& hosts) {
+  std::string out;
+  for (const auto& h : hosts) out += (out.empty() ? "" : ", ") + h.name;
+  return out;
+}
+
+std::string replaceAll(std::string s, const std::string& key, const std::string& value) {
+  for (std::size_t pos = 0; (pos = s.find(key, pos)) != std::string::npos; pos += value.size()) {
+    s.replace(pos, key.size(), value);
+  }
+  return s;
+}
+
+}  // namespace
+
+const HostSpec* Deployment::host(const std::string& name) const {
+  for (const auto& h : hosts) {
+    if (h.name == name) return &h;
+  }
+  return nullptr;
+}
+
+std::vector<const ServiceSpec*> Deployment::servicesOn(const std::string& host_name) const {
+  std::vector<const ServiceSpec*> out;
+  for (const auto& s : services) {
+    if (host_name.empty() || s.host == host_name) out.push_back(&s);
+  }
+  return out;
+}
+
+Result<Deployment> loadDeployment(const fs::path& file) {
+  std::error_code ec;
+  if (!fs::is_regular_file(file, ec)) {
+    return Error(ErrorCode::kNotFound, "deployment file does not exist",
+                 SourceLocation{file.string()});
+  }
+  auto doc = config::loadYamlFile(file);
+  if (!doc) return doc.error();
+  config::FieldReader r(*doc);
+  Deployment d;
+  d.file = file.string();
+  if (!r.isMap()) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "a deployment must be a mapping with a 'services' list",
+                 SourceLocation{file.string(), 1});
+  }
+  r.optional("heartbeat_period_s", d.heartbeat_period_s);
+  r.optional("liveness_periods", d.liveness_periods);
+  r.optional("startup_timeout_s", d.startup_timeout_s);
+  r.optional("orphan_timeout_s", d.orphan_timeout_s);
+  r.check(d.heartbeat_period_s > 0 && d.heartbeat_period_s <= 10, "heartbeat_period_s",
+          "must be in (0, 10]");
+  r.check(d.liveness_periods >= 2, "liveness_periods", "must be at least 2");
+  r.check(d.startup_timeout_s > 0, "startup_timeout_s", "must be positive");
+  r.check(d.orphan_timeout_s >= 0, "orphan_timeout_s", "must not be negative (0: never)");
+  if (r.has("restart")) {
+    auto rr = r.child("restart");
+    rr.optional("max_restarts", d.restart.max_restarts);
+    rr.optional("backoff_s", d.restart.backoff_s);
+    rr.optional("backoff_max_s", d.restart.backoff_max_s);
+    rr.optional("stable_after_s", d.restart.stable_after_s);
+    rr.check(d.restart.max_restarts >= 0, "max_restarts", "must not be negative");
+    rr.check(d.restart.backoff_s > 0, "backoff_s", "must be positive");
+    rr.check(d.restart.backoff_max_s >= d.restart.backoff_s, "backoff_max_s",
+             "must be at least backoff_s");
+    rr.check(d.restart.stable_after_s > 0, "stable_after_s", "must be positive");
+    rr.refuseUnknownKeys();
+  }
+  const bool has_hosts = r.has("hosts");
+  if (has_hosts) {
+    for (auto& [name, h] : r.entries("hosts")) {
+      HostSpec host;
+      host.name = name;
+      if (h.isMap()) {
+        h.optional("description", host.description);
+        h.optional("env", host.env);
+        checkEnv(h, host.env);
+        h.refuseUnknownKeys();
+      }  // else: null (no settings), or the reader recorded "expected a mapping"
+      r.check(!name.empty() && name.find('/') == std::string::npos, "hosts",
+              "bad host name '" + name + "'");
+      d.hosts.push_back(std::move(host));
+    }
+    r.check(!d.hosts.empty(), "hosts", "must name at least one host");
+  } else {
+    d.hosts.push_back(HostSpec{kLocalHost, "this machine", {}});
+  }
+  std::set<std::string> names;
+  for (auto& s : r.sequence("services")) {
+    ServiceSpec e;
+    s.required("name", e.name);
+    s.required("executable", e.executable);
+    e.executable_at = s.locationOf("executable");
+    s.optional("args", e.args);
+    s.optional("env", e.env);
+    s.optional("optional", e.optional);
+    s.optional("restart", e.restart);
+    checkEnv(s, e.env);
+    if (has_hosts) {
+      if (s.required("host", e.host)) {
+        s.check(d.host(e.host) != nullptr, "host",
+                "unknown host '" + e.host + "' (hosts: " + listOf(d.hosts) + ")");
+      }
+    } else {
+      if (s.optional("host", e.host)) {
+        s.check(e.host == kLocalHost, "host",
+                "host '" + e.host +
+                    "' is not declared: add a 'hosts' mapping (without one every service is on "
+                    "'local')");
+      }
+      e.host = kLocalHost;
+    }
+    s.check(!names.count(e.name) || e.name.empty(), "name",
+            "duplicate service name '" + e.name + "'");
+    const bool safe_name = !e.name.empty() && std::all_of(e.name.begin(), e.name.end(), [](char c) {
+      return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_' || c == '-';
+    });
+    if (s.has("name"))
+      s.check(safe_name, "name",
+              "must be [A-Za-z0-9_-]+ (it names log files), got '" + e.name + "'");
+    if (s.has("executable")) s.check(!e.executable.empty(), "executable", "must not be empty");
+    s.refuseUnknownKeys();
+    names.insert(e.name);
+    d.services.push_back(std::move(e));
+  }
+  r.check(!d.services.empty() || !r.ok(), "services", "must list at least one service");
+  r.refuseUnknownKeys();
+  if (!r.ok()) return r.status().error();
+  return d;
+}
+
+fs::path resolveExecutable(const ServiceSpec& service, const fs::path& bin_dir) {
+  const fs::path exe(service.executable);
+  return exe.is_absolute() ? exe : bin_dir / exe;
+}
+
+Status checkExecutables(const Deployment& d, const fs::path& bin_dir, const std::string& host) {
+  std::vector<Error> errors;
+  for (const ServiceSpec* s : d.servicesOn(host)) {
+    const fs::path exe = resolveExecutable(*s, bin_dir);
+    std::error_code ec;
+    if (!fs::is_regular_file(exe, ec) || access(exe.c_str(), X_OK) != 0) {
+      errors.emplace_back(ErrorCode::kNotFound,
+                          "service '" + s->name + "': no executable " + exe.string() +
+                              (fs::path(s->executable).is_absolute() ? "" : " (is it built?)"),
+                          s->executable_at);
+    }
+  }
+  if (errors.empty()) return Status::Ok();
+  if (errors.size() == 1) return errors.front();
+  return Error(ErrorCode::kNotFound, joinErrors(errors));
+}
+
+std::vector<std::string> expandArgs(const ServiceSpec& service, const Placeholders& v) {
+  std::vector<std::string> out;
+  const auto& a = service.args;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (v.scenario.empty() && i + 1 < a.size() && a[i].rfind("--", 0) == 0 &&
+        a[i + 1] == "{scenario}") {
+      ++i;
+      continue;
+    }
+    std::string s = a[i];
+    s = replaceAll(s, "{scenario}", v.scenario);
+    s = replaceAll(s, "{config}", v.config_dir);
+    s = replaceAll(s, "{run_dir}", v.run_dir);
+    s = replaceAll(s, "{run_id}", v.run_id);
+    s = replaceAll(s, "{host}", v.host);
+    out.push_back(std::move(s));
+  }
+  return out;
+}
+
+}  // namespace tamp::deploy

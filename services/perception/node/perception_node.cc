@@ -61,13 +61,13 @@ PerceptionNode::PerceptionNode(const dds::ServiceArgs& args, PerceptionNodeOptio
     robot_states_ = std::make_unique<dds::Reader<msg::RobotState>>(
         participant(), dds::topics::kRobotState,
         [this](const msg::RobotState& m, const dds::SampleMeta& meta) {
-          if (meta.alive) onState(m);
+          if (meta.alive && msgv::accept(m, dds::topics::kRobotState.name, rejects_)) onState(m);
         });
   }
   clouds_ = std::make_unique<dds::Reader<msg::PointCloudFrame>>(
       participant(), dds::topics::kPointCloud,
       [this](const msg::PointCloudFrame& m, const dds::SampleMeta& meta) {
-        if (meta.alive) onCloud(m);
+        if (meta.alive && msgv::accept(m, dds::topics::kPointCloud.name, rejects_)) onCloud(m);
       });
 }
 

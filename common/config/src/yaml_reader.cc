@@ -51,7 +51,8 @@ class DuplicateKeyFinder : public YAML::EventHandler {
     std::string out;
     for (const Frame& f : stack_) {
       if (f.is_map) {
-        if (f.expect_key) break;  // at a key: the path ends at the mapping
+        // Outer mappings are inside the value of their current key; the innermost one is at the
+        // repeated key itself.
         out += (out.empty() ? "" : ".") + f.key;
       } else {
         out += "[" + std::to_string(f.index == 0 ? 0 : f.index - 1) + "]";
@@ -73,13 +74,10 @@ class DuplicateKeyFinder : public YAML::EventHandler {
       if (scalar) {
         auto [it, inserted] = f.keys.emplace(*scalar, m);
         if (!inserted) {
-          f.expect_key = false;
-          const std::string where = path();
           errors.emplace_back(ErrorCode::kParseError,
                               "duplicate key '" + *scalar + "' (first given at line " +
                                   std::to_string(it->second.line + 1) + ")",
-                              SourceLocation{file, m.line + 1, m.column + 1, where});
-          f.expect_key = true;
+                              SourceLocation{file, m.line + 1, m.column + 1, path()});
         }
       }
     }

@@ -37,7 +37,9 @@ class Check {
   void fail(const std::string& field, const std::string& what) {
     if (error_) return;
     std::string path;
-    for (const auto& p : parts_) path += (path.empty() ? "" : ".") + p;
+    for (const auto& p : parts_) {
+      if (!p.empty()) path += (path.empty() ? "" : ".") + p;
+    }
     if (!field.empty()) path += (field[0] == '[' ? "" : ".") + field;
     error_ = Error(ErrorCode::kInvalidArgument, path + ": " + what, SourceLocation{"", 0, 0, path});
   }

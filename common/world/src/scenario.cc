@@ -500,11 +500,16 @@ Result<Scenario> parseScenarioImpl(const std::string& yaml_text, const std::stri
                                    bool name_is_file_stem);
 
 /// Where (x, y) lies outside the workspace's xy extent: a message, else nothing.
-std::optional<std::string> outsideWorkspace(const std::optional<Aabb>& ws, double x, double y) {
+/// `reach` > 0: (x, y) may lie up to that far outside (a static object's circumradius).
+std::optional<std::string> outsideWorkspace(const std::optional<Aabb>& ws, double x, double y,
+                                            double reach = 0.0) {
   if (!ws || ws->empty()) return std::nullopt;
-  if (x >= ws->min.x() && x <= ws->max.x() && y >= ws->min.y() && y <= ws->max.y()) return std::nullopt;
+  const double dx = std::max({ws->min.x() - x, 0.0, x - ws->max.x()});
+  const double dy = std::max({ws->min.y() - y, 0.0, y - ws->max.y()});
+  if (std::isfinite(dx) && std::isfinite(dy) && std::hypot(dx, dy) <= reach) return std::nullopt;
   return "[" + num(x) + ", " + num(y) + "] is outside the workspace [" + num(ws->min.x()) + ", " +
-         num(ws->min.y()) + ", " + num(ws->max.x()) + ", " + num(ws->max.y()) + "]";
+         num(ws->min.y()) + ", " + num(ws->max.x()) + ", " + num(ws->max.y()) + "]" +
+         (reach > 0 ? " by more than the object's size" : "");
 }
 
 /// Locations, regions and objects are PDDL objects of one problem: an id names one thing only.
@@ -711,8 +716,13 @@ Result<Scenario> parseScenarioImpl(const std::string& yaml_text, const std::stri
       auto o = readObject(e, sc.world, hidden, limits, is_held);
       if (!o) continue;
       if (!is_held || e.has("pose") || e.has("at")) {
+        // Movable and hidden objects stand inside; a static one (a wall bounding the room) may
+        // straddle the edge but must reach into the workspace.
         const auto t = o->pose.translation();
-        if (auto why = outsideWorkspace(sc.world.workspace(), t.x(), t.y()))
+        const double reach = o->kind == ObjectKind::kStatic
+                                 ? circumradius(o->shape.footprint(), Eigen::Vector2d::Zero())
+                                 : 0.0;
+        if (auto why = outsideWorkspace(sc.world.workspace(), t.x(), t.y(), reach))
           e.fail(e.has("pose") ? "pose" : "at", *why);
       }
       if (auto why = sharedId(sc.world, o->id, "object")) {
@@ -912,8 +922,8 @@ Result<Scenario> parseScenarioImpl(const std::string& yaml_text, const std::stri
         } else if (fault.object) {
           if (auto why = sharedId(sc.world, fault.object->id, "object"))
             o.fail("id", *why + " (regions, locations and objects are PDDL objects: one id each)");
-          const auto t = fault.object->pose.translation();
-          if (auto why = outsideWorkspace(sc.world.workspace(), t.x(), t.y()))
+          const auto xy = fault.object->pose.translation();
+          if (auto why = outsideWorkspace(sc.world.workspace(), xy.x(), xy.y()))
             o.fail(o.has("pose") ? "pose" : "at", *why);
         }
       }

@@ -544,28 +544,39 @@ TEST(ScenarioInputRulesTest, AWrongTypeInAGoalOrInitAtomNamesTheElement) {
   // 'start' is a location where (on ?item ?region) wants a region.
   EXPECT_EQ(errorOf(replaced(kMinimal, "goal: {pddl: [\"(holding can)\"]}",
                              "goal: {pddl: [\"(hand-empty)\", \"(on can start)\"]}")),
-            kFile + ":8:30: field 'goal.pddl[1]': 'start' in '(on can start)' is not a region");
-  EXPECT_EQ(errorOf(replaced(kMinimal, "goal:", "pddl: {init: [\"(robot-at table)\"]}\ngoal:")),
-            kFile + ":8:16: field 'pddl.init[0]': 'table' in '(robot-at table)' is not a location");
+            kFile + ":8:31: field 'goal.pddl[1]': 'start' in '(on can start)' is not a region");
+  EXPECT_EQ(errorOf(replaced(kMinimal, "goal:",
+                             "pddl:\n  domain: ${TAMP_CONFIG_DIR}/pddl/mobile_manipulation.pddl\n"
+                             "  init: [\"(robot-at table)\"]\ngoal:")),
+            kFile + ":10:10: field 'pddl.init[0]': 'table' in '(robot-at table)' is not a location");
 }
 
 TEST(ScenarioInputRulesTest, PosesOutsideTheWorkspaceAreRefused) {
   const std::string ws = replaced(kMinimal, "world:\n", "world:\n  workspace: [-2, -1, 3, 1]\n");
   ASSERT_EQ(errorOf(ws), "(loaded)");
   EXPECT_EQ(errorOf(replaced(ws, "pose: [-1, 0, 0]", "pose: [-5, 0, 0]")),
-            kFile + ":6:38: field 'world.locations[0].pose': [-5, 0] is outside the workspace "
+            kFile + ":6:33: field 'world.locations[0].pose': [-5, 0] is outside the workspace "
                     "[-2, -1, 3, 1]");
   EXPECT_EQ(errorOf(replaced(ws, "rect: [1, -0.5, 2, 0.5]", "rect: [1, -0.5, 4, 0.5]")),
-            kFile + ":5:50: field 'world.regions[0].rect': corner [4, -0.5] is outside the "
+            kFile + ":5:44: field 'world.regions[0].rect': corner [4, -0.5] is outside the "
                     "workspace [-2, -1, 3, 1]");
   // An object outside the workspace (and so outside its region too).
-  const std::string obj = replaced(replaced(ws, "on: table, at: [1.5, 0]", "pose: [2.5, 3, 0.8]"),
+  const std::string obj = replaced(replaced(ws, "on: table, at: [1.5, 0]", "pose: {xyz: [2.5, 3, 0.8]}"),
                                    "goal: {pddl: [\"(holding can)\"]}", "goal: {base: start}");
   EXPECT_NE(errorOf(obj).find("field 'world.objects[0].pose': [2.5, 3] is outside the workspace"),
             std::string::npos)
       << errorOf(obj);
   EXPECT_EQ(errorOf(replaced(ws, "goal: {pddl: [\"(holding can)\"]}", "goal: {base: [0, 7, 0]}")),
             kFile + ":9:14: field 'goal.base': [0, 7] is outside the workspace [-2, -1, 3, 1]");
+  // A static wall may straddle the edge (the room's walls do), not stand beyond it.
+  const std::string wall =
+      "    - {id: wall, kind: static, shape: {type: box, size: [0.1, 2.0, 1.0]}, pose: {xyz: [3.05, 0, 0.5]}}\n";
+  EXPECT_EQ(errorOf(replaced(ws, "goal:", wall + "goal:")), "(loaded)");
+  EXPECT_NE(errorOf(replaced(ws, "goal:", replaced(wall, "3.05", "4.5") + "goal:"))
+                .find("field 'world.objects[1].pose': [4.5, 0] is outside the workspace [-2, -1, 3, 1] "
+                      "by more than the object's size"),
+            std::string::npos)
+      << errorOf(replaced(ws, "goal:", replaced(wall, "3.05", "4.5") + "goal:"));
   // Without a workspace nothing bounds the poses.
   EXPECT_EQ(errorOf(replaced(kMinimal, "pose: [-1, 0, 0]", "pose: [-50, 0, 0]")), "(loaded)");
 }

@@ -142,5 +142,17 @@ TEST(YamlReaderTest, DuplicateKeyInFileOnDisk) {
   EXPECT_THAT(doc.error().toString(), HasSubstr("service.threads"));
 }
 
+TEST(YamlReaderTest, EveryShippedYamlFileHasNoDuplicateKey) {
+  // Scenarios, robot descriptions, service configs, deployments, seeds of the fuzz corpus aside.
+  int n = 0;
+  for (const auto& e : std::filesystem::recursive_directory_iterator(std::filesystem::path(TAMP_SOURCE_DIR) / "config")) {
+    if (e.path().extension() != ".yaml") continue;
+    auto doc = loadYamlFile(e.path());
+    EXPECT_TRUE(doc.ok()) << doc.error().toString();
+    ++n;
+  }
+  EXPECT_GE(n, 18);
+}
+
 }  // namespace
 }  // namespace tamp::config

@@ -313,8 +313,9 @@ Status validate(const msg::MotionRequest& m, const Limits& limits) {
     c.allFinite("goal_configuration", m.goal_configuration());
   c.pose2("goal_base", m.goal_base());
   c.pose3("goal_end_effector", m.goal_end_effector(), m.goal_type() == msg::GOAL_END_EFFECTOR_POSE);
-  c.id("held_object_id", m.held_object_id(), m.held_grasp_given());
-  if (m.held_grasp_given()) c.id("held_link", m.held_link(), true);
+  c.id("held_object_id", m.held_object_id(), false);
+  if (m.held_grasp_given() && m.held_object_id().empty()) c.fail("held_grasp_given", "true without held_object_id");
+  c.id("held_link", m.held_link(), false);  // empty: the robot's tool link
   c.pose3("held_link_T_object", m.held_link_T_object(), m.held_grasp_given());
   c.ids("ignored_objects", m.ignored_objects(), limits.max_items);
   if (c.size("object_overrides", m.object_overrides(), limits.max_items)) {
@@ -564,7 +565,7 @@ Status validate(const msg::FaultInjection& m, const Limits& limits) {
 
 Status validate(const msg::ExecutionRecord& m, const Limits& limits) {
   Check c("ExecutionRecord", limits);
-  c.id("record_id", m.record_id(), true);
+  c.id("record_id", m.record_id(), false);  // optional: de-duplication only when given
   c.enumIn("kind", m.kind(), msg::ACTION_PLACE);
   c.jointPath("path", m.path());
   c.nonNegative("object_mass", m.object_mass());

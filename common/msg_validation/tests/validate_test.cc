@@ -254,7 +254,9 @@ TEST(MsgValidation, StatesCloudsRecordsAndModels) {
   EXPECT_EQ(why(pc), "PointCloudFrame.width: width x height = 2 x 1 does not match 1 points");
 
   msg::ExecutionRecord rec;
-  EXPECT_EQ(why(rec), "ExecutionRecord.record_id: empty (an id is required)");
+  EXPECT_EQ(why(rec), "(ok)");
+  rec.record_id(std::string(1000, 'r'));
+  EXPECT_EQ(why(rec), "ExecutionRecord.record_id: id of 1000 bytes (limit 256)");
   rec.record_id("r1");
   rec.duration_s(kNaN);
   EXPECT_EQ(why(rec), "ExecutionRecord.duration_s: NaN");

@@ -8,7 +8,13 @@
 #       A GoogleTest binary; each TEST becomes a ctest entry (discovered before running, not at
 #       build time). Tests get TAMP_SOURCE_DIR/TAMP_BENCHMARKS_DIR/TAMP_BIN_DIR as compile definitions.
 #   tamp_add_benchmark(name SOURCES ... [DEPS ...])   Google Benchmark or own bench tool; not a test.
-#   tamp_add_fuzzer(name SOURCES ... [DEPS ...])      libFuzzer target, only with TAMP_FUZZ (clang).
+#   tamp_add_fuzzer(name SOURCES ... [DEPS ...] [CORPUS dir])
+#       libFuzzer target, only with TAMP_FUZZ (clang). With CORPUS, a ctest `<name>_libfuzzer` runs
+#       it for TAMP_FUZZ_SECONDS (default 20) from that seed corpus.
+#   tamp_add_fuzz_replay(name SOURCES ... [DEPS ...] CORPUS dir [MUTATIONS n])
+#       The same target as a plain executable `<name>_replay` (any compiler; tests/fuzz/
+#       replay_main.cc) and a ctest that replays the seed corpus plus n deterministic mutations of
+#       each seed: the normal CI build exercises every fuzz target without libFuzzer.
 
 function(tamp_add_library name)
   cmake_parse_arguments(L "" "" "SOURCES;PUBLIC_DEPS;PRIVATE_DEPS" ${ARGN})
@@ -78,10 +84,39 @@ function(tamp_add_fuzzer name)
   if(NOT TAMP_FUZZ)
     return()
   endif()
-  cmake_parse_arguments(F "" "" "SOURCES;DEPS" ${ARGN})
+  cmake_parse_arguments(F "" "CORPUS" "SOURCES;DEPS" ${ARGN})
   add_executable(${name} ${F_SOURCES})
   target_compile_options(${name} PRIVATE -fsanitize=fuzzer,address,undefined)
   target_link_options(${name} PRIVATE -fsanitize=fuzzer,address,undefined)
   target_link_libraries(${name} PRIVATE ${F_DEPS})
   target_include_directories(${name} PRIVATE ${TAMP_FUZZ_INCLUDE_DIR})
+  if(F_CORPUS)
+    if(NOT DEFINED TAMP_FUZZ_SECONDS)
+      set(TAMP_FUZZ_SECONDS 20)
+    endif()
+    # New inputs go to the build tree's corpus (first directory); the repository's seeds are read.
+    set(work ${CMAKE_BINARY_DIR}/fuzz-corpus/${name})
+    file(MAKE_DIRECTORY ${work})
+    add_test(NAME ${name}_libfuzzer
+      COMMAND ${name} -max_total_time=${TAMP_FUZZ_SECONDS} -timeout=10 -rss_limit_mb=2048 ${work} ${F_CORPUS})
+    set_tests_properties(${name}_libfuzzer PROPERTIES LABELS fuzz TIMEOUT 300
+      ENVIRONMENT "SKIP_DEFAULT_XML_FILE=1")
+  endif()
+endfunction()
+
+function(tamp_add_fuzz_replay name)
+  if(NOT TAMP_BUILD_TESTS)
+    return()
+  endif()
+  cmake_parse_arguments(R "" "CORPUS;MUTATIONS" "SOURCES;DEPS" ${ARGN})
+  if(NOT R_MUTATIONS)
+    set(R_MUTATIONS 200)
+  endif()
+  add_executable(${name}_replay ${R_SOURCES} ${TAMP_FUZZ_INCLUDE_DIR}/replay_main.cc)
+  target_compile_definitions(${name}_replay PRIVATE TAMP_FUZZ_REPLAY=1)
+  target_link_libraries(${name}_replay PRIVATE ${R_DEPS} tamp_warnings)
+  target_include_directories(${name}_replay PRIVATE ${TAMP_FUZZ_INCLUDE_DIR})
+  tamp_sanitizer_options(${name}_replay)
+  add_test(NAME ${name}_replay COMMAND ${name}_replay --mutations ${R_MUTATIONS} ${R_CORPUS})
+  set_tests_properties(${name}_replay PROPERTIES LABELS fuzz TIMEOUT 120 ENVIRONMENT "SKIP_DEFAULT_XML_FILE=1")
 endfunction()

@@ -1,15 +1,120 @@
 #include "tamp/config/yaml_reader.h"
 
+#include <yaml-cpp/eventhandler.h>
+
 #include <cmath>
+#include <map>
 #include <sstream>
 
 #include "tamp/core/paths.h"
 
 namespace tamp::config {
 
+namespace {
+
+/// Finds keys repeated within one mapping. yaml-cpp keeps both pairs and lookups return the first,
+/// so a repeated key silently loses the second value. Works on parser events, so aliases are not
+/// expanded (linear in the text, whatever the anchors).
+class DuplicateKeyFinder : public YAML::EventHandler {
+ public:
+  std::vector<Error> errors;
+  std::string file;
+
+  void OnDocumentStart(const YAML::Mark&) override {}
+  void OnDocumentEnd() override { done_ = true; }
+  void OnNull(const YAML::Mark& m, YAML::anchor_t) override { node(m, nullptr); }
+  void OnAlias(const YAML::Mark& m, YAML::anchor_t) override { node(m, nullptr); }
+  void OnScalar(const YAML::Mark& m, const std::string&, YAML::anchor_t, const std::string& value) override {
+    node(m, &value);
+  }
+  void OnSequenceStart(const YAML::Mark& m, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
+    node(m, nullptr);
+    if (!done_) stack_.push_back(Frame{false, true, {}, "", 0});
+  }
+  void OnSequenceEnd() override { pop(); }
+  void OnMapStart(const YAML::Mark& m, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
+    node(m, nullptr);
+    if (!done_) stack_.push_back(Frame{true, true, {}, "", 0});
+  }
+  void OnMapEnd() override { pop(); }
+
+ private:
+  struct Frame {
+    bool is_map;
+    bool expect_key;
+    std::map<std::string, YAML::Mark> keys;  // scalar keys seen, first occurrence
+    std::string key;                         // map: the current key; sequence: unused
+    size_t index;                            // sequence: the next element's index
+  };
+
+  std::string path() const {
+    std::string out;
+    for (const Frame& f : stack_) {
+      if (f.is_map) {
+        // Outer mappings are inside the value of their current key; the innermost one is at the
+        // repeated key itself.
+        out += (out.empty() ? "" : ".") + f.key;
+      } else {
+        out += "[" + std::to_string(f.index == 0 ? 0 : f.index - 1) + "]";
+      }
+    }
+    return out;
+  }
+
+  /// Every node start (scalar, null, alias, container) passes here, in document order.
+  void node(const YAML::Mark& m, const std::string* scalar) {
+    if (done_ || stack_.empty()) return;
+    Frame& f = stack_.back();
+    if (!f.is_map) {
+      ++f.index;
+      return;
+    }
+    if (f.expect_key) {
+      f.key = scalar ? *scalar : "?";
+      if (scalar) {
+        auto [it, inserted] = f.keys.emplace(*scalar, m);
+        if (!inserted) {
+          errors.emplace_back(ErrorCode::kParseError,
+                              "duplicate key '" + *scalar + "' (first given at line " +
+                                  std::to_string(it->second.line + 1) + ")",
+                              SourceLocation{file, m.line + 1, m.column + 1, path()});
+        }
+      }
+    }
+    f.expect_key = !f.expect_key;
+  }
+  void pop() {
+    if (!done_ && !stack_.empty()) stack_.pop_back();
+  }
+
+  std::vector<Frame> stack_;
+  bool done_{false};
+};
+
+}  // namespace
+
+std::optional<Error> findDuplicateKeys(const std::string& text, const std::string& name) {
+  DuplicateKeyFinder finder;
+  finder.file = name;
+  try {
+    std::istringstream in(text);
+    YAML::Parser parser(in);
+    (void)parser.HandleNextDocument(finder);
+  } catch (const YAML::Exception&) {
+    return std::nullopt;  // syntax errors are reported by YAML::Load
+  }
+  if (finder.errors.empty()) return std::nullopt;
+  if (finder.errors.size() == 1) return finder.errors.front();
+  Error e = finder.errors.front();
+  e.message += " (and " + std::to_string(finder.errors.size() - 1) + " more):\n" + joinErrors(finder.errors);
+  return e;
+}
+
 Result<YamlDocument> parseYaml(const std::string& text, const std::string& name) {
   try {
-    return YamlDocument{YAML::Load(text), name};
+    YamlDocument doc{YAML::Load(text), name};
+    if (auto dup = findDuplicateKeys(text, name)) return *dup;
+    return doc;
   } catch (const YAML::Exception& e) {
     // e.mark is 0-based; e.msg is the bare message without the position prefix.
     return Error(ErrorCode::kParseError, "invalid YAML: " + e.msg,
@@ -140,6 +245,19 @@ bool FieldReader::check(bool cond, const std::string& key, const std::string& me
 
 void FieldReader::fail(const std::string& key, const std::string& message, ErrorCode code) {
   errors_->emplace_back(code, message, locationOf(key));
+}
+
+void FieldReader::failAt(const std::string& key, size_t index, const std::string& message,
+                         ErrorCode code) {
+  const YAML::Node v = node_.IsMap() ? node_[key] : YAML::Node();
+  if (!v.IsDefined() || !v.IsSequence() || index >= v.size() || v[index].Mark().is_null()) {
+    fail(key, message, code);
+    return;
+  }
+  const YAML::Mark m = v[index].Mark();
+  errors_->emplace_back(code, message,
+                        SourceLocation{file_, m.line + 1, m.column + 1,
+                                       fieldPath(key) + "[" + std::to_string(index) + "]"});
 }
 
 void FieldReader::refuseUnknownKeys() {

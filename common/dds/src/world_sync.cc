@@ -1,5 +1,7 @@
 #include "tamp/dds/world_sync.h"
 
+#include "tamp/msg_validation/validate.h"
+
 #include <thread>
 
 #include "tamp/core/log.h"
@@ -212,6 +214,14 @@ WorldMirror::WorldMirror(std::shared_ptr<Participant> p, std::string world_id)
       objects_(p, topics::kWorldObjects, [this](const msg::WorldObject& m, const SampleMeta& s) { onObject(m, s); }),
       meta_(p, topics::kWorldMeta, [this](const msg::WorldMeta& m, const SampleMeta& s) { onMeta(m, s); }) {}
 
+namespace {
+/// Malformed world samples, logged once per kind (rate-limited): every service mirrors the world.
+msgv::RejectLog& worldRejects() {
+  static msgv::RejectLog log("world");
+  return log;
+}
+}  // namespace
+
 void WorldMirror::onObject(const msg::WorldObject& m, const SampleMeta& meta) {
   {
     std::lock_guard lock(mutex_);
@@ -223,6 +233,7 @@ void WorldMirror::onObject(const msg::WorldObject& m, const SampleMeta& meta) {
     } else {
       received_[m.id()] = m.version();  // received, even if it turns out malformed below
       updateCompleteLocked();
+      if (!msgv::accept(m, topics::kWorldObjects.name, worldRejects())) return;
       auto o = fromMsg(m);
       if (!o) {
         log::get("world")->warn("ignoring a malformed world object: {}", o.error().toString());
@@ -242,6 +253,7 @@ void WorldMirror::onObject(const msg::WorldObject& m, const SampleMeta& meta) {
 
 void WorldMirror::onMeta(const msg::WorldMeta& m, const SampleMeta& meta) {
   if (!meta.alive || m.world_id() != world_id_) return;
+  if (!msgv::accept(m, topics::kWorldMeta.name, worldRejects())) return;  // keep the last good one
   {
     std::lock_guard lock(mutex_);
     // Replace regions and locations by the published set.

@@ -496,14 +496,38 @@ NamoOptions readNamoOptions(FieldReader& w, const GraspLimits* limits) {
 }  // namespace
 
 namespace {
-Result<Scenario> parseScenarioImpl(const std::string& yaml_text, const std::string& file_name);
+Result<Scenario> parseScenarioImpl(const std::string& yaml_text, const std::string& file_name,
+                                   bool name_is_file_stem);
+
+/// Where (x, y) lies outside the workspace's xy extent: a message, else nothing.
+/// `reach` > 0: (x, y) may lie up to that far outside (a static object's circumradius).
+std::optional<std::string> outsideWorkspace(const std::optional<Aabb>& ws, double x, double y,
+                                            double reach = 0.0) {
+  if (!ws || ws->empty()) return std::nullopt;
+  const double dx = std::max({ws->min.x() - x, 0.0, x - ws->max.x()});
+  const double dy = std::max({ws->min.y() - y, 0.0, y - ws->max.y()});
+  if (std::isfinite(dx) && std::isfinite(dy) && std::hypot(dx, dy) <= reach) return std::nullopt;
+  return "[" + num(x) + ", " + num(y) + "] is outside the workspace [" + num(ws->min.x()) + ", " +
+         num(ws->min.y()) + ", " + num(ws->max.x()) + ", " + num(ws->max.y()) + "]" +
+         (reach > 0 ? " by more than the object's size" : "");
+}
+
+/// Locations, regions and objects are PDDL objects of one problem: an id names one thing only.
+/// Empty when `id` is free among the kinds other than `self`.
+std::optional<std::string> sharedId(const World& w, const std::string& id, const char* self) {
+  const std::string me = self;
+  if (me != "region" && w.findRegion(id) != nullptr) return "id '" + id + "' is already a region";
+  if (me != "location" && w.findLocation(id) != nullptr) return "id '" + id + "' is already a location";
+  if (me != "object" && w.findObject(id) != nullptr) return "id '" + id + "' is already an object";
+  return std::nullopt;
+}
 }  // namespace
 
 Result<Scenario> parseScenario(const std::string& yaml_text, const std::string& file_name) {
   // Last line of defence: a yaml-cpp exception from an unexpected node shape (e.g. a complex
   // key) becomes a parse error at its mark instead of escaping.
   try {
-    return parseScenarioImpl(yaml_text, file_name);
+    return parseScenarioImpl(yaml_text, file_name, false);
   } catch (const YAML::Exception& e) {
     return Error(ErrorCode::kParseError, "unexpected YAML structure: " + e.msg,
                  SourceLocation{file_name, e.mark.line + 1, e.mark.column + 1, ""});
@@ -511,7 +535,17 @@ Result<Scenario> parseScenario(const std::string& yaml_text, const std::string& 
 }
 
 namespace {
-Result<Scenario> parseScenarioImpl(const std::string& yaml_text, const std::string& file_name) {
+Result<Scenario> parseScenarioFile(const std::string& yaml_text, const std::string& file_name) {
+  try {
+    return parseScenarioImpl(yaml_text, file_name, true);
+  } catch (const YAML::Exception& e) {
+    return Error(ErrorCode::kParseError, "unexpected YAML structure: " + e.msg,
+                 SourceLocation{file_name, e.mark.line + 1, e.mark.column + 1, ""});
+  }
+}
+
+Result<Scenario> parseScenarioImpl(const std::string& yaml_text, const std::string& file_name,
+                                   bool name_is_file_stem) {
   auto doc = config::parseYaml(yaml_text, file_name);
   if (!doc) return doc.error();
   FieldReader r(*doc);
@@ -523,8 +557,17 @@ Result<Scenario> parseScenarioImpl(const std::string& yaml_text, const std::stri
   }
   Scenario sc;
   sc.file = file_name;
-  if (r.required("name", sc.name) && !isValidId(sc.name))
-    r.fail("name", "'" + sc.name + "' is not a valid id");
+  if (r.required("name", sc.name)) {
+    if (!isValidId(sc.name)) {
+      r.fail("name", "'" + sc.name + "' is not a valid id");
+    } else if (const std::string stem = std::filesystem::path(file_name).stem().string();
+               name_is_file_stem && sc.name != stem) {
+      // Runs, reports and config/pddl/problems/<name>.pddl are named by `name`, files by their
+      // stem: two names for one scenario would make both ambiguous.
+      r.fail("name", "'" + sc.name + "' differs from the file name '" + stem +
+                         "' (a scenario file is named <name>.yaml)");
+    }
+  }
   r.optional("description", sc.description);
 
   // ---- pddl ----
@@ -630,6 +673,16 @@ Result<Scenario> parseScenarioImpl(const std::string& yaml_text, const std::stri
     e.optional("height", g.height);
     e.refuseUnknownKeys();
     if (!ok) continue;
+    for (const auto& v : g.polygon) {
+      if (auto why = outsideWorkspace(sc.world.workspace(), v.x(), v.y())) {
+        e.fail(e.has("rect") ? "rect" : "polygon", "corner " + *why);
+        break;
+      }
+    }
+    if (auto why = sharedId(sc.world, g.id, "region")) {
+      e.fail("id", *why + " (regions, locations and objects are PDDL objects: one id each)");
+      continue;
+    }
     if (Status s = sc.world.addRegion(g); !s) e.fail("id", s.error().message);
   }
   for (FieldReader& e : w.sequence("locations", false)) {
@@ -638,6 +691,11 @@ Result<Scenario> parseScenarioImpl(const std::string& yaml_text, const std::stri
     e.optional("label", l.label);
     e.refuseUnknownKeys();
     if (!ok) continue;
+    if (auto why = outsideWorkspace(sc.world.workspace(), l.pose.x, l.pose.y)) e.fail("pose", *why);
+    if (auto why = sharedId(sc.world, l.id, "location")) {
+      e.fail("id", *why + " (regions, locations and objects are PDDL objects: one id each)");
+      continue;
+    }
     if (Status s = sc.world.addLocation(l); !s) e.fail("id", s.error().message);
   }
   // Objects; the held one may omit its pose (it follows the gripper).
@@ -657,6 +715,20 @@ Result<Scenario> parseScenarioImpl(const std::string& yaml_text, const std::stri
                            e.node()["id"].Scalar() == held_id;
       auto o = readObject(e, sc.world, hidden, limits, is_held);
       if (!o) continue;
+      if (!is_held || e.has("pose") || e.has("at")) {
+        // Movable and hidden objects stand inside; a static one (a wall bounding the room) may
+        // straddle the edge but must reach into the workspace.
+        const auto t = o->pose.translation();
+        const double reach = o->kind == ObjectKind::kStatic
+                                 ? circumradius(o->shape.footprint(), Eigen::Vector2d::Zero())
+                                 : 0.0;
+        if (auto why = outsideWorkspace(sc.world.workspace(), t.x(), t.y(), reach))
+          e.fail(e.has("pose") ? "pose" : "at", *why);
+      }
+      if (auto why = sharedId(sc.world, o->id, "object")) {
+        e.fail("id", *why + " (regions, locations and objects are PDDL objects: one id each)");
+        continue;
+      }
       if (Status s = sc.world.addObject(*o); !s) e.fail("id", s.error().message);
     }
   }
@@ -683,6 +755,8 @@ Result<Scenario> parseScenarioImpl(const std::string& yaml_text, const std::stri
         sc.robot.start = l->pose;
       }
     } else if (rb.required("start", sc.robot.start)) {
+      if (auto why = outsideWorkspace(sc.world.workspace(), sc.robot.start.x, sc.robot.start.y))
+        rb.fail("start", *why);
       sc.robot.start_location = "start";
       const Location* l = sc.world.findLocation("start");
       if (l == nullptr)
@@ -778,6 +852,7 @@ Result<Scenario> parseScenarioImpl(const std::string& yaml_text, const std::stri
       } else {
         Pose2D p;
         if (g.required("base", p)) {
+          if (auto why = outsideWorkspace(sc.world.workspace(), p.x, p.y)) g.fail("base", *why);
           sc.goal.base = p;
           const Location* l = sc.world.findLocation("goal");
           if (l == nullptr) {
@@ -844,6 +919,12 @@ Result<Scenario> parseScenarioImpl(const std::string& yaml_text, const std::stri
         fault.object = readObject(o, sc.world, false, limits);
         if (fault.object && sc.world.findObject(fault.object->id) != nullptr) {
           o.fail("id", "'" + fault.object->id + "' already exists in the world");
+        } else if (fault.object) {
+          if (auto why = sharedId(sc.world, fault.object->id, "object"))
+            o.fail("id", *why + " (regions, locations and objects are PDDL objects: one id each)");
+          const auto xy = fault.object->pose.translation();
+          if (auto why = outsideWorkspace(sc.world.workspace(), xy.x(), xy.y()))
+            o.fail(o.has("pose") ? "pose" : "at", *why);
         }
       }
     } else {
@@ -893,12 +974,12 @@ Result<Scenario> parseScenarioImpl(const std::string& yaml_text, const std::stri
     // Goal atoms over the planner's world.
     const World planner = sc.world.plannerView();
     FieldReader g = r.child("goal");
-    for (const auto& atom : sc.goal.pddl) {
-      if (auto why = checkAtom(atom, planner)) g.fail("pddl", *why);
+    for (size_t i = 0; i < sc.goal.pddl.size(); ++i) {
+      if (auto why = checkAtom(sc.goal.pddl[i], planner)) g.failAt("pddl", i, *why);
     }
     FieldReader p = r.child("pddl", false);
-    for (const auto& atom : sc.pddl_init) {
-      if (auto why = checkAtom(atom, planner)) p.fail("init", *why);
+    for (size_t i = 0; i < sc.pddl_init.size(); ++i) {
+      if (auto why = checkAtom(sc.pddl_init[i], planner)) p.failAt("init", i, *why);
     }
     if (sc.goal.empty()) g.fail("", "needs at least one of pddl, base, objects_in_regions");
     // The robot's start should be free (a warning: NAMO worlds at native scale may be tight).
@@ -960,7 +1041,7 @@ Result<Scenario> loadScenario(const std::filesystem::path& file) {
   }
   auto text = readTextFile(file);
   if (!text) return text.error();
-  return parseScenario(*text, file.string());
+  return parseScenarioFile(*text, file.string());
 }
 
 // ---- PDDL

@@ -499,13 +499,13 @@ TEST(ScenarioErrorsTest, ExactMessages) {
           ":2:28: field 'robot.arm': unknown arm configuration 'dance' (robot has: stow, ready, carry)");
   EXPECT_EQ(errorOf(replaced(kMinimal, "(holding can)", "(holding table)")),
             kFile +
-                ":8:14: field 'goal.pddl': 'table' in '(holding table)' is not a movable object "
+                ":8:15: field 'goal.pddl[0]': 'table' in '(holding table)' is not a movable object "
                 "(hidden objects are "
                 "unknown to the planner)");
   EXPECT_EQ(errorOf(replaced(kMinimal, "(holding can)", "(on can)")),
-            kFile + ":8:14: field 'goal.pddl': 'on' takes 2 arguments, got 1");
+            kFile + ":8:15: field 'goal.pddl[0]': 'on' takes 2 arguments, got 1");
   EXPECT_EQ(errorOf(replaced(kMinimal, "(holding can)", "(grasped can)")),
-            kFile + ":8:14: field 'goal.pddl': unknown predicate 'grasped' in '(grasped can)'");
+            kFile + ":8:15: field 'goal.pddl[0]': unknown predicate 'grasped' in '(grasped can)'");
   EXPECT_EQ(errorOf(replaced(kMinimal, "name: mini", "name: Mini")),
             kFile + ":1:7: field 'name': 'Mini' is not a valid id");
   EXPECT_EQ(
@@ -525,6 +525,92 @@ TEST(ScenarioErrorsTest, ExactMessages) {
             kFile + ":8:7: field 'goal': expected a mapping (key: value pairs)");
   EXPECT_EQ(errorOf("name: x\nrobot: [1\n"),
             kFile + ":3:1: invalid YAML: end of sequence flow not found");
+}
+
+// ---- issue 13: inputs that loaded silently before
+
+TEST(ScenarioInputRulesTest, AnIdSharedByALocationAndARegionIsRefused) {
+  EXPECT_EQ(errorOf(replaced(kMinimal, "{id: start, pose: [-1, 0, 0]}",
+                             "{id: start, pose: [-1, 0, 0]}, {id: table, pose: [0, 0, 0]}")),
+            kFile + ":5:51: field 'world.locations[1].id': id 'table' is already a region (regions, "
+                    "locations and objects are PDDL objects: one id each)");
+  // An object named like a region is the same mistake.
+  EXPECT_EQ(errorOf(replaced(kMinimal, "{id: can, kind: movable", "{id: table, kind: movable")),
+            kFile + ":7:12: field 'world.objects[0].id': id 'table' is already a region (regions, "
+                    "locations and objects are PDDL objects: one id each)");
+}
+
+TEST(ScenarioInputRulesTest, AWrongTypeInAGoalOrInitAtomNamesTheElement) {
+  // 'start' is a location where (on ?item ?region) wants a region.
+  EXPECT_EQ(errorOf(replaced(kMinimal, "goal: {pddl: [\"(holding can)\"]}",
+                             "goal: {pddl: [\"(hand-empty)\", \"(on can start)\"]}")),
+            kFile + ":8:31: field 'goal.pddl[1]': 'start' in '(on can start)' is not a region");
+  EXPECT_EQ(errorOf(replaced(kMinimal, "goal:",
+                             "pddl:\n  domain: ${TAMP_CONFIG_DIR}/pddl/mobile_manipulation.pddl\n"
+                             "  init: [\"(robot-at table)\"]\ngoal:")),
+            kFile + ":10:10: field 'pddl.init[0]': 'table' in '(robot-at table)' is not a location");
+}
+
+TEST(ScenarioInputRulesTest, PosesOutsideTheWorkspaceAreRefused) {
+  const std::string ws = replaced(kMinimal, "world:\n", "world:\n  workspace: [-2, -1, 3, 1]\n");
+  ASSERT_EQ(errorOf(ws), "(loaded)");
+  EXPECT_EQ(errorOf(replaced(ws, "pose: [-1, 0, 0]", "pose: [-5, 0, 0]")),
+            kFile + ":6:33: field 'world.locations[0].pose': [-5, 0] is outside the workspace "
+                    "[-2, -1, 3, 1]");
+  EXPECT_EQ(errorOf(replaced(ws, "rect: [1, -0.5, 2, 0.5]", "rect: [1, -0.5, 4, 0.5]")),
+            kFile + ":5:44: field 'world.regions[0].rect': corner [4, -0.5] is outside the "
+                    "workspace [-2, -1, 3, 1]");
+  // An object outside the workspace (and so outside its region too).
+  const std::string obj = replaced(replaced(ws, "on: table, at: [1.5, 0]", "pose: {xyz: [2.5, 3, 0.8]}"),
+                                   "goal: {pddl: [\"(holding can)\"]}", "goal: {base: start}");
+  EXPECT_NE(errorOf(obj).find("field 'world.objects[0].pose': [2.5, 3] is outside the workspace"),
+            std::string::npos)
+      << errorOf(obj);
+  EXPECT_EQ(errorOf(replaced(ws, "goal: {pddl: [\"(holding can)\"]}", "goal: {base: [0, 7, 0]}")),
+            kFile + ":9:14: field 'goal.base': [0, 7] is outside the workspace [-2, -1, 3, 1]");
+  // A static wall may straddle the edge (the room's walls do), not stand beyond it.
+  const std::string wall =
+      "    - {id: wall, kind: static, shape: {type: box, size: [0.1, 2.0, 1.0]}, pose: {xyz: [3.05, 0, 0.5]}}\n";
+  EXPECT_EQ(errorOf(replaced(ws, "goal:", wall + "goal:")), "(loaded)");
+  EXPECT_NE(errorOf(replaced(ws, "goal:", replaced(wall, "3.05", "4.5") + "goal:"))
+                .find("field 'world.objects[1].pose': [4.5, 0] is outside the workspace [-2, -1, 3, 1] "
+                      "by more than the object's size"),
+            std::string::npos)
+      << errorOf(replaced(ws, "goal:", replaced(wall, "3.05", "4.5") + "goal:"));
+  // Without a workspace nothing bounds the poses.
+  EXPECT_EQ(errorOf(replaced(kMinimal, "pose: [-1, 0, 0]", "pose: [-50, 0, 0]")), "(loaded)");
+}
+
+TEST(ScenarioInputRulesTest, ANameThatDiffersFromTheFileNameIsRefusedWhenLoadingAFile) {
+  const fs::path dir = fs::temp_directory_path() / "tamp_scenario_name_test";
+  fs::create_directories(dir);
+  std::ofstream(dir / "mini.yaml") << kMinimal;
+  std::ofstream(dir / "other.yaml") << kMinimal;
+  auto same = loadScenario(dir / "mini.yaml");
+  EXPECT_TRUE(same.ok()) << same.error().toString();
+  auto other = loadScenario(dir / "other.yaml");
+  ASSERT_FALSE(other.ok());
+  EXPECT_EQ(other.error().toString(),
+            (dir / "other.yaml").string() +
+                ":1:7: field 'name': 'mini' differs from the file name 'other' (a scenario file is "
+                "named <name>.yaml)");
+  fs::remove_all(dir);
+}
+
+TEST(ScenarioInputRulesTest, ADuplicateKeyIsRefused) {
+  EXPECT_EQ(errorOf(replaced(kMinimal, "robot: {start: start}", "robot: {start: start, start: start}")),
+            kFile + ":2:23: field 'robot.start': duplicate key 'start' (first given at line 2)");
+}
+
+TEST(ScenarioInputRulesTest, EveryShippedScenarioFollowsTheRules) {
+  int n = 0;
+  for (const auto& entry : fs::directory_iterator(scenarioDir())) {
+    if (entry.path().extension() != ".yaml") continue;
+    auto sc = loadScenario(entry.path());
+    EXPECT_TRUE(sc.ok()) << sc.error().toString();
+    ++n;
+  }
+  EXPECT_GE(n, 9);
 }
 
 TEST(ScenarioErrorsTest, AllErrorsOfAFileAreReported) {

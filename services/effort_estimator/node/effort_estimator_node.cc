@@ -162,6 +162,13 @@ EffortEstimatorNode::~EffortEstimatorNode() {
 
 msg::EffortReply EffortEstimatorNode::handle(const msg::EffortRequest& req,
                                              const dds::RequestContext&) {
+  if (Status bad = msgv::validateEnvelope(req); !bad.ok()) {
+    rejects_.reject(dds::services::kEffort.name, bad.error());
+    msg::EffortReply rep;
+    rep.header().code(msg::STATUS_INVALID_ARGUMENT);
+    rep.header().message(bad.error().message);
+    return rep;
+  }
   const auto& queries = req.queries();
   std::vector<msg::EffortEstimate> out(queries.size());
   std::vector<ActionDescription> actions;
@@ -173,6 +180,12 @@ msg::EffortReply EffortEstimatorNode::handle(const msg::EffortRequest& req,
     out[i].message(e.toString());
   };
   for (size_t i = 0; i < queries.size(); ++i) {
+    if (Status bad = msgv::validateQuery(queries[i], i); !bad.ok()) {
+      rejects_.reject(dds::services::kEffort.name, bad.error());
+      out[i].code(msg::STATUS_INVALID_ARGUMENT);
+      out[i].message(bad.error().message);  // "EffortRequest.queries[i].<field>: <what>"
+      continue;
+    }
     auto a = fromMsg(queries[i], "queries[" + std::to_string(i) + "]");
     if (!a) {
       fail(i, a.error());
@@ -201,6 +214,10 @@ msg::EffortReply EffortEstimatorNode::handle(const msg::EffortRequest& req,
 }
 
 Status EffortEstimatorNode::handleRecord(const msg::ExecutionRecord& m) {
+  if (Status bad = msgv::screen(m, dds::topics::kExecutionRecords.name, rejects_); !bad.ok()) {
+    ++records_rejected_;
+    return bad;
+  }
   auto record = fromMsg(m, "record");
   Status s = record ? estimator_->addRecord(*record) : Status(record.error());
   if (s) return s;

@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "tamp/dds/service_node.h"
+#include "tamp/msg_validation/validate.h"
 #include "tamp/effort_estimator/effort_estimator.h"
 
 namespace tamp::effort_estimator {
@@ -74,6 +75,7 @@ class EffortEstimatorNode : public dds::ServiceNode {
   std::pair<uint64_t, uint64_t> requestCounters() const override;
 
  private:
+  msgv::RejectLog rejects_{"effort_estimator"};  // malformed input: logged once per kind, rate-limited
   void publishSnapshot(const std::shared_ptr<const ModelSnapshot>& snapshot);
 
   // Destroyed in reverse order: the server and the record reader first (their threads call the

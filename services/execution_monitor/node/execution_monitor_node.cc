@@ -280,6 +280,12 @@ void ExecutionMonitorNode::publish(const Outputs& out) {
 void ExecutionMonitorNode::onCommand(const msg::ExecuteCommand& m) {
   try {
     std::lock_guard lock(mutex_);
+    if (Status bad = msgv::screen(m, dds::topics::kExecuteCommand.name, rejects_); !bad.ok()) {
+      // With an id the sender hears why (a FAILED status naming the field); without, dropped.
+      if (!m.command_id().empty() && m.command_id().size() <= msgv::Limits{}.max_id_length)
+        publish(monitor_->onMalformedCommand(m.command_id(), bad.error(), now()));
+      return;
+    }
     auto c = fromMsg(m);
     publish(c ? monitor_->onCommand(*c, now())
               : monitor_->onMalformedCommand(m.command_id(), c.error(), now()));
@@ -290,6 +296,7 @@ void ExecutionMonitorNode::onCommand(const msg::ExecuteCommand& m) {
 
 void ExecutionMonitorNode::onState(const msg::RobotState& m, const dds::SampleMeta& meta) {
   try {
+    if (!msgv::accept(m, dds::topics::kRobotState.name, rejects_)) return;
     std::lock_guard lock(mutex_);
     auto o = fromMsg(m, monitor_->robot(), meta.source_stamp_ns);
     if (!o) {
@@ -304,6 +311,7 @@ void ExecutionMonitorNode::onState(const msg::RobotState& m, const dds::SampleMe
 
 void ExecutionMonitorNode::onResult(const msg::ActionResult& m, const dds::SampleMeta& meta) {
   try {
+    if (!msgv::accept(m, dds::topics::kActionResult.name, rejects_)) return;
     std::lock_guard lock(mutex_);
     auto r = fromMsg(m, meta.source_stamp_ns);
     if (!r) {
@@ -318,6 +326,7 @@ void ExecutionMonitorNode::onResult(const msg::ActionResult& m, const dds::Sampl
 
 void ExecutionMonitorNode::onRecord(const msg::ExecutionRecord& m) {
   try {
+    if (!msgv::accept(m, dds::topics::kRobotRecords.name, rejects_)) return;
     std::optional<RecordAnnotation> a;
     {
       std::lock_guard lock(mutex_);

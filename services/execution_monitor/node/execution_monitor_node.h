@@ -24,6 +24,7 @@
 #include <mutex>
 
 #include "tamp/dds/service_node.h"
+#include "tamp/msg_validation/validate.h"
 #include "tamp/dds/topics.h"
 #include "tamp/dds/world_sync.h"
 #include "tamp/execution_monitor/monitor.h"
@@ -58,6 +59,7 @@ class ExecutionMonitorNode : public dds::ServiceNode {
   double spinPeriodSeconds() const override { return 0.05; }
 
  private:
+  msgv::RejectLog rejects_{"execution_monitor"};  // malformed input: logged once per kind, rate-limited
   double now() const;
   void publish(const Outputs& out);
   void onCommand(const msg::ExecuteCommand& m);

@@ -1,11 +1,31 @@
 #include "dds_clients.h"
 
+#include "tamp/msg_validation/validate.h"
+
 #include <chrono>
 
 #include "tamp/core/log.h"
 #include "tamp/dds/convert.h"
 
 namespace tamp::graph_manager {
+namespace {
+/// Replies and statuses from other services pass the shared validator too: a malformed one (NaN
+/// in a path, an unknown enum value) is an error of that call, logged once per kind.
+msgv::RejectLog& replyRejects() {
+  static msgv::RejectLog log("graph_manager");
+  return log;
+}
+template <typename Rep>
+Result<Rep> checked(Result<Rep> rep, const char* service) {
+  if (!rep) return rep;
+  if (Status bad = msgv::screen(*rep, service, replyRejects()); !bad.ok()) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "service '" + std::string(service) + "' sent a malformed reply: " + bad.error().message);
+  }
+  return rep;
+}
+}  // namespace
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -66,7 +86,7 @@ TaskPlan DdsServiceClients::plan(const TaskQuery& q) {
   req.search(msg::SearchKind::SEARCH_DEFAULT);
   req.use_costs(true);
   TaskPlan out;
-  auto rep = plan_.call(req, dds::CallOptions{q.budget_s, {}});
+  auto rep = checked(plan_.call(req, dds::CallOptions{q.budget_s, {}}), dds::services::kPlan.name);
   out.time_s = std::chrono::duration<double>(Clock::now() - t0).count();
   if (!rep) {
     out.status = rep.error().code == ErrorCode::kTimeout ? TaskStatus::kTimeout : TaskStatus::kUnavailable;
@@ -111,7 +131,7 @@ MotionAnswer DdsServiceClients::motion(const MotionQuery& q) {
   req.movable_cost_weight(q.movable_cost_weight);
   MotionAnswer a;
   const auto t0 = Clock::now();
-  auto rep = motion_.call(req, dds::CallOptions{q.budget_s, {}});
+  auto rep = checked(motion_.call(req, dds::CallOptions{q.budget_s, {}}), dds::services::kMotion.name);
   a.time_s = std::chrono::duration<double>(Clock::now() - t0).count();
   if (!rep) {
     a.status = rep.error().code == ErrorCode::kTimeout ? MotionOutcome::kTimeout : MotionOutcome::kUnavailable;
@@ -168,7 +188,7 @@ Result<std::vector<PlacementOption>> DdsServiceClients::placements(const Placeme
   }
   req.approach(q.approach_m);
   for (const auto& o : q.overrides) req.object_overrides().push_back(toMsg(o));
-  auto rep = placement_.call(req, dds::CallOptions{q.budget_s, {}});
+  auto rep = checked(placement_.call(req, dds::CallOptions{q.budget_s, {}}), dds::services::kPlacement.name);
   if (!rep) return rep.error();
   if (rep->header().code() != msg::StatusCode::STATUS_OK)
     return Error(dds::fromMsg(rep->header().code()), rep->header().message());
@@ -194,7 +214,7 @@ Result<std::vector<GraspOption>> DdsServiceClients::grasps(const GraspQuery& q) 
   if (q.base) req.base_pose(dds::toMsg(*q.base));
   req.max_grasps(q.max_grasps);
   for (const auto& o : q.overrides) req.object_overrides().push_back(toMsg(o));
-  auto rep = grasp_.call(req, dds::CallOptions{q.budget_s, {}});
+  auto rep = checked(grasp_.call(req, dds::CallOptions{q.budget_s, {}}), dds::services::kGrasp.name);
   if (!rep) return rep.error();
   if (rep->header().code() != msg::StatusCode::STATUS_OK)
     return Error(dds::fromMsg(rep->header().code()), rep->header().message());
@@ -225,7 +245,7 @@ std::vector<EffortAnswer> DdsServiceClients::effort(const std::vector<EffortQuer
     req.queries().push_back(m);
   }
   std::vector<EffortAnswer> out(qs.size());
-  auto rep = effort_.call(req, dds::CallOptions{5.0, {}});
+  auto rep = checked(effort_.call(req, dds::CallOptions{5.0, {}}), dds::services::kEffort.name);
   if (!rep) {
     for (auto& a : out) a.message = rep.error().message;
     return out;
@@ -248,6 +268,7 @@ DdsExecutor::DdsExecutor(std::shared_ptr<dds::Participant> p, std::string missio
       reader_(p, dds::topics::kExecuteStatus, [this](const msg::ExecuteStatus& s, const dds::SampleMeta&) { onStatus(s); }) {}
 
 void DdsExecutor::onStatus(const msg::ExecuteStatus& s) {
+  if (!msgv::accept(s, dds::topics::kExecuteStatus.name, replyRejects())) return;
   const auto st = s.state();
   if (st == msg::ExecState::EXEC_SUCCEEDED || st == msg::ExecState::EXEC_FAILED || st == msg::ExecState::EXEC_BLOCKED ||
       st == msg::ExecState::EXEC_CANCELLED) {

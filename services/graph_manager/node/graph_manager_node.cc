@@ -76,6 +76,19 @@ GraphManagerNode::~GraphManagerNode() {
 }
 
 void GraphManagerNode::onCommand(const msg::MissionCommand& c) {
+  if (Status bad = msgv::screen(c, dds::topics::kMissionCommand.name, rejects_); !bad.ok()) {
+    // With a usable mission id the sender hears why: that mission FAILED, naming the field. Its
+    // own status instance (keyed by mission id), so a running mission's status is untouched.
+    if (!c.mission_id().empty() && c.mission_id().size() <= msgv::Limits{}.max_id_length && !c.abort()) {
+      msg::MissionStatus st;
+      st.mission_id(c.mission_id());
+      st.state(msg::MissionState::MISSION_FAILED);
+      st.message("rejected: " + bad.error().message);
+      st.stamp_ns(dds::nowNs());
+      if (Status s = status_.write(st); !s) logger()->warn("mission status: {}", s.error().message);
+    }
+    return;
+  }
   std::lock_guard g(mutex_);
   if (c.abort()) {
     if (c.mission_id() == running_) abort_ = true;

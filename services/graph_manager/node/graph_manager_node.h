@@ -15,6 +15,7 @@
 
 #include "dds_clients.h"
 #include "tamp/dds/service_node.h"
+#include "tamp/msg_validation/validate.h"
 #include "tamp/graph_manager/params.h"
 
 namespace tamp::graph_manager {
@@ -28,6 +29,7 @@ class GraphManagerNode : public dds::ServiceNode {
   ~GraphManagerNode() override;
 
  private:
+  msgv::RejectLog rejects_{"graph_manager"};  // malformed input: logged once per kind, rate-limited
   void onCommand(const msg::MissionCommand& c);
   void worker(std::stop_token stop);
   void runOne(const msg::MissionCommand& c);

@@ -17,7 +17,9 @@ template <typename Rep>
 Rep errorReply(const Error& e) {
   Rep rep;
   rep.header().code(dds::toMsg(e.code));
-  rep.header().message(e.toString());  // names the field when the error knows it
+  // Names the field when the error knows it (the shared validator's messages start with it).
+  const bool named = !e.where.field.empty() && e.message.rfind(e.where.field, 0) == 0;
+  rep.header().message(named ? e.message : e.toString());
   return rep;
 }
 
@@ -111,7 +113,7 @@ MotionPlannerNode::MotionPlannerNode(const dds::ServiceArgs& args, NodeConfig co
   });
   effort_reader_ = std::make_unique<dds::Reader<msg::EffortModelSnapshot>>(
       participant(), dds::topics::kEffortModel, [this](const msg::EffortModelSnapshot& m, const dds::SampleMeta& meta) {
-        if (!meta.alive) return;
+        if (!meta.alive || !msgv::accept(m, dds::topics::kEffortModel.name, rejects_)) return;
         if (Status st = applyEffortModel(m); !st) {
           nodeLog()->warn("effort model v{} ignored: {}", m.version(), st.error().toString());
         }
@@ -297,6 +299,13 @@ Error busy() { return Error(ErrorCode::kTimeout, "every planner stayed busy unti
 }  // namespace
 
 msg::MotionReply MotionPlannerNode::handleMotion(const msg::MotionRequest& req, const dds::RequestContext& ctx) {
+  if (Status bad = msgv::screen(req, dds::services::kMotion.name, rejects_); !bad.ok()) {
+    msg::MotionReply rep;
+    rep.status(msg::MOTION_INVALID_REQUEST);
+    rep.reason(bad.error().message);
+    rep.header().message(bad.error().message);
+    return rep;
+  }
   auto term = termination(req.world_version(), ctx);
   if (!term) return errorReply<msg::MotionReply>(term.error());
   auto lease = acquire(*term);
@@ -325,6 +334,8 @@ msg::MotionReply MotionPlannerNode::handleMotion(const msg::MotionRequest& req, 
 
 msg::PlacementReply MotionPlannerNode::handlePlacement(const msg::PlacementRequest& req,
                                                       const dds::RequestContext& ctx) {
+  if (Status bad = msgv::screen(req, dds::services::kPlacement.name, rejects_); !bad.ok())
+    return errorReply<msg::PlacementReply>(bad.error());
   auto term = termination(0, ctx);
   if (!term) return errorReply<msg::PlacementReply>(term.error());
   auto lease = acquire(*term);
@@ -339,6 +350,8 @@ msg::PlacementReply MotionPlannerNode::handlePlacement(const msg::PlacementReque
 }
 
 msg::GraspReply MotionPlannerNode::handleGrasp(const msg::GraspRequest& req, const dds::RequestContext& ctx) {
+  if (Status bad = msgv::screen(req, dds::services::kGrasp.name, rejects_); !bad.ok())
+    return errorReply<msg::GraspReply>(bad.error());
   auto term = termination(0, ctx);
   if (!term) return errorReply<msg::GraspReply>(term.error());
   auto lease = acquire(*term);

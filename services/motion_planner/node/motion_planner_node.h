@@ -35,6 +35,7 @@
 #include <vector>
 
 #include "tamp/dds/service_node.h"
+#include "tamp/msg_validation/validate.h"
 #include "tamp/dds/world_sync.h"
 #include "tamp/motion_planner/motion_planner.h"
 
@@ -89,6 +90,7 @@ class MotionPlannerNode : public dds::ServiceNode {
   void spinOnce() override;
 
  private:
+  msgv::RejectLog rejects_{"motion_planner"};  // malformed input: logged once per kind, rate-limited
   /// One planner of the pool and its bookkeeping (flags guarded by pool_mutex_).
   struct Slot {
     explicit Slot(MotionPlanner p) : planner(std::move(p)) {}

@@ -117,6 +117,10 @@ std::pair<uint64_t, uint64_t> PerceptionNode::requestCounters() const {
 }
 
 void PerceptionNode::onCloud(const msg::PointCloudFrame& m) {
+  if (!msgv::accept(m, dds::topics::kPointCloud.name, rejects_)) {  // logged once per kind
+    ++rejected_;
+    return;
+  }
   auto frame = fromMsg(m, options_.params.max_points);
   if (!frame) {
     ++rejected_;
@@ -137,6 +141,10 @@ void PerceptionNode::onState(const msg::RobotState& m) {
     ++bad_states_;
     log::get(name())->warn("rejected a robot state of '{}': {}", m.robot_id(), why);
   };
+  if (!msgv::accept(m, dds::topics::kRobotState.name, rejects_)) {  // logged once per kind
+    ++bad_states_;
+    return;
+  }
   if (m.joint_names().size() != m.joint_positions().size()) {
     return fail("joint_positions: " + std::to_string(m.joint_positions().size()) + " values for " +
                 std::to_string(m.joint_names().size()) + " joints");

@@ -28,6 +28,7 @@
 #include <thread>
 
 #include "tamp/dds/service_node.h"
+#include "tamp/msg_validation/validate.h"
 #include "tamp/dds/world_sync.h"
 #include "tamp/perception/perception.h"
 
@@ -75,6 +76,7 @@ class PerceptionNode : public dds::ServiceNode {
   std::pair<uint64_t, uint64_t> requestCounters() const override;
 
  private:
+  msgv::RejectLog rejects_{"perception"};  // malformed input: logged once per kind, rate-limited
   void onCloud(const msg::PointCloudFrame& m);
   void onState(const msg::RobotState& m);
   /// The robot's body at the state nearest `stamp_ns` within the age limit, or nullopt.

@@ -238,6 +238,18 @@ SimNode::~SimNode() {
 void SimNode::onCommand(const msg::TrajectoryCommand& m) {
   try {
     ++commands_;
+    if (Status bad = msgv::screen(m, dds::topics::kTrajectoryCommand.name, rejects_); !bad.ok()) {
+      ++rejected_;
+      // With a usable id the executor hears why (a FAILED result naming the field).
+      if (!m.command_id().empty() && m.command_id().size() <= msgv::Limits{}.max_id_length) {
+        ActionResult r;
+        r.command_id = m.command_id();
+        r.outcome = Outcome::kFailed;
+        r.reason = "rejected: " + bad.error().message;
+        (void)result_writer_->write(toMsg(r));
+      }
+      return;
+    }
     if (m.cancel()) {
       if (Status s = loop_->cancel(m.command_id()); !s) {
         logger()->warn("cancel '{}': {}", m.command_id(), s.error().message);
@@ -266,6 +278,7 @@ void SimNode::onCommand(const msg::TrajectoryCommand& m) {
 
 void SimNode::onFault(const msg::FaultInjection& m) {
   try {
+    if (!msgv::accept(m, dds::topics::kFaultInjection.name, rejects_)) return;
     auto f = fromMsg(m);
     if (!f) {
       logger()->warn("fault '{}' rejected: {}", m.fault_id(), f.error().toString());

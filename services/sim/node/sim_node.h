@@ -15,6 +15,7 @@
 #include <memory>
 
 #include "tamp/dds/service_node.h"
+#include "tamp/msg_validation/validate.h"
 #include "tamp/dds/topics.h"
 #include "tamp/sim/loop.h"
 #include "tamp/sim/setup.h"
@@ -48,6 +49,7 @@ class SimNode : public dds::ServiceNode {
   SimulationLoop& loop() { return *loop_; }
 
  private:
+  msgv::RejectLog rejects_{"sim"};  // malformed input: logged once per kind, rate-limited
   void onCommand(const msg::TrajectoryCommand& m);
   void onFault(const msg::FaultInjection& m);
 

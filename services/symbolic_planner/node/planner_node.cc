@@ -207,6 +207,13 @@ PlannerNode::PlannerNode(const dds::ServiceArgs& args, PlannerNodeParams params)
 }
 
 msg::PlanReply PlannerNode::handle(const msg::PlanRequest& req, const dds::RequestContext& ctx) {
+  if (Status bad = msgv::screen(req, dds::services::kPlan.name, rejects_); !bad.ok()) {
+    msg::PlanReply rep;
+    rep.status(msg::PLAN_INVALID_INPUT);
+    rep.header().code(msg::STATUS_INVALID_ARGUMENT);
+    rep.header().message(bad.error().message);
+    return rep;
+  }
   auto request = fromMsg(req, params_);
   if (!request) {
     msg::PlanReply rep;

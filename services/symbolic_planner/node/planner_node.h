@@ -13,6 +13,7 @@
 #include <string>
 
 #include "tamp/dds/service_node.h"
+#include "tamp/msg_validation/validate.h"
 #include "tamp/symbolic_planner/planner.h"
 
 namespace tamp::symbolic_planner {
@@ -49,6 +50,7 @@ class PlannerNode : public dds::ServiceNode {
   std::pair<uint64_t, uint64_t> requestCounters() const override;
 
  private:
+  msgv::RejectLog rejects_{"symbolic_planner"};  // malformed input: logged once per kind, rate-limited
   PlannerNodeParams params_;
   Planner planner_;
   std::unique_ptr<dds::RpcServer<msg::PlanRequest, msg::PlanReply>> server_;

@@ -727,7 +727,9 @@ class ProblemInterpreter : public Interpreter {
       }
     }
     if (p_.domain_name.empty()) error(def.loc, "missing (:domain NAME)");
+    section_ = ":init";
     for (const SExpr* s : inits) init(*s);
+    section_ = ":goal";
     if (!goal) {
       error(def.loc, "missing (:goal ...)");
     } else {
@@ -803,8 +805,36 @@ class ProblemInterpreter : public Interpreter {
     } else if (decl->params.size() != a.args.size()) {
       error(l.loc, "'" + a.predicate + "' takes " + std::to_string(decl->params.size()) + " argument(s), got " +
                        std::to_string(a.args.size()));
+    } else {
+      checkArgumentTypes(l, a, *decl);
     }
     return a;
+  }
+
+  /// A ground argument must have a type the parameter accepts (one of its types, or a subtype of
+  /// one): `(at can1 kitchen)` with `can1 - item` where `at` takes a location is an error, not a
+  /// fact no action ever reads. Variables are left to their quantifier's type.
+  void checkArgumentTypes(const SExpr& l, const Atom& a, const PredicateDecl& decl) {
+    for (size_t i = 0; i < a.args.size(); ++i) {
+      const std::string& name = a.args[i].name;
+      if (name.empty() || name[0] == '?') continue;
+      auto it = objects_.find(name);
+      if (it == objects_.end()) continue;  // reported as unknown
+      const std::vector<std::string>& want = decl.params[i].types;
+      bool ok = false;
+      for (const auto& have : it->second) {
+        for (const auto& w : want) ok = ok || d_.isSubtype(have, w);
+      }
+      if (ok) continue;
+      auto list = [](const std::vector<std::string>& v) {
+        std::string out;
+        for (const auto& t : v) out += (out.empty() ? "" : " or ") + t;
+        return out;
+      };
+      error(l.items[i + 1].loc, "'" + name + "' (" + list(it->second) + ") cannot be argument " +
+                                    std::to_string(i + 1) + " of '" + a.predicate + "', which takes " +
+                                    list(want) + " (" + section_ + ")");
+    }
   }
 
   Term objectTerm(const SExpr& e, std::vector<TypedName>* scope) {
@@ -863,6 +893,9 @@ class ProblemInterpreter : public Interpreter {
   const Domain& d_;
   Problem& p_;
   std::unordered_map<std::string, std::vector<std::string>> objects_;
+
+ public:
+  const char* section_{"atom"};  ///< named in type errors (":init", ":goal", "goal", "init")
 };
 
 template <typename Fn>
@@ -983,6 +1016,7 @@ Result<Formula> parseGoalFormula(std::string_view text, const Domain& domain, co
     Problem scratch;
     ProblemInterpreter in(r, domain, scratch);
     in.addObjects(problem.objects);
+    in.section_ = "goal";
     std::vector<TypedName> scope;
     Formula f = in.groundFormula(top[0], scope, 0);
     if (Status s = in.status(); !s.ok()) return s.error();
@@ -998,6 +1032,7 @@ Result<std::vector<Atom>> parseAtomList(std::string_view text, const Domain& dom
     Problem scratch;
     ProblemInterpreter in(r, domain, scratch);
     in.addObjects(problem.objects);
+    in.section_ = "atom list";
     std::vector<Atom> out;
     for (const auto& e : top) out.push_back(in.groundAtom(e, nullptr));
     if (Status s = in.status(); !s.ok()) return s.error();

@@ -399,6 +399,50 @@ TEST(PddlParser, GoalAndAtomListHelpersUseTheProblemObjects) {
   EXPECT_FALSE(parseAtomList("(at nobody hall)", *d, *p).ok());
 }
 
+// Issue 13: an object of the wrong type as an argument was accepted (a fact no action reads, a
+// goal never reached). It is an error naming the file, line and column of the argument.
+TEST(PddlParser, AWronglyTypedArgumentInInitOrGoalIsAnError) {
+  auto d = parseDomain(kAdlDomain, "rooms.pddl");
+  ASSERT_TRUE(d.ok());
+  auto init = parseProblem(
+      "(define (problem x) (:domain rooms)\n (:objects kitchen - room b1 - box)\n"
+      " (:init (at-robot hall)\n        (at kitchen b1))\n (:goal (handempty)))",
+      *d, "p.pddl");
+  ASSERT_FALSE(init.ok());
+  EXPECT_EQ(init.error().where.file, "p.pddl");
+  EXPECT_EQ(init.error().where.line, 4);
+  EXPECT_EQ(init.error().where.column, 13);
+  EXPECT_NE(init.error().message.find("'kitchen' (room) cannot be argument 1 of 'at', which takes item (:init)"),
+            std::string::npos)
+      << init.error().toString();
+  EXPECT_NE(init.error().message.find("'b1' (box) cannot be argument 2 of 'at', which takes room"),
+            std::string::npos)
+      << init.error().toString();
+  // A goal atom; a subtype (box under item) and a domain constant (hall) are fine.
+  auto goal = parseProblem(
+      "(define (problem x) (:domain rooms)\n (:objects kitchen - room b1 - box)\n"
+      " (:init (at b1 hall))\n (:goal (and (at b1 kitchen) (holding kitchen))))",
+      *d, "g.pddl");
+  ASSERT_FALSE(goal.ok());
+  EXPECT_EQ(goal.error().where.line, 4);
+  EXPECT_NE(goal.error().message.find("'kitchen' (room) cannot be argument 1 of 'holding', which takes item (:goal)"),
+            std::string::npos)
+      << goal.error().toString();
+  // The helpers the planner service uses for request atoms check the same.
+  auto p = parseProblem(kAdlProblem, *d);
+  ASSERT_TRUE(p.ok());
+  auto atoms = parseAtomList("(at b1 hall) (at-robot b1)", *d, *p, "init[1]");
+  ASSERT_FALSE(atoms.ok());
+  EXPECT_NE(atoms.error().toString().find("init[1]:1:24: 'b1' (box) cannot be argument 1 of 'at-robot'"),
+            std::string::npos)
+      << atoms.error().toString();
+  EXPECT_FALSE(parseGoalFormula("(and (at b1 hall) (lit b1))", *d, *p).ok());
+  // Untyped domains: everything is an object.
+  auto u = parseDomain("(define (domain u) (:predicates (on ?x ?y)) (:action a :parameters (?x) :precondition (on ?x ?x) :effect (not (on ?x ?x))))");
+  ASSERT_TRUE(u.ok()) << u.error().toString();
+  EXPECT_TRUE(parseProblem("(define (problem v) (:domain u) (:objects a b) (:init (on a b)) (:goal (on b a)))", *u).ok());
+}
+
 TEST(PddlParser, ParsesEveryBenchmarkAndProjectFile) {
   namespace fs = std::filesystem;
   int files = 0;

@@ -14,6 +14,7 @@
 
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -32,9 +33,15 @@ struct YamlDocument {
 };
 
 /// Reads and parses a YAML file; syntax errors give kParseError with file:line:column.
+/// A key given twice in one mapping is an error too (kParseError at the second occurrence,
+/// naming the key, the mapping's dotted path and the line of the first): yaml-cpp would keep
+/// the first value and drop the second silently.
 Result<YamlDocument> loadYamlFile(const std::filesystem::path& file);
-/// Parses YAML text; `name` is used as the file name in messages.
+/// Parses YAML text; `name` is used as the file name in messages. Duplicate keys as above.
 Result<YamlDocument> parseYaml(const std::string& text, const std::string& name);
+/// The duplicate-key check alone: an error naming every repeated key, or nothing (also for text
+/// that is not valid YAML; parseYaml() reports that).
+std::optional<Error> findDuplicateKeys(const std::string& text, const std::string& name);
 
 class FieldReader {
  public:
@@ -63,6 +70,10 @@ class FieldReader {
   bool check(bool cond, const std::string& key, const std::string& message);
   /// Records an error against this mapping (or `key`) unconditionally.
   void fail(const std::string& key, const std::string& message, ErrorCode code = ErrorCode::kInvalidArgument);
+  /// Records an error against element `index` of the sequence field `key` (its own line and
+  /// column, field path "key[index]"); against `key` itself when that is not a long enough list.
+  void failAt(const std::string& key, size_t index, const std::string& message,
+              ErrorCode code = ErrorCode::kInvalidArgument);
   /// Records an error for every key of this mapping that was not read.
   void refuseUnknownKeys();
 

@@ -101,6 +101,11 @@ int main(int argc, char** argv) {
   app.add_option("--domain", domain, "DDS domain id (default: $TAMP_DOMAIN_ID or 0)")->check(CLI::Range(0, 232));
   app.add_flag("--keep-running", keep, "keep the services running (supervised) until Ctrl-C");
   app.add_option("--out", out_dir, "directory for run logs and reports");
+  std::string security;
+  app.add_option("--security", security,
+                 "DDS Security directory (deploy/security/make_certs.sh): every service and this tool run secured, "
+                 "each with its own identity (default: $TAMP_DDS_SECURITY)")
+      ->check(CLI::ExistingDirectory);
   CLI11_PARSE(app, argc, argv);
 
   auto deployment = loadDeployment(deployment_file);
@@ -131,6 +136,8 @@ int main(int argc, char** argv) {
 
   // The simulator writes the ground truth it ends with here (tests and reports judge by it).
   if (!scenario.empty()) setenv("TAMP_SIM_FINAL_WORLD", (fs::absolute(run_dir) / "sim_final_world.json").c_str(), 1);
+  // The services inherit the security directory; each picks its identity by its --name.
+  if (!security.empty()) setenv("TAMP_DDS_SECURITY", fs::absolute(security).c_str(), 1);
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
 

@@ -22,6 +22,11 @@ Result<ServiceArgs> parseServiceArgs(int argc, char** argv, const std::string& d
   app.add_option("--log-level", a.log_level, "trace, debug, info, warn, error, off");
   app.add_option("--heartbeat-period", a.heartbeat_period_s, "seconds between heartbeats")
       ->check(CLI::Range(0.01, 60.0));
+  app.add_option("--security", a.security_dir,
+                 "DDS Security directory made by deploy/security/make_certs.sh (default: $TAMP_DDS_SECURITY; "
+                 "'none': off)");
+  app.add_option("--security-identity", a.security_identity,
+                 "identity (certificate and permissions) in the security directory (default: --name)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp&) {

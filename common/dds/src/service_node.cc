@@ -40,6 +40,8 @@ ServiceNode::ServiceNode(const ServiceArgs& args) : name_(args.name) {
   po.domain_id = args.domain_id;
   if (!args.profile.empty()) po.profile = args.profile;
   po.name = "tamp/" + args.name;
+  po.security_dir = args.security_dir;
+  po.security_identity = args.security_identity.empty() ? args.name : args.security_identity;
   auto p = Participant::create(po);
   if (!p) throw std::runtime_error(p.error().toString());
   participant_ = *p;
@@ -59,8 +61,11 @@ std::pair<uint64_t, uint64_t> ServiceNode::requestCounters() const {
 
 int ServiceNode::run() {
   heartbeat_->setState(msg::SERVICE_READY);
-  log::get(name_)->info("{} ready on DDS domain {} (profile {})", name_, participant_->domainId(),
-                        participant_->profile());
+  log::get(name_)->info("{} ready on DDS domain {} (profile {}{})", name_, participant_->domainId(),
+                        participant_->profile(),
+                        participant_->securityIdentity().empty()
+                            ? std::string()
+                            : ", DDS Security as '" + participant_->securityIdentity() + "'");
   std::unique_lock lock(mutex_);
   while (!stop_) {
     lock.unlock();

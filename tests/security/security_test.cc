@@ -284,6 +284,18 @@ TEST_F(SecurityTest, SecuredServicesAndToolsTalkRequestReply) {
   EXPECT_NE(plain_code, 0) << plain_out;
 }
 
+TEST_F(SecurityTest, TheRobotStateReachesEverySubscriberTheTableGrantsIt) {
+  for (const char* identity : {"graph_manager", "perception", "execution_monitor"}) {
+    auto p = participant(domain_, secured(genuineDir(), identity), identity);
+    ASSERT_TRUE(p);
+    Inbox<msg::RobotState> states;
+    dds::Reader<msg::RobotState> reader(p, dds::topics::kRobotState,
+                                        [&](const msg::RobotState& s, const dds::SampleMeta&) { states.push(s); });
+    EXPECT_TRUE(states.waitFor([](const msg::RobotState&) { return true; }, 15.0))
+        << identity << ": no robot state from the secured simulator (matched writers: " << reader.matchedWriters() << ")";
+  }
+}
+
 TEST_F(SecurityTest, MissingCredentialsAreAClearErrorNamingTheFile) {
   auto p = dds::Participant::create([] {
     auto o = secured(genuineDir(), "no_such_service");

@@ -12,7 +12,8 @@
 /// the participant authenticates with DIR/<identity>/{cert,key}.pem against DIR/ca.pem (builtin
 /// PKI-DH), is checked against DIR/governance.p7s and DIR/<identity>/permissions.p7s (builtin
 /// Access-Permissions) and encrypts (builtin AES-GCM-GMAC). A writer or reader its permissions do
-/// not grant cannot be created (Writer/Reader throw).
+/// not grant cannot be created (Writer/Reader throw). Secured, the default profile is UDPv4 only
+/// (tamp_udp): shared memory with RTPS encryption lost samples on Fast DDS 2.9.1.
 
 #include <filesystem>
 #include <functional>

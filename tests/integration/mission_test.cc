@@ -47,7 +47,7 @@ fs::path fastDeployment(const fs::path& dir, double factor) {
 
 Mission run(const std::string& scenario, const std::vector<std::string>& extra = {}) {
   std::string tag = fs::path(scenario).stem().string();
-  for (const auto& a : extra) tag += "_" + a;
+  for (const auto& a : extra) tag += "_" + fs::path(a).filename().string();
   const fs::path out = tempFile("tamp_mission_" + tag);
   fs::remove_all(out);
   fs::create_directories(out / "deploy" / "store");
@@ -119,6 +119,34 @@ TEST(MissionTest, CorridorShortDetourIsTakenInsteadOfMovingTheBox) {
   ASSERT_EQ(m.exit_code, 0) << m.output;
   EXPECT_LT(distance(m.truth["robot"], 8.5, 1.2), 0.10) << m.truth.dump();
   EXPECT_LT(distance(m.truth["objects"]["box"], 4.62, 1.2), 0.02);
+}
+
+// The DDS Security profile (deploy/security/): every service with its own certificate and
+// permissions, everything encrypted; the mission must still succeed. A topic a node uses but the
+// access table does not grant it makes that node fail to start (or the call fail), so this is
+// also the check that deploy/security/access.txt covers the code.
+TEST(MissionTest, SecuredCorridorMissionSucceeds) {
+  const fs::path pki = tempFile("tamp_mission_pki");
+  fs::remove_all(pki);
+  const std::string cmd = std::string("bash ") + TAMP_SOURCE_DIR + "/deploy/security/make_certs.sh '" + pki.string() +
+                          "' > '" + pki.string() + ".log' 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << readFile(pki.string() + ".log");
+  Mission m = run("namo_corridor.yaml", {"--policy", "effort", "--security", pki.string()});
+  if (m.exit_code != 0) {
+    // Known weakness, docs/benchmarks.md: secured, 2 corridor runs of 6 failed on this loaded VM
+    // (a service pair not matched within the graph manager's 10 s, a lost reply). One more try,
+    // the first failure shown; two failures in a row fail the test.
+    std::cerr << "secured mission failed once (exit " << m.exit_code << "), trying again:\n" << m.output << "\n";
+    RecordProperty("secured_first_attempt_failed", "true");
+    m = run("namo_corridor.yaml", {"--policy", "effort", "--security", pki.string()});
+  }
+  fs::remove_all(pki);
+  ASSERT_EQ(m.exit_code, 0) << m.output;
+  EXPECT_NE(m.output.find("ok"), std::string::npos) << m.output;
+  ASSERT_TRUE(m.truth.is_object()) << m.output;
+  EXPECT_LT(distance(m.truth["robot"], 8.5, 1.2), 0.10) << m.truth.dump();
+  EXPECT_EQ(m.report["status"], "succeeded") << m.report.dump(1);
+  EXPECT_EQ(m.report["objects_moved"], nlohmann::json::array({"box"})) << m.report.dump(1);
 }
 
 TEST(MissionTest, ABadScenarioIsAnInputErrorBeforeAnyServiceStarts) {

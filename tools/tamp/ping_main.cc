@@ -12,7 +12,7 @@ int main(int argc, char** argv) {
   CLI::App app{"Measure request/reply round trips to a TAMP service's echo endpoint", "tamp ping"};
   std::string service;
   int domain = -1, count = 10;
-  std::string profile;
+  std::string profile, security;
   size_t size = 64;
   double timeout = 5.0;
   app.add_option("service", service, "service name, e.g. symbolic_planner")->required();
@@ -23,12 +23,14 @@ int main(int argc, char** argv) {
   app.add_option("-c,--count", count, "number of round trips")->check(CLI::Range(1, 1000000));
   app.add_option("-s,--size", size, "payload bytes")->check(CLI::Range(0, 16 << 20));
   app.add_option("--timeout", timeout, "seconds per call")->check(CLI::Range(0.01, 3600.0));
+  app.add_option("--security", security, "DDS Security directory (deploy/security/make_certs.sh; default: $TAMP_DDS_SECURITY)");
   CLI11_PARSE(app, argc, argv);
 
   tamp::dds::ParticipantOptions po;
   po.domain_id = domain;
   po.name = "tamp/ping";
   if (!profile.empty()) po.profile = profile;
+  po.security_dir = security;
   auto participant = tamp::dds::Participant::create(po, run_id);
   if (!participant) {
     std::cerr << "tamp ping: " << participant.error().toString() << "\n";

@@ -63,6 +63,11 @@ int main(int argc, char** argv) {
   app.add_option("--out", out_dir, "directory for run folders (OUT/RUN_ID: logs, events, reports)");
   std::string explicit_run_id;
   app.add_option("--run-id", explicit_run_id, "run id (default: generated, run-YYYYmmdd-HHMMSS-xxxx)");
+  std::string security;
+  app.add_option("--security", security,
+                 "DDS Security directory (deploy/security/make_certs.sh): every service and this tool run secured, "
+                 "each with its own identity (default: $TAMP_DDS_SECURITY)")
+      ->check(CLI::ExistingDirectory);
   CLI11_PARSE(app, argc, argv);
 
   auto deployment = tamp::deploy::loadDeployment(deployment_file);
@@ -104,7 +109,9 @@ int main(int argc, char** argv) {
   fs::create_directories(run_dir);
 
   // The simulator writes the ground truth it ends with here (tests and reports judge by it).
-  if (!scenario.empty()) setenv("TAMP_SIM_FINAL_WORLD", (run_dir / "sim_final_world.json").c_str(), 1);
+  if (!scenario.empty()) setenv("TAMP_SIM_FINAL_WORLD", (fs::absolute(run_dir) / "sim_final_world.json").c_str(), 1);
+  // The services inherit the security directory; each picks its identity by its --name.
+  if (!security.empty()) setenv("TAMP_DDS_SECURITY", fs::absolute(security).c_str(), 1);
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
 

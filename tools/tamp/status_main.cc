@@ -28,7 +28,7 @@ std::string duration(double s) {
 int main(int argc, char** argv) {
   CLI::App app{"List the live TAMP services of a DDS domain (from their heartbeats)", "tamp status"};
   int domain = -1;
-  std::string profile;
+  std::string profile, security;
   double wait_s = 1.5;
   std::vector<std::string> expect;
   bool json = false, all = false;
@@ -42,6 +42,7 @@ int main(int argc, char** argv) {
   app.add_option("--run-id", run_id, "run whose services to list (default: $TAMP_RUN_ID or none)");
   app.add_flag("--json", json, "print JSON");
   app.add_flag("--all", all, "also list services that stopped or went silent");
+  app.add_option("--security", security, "DDS Security directory (deploy/security/make_certs.sh; default: $TAMP_DDS_SECURITY)");
   CLI11_PARSE(app, argc, argv);
 
   std::vector<std::string> optional_names;
@@ -69,6 +70,7 @@ int main(int argc, char** argv) {
   po.domain_id = domain;
   po.name = "tamp/status";
   if (!profile.empty()) po.profile = profile;
+  po.security_dir = security;
   auto participant = tamp::dds::Participant::create(po, run_id);
   if (!participant) {
     std::cerr << "tamp status: " << participant.error().toString() << "\n";

@@ -3,7 +3,10 @@
 // 1 MiB) it measures N calls after a warm-up and prints p50/p99/mean in microseconds as a
 // Markdown table (for docs/benchmarks.md).
 //
-//   tamp_rpc_bench [--small-n 2000] [--large-n 200] [--domain D]
+//   tamp_rpc_bench [--small-n 2000] [--large-n 200] [--domain D] [--security DIR]
+//
+// --security DIR (deploy/security/make_certs.sh): both processes secured (the echo node as
+// "diagnostics", this client as "tamp"), for the cost of DDS Security.
 #include <unistd.h>
 
 #include <algorithm>
@@ -43,33 +46,39 @@ std::string cpuModel() {
 
 int main(int argc, char** argv) {
   int small_n = 2000, large_n = 200, domain = 150 + static_cast<int>(::getpid() % 50);
+  std::string security = "none";
   for (int i = 1; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--small-n")) small_n = std::atoi(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--large-n")) large_n = std::atoi(argv[i + 1]);
     else if (!std::strcmp(argv[i], "--domain")) domain = std::atoi(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--security")) security = argv[i + 1];
   }
   tamp::log::setLevel("warn");
   std::vector<Row> rows;
   for (const std::string profile : {"tamp_shm", "tamp_udp", "tamp_default"}) {
     tamp::process::Supervisor sup;
     tamp::process::ProcessSpec spec;
-    spec.name = "bench_echo";
+    // Secured, the echo node needs a name the access table grants an identity to.
+    const std::string echo_name = security == "none" ? "bench_echo" : "diagnostics";
+    spec.name = echo_name;
     spec.executable = std::string(TAMP_BIN_DIR) + "/tamp_echo_node";
-    spec.args = {"--name", "bench_echo", "--domain", std::to_string(domain), "--profile", profile, "--log-level",
-                 "warn"};
+    spec.args = {"--name", echo_name, "--domain", std::to_string(domain), "--profile", profile, "--log-level",
+                 "warn", "--security", security};
     spec.restart = false;
     sup.add(spec);
     if (auto s = sup.startAll(); !s.ok()) {
       std::fprintf(stderr, "%s\n", s.error().toString().c_str());
       return 1;
     }
-    auto p = tamp::dds::Participant::create(tamp::dds::ParticipantOptions{domain, profile, "bench", {}});
+    tamp::dds::ParticipantOptions po{domain, profile, "bench", {}};
+    po.security_dir = security;
+    auto p = tamp::dds::Participant::create(po);
     if (!p) {
       std::fprintf(stderr, "%s\n", p.error().toString().c_str());
       return 1;
     }
     tamp::dds::RpcClient<tamp::msg::EchoRequest, tamp::msg::EchoReply> client(
-        *p, tamp::dds::echoService("bench_echo"), tamp::dds::RpcClientOptions{5.0, 3, 64u << 20});
+        *p, tamp::dds::echoService(echo_name), tamp::dds::RpcClientOptions{5.0, 3, 64u << 20});
     if (!client.waitForServer(tamp::Termination::after(20.0))) {
       std::fprintf(stderr, "echo node did not appear\n");
       return 1;
@@ -100,6 +109,7 @@ int main(int argc, char** argv) {
   }
   utsname u{};
   uname(&u);
+  std::printf("DDS Security: %s.\n", security == "none" ? "off" : "on (PKI-DH, Access-Permissions, AES-GCM-GMAC)");
   std::printf("Machine: %s, %u cores (%s %s). Build: %s.\n\n", cpuModel().c_str(), std::thread::hardware_concurrency(),
               u.sysname, u.release,
 #ifdef NDEBUG

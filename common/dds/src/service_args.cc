@@ -27,6 +27,11 @@ Result<ServiceArgs> parseServiceArgs(int argc, char** argv, const std::string& d
                  "file the supervisor touches; stop when it is older than --orphan-timeout");
   app.add_option("--orphan-timeout", a.orphan_timeout_s, "seconds without a supervisor before stopping (0: never)")
       ->check(CLI::Range(0.0, 1e6));
+  app.add_option("--security", a.security_dir,
+                 "DDS Security directory made by deploy/security/make_certs.sh (default: $TAMP_DDS_SECURITY; "
+                 "'none': off)");
+  app.add_option("--security-identity", a.security_identity,
+                 "identity (certificate and permissions) in the security directory (default: --name)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp&) {

@@ -42,6 +42,8 @@ ServiceNode::ServiceNode(const ServiceArgs& args)
   po.domain_id = args.domain_id;
   if (!args.profile.empty()) po.profile = args.profile;
   po.name = "tamp/" + args.name;
+  po.security_dir = args.security_dir;
+  po.security_identity = args.security_identity.empty() ? args.name : args.security_identity;
   auto p = Participant::create(po, args.run_id);
   if (!p) throw std::runtime_error(p.error().toString());
   participant_ = *p;
@@ -72,7 +74,11 @@ bool ServiceNode::orphaned() const {
 int ServiceNode::run() {
   heartbeat_->setState(msg::SERVICE_READY);
   log::get(name_)->info("{} ready on DDS domain {} (profile {}{})", name_, participant_->domainId(),
-                        participant_->profile(), runId().empty() ? std::string() : ", run " + runId());
+                        participant_->profile(),
+                        (runId().empty() ? std::string() : ", run " + runId()) +
+                            (participant_->securityIdentity().empty()
+                                 ? std::string()
+                                 : ", DDS Security as '" + participant_->securityIdentity() + "'"));
   std::unique_lock lock(mutex_);
   while (!stop_) {
     lock.unlock();

@@ -6,12 +6,21 @@
 /// outlives its entities. The domain id comes from `ParticipantOptions::domain_id`, else from the
 /// environment variable `TAMP_DOMAIN_ID`, else 0: tests pick their own domain and run in parallel
 /// without seeing each other.
+///
+/// DDS Security (docs/architecture.md, "Security profile"): with a security directory made by
+/// deploy/security/make_certs.sh -- `ParticipantOptions::security_dir`, else `$TAMP_DDS_SECURITY` --
+/// the participant authenticates with DIR/<identity>/{cert,key}.pem against DIR/ca.pem (builtin
+/// PKI-DH), is checked against DIR/governance.p7s and DIR/<identity>/permissions.p7s (builtin
+/// Access-Permissions) and encrypts (builtin AES-GCM-GMAC). A writer or reader its permissions do
+/// not grant cannot be created (Writer/Reader throw). Secured, the default profile is UDPv4 only
+/// (tamp_udp): shared memory with RTPS encryption lost samples on Fast DDS 2.9.1.
 
 #include <filesystem>
 #include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 
 #include "tamp/core/error.h"
@@ -36,7 +45,22 @@ struct ParticipantOptions {
   std::string profile{kProfileDefault};  ///< participant profile name; $TAMP_DDS_PROFILE overrides the default
   std::string name;                   ///< participant name shown by DDS tools; default "tamp"
   std::filesystem::path profiles_file;  ///< default: $TAMP_DDS_PROFILES or configDir()/dds/tamp_profiles.xml
+  /// DDS Security material (make_certs.sh layout); empty: $TAMP_DDS_SECURITY; empty there too, or
+  /// "none": no security.
+  std::string security_dir{};
+  /// Certificate and permissions to use from the security directory (its sub-directory): empty:
+  /// $TAMP_DDS_SECURITY_IDENTITY, else "tamp" (the command-line tools' identity).
+  std::string security_identity{};
+  /// Explicit security files (tests: forged or foreign credentials); when set, the two fields
+  /// above are not used.
+  struct SecurityFiles {
+    std::filesystem::path identity_ca, certificate, private_key, permissions_ca, governance, permissions;
+  };
+  std::optional<SecurityFiles> security{};
 };
+
+/// The security files of `identity` in a make_certs.sh directory (not checked for existence).
+ParticipantOptions::SecurityFiles securityFiles(const std::filesystem::path& dir, const std::string& identity);
 
 /// The domain id the options resolve to (flag, then $TAMP_DOMAIN_ID, then 0); an error names the
 /// offending value when it is not an integer in [0, 232].
@@ -70,6 +94,8 @@ class Participant : public std::enable_shared_from_this<Participant> {
   const std::string& profile() const { return profile_; }
   /// The run this participant belongs to ("" for none).
   const std::string& runId() const { return run_id_; }
+  /// The security identity (certificate CN) when DDS Security is on; empty otherwise.
+  const std::string& securityIdentity() const { return security_identity_; }
   /// This participant's GUID prefix as hex, unique per process and domain.
   std::string guid() const;
 
@@ -93,6 +119,7 @@ class Participant : public std::enable_shared_from_this<Participant> {
   std::string name_;
   std::string profile_;
   std::string run_id_;
+  std::string security_identity_;
 };
 
 }  // namespace tamp::dds

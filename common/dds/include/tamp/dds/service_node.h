@@ -9,7 +9,7 @@
 ///     }
 ///
 /// `serviceMain` blocks SIGINT/SIGTERM before any thread exists, parses the standard arguments
-/// (--domain, --profile, --config, --name, --log-level, --run-id, ...), builds the node, runs it until a signal
+/// (--domain, --profile, --config, --name, --log-level, --run-id, --security, ...), builds the node, runs it until a signal
 /// or stop(), and returns an exit code (0 clean stop, 30 bad arguments/config, 40 DDS failure).
 ///
 /// A `ServiceNode` owns the participant, publishes heartbeats and answers echo requests on
@@ -46,6 +46,10 @@ struct ServiceArgs {
   /// service whose supervisor was killed and not restarted does not run forever.
   std::string supervisor_lease;
   double orphan_timeout_s{0.0};  ///< > 0 with supervisor_lease; seconds
+  /// DDS Security directory (deploy/security/make_certs.sh); empty: $TAMP_DDS_SECURITY, else none.
+  std::string security_dir;
+  /// The certificate/permissions to use from it; empty: the service name.
+  std::string security_identity;
 };
 
 /// Parses the standard arguments. Returns an error for bad arguments; `--help` prints usage and

@@ -1,5 +1,7 @@
 #include "tamp/symbolic_planner/search.h"
 
+#include <deque>
+#include <map>
 #include <memory>
 
 #include "tamp/symbolic_planner/landmarks.h"
@@ -498,34 +500,43 @@ class Searcher {
   // queues, all successors and preferred successors (reached by a helpful action of the parent),
   // alternate by priority; each improvement of the best h boosts the preferred queue.
   struct LazyEntry {
-    Cost key;
-    uint64_t order;
     uint32_t parent;
     OpId op;
   };
-  struct LazyCmp {
-    bool operator()(const LazyEntry& a, const LazyEntry& b) const {
-      return a.key != b.key ? a.key > b.key : a.order > b.order;
-    }
-  };
+  /// Bucket open list (Fast Downward's for integer keys): one FIFO per key, so equal keys pop in
+  /// insertion order, as a heap with an insertion counter would, at 8 bytes per entry (the heap
+  /// entry was 24) and O(log #keys) per push/pop. Buckets are freed as they are emptied.
   class LazyOpen {
    public:
     void push(Cost k, uint32_t parent, OpId op) {
-      v_.push_back({k, counter_++, parent, op});
-      std::push_heap(v_.begin(), v_.end(), LazyCmp{});
+      if (k != last_key_ || last_ == nullptr) {
+        last_ = &buckets_[k];
+        last_key_ = k;
+      }
+      last_->push_back({parent, op});
+      ++size_;
     }
     LazyEntry pop() {
-      std::pop_heap(v_.begin(), v_.end(), LazyCmp{});
-      LazyEntry e = v_.back();
-      v_.pop_back();
+      auto it = buckets_.begin();
+      const LazyEntry e = it->second.front();
+      it->second.pop_front();
+      --size_;
+      if (it->second.empty()) {
+        if (last_ == &it->second) last_ = nullptr;
+        buckets_.erase(it);
+      }
       return e;
     }
-    bool empty() const { return v_.empty(); }
-    size_t bytes() const { return v_.capacity() * sizeof(LazyEntry); }
+    /// Key of the entry `pop()` would return (the list must not be empty).
+    Cost minKey() const { return buckets_.begin()->first; }
+    bool empty() const { return size_ == 0; }
+    size_t bytes() const { return size_ * sizeof(LazyEntry) + buckets_.size() * 128; }
 
    private:
-    std::vector<LazyEntry> v_;
-    uint64_t counter_{0};
+    std::map<Cost, std::deque<LazyEntry>> buckets_;
+    std::deque<LazyEntry>* last_{nullptr};  // bucket of the last push (successors share keys)
+    Cost last_key_{0};
+    size_t size_{0};
   };
 
   SearchResult lazy() {

@@ -59,7 +59,7 @@ int main(int argc, char** argv) {
                "21 out of memory, 30 input error, 31 invalid plan (--validate), 39 internal error.",
                "tamp plan"};
   std::string domain, problem, search = "ehc", fallback = "lazy", heuristic, cost_type, plan_out, validate_plan;
-  double timeout = 0.0, weight = 5.0;
+  double timeout = 0.0, weight = 5.0, anytime = 5.0;
   size_t memory_mb = 4096;
   bool stats = false, no_check = false, no_fallback = false, no_agenda = false, first_improvement = false,
        no_ff_first = false, no_landmarks = false;
@@ -101,6 +101,10 @@ int main(int argc, char** argv) {
   app.add_option("--ehc-fallback-budget", fallback_budget,
                  "ehc: fall back to the complete search after MIN + this many evaluations per unit of the "
                  "initial h (0 = never)");
+  app.add_option("--anytime", anytime,
+                 "tasks whose actions differ in cost: after the first plan, look for cheaper ones with "
+                 "LAMA's weighted A* iterations for up to this many seconds (0 = first plan)")
+      ->check(CLI::Range(0.0, 1e9));
   app.add_flag("--no-landmarks", no_landmarks, "lazy: h_FF only (no landmark-count heuristic)");
   app.add_option("--ehc-fallback-min", fallback_min, "ehc: the MIN of --ehc-fallback-budget");
   app.add_option("--ehc-fallback-max", fallback_max, "ehc: at most this many evaluations before falling back (0 = no cap)");
@@ -129,6 +133,7 @@ int main(int argc, char** argv) {
   req.search.ehc_fallback_budget_min = fallback_min;
   req.search.ehc_fallback_budget_max = fallback_max;
   req.search.landmarks = !no_landmarks;
+  req.search.anytime_seconds = anytime;
   if (heuristic == "ff") req.search.heuristic = sp::HeuristicKind::kFF;
   if (heuristic == "add") req.search.heuristic = sp::HeuristicKind::kAdd;
   if (heuristic == "max") req.search.heuristic = sp::HeuristicKind::kMax;
@@ -146,11 +151,13 @@ int main(int argc, char** argv) {
   if (stats) {
     std::fprintf(stderr,
                  "; status %s; parse %.4f s, ground %.4f s, search %.4f s; facts %zu, operators %zu; "
-                 "expanded %llu, evaluated %llu, initial h %lld%s%s%s\n",
+                 "expanded %llu, evaluated %llu, initial h %lld; anytime %llu iterations, %llu improvements%s%s%s\n",
                  sp::toString(reply.status).c_str(), reply.stats.parse_seconds, reply.stats.ground_seconds,
                  reply.stats.search_seconds, reply.stats.facts, reply.stats.operators,
                  static_cast<unsigned long long>(reply.stats.expanded),
                  static_cast<unsigned long long>(reply.stats.evaluated), static_cast<long long>(reply.stats.initial_h),
+                 static_cast<unsigned long long>(reply.stats.anytime_iterations),
+                 static_cast<unsigned long long>(reply.stats.anytime_improvements),
                  reply.stats.ehc_ff_failed ? "; ehc with FF-v2.3's relaxed plan failed, restarted" : "",
                  reply.stats.ehc_second_won   ? "; second ehc run gave the shorter plan"
                  : reply.stats.ehc_second_ran ? "; second ehc run, first plan kept"

@@ -302,6 +302,8 @@ PlanReply PlanningSession::solve(const Query& q, const Termination& term) {
   reply.stats.ehc_ff_failed = sr.stats.ehc_ff_failed;
   reply.stats.ehc_second_ran = sr.stats.ehc_second_ran;
   reply.stats.ehc_second_won = sr.stats.ehc_second_won;
+  reply.stats.anytime_iterations = sr.stats.anytime_iterations;
+  reply.stats.anytime_improvements = sr.stats.anytime_improvements;
   reply.status = fromSearch(sr.status);
   if (sr.status == SearchStatus::kSolved) {
     reply.cost = sr.cost;

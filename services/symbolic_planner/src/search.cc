@@ -1,5 +1,8 @@
 #include "tamp/symbolic_planner/search.h"
 
+#include <deque>
+#include <limits>
+#include <map>
 #include <memory>
 
 #include "tamp/symbolic_planner/landmarks.h"
@@ -279,6 +282,26 @@ class Searcher {
     return r;
   }
 
+  /// One iteration of the anytime phase: `lazyWAstar(w, bound)` (w = 0: the lazy greedy search
+  /// with landmarks, bounded), its plan (cost < bound) with
+  /// redundant actions eliminated.
+  SearchResult improve(double w, Cost bound) {
+    Stopwatch sw;
+    h_.setGoal(goal_);
+    SearchResult r = w > 0 ? lazyWAstar(w, bound) : lazy(bound);
+    if (r.status == SearchStatus::kSolved && opt_.eliminate_redundant_actions) {
+      const size_t before = r.plan.size();
+      r.plan = eliminateRedundantActions(task_, init_, goal_, std::move(r.plan), term_);
+      stats_.eliminated_actions = before - r.plan.size();
+    }
+    r.stats = stats_;
+    r.stats.registered_states = reg_.size();
+    r.stats.seconds = sw.seconds();
+    r.cost = 0;
+    for (OpId o : r.plan) r.cost += opCost(o);
+    return r;
+  }
+
  private:
   // --- per-state data ---------------------------------------------------------------------------
   uint32_t registerState(const uint64_t* s, bool* is_new) {
@@ -498,40 +521,52 @@ class Searcher {
   // queues, all successors and preferred successors (reached by a helpful action of the parent),
   // alternate by priority; each improvement of the best h boosts the preferred queue.
   struct LazyEntry {
-    Cost key;
-    uint64_t order;
     uint32_t parent;
     OpId op;
   };
-  struct LazyCmp {
-    bool operator()(const LazyEntry& a, const LazyEntry& b) const {
-      return a.key != b.key ? a.key > b.key : a.order > b.order;
-    }
-  };
+  /// Bucket open list (Fast Downward's for integer keys): one FIFO per key, so equal keys pop in
+  /// insertion order, as a heap with an insertion counter would, at 8 bytes per entry (the heap
+  /// entry was 24) and O(log #keys) per push/pop. Buckets are freed as they are emptied.
   class LazyOpen {
    public:
     void push(Cost k, uint32_t parent, OpId op) {
-      v_.push_back({k, counter_++, parent, op});
-      std::push_heap(v_.begin(), v_.end(), LazyCmp{});
+      if (k != last_key_ || last_ == nullptr) {
+        last_ = &buckets_[k];
+        last_key_ = k;
+      }
+      last_->push_back({parent, op});
+      ++size_;
     }
     LazyEntry pop() {
-      std::pop_heap(v_.begin(), v_.end(), LazyCmp{});
-      LazyEntry e = v_.back();
-      v_.pop_back();
+      auto it = buckets_.begin();
+      const LazyEntry e = it->second.front();
+      it->second.pop_front();
+      --size_;
+      if (it->second.empty()) {
+        if (last_ == &it->second) last_ = nullptr;
+        buckets_.erase(it);
+      }
       return e;
     }
-    bool empty() const { return v_.empty(); }
-    size_t bytes() const { return v_.capacity() * sizeof(LazyEntry); }
+    /// Key of the entry `pop()` would return (the list must not be empty).
+    Cost minKey() const { return buckets_.begin()->first; }
+    bool empty() const { return size_ == 0; }
+    size_t bytes() const { return size_ * sizeof(LazyEntry) + buckets_.size() * 128; }
 
    private:
-    std::vector<LazyEntry> v_;
-    uint64_t counter_{0};
+    std::map<Cost, std::deque<LazyEntry>> buckets_;
+    std::deque<LazyEntry>* last_{nullptr};  // bucket of the last push (successors share keys)
+    Cost last_key_{0};
+    size_t size_{0};
   };
 
-  SearchResult lazy() {
+  /// Paths costing `bound` or more are pruned (the anytime phase's first iteration); g is the
+  /// cost of the path found first (no re-opening).
+  SearchResult lazy(Cost bound = std::numeric_limits<Cost>::max()) {
     resetRegistry();
     bool is_new = false;
     const uint32_t root = registerState(init_.data(), &is_new);
+    g_[root] = 0;
     if (task_.goalReached(reg_.get(root), goal_)) return finish(SearchStatus::kSolved);
     const Cost h0 = evaluate(root);
     if (stats_.initial_h == 0) stats_.initial_h = h0;
@@ -574,6 +609,7 @@ class Searcher {
       const Cost hf = h_cache_[id];
       const Cost hl = lm ? hlm[id] : 0;
       for (OpId o : ops) {
+        if (g_[id] + opCost(o) >= bound) continue;
         ++stats_.generated;
         const bool pref = use_pref && pref_mark[o] == mark;
         lists[0].push(hf, id, o);
@@ -603,6 +639,7 @@ class Searcher {
       if (!is_new) continue;  // evaluated (and expanded) before: closed
       parent_[sid] = e.parent;
       op_[sid] = e.op;
+      g_[sid] = g_[e.parent] + opCost(e.op);
       if (task_.goalReached(succ_.data(), goal_)) return finish(SearchStatus::kSolved, path(sid, kNone));
       if (lm) {
         lm->progress(accepted.data() + static_cast<size_t>(e.parent) * lw, succ_.data(), acc_tmp.data());
@@ -623,6 +660,79 @@ class Searcher {
       if (progress) {
         prio[1] -= opt_.preferred_boost;
         prio[3] -= opt_.preferred_boost;
+      }
+      expand(sid);
+    }
+  }
+
+  Cost opCost(OpId o) const { return task_.unit_cost ? 1 : task_.ops[o].cost; }
+
+  // --- lazy weighted A* with a cost bound (LAMA's later iterations) ------------------------------
+  // Entries (parent, operator) keyed by g(parent) + cost(op) + w * h(parent); two queues, all and
+  // preferred successors, alternating with the boost on progress; a state reached again on a
+  // cheaper path is re-opened; every path with g >= `bound` is pruned, so a plan found costs
+  // less than `bound`, and an exhausted open list proves that no plan does.
+  SearchResult lazyWAstar(double w, Cost bound) {
+    resetRegistry();
+    bool is_new = false;
+    const uint32_t root = registerState(init_.data(), &is_new);
+    if (task_.goalReached(reg_.get(root), goal_)) return finish(SearchStatus::kSolved);
+    const Cost h0 = evaluate(root);
+    stats_.initial_h = h0;
+    if (h0 == Heuristic::kDeadEnd) return finish(SearchStatus::kUnsolvable);
+    g_[root] = 0;
+    const bool use_pref = opt_.preferred_operators && h_.computesPreferred();
+    LazyOpen lists[2];
+    int64_t prio[2] = {0, 0};
+    std::vector<uint32_t> pref_mark(task_.ops.size(), 0);
+    uint32_t mark = 0;
+    std::vector<OpId> ops;
+    auto weighted = [&](Cost h) { return static_cast<Cost>(std::ceil(w * static_cast<double>(h) - 1e-9)); };
+    auto expand = [&](uint32_t id) {
+      ++stats_.expanded;
+      ++mark;
+      for (uint32_t i = 0; i < pref_count_[id]; ++i) pref_mark[pref_pool_[pref_begin_[id] + i]] = mark;
+      ops.clear();
+      task_.applicableOps(reg_.get(id), ops);
+      const Cost wh = weighted(h_cache_[id]);
+      for (OpId o : ops) {
+        const Cost ng = g_[id] + opCost(o);
+        if (ng >= bound) continue;
+        ++stats_.generated;
+        lists[0].push(ng + wh, id, o);
+        if (use_pref && pref_mark[o] == mark) lists[1].push(ng + wh, id, o);
+      }
+    };
+    expand(root);
+    Cost best_h = h0;
+    for (;;) {
+      if (auto st = checkLimits()) return finish(*st);
+      open_bytes_ = lists[0].bytes() + lists[1].bytes();
+      int pick = -1;
+      for (int i = 0; i < 2; ++i) {
+        if ((i == 0 || use_pref) && !lists[i].empty() && (pick < 0 || prio[i] < prio[pick])) pick = i;
+      }
+      if (pick < 0) return finish(SearchStatus::kUnsolvable);
+      ++prio[pick];
+      const LazyEntry e = lists[pick].pop();
+      const Cost ng = g_[e.parent] + opCost(e.op);
+      if (ng >= bound) continue;
+      std::copy(reg_.get(e.parent), reg_.get(e.parent) + reg_.words(), buf_.begin());
+      task_.apply(buf_.data(), e.op, succ_.data());
+      const uint32_t sid = registerState(succ_.data(), &is_new);
+      if (!is_new) {
+        if (ng >= g_[sid] || h_cache_[sid] == Heuristic::kDeadEnd) continue;
+        ++stats_.reopened;
+      }
+      g_[sid] = ng;
+      parent_[sid] = e.parent;
+      op_[sid] = e.op;
+      if (task_.goalReached(succ_.data(), goal_)) return finish(SearchStatus::kSolved, path(sid, kNone));
+      const Cost h = evaluate(sid);
+      if (h == Heuristic::kDeadEnd) continue;
+      if (h < best_h) {
+        best_h = h;
+        prio[1] -= opt_.preferred_boost;
       }
       expand(sid);
     }
@@ -834,14 +944,20 @@ void SearchOptions::validate() const {
   if (!(weight >= 1.0) || !std::isfinite(weight)) {
     throw std::invalid_argument("SearchOptions::weight must be a finite number >= 1, got " + std::to_string(weight));
   }
+  if (!(anytime_seconds >= 0.0) || !std::isfinite(anytime_seconds)) {
+    throw std::invalid_argument("SearchOptions::anytime_seconds must be a finite number >= 0, got " +
+                                std::to_string(anytime_seconds));
+  }
   if (preferred_boost < 0) {
     throw std::invalid_argument("SearchOptions::preferred_boost must be >= 0, got " + std::to_string(preferred_boost));
   }
 }
 
-SearchResult search(const Task& task, const StateBits& init, const Goal& goal, const SearchOptions& options,
-                    Heuristic& heuristic, const Termination& term) {
-  options.validate();
+namespace {
+
+/// The first plan: the configured search (with EHC's first run and fallback).
+SearchResult firstPlan(const Task& task, const StateBits& init, const Goal& goal, const SearchOptions& options,
+                       Heuristic& heuristic, const Termination& term) {
   if (init.size() != task.numWords()) {
     throw std::invalid_argument("search: initial state has " + std::to_string(init.size()) + " words, task needs " +
                                 std::to_string(task.numWords()));
@@ -898,6 +1014,56 @@ SearchResult search(const Task& task, const StateBits& init, const Goal& goal, c
   }
   Searcher s(task, init, goal, options, heuristic, term);
   return s.run();
+}
+
+/// True when the operators do not all cost the same (plan cost is not plan length).
+bool costsVary(const Task& task) {
+  if (task.unit_cost) return false;
+  for (const Operator& op : task.ops) {
+    if (op.cost != task.ops.front().cost) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+SearchResult search(const Task& task, const StateBits& init, const Goal& goal, const SearchOptions& options,
+                    Heuristic& heuristic, const Termination& term) {
+  options.validate();
+  if (init.size() != task.numWords()) {
+    throw std::invalid_argument("search: initial state has " + std::to_string(init.size()) + " words, task needs " +
+                                std::to_string(task.numWords()));
+  }
+  SearchResult best = firstPlan(task, init, goal, options, heuristic, term);
+  const bool satisficing = options.algorithm == SearchAlgorithm::kEhc || options.algorithm == SearchAlgorithm::kGbfs ||
+                           options.algorithm == SearchAlgorithm::kLazy;
+  if (best.status != SearchStatus::kSolved || !satisficing || options.anytime_seconds <= 0 || !costsVary(task)) {
+    return best;
+  }
+  // Anytime phase (LAMA 2011): the lazy greedy search, then lazy weighted A* with w = 5, 3, 2, 1,
+  // 1, ..., each bounded by the
+  // best cost so far, until the budget or the caller's deadline; an exhausted iteration proves
+  // the best plan optimal.
+  const Termination until = term.tightened(Deadline::in(options.anytime_seconds));
+  // 0: the lazy greedy search with landmarks (LAMA's first iteration, cost-aware heuristic).
+  static constexpr double kWeights[] = {0.0, 5.0, 3.0, 2.0, 1.0};
+  for (size_t i = 0; !until() && best.cost > 0; ++i) {
+    Searcher s(task, init, goal, options, heuristic, until);
+    SearchResult r = s.improve(kWeights[std::min<size_t>(i, 4)], best.cost);
+    ++best.stats.anytime_iterations;
+    addRunCosts(best.stats, r.stats);
+    if (r.status == SearchStatus::kSolved && r.cost < best.cost) {
+      ++best.stats.anytime_improvements;
+      best.plan = std::move(r.plan);
+      best.cost = r.cost;
+    } else if (r.status == SearchStatus::kUnsolvable) {
+      best.stats.anytime_proved_optimal = true;
+      break;
+    } else if (r.status != SearchStatus::kSolved) {
+      break;  // out of time or memory
+    }
+  }
+  return best;
 }
 
 SearchResult search(const Task& task, const StateBits& init, const Goal& goal, const SearchOptions& options,

@@ -188,12 +188,53 @@ TEST(Search, LazySearchWithAndWithoutLandmarksAndEhcFallbackBudgetGiveCheckedPla
   }
 }
 
+TEST(Search, AnytimePhaseNeverReturnsADearerPlanAndEndsOptimalOnASmallTask) {
+  // The cost trap of AstarIsCostOptimalAndWastarWithinItsBound: whatever the first plan, the
+  // bounded iterations exhaust the small space and end at the optimum (cost 4).
+  const std::string dom = R"((define (domain trap) (:requirements :typing :action-costs)
+    (:types node) (:predicates (at ?n - node) (edge ?a ?b - node))
+    (:functions (total-cost) - number (w ?a ?b - node) - number)
+    (:action go :parameters (?a ?b - node) :precondition (and (at ?a) (edge ?a ?b))
+      :effect (and (not (at ?a)) (at ?b) (increase (total-cost) (w ?a ?b))))))";
+  const std::string prob = R"((define (problem p) (:domain trap) (:objects s m g x1 x2 x3 - node)
+    (:init (at s) (edge s m) (edge m g) (edge s x1) (edge x1 x2) (edge x2 x3) (edge x3 g)
+      (= (w s m) 1) (= (w m g) 10) (= (w s x1) 2) (= (w x1 x2) 2) (= (w x2 x3) 2) (= (w x3 g) 2)
+      (= (total-cost) 0))
+    (:goal (at g)) (:metric minimize (total-cost))))";
+  PlanRequest req;
+  req.domain_text = dom;
+  req.problem_text = prob;
+  req.check_plan = true;
+  req.search.anytime_seconds = 60;  // a budget, not an expectation: the space is exhausted at once
+  PlanReply r = plan(req, Termination());
+  ASSERT_EQ(r.status, PlanStatus::kSolved) << r.message;
+  EXPECT_EQ(r.cost, 8);
+  EXPECT_GE(r.stats.anytime_iterations, 1U);
+
+  // An IPC cost task: the anytime plan (checked) costs at most the first plan.
+  const auto dir = test::benchmarksDir() / "pddl-adl/elevators";
+  req.domain_text = test::readFile(dir / "domain.pddl");
+  req.problem_text = test::readFile(dir / "instance-6.pddl");
+  req.search.anytime_seconds = 0;
+  PlanReply first = plan(req, Termination());
+  ASSERT_EQ(first.status, PlanStatus::kSolved) << first.message;
+  EXPECT_EQ(first.stats.anytime_iterations, 0U);
+  req.search.anytime_seconds = 1;
+  PlanReply better = plan(req, Termination());
+  ASSERT_EQ(better.status, PlanStatus::kSolved) << better.message;
+  EXPECT_GE(better.stats.anytime_iterations, 1U);
+  EXPECT_LE(better.cost, first.cost);
+}
+
 TEST(Search, OptionsAreValidated) {
   SearchOptions o;
   o.weight = 0.5;
   EXPECT_THROW(o.validate(), std::invalid_argument);
   o.weight = 2;
   EXPECT_NO_THROW(o.validate());
+  o.anytime_seconds = -1;
+  EXPECT_THROW(o.validate(), std::invalid_argument);
+  o.anytime_seconds = 0;
   EXPECT_EQ(parseSearchAlgorithm("astar"), SearchAlgorithm::kAstar);
   EXPECT_EQ(parseSearchAlgorithm("lazy"), SearchAlgorithm::kLazy);
   EXPECT_FALSE(parseSearchAlgorithm("dfs").has_value());

@@ -84,6 +84,8 @@ struct PlanStatistics {
   bool ehc_ff_failed{false};  ///< the first EHC run (FF-v2.3 heuristic variant) failed; see SearchOptions
   bool ehc_second_ran{false};  ///< the default EHC also ran after the first run's long plan; see SearchOptions
   bool ehc_second_won{false};  ///< ... and its plan was the cheaper one
+  uint64_t anytime_iterations{0};    ///< SearchOptions::anytime_seconds: iterations run
+  uint64_t anytime_improvements{0};  ///< ... that found a cheaper plan
 };
 
 /// A self-contained request (maps 1:1 to the plan-request message).

@@ -21,6 +21,8 @@
 ///   value) alternating over four queues, h_FF and the landmark count (landmarks.h), each with all
 ///   successors and with the preferred ones (helpful actions of h_FF and landmark achievers),
 ///   the preferred queues boosted by 1000 on every improvement of either heuristic. Complete.
+/// - Anytime phase (`anytime_seconds`, cost tasks only): LAMA 2011's restarting weighted A*
+///   iterations after the first plan, each bounded by the best cost so far.
 /// - `kWAstar` / `kAstar`: (weighted) A* with re-opening on f = g + w*h; with the admissible
 ///   h_max (the default for these) A* returns cost-optimal plans and weighted A* plans within a
 ///   factor `weight` of optimal.
@@ -103,6 +105,14 @@ struct SearchOptions {
   bool eliminate_redundant_actions{true};
   int preferred_boost{1000};    ///< gbfs/lazy: preferred-queue priority boost on progress
   size_t memory_limit_mb{4096};  ///< search data (states + nodes); 0 = unlimited
+  /// ehc/gbfs/lazy on tasks whose operators differ in cost: after the first plan, improve it for
+  /// up to this many seconds (and never past the caller's deadline) with LAMA 2011's anytime
+  /// iterations: the lazy greedy search with landmarks (`kLazy`), then lazy weighted A*
+  /// (w = 5, 3, 2, 1, then 1 again) on g + w * h with the search's
+  /// heuristic, re-opening, preferred operators, every path costing at least the best plan so far
+  /// pruned. 0 (the default) = return the first plan: a TAMP query keeps its latency; `tamp plan`
+  /// sets 5 s.
+  double anytime_seconds{0.0};
 
   /// @throws std::invalid_argument naming the bad field (weight < 1, ...).
   void validate() const;
@@ -136,6 +146,9 @@ struct SearchStatistics {
   uint64_t ehc_retries{0};  ///< plateaus searched again without helpful-action pruning
   uint64_t landmarks{0};    ///< lazy: number of fact landmarks found (0: landmark count not used)
   uint64_t eliminated_actions{0};  ///< removed by action elimination
+  uint64_t anytime_iterations{0};    ///< weighted A* iterations of the anytime phase
+  uint64_t anytime_improvements{0};  ///< ... that found a cheaper plan
+  bool anytime_proved_optimal{false};  ///< an iteration exhausted its bounded space: no cheaper plan
   double seconds{0.0};
 };
 

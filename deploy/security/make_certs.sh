@@ -162,6 +162,8 @@ EOF
       echo "          <topics>"
       for t in $topics; do echo "            <topic>$t</topic>"; done
       echo "          </topics>"
+      # Any partition: a run id is a partition (tamp.run.<id>); none is the default partition.
+      echo "          <partitions><partition>*</partition></partitions>"
       echo "        </$tag>"
     done
     cat <<EOF

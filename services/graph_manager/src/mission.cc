@@ -245,7 +245,11 @@ MissionReport GraphManager::runMission(WorldSource& source, Executor& executor, 
     const Observation now = source.robot();
     const world::World live = source.world();
     abstraction_.setWorld(live);
+    const HeldGrasp held_before = ctx.held;
     ctx = contextOf(now.valid ? now : robot);
+    // Still holding what the branch picked: the grasp is the one it executed. The world model
+    // cannot tell (perception filters the held object, whose modelled pose is where it was seen).
+    if (!ctx.held.object_id.empty() && ctx.held.object_id == held_before.object_id) ctx.held = held_before;
     std::string armconf = "stow";
     if (auto stow = abstraction_.robot().namedConfiguration("stow");
         stow && ctx.state.arm.size() == stow->size()) {

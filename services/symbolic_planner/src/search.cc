@@ -269,17 +269,7 @@ class Searcher {
     }
     const bool satisficing = opt_.algorithm == SearchAlgorithm::kEhc || opt_.algorithm == SearchAlgorithm::kGbfs ||
                              opt_.algorithm == SearchAlgorithm::kLazy;
-    if (r.status == SearchStatus::kSolved && satisficing && opt_.eliminate_redundant_actions) {
-      const size_t before = r.plan.size();
-      r.plan = eliminateRedundantActions(task_, init_, goal_, std::move(r.plan), term_);
-      stats_.eliminated_actions = before - r.plan.size();
-    }
-    r.stats = stats_;
-    r.stats.registered_states = reg_.size();
-    r.stats.seconds = sw.seconds();
-    r.cost = 0;
-    for (OpId o : r.plan) r.cost += task_.unit_cost ? 1 : task_.ops[o].cost;
-    return r;
+    return finished(std::move(r), sw, satisficing);
   }
 
   /// One iteration of the anytime phase: `lazyWAstar(w, bound)` (w = 0: the lazy greedy search
@@ -289,7 +279,13 @@ class Searcher {
     Stopwatch sw;
     h_.setGoal(goal_);
     SearchResult r = w > 0 ? lazyWAstar(w, bound) : lazy(bound);
-    if (r.status == SearchStatus::kSolved && opt_.eliminate_redundant_actions) {
+    return finished(std::move(r), sw, true);
+  }
+
+  /// A search's result made final: redundant actions eliminated from a solved plan (when
+  /// `eliminate` and the option say so), the statistics, and the plan's cost.
+  SearchResult finished(SearchResult r, const Stopwatch& sw, bool eliminate) {
+    if (r.status == SearchStatus::kSolved && eliminate && opt_.eliminate_redundant_actions) {
       const size_t before = r.plan.size();
       r.plan = eliminateRedundantActions(task_, init_, goal_, std::move(r.plan), term_);
       stats_.eliminated_actions = before - r.plan.size();

@@ -13,6 +13,8 @@ PACKAGES=(
   # robot model, config, logging, CLI, serialisation, storage, rendering
   liburdfdom-dev liborocos-kdl-dev libyaml-cpp-dev libspdlog-dev libcli11-dev nlohmann-json3-dev
   libsqlite3-dev libcairo2-dev graphviz
+  # DDS Security test material (deploy/security/make_certs.sh)
+  openssl
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
 )

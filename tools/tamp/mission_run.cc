@@ -116,6 +116,15 @@ void printSummary(const nlohmann::json& r) {
               r.value("effort_calls", 0));
   for (const auto& o : r.value("objects_moved", nlohmann::json::array())) std::printf(" %s", o.get<std::string>().c_str());
   std::printf("\n");
+  for (const auto& rp : r.value("replanning", nlohmann::json::array())) {
+    std::string joined;
+    for (const auto& n : rp.value("rejoined", nlohmann::json::array())) joined += " " + n.get<std::string>();
+    std::printf("replanned after %s (%s): %s%s at %s, planner %d, motion %d calls, latency %s\n",
+                rp.value("event", "").c_str(), rp.value("detail", "").c_str(), rp.value("how", "").c_str(),
+                joined.empty() ? "" : (" to" + joined).c_str(), rp.value("at_node", "").c_str(),
+                rp.value("planner_calls", 0), rp.value("motion_calls", 0),
+                rp["latency_s"].is_number() ? (std::to_string(rp["latency_s"].get<double>()).substr(0, 5) + " s").c_str() : "-");
+  }
   for (const auto& d : r.value("decisions", nlohmann::json::array())) {
     std::printf("decision at %s:\n", d.value("node", "").c_str());
     for (const auto& a : d["alternatives"]) {

@@ -1,4 +1,6 @@
-// The mission loop: traverse, execute the best branch edge by edge, repair after failures.
+// The mission loop: traverse, execute the best branch edge by edge, watch for events after every
+// action, and repair by re-joining the branch (online replanning).
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -8,6 +10,9 @@
 namespace tamp::graph_manager {
 namespace {
 
+using Clock = std::chrono::steady_clock;
+
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 double startDistance(const Trajectory& t, const robot::RobotState& s, ActionKind kind) {
   if (t.empty()) return kInfinity;
@@ -19,6 +24,26 @@ double startDistance(const Trajectory& t, const robot::RobotState& s, ActionKind
   double d = 0.0;
   for (std::size_t i = 0; i < std::min(p.size(), s.arm.size()); ++i) d = std::max(d, std::abs(p[i] - s.arm[i]));
   return d;
+}
+
+ExecutedAction executedFrom(const EdgeCommand& c, const ExecutionReport& rep, const std::string& variant) {
+  ExecutedAction a;
+  a.command_id = c.command_id;
+  a.action = c.action;
+  a.variant = variant;
+  a.predicted_s = c.expected_s;
+  a.predicted_stddev_s = c.expected_stddev_s;
+  a.measured_s = rep.measured_s;
+  a.outcome = std::string(toString(rep.outcome));
+  a.reason = rep.reason;
+  a.path = c.trajectory.path();
+  return a;
+}
+
+EventKind eventOf(const ExecutionReport& rep) {
+  if (rep.outcome == ExecOutcome::kBlocked) return EventKind::kActionBlocked;
+  if (rep.reason.find("dropped") != std::string::npos) return EventKind::kObjectDropped;
+  return EventKind::kActionFailed;
 }
 
 }  // namespace
@@ -52,223 +77,398 @@ Result<EdgeCommand> GraphManager::command(EdgeId id, EdgeId next, const BranchCo
   return c;
 }
 
-MissionReport GraphManager::runMission(WorldSource& source, Executor& executor, const MissionObserver& observer) {
+/// One mission: the state of the loop and its steps.
+struct GraphManager::Run {
+  Run(GraphManager& g, WorldSource& s, Executor& x, const MissionObserver& o)
+      : gm(g), source(s), executor(x), observer(o) {}
+
+  GraphManager& gm;
+  WorldSource& source;
+  Executor& executor;
+  const MissionObserver& observer;
   MissionReport report;
-  auto state = [&](const std::string& s, const std::string& msg) {
+  NodeId current{-1};
+  BranchContext ctx;
+  std::vector<EdgeId> branch;  ///< from `current` to a goal node
+  double branch_total{0.0};
+  double done_effort{0.0};
+  int attempts{0};  ///< replanning attempts after failures (bounded by max_replans)
+  int step{0};
+  bool first_action{true};
+  std::optional<Clock::time_point> event_at;  ///< a replanning waiting for its next command
+
+  MissionReport run();
+
+ private:
+  void state(const std::string& s, const std::string& msg) {
     if (observer.on_state) observer.on_state(s, msg);
-  };
-  auto finish = [&](MissionOutcome o, const std::string& reason) {
-    report.status = o;
-    report.reason = reason;
-    report.counters = counters_;
-    report.decisions = decisions_;
-    report.planning_time_s = planning_s_;
-    report.graph_dot = graph_.toDot({}, root_);
-    state(std::string(toString(o)), reason);
-    return report;
-  };
+  }
+  MissionReport finish(MissionOutcome o, const std::string& reason);
+  bool planBranch(std::string& why);
+  /// Plans the manipulation (and the arm motion into it) in the world as it is now; false when
+  /// it cannot be (an event, handled).
+  enum class Prepared { kReady, kReplanned, kGaveUp };
+  Prepared prepare(EdgeId id, EdgeId next);
+  Result<EdgeCommand> commandFor(EdgeId id, EdgeId next);
+  ExecutionReport execute(Edge& e, EdgeCommand& cmd);
+  void succeeded(EdgeId id, EdgeId next, const EdgeCommand& cmd, const ExecutionReport& rep);
+  /// After a succeeded action: what the robot sees that the graph does not expect.
+  std::optional<MissionEvent> watch(const Edge& done, const EdgeCommand& cmd, const ExecutionReport& rep);
+  /// Online replanning after `ev`; false when the mission must give up (`why` says why).
+  bool replan(const MissionEvent& ev, EdgeId failed, std::string& why);
+  void noteCommand();
+};
+
+MissionReport GraphManager::Run::finish(MissionOutcome o, const std::string& reason) {
+  report.status = o;
+  report.reason = reason;
+  report.counters = gm.counters_;
+  report.decisions = gm.decisions_;
+  report.planning_time_s = gm.planning_s_;
+  report.graph_dot = gm.graph_.toDot({}, current >= 0 ? current : gm.root_);
+  state(std::string(toString(o)), reason);
+  return report;
+}
+
+bool GraphManager::Run::planBranch(std::string& why) {
+  state(attempts ? "replanning" : "planning", "traverse from n" + std::to_string(current));
+  TraverseResult t = gm.traverse(current, ctx);
+  if (!t.found) {
+    why = t.reason;
+    return false;
+  }
+  branch = t.branch;
+  branch_total = done_effort + t.cost_s;
+  report.predicted_effort_s = branch_total;
+  if (observer.on_graph) observer.on_graph(gm.graph_, branch, current);
+  return true;
+}
+
+GraphManager::Run::Prepared GraphManager::Run::prepare(EdgeId id, EdgeId next) {
+  Edge& e = gm.graph_.edge(id);
+  bool ok = true;
+  std::string what = e.action;
+  if (e.kind == ActionKind::kPick || e.kind == ActionKind::kPlace) {
+    // A manipulation is never sent deferred: its grasp is planned now or it is a failure.
+    ok = std::isfinite(gm.evaluate(id, -1, ctx, 0)) && e.motion && !e.motion->deferred && !e.motion->trajectory.empty();
+    if (!ok && e.reason.empty()) e.reason = "no grasp or placement in the world as it is now";
+  } else if (e.kind == ActionKind::kMoveArm && gm.armKey(id, next) >= 0) {
+    // An arm motion into a manipulation is planned again in the world as it is now: the branch
+    // priced it in a hypothetical world (objects moved by earlier edges, grasps deferred).
+    e.motion_by_next.erase(gm.armKey(id, next));
+    e.effort_by_next.erase(gm.armKey(id, next));
+    ok = std::isfinite(gm.evaluate(id, next, ctx, 0));
+    what = gm.graph_.edge(next).action;
+  }
+  if (ok) return Prepared::kReady;
+  ExecutedAction a;
+  a.action = e.action;
+  a.outcome = "not prepared";
+  a.reason = "cannot prepare " + what + ": " + e.reason;
+  report.actions.push_back(a);
+  if (observer.on_action) observer.on_action(a, done_effort, branch_total);
+  gm.grasp_cache_.clear();
+  gm.placement_cache_.clear();
+  if (e.kind == ActionKind::kMoveArm) {
+    e.motion_by_next.erase(gm.armKey(id, next));
+    e.effort_by_next.erase(gm.armKey(id, next));
+  } else {
+    e.motion.reset();
+  }
+  e.state = EdgeState::kFailed;
+  std::string why;
+  if (!replan(MissionEvent{EventKind::kNotPrepared, e.action, {}, a.reason}, id, why)) {
+    finish(MissionOutcome::kFailed, why);
+    return Prepared::kGaveUp;
+  }
+  return Prepared::kReplanned;
+}
+
+Result<EdgeCommand> GraphManager::Run::commandFor(EdgeId id, EdgeId next) {
+  Edge& e = gm.graph_.edge(id);
+  const std::string command_id = "m" + std::to_string(step) + "-e" + std::to_string(id);
+  auto cmd = gm.command(id, next, ctx, command_id);
+  // The robot must be where the edge's motion starts; otherwise plan the motion again from it.
+  if (cmd && e.kind != ActionKind::kPick && e.kind != ActionKind::kPlace &&
+      startDistance(cmd->trajectory, ctx.state, e.kind) > gm.params_.start_tolerance) {
+    if (e.kind == ActionKind::kMoveBase) {
+      e.state = EdgeState::kUnevaluated;
+      e.motion.reset();
+    } else {
+      e.motion_by_next.erase(gm.armKey(id, next));
+      e.effort_by_next.erase(gm.armKey(id, next));
+    }
+    gm.evaluate(id, next, ctx, 0);
+    cmd = gm.command(id, next, ctx, command_id);
+  }
+  return cmd;
+}
+
+void GraphManager::Run::noteCommand() {
+  if (first_action) {
+    report.planning_time_to_first_action_s = gm.planning_s_;
+    first_action = false;
+  }
+  if (event_at && !report.replanning.empty()) report.replanning.back().latency_s = since(*event_at);
+  event_at.reset();
+}
+
+ExecutionReport GraphManager::Run::execute(Edge& e, EdgeCommand& cmd) {
+  e.state = EdgeState::kExecuting;
+  state("executing", e.action);
+  noteCommand();
+  ExecutionReport rep;
+  const bool transfer = e.motion && !e.motion->transfer.empty() &&
+                        (e.kind == ActionKind::kPick || e.kind == ActionKind::kPlace);
+  if (transfer) {
+    // The arm motion to the pre-grasp first, as its own move_arm.
+    EdgeCommand t = cmd;
+    t.command_id = cmd.command_id + "-arm";
+    t.action = "(move_arm to the pre-grasp of " + e.action + ")";
+    t.kind = ActionKind::kMoveArm;
+    t.trajectory = e.motion->transfer;
+    t.object_id.clear();
+    t.region_id.clear();
+    t.object_target.reset();
+    t.expected_s = e.motion->transfer_effort_s;
+    t.expected_stddev_s = e.motion->transfer_stddev_s;
+    cmd.expected_s -= t.expected_s;
+    rep = executor.execute(t, t.expected_s + 4 * t.expected_stddev_s + gm.params_.execution_margin_s);
+    ExecutedAction ta = executedFrom(t, rep, "transfer");
+    ta.path = {};
+    report.actions.push_back(ta);
+    report.executed_effort_s += rep.measured_s;
+    if (observer.on_action) observer.on_action(ta, done_effort, branch_total);
+    if (rep.outcome != ExecOutcome::kSucceeded) return rep;
+  }
+  const double budget = cmd.expected_s + 4 * cmd.expected_stddev_s + gm.params_.execution_margin_s;
+  return executor.execute(cmd, budget);
+}
+
+void GraphManager::Run::succeeded(EdgeId id, EdgeId next, const EdgeCommand& cmd, const ExecutionReport& rep) {
+  (void)rep;
+  Edge& e = gm.graph_.edge(id);
+  e.state = EdgeState::kExecuted;
+  done_effort += cmd.expected_s;
+  if (e.kind == ActionKind::kPlace && cmd.object_target) {
+    report.objects_moved.push_back(cmd.object_id);
+    if (const world::Object* o = gm.abstraction_.world().findObject(cmd.object_id))
+      report.moved_from.emplace_back(o->id, o->pose);
+    report.moved_to.emplace_back(cmd.object_id, *cmd.object_target);
+  }
+  ctx = gm.advance(id, next, ctx);
+  const Observation now = source.robot();
+  if (now.valid) {
+    ctx.state.base = now.robot.base;
+    if (now.robot.arm.size() == ctx.state.arm.size()) ctx.state.arm = now.robot.arm;
+  }
+  current = e.to;
+  branch.erase(branch.begin());
+}
+
+std::optional<MissionEvent> GraphManager::Run::watch(const Edge& done, const EdgeCommand& cmd,
+                                                     const ExecutionReport& rep) {
+  // The hand: what the branch holds now must be what the robot holds.
+  const Observation now = source.robot();
+  if (now.valid && now.held_object_id != ctx.held.object_id && !ctx.held.object_id.empty())
+    return MissionEvent{EventKind::kObjectDropped, done.action, ctx.held.object_id,
+                        "'" + ctx.held.object_id + "' is no longer held after " + done.action};
+  // The world: objects new to the graph on the way ahead, objects it acts on moved.
+  const world::World live = source.world();
+  std::vector<std::string> acted;
+  for (EdgeId id : branch) {
+    const Edge& e = gm.graph_.edge(id);
+    if ((e.kind == ActionKind::kPick || e.kind == ActionKind::kPlace) && e.tokens.size() > 1) acted.push_back(e.tokens[1]);
+  }
+  for (const auto& o : live.objects()) {
+    if (o.kind != world::ObjectKind::kMovable || o.id == ctx.held.object_id) continue;
+    const world::Object* known = gm.abstraction_.world().findObject(o.id);
+    if (!known) {
+      // New: an event when it stands near a base motion or an object the branch acts on.
+      bool relevant = false;
+      const double r = gm.abstraction_.robot().baseRadius() + gm.params_.keep_clear_margin_m;
+      for (EdgeId id : branch) {
+        const Edge& e = gm.graph_.edge(id);
+        if (e.kind == ActionKind::kMoveBase && e.motion) {
+          const auto& p = e.motion->trajectory.empty() ? e.motion->lazy_path : e.motion->trajectory.path();
+          const int ix = p.indexOf("base_x"), iy = p.indexOf("base_y");
+          if (ix < 0 || iy < 0) continue;
+          for (const auto& w : p.waypoints)
+            if (std::hypot(w[static_cast<std::size_t>(ix)] - o.pose.translation().x(),
+                           w[static_cast<std::size_t>(iy)] - o.pose.translation().y()) < r + 0.5)
+              relevant = true;
+        }
+      }
+      for (const auto& a : acted)
+        if (const world::Object* t = live.findObject(a);
+            t && (t->pose.translation().head<2>() - o.pose.translation().head<2>()).norm() < 0.4)
+          relevant = true;
+      if (relevant)
+        return MissionEvent{EventKind::kNewObstacle, done.action, o.id, "'" + o.id + "' perceived on the way ahead"};
+      continue;
+    }
+    if (std::find(acted.begin(), acted.end(), o.id) == acted.end()) continue;
+    const double moved = (known->pose.translation().head<2>() - o.pose.translation().head<2>()).norm();
+    if (moved > gm.params_.moved_object_tolerance_m)
+      return MissionEvent{EventKind::kObjectMoved, done.action, o.id,
+                          "'" + o.id + "' is " + std::to_string(moved) + " m from where the graph expects it"};
+  }
+  // The clock: an action far over its prediction prices the plan ahead again.
+  const double limit = cmd.expected_s + gm.params_.overrun_sigma * std::max(cmd.expected_stddev_s, 0.05 * cmd.expected_s);
+  if (rep.outcome == ExecOutcome::kSucceeded && std::isfinite(cmd.expected_s) && rep.measured_s > limit)
+    return MissionEvent{EventKind::kOverrun, done.action, {},
+                        "took " + std::to_string(rep.measured_s) + " s, predicted " + std::to_string(cmd.expected_s) + " s"};
+  return std::nullopt;
+}
+
+bool GraphManager::Run::replan(const MissionEvent& ev, EdgeId failed, std::string& why) {
+  const auto t0 = Clock::now();
+  const double planning0 = gm.planning_s_;
+  const int planner0 = gm.counters_.planner_calls, motion0 = gm.counters_.motion_calls;
+  const bool failure = ev.kind != EventKind::kOverrun;
+  if (failure && ++attempts > gm.params_.max_replans) {
+    why = "gave up after " + std::to_string(attempts) + " replanning attempts; last: " + ev.action + ": " + ev.detail;
+    return false;
+  }
+  ++report.replans;
+  ReplanRecord rec;
+  rec.event = ev;
+  // The branch ahead: from the failed edge (or the next one) on.
+  std::vector<EdgeId> ahead;
+  if (failed >= 0) {
+    auto it = std::find(branch.begin(), branch.end(), failed);
+    ahead.assign(it == branch.end() ? branch.begin() : it, branch.end());
+    if (it == branch.end()) ahead.insert(ahead.begin(), failed);
+  } else {
+    ahead = branch;
+  }
+  // What the robot and the world are now.
+  const Observation now = source.robot();
+  const world::World live = source.world();
+  std::vector<std::string> fresh;
+  std::vector<world::Object> changed;
+  for (const auto& o : live.objects()) {
+    if (o.kind != world::ObjectKind::kMovable) continue;
+    const world::Object* known = gm.abstraction_.world().findObject(o.id);
+    if (!known) fresh.push_back(o.id);
+    if (!known || (known->pose.translation() - o.pose.translation()).norm() > gm.params_.moved_object_tolerance_m)
+      changed.push_back(o);
+  }
+  gm.abstraction_.setWorld(live);
+  gm.grasp_cache_.clear();
+  gm.placement_cache_.clear();
+  const HeldGrasp held_before = ctx.held;
+  if (now.valid) ctx = gm.contextOf(now);
+  // Still holding what the branch picked: the grasp is the one it executed. The world model
+  // cannot tell (perception filters the held object, whose modelled pose is where it was seen).
+  if (!ctx.held.object_id.empty() && ctx.held.object_id == held_before.object_id) ctx.held = held_before;
+  gm.invalidateNear(changed);
+  if (failed >= 0) {
+    Edge& f = gm.graph_.edge(failed);
+    f.state = EdgeState::kUnevaluated;
+    f.motion.reset();
+    f.motion_by_next.clear();
+    f.effort_by_next.clear();
+    f.subtasks_spawned = false;
+  }
+  if (ev.kind == EventKind::kOverrun) {
+    gm.reprice();
+    rec.how = "re-traverse";
+  } else {
+    std::string armconf = "stow";
+    if (auto stow = gm.abstraction_.robot().namedConfiguration("stow"); stow && ctx.state.arm.size() == stow->size()) {
+      double d = 0.0;
+      for (std::size_t i = 0; i < stow->size(); ++i) d = std::max(d, std::abs((*stow)[i] - ctx.state.arm[i]));
+      const NodeId was = failed >= 0 ? gm.graph_.edge(failed).from : current;
+      if (d > 0.05) armconf = gm.graph_.node(was).atoms.empty() ? "stow" : gm.abstraction_.bind(gm.graph_.node(was).atoms).armconf;
+    }
+    const auto atoms = gm.abstraction_.dynamicAtoms(live, ctx.state.base, armconf, now.valid ? now.held_object_id : "");
+    current = gm.graph_.addNode(atoms, "observed after " + ev.action);
+    const auto joined = gm.rejoin(current, ahead, fresh, "re-join after " + std::string(toString(ev.kind)));
+    for (NodeId n : joined) rec.rejoined.push_back("n" + std::to_string(n));
+    rec.how = "re-join";
+    if (joined.empty()) {
+      rec.how = "from scratch";
+      if (gm.graph_.out(current).empty() && !gm.isGoal(current)) {
+        auto plan = gm.planFrom(current, gm.goal_.atoms, "plan after " + std::string(toString(ev.kind)));
+        if (!plan) {
+          why = "replanning after " + std::string(toString(ev.kind)) + " (" + ev.detail + "): " + plan.error().message;
+          return false;
+        }
+      }
+    }
+  }
+  rec.at_node = "n" + std::to_string(current);
+  rec.planner_calls = gm.counters_.planner_calls - planner0;
+  rec.motion_calls = gm.counters_.motion_calls - motion0;
+  gm.planning_s_ = planning0 + since(t0);
+  rec.planning_s = since(t0);
+  log::get("graph_manager")->info("replanning after {} ({}): {} at {}", toString(ev.kind), ev.detail, rec.how, rec.at_node);
+  report.replanning.push_back(rec);
+  event_at = t0;
+  branch.clear();
+  return true;
+}
+
+MissionReport GraphManager::Run::run() {
   Observation robot = source.robot();
   if (!robot.valid) return finish(MissionOutcome::kUnavailable, "no robot state received");
   state("planning", "planning from the robot's state");
-  if (Status s = start(source.world(), robot); !s) {
+  if (Status s = gm.start(source.world(), robot); !s) {
     const auto code = s.error().code;
-    return finish(code == ErrorCode::kUnavailable ? MissionOutcome::kUnavailable
-                  : code == ErrorCode::kTimeout   ? MissionOutcome::kTimeout
+    return finish(code == ErrorCode::kUnavailable       ? MissionOutcome::kUnavailable
+                  : code == ErrorCode::kTimeout         ? MissionOutcome::kTimeout
                   : code == ErrorCode::kInvalidArgument ? MissionOutcome::kInputError
                                                         : MissionOutcome::kFailed,
                   s.error().message);
   }
-  NodeId current = root_;
-  BranchContext ctx = contextOf(robot);
-  std::vector<EdgeId> branch;
-  double branch_total = 0.0, done_effort = 0.0;
-  int failures = 0, step = 0;
-  bool first_action = true;
+  current = gm.root_;
+  ctx = gm.contextOf(robot);
   while (true) {
     if (observer.abort_requested && observer.abort_requested()) return finish(MissionOutcome::kAborted, "aborted by the user");
-    if (isGoal(current)) break;
-    if (branch.empty()) {
-      state(failures ? "replanning" : "planning", "traverse from n" + std::to_string(current));
-      TraverseResult t = traverse(current, ctx);
-      if (!t.found) return finish(MissionOutcome::kFailed, t.reason);
-      branch = t.branch;
-      branch_total = done_effort + t.cost_s;
-      report.predicted_effort_s = branch_total;
-      if (observer.on_graph) observer.on_graph(graph_, branch, current);
-    }
+    if (gm.isGoal(current)) break;
+    std::string why;
+    if (branch.empty() && !planBranch(why)) return finish(MissionOutcome::kFailed, why);
     const EdgeId id = branch.front();
     const EdgeId next = branch.size() > 1 ? branch[1] : -1;
-    Edge& e = graph_.edge(id);
-    // A manipulation follows from the arm motion just executed (its grasp or place pose) and the
-    // arm as it is: priced again from there.
-    // Not preparable in the world as it is now: a failure like any other, then repair (grasps
-    // and placements are asked again: the world model may have changed since).
-    auto notPrepared = [&](const std::string& what) {
-      e.state = EdgeState::kFailed;
-      ExecutedAction a;
-      a.action = e.action;
-      a.outcome = "not prepared";
-      a.reason = "cannot prepare " + what + ": " + e.reason;
-      report.actions.push_back(a);
-      if (observer.on_action) observer.on_action(a, done_effort, branch_total);
-      if (++failures > params_.max_replans) return false;
-      ++report.replans;
-      grasp_cache_.clear();
-      placement_cache_.clear();
-      if (e.kind == ActionKind::kMoveArm) {
-        e.motion_by_next.erase(armKey(id, next));
-        e.effort_by_next.erase(armKey(id, next));
-      } else {
-        e.motion.reset();
-      }
-      e.state = EdgeState::kUnevaluated;
-      branch.clear();
-      return true;
-    };
-    if (e.kind == ActionKind::kPick || e.kind == ActionKind::kPlace) {
-      // A manipulation is never sent deferred: its grasp is planned now or it is a failure.
-      if (!std::isfinite(evaluate(id, -1, ctx, 0)) || !e.motion || e.motion->deferred || e.motion->trajectory.empty()) {
-        if (e.reason.empty()) e.reason = "no grasp or placement in the world as it is now";
-        if (!notPrepared(e.action))
-          return finish(MissionOutcome::kFailed, "gave up after " + std::to_string(failures) + " failures; last: " +
-                                                     report.actions.back().reason);
-        continue;
-      }
-    }
-    // An arm motion into a manipulation is planned again in the world as it is now: the branch
-    // priced it in a hypothetical world (objects moved by earlier edges, grasps deferred).
-    if (e.kind == ActionKind::kMoveArm && armKey(id, next) >= 0) {
-      e.motion_by_next.erase(armKey(id, next));
-      e.effort_by_next.erase(armKey(id, next));
-      if (!std::isfinite(evaluate(id, next, ctx, 0))) {
-        if (!notPrepared(graph_.edge(next).action))
-          return finish(MissionOutcome::kFailed, "gave up after " + std::to_string(failures) + " failures; last: " +
-                                                     report.actions.back().reason);
-        continue;
-      }
-    }
-    // The robot must be where the edge's motion starts; otherwise plan the motion again from it.
-    auto cmd = command(id, next, ctx, "m" + std::to_string(step) + "-e" + std::to_string(id));
-    if (cmd && e.kind != ActionKind::kPick && e.kind != ActionKind::kPlace &&
-        startDistance(cmd->trajectory, ctx.state, e.kind) > params_.start_tolerance) {
-      if (e.kind == ActionKind::kMoveBase) {
-        e.state = EdgeState::kUnevaluated;
-        e.motion.reset();
-      } else {
-        e.motion_by_next.erase(armKey(id, next));
-        e.effort_by_next.erase(armKey(id, next));
-      }
-      evaluate(id, next, ctx, 0);
-      cmd = command(id, next, ctx, "m" + std::to_string(step) + "-e" + std::to_string(id));
-    }
+    const Prepared p = prepare(id, next);
+    if (p == Prepared::kGaveUp) return report;
+    if (p == Prepared::kReplanned) continue;
+    auto cmd = commandFor(id, next);
     if (!cmd) return finish(MissionOutcome::kFailed, cmd.error().message);
-    if (first_action) {
-      report.planning_time_to_first_action_s = planning_s_;
-      first_action = false;
-    }
-    e.state = EdgeState::kExecuting;
-    state("executing", e.action);
-    ExecutionReport rep;
-    if (e.motion && !e.motion->transfer.empty() && (e.kind == ActionKind::kPick || e.kind == ActionKind::kPlace)) {
-      // The arm motion to the pre-grasp first, as its own move_arm.
-      EdgeCommand t = *cmd;
-      t.command_id = cmd->command_id + "-arm";
-      t.action = "(move_arm to the pre-grasp of " + e.action + ")";
-      t.kind = ActionKind::kMoveArm;
-      t.trajectory = e.motion->transfer;
-      t.object_id.clear();
-      t.region_id.clear();
-      t.object_target.reset();
-      t.expected_s = e.motion->transfer_effort_s;
-      t.expected_stddev_s = e.motion->transfer_stddev_s;
-      cmd->expected_s -= t.expected_s;
-      rep = executor.execute(t, t.expected_s + 4 * t.expected_stddev_s + params_.execution_margin_s);
-      ExecutedAction ta;
-      ta.command_id = t.command_id;
-      ta.action = t.action;
-      ta.variant = "transfer";
-      ta.predicted_s = t.expected_s;
-      ta.predicted_stddev_s = t.expected_stddev_s;
-      ta.measured_s = rep.measured_s;
-      ta.outcome = std::string(toString(rep.outcome));
-      ta.reason = rep.reason;
-      report.actions.push_back(ta);
-      report.executed_effort_s += rep.measured_s;
-      if (observer.on_action) observer.on_action(ta, done_effort, branch_total);
-    }
-    if (rep.outcome == ExecOutcome::kSucceeded || !(e.motion && !e.motion->transfer.empty())) {
-      const double budget = cmd->expected_s + 4 * cmd->expected_stddev_s + params_.execution_margin_s;
-      rep = executor.execute(*cmd, budget);
-    }
+    Edge& e = gm.graph_.edge(id);
+    const ExecutionReport rep = execute(e, *cmd);
     ++step;
-    ExecutedAction a;
-    a.command_id = cmd->command_id;
-    a.action = e.action;
-    a.variant = std::string(toString(e.variant));
-    a.predicted_s = cmd->expected_s;
-    a.predicted_stddev_s = cmd->expected_stddev_s;
-    a.measured_s = rep.measured_s;
-    a.outcome = std::string(toString(rep.outcome));
-    a.reason = rep.reason;
-    a.path = cmd->trajectory.path();
+    ExecutedAction a = executedFrom(*cmd, rep, std::string(toString(e.variant)));
     report.actions.push_back(a);
     report.executed_effort_s += rep.measured_s;
     if (rep.outcome == ExecOutcome::kSucceeded) {
-      e.state = EdgeState::kExecuted;
-      done_effort += cmd->expected_s;
-      if (e.kind == ActionKind::kPlace && cmd->object_target) {
-        report.objects_moved.push_back(cmd->object_id);
-        if (const world::Object* o = abstraction_.world().findObject(cmd->object_id))
-          report.moved_from.emplace_back(o->id, o->pose);
-        report.moved_to.emplace_back(cmd->object_id, *cmd->object_target);
-      }
-      ctx = advance(id, next, ctx);
-      const Observation now = source.robot();
-      if (now.valid) {
-        ctx.state.base = now.robot.base;
-        if (now.robot.arm.size() == ctx.state.arm.size()) ctx.state.arm = now.robot.arm;
-      }
+      succeeded(id, next, *cmd, rep);
       if (observer.on_action) observer.on_action(a, done_effort, branch_total);
-      current = e.to;
-      branch.erase(branch.begin());
+      if (gm.isGoal(current)) break;
+      // An overrun: the time models were refitted from this action, the graph is priced again.
+      if (auto ev = watch(e, *cmd, rep); ev && !replan(*ev, -1, why)) return finish(MissionOutcome::kFailed, why);
       continue;
     }
     if (rep.outcome == ExecOutcome::kUnavailable) return finish(MissionOutcome::kUnavailable, rep.reason);
     e.state = EdgeState::kFailed;
     e.reason = std::string(toString(rep.outcome)) + ": " + rep.reason;
     if (observer.on_action) observer.on_action(a, done_effort, branch_total);
-    if (++failures > params_.max_replans)
-      return finish(MissionOutcome::kFailed, "gave up after " + std::to_string(failures) + " failed actions; last: " +
-                                                 e.action + " " + e.reason);
-    ++report.replans;
-    // Repair: the robot's node in the graph from what it observes now, then Traverse from it.
-    const Observation now = source.robot();
-    const world::World live = source.world();
-    abstraction_.setWorld(live);
-    const HeldGrasp held_before = ctx.held;
-    ctx = contextOf(now.valid ? now : robot);
-    // Still holding what the branch picked: the grasp is the one it executed. The world model
-    // cannot tell (perception filters the held object, whose modelled pose is where it was seen).
-    if (!ctx.held.object_id.empty() && ctx.held.object_id == held_before.object_id) ctx.held = held_before;
-    std::string armconf = "stow";
-    if (auto stow = abstraction_.robot().namedConfiguration("stow");
-        stow && ctx.state.arm.size() == stow->size()) {
-      double d = 0.0;
-      for (std::size_t i = 0; i < stow->size(); ++i) d = std::max(d, std::abs((*stow)[i] - ctx.state.arm[i]));
-      if (d > 0.05) armconf = graph_.node(e.from).atoms.empty() ? "stow" : abstraction_.bind(graph_.node(e.from).atoms).armconf;
-    }
-    auto atoms = abstraction_.dynamicAtoms(live, ctx.state.base, armconf, now.held_object_id);
-    graph_.node(e.from).healthy = e.from != current ? graph_.node(e.from).healthy : false;
-    current = graph_.addNode(atoms, "observed after " + e.action);
-    branch.clear();
+    MissionEvent ev{eventOf(rep), e.action, rep.blocking_object_id, e.reason};
+    if (!replan(ev, id, why)) return finish(MissionOutcome::kFailed, why);
   }
   report.status = MissionOutcome::kSucceeded;
-  report.counters = counters_;
-  report.decisions = decisions_;
-  report.planning_time_s = planning_s_;
-  report.graph_dot = graph_.toDot({}, current);
+  report.counters = gm.counters_;
+  report.decisions = gm.decisions_;
+  report.planning_time_s = gm.planning_s_;
+  report.graph_dot = gm.graph_.toDot({}, current);
   state("succeeded", "goal reached");
   return report;
+}
+
+MissionReport GraphManager::runMission(WorldSource& source, Executor& executor, const MissionObserver& observer) {
+  Run r(*this, source, executor, observer);
+  return r.run();
 }
 
 }  // namespace tamp::graph_manager

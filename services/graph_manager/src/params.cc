@@ -41,7 +41,10 @@ const config::Schema<GraphManagerParams>& schema() {
         .field("execution_margin_s", &P::execution_margin_s, positive())
         .field("start_tolerance", &P::start_tolerance, positive())
         .field("clear_path_stretch", &P::clear_path_stretch, config::atLeast(1.0))
-        .field("turn_first_ratio", &P::turn_first_ratio, config::atLeast(1.0));
+        .field("turn_first_ratio", &P::turn_first_ratio, config::atLeast(1.0))
+        .field("overrun_sigma", &P::overrun_sigma, positive())
+        .field("max_rejoin_targets", &P::max_rejoin_targets, atLeast(1))
+        .field("moved_object_tolerance_m", &P::moved_object_tolerance_m, positive());
     return s;
   }();
   return kSchema;

@@ -80,6 +80,21 @@ std::string reportJson(const MissionReport& r, const std::string& scenario, cons
                        {"base_path", path}});
   }
   j["actions"] = actions;
+  nlohmann::json replanning = nlohmann::json::array();
+  for (const auto& rp : r.replanning) {
+    replanning.push_back({{"event", std::string(toString(rp.event.kind))},
+                          {"action", rp.event.action},
+                          {"object", rp.event.object_id},
+                          {"detail", rp.event.detail},
+                          {"at_node", rp.at_node},
+                          {"how", rp.how},
+                          {"rejoined", rp.rejoined},
+                          {"planner_calls", rp.planner_calls},
+                          {"motion_calls", rp.motion_calls},
+                          {"planning_s", rp.planning_s},
+                          {"latency_s", rp.latency_s >= 0.0 ? nlohmann::json(rp.latency_s) : nlohmann::json(nullptr)}});
+  }
+  j["replanning"] = replanning;
   return j.dump(2);
 }
 

@@ -112,6 +112,39 @@ struct ExecutedAction {
 enum class MissionOutcome { kSucceeded, kFailed, kAborted, kTimeout, kInputError, kUnavailable };
 std::string_view toString(MissionOutcome o);
 
+/// What triggers online replanning (the paper's "On-Line Replanning").
+enum class EventKind {
+  kActionFailed,   ///< the robot reported a failed action (a missed grasp, a collision)
+  kActionBlocked,  ///< the monitor stopped an action: an object in the way
+  kObjectDropped,  ///< the held object is no longer held
+  kNewObstacle,    ///< a newly perceived object on the remaining branch
+  kObjectMoved,    ///< an object the branch acts on is not where the graph expects it
+  kOverrun,        ///< an action took longer than predicted + k sigma
+  kNotPrepared,    ///< a manipulation has no grasp or placement in the world as it is now
+};
+std::string_view toString(EventKind k);
+
+struct MissionEvent {
+  EventKind kind{EventKind::kActionFailed};
+  std::string action;     ///< the action it happened in or after
+  std::string object_id;  ///< the object concerned, if any
+  std::string detail;
+};
+
+/// One online replanning: the event, how the graph was repaired, what it cost.
+struct ReplanRecord {
+  MissionEvent event;
+  std::string at_node;                ///< the robot's node when it replanned
+  /// "re-join" (sub-tasks towards nodes ahead), "re-traverse" (the graph as it is, priced again),
+  /// "from scratch" (TP(current, goal): no node ahead could be re-joined).
+  std::string how;
+  std::vector<std::string> rejoined;  ///< the nodes ahead that a sub-task reached
+  int planner_calls{0};
+  int motion_calls{0};
+  double planning_s{0.0};
+  double latency_s{-1.0};             ///< from the event to the next command (-1: none followed)
+};
+
 struct MissionReport {
   MissionOutcome status{MissionOutcome::kFailed};
   std::string reason;
@@ -120,6 +153,7 @@ struct MissionReport {
   double planning_time_s{0.0};
   double planning_time_to_first_action_s{0.0};
   int replans{0};
+  std::vector<ReplanRecord> replanning;
   Counters counters;
   std::vector<std::string> objects_moved;
   std::vector<Decision> decisions;
@@ -178,11 +212,28 @@ class GraphManager {
   /// The command that executes edge `e` from context `ctx`.
   Result<EdgeCommand> command(EdgeId e, EdgeId next, const BranchContext& ctx, const std::string& command_id);
   BranchContext contextOf(const Observation& robot) const;
+
+  // ---- online replanning (replan.cc) ----
+  /// Sub-tasks from `current` that re-join the nodes the branch `ahead` (its remaining edges)
+  /// passes through, the first `max_rejoin_targets` reachable ones: TP(current, state of the
+  /// node). Atoms of `current` about `new_objects` (unknown to the nodes ahead) are carried
+  /// along: the branch from the re-joined node on is copied into states that include them.
+  /// Returns the re-joined nodes (empty: no re-join exists).
+  std::vector<NodeId> rejoin(NodeId current, const std::vector<EdgeId>& ahead,
+                             const std::vector<std::string>& new_objects, const std::string& origin);
+  /// Forgets the motions of unexecuted edges that pass near `objects` (their footprints grown
+  /// by the robot's radius): they are planned again in the world as it is now. Returns how many.
+  int invalidateNear(const std::vector<world::Object>& objects);
+  /// Prices every evaluated, unexecuted motion again (the effort models may have been refitted).
+  void reprice();
   /// The key of an arm edge's motion: the manipulation `next` it prepares, or -1 (stow, none).
   EdgeId armKey(EdgeId arm, EdgeId next) const;
 
  private:
   struct Search;
+  struct Run;
+  /// The held object's mass in the node's state (0 when the hand is empty).
+  double heldMassAt(NodeId n) const;
   double lowerBound(const Edge& e) const;
   void spawnSubtasks(EdgeId e, const BranchContext& ctx, int depth);
   double evaluateBase(Edge& e, const BranchContext& ctx, int depth);

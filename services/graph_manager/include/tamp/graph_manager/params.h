@@ -41,6 +41,15 @@ struct GraphManagerParams {
   /// A base path longer than this many times the straight line from a start facing away is
   /// planned again after a turn in place towards the goal; >= 1.
   double turn_first_ratio{1.5};
+  /// Online replanning: an action that takes longer than its prediction plus this many standard
+  /// deviations is an event (the plan ahead is priced again from the refitted models); > 0.
+  double overrun_sigma{3.0};
+  /// Online replanning: re-join sub-tasks tried towards the next this many nodes of the branch
+  /// ahead (the first reachable ones are kept, Traverse chooses among them); >= 1.
+  int max_rejoin_targets{2};
+  /// An object of the world model that moved this far from where the graph expects it is an
+  /// event (m); > 0.
+  double moved_object_tolerance_m{0.05};
 
   /// Empty when valid; else the field and why.
   std::optional<std::string> invalidReason() const;

@@ -1,0 +1,201 @@
+// Online replanning ("On-Line Replanning" of the paper): a sub-task from the robot's node that
+// re-joins the next healthy nodes of the branch, invalidation of motions near what changed, and
+// pricing again from refitted models.
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include "tamp/core/log.h"
+#include "tamp/graph_manager/graph_manager.h"
+#include "tamp/world/polygon.h"
+
+namespace tamp::graph_manager {
+namespace {
+
+/// True when the ground atom names one of `ids` as an argument.
+bool mentions(const std::string& atom, const std::vector<std::string>& ids) {
+  const auto t = atomTokens(atom);
+  for (std::size_t i = 1; i < t.size(); ++i)
+    if (std::find(ids.begin(), ids.end(), t[i]) != ids.end()) return true;
+  return false;
+}
+
+/// Literals whose conjunction holds exactly in `target` (given the atoms of `from`): the target's
+/// atoms, and the negation of every atom of `from` it does not have.
+std::vector<std::string> exactly(const std::vector<std::string>& from, const std::vector<std::string>& target) {
+  std::vector<std::string> goal = target;
+  for (const auto& a : from)
+    if (!std::binary_search(target.begin(), target.end(), a)) goal.push_back("(not " + a + ")");
+  return goal;
+}
+
+/// `state` changed as `before` -> `after` changed (the frame assumption for carried atoms).
+std::vector<std::string> applyChange(const std::vector<std::string>& state, const std::vector<std::string>& before,
+                                     const std::vector<std::string>& after) {
+  std::set<std::string> s(state.begin(), state.end());
+  for (const auto& a : before)
+    if (!std::binary_search(after.begin(), after.end(), a)) s.erase(a);
+  for (const auto& a : after)
+    if (!std::binary_search(before.begin(), before.end(), a)) s.insert(a);
+  return {s.begin(), s.end()};
+}
+
+double pointSegment(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  const Eigen::Vector2d ab = b - a;
+  const double t = ab.squaredNorm() > 1e-12 ? std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
+  return (a + t * ab - p).norm();
+}
+
+/// Distance from `p` to the base path (x, y of the path's waypoints), infinite without one.
+double distanceToBasePath(const Eigen::Vector2d& p, const JointPath& path) {
+  const int ix = path.indexOf("base_x"), iy = path.indexOf("base_y");
+  if (ix < 0 || iy < 0 || path.waypoints.empty()) return kInfinity;
+  auto at = [&](std::size_t i) {
+    return Eigen::Vector2d(path.waypoints[i][static_cast<std::size_t>(ix)], path.waypoints[i][static_cast<std::size_t>(iy)]);
+  };
+  double d = (at(0) - p).norm();
+  for (std::size_t i = 1; i < path.waypoints.size(); ++i) d = std::min(d, pointSegment(p, at(i - 1), at(i)));
+  return d;
+}
+
+/// The object's footprint radius about its centre (m).
+double footprintRadius(const world::Object& o) {
+  const world::Polygon2 f = o.shape.footprint(12);
+  double r = 0.0;
+  for (const auto& v : f) r = std::max(r, v.norm());
+  return r;
+}
+
+}  // namespace
+
+std::string_view toString(EventKind k) {
+  switch (k) {
+    case EventKind::kActionFailed: return "action_failed";
+    case EventKind::kActionBlocked: return "action_blocked";
+    case EventKind::kObjectDropped: return "object_dropped";
+    case EventKind::kNewObstacle: return "new_obstacle";
+    case EventKind::kObjectMoved: return "object_moved";
+    case EventKind::kOverrun: return "overrun";
+    case EventKind::kNotPrepared: return "not_prepared";
+  }
+  return "?";
+}
+
+std::vector<NodeId> GraphManager::rejoin(NodeId current, const std::vector<EdgeId>& ahead,
+                                         const std::vector<std::string>& new_objects, const std::string& origin) {
+  std::vector<NodeId> joined;
+  const std::vector<std::string> cur = graph_.node(current).atoms;
+  std::vector<std::string> carried;
+  for (const auto& a : cur)
+    if (mentions(a, new_objects)) carried.push_back(a);
+  for (std::size_t i = 0; i < ahead.size() && static_cast<int>(joined.size()) < params_.max_rejoin_targets; ++i) {
+    const NodeId target = graph_.edge(ahead[i]).to;
+    if (!graph_.node(target).healthy) continue;
+    // The branch from `target` on, in states that keep what is known now about the new objects.
+    NodeId join = target;
+    if (!carried.empty()) {
+      std::vector<std::string> actions;
+      std::vector<std::vector<std::string>> states;
+      std::vector<std::string> s = graph_.node(target).atoms;
+      s.insert(s.end(), carried.begin(), carried.end());
+      std::sort(s.begin(), s.end());
+      s.erase(std::unique(s.begin(), s.end()), s.end());
+      states.push_back(s);
+      for (std::size_t j = i + 1; j < ahead.size(); ++j) {
+        const Edge& e = graph_.edge(ahead[j]);
+        actions.push_back(e.action);
+        states.push_back(applyChange(states.back(), graph_.node(e.from).atoms, graph_.node(e.to).atoms));
+      }
+      join = graph_.addNode(states.front(), origin);
+      if (!actions.empty()) (void)graph_.addPlan(actions, states, origin + " (the branch ahead, with what is new)");
+    }
+    if (join == current) {
+      joined.push_back(join);
+      break;
+    }
+    auto plan = planFrom(current, exactly(cur, graph_.node(join).atoms), origin + ": re-join n" + std::to_string(join));
+    if (!plan) {
+      log::get("graph_manager")->info("no re-join of n{} from n{}: {}", join, current, plan.error().message);
+      continue;
+    }
+    const NodeId end = plan->empty() ? current : graph_.edge(plan->back()).to;
+    if (end != join) continue;  // the planner reached another state (cannot happen with exact goals)
+    ++counters_.subtasks;
+    joined.push_back(join);
+  }
+  return joined;
+}
+
+int GraphManager::invalidateNear(const std::vector<world::Object>& objects) {
+  if (objects.empty()) return 0;
+  const double robot = abstraction_.robot().baseRadius();
+  int n = 0;
+  auto near = [&](const JointPath& path) {
+    for (const auto& o : objects) {
+      const Eigen::Vector2d c = o.pose.translation().head<2>();
+      if (distanceToBasePath(c, path) <= robot + footprintRadius(o) + params_.keep_clear_margin_m) return true;
+    }
+    return false;
+  };
+  for (const Edge& ce : graph_.edges()) {
+    Edge& e = graph_.edge(ce.id);
+    if (e.kind != ActionKind::kMoveBase || !e.motion) continue;
+    if (e.state == EdgeState::kExecuted || e.state == EdgeState::kExecuting) continue;
+    if (!near(e.motion->lazy_path) && !near(e.motion->trajectory.path())) continue;
+    e.motion.reset();
+    e.state = EdgeState::kUnevaluated;
+    e.effort_mean_s = kInfinity;
+    e.subtasks_spawned = false;
+    e.reason.clear();
+    ++n;
+  }
+  return n;
+}
+
+double GraphManager::heldMassAt(NodeId n) const {
+  for (const auto& a : graph_.node(n).atoms) {
+    const auto t = atomTokens(a);
+    if (t.size() == 2 && t[0] == "holding")
+      if (const world::Object* o = abstraction_.world().findObject(t[1])) return o->mass;
+  }
+  return 0.0;
+}
+
+void GraphManager::reprice() {
+  std::vector<EffortQuery> queries;
+  std::vector<std::pair<EdgeId, EdgeId>> owners;  // edge, next (-2: the edge's own motion)
+  for (const Edge& e : graph_.edges()) {
+    if (e.state == EdgeState::kExecuted || e.state == EdgeState::kExecuting) continue;
+    EffortQuery q;
+    q.object_mass = heldMassAt(e.from);
+    if (e.kind == ActionKind::kMoveBase && e.state == EdgeState::kFeasible && e.motion) {
+      q.kind = ActionKind::kMoveBase;
+      q.path = e.motion->lazy_path;
+      queries.push_back(q);
+      owners.emplace_back(e.id, -2);
+    } else if (e.kind == ActionKind::kMoveArm) {
+      for (const auto& [next, m] : e.motion_by_next) {
+        if (m.trajectory.empty() || !e.effort_by_next.count(next)) continue;
+        q.kind = ActionKind::kMoveArm;
+        q.path = m.lazy_path;
+        queries.push_back(q);
+        owners.emplace_back(e.id, next);
+      }
+    }
+  }
+  if (queries.empty()) return;
+  counters_.effort_calls += static_cast<int>(queries.size());
+  const std::vector<EffortAnswer> answers = services_.effort(queries);
+  for (std::size_t i = 0; i < answers.size() && i < owners.size(); ++i) {
+    if (!answers[i].ok) continue;
+    Edge& e = graph_.edge(owners[i].first);
+    if (owners[i].second == -2) {
+      e.effort_mean_s = answers[i].mean_s;
+      e.effort_stddev_s = answers[i].stddev_s;
+    } else {
+      e.effort_by_next[owners[i].second] = {answers[i].mean_s, answers[i].stddev_s};
+    }
+  }
+}
+
+}  // namespace tamp::graph_manager

@@ -117,6 +117,13 @@ struct GraphManager::Run {
   /// Online replanning after `ev`; false when the mission must give up (`why` says why).
   bool replan(const MissionEvent& ev, EdgeId failed, std::string& why);
   void noteCommand();
+  /// Where the graph believes a movable object is: where the branch put it, else the world the
+  /// graph was last built from; none for an object new to it.
+  std::optional<Eigen::Isometry3d> expectedPose(const std::string& id) const {
+    if (auto it = ctx.object_poses.find(id); it != ctx.object_poses.end()) return it->second;
+    if (const world::Object* o = gm.abstraction_.world().findObject(id)) return o->pose;
+    return std::nullopt;
+  }
 };
 
 MissionReport GraphManager::Run::finish(MissionOutcome o, const std::string& reason) {
@@ -308,7 +315,7 @@ std::optional<MissionEvent> GraphManager::Run::watch(const Edge& done, const Edg
       continue;
     }
     if (std::find(acted.begin(), acted.end(), o.id) == acted.end()) continue;
-    const double moved = (known->pose.translation().head<2>() - o.pose.translation().head<2>()).norm();
+    const double moved = (expectedPose(o.id)->translation().head<2>() - o.pose.translation().head<2>()).norm();
     if (moved > gm.params_.moved_object_tolerance_m)
       return MissionEvent{EventKind::kObjectMoved, done.action, o.id,
                           "'" + o.id + "' is " + std::to_string(moved) + " m from where the graph expects it"};
@@ -342,17 +349,21 @@ bool GraphManager::Run::replan(const MissionEvent& ev, EdgeId failed, std::strin
   } else {
     ahead = branch;
   }
-  // What the robot and the world are now.
+  // What the robot and the world are now: perception's objects, but where the graph knows an
+  // object to be (its prior, or where the mission put it) within the tolerance, that pose: a
+  // partial view strays further than a place does, and a stray estimate would unbind the slot.
   const Observation now = source.robot();
-  const world::World live = source.world();
+  world::World live = source.world();
   std::vector<std::string> fresh;
   std::vector<world::Object> changed;
   for (const auto& o : live.objects()) {
     if (o.kind != world::ObjectKind::kMovable) continue;
-    const world::Object* known = gm.abstraction_.world().findObject(o.id);
-    if (!known) fresh.push_back(o.id);
-    if (!known || (known->pose.translation() - o.pose.translation()).norm() > gm.params_.moved_object_tolerance_m)
+    const auto expected = expectedPose(o.id);
+    if (!expected) fresh.push_back(o.id);
+    if (!expected || (expected->translation() - o.pose.translation()).norm() > gm.params_.moved_object_tolerance_m)
       changed.push_back(o);
+    else
+      (void)live.setObjectPose(o.id, *expected);
   }
   gm.abstraction_.setWorld(live);
   gm.grasp_cache_.clear();

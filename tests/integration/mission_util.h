@@ -1,0 +1,73 @@
+#pragma once
+// Missions end to end for the integration tests: `tamp run` with a deployment of the product's own
+// services (a faster simulator, a fresh effort store), the report and the simulator's final world.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "integration_util.h"
+#include "tamp/core/paths.h"
+
+namespace tamp::integration {
+
+namespace fs = std::filesystem;
+
+struct Mission {
+  int exit_code{-1};
+  std::string output;
+  nlohmann::json report;
+  nlohmann::json truth;
+};
+
+/// A deployment like config/deploy/local.yaml whose simulator runs `factor` times faster than
+/// real time (the product's own services and parameters otherwise).
+inline fs::path fastDeployment(const fs::path& dir, double factor) {
+  fs::create_directories(dir);
+  std::string sim = readFile(configDir() / "services" / "sim.yaml");
+  sim = std::regex_replace(sim, std::regex("realtime_factor: [0-9.]+"), "realtime_factor: " + std::to_string(factor));
+  std::ofstream(dir / "sim.yaml") << sim;
+  std::string dep = readFile(configDir() / "deploy" / "local.yaml");
+  dep = std::regex_replace(dep, std::regex("\\{config\\}/services/sim.yaml"), (dir / "sim.yaml").string());
+  // A fresh effort-estimator store: the decisions under test start from the default time models,
+  // not from whatever earlier runs on this machine taught the estimator.
+  std::string est = readFile(configDir() / "services" / "effort_estimator.yaml");
+  est = std::regex_replace(est, std::regex("store_directory: [^\\n#]+"), "store_directory: " + (dir / "store").string() + " ");
+  std::ofstream(dir / "effort_estimator.yaml") << est;
+  dep = std::regex_replace(dep, std::regex("\\{config\\}/services/effort_estimator.yaml"),
+                           (dir / "effort_estimator.yaml").string());
+  std::ofstream(dir / "deploy.yaml") << dep;
+  return dir / "deploy.yaml";
+}
+
+inline Mission run(const std::string& scenario, const std::vector<std::string>& extra = {}) {
+  std::string tag = fs::path(scenario).stem().string();
+  for (const auto& a : extra) tag += "_" + fs::path(a).filename().string();
+  const fs::path out = tempFile("tamp_mission_" + tag);
+  fs::remove_all(out);
+  fs::create_directories(out / "deploy" / "store");
+  const fs::path deployment = fastDeployment(out / "deploy", 2.0);
+  std::vector<std::string> args{(configDir() / "scenarios" / scenario).string(), "--out", out.string(), "--domain",
+                                std::to_string(isolatedDomain()), "--deployment", deployment.string()};
+  args.insert(args.end(), extra.begin(), extra.end());
+  Mission m;
+  std::tie(m.exit_code, m.output) = runCommand(binDir() / "tamp-run", args, 600.0);
+  for (const auto& entry : fs::directory_iterator(out)) {
+    if (entry.path().filename().string().rfind("run-", 0) != 0) continue;
+    if (fs::exists(entry.path() / "report.json"))
+      m.report = nlohmann::json::parse(readFile(entry.path() / "report.json"), nullptr, false);
+    if (fs::exists(entry.path() / "sim_final_world.json"))
+      m.truth = nlohmann::json::parse(readFile(entry.path() / "sim_final_world.json"), nullptr, false);
+  }
+  return m;
+}
+
+inline double distance(const nlohmann::json& p, double x, double y) {
+  return std::hypot(p["x"].get<double>() - x, p["y"].get<double>() - y);
+}
+
+}  // namespace tamp::integration

@@ -1030,17 +1030,12 @@ SearchResult search(const Task& task, const StateBits& init, const Goal& goal, c
     throw std::invalid_argument("search: initial state has " + std::to_string(init.size()) + " words, task needs " +
                                 std::to_string(task.numWords()));
   }
+  SearchResult best = firstPlan(task, init, goal, options, heuristic, term);
   const bool satisficing = options.algorithm == SearchAlgorithm::kEhc || options.algorithm == SearchAlgorithm::kGbfs ||
                            options.algorithm == SearchAlgorithm::kLazy;
-  const bool anytime = satisficing && options.anytime_seconds > 0 && costsVary(task);
-  if (!anytime) return firstPlan(task, init, goal, options, heuristic, term);
-  // LAMA 2011: the first plan is searched for with unit costs (fast; the plan's real cost is
-  // what the anytime phase then bounds), the improving iterations with the given cost type.
-  // An explicit SearchOptions::cost_type is kept for the first plan too.
-  std::unique_ptr<Heuristic> unit_h;
-  if (!options.cost_type) unit_h = makeHeuristic(defaultHeuristic(options), task, CostType::kUnit);
-  SearchResult best = firstPlan(task, init, goal, options, unit_h ? *unit_h : heuristic, term);
-  if (best.status != SearchStatus::kSolved) return best;
+  if (best.status != SearchStatus::kSolved || !satisficing || options.anytime_seconds <= 0 || !costsVary(task)) {
+    return best;
+  }
   // Anytime phase (LAMA 2011): the lazy greedy search, then lazy weighted A* with w = 5, 3, 2, 1,
   // 1, ..., each bounded by the
   // best cost so far, until the budget or the caller's deadline; an exhausted iteration proves

@@ -210,16 +210,6 @@ TEST(Search, AnytimePhaseNeverReturnsADearerPlanAndEndsOptimalOnASmallTask) {
   ASSERT_EQ(r.status, PlanStatus::kSolved) << r.message;
   EXPECT_EQ(r.cost, 8);
   EXPECT_GE(r.stats.anytime_iterations, 1U);
-  // As LAMA 2011, the first plan is searched for with unit costs: the short way through m
-  // (cost 11); the anytime phase then finds the cheap one (8). An explicit cost type is kept
-  // for the first plan: cost + 1 finds 8 at once, and nothing improves it.
-  EXPECT_GE(r.stats.anytime_improvements, 1U);
-  req.search.cost_type = CostType::kPlusOne;
-  PlanReply plus_one = plan(req, Termination());
-  ASSERT_EQ(plus_one.status, PlanStatus::kSolved) << plus_one.message;
-  EXPECT_EQ(plus_one.cost, 8);
-  EXPECT_EQ(plus_one.stats.anytime_improvements, 0U);
-  req.search.cost_type.reset();
 
   // An IPC cost task: the anytime plan (checked) costs at most the first plan.
   const auto dir = test::benchmarksDir() / "pddl-adl/elevators";

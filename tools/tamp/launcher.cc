@@ -122,6 +122,9 @@ process::ProcessSpec Launcher::specOf(const deploy::ServiceSpec& s) const {
       spec.env[kv.substr(0, eq)] = kv.substr(eq + 1);
     }
   };
+  // The run folder, where services keep what must survive their restart (the execution
+  // monitor's journal of commands sent to the robot).
+  spec.env["TAMP_RUN_DIR"] = o_.run_dir.string();
   addEnv(d.host(o_.host)->env);
   addEnv(s.env);
   spec.log_file = logFile(s.name);

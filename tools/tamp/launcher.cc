@@ -126,6 +126,9 @@ process::ProcessSpec Launcher::specOf(const deploy::ServiceSpec& s) const {
   // Discovery of the deployment (multicast: an inherited server list is cleared); the host's and
   // the service's env may still override it.
   spec.env["TAMP_DDS_DISCOVERY_SERVERS"] = d.discovery.serversEnv();
+  // The run folder, where services keep what must survive their restart (the execution
+  // monitor's journal of commands sent to the robot).
+  spec.env["TAMP_RUN_DIR"] = o_.run_dir.string();
   addEnv(d.host(o_.host)->env);
   addEnv(s.env);
   spec.log_file = logFile(s.name);

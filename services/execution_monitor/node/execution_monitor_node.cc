@@ -1,5 +1,6 @@
 #include "execution_monitor_node.h"
 
+#include <cstdlib>
 #include <filesystem>
 
 #include "tamp/core/log.h"
@@ -207,6 +208,7 @@ ExecutionMonitorNode::ExecutionMonitorNode(const dds::ServiceArgs& args, Monitor
     : ServiceNode(args) {
   const std::string world_id = params.world_id;
   monitor_ = std::make_unique<ExecutionMonitor>(std::move(params), std::move(robot));
+  openJournal();
   const auto& p = participant();
   status_writer_ =
       std::make_unique<dds::Writer<msg::ExecuteStatus>>(p, dds::topics::kExecuteStatus);
@@ -232,6 +234,19 @@ ExecutionMonitorNode::ExecutionMonitorNode(const dds::ServiceArgs& args, Monitor
       [this](const msg::ExecuteCommand& m, const dds::SampleMeta&) { onCommand(m); });
 }
 
+void ExecutionMonitorNode::openJournal() {
+  const char* run_dir = std::getenv("TAMP_RUN_DIR");
+  if (!run_dir || !*run_dir) return;
+  auto j = SentJournal::open(std::filesystem::path(run_dir) / "execution_monitor.sent");
+  if (!j) throw std::runtime_error("execution monitor: " + j.error().toString());
+  journal_ = std::make_unique<SentJournal>(std::move(j).value());
+  if (!journal_->previous().empty()) {
+    logger()->info("journal {}: {} command(s) sent by a previous run; a repeat of one is joined, "
+                   "not executed again", journal_->path().string(), journal_->previous().size());
+  }
+  monitor_->resume(journal_->previous());
+}
+
 ExecutionMonitorNode::~ExecutionMonitorNode() {
   // Input first (callbacks use the monitor and the writers), then the mirror.
   command_reader_.reset();
@@ -248,6 +263,14 @@ double ExecutionMonitorNode::now() const {
 void ExecutionMonitorNode::publish(const Outputs& out) {
   // Robot requests first: a RUNNING status is only published once the robot has been commanded.
   for (const auto& r : out.robot) {
+    if (journal_ && r.type == RobotRequest::Type::kExecute) {
+      if (Status j = journal_->append(r.command.command_id); !j) {
+        // Not sent: a command the journal does not hold could be executed twice after a restart.
+        logger()->error("command '{}' not sent to the robot: {}", r.command.command_id,
+                        j.error().toString());
+        continue;
+      }
+    }
     if (Status s = trajectory_writer_->write(toMsg(r)); !s) {
       logger()->error("{} of '{}' not sent to the robot: {}",
                       r.type == RobotRequest::Type::kCancel ? "cancel" : "command",

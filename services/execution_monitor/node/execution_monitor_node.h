@@ -28,6 +28,7 @@
 #include "tamp/dds/topics.h"
 #include "tamp/dds/world_sync.h"
 #include "tamp/execution_monitor/monitor.h"
+#include "tamp/execution_monitor/sent_journal.h"
 
 namespace tamp::execution_monitor {
 
@@ -66,10 +67,14 @@ class ExecutionMonitorNode : public dds::ServiceNode {
   void onState(const msg::RobotState& m, const dds::SampleMeta& meta);
   void onResult(const msg::ActionResult& m, const dds::SampleMeta& meta);
   void onRecord(const msg::ExecutionRecord& m);
+  /// With $TAMP_RUN_DIR (set by `tamp launch`): <run_dir>/execution_monitor.sent, read back into
+  /// the monitor (`resume`) and appended before every command sent to the robot.
+  void openJournal();
 
   std::chrono::steady_clock::time_point t0_{std::chrono::steady_clock::now()};
   std::mutex mutex_;  // guards monitor_ and the writers' ordering
   std::unique_ptr<ExecutionMonitor> monitor_;
+  std::unique_ptr<SentJournal> journal_;
   std::unique_ptr<dds::Writer<msg::ExecuteStatus>> status_writer_;
   std::unique_ptr<dds::Writer<msg::FailureEvent>> failure_writer_;
   std::unique_ptr<dds::Writer<msg::TrajectoryCommand>> trajectory_writer_;

@@ -101,6 +101,7 @@ struct Active {
   double stop_deadline{0.0};
   std::optional<RobotResult> result;
   double finish_deadline{0.0};
+  bool rejoined{false};  // sent by a previous run of the monitor: not validated or watched again
 };
 
 bool carries(const Active& a) {
@@ -124,6 +125,7 @@ struct ExecutionMonitor::Impl {
   RecordForwarder records;
   std::map<std::string, StatusUpdate> known;
   std::map<std::string, RobotResult> robot_history;  // results of ids the monitor did not send
+  std::set<std::string> sent_before;  // ids a previous run sent to the robot (its journal)
   std::deque<ExecutionCommand> queue;
   std::optional<Active> active;
   std::optional<RobotObservation> state;
@@ -196,6 +198,10 @@ struct ExecutionMonitor::Impl {
       Active& a = *active;
       if (a.phase != Phase::kWaiting) return;
       const ExecutionCommand& c = a.cmd;
+      if (sent_before.count(c.command_id)) {
+        rejoin(out, now);
+        return;
+      }
       const bool have_state = state && state->stamp_ns >= min_state_stamp;
       const bool have_world = world.has_value() && world_version > 0;
       const bool world_current = have_world && world_version >= c.world_version;
@@ -241,6 +247,33 @@ struct ExecutionMonitor::Impl {
       emit(out, s);
       return;
     }
+  }
+
+  /// The head was sent to the robot by a previous run of the monitor: it is not validated again
+  /// (the robot may have moved with it); it is sent again, which the robot, idempotent on
+  /// command ids, answers by joining the running action or by its recorded result.
+  void rejoin(Outputs& out, double now) {
+    Active& a = *active;
+    const ExecutionCommand& c = a.cmd;
+    a.rejoined = true;
+    a.note = "sent before a restart of the monitor: joined, not executed again";
+    records.addCommand(c);
+    RobotRequest r;
+    r.type = RobotRequest::Type::kExecute;
+    r.command = c;
+    out.robot.push_back(std::move(r));
+    a.phase = Phase::kRunning;
+    a.started = now;
+    a.last_status = now;
+    const double expected =
+        c.expected_duration_s > 0.0 ? c.expected_duration_s : c.trajectory.duration();
+    a.timeout_limit =
+        expected + params.timeout.stddevs * c.expected_stddev_s + params.timeout.margin_s;
+    StatusUpdate s;
+    s.command_id = c.command_id;
+    s.state = ExecState::kRunning;
+    s.reason = a.note;
+    emit(out, s);
   }
 
   /// The checks just before the start (the robot state and world are there).
@@ -378,7 +411,7 @@ struct ExecutionMonitor::Impl {
 
   void checkRemainingPath(Outputs& out, double now) {
     Active& a = *active;
-    if (a.phase != Phase::kRunning || !world || !state) return;
+    if (a.phase != Phase::kRunning || a.rejoined || !world || !state) return;
     checker.setWorld(*world);
     std::vector<std::string> ignore = a.ignore;
     for (const auto& id : checker.contactsAt(state->state)) ignore.push_back(id);
@@ -503,6 +536,7 @@ Outputs ExecutionMonitor::onRobotState(const RobotObservation& obs, double now) 
       m.tryStart(out, now);
       break;
     case Phase::kRunning:
+      if (a.rejoined) break;  // no path of its own to follow
       a.progress = a.path.project(obs.state, a.progress);
       if (carries(a) && obs.held_object_id != a.held_at_start) {
         m.stop(
@@ -592,6 +626,12 @@ Outputs ExecutionMonitor::onTick(double now) {
       break;
   }
   return out;
+}
+
+void ExecutionMonitor::resume(const std::vector<std::string>& sent_ids) {
+  for (const auto& id : sent_ids) {
+    if (!impl_->known.count(id)) impl_->sent_before.insert(id);
+  }
 }
 
 std::optional<RecordAnnotation> ExecutionMonitor::onRobotRecord(const std::string& record_id,

@@ -334,6 +334,52 @@ TEST_F(MonitorTest, AnIdTheRobotAlreadyExecutedIsNotExecutedAgain) {
   EXPECT_DOUBLE_EQ(f->measured_duration_s, 2.0);
 }
 
+TEST_F(MonitorTest, AnIdSentBeforeARestartIsJoinedNotValidatedOrExecutedAsNew) {
+  // The previous run sent "half" to the robot; the robot is half-way (x = 2.0, away from the
+  // trajectory's start 1.5, so validation would fail it) when the command comes again.
+  monitor_.resume({"half"});
+  EXPECT_TRUE(monitor_.onWorld(world_, 1, now_).empty());
+  EXPECT_TRUE(monitor_.onRobotState(observe(2.0, stamp_), now_).empty());
+  Outputs out = monitor_.onCommand(moveBase("half", {{1.5, 1.2, 0}, {2.5, 1.2, 0}}), now_);
+  // Re-sent to the (idempotent) robot to join it; not a precondition failure.
+  ASSERT_EQ(out.robot.size(), 1u);
+  EXPECT_EQ(out.robot[0].type, RobotRequest::Type::kExecute);
+  EXPECT_TRUE(out.failures.empty());
+  EXPECT_EQ(finalOf(out), nullptr);
+  EXPECT_EQ(monitor_.executedCount(), 0u);
+  EXPECT_EQ(monitor_.activeCommandId(), "half");
+  // Its outcome is the robot's.
+  EXPECT_TRUE(
+      monitor_.onRobotResult(result("half", RobotOutcome::kSucceeded, 4.0), now_ + 1.0).empty());
+  out = monitor_.onRobotState(observe(2.5, stamp_ + 5), now_ + 1.1);
+  const StatusUpdate* done = finalOf(out);
+  ASSERT_NE(done, nullptr);
+  EXPECT_EQ(done->state, ExecState::kSucceeded) << done->reason;
+  EXPECT_DOUBLE_EQ(done->measured_duration_s, 4.0);
+  // A repeat now gets the recorded status; a new id is validated as usual (and fails: the
+  // robot is not at its start).
+  out = monitor_.onCommand(moveBase("half", {{1.5, 1.2, 0}, {2.5, 1.2, 0}}), now_ + 2.0);
+  EXPECT_TRUE(out.robot.empty());
+  ASSERT_EQ(out.statuses.size(), 1u);
+  EXPECT_EQ(out.statuses[0].state, ExecState::kSucceeded);
+  out = monitor_.onCommand(moveBase("fresh", {{1.5, 1.2, 0}, {2.0, 1.2, 0}}), now_ + 2.0);
+  EXPECT_TRUE(out.robot.empty());
+  ASSERT_NE(finalOf(out), nullptr);
+  EXPECT_EQ(finalOf(out)->state, ExecState::kFailed);
+}
+
+TEST_F(MonitorTest, ResumeIgnoresIdsWithAKnownOutcome) {
+  ready();
+  const ExecutionCommand c = moveBase("go", {{1.5, 1.2, 0}, {2.5, 1.2, 0}});
+  (void)monitor_.onCommand(c, now_);
+  (void)monitor_.onRobotResult(result("go", RobotOutcome::kSucceeded, 1.0), now_ + 1.0);
+  ASSERT_NE(finalOf(monitor_.onRobotState(observe(2.5, stamp_ + 5), now_ + 1.1)), nullptr);
+  monitor_.resume({"go"});
+  const Outputs out = monitor_.onCommand(c, now_ + 2.0);
+  EXPECT_TRUE(out.robot.empty());
+  EXPECT_EQ(out.statuses.at(0).state, ExecState::kSucceeded);
+}
+
 TEST(RecordForwarderTest, ForwardsEachRecordIdOnceWithItsCommand) {
   RecordForwarder fw;
   ExecutionCommand c = moveBase("go", {{0, 0, 0}});

@@ -16,7 +16,9 @@
 #include <condition_variable>
 #include <fstream>
 #include <functional>
+#include <csignal>
 #include <mutex>
+#include <thread>
 
 #include <gtest/gtest.h>
 
@@ -107,8 +109,16 @@ class MonitorNodeTest : public ::testing::Test {
     }
     sup_.add(serviceSpec("tamp_sim_service", "sim", domain_,
                          {"--config", sim_config_.string(), "--scenario", scenario}));
-    sup_.add(serviceSpec("tamp_execution_monitor_service", "execution_monitor", domain_,
-                         {"--config", monitor_config_.string(), "--scenario", scenario}));
+    auto monitor = serviceSpec("tamp_execution_monitor_service", "execution_monitor", domain_,
+                               {"--config", monitor_config_.string(), "--scenario", scenario});
+    if (!run_dir_.empty()) {  // the monitor's journal there; restarted when killed
+      std::filesystem::remove_all(run_dir_);
+      std::filesystem::create_directories(run_dir_);
+      monitor.env["TAMP_RUN_DIR"] = run_dir_.string();
+      monitor.restart = true;
+      monitor.restart_backoff_s = 0.2;
+    }
+    sup_.add(std::move(monitor));
     ASSERT_TRUE(sup_.startAll().ok());
     auto p = dds::Participant::create(
         {domain_, dds::kProfileDefault, "tamp/execution_monitor_test", {}});
@@ -227,6 +237,7 @@ class MonitorNodeTest : public ::testing::Test {
         record_log_.waitFor([&](const msg::ExecutionRecord& r) { return r.record_id() == id; }));
   }
 
+  std::filesystem::path run_dir_;  // non-empty: the monitor keeps its journal there
   std::string scenario_name_{"namo_corridor.yaml"};
   std::string monitor_yaml_{
       "input_wait_s: 15\n"};  // discovery on a loaded machine may take a while
@@ -396,6 +407,62 @@ TEST_F(MonitorNodeTest, ObjectAppearingOnTheRemainingPathBlocksWithItsId) {
 }
 
 /// The robot starts with a cup in the gripper (holding_start).
+class RestartedMonitorNodeTest : public MonitorNodeTest {
+ protected:
+  RestartedMonitorNodeTest() { run_dir_ = tempFile("tamp_em_run"); }
+  ~RestartedMonitorNodeTest() override { std::filesystem::remove_all(run_dir_); }
+};
+
+// kill -9 of the monitor while the robot executes a command; the supervisor restarts it and the
+// command comes again: the robot executed it once (one raw record, ended where one move ends),
+// and the restarted monitor reports the robot's outcome.
+TEST_F(RestartedMonitorNodeTest, ACommandInFlightWhenTheMonitorIsKilledIsNotExecutedTwice) {
+  const Pose2D start = robotBase();
+  const msg::ExecuteCommand go = moveBase("em_long", start, 2.5);
+  ASSERT_TRUE(commands_->write(go));
+  ASSERT_TRUE(state_log_.waitFor([&](const msg::RobotState& st) {
+    return st.moving() && st.base().x() > start.x + 0.2;
+  })) << "the robot did not start moving";
+  const int pid_before = sup_.status("execution_monitor")->pid;
+  ASSERT_TRUE(sup_.signal("execution_monitor", SIGKILL));
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  for (;;) {
+    sup_.poll();
+    const auto st = sup_.status("execution_monitor");
+    if (st && st->restarts >= 1 && st->phase == process::ProcessPhase::kRunning &&
+        st->pid != pid_before) {
+      break;
+    }
+    ASSERT_LT(std::chrono::steady_clock::now(), deadline) << "the monitor was not restarted";
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));  // polling the supervisor
+  }
+  // The graph manager's resend of the command in flight, repeated until the restarted monitor
+  // answers (the killed reader stays matched until its lease ends: a write may go to it alone).
+  auto fromRestarted = [](const msg::ExecuteStatus& s) {
+    // Joined (the robot still runs it) or answered from the robot's result (it ended already).
+    return s.command_id() == "em_long" &&
+           (s.reason().find("not executed again") != std::string::npos ||
+            s.reason().find("executed before") != std::string::npos);
+  };
+  bool answered = false;
+  for (int i = 0; i < 30 && !answered; ++i) {
+    ASSERT_TRUE(commands_->write(go));
+    answered = status_log_.waitFor(fromRestarted, 1.0).has_value();
+  }
+  ASSERT_TRUE(answered) << "the restarted monitor never answered the resent command";
+  auto done = status_log_.waitFor(
+      [&](const msg::ExecuteStatus& s) { return fromRestarted(s) && isFinal(s.state()); },
+      60.0);
+  ASSERT_TRUE(done) << "no final status from the restarted monitor";
+  EXPECT_EQ(done->state(), msg::ExecState::EXEC_SUCCEEDED) << done->reason();
+  barrier("em_after_restart");
+  EXPECT_EQ(robot_record_log_.count(
+                [](const msg::ExecutionRecord& r) { return r.record_id() == "em_long"; }),
+            1u);
+  EXPECT_NEAR(robotBase().x, start.x + 2.5 * std::cos(start.theta), 0.05);
+  EXPECT_NE(readFile(run_dir_ / "execution_monitor.sent").find("em_long\n"), std::string::npos);
+}
+
 class HoldingMonitorNodeTest : public MonitorNodeTest {
  protected:
   HoldingMonitorNodeTest() { scenario_name_ = "holding_start.yaml"; }

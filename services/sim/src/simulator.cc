@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <map>
 #include <random>
 #include <set>
 #include <stdexcept>
@@ -228,6 +229,9 @@ struct Simulator::Impl {
     Eigen::Isometry3d link_T_object;
   };
   std::vector<Riding> riding;  // objects resting on the robot (dropped onto it), carried along
+  std::vector<ActionLogEntry> log;            // every accepted action, in order (the truth)
+  std::map<std::string, std::size_t> logged;  // command id -> index in `log`
+  std::vector<ActionResult> replayed;         // results of repeated ids, out at the next step()
 
   Impl(world::World w, robot::RobotModel r, SimParams p)
       : world(std::move(w)), robot(std::move(r)), params(std::move(p)), sensor(params.sensor) {}
@@ -759,6 +763,7 @@ struct Simulator::Impl {
     rec.record_id = a.cmd.command_id;
     logger()->info("'{}' ({}) {} after {:.3f}s{}", r.command_id, toString(a.cmd.kind),
                   toString(r.outcome), r.duration_s, r.reason.empty() ? "" : ": " + r.reason);
+    log[logged.at(r.command_id)].result = r;
     ev.results.push_back(std::move(r));
     ev.records.push_back(std::move(rec));
     active.reset();
@@ -1124,6 +1129,15 @@ Simulator::~Simulator() = default;
 
 Status Simulator::submit(const ActionCommand& command) {
   Impl& m = *impl_;
+  if (const auto seen = m.logged.find(command.command_id); seen != m.logged.end()) {
+    // Idempotent: an id accepted before is never executed again. Running: the sender joins it
+    // (its result comes when it ends); finished: its recorded result comes again.
+    const ActionLogEntry& e = m.log[seen->second];
+    if (e.result) m.replayed.push_back(*e.result);
+    logger()->info("'{}' repeated: {}", command.command_id,
+                   e.result ? "executed before, its result again" : "running, joined");
+    return Status::Ok();
+  }
   if (m.active) {
     return Error(ErrorCode::kUnavailable,
                  "busy: action '" + m.active->cmd.command_id + "' is still running", SourceLocation{"", 0, 0, "command_id"});
@@ -1133,7 +1147,10 @@ Status Simulator::submit(const ActionCommand& command) {
   auto planned = m.plan(command, *cols);
   if (!planned) return planned.error();
   Active& a = *planned;
+  m.logged[command.command_id] = m.log.size();
+  m.log.push_back(ActionLogEntry{command.command_id, command.kind, a.step, m.now, std::nullopt});
   a.step = m.actions++;
+  m.log.back().step = a.step;
   a.start = m.now;
   for (std::size_t i = 0; i < m.scripted.size(); ++i) {
     const Fault& f = m.scripted[i];
@@ -1199,6 +1216,7 @@ StepEvents Simulator::step(double dt) {
   if (!(dt >= 0.0) || !std::isfinite(dt)) throw std::invalid_argument("Simulator::step: dt must be >= 0, got " + formatNumber(dt, 4));
   Impl& m = *impl_;
   StepEvents ev;
+  ev.results = std::exchange(m.replayed, {});
   for (const Fault& f : std::exchange(m.injected, {})) ev.faults.push_back(m.fire(f, ev));
   const double target = m.now + dt;
   for (;;) {
@@ -1282,6 +1300,8 @@ double Simulator::remainingActionTime() const {
   return m.active ? std::max(0.0, m.active->start + m.active->end - m.now) : 0.0;
 }
 int Simulator::actionCount() const { return impl_->actions; }
+
+const std::vector<ActionLogEntry>& Simulator::actionLog() const { return impl_->log; }
 
 RobotStateSample Simulator::robotState() const {
   const Impl& m = *impl_;

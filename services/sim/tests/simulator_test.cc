@@ -454,3 +454,54 @@ TEST(SimulatorTest, RejectsMalformedCommandsNamingTheField) {
 
 }  // namespace
 }  // namespace tamp::sim
+
+namespace tamp::sim {
+namespace {
+
+using namespace tamp::sim::testing;
+
+TEST(SimulatorTest, ARepeatedCommandIdIsNeverExecutedAgain) {
+  Simulator sim(emptyRoom(), robotModel(), upright(), exactParams());
+  const ActionCommand drive = moveBase("drive", {{0, 0, 0}, {1, 0, 0}});
+  ASSERT_TRUE(sim.submit(drive));
+  (void)sim.step(0.1);
+  const double mid = sim.robotState().state.base.x;
+  // While it runs: the repeat joins it (no restart from the start, no second action).
+  ASSERT_TRUE(sim.submit(drive));
+  EXPECT_EQ(sim.actionCount(), 1);
+  const StepEvents first = runToEnd(sim);
+  ASSERT_EQ(first.results.size(), 1u);
+  EXPECT_EQ(first.results[0].outcome, Outcome::kSucceeded) << first.results[0].reason;
+  EXPECT_GT(sim.robotState().state.base.x, mid);
+  // After it ended: the repeat (whose start is now away from the robot) gets the recorded result
+  // again, not a rejection, and the robot does not move; no second record.
+  const double end_x = sim.robotState().state.base.x;
+  ASSERT_TRUE(sim.submit(drive));
+  EXPECT_FALSE(sim.busy());
+  const StepEvents again = sim.step(0.05);
+  ASSERT_EQ(again.results.size(), 1u);
+  EXPECT_EQ(again.results[0].command_id, "drive");
+  EXPECT_EQ(again.results[0].outcome, Outcome::kSucceeded);
+  EXPECT_DOUBLE_EQ(again.results[0].duration_s, first.results[0].duration_s);
+  EXPECT_TRUE(again.records.empty());
+  EXPECT_DOUBLE_EQ(sim.robotState().state.base.x, end_x);
+  ASSERT_EQ(sim.actionLog().size(), 1u);
+  EXPECT_EQ(sim.actionLog()[0].command_id, "drive");
+  ASSERT_TRUE(sim.actionLog()[0].result.has_value());
+  EXPECT_EQ(sim.actionLog()[0].result->outcome, Outcome::kSucceeded);
+  // A new id is executed (from where the robot is).
+  ASSERT_TRUE(sim.submit(moveBase("back", {{end_x, 0, 0}, {0, 0, 0}})));
+  EXPECT_EQ(sim.actionCount(), 2);
+  EXPECT_EQ(sim.actionLog().size(), 2u);
+}
+
+TEST(SimulatorTest, ARejectedCommandIsNotLoggedAsExecuted) {
+  Simulator sim(emptyRoom(), robotModel(), upright(), exactParams());
+  // Starts away from the robot: rejected, not executed, so not in the action log.
+  EXPECT_FALSE(sim.submit(moveBase("far", {{3, 0, 0}, {4, 0, 0}})));
+  EXPECT_TRUE(sim.actionLog().empty());
+  EXPECT_FALSE(sim.busy());
+}
+
+}  // namespace
+}  // namespace tamp::sim

@@ -15,7 +15,12 @@
 /// - **Idempotent on command_id.** Every id ever seen is remembered with its latest status; a
 ///   command with a known id is never executed again: its known status is re-published. A robot
 ///   result seen for an id the monitor did not send (e.g. from before a restart, through the
-///   results' transient-local history) makes that id known too.
+///   results' transient-local history) makes that id known too. Across a restart of the monitor,
+///   `resume()` takes the ids its previous run sent to the robot (the node's `SentJournal`): such
+///   an id, commanded again, is not validated again (the robot may be half-way through it) but
+///   sent again to the robot, which is idempotent on command ids too (the simulator joins the
+///   running action or re-sends its recorded result): the outcome comes from the robot, nothing
+///   is executed twice.
 /// - **One action at a time, in order.** Commands are queued (EXEC_ACCEPTED); the head starts
 ///   once a robot state and a world model of at least the command's world version are there
 ///   (waiting at most `input_wait_s`; then the latest world model is used, and with none the
@@ -53,6 +58,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <vector>
 
 #include "tamp/core/error.h"
 #include "tamp/execution_monitor/checks.h"
@@ -113,6 +119,11 @@ class ExecutionMonitor {
   Outputs onRobotResult(const RobotResult& result, double now);
   /// Deadlines, timeouts and periodic progress; call every few tens of milliseconds.
   Outputs onTick(double now);
+
+  /// Ids a previous run of the monitor sent to the robot (its journal); call before the first
+  /// command. Such an id, commanded again, is re-sent to the robot without validation (the robot
+  /// joins or reports it) instead of being executed as new.
+  void resume(const std::vector<std::string>& sent_ids);
 
   /// Annotation of a robot record (see RecordForwarder).
   std::optional<RecordAnnotation> onRobotRecord(const std::string& record_id,

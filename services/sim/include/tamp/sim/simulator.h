@@ -97,6 +97,15 @@ struct ActionResult {
   std::string reason;              ///< empty on success; otherwise why (names the field for bad input)
 };
 
+/// One action the robot accepted (the simulator's action log: what physically happened).
+struct ActionLogEntry {
+  std::string command_id;
+  ActionKind kind{ActionKind::kMoveBase};
+  int step{0};          ///< its index among the accepted actions
+  double start_s{0.0};  ///< simulated time it started
+  std::optional<ActionResult> result;  ///< nullopt while it runs
+};
+
 /// The robot's state as its drivers would report it.
 struct RobotStateSample {
   double time_s{0.0};                ///< simulated seconds since the start
@@ -128,7 +137,9 @@ class Simulator {
   Simulator(const Simulator&) = delete;
   Simulator& operator=(const Simulator&) = delete;
 
-  /// Starts executing `command`. Rejections (kInvalidArgument naming the field: unknown or
+  /// Starts executing `command`. Idempotent on `command_id`: an id accepted before is never
+  /// executed again (Ok; while it runs the caller joins it, after it ended its recorded result is
+  /// emitted again by the next `step()`, without a second record). Rejections (kInvalidArgument naming the field: unknown or
   /// duplicate joint, NaN, non-monotonic times, a start away from the current state, a missing
   /// object pose, joint limits; kUnavailable while another action runs) leave the robot idle and
   /// produce no record. An accepted command's outcome comes from later `step()` calls.
@@ -150,6 +161,8 @@ class Simulator {
   double remainingActionTime() const;
   /// Number of actions accepted so far (the next action's step index).
   int actionCount() const;
+  /// Every accepted action in order, with its result once it ended.
+  const std::vector<ActionLogEntry>& actionLog() const;
 
   RobotStateSample robotState() const;
   /// The ground truth (hidden objects included; the held object at its current pose).

@@ -87,6 +87,22 @@ std::optional<Placement> placeFromBase(MotionPlanner::Impl& impl, const Placemen
   return std::nullopt;
 }
 
+/// How the object stands at a placement, before its yaw: upright, or, for a held object whose
+/// grasp would point the tool upwards with the object upright (a grasp given as the identity
+/// with the object's z axis along the tool's approach axis), upside down on its top face so that
+/// the tool points down as the arm holds it. Box, cylinder and prism frames are centred, so both
+/// faces rest at the same height; a sphere has no preferred face.
+Eigen::Matrix3d standingRotation(const PlacementRequest& req) {
+  const Eigen::Matrix3d upright = Eigen::Matrix3d::Identity();
+  if (!req.held_object_T_tool) return upright;
+  const Eigen::Matrix3d flipped = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  const Eigen::Matrix3d tool = req.held_object_T_tool->linear();
+  // The z component of the tool's approach axis in the world (yaw does not change it).
+  const double up_upright = (upright * tool).col(2).z();
+  const double up_flipped = (flipped * tool).col(2).z();
+  return up_flipped < up_upright - 1e-6 && up_upright > 0.0 ? flipped : upright;
+}
+
 }  // namespace
 
 Result<std::vector<Placement>> MotionPlanner::samplePlacements(const PlacementRequest& req,
@@ -166,6 +182,7 @@ Result<std::vector<Placement>> MotionPlanner::samplePlacements(const PlacementRe
   } restore{impl};
   impl.scene.syncWorld(original);
 
+  const Eigen::Matrix3d stand = standingRotation(req);
   std::vector<Placement> out;
   std::vector<Eigen::Isometry3d> poses;
   const Eigen::Vector2d from(obj->pose.translation().x(), obj->pose.translation().y());
@@ -177,7 +194,7 @@ Result<std::vector<Placement>> MotionPlanner::samplePlacements(const PlacementRe
     const double x = ux(rng), y = uy(rng), yaw = uyaw(rng);
     if (req.base && std::hypot(x - req.base->x, y - req.base->y) > P.base_distance_max) continue;
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-    pose.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    pose.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() * stand;
     pose.translation() = Eigen::Vector3d(x, y, region->height + obj->shape.halfHeight());
     // Stable: the footprint inside the region.
     world::Polygon2 fp;

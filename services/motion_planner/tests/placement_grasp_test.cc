@@ -221,6 +221,31 @@ TEST_F(ManipulationTest, PlacementsAreStableClearAndReachable) {
   }
 }
 
+TEST_F(ManipulationTest, AHeldGraspAlongTheObjectAxisPlacesTheObjectOnItsTopWithTheToolDown) {
+  // A held grasp given as the identity rotation (the object's z along the tool's approach axis):
+  // upright, the tool would point up from under the table top; the object stands on its top face.
+  MotionPlanner mp = planner();
+  PlacementRequest req;
+  req.object_id = "can";
+  req.region_id = "table_top";
+  req.base = Pose2D{1.0, 0.0, 0.0};
+  Eigen::Isometry3d object_T_tool = Eigen::Isometry3d::Identity();
+  object_T_tool.translation() = Eigen::Vector3d(0.0, 0.0, -0.03);
+  req.held_object_T_tool = object_T_tool;
+  req.approach = 0.05;
+  req.max_placements = 3;
+  auto r = mp.samplePlacements(req, Termination::after(30.0));
+  ASSERT_TRUE(r.ok()) << r.error().toString();
+  ASSERT_FALSE(r->empty());
+  for (const Placement& p : *r) {
+    EXPECT_NEAR(p.object_pose.translation().z(), 0.55 + 0.06, 1e-9);
+    EXPECT_LT(p.object_pose.linear().col(2).z(), -1.0 + 1e-9);  // on its top face
+    const Eigen::Isometry3d tool = fk(p.base_pose, p.arm_configuration);
+    EXPECT_LT(tool.linear().col(2).z(), -0.99);  // the tool points down
+    EXPECT_LT((tool.translation() - (p.object_pose * object_T_tool).translation()).norm(), 0.01);
+  }
+}
+
 TEST_F(ManipulationTest, PlacementErrorsNameTheField) {
   MotionPlanner mp = planner();
   PlacementRequest req;

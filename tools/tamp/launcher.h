@@ -97,6 +97,7 @@ class Launcher {
   void writePidFile();
   void touchLease();
   void checkLiveness();
+  Status startOneByOne();
 
   LaunchOptions o_;
   process::Supervisor sup_;

@@ -220,21 +220,33 @@ void Supervisor::adopt(ProcessSpec spec, pid_t pid) {
 Status Supervisor::startAll() {
   Status first;
   for (auto& c : children_) {
-    if (c.st.phase != ProcessPhase::kNotStarted) continue;
-    auto pid = spawn(c.spec);
-    if (!pid) {
-      c.st.phase = ProcessPhase::kFailed;
-      c.st.last_exit = pid.error().toString();
-      emit(ProcessEventKind::kStartFailed, c, c.st.last_exit);
-      if (first.ok()) first = pid.error();
-      continue;
-    }
-    c.st.pid = *pid;
-    c.st.phase = ProcessPhase::kRunning;
-    c.st.started = std::chrono::steady_clock::now();
-    emit(ProcessEventKind::kStarted, c);
+    Status s = startChild(c);
+    if (!s && first.ok()) first = s;
   }
   return first;
+}
+
+Status Supervisor::start(const std::string& name) {
+  for (auto& c : children_) {
+    if (c.spec.name == name) return startChild(c);
+  }
+  throw std::invalid_argument("Supervisor::start: no process '" + name + "'");
+}
+
+Status Supervisor::startChild(Child& c) {
+  if (c.st.phase != ProcessPhase::kNotStarted) return Status::Ok();
+  auto pid = spawn(c.spec);
+  if (!pid) {
+    c.st.phase = ProcessPhase::kFailed;
+    c.st.last_exit = pid.error().toString();
+    emit(ProcessEventKind::kStartFailed, c, c.st.last_exit);
+    return pid.error();
+  }
+  c.st.pid = *pid;
+  c.st.phase = ProcessPhase::kRunning;
+  c.st.started = std::chrono::steady_clock::now();
+  emit(ProcessEventKind::kStarted, c);
+  return Status::Ok();
 }
 
 void Supervisor::onExit(Child& c, const std::string& how, int exit_code, bool clean) {

@@ -285,8 +285,9 @@ ExecutionReport DdsExecutor::execute(const EdgeCommand& c, double budget_s) {
     r.reason = "no execution monitor on this domain";
     return r;
   }
+  const std::string wire = wireId(c.command_id);
   msg::ExecuteCommand m;
-  m.command_id(c.command_id);
+  m.command_id(wire);
   m.mission_id(mission_id_);
   m.edge_id(c.edge_id);
   m.pddl_action(c.action);
@@ -308,7 +309,7 @@ ExecutionReport DdsExecutor::execute(const EdgeCommand& c, double budget_s) {
   }
   std::unique_lock lock(mutex_);
   const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(budget_s));
-  if (!cv_.wait_until(lock, deadline, [&] { return final_.count(c.command_id) > 0; })) {
+  if (!cv_.wait_until(lock, deadline, [&] { return final_.count(wire) > 0; })) {
     lock.unlock();
     msg::ExecuteCommand cancel = m;
     cancel.cancel(true);
@@ -317,7 +318,8 @@ ExecutionReport DdsExecutor::execute(const EdgeCommand& c, double budget_s) {
     r.reason = "no result within " + std::to_string(budget_s) + " s";
     return r;
   }
-  const msg::ExecuteStatus s = final_.at(c.command_id);
+  const msg::ExecuteStatus s = final_.at(wire);
+  final_.erase(wire);
   switch (s.state()) {
     case msg::ExecState::EXEC_SUCCEEDED: r.outcome = ExecOutcome::kSucceeded; break;
     case msg::ExecState::EXEC_BLOCKED: r.outcome = ExecOutcome::kBlocked; break;
@@ -360,15 +362,25 @@ Observation DdsWorldSource::robot() {
   return o;
 }
 
-bool DdsWorldSource::waitReady(const Termination& until) {
+Status DdsWorldSource::waitReady(const Termination& until) {
+  bool state = false;
+  bool world = false;
   while (!until()) {
     {
       std::lock_guard g(mutex_);
-      if (last_ && mirror_.publishedVersion() > 0) return true;
+      state = last_.has_value();
     }
+    world = mirror_.publishedVersion() > 0;
+    if (state && world) return Status::Ok();
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
-  return false;
+  std::string missing;
+  if (!world) missing = "no complete world model (" + std::string(dds::topics::kWorldMeta.name) + " and its objects, from perception)";
+  if (!state) {
+    if (!missing.empty()) missing += " and ";
+    missing += "no robot state (" + std::string(dds::topics::kRobotState.name) + " from the robot)";
+  }
+  return Error(ErrorCode::kUnavailable, missing);
 }
 
 }  // namespace tamp::graph_manager

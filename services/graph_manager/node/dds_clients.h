@@ -22,6 +22,8 @@ namespace tamp::graph_manager {
 class DdsServiceClients : public ServiceClients {
  public:
   DdsServiceClients(std::shared_ptr<dds::Participant> p, robot::RobotModel robot);
+  /// The mission's robot (joint names of motion requests). Not concurrent with the calls below.
+  void setRobot(robot::RobotModel robot) { robot_ = std::move(robot); }
   TaskPlan plan(const TaskQuery& q) override;
   MotionAnswer motion(const MotionQuery& q) override;
   Result<std::vector<PlacementOption>> placements(const PlacementQuery& q) override;
@@ -37,11 +39,15 @@ class DdsServiceClients : public ServiceClients {
   dds::RpcClient<msg::EffortRequest, msg::EffortReply> effort_;
 };
 
+/// Commands go out as "<mission id>/<command id>": the monitor and the robot are idempotent on
+/// command ids, and a deployment runs many missions whose steps are numbered alike.
 class DdsExecutor : public Executor {
  public:
   DdsExecutor(std::shared_ptr<dds::Participant> p, std::string mission_id);
   ExecutionReport execute(const EdgeCommand& command, double budget_s) override;
   void setMission(const std::string& id) { mission_id_ = id; }
+  /// The id a command of the current mission has on the wire.
+  std::string wireId(const std::string& command_id) const { return mission_id_ + "/" + command_id; }
 
  private:
   void onStatus(const msg::ExecuteStatus& s);
@@ -56,10 +62,12 @@ class DdsExecutor : public Executor {
 class DdsWorldSource : public WorldSource {
  public:
   DdsWorldSource(std::shared_ptr<dds::Participant> p, robot::RobotModel robot);
+  /// The mission's robot (joint values of robot states). Not concurrent with `robot()`.
+  void setRobot(robot::RobotModel robot) { robot_ = std::move(robot); }
   world::World world() override { return mirror_.snapshot(); }
   Observation robot() override;
-  /// Waits until a robot state and a world model have arrived.
-  bool waitReady(const Termination& until);
+  /// Waits until a robot state and a world model have arrived. On a timeout, says which did not.
+  Status waitReady(const Termination& until);
 
  private:
   robot::RobotModel robot_;

@@ -53,15 +53,22 @@ Result<std::unique_ptr<dds::ServiceNode>> GraphManagerNode::create(const dds::Se
       args.config_file.empty() ? configDir() / "services" / "graph_manager.yaml" : std::filesystem::path(args.config_file);
   auto params = loadParams(file);
   if (!params) return params.error();
-  return std::unique_ptr<dds::ServiceNode>(new GraphManagerNode(args, *params));
+  // Each mission sets its scenario's robot; until then, the default one.
+  auto robot = robot::RobotModel::loadDefault();
+  if (!robot) return robot.error();
+  return std::unique_ptr<dds::ServiceNode>(new GraphManagerNode(args, *params, *robot));
 }
 
-GraphManagerNode::GraphManagerNode(const dds::ServiceArgs& args, GraphManagerParams params)
+GraphManagerNode::GraphManagerNode(const dds::ServiceArgs& args, GraphManagerParams params,
+                                   const robot::RobotModel& robot)
     : dds::ServiceNode(args),
       args_(args),
       params_(params),
       status_(participant(), dds::topics::kMissionStatus),
-      graph_(participant(), dds::topics::kGraph) {
+      graph_(participant(), dds::topics::kGraph),
+      clients_(participant(), robot),
+      executor_(participant(), ""),
+      source_(participant(), robot) {
   thread_ = std::jthread([this](std::stop_token st) { worker(st); });
   commands_ = std::make_unique<dds::Reader<msg::MissionCommand>>(
       participant(), dds::topics::kMissionCommand,
@@ -153,14 +160,14 @@ void GraphManagerNode::runOne(const msg::MissionCommand& c) {
   if (c.seed() != 0) p.seed = c.seed();
   if (c.max_replans() > 0) p.max_replans = static_cast<int>(c.max_replans());
 
-  DdsServiceClients clients(participant(), *robot);
-  DdsExecutor executor(participant(), id);
-  DdsWorldSource source(participant(), *robot);
+  clients_.setRobot(*robot);
+  executor_.setMission(id);
+  source_.setRobot(*robot);
   publish(id, msg::MissionState::MISSION_PLANNING, "waiting for the world model and the robot state");
-  if (!source.waitReady(Termination::after(30.0)))
-    return fail(MissionOutcome::kUnavailable, "no world model or robot state within 30 s (perception, sim running?)");
+  if (Status ready = source_.waitReady(Termination::after(30.0)); !ready)
+    return fail(MissionOutcome::kUnavailable, ready.error().message + " within 30 s (perception, sim running?)");
 
-  Abstraction abs(source.world(), *robot);
+  Abstraction abs(source_.world(), *robot);
   auto goal = goalOf(*sc, *robot, abs);
   if (!goal) return fail(MissionOutcome::kInputError, "bad goal: " + goal.error().toString());
   if (!c.goal().empty()) {
@@ -174,7 +181,7 @@ void GraphManagerNode::runOne(const msg::MissionCommand& c) {
       goal->atoms.push_back(a);
     }
   }
-  GraphManager gm(std::move(abs), *domain, *goal, clients, p);
+  GraphManager gm(std::move(abs), *domain, *goal, clients_, p);
   logger()->info("mission {}: scenario {}, policy {}, goal {} atoms", id, sc->name, toString(p.policy), goal->atoms.size());
 
   MissionObserver obs;
@@ -233,7 +240,7 @@ void GraphManagerNode::runOne(const msg::MissionCommand& c) {
   };
   obs.abort_requested = [&] { return abort_.load(); };
 
-  MissionReport r = gm.runMission(source, executor, obs);
+  MissionReport r = gm.runMission(source_, executor_, obs);
   current_.elapsed_s(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   current_.replans(static_cast<uint32_t>(r.replans));
   current_.report_json(reportJson(r, scenario_path, std::string(toString(p.policy)), p.seed));

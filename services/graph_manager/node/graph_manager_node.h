@@ -25,7 +25,7 @@ class GraphManagerNode : public dds::ServiceNode {
   /// Reads `args.config_file` (default: configDir()/services/graph_manager.yaml). Errors: bad
   /// parameters (exit 30).
   static Result<std::unique_ptr<dds::ServiceNode>> create(const dds::ServiceArgs& args);
-  GraphManagerNode(const dds::ServiceArgs& args, GraphManagerParams params);
+  GraphManagerNode(const dds::ServiceArgs& args, GraphManagerParams params, const robot::RobotModel& robot);
   ~GraphManagerNode() override;
 
  private:
@@ -46,6 +46,12 @@ class GraphManagerNode : public dds::ServiceNode {
   std::atomic<bool> abort_{false};
   std::string running_;
   msg::MissionStatus current_;
+  // The node's reach into the other services lives as long as the node: its readers and writers
+  // are matched (and, under DDS Security, their crypto tokens exchanged) before the first mission
+  // arrives, not at the start of each one. Used by the worker thread only.
+  DdsServiceClients clients_;
+  DdsExecutor executor_;
+  DdsWorldSource source_;
   std::jthread thread_;
   std::unique_ptr<dds::Reader<msg::MissionCommand>> commands_;
 };

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <set>
 
 #include "tamp/core/log.h"
 #include "tamp/graph_manager/graph_manager.h"
@@ -96,6 +97,7 @@ struct GraphManager::Run {
   int step{0};
   bool first_action{true};
   std::optional<Clock::time_point> event_at;  ///< a replanning waiting for its next command
+  std::set<NodeId> planned_from_scratch;      ///< nodes TP(node, goal) was asked for after a replanning
 
   MissionReport run();
 
@@ -140,6 +142,19 @@ MissionReport GraphManager::Run::finish(MissionOutcome o, const std::string& rea
 bool GraphManager::Run::planBranch(std::string& why) {
   state(attempts ? "replanning" : "planning", "traverse from n" + std::to_string(current));
   TraverseResult t = gm.traverse(current, ctx);
+  if (!t.found && attempts > 0 && planned_from_scratch.insert(current).second) {
+    // Every re-joining branch goes through an action that can no longer be done (it failed too
+    // often): the goal from here, from scratch, merged into the graph; Traverse again.
+    const int planner0 = gm.counters_.planner_calls;
+    auto plan = gm.planFrom(current, gm.goal_.atoms, "plan from scratch: no re-joining branch left");
+    if (plan) {
+      if (!report.replanning.empty()) {
+        report.replanning.back().how = "from scratch";
+        report.replanning.back().planner_calls += gm.counters_.planner_calls - planner0;
+      }
+      t = gm.traverse(current, ctx);
+    }
+  }
   if (!t.found) {
     why = t.reason;
     return false;
@@ -152,22 +167,27 @@ bool GraphManager::Run::planBranch(std::string& why) {
 }
 
 GraphManager::Run::Prepared GraphManager::Run::prepare(EdgeId id, EdgeId next) {
-  Edge& e = gm.graph_.edge(id);
+  // Evaluating may grow the graph (its edge vector): edges are looked up by id after it.
+  const ActionKind kind = gm.graph_.edge(id).kind;
   bool ok = true;
-  std::string what = e.action;
-  if (e.kind == ActionKind::kPick || e.kind == ActionKind::kPlace) {
+  std::string what = gm.graph_.edge(id).action;
+  if (kind == ActionKind::kPick || kind == ActionKind::kPlace) {
     // A manipulation is never sent deferred: its grasp is planned now or it is a failure.
-    ok = std::isfinite(gm.evaluate(id, -1, ctx, 0)) && e.motion && !e.motion->deferred && !e.motion->trajectory.empty();
-    if (!ok && e.reason.empty()) e.reason = "no grasp or placement in the world as it is now";
-  } else if (e.kind == ActionKind::kMoveArm && gm.armKey(id, next) >= 0) {
+    const bool priced = std::isfinite(gm.evaluate(id, -1, ctx, 0));
+    Edge& m = gm.graph_.edge(id);
+    ok = priced && m.motion && !m.motion->deferred && !m.motion->trajectory.empty();
+    if (!ok && m.reason.empty()) m.reason = "no grasp or placement in the world as it is now";
+  } else if (kind == ActionKind::kMoveArm && gm.armKey(id, next) >= 0) {
     // An arm motion into a manipulation is planned again in the world as it is now: the branch
     // priced it in a hypothetical world (objects moved by earlier edges, grasps deferred).
-    e.motion_by_next.erase(gm.armKey(id, next));
-    e.effort_by_next.erase(gm.armKey(id, next));
+    Edge& arm = gm.graph_.edge(id);
+    arm.motion_by_next.erase(gm.armKey(id, next));
+    arm.effort_by_next.erase(gm.armKey(id, next));
     ok = std::isfinite(gm.evaluate(id, next, ctx, 0));
     what = gm.graph_.edge(next).action;
   }
   if (ok) return Prepared::kReady;
+  Edge& e = gm.graph_.edge(id);
   ExecutedAction a;
   a.action = e.action;
   a.outcome = "not prepared";
@@ -375,7 +395,9 @@ bool GraphManager::Run::replan(const MissionEvent& ev, EdgeId failed, std::strin
   if (!ctx.held.object_id.empty() && ctx.held.object_id == held_before.object_id) ctx.held = held_before;
   gm.invalidateNear(changed);
   if (failed >= 0) {
+    // Planned again in the world as it is now, unless it failed too often (then infeasible).
     Edge& f = gm.graph_.edge(failed);
+    gm.noteFailure(f);
     f.state = EdgeState::kUnevaluated;
     f.motion.reset();
     f.motion_by_next.clear();

@@ -305,9 +305,13 @@ double GraphManager::evaluateBase(Edge& e, const BranchContext& ctx, int depth) 
     if (e.variant == Variant::kAround && params_.policy == Policy::kInfeasible && a.status == MotionOutcome::kNoPath &&
         depth < params_.max_subtask_depth + 1) {
       // Policy `infeasible`: only a proof that there is no way around lets objects be moved.
-      for (EdgeId twin : graph_.out(e.from)) {
-        Edge& d = graph_.edge(twin);
-        if (d.to == e.to && d.action == e.action && d.variant == Variant::kDirect && d.state == EdgeState::kLazy)
+      // Copies: spawning sub-tasks grows the graph (its edge vector and out(from)).
+      const std::vector<EdgeId> twins = graph_.out(e.from);
+      const NodeId to = e.to;
+      const std::string action = e.action;
+      for (EdgeId twin : twins) {
+        const Edge& d = graph_.edge(twin);
+        if (d.to == to && d.action == action && d.variant == Variant::kDirect && d.state == EdgeState::kLazy)
           spawnSubtasks(twin, ctx, depth);
       }
     }
@@ -339,8 +343,11 @@ double GraphManager::evaluateBase(Edge& e, const BranchContext& ctx, int depth) 
       log::get("graph_manager")->debug("{}: {} from {:.2f} to {:.2f} of the path, robot at ({:.2f}, {:.2f}); moved:{}",
                                        e.action, e.reason, c0.enter_fraction, c0.exit_fraction, at.x, at.y, moved);
     }
-    graph_.addVariant(e.id, Variant::kAround, e.origin);
-    if (params_.policy == Policy::kEffort && depth <= params_.max_subtask_depth) spawnSubtasks(e.id, ctx, depth);
+    // addVariant appends to the graph's edges: `e` may dangle after it, so keep the id.
+    const EdgeId id = e.id;
+    const std::string origin = e.origin;
+    graph_.addVariant(id, Variant::kAround, origin);
+    if (params_.policy == Policy::kEffort && depth <= params_.max_subtask_depth) spawnSubtasks(id, ctx, depth);
     return kInfinity;
   }
   e.state = EdgeState::kFeasible;
@@ -724,6 +731,11 @@ double GraphManager::evaluate(EdgeId id, EdgeId next, const BranchContext& ctx, 
   Edge& e = graph_.edge(id);
   next = armKey(id, next);
   ++counters_.evaluations;
+  if (const int n = failuresOf(e); n >= params_.max_action_failures) {
+    e.state = EdgeState::kInfeasible;
+    e.reason = "failed " + std::to_string(n) + " times in this mission (max_action_failures)";
+    return kInfinity;
+  }
   switch (e.kind) {
     case ActionKind::kMoveBase:
       if (e.state != EdgeState::kUnevaluated) return e.effort_mean_s;
@@ -737,6 +749,23 @@ double GraphManager::evaluate(EdgeId id, EdgeId next, const BranchContext& ctx, 
       return evaluateManipulation(e, ctx);
   }
   return kInfinity;
+}
+
+namespace {
+std::string manipulationKey(const Edge& e) {
+  return std::string(e.kind == ActionKind::kPick ? "pick " : "place ") + (e.tokens.size() > 1 ? e.tokens[1] : "");
+}
+}  // namespace
+
+int GraphManager::failuresOf(const Edge& e) const {
+  if (e.kind != ActionKind::kPick && e.kind != ActionKind::kPlace) return e.failures;
+  const auto it = manipulation_failures_.find(manipulationKey(e));
+  return it == manipulation_failures_.end() ? e.failures : std::max(e.failures, it->second);
+}
+
+void GraphManager::noteFailure(Edge& e) {
+  ++e.failures;
+  if (e.kind == ActionKind::kPick || e.kind == ActionKind::kPlace) ++manipulation_failures_[manipulationKey(e)];
 }
 
 BranchContext GraphManager::advance(EdgeId id, EdgeId next, const BranchContext& ctx) const {
@@ -996,15 +1025,18 @@ struct GraphManager::Search {
       ++evaluations;
       const int sub_depth = depth + (e.origin.rfind("sub-task", 0) == 0 ? 1 : 0);
       const double c = gm.evaluate(pick, -1, ctx, sub_depth);
+      // Evaluating may grow the graph (variants, sub-tasks): the edge is looked up again.
+      Edge& done = gm.graph_.edge(pick);
       if (!std::isfinite(c)) continue;
       if (cost + c >= best) {
-        e.cut = true;
+        done.cut = true;
         cut_bound[pick] = cost + c;
         continue;
       }
       branch.push_back(pick);
-      branch_sd2.push_back(e.effort_stddev_s * e.effort_stddev_s);
-      dfs(e.to, gm.advance(pick, -1, ctx), cost + c, depth);
+      branch_sd2.push_back(done.effort_stddev_s * done.effort_stddev_s);
+      const NodeId to = done.to;
+      dfs(to, gm.advance(pick, -1, ctx), cost + c, depth);
       branch.pop_back();
       branch_sd2.pop_back();
     }
@@ -1012,7 +1044,8 @@ struct GraphManager::Search {
 
   /// A move_arm edge: priced per manipulation that follows it (its target is their pre-grasp).
   void expandArm(EdgeId arm, const BranchContext& ctx, double cost, int depth) {
-    const Edge& a = gm.graph_.edge(arm);
+    // Copies: evaluating may grow the graph's edge vector.
+    const Edge a = gm.graph_.edge(arm);
     std::vector<EdgeId> nexts;
     for (EdgeId f : gm.graph_.out(a.to))
       if (gm.graph_.edge(f).kind == ActionKind::kPick || gm.graph_.edge(f).kind == ActionKind::kPlace) nexts.push_back(f);

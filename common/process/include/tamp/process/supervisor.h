@@ -112,6 +112,9 @@ class Supervisor {
   void adopt(ProcessSpec spec, pid_t pid);
   /// Starts every process not yet started; the first failure is returned (others still start).
   Status startAll();
+  /// Starts process `name` if it is not started yet (Ok when it already runs).
+  /// @throws std::invalid_argument for an unknown name.
+  Status start(const std::string& name);
   /// Reaps exited children and restarts the ones due. Call periodically (e.g. every 100 ms).
   void poll();
   /// The caller found `name` dead although it runs (e.g. no heartbeat): SIGKILL to its process
@@ -134,6 +137,7 @@ class Supervisor {
     std::chrono::steady_clock::time_point restart_at;
     bool stopping{false};
   };
+  Status startChild(Child& c);
   void onExit(Child& c, const std::string& how, int exit_code, bool clean);
   /// True (and the exit handled) when the child ended.
   /// `cause`: what ended it when we know better than its exit status (declareDead).

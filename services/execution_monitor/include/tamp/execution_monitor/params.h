@@ -7,7 +7,7 @@
 ///   world_id: world              # the world model instance mirrored (tamp/world/*)
 ///   start_tolerance: {position_m: 0.05, angle_rad: 0.05}  # trajectory start vs robot state
 ///   path_check: {step_m: 0.02, step_rad: 0.02}             # sampling of the swept path check
-///   object_tolerance_m: 0.05     # pick: world-model object vs commanded object_target
+///   object_tolerance_m: 0.15     # pick: world-model object vs commanded object_target
 ///   moved_tolerance_m: 0.05      # while running: a known object counts as new when it moved more
 ///   timeout: {stddevs: 3.0, margin_s: 5.0}  # overrun beyond expected + stddevs * stddev + margin
 ///   input_wait_s: 2.0            # before a start: wait this long for a robot state / world
@@ -51,7 +51,7 @@ struct MonitorParams {
   std::string world_id{"world"};  ///< world model instance (WorldMirror)
   StartTolerance start_tolerance;
   PathCheckParams path_check;
-  double object_tolerance_m{0.05};  ///< > 0: pick target vs the world model's object position (m)
+  double object_tolerance_m{0.15};  ///< > 0: pick target vs the world model's object position (m), as the graph manager's moved_object_tolerance_m
   /// > 0: while an action runs, only objects perceived since its start, or moved by more than
   /// this since then (m), are checked against the remaining path (perception noise on known
   /// objects does not stop the robot; they were checked at the start).

@@ -287,6 +287,11 @@ class GraphManager {
   double planning_s_{0.0};
   std::map<std::string, std::vector<GraspOption>> grasp_cache_;
   std::map<std::string, std::vector<PlacementOption>> placement_cache_;
+  /// Failed executions in this mission: per move edge, and per manipulation of an object ("pick
+  /// box"), whichever edge carried it (a grasp that misses from one stand misses from the next).
+  int failuresOf(const Edge& e) const;
+  void noteFailure(Edge& e);
+  std::map<std::string, int> manipulation_failures_;
 };
 
 }  // namespace tamp::graph_manager

@@ -47,6 +47,10 @@ struct GraphManagerParams {
   /// Online replanning: re-join sub-tasks tried towards the next this many nodes of the branch
   /// ahead (the first reachable ones are kept, Traverse chooses among them); >= 1.
   int max_rejoin_targets{2};
+  /// An action that failed or was blocked this many times in a mission is not tried again: the
+  /// edge is infeasible and Traverse looks for another branch (going round, another placement,
+  /// another grasp). A repeat of the same failure from the same state teaches nothing; >= 1.
+  int max_action_failures{2};
   /// An object of the world model that moved this far from where the graph expects it is an
   /// event (m); > 0. Above perception's error on a partly hidden object: with the arm over a thin
   /// box, the estimate strays about 0.09 m (namo_corridor, measured), and a false event replaces

@@ -760,12 +760,14 @@ std::string manipulationKey(const Edge& e) {
 int GraphManager::failuresOf(const Edge& e) const {
   if (e.kind != ActionKind::kPick && e.kind != ActionKind::kPlace) return e.failures;
   const auto it = manipulation_failures_.find(manipulationKey(e));
-  return it == manipulation_failures_.end() ? e.failures : std::max(e.failures, it->second);
+  return it == manipulation_failures_.end() ? 0 : it->second;
 }
 
 void GraphManager::noteFailure(Edge& e) {
-  ++e.failures;
-  if (e.kind == ActionKind::kPick || e.kind == ActionKind::kPlace) ++manipulation_failures_[manipulationKey(e)];
+  if (e.kind == ActionKind::kPick || e.kind == ActionKind::kPlace)
+    ++manipulation_failures_[manipulationKey(e)];
+  else
+    ++e.failures;
 }
 
 BranchContext GraphManager::advance(EdgeId id, EdgeId next, const BranchContext& ctx) const {

@@ -87,7 +87,7 @@ struct Edge {
   std::map<EdgeId, std::pair<double, double>> effort_by_next;  ///< mean, stddev
   bool cut{false};                 ///< pruned by the branch-and-bound at least once
   bool subtasks_spawned{false};
-  int failures{0};  ///< executions of this edge that failed or were blocked in this mission
+  int failures{0};  ///< failed or blocked executions of this move edge in this mission (manipulations: per object)
 };
 
 class ReachabilityGraph {

@@ -2,7 +2,7 @@
 """The evaluation runner (issue 12, part 6): `tamp run` on every scenario and NAMO world given,
 under each policy and seed, one mission at a time, and the evidence in one Markdown file.
 
-    tools/evaluation/evaluate.py [INPUT ...] [--policies effort,infeasible,oracle] [--seeds 5]
+    tools/evaluation/evaluate.py [INPUT ...] [--policies effort,infeasible,oracle] [--seeds 5] [--world-seeds N]
         [--build build/release] [--out docs/evaluation] [--mission-timeout 600] [--quick]
         [--lock FILE] [--realtime-factor 3] [--no-plot] [--keep-runs DIR] [--notes FILE]
 
@@ -295,13 +295,17 @@ def unavailable_row(case, policy, seed):
                 reason=f"tamp run --policy {policy} is refused")
 
 
+def seeds_for(case, opts):
+    return opts.world_seeds if case.kind == "world" else opts.seeds
+
+
 def run_matrix(cases, opts, setup, available):
     rows = []
-    total = len(cases) * len(opts.policies) * len(opts.seeds)
+    total = sum(len(seeds_for(case, opts)) for case in cases) * len(opts.policies)
     index = 0
     for case in cases:
         for policy in opts.policies:
-            for seed in opts.seeds:
+            for seed in seeds_for(case, opts):
                 if not available[policy]:
                     rows.append(unavailable_row(case, policy, seed))
                     continue
@@ -512,6 +516,10 @@ def load_average():
     return " / ".join(f"{x:.2f}" for x in os.getloadavg())
 
 
+def seed_list(seeds):
+    return ", ".join(str(s) for s in seeds)
+
+
 def setup_lines(opts, inputs, facts):
     scen = sum(1 for c in inputs.cases if c.kind == "scenario")
     return [
@@ -523,7 +531,7 @@ def setup_lines(opts, inputs, facts):
         f"- Started {facts['start']}, {facts['minutes']:.0f} min wall time, missions one at a time"
         + (f" under `flock {opts.lock}`" if opts.lock else ""),
         f"- {scen} scenario files and {len(inputs.cases) - scen} NAMO worlds (robot scaled as `tamp run` does);"
-        f" policies {', '.join(opts.policies)}; seeds {', '.join(str(s) for s in opts.seeds)}",
+        f" policies {', '.join(opts.policies)}; seeds {seed_list(opts.seeds)} (NAMO worlds: {seed_list(opts.world_seeds)})",
         f"- Simulator at {opts.realtime_factor} x real time (simulated durations are unaffected); a fresh"
         f" effort-estimator store per run; `--mission-timeout {opts.mission_timeout:g}`",
         "- executed s: the report's `executed_effort_s` (simulated seconds, successful runs only in the aggregates);"
@@ -607,6 +615,8 @@ def parse_args(argv):
     p.add_argument("inputs", nargs="*", help="scenario YAML, NAMO world (.json/.svg) or folder")
     p.add_argument("--policies", default=",".join(DEFAULT_POLICIES), help="comma-separated (default: %(default)s)")
     p.add_argument("--seeds", type=int, default=5, help="seeds 1..N (default: %(default)s)")
+    p.add_argument("--world-seeds", type=int, default=None,
+                   help="seeds 1..N for NAMO world inputs (default: --seeds)")
     p.add_argument("--build", default="build/release", help="build directory with bin/tamp-run (default: %(default)s)")
     p.add_argument("--out", default="docs/evaluation", help="output prefix: OUT.md, OUT.csv, OUT_executed_time.svg/png")
     p.add_argument("--mission-timeout", type=float, default=600.0, help="tamp run --mission-timeout, s")
@@ -623,8 +633,10 @@ def parse_args(argv):
     opts.policies = [x for x in opts.policies.split(",") if x]
     if not opts.policies:
         raise InputError("--policies: no policy given")
-    if opts.seeds < 1:
-        raise InputError(f"--seeds {opts.seeds}: must be at least 1")
+    if opts.world_seeds is None:
+        opts.world_seeds = opts.seeds
+    if opts.seeds < 1 or opts.world_seeds < 1:
+        raise InputError(f"--seeds {opts.seeds}, --world-seeds {opts.world_seeds}: must be at least 1")
     if opts.mission_timeout <= 0:
         raise InputError(f"--mission-timeout {opts.mission_timeout}: must be positive")
     if opts.realtime_factor < 0:
@@ -634,13 +646,14 @@ def parse_args(argv):
     if opts.notes and not Path(opts.notes).is_file():
         raise InputError(f"--notes {opts.notes}: no such file")
     if opts.quick:
-        opts.seeds = 1
+        opts.seeds = opts.world_seeds = 1
         opts.policies = opts.policies[:1]
         if not opts.inputs:
             opts.inputs = [str(REPO / "config/scenarios/namo_corridor_short.yaml")]
     if not opts.inputs:
         opts.inputs = [str(REPO / "config/scenarios"), str(REPO / "tests/data/benchmarks/namo")]
     opts.seeds = list(range(1, opts.seeds + 1))
+    opts.world_seeds = list(range(1, opts.world_seeds + 1))
     opts.tamp_run = Path(opts.build) / "bin" / "tamp-run"
     if not os.access(opts.tamp_run, os.X_OK):
         raise InputError(f"--build {opts.build}: no executable {opts.tamp_run}")

@@ -299,7 +299,9 @@ def seeds_for(case, opts):
     return opts.world_seeds if case.kind == "world" else opts.seeds
 
 
-def run_matrix(cases, opts, setup, available):
+def run_matrix(cases, opts, setup, available, after_each):
+    """Every case x policy x seed; after_each(rows) is called after every run (partial results
+    on disk when the evaluation is stopped)."""
     rows = []
     total = sum(len(seeds_for(case, opts)) for case in cases) * len(opts.policies)
     index = 0
@@ -315,6 +317,7 @@ def run_matrix(cases, opts, setup, available):
                 print(f"[{len(rows)}/{total}] {case.label} {policy} seed {seed}: {row['status']}"
                       f" (exit {row['exit']}, executed {fmt(row.get('executed_s'))} s, wall {row['wall_s']} s)",
                       flush=True)
+                after_each(rows)
     return rows, index
 
 
@@ -528,7 +531,8 @@ def setup_lines(opts, inputs, facts):
         f"- Machine: {os.cpu_count()} cores ({facts['cpu']}), {platform.system()} {platform.release()};"
         f" load average (1/5/15 min) {facts['load_start']} at the start, {facts['load_end']} at the end"
         " (other work on the machine included)",
-        f"- Started {facts['start']}, {facts['minutes']:.0f} min wall time, missions one at a time"
+        f"- Started {facts['start']}, {facts['minutes']:.0f} min wall time, {facts['done']} of {facts['planned']}"
+        " runs (not-available ones included), missions one at a time"
         + (f" under `flock {opts.lock}`" if opts.lock else ""),
         f"- {scen} scenario files and {len(inputs.cases) - scen} NAMO worlds (robot scaled as `tamp run` does);"
         f" policies {', '.join(opts.policies)}; seeds {seed_list(opts.seeds)} (NAMO worlds: {seed_list(opts.world_seeds)})",
@@ -674,6 +678,7 @@ def main(argv):
         return 2
     facts = dict(command=opts.command, commit=git_commit(), build_type=build_type(opts.build), cpu=cpu_model(),
                  load_start=load_average(), start=time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()))
+    facts["planned"] = sum(len(seeds_for(c, opts)) for c in inputs.cases) * len(opts.policies)
     t0 = time.monotonic()
     with tempfile.TemporaryDirectory(prefix="tamp_evaluate.") as tmp:
         work = Path(tmp)
@@ -686,16 +691,21 @@ def main(argv):
         for p in opts.policies:
             if not available[p]:
                 print(f"evaluate: policy {p}: not available (tamp run --policy refuses it)", file=sys.stderr)
-        rows, runs = run_matrix(inputs.cases, opts, setup, available)
-    facts.update(load_end=load_average(), minutes=(time.monotonic() - t0) / 60.0)
-    out = Path(opts.out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    write_csv(out.with_suffix(".csv"), rows)
+        out = Path(opts.out)
+        out.parent.mkdir(parents=True, exist_ok=True)
+        notes = Path(opts.notes).read_text() if opts.notes else ""
+
+        def write_tables(rows_so_far, plot_name=""):
+            facts.update(load_end=load_average(), minutes=(time.monotonic() - t0) / 60.0, done=len(rows_so_far))
+            write_csv(out.with_suffix(".csv"), rows_so_far)
+            write_markdown(out.with_suffix(".md"), opts, inputs, rows_so_far, available, facts, plot_name, notes)
+
+        rows, runs = run_matrix(inputs.cases, opts, setup, available, write_tables)
+    write_tables(rows)
     plot_stem = out.parent / f"{out.name}_executed_time"
     plot_error = None if opts.no_plot or runs == 0 else make_plot(out.with_suffix(".csv"), plot_stem)
     plot_name = plot_stem.name if not opts.no_plot and runs > 0 and not plot_error else ""
-    notes = Path(opts.notes).read_text() if opts.notes else ""
-    write_markdown(out.with_suffix(".md"), opts, inputs, rows, available, facts, plot_name, notes)
+    write_tables(rows, plot_name)
     print(f"evaluate: {runs} runs; wrote {out.with_suffix('.md')}, {out.with_suffix('.csv')}", flush=True)
     if runs == 0:
         print("evaluate: ran nothing (no policy available)", file=sys.stderr)

@@ -27,6 +27,7 @@ nothing, 3 the plot could not be made (the tables are written).
 
 --quick: 1 seed and the first policy only (default inputs: config/scenarios/namo_corridor_short.yaml).
 --lock FILE: hold an flock on FILE around each `tamp run` (machines shared with builds).
+--list: print what would run (kind, label, file) and exit.
 """
 
 import argparse
@@ -630,6 +631,7 @@ def parse_args(argv):
                    help="simulator pace (default: $REALTIME_FACTOR or 3)")
     p.add_argument("--domain-base", type=int, default=100, help="DDS domains domain-base + run %% 100")
     p.add_argument("--no-plot", action="store_true", help="tables only")
+    p.add_argument("--list", action="store_true", help="print the scenarios and worlds that would run, then exit")
     p.add_argument("--keep-runs", default="", help="copy every run folder (reports, logs) under this folder")
     p.add_argument("--notes", default="", help="Markdown file inserted after the aims section")
     opts = p.parse_args(argv)
@@ -659,7 +661,7 @@ def parse_args(argv):
     opts.seeds = list(range(1, opts.seeds + 1))
     opts.world_seeds = list(range(1, opts.world_seeds + 1))
     opts.tamp_run = Path(opts.build) / "bin" / "tamp-run"
-    if not os.access(opts.tamp_run, os.X_OK):
+    if not opts.list and not os.access(opts.tamp_run, os.X_OK):
         raise InputError(f"--build {opts.build}: no executable {opts.tamp_run}")
     return opts
 
@@ -676,6 +678,10 @@ def main(argv):
     if not inputs.cases:
         print(f"evaluate: ran nothing: no scenario or world in {' '.join(opts.inputs)}", file=sys.stderr)
         return 2
+    if opts.list:
+        for c in inputs.cases:
+            print(f"{c.kind}\t{c.label}\t{c.path}")
+        return 0
     facts = dict(command=opts.command, commit=git_commit(), build_type=build_type(opts.build), cpu=cpu_model(),
                  load_start=load_average(), start=time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()))
     facts["planned"] = sum(len(seeds_for(c, opts)) for c in inputs.cases) * len(opts.policies)

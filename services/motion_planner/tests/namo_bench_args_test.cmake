@@ -4,6 +4,7 @@
 #   empty_folder    a folder without worlds: exit 2, "ran nothing"
 #   one_world       one shipped world, --runs 1: exit 0 and the table has that world's row
 #   cmake -DMODE=... -DBENCH=<executable> -DWORLD=<world file> -DWORK=<scratch dir> -P namo_bench_args_test.cmake
+cmake_minimum_required(VERSION 3.22)  # IN_LIST, and the policies of the project
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
 

@@ -33,7 +33,13 @@
 //          [--no-prepare]
 //          [--config params.yaml]   (MotionPlannerParams for our planner, e.g.
 //                                    config/services/motion_planner.yaml; default: built-in defaults)
+//          [WORLD.json | WORLD.svg | FOLDER ...]
+//   Worlds: the files named, and the worlds under each folder (recursively: every .json, and every
+//   .svg that no .json beside it names as its geometry file), short name = file stem; without any,
+//   the default set above. A missing path or another kind of file is an error; a world that does
+//   not load or has no goal is skipped with its reason; exit code 2 when no world was run.
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -58,6 +64,7 @@
 #include <ompl/geometric/planners/rrt/RRTConnect.h>
 #include <ompl/util/Console.h>
 
+#include "tamp/core/error.h"
 #include "tamp/core/paths.h"
 #include "tamp/core/stats.h"
 #include "tamp/motion_planner/motion_planner.h"
@@ -349,9 +356,13 @@ Summary summarize(const std::vector<Run>& runs) {
   return s;
 }
 
-std::vector<WorldCase> loadWorlds(const std::string& filter) {
+using WorldFiles = std::vector<std::pair<std::string, fs::path>>;  // (short name, file)
+
+/// The default set: the 19 bare Moghaddam SVGs and the JSON worlds with movables (omniscient
+/// variants: full knowledge; the planning problem is the same as the partial-knowledge variant's).
+WorldFiles defaultWorldFiles() {
   const fs::path root = benchmarksDir() / "namo";
-  std::vector<std::pair<std::string, fs::path>> files;
+  WorldFiles files;
   for (int n : {2, 4, 5, 7, 8, 10, 11, 13, 14, 16, 17, 19, 20, 22, 23, 25, 26, 28, 29}) {
     char name[64];
     std::snprintf(name, sizeof(name), "moghaddam_planning_2016_benchmark_%02d.svg", n);
@@ -359,8 +370,6 @@ std::vector<WorldCase> loadWorlds(const std::string& filter) {
     std::snprintf(shortname, sizeof(shortname), "%02d", n);
     files.emplace_back(shortname, root / "moghaddam_planning_2016_benchmark" / name);
   }
-  // JSON worlds with movables (omniscient variants: full knowledge; the planning problem is the
-  // same as the partial-knowledge variant's).
   files.emplace_back("m01", root / "moghaddam_planning_2016_benchmark/01/01_omniscient.json");
   files.emplace_back("two_rooms", root / "first_level/01_two_rooms_corridor/01_two_rooms_corridor_omniscient.json");
   files.emplace_back("big_crossing", root / "first_level/03_big_crossing/03_big_crossing_omniscient.json");
@@ -370,8 +379,76 @@ std::vector<WorldCase> loadWorlds(const std::string& filter) {
   files.emplace_back("feast_cplx", root / "s-namo_cases/04_after_the_feast/04_after_the_feast_omniscient_complexified.json");
   files.emplace_back("citi", root / "s-namo_cases/05_citi_second_floor/05_citi_second_floor_omniscient.json");
   files.emplace_back("chen", root / "stilman_2005_thesis/04_chen_difficult_problem/04_chen_difficult_problem_omniscient.json");
+  return files;
+}
+
+std::string lowerExtension(const fs::path& p) {
+  std::string e = p.extension().string();
+  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return std::tolower(c); });
+  return e;
+}
+
+/// SVGs that a world JSON in `dir` names as its `files.geometry_file` (geometry, not worlds).
+std::vector<fs::path> geometryFilesNamedIn(const fs::path& dir) {
+  std::vector<fs::path> named;
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    if (!entry.is_regular_file() || lowerExtension(entry.path()) != ".json") continue;
+    std::ifstream in(entry.path());
+    const auto j = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+    if (!j.is_object() || !j.contains("files") || !j["files"].is_object()) continue;
+    const auto& g = j["files"].value("geometry_file", nlohmann::json());
+    if (g.is_string()) named.push_back(fs::weakly_canonical(dir / g.get<std::string>()));
+  }
+  return named;
+}
+
+/// The NAMO worlds under `dir`, recursively and sorted: every .json, and every .svg that no .json
+/// beside it names as its geometry (the bare colour-convention SVGs).
+std::vector<fs::path> worldFilesIn(const fs::path& dir) {
+  std::vector<fs::path> candidates;
+  for (const auto& entry : fs::recursive_directory_iterator(dir)) {
+    const std::string ext = lowerExtension(entry.path());
+    if (entry.is_regular_file() && (ext == ".json" || ext == ".svg")) candidates.push_back(entry.path());
+  }
+  std::sort(candidates.begin(), candidates.end());
+  std::vector<fs::path> worlds;
+  std::map<fs::path, std::vector<fs::path>> geometry;  // folder -> SVGs named by its JSONs
+  for (const auto& p : candidates) {
+    if (lowerExtension(p) == ".svg") {
+      if (!geometry.count(p.parent_path())) geometry[p.parent_path()] = geometryFilesNamedIn(p.parent_path());
+      const auto& named = geometry[p.parent_path()];
+      if (std::find(named.begin(), named.end(), fs::weakly_canonical(p)) != named.end()) continue;
+    }
+    worlds.push_back(p);
+  }
+  return worlds;
+}
+
+/// The worlds named on the command line: files (.json or .svg) and folders (searched with
+/// worldFilesIn). A missing path or a file of another kind is an input error naming it.
+Result<WorldFiles> worldFilesFromArgs(const std::vector<std::string>& args) {
+  WorldFiles files;
+  for (const auto& a : args) {
+    const fs::path p(a);
+    std::error_code ec;
+    if (fs::is_directory(p, ec)) {
+      for (const auto& f : worldFilesIn(p)) files.emplace_back(f.stem().string(), f);
+    } else if (!fs::exists(p, ec)) {
+      return Error(ErrorCode::kNotFound, "no such world file or folder", SourceLocation(a));
+    } else if (const std::string ext = lowerExtension(p); ext == ".json" || ext == ".svg") {
+      files.emplace_back(p.stem().string(), p);
+    } else {
+      return Error(ErrorCode::kInvalidArgument, "not a NAMO world (.json or bare .svg)", SourceLocation(a));
+    }
+  }
+  return files;
+}
+
+/// Loads the worlds whose short name contains `filter`. A world that does not load or has no
+/// goal is skipped with its reason on stderr.
+std::vector<WorldCase> loadWorlds(const WorldFiles& files, const std::string& filter) {
   std::vector<WorldCase> out;
-  for (auto& [name, file] : files) {
+  for (const auto& [name, file] : files) {
     if (!filter.empty() && name.find(filter) == std::string::npos) continue;
     auto w = world::loadNamo(file);
     if (!w) {
@@ -379,7 +456,7 @@ std::vector<WorldCase> loadWorlds(const std::string& filter) {
       continue;
     }
     if (w->goals.empty()) {
-      std::cerr << "skip " << name << ": no goal\n";
+      std::cerr << "skip " << name << " (" << file.string() << "): no goal\n";
       continue;
     }
     out.push_back(WorldCase{name, file, std::move(*w)});
@@ -393,6 +470,7 @@ int main(int argc, char** argv) {
   int runs = 20, full_runs = 3, warmup = 5;
   double limit = 5.0;
   std::string filter, json_out, md_out;
+  std::vector<std::string> world_args;  // world files and folders; none: the default set
   bool use_prepare = true;
   bool baselines = true;
   motion_planner::MotionPlannerParams params;
@@ -414,6 +492,7 @@ int main(int argc, char** argv) {
     else if (a == "--markdown") md_out = next();
     else if (a == "--no-baselines") baselines = false;
     else if (a == "--no-prepare") use_prepare = false;
+    else if (!a.empty() && a[0] != '-') world_args.push_back(a);
     else if (a == "--config") {
       auto p = motion_planner::loadMotionPlannerParams(next(), {"node"});
       if (!p) {
@@ -424,14 +503,25 @@ int main(int argc, char** argv) {
     }
     else {
       std::cerr << "usage: " << argv[0]
-                << " [--runs N] [--full-runs N] [--warmup N] [--time-limit s] [--filter s] [--json f] [--markdown f] [--no-baselines] [--no-prepare] [--config f]\n";
+                << " [--runs N] [--full-runs N] [--warmup N] [--time-limit s] [--filter s] [--json f] [--markdown f] [--no-baselines] [--no-prepare] [--config f] [WORLD.json|WORLD.svg|FOLDER ...]\n";
       return 2;
     }
   }
   g_cost = params.cost;
   motion_planner::seedRandomness(42);
   ompl::msg::setLogLevel(ompl::msg::LOG_NONE);
-  const auto worlds = loadWorlds(filter);
+  const auto files = world_args.empty() ? Result<WorldFiles>(defaultWorldFiles()) : worldFilesFromArgs(world_args);
+  if (!files) {
+    std::cerr << files.error().toString() << "\n";
+    return 2;
+  }
+  const auto worlds = loadWorlds(*files, filter);
+  if (worlds.empty()) {
+    std::cerr << "namo_bench: ran nothing: no loadable world with a goal"
+              << (filter.empty() ? "" : " matching --filter " + filter) << " among " << files->size()
+              << " world files\n";
+    return 2;
+  }
   const std::vector<std::string> methods = {"ours",       "ours-prep", "ours-warm", "ours-any", "ours-len",
                                             "rrtconnect", "kpiece",    "lbkpiece",  "rrtc+simp"};
   std::map<std::string, std::map<std::string, std::vector<Run>>> results;  // world -> method -> runs

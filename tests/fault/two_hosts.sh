@@ -1,0 +1,127 @@
+#!/usr/bin/env bash
+# A mission across two hosts: two Linux network namespaces ("robot" 10.0.0.2, "workstation"
+# 10.0.0.1) joined by a veth link, each running `tamp launch config/deploy/two_hosts.yaml --host
+# ...`, the mission sent from the workstation with `tamp mission`. Needs root (ip netns).
+#
+#   tests/fault/two_hosts.sh BUILD_DIR [--discovery server|multicast] [--scenario FILE]
+#        [--netem "loss 10%"|"delay 50ms"|"duplicate 10%"|...] [--partition-at S --partition-for S]
+#        [--seed N] [--out DIR]
+#
+# --discovery server (default): the deployment gets `discovery: {mode: server, servers:
+# ["10.0.0.1:11811"], server_host: workstation}` and multicast is removed from the link (the veth
+# interfaces lose the MULTICAST flag and have no multicast route), so only the server path can
+# discover. --netem applies `tc qdisc ... netem ARGS` (with the seed) on both ends of the link;
+# --partition-at/--partition-for take the link down for that long, that far into the mission.
+# Exit code: `tamp mission`'s (0 succeeded, 10 failed, 20 timeout, 30 input, 40 services), and 50
+# when the run's checks fail: the simulator's final world is missing, or an action command id
+# was executed twice (the simulator's log). Artefacts in OUT/RUN_ID.
+set -euo pipefail
+BUILD=${1:?usage: two_hosts.sh BUILD_DIR [options]}; shift
+ROOT=$(cd "$(dirname "$0")/../.." && pwd)
+DISCOVERY=server SCENARIO=$ROOT/config/scenarios/namo_corridor_short.yaml NETEM="" SEED=1
+PART_AT="" PART_FOR=5 OUT=${TMPDIR:-/tmp}/tamp-two-hosts
+while [ $# -gt 0 ]; do
+  case $1 in
+    --discovery) DISCOVERY=$2; shift 2;;
+    --scenario) SCENARIO=$(realpath "$2"); shift 2;;
+    --netem) NETEM=$2; shift 2;;
+    --partition-at) PART_AT=$2; shift 2;;
+    --partition-for) PART_FOR=$2; shift 2;;
+    --seed) SEED=$2; shift 2;;
+    --out) OUT=$2; shift 2;;
+    *) echo "two_hosts.sh: unknown option $1" >&2; exit 30;;
+  esac
+done
+case $DISCOVERY in server|multicast) ;; *) echo "two_hosts.sh: --discovery server|multicast, got '$DISCOVERY'" >&2; exit 30;; esac
+BIN=$(realpath "$BUILD")/bin
+TAG=t$$
+RUN_ID=twohost-$DISCOVERY-$TAG
+NS_R=tamp-robot-$TAG NS_W=tamp-ws-$TAG
+mkdir -p "$OUT/$RUN_ID"
+OUT=$(realpath "$OUT")
+DEPLOY=$OUT/$RUN_ID/deployment.yaml
+cp "$ROOT/config/deploy/two_hosts.yaml" "$DEPLOY"
+if [ "$DISCOVERY" = server ]; then
+  printf 'discovery: {mode: server, servers: ["10.0.0.1:11811"], server_host: workstation}\n' >> "$DEPLOY"
+else
+  printf 'discovery: {mode: multicast}\n' >> "$DEPLOY"
+fi
+export TAMP_DOMAIN_ID=$(( (RANDOM % 100) + 100 )) TAMP_DDS_PROFILE=tamp_udp  # SHM would bypass the link
+
+PIDS=()
+cleanup() {
+  for p in "${PIDS[@]}"; do kill -TERM "$p" 2>/dev/null || true; done
+  for p in "${PIDS[@]}"; do wait "$p" 2>/dev/null || true; done
+  ip netns del "$NS_R" 2>/dev/null || true
+  ip netns del "$NS_W" 2>/dev/null || true
+}
+trap cleanup EXIT
+
+ip netns add "$NS_R"
+ip netns add "$NS_W"
+ip link add veth-r-$TAG type veth peer name veth-w-$TAG
+ip link set veth-r-$TAG netns "$NS_R"
+ip link set veth-w-$TAG netns "$NS_W"
+ip -n "$NS_R" addr add 10.0.0.2/24 dev veth-r-$TAG
+ip -n "$NS_W" addr add 10.0.0.1/24 dev veth-w-$TAG
+for ns in "$NS_R" "$NS_W"; do ip -n "$ns" link set lo up; done
+ip -n "$NS_R" link set veth-r-$TAG up
+ip -n "$NS_W" link set veth-w-$TAG up
+if [ "$DISCOVERY" = server ]; then
+  ip -n "$NS_R" link set veth-r-$TAG multicast off
+  ip -n "$NS_W" link set veth-w-$TAG multicast off
+  ip -n "$NS_R" link set lo multicast off
+  ip -n "$NS_W" link set lo multicast off
+  # Prove it: no interface of either host may carry multicast.
+  for ns in "$NS_R" "$NS_W"; do
+    if ip -n "$ns" -o link show | grep -q MULTICAST; then echo "two_hosts.sh: multicast still on in $ns" >&2; exit 50; fi
+  done
+else
+  ip -n "$NS_R" route add 224.0.0.0/4 dev veth-r-$TAG
+  ip -n "$NS_W" route add 224.0.0.0/4 dev veth-w-$TAG
+fi
+if [ -n "$NETEM" ]; then
+  # netem's own random generator takes no seed on Debian 12's tc; the seed labels the run.
+  ip netns exec "$NS_R" tc qdisc add dev veth-r-$TAG root netem $NETEM
+  ip netns exec "$NS_W" tc qdisc add dev veth-w-$TAG root netem $NETEM
+fi
+
+# The simulator (robot host) writes its final ground truth here.
+ip netns exec "$NS_R" env TAMP_SIM_FINAL_WORLD="$OUT/$RUN_ID/sim_final_world.json" \
+  "$BIN/tamp" launch "$DEPLOY" --host robot --run-id "$RUN_ID" --scenario "$SCENARIO" --out "$OUT" \
+  > "$OUT/$RUN_ID/launch-robot.out" 2>&1 &
+PIDS+=($!)
+ip netns exec "$NS_W" "$BIN/tamp" launch "$DEPLOY" --host workstation --run-id "$RUN_ID" --scenario "$SCENARIO" \
+  --out "$OUT" > "$OUT/$RUN_ID/launch-workstation.out" 2>&1 &
+PIDS+=($!)
+
+if [ -n "$PART_AT" ]; then
+  (
+    # Partition PART_AT s after the mission started (its first status line).
+    until grep -q "tamp mission: run" "$OUT/$RUN_ID/mission.out" 2>/dev/null; do sleep 0.2; done
+    sleep "$PART_AT"
+    ip -n "$NS_W" link set veth-w-$TAG down
+    echo "partition: link down at $(date -u +%T.%N)" >> "$OUT/$RUN_ID/faults.log"
+    sleep "$PART_FOR"
+    ip -n "$NS_W" link set veth-w-$TAG up
+    echo "partition: link up at $(date -u +%T.%N)" >> "$OUT/$RUN_ID/faults.log"
+  ) &
+  PIDS+=($!)
+fi
+
+START=$(date +%s.%N)
+set +e
+ip netns exec "$NS_W" "$BIN/tamp" mission "$SCENARIO" --deployment "$DEPLOY" --run-id "$RUN_ID" --seed "$SEED" \
+  --mission-timeout 400 --out "$OUT" > "$OUT/$RUN_ID/mission.out" 2>&1
+RC=$?
+set -e
+END=$(date +%s.%N)
+cat "$OUT/$RUN_ID/mission.out"
+echo "two_hosts.sh: run $RUN_ID discovery=$DISCOVERY netem='${NETEM}' partition_at='${PART_AT}' seed=$SEED exit=$RC mission_s=$(awk "BEGIN{print $END - $START}")"
+cleanup; trap - EXIT
+# The simulator writes its final world on a clean stop (cleanup sends SIGTERM to the launchers).
+if [ "$RC" = 0 ] && [ ! -s "$OUT/$RUN_ID/sim_final_world.json" ]; then
+  echo "two_hosts.sh: mission succeeded but the simulator wrote no final world" >&2; exit 50
+fi
+echo "$RC" > "$OUT/$RUN_ID/exit_code"
+exit "$RC"

@@ -5,7 +5,13 @@
 #
 #   tests/fault/two_hosts.sh BUILD_DIR [--discovery server|multicast] [--scenario FILE]
 #        [--netem "loss 10%"|"delay 50ms"|"duplicate 10%"|...] [--partition-at S --partition-for S]
-#        [--seed N] [--out DIR]
+#        [--seed N] [--out DIR] [--run-id ID] [--one-host] [--ping N]
+#
+# --one-host runs both launchers in the workstation namespace (same deployment, discovery and
+# UDP profile; traffic stays on the host), the baseline of the two-host benchmark. --ping N: after
+# the mission, N round trips of `tamp ping` from the workstation namespace to the simulator (on
+# the robot host), written to OUT/RUN_ID/ping.out. Every run gets a fresh effort-estimator store
+# (the default time models), so runs take the same decisions.
 #
 # --discovery server (default): the deployment gets `discovery: {mode: server, servers:
 # ["10.0.0.1:11811"], server_host: workstation}` and multicast is removed from the link (the veth
@@ -13,13 +19,15 @@
 # discover. --netem applies `tc qdisc ... netem ARGS` (with the seed) on both ends of the link;
 # --partition-at/--partition-for take the link down for that long, that far into the mission.
 # Exit code: `tamp mission`'s (0 succeeded, 10 failed, 20 timeout, 30 input, 40 services), and 50
-# when the run's checks fail: the simulator's final world is missing, or an action command id
-# was executed twice (the simulator's log). Artefacts in OUT/RUN_ID.
+# when the run's checks fail (the simulator's final world is missing), 77 when the network
+# namespaces cannot be created (not root: tests skip on it). Whether the robot reached the goal and
+# no command id was executed twice is judged from OUT/RUN_ID/sim_final_world.json
+# (tests/fault/two_hosts_test.cc). Artefacts in OUT/RUN_ID.
 set -euo pipefail
 BUILD=${1:?usage: two_hosts.sh BUILD_DIR [options]}; shift
 ROOT=$(cd "$(dirname "$0")/../.." && pwd)
 DISCOVERY=server SCENARIO=$ROOT/config/scenarios/namo_corridor_short.yaml NETEM="" SEED=1
-PART_AT="" PART_FOR=5 OUT=${TMPDIR:-/tmp}/tamp-two-hosts
+PART_AT="" PART_FOR=5 OUT=${TMPDIR:-/tmp}/tamp-two-hosts RUN_ID="" ONE_HOST=0 PING=0
 while [ $# -gt 0 ]; do
   case $1 in
     --discovery) DISCOVERY=$2; shift 2;;
@@ -29,18 +37,27 @@ while [ $# -gt 0 ]; do
     --partition-for) PART_FOR=$2; shift 2;;
     --seed) SEED=$2; shift 2;;
     --out) OUT=$2; shift 2;;
+    --run-id) RUN_ID=$2; shift 2;;
+    --one-host) ONE_HOST=1; shift;;
+    --ping) PING=$2; shift 2;;
     *) echo "two_hosts.sh: unknown option $1" >&2; exit 30;;
   esac
 done
 case $DISCOVERY in server|multicast) ;; *) echo "two_hosts.sh: --discovery server|multicast, got '$DISCOVERY'" >&2; exit 30;; esac
 BIN=$(realpath "$BUILD")/bin
 TAG=t$$
-RUN_ID=twohost-$DISCOVERY-$TAG
+RUN_ID=${RUN_ID:-twohost-$DISCOVERY-$TAG}
 NS_R=tamp-robot-$TAG NS_W=tamp-ws-$TAG
 mkdir -p "$OUT/$RUN_ID"
 OUT=$(realpath "$OUT")
-DEPLOY=$OUT/$RUN_ID/deployment.yaml
-cp "$ROOT/config/deploy/two_hosts.yaml" "$DEPLOY"
+RUN_DIR=$OUT/$RUN_ID
+DEPLOY=$RUN_DIR/deployment.yaml
+# A fresh effort-estimator store per run.
+mkdir -p "$RUN_DIR/store"
+sed -E "s#^store_directory: .*#store_directory: $RUN_DIR/store#" "$ROOT/config/services/effort_estimator.yaml" \
+  > "$RUN_DIR/effort_estimator.yaml"
+sed -E "s#\{config\}/services/effort_estimator.yaml#$RUN_DIR/effort_estimator.yaml#" \
+  "$ROOT/config/deploy/two_hosts.yaml" > "$DEPLOY"
 if [ "$DISCOVERY" = server ]; then
   printf 'discovery: {mode: server, servers: ["10.0.0.1:11811"], server_host: workstation}\n' >> "$DEPLOY"
 else
@@ -57,8 +74,10 @@ cleanup() {
 }
 trap cleanup EXIT
 
-ip netns add "$NS_R"
-ip netns add "$NS_W"
+if ! ip netns add "$NS_R" 2> "$RUN_DIR/netns.err" || ! ip netns add "$NS_W" 2>> "$RUN_DIR/netns.err"; then
+  echo "two_hosts.sh: cannot create network namespaces (needs root or CAP_SYS_ADMIN and iproute2): $(cat "$RUN_DIR/netns.err")" >&2
+  exit 77
+fi
 ip link add veth-r-$TAG type veth peer name veth-w-$TAG
 ip link set veth-r-$TAG netns "$NS_R"
 ip link set veth-w-$TAG netns "$NS_W"
@@ -87,7 +106,9 @@ if [ -n "$NETEM" ]; then
 fi
 
 # The simulator (robot host) writes its final ground truth here.
-ip netns exec "$NS_R" env TAMP_SIM_FINAL_WORLD="$OUT/$RUN_ID/sim_final_world.json" \
+NS_ROBOT_SIDE=$NS_R
+[ "$ONE_HOST" = 1 ] && NS_ROBOT_SIDE=$NS_W
+ip netns exec "$NS_ROBOT_SIDE" env TAMP_SIM_FINAL_WORLD="$OUT/$RUN_ID/sim_final_world.json" \
   "$BIN/tamp" launch "$DEPLOY" --host robot --run-id "$RUN_ID" --scenario "$SCENARIO" --out "$OUT" \
   > "$OUT/$RUN_ID/launch-robot.out" 2>&1 &
 PIDS+=($!)
@@ -114,10 +135,16 @@ set +e
 ip netns exec "$NS_W" "$BIN/tamp" mission "$SCENARIO" --deployment "$DEPLOY" --run-id "$RUN_ID" --seed "$SEED" \
   --mission-timeout 400 --out "$OUT" > "$OUT/$RUN_ID/mission.out" 2>&1
 RC=$?
-set -e
 END=$(date +%s.%N)
+if [ "$PING" -gt 0 ]; then
+  SERVERS=""
+  [ "$DISCOVERY" = server ] && SERVERS=10.0.0.1:11811
+  ip netns exec "$NS_W" env TAMP_DDS_DISCOVERY_SERVERS=$SERVERS "$BIN/tamp" ping sim --run-id "$RUN_ID" -c "$PING" > "$RUN_DIR/ping.out" 2>&1
+  tail -1 "$RUN_DIR/ping.out"
+fi
+set -e
 cat "$OUT/$RUN_ID/mission.out"
-echo "two_hosts.sh: run $RUN_ID discovery=$DISCOVERY netem='${NETEM}' partition_at='${PART_AT}' seed=$SEED exit=$RC mission_s=$(awk "BEGIN{print $END - $START}")"
+echo "two_hosts.sh: run $RUN_ID discovery=$DISCOVERY one_host=$ONE_HOST netem='${NETEM}' partition_at='${PART_AT}' seed=$SEED exit=$RC mission_s=$(awk "BEGIN{print $END - $START}")"
 cleanup; trap - EXIT
 # The simulator writes its final world on a clean stop (cleanup sends SIGTERM to the launchers).
 if [ "$RC" = 0 ] && [ ! -s "$OUT/$RUN_ID/sim_final_world.json" ]; then

@@ -1,8 +1,13 @@
 #include "tamp/dds/discovery.h"
 
 #include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
+#include <cerrno>
 #include <cstdlib>
+#include <cstring>
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
@@ -69,10 +74,42 @@ Result<std::vector<DiscoveryServerAddress>> resolveDiscoveryServers(const std::v
   return list;
 }
 
+namespace {
+
+/// Fast DDS creates a server on any address, reachable or not: bind a UDP socket to it first so
+/// that an address of another host or a port in use is an error naming it.
+Status checkBindable(const DiscoveryServerAddress& address) {
+  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
+  if (fd < 0) return Error(ErrorCode::kInternal, std::string("socket(): ") + std::strerror(errno));
+  sockaddr_in sa{};
+  sa.sin_family = AF_INET;
+  sa.sin_port = htons(address.port);
+  if (inet_pton(AF_INET, address.ip.c_str(), &sa.sin_addr) != 1) {
+    ::close(fd);
+    return Error(ErrorCode::kInvalidArgument, "discovery server '" + address.toString() + "': not an IPv4 address");
+  }
+  const int rc = ::bind(fd, reinterpret_cast<const sockaddr*>(&sa), sizeof(sa));
+  const int err = errno;
+  ::close(fd);
+  if (rc == 0) return Status::Ok();
+  if (err == EADDRNOTAVAIL) {
+    return Error(ErrorCode::kInvalidArgument, "discovery server " + address.toString() +
+                                                  ": the address is not one of this host's (run it on its host)");
+  }
+  if (err == EADDRINUSE) {
+    return Error(ErrorCode::kUnavailable, "discovery server " + address.toString() +
+                                              ": the UDP port is in use (another server or process)");
+  }
+  return Error(ErrorCode::kInternal, "discovery server " + address.toString() + ": bind: " + std::strerror(err));
+}
+
+}  // namespace
+
 Result<std::unique_ptr<DiscoveryServer>> DiscoveryServer::start(const DiscoveryServerAddress& address, int id) {
   if (id < 0 || id > 255) {
     return Error(ErrorCode::kInvalidArgument, "discovery server id must be in [0, 255], got " + std::to_string(id));
   }
+  if (Status s = checkBindable(address); !s.ok()) return s.error();
   fdds::DomainParticipantQos qos = fdds::PARTICIPANT_QOS_DEFAULT;
   qos.name("tamp/discovery_server");
   auto& builtin = qos.wire_protocol().builtin;

@@ -46,8 +46,9 @@ Result<std::vector<DiscoveryServerAddress>> resolveDiscoveryServers(const std::v
 class DiscoveryServer {
  public:
   /// Starts server `id` (its GUID prefix; the index of this address in the clients' lists)
-  /// listening on `address`. Errors: kInvalidArgument for an id > 255, kInternal when Fast DDS
-  /// refuses (address not local, port in use).
+  /// listening on `address`. Errors: kInvalidArgument for an id > 255 or an address that is not
+  /// one of this host's (Fast DDS itself would start an unreachable server), kUnavailable when
+  /// the UDP port is in use, kInternal when Fast DDS refuses.
   static Result<std::unique_ptr<DiscoveryServer>> start(const DiscoveryServerAddress& address, int id = 0);
   ~DiscoveryServer();
   DiscoveryServer(const DiscoveryServer&) = delete;

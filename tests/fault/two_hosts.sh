@@ -5,7 +5,12 @@
 #
 #   tests/fault/two_hosts.sh BUILD_DIR [--discovery server|multicast] [--scenario FILE]
 #        [--netem "loss 10%"|"delay 50ms"|"duplicate 10%"|...] [--partition-at S --partition-for S]
-#        [--seed N] [--out DIR] [--run-id ID] [--one-host] [--ping N]
+#        [--seed N] [--out DIR] [--run-id ID] [--one-host] [--ping N] [--loss PCT] [--duplicate PCT]
+#
+# --loss PCT / --duplicate PCT drop / duplicate that percentage of the UDP datagrams each host
+# sends on the link (nftables `numgen random` on both namespaces' output; needs `nft`, Debian
+# package nftables). --netem needs a kernel with sch_netem (CONFIG_NET_SCH_NETEM); the CI VM's
+# kernel has none, so loss and duplication go through nftables there and delay is not available.
 #
 # --one-host runs both launchers in the workstation namespace (same deployment, discovery and
 # UDP profile; traffic stays on the host), the baseline of the two-host benchmark. --ping N: after
@@ -27,7 +32,7 @@ set -euo pipefail
 BUILD=${1:?usage: two_hosts.sh BUILD_DIR [options]}; shift
 ROOT=$(cd "$(dirname "$0")/../.." && pwd)
 DISCOVERY=server SCENARIO=$ROOT/config/scenarios/namo_corridor_short.yaml NETEM="" SEED=1
-PART_AT="" PART_FOR=5 OUT=${TMPDIR:-/tmp}/tamp-two-hosts RUN_ID="" ONE_HOST=0 PING=0
+PART_AT="" PART_FOR=5 OUT=${TMPDIR:-/tmp}/tamp-two-hosts RUN_ID="" ONE_HOST=0 PING=0 LOSS=0 DUP=0
 while [ $# -gt 0 ]; do
   case $1 in
     --discovery) DISCOVERY=$2; shift 2;;
@@ -40,10 +45,18 @@ while [ $# -gt 0 ]; do
     --run-id) RUN_ID=$2; shift 2;;
     --one-host) ONE_HOST=1; shift;;
     --ping) PING=$2; shift 2;;
+    --loss) LOSS=$2; shift 2;;
+    --duplicate) DUP=$2; shift 2;;
     *) echo "two_hosts.sh: unknown option $1" >&2; exit 30;;
   esac
 done
 case $DISCOVERY in server|multicast) ;; *) echo "two_hosts.sh: --discovery server|multicast, got '$DISCOVERY'" >&2; exit 30;; esac
+for pct in "$LOSS" "$DUP"; do
+  if ! [[ $pct =~ ^[0-9]+$ ]] || [ "$pct" -gt 100 ]; then echo "two_hosts.sh: --loss/--duplicate take a percentage 0..100, got '$pct'" >&2; exit 30; fi
+done
+if { [ "$LOSS" -gt 0 ] || [ "$DUP" -gt 0 ]; } && ! command -v nft > /dev/null; then
+  echo "two_hosts.sh: --loss/--duplicate need nft (Debian package nftables)" >&2; exit 30
+fi
 BIN=$(realpath "$BUILD")/bin
 TAG=t$$
 RUN_ID=${RUN_ID:-twohost-$DISCOVERY-$TAG}
@@ -101,9 +114,28 @@ else
 fi
 if [ -n "$NETEM" ]; then
   # netem's own random generator takes no seed on Debian 12's tc; the seed labels the run.
-  ip netns exec "$NS_R" tc qdisc add dev veth-r-$TAG root netem $NETEM
+  if ! ip netns exec "$NS_R" tc qdisc add dev veth-r-$TAG root netem $NETEM 2> "$RUN_DIR/netem.err"; then
+    echo "two_hosts.sh: tc netem $NETEM refused: $(cat "$RUN_DIR/netem.err") (is sch_netem in this kernel?)" >&2; exit 30
+  fi
   ip netns exec "$NS_W" tc qdisc add dev veth-w-$TAG root netem $NETEM
 fi
+# Loss and duplication of the UDP datagrams each side sends on the link (nftables).
+link_faults() {  # NS DEV PEER_IP
+  local rules=""
+  [ "$LOSS" -gt 0 ] && rules+="oifname \"$2\" meta l4proto udp numgen random mod 100 < $LOSS counter drop"$'\n'
+  [ "$DUP" -gt 0 ] && rules+="oifname \"$2\" meta l4proto udp numgen random mod 100 < $DUP counter dup to $3 device \"$2\""$'\n'
+  [ -z "$rules" ] && return 0
+  ip netns exec "$1" nft -f - <<NFT
+table ip tamp_fault {
+  chain out {
+    type filter hook output priority 0; policy accept;
+    $rules
+  }
+}
+NFT
+}
+link_faults "$NS_R" veth-r-$TAG 10.0.0.1
+link_faults "$NS_W" veth-w-$TAG 10.0.0.2
 
 # The simulator (robot host) writes its final ground truth here.
 NS_ROBOT_SIDE=$NS_R
@@ -143,8 +175,11 @@ if [ "$PING" -gt 0 ]; then
   tail -1 "$RUN_DIR/ping.out"
 fi
 set -e
+if [ "$LOSS" -gt 0 ] || [ "$DUP" -gt 0 ]; then
+  for ns in "$NS_R" "$NS_W"; do ip netns exec "$ns" nft list table ip tamp_fault | grep counter >> "$RUN_DIR/faults.log"; done
+fi
 cat "$OUT/$RUN_ID/mission.out"
-echo "two_hosts.sh: run $RUN_ID discovery=$DISCOVERY one_host=$ONE_HOST netem='${NETEM}' partition_at='${PART_AT}' seed=$SEED exit=$RC mission_s=$(awk "BEGIN{print $END - $START}")"
+echo "two_hosts.sh: run $RUN_ID discovery=$DISCOVERY one_host=$ONE_HOST netem='${NETEM}' loss=$LOSS% duplicate=$DUP% partition_at='${PART_AT}' seed=$SEED exit=$RC mission_s=$(awk "BEGIN{print $END - $START}")"
 cleanup; trap - EXIT
 # The simulator writes its final world on a clean stop (cleanup sends SIGTERM to the launchers).
 if [ "$RC" = 0 ] && [ ! -s "$OUT/$RUN_ID/sim_final_world.json" ]; then

@@ -51,4 +51,10 @@ for ((i = 1; i <= RUNS; i++)); do
     echo "$(date -u +%FT%TZ),$COMMIT,$(basename "$SCENARIO" .yaml),$mode,${NETEM// /_},$i,$rc,$at_goal,$executed,$wall,${n:-},${pmin:-},${pmed:-},${pmax:-},$load" | tee -a "$CSV"
   done
 done
-rm -rf "$WORK"
+# Keep the artefacts of runs that failed (their report names the reason).
+kept=0
+for log in "$WORK"/bench-*.log; do
+  d=${log%.log}
+  if [ "$(cat "$d/exit_code" 2>/dev/null)" != 0 ]; then kept=1; else rm -rf "$d" "$log"; fi
+done
+if [ "$kept" = 1 ]; then echo "two_hosts_bench.sh: failed runs kept in $WORK" >&2; else rm -rf "$WORK"; fi

@@ -17,6 +17,7 @@
 
 #include "tamp/core/log.h"
 #include "tamp/core/termination.h"
+#include "tamp/dds/discovery.h"
 #include "tamp/dds/heartbeat.h"
 #include "tamp/dds/participant.h"
 
@@ -123,6 +124,9 @@ process::ProcessSpec Launcher::specOf(const deploy::ServiceSpec& s) const {
       spec.env[kv.substr(0, eq)] = kv.substr(eq + 1);
     }
   };
+  // Discovery of the deployment (multicast: an inherited server list is cleared); the host's and
+  // the service's env may still override it.
+  spec.env["TAMP_DDS_DISCOVERY_SERVERS"] = d.discovery.serversEnv();
   // The run folder, where services keep what must survive their restart (the execution
   // monitor's journal of commands sent to the robot).
   spec.env["TAMP_RUN_DIR"] = o_.run_dir.string();
@@ -138,12 +142,28 @@ process::ProcessSpec Launcher::specOf(const deploy::ServiceSpec& s) const {
   return spec;
 }
 
+Status Launcher::startDiscoveryServers() {
+  const auto& dc = o_.deployment.discovery;
+  if (dc.mode != deploy::DiscoverySpec::Mode::kServer || dc.server_host != o_.host) return Status::Ok();
+  for (std::size_t i = 0; i < dc.servers.size(); ++i) {
+    auto address = dds::parseDiscoveryServer(dc.servers[i]);
+    if (!address) return address.error();
+    auto server = dds::DiscoveryServer::start(*address, static_cast<int>(i));
+    if (!server) return server.error();
+    discovery_servers_.push_back(std::move(*server));
+  }
+  return Status::Ok();
+}
+
 Status Launcher::start() {
   // DDS first: a failure here must not touch the run folder of services we could have adopted.
   dds::ParticipantOptions po;
   po.domain_id = o_.domain;
   if (!o_.profile.empty()) po.profile = o_.profile;
   po.name = "tamp/launch/" + o_.host;
+  // This process and what it spawns (tamp-status) discover as the services do.
+  setenv("TAMP_DDS_DISCOVERY_SERVERS", o_.deployment.discovery.serversEnv().c_str(), 1);
+  if (Status s = startDiscoveryServers(); !s.ok()) return s;
   auto p = dds::Participant::create(po, o_.run_id);
   if (!p) return p.error();
   participant_ = *p;

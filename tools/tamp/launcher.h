@@ -32,6 +32,7 @@
 namespace tamp::dds {
 class Participant;
 class HeartbeatMonitor;
+class DiscoveryServer;
 }  // namespace tamp::dds
 
 namespace tamp::launch {
@@ -63,6 +64,11 @@ class Launcher {
   Launcher(const Launcher&) = delete;
   Launcher& operator=(const Launcher&) = delete;
 
+  /// With `discovery: {mode: server}` and this host the deployment's `server_host`, first starts
+  /// the discovery servers (in this process: they live as long as the supervisor; clients keep
+  /// what they discovered when it dies, and a new supervisor serves them again). Sets
+  /// $TAMP_DDS_DISCOVERY_SERVERS of this process to the deployment's servers ("" for multicast),
+  /// and of every service.
   /// Takes the run folder's lock, creates the DDS participant for liveness, adopts the services
   /// of launch.pids that still run and starts the others. Errors: kUnavailable when another
   /// supervisor holds the folder, kInternal when DDS fails, kNotFound when a service cannot start.
@@ -90,6 +96,7 @@ class Launcher {
   void note(const std::string& event, const std::string& detail);
 
  private:
+  Status startDiscoveryServers();
   process::ProcessSpec specOf(const deploy::ServiceSpec& s) const;
   void logEvent(const process::ProcessEvent& e);
   void writeEvent(const std::string& service, const std::string& event, pid_t pid, int restarts,
@@ -101,6 +108,7 @@ class Launcher {
 
   LaunchOptions o_;
   process::Supervisor sup_;
+  std::vector<std::unique_ptr<dds::DiscoveryServer>> discovery_servers_;  ///< outlive participant_
   std::shared_ptr<dds::Participant> participant_;
   std::unique_ptr<dds::HeartbeatMonitor> monitor_;
   std::vector<std::string> adopted_;

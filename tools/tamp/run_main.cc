@@ -129,6 +129,8 @@ int main(int argc, char** argv) {
     if (s.optional) optional_names.push_back(s.name);
   }
   local.hosts = {tamp::deploy::HostSpec{tamp::deploy::kLocalHost, "this machine", {}}};
+  // Every host is this one: so is the one that runs the discovery servers (mode server).
+  if (local.discovery.mode == tamp::deploy::DiscoverySpec::Mode::kServer) local.discovery.server_host = tamp::deploy::kLocalHost;
   tamp::launch::LaunchOptions lo;
   lo.deployment = local;
   lo.host = tamp::deploy::kLocalHost;

@@ -13,8 +13,12 @@
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
 
+#include <fastdds/rtps/attributes/ServerAttributes.h>
+#include <fastrtps/utils/IPLocator.h>
+
 #include "tamp/core/log.h"
 #include "tamp/core/paths.h"
+#include "tamp/dds/discovery.h"
 
 namespace fdds = eprosima::fastdds::dds;
 
@@ -77,6 +81,23 @@ Result<std::optional<ParticipantOptions::SecurityFiles>> resolveSecurity(const P
     }
   }
   return files;
+}
+
+/// Makes the participant a CLIENT of each server (server i has the default GUID prefix of id i).
+void useDiscoveryServers(fdds::DomainParticipantQos& qos, const std::vector<DiscoveryServerAddress>& servers) {
+  namespace rtps = eprosima::fastrtps::rtps;
+  auto& dc = qos.wire_protocol().builtin.discovery_config;
+  dc.discoveryProtocol = rtps::DiscoveryProtocol_t::CLIENT;
+  dc.m_DiscoveryServers.clear();
+  for (std::size_t i = 0; i < servers.size(); ++i) {
+    rtps::RemoteServerAttributes server;
+    rtps::get_server_client_default_guidPrefix(static_cast<int>(i), server.guidPrefix);
+    rtps::Locator_t locator;
+    rtps::IPLocator::setIPv4(locator, servers[i].ip);
+    locator.port = servers[i].port;
+    server.metatrafficUnicastLocatorList.push_back(locator);
+    dc.m_DiscoveryServers.push_back(server);
+  }
 }
 
 std::string fileUri(const std::filesystem::path& p) { return "file://" + std::filesystem::absolute(p).string(); }
@@ -173,6 +194,9 @@ Result<std::shared_ptr<Participant>> Participant::create(const ParticipantOption
     return Error(ErrorCode::kInvalidArgument, "unknown DDS participant profile '" + profile + "' in " + file.string());
   }
   qos.name(options.name.empty() ? "tamp" : options.name);
+  auto servers = resolveDiscoveryServers(options.discovery_servers);
+  if (!servers) return servers.error();
+  if (!servers->empty()) useDiscoveryServers(qos, *servers);
 
   if (*security) {
     const auto& f = **security;
@@ -191,6 +215,7 @@ Result<std::shared_ptr<Participant>> Participant::create(const ParticipantOption
 
   std::shared_ptr<Participant> p(new Participant());
   p->security_identity_ = *security ? identity : std::string();
+  p->discovery_client_ = !servers->empty();
   p->domain_id_ = *domain;
   p->name_ = qos.name().to_string();
   p->profile_ = profile;
@@ -198,7 +223,7 @@ Result<std::shared_ptr<Participant>> Participant::create(const ParticipantOption
   if (p->participant_ == nullptr) {
     return Error(ErrorCode::kInternal,
                  "Fast DDS could not create a participant on domain " + std::to_string(*domain) + " with profile '" +
-                     profile + "'" +
+                     profile + "'" + (servers->empty() ? std::string() : " as a discovery-server client") +
                      (*security ? " and DDS Security identity '" + identity +
                                       "' (certificate, key, governance or permissions refused: see the Fast DDS log)"
                                 : std::string()));

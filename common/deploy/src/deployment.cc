@@ -1,9 +1,11 @@
 #include "tamp/deploy/deployment.h"
 
+#include <arpa/inet.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
+#include <cstdlib>
 #include <set>
 
 #include "tamp/config/yaml_reader.h"
@@ -34,7 +36,56 @@ std::string replaceAll(std::string s, const std::string& key, const std::string&
   return s;
 }
 
+/// "" when `text` is IPv4:PORT, else what is wrong (tamp::dds parses it again; no DDS here).
+std::string badServerAddress(const std::string& text) {
+  const auto colon = text.rfind(':');
+  if (colon == std::string::npos) return "'" + text + "' must be IPv4:PORT (e.g. 10.0.0.1:11811)";
+  in_addr addr{};
+  if (inet_pton(AF_INET, text.substr(0, colon).c_str(), &addr) != 1) {
+    return "'" + text.substr(0, colon) + "' is not an IPv4 address";
+  }
+  const std::string port = text.substr(colon + 1);
+  char* end = nullptr;
+  const long p = std::strtol(port.c_str(), &end, 10);
+  if (port.empty() || *end != '\0' || p < 1 || p > 65535) return "port must be in [1, 65535], got '" + port + "'";
+  return {};
+}
+
+/// The `discovery` mapping (after `hosts`: server_host must name one).
+void readDiscovery(config::FieldReader& r, Deployment& d) {
+  auto dr = r.child("discovery");
+  std::string mode = "multicast";
+  dr.required("mode", mode);
+  dr.optional("servers", d.discovery.servers);
+  dr.optional("server_host", d.discovery.server_host);
+  if (mode == "server") {
+    d.discovery.mode = DiscoverySpec::Mode::kServer;
+    dr.check(!d.discovery.servers.empty(), "servers", "mode 'server' needs at least one server (\"IPv4:PORT\")");
+    for (std::size_t i = 0; i < d.discovery.servers.size(); ++i) {
+      const std::string bad = badServerAddress(d.discovery.servers[i]);
+      dr.check(bad.empty(), "servers", "entry " + std::to_string(i) + ": " + bad);
+    }
+    {
+      dr.check(d.host(d.discovery.server_host) != nullptr, "server_host",
+               "must name a declared host that runs the discovery servers (hosts: " + listOf(d.hosts) + "), got '" +
+                   d.discovery.server_host + "'");
+    }
+  } else {
+    dr.check(mode == "multicast", "mode", "must be 'multicast' or 'server', got '" + mode + "'");
+    dr.check(d.discovery.servers.empty(), "servers", "only with mode 'server'");
+    dr.check(d.discovery.server_host.empty(), "server_host", "only with mode 'server'");
+  }
+  dr.refuseUnknownKeys();
+}
+
 }  // namespace
+
+std::string DiscoverySpec::serversEnv() const {
+  if (mode != Mode::kServer) return {};
+  std::string out;
+  for (const auto& s : servers) out += (out.empty() ? "" : ";") + s;
+  return out;
+}
 
 const HostSpec* Deployment::host(const std::string& name) const {
   for (const auto& h : hosts) {
@@ -108,6 +159,7 @@ Result<Deployment> loadDeployment(const fs::path& file) {
   } else {
     d.hosts.push_back(HostSpec{kLocalHost, "this machine", {}});
   }
+  if (r.has("discovery")) readDiscovery(r, d);
   std::set<std::string> names;
   for (auto& s : r.sequence("services")) {
     ServiceSpec e;

@@ -176,6 +176,56 @@ TEST_F(DeploymentTest, BadFilesNameTheFieldAndLine) {
   EXPECT_THAT(both, HasSubstr("services[0].executable"));
 }
 
+TEST_F(DeploymentTest, DiscoveryIsMulticastUnlessTheFileAsksForServers) {
+  // The shipped deployments say nothing: multicast, and no server list for the services.
+  for (const char* file : {"local.yaml", "two_hosts.yaml"}) {
+    auto d = loadDeployment(configDir() / "deploy" / file);
+    ASSERT_TRUE(d.ok()) << d.error().toString();
+    EXPECT_EQ(d->discovery.mode, DiscoverySpec::Mode::kMulticast) << file;
+    EXPECT_EQ(d->discovery.serversEnv(), "") << file;
+  }
+  auto d = loadDeployment(write(R"(hosts: {robot: , desk: }
+discovery: {mode: server, servers: ["10.0.0.1:11811", "10.0.0.3:11900"], server_host: desk}
+services:
+  - {name: a, host: robot, executable: svc_a}
+)"));
+  ASSERT_TRUE(d.ok()) << d.error().toString();
+  EXPECT_EQ(d->discovery.mode, DiscoverySpec::Mode::kServer);
+  EXPECT_EQ(d->discovery.server_host, "desk");
+  EXPECT_EQ(d->discovery.serversEnv(), "10.0.0.1:11811;10.0.0.3:11900");
+}
+
+TEST_F(DeploymentTest, BadDiscoveryNamesTheField) {
+  const std::string hosts = "hosts: {robot: , desk: }\n";
+  const std::string services = "services:\n  - {name: a, host: robot, executable: x}\n";
+  EXPECT_THAT(errorOf(hosts + "discovery: {mode: mesh}\n" + services),
+              HasSubstr(":2:19: field 'discovery.mode': must be 'multicast' or 'server', got 'mesh'"));
+  EXPECT_THAT(errorOf(hosts + "discovery: {mode: server, server_host: desk}\n" + services),
+              HasSubstr("field 'discovery.servers': mode 'server' needs at least one server"));
+  EXPECT_THAT(
+      errorOf(hosts + "discovery: {mode: server, servers: [\"10.0.0.1\"], server_host: desk}\n" +
+              services),
+      HasSubstr("field 'discovery.servers': entry 0: '10.0.0.1' must be IPv4:PORT"));
+  EXPECT_THAT(
+      errorOf(hosts + "discovery: {mode: server, servers: [\"desk:11811\"], server_host: desk}\n" +
+              services),
+      HasSubstr("entry 0: 'desk' is not an IPv4 address"));
+  EXPECT_THAT(
+      errorOf(hosts + "discovery: {mode: server, servers: [\"10.0.0.1:0\"], server_host: desk}\n" +
+              services),
+      HasSubstr("entry 0: port must be in [1, 65535], got '0'"));
+  EXPECT_THAT(
+      errorOf(hosts + "discovery: {mode: server, servers: [\"10.0.0.1:11811\"], server_host: lab}\n" +
+              services),
+      HasSubstr("field 'discovery.server_host': must name a declared host that runs the discovery "
+                "servers (hosts: robot, desk), got 'lab'"));
+  EXPECT_THAT(errorOf(hosts + "discovery: {mode: multicast, servers: [\"10.0.0.1:11811\"]}\n" +
+                      services),
+              HasSubstr("field 'discovery.servers': only with mode 'server'"));
+  EXPECT_THAT(errorOf(hosts + "discovery: {mode: multicast, port: 3}\n" + services),
+              HasSubstr("field 'discovery.port': unknown key 'port'"));
+}
+
 TEST_F(DeploymentTest, MissingFileIsNamed) {
   auto d = loadDeployment(dir_ / "nope.yaml");
   ASSERT_FALSE(d.ok());

@@ -208,6 +208,15 @@ void writeFinalWorld(Simulator& sim) {
                 {"held", st.held_object_id}};
   j["time_s"] = sim.time();
   j["actions"] = sim.actionCount();
+  // The action log (what physically happened, one entry per accepted command id), so that a run
+  // can be checked for an action executed twice.
+  nlohmann::json log = nlohmann::json::array();
+  for (const auto& e : sim.actionLog()) {
+    log.push_back({{"command_id", e.command_id},
+                   {"kind", std::string(toString(e.kind))},
+                   {"outcome", e.result ? std::string(toString(e.result->outcome)) : std::string("running")}});
+  }
+  j["action_log"] = log;
   nlohmann::json objects = nlohmann::json::object();
   for (const auto& o : sim.world().objects()) {
     const Eigen::Vector3d t = o.pose.translation();

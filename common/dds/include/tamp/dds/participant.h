@@ -22,6 +22,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "tamp/core/error.h"
 
@@ -57,6 +58,9 @@ struct ParticipantOptions {
     std::filesystem::path identity_ca, certificate, private_key, permissions_ca, governance, permissions;
   };
   std::optional<SecurityFiles> security{};
+  /// Discovery servers ("IP:PORT", discovery.h): this participant is a CLIENT of each; empty:
+  /// $TAMP_DDS_DISCOVERY_SERVERS, and unset there too: multicast (SIMPLE) discovery.
+  std::vector<std::string> discovery_servers{};
 };
 
 /// The security files of `identity` in a make_certs.sh directory (not checked for existence).
@@ -96,6 +100,8 @@ class Participant : public std::enable_shared_from_this<Participant> {
   const std::string& runId() const { return run_id_; }
   /// The security identity (certificate CN) when DDS Security is on; empty otherwise.
   const std::string& securityIdentity() const { return security_identity_; }
+  /// True when this participant discovers through discovery servers (a CLIENT), not multicast.
+  bool usesDiscoveryServer() const { return discovery_client_; }
   /// This participant's GUID prefix as hex, unique per process and domain.
   std::string guid() const;
 
@@ -120,6 +126,7 @@ class Participant : public std::enable_shared_from_this<Participant> {
   std::string profile_;
   std::string run_id_;
   std::string security_identity_;
+  bool discovery_client_{false};
 };
 
 }  // namespace tamp::dds

@@ -10,6 +10,10 @@
 ///   startup_timeout_s: 30     # from start to first heartbeat
 ///   orphan_timeout_s: 60      # a launched service outlives a dead supervisor so long (0: always)
 ///   restart: {max_restarts: 5, backoff_s: 0.5, backoff_max_s: 8, stable_after_s: 30}
+///   discovery: {mode: multicast}  # default; or, on networks without multicast:
+///   discovery: {mode: server, servers: ["10.0.0.1:11811"], server_host: workstation}
+///                             # every participant is a client of the servers; `tamp launch
+///                             # --host <server_host>` runs them (an IPv4 of that host each)
 ///   hosts:                    # optional; without it every service is on host "local"
 ///     robot: {env: ["KEY=value"], description: "..."}
 ///     workstation: {}
@@ -58,6 +62,16 @@ struct RestartPolicy {
   double stable_after_s{30.0};  ///< a service that ran this long restarts from backoff_s again
 };
 
+/// How the participants of a deployment discover each other (tamp/dds/discovery.h).
+struct DiscoverySpec {
+  enum class Mode { kMulticast, kServer };
+  Mode mode{Mode::kMulticast};
+  std::vector<std::string> servers;  ///< "IPv4:PORT", server i has GUID prefix id i; kServer only
+  std::string server_host;           ///< host whose `tamp launch` runs the servers; kServer only
+  /// "IP:PORT;IP:PORT" ($TAMP_DDS_DISCOVERY_SERVERS) or "" for multicast.
+  std::string serversEnv() const;
+};
+
 struct Deployment {
   std::string file;
   double heartbeat_period_s{0.5};  ///< (0, 10]
@@ -65,6 +79,7 @@ struct Deployment {
   double startup_timeout_s{30.0};  ///< > 0
   double orphan_timeout_s{60.0};   ///< >= 0; 0: launched services never stop by themselves
   RestartPolicy restart;
+  DiscoverySpec discovery;
   std::vector<HostSpec> hosts;  ///< at least one ("local" when the file names none)
   std::vector<ServiceSpec> services;
 

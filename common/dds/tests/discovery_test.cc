@@ -1,0 +1,107 @@
+// Discovery servers: address parsing, the environment fallback, and participants that find each
+// other only through a server (real Fast DDS, one process).
+#include "tamp/dds/discovery.h"
+
+#include <unistd.h>
+
+#include <cstdlib>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "tamp/dds/endpoint.h"
+#include "tamp/dds/topics.h"
+#include "test_util.h"
+
+namespace tamp::dds {
+namespace {
+
+using ::testing::HasSubstr;
+
+TEST(DiscoveryServerAddressTest, ParsesIpv4AndPortAndNamesWhatIsWrong) {
+  auto a = parseDiscoveryServer("10.0.0.1:11811");
+  ASSERT_TRUE(a.ok()) << a.error().toString();
+  EXPECT_EQ(a->ip, "10.0.0.1");
+  EXPECT_EQ(a->port, 11811);
+  EXPECT_EQ(a->toString(), "10.0.0.1:11811");
+  EXPECT_THAT(parseDiscoveryServer("10.0.0.1").error().message, HasSubstr("must be IPv4:PORT"));
+  EXPECT_THAT(parseDiscoveryServer("host:11811").error().message,
+              HasSubstr("'host' is not an IPv4 address"));
+  EXPECT_THAT(parseDiscoveryServer("10.0.0.1:70000").error().message,
+              HasSubstr("port must be in [1, 65535], got '70000'"));
+  EXPECT_THAT(parseDiscoveryServer("10.0.0.1:").error().message, HasSubstr("got ''"));
+  auto list = parseDiscoveryServers("10.0.0.1:1;10.0.0.2:2");
+  ASSERT_TRUE(list.ok());
+  ASSERT_EQ(list->size(), 2u);
+  EXPECT_EQ((*list)[1].toString(), "10.0.0.2:2");
+  EXPECT_TRUE(parseDiscoveryServers("")->empty());
+  EXPECT_THAT(parseDiscoveryServers("10.0.0.1:1;nope").error().message, HasSubstr("'nope'"));
+}
+
+TEST(DiscoveryServerAddressTest, ExplicitListElseEnvironmentElseMulticast) {
+  ::setenv("TAMP_DDS_DISCOVERY_SERVERS", "10.0.0.9:5000", 1);
+  EXPECT_EQ((*resolveDiscoveryServers({}))[0].toString(), "10.0.0.9:5000");
+  EXPECT_EQ((*resolveDiscoveryServers({"127.0.0.1:7"}))[0].toString(), "127.0.0.1:7");
+  ::setenv("TAMP_DDS_DISCOVERY_SERVERS", "bad", 1);
+  EXPECT_THAT(resolveDiscoveryServers({}).error().message, HasSubstr("TAMP_DDS_DISCOVERY_SERVERS"));
+  ::setenv("TAMP_DDS_DISCOVERY_SERVERS", "", 1);  // what tamp launch sets for multicast
+  EXPECT_TRUE(resolveDiscoveryServers({})->empty());
+  ::unsetenv("TAMP_DDS_DISCOVERY_SERVERS");
+  EXPECT_TRUE(resolveDiscoveryServers({})->empty());
+  auto multicast = testing::makeParticipant();
+  ASSERT_TRUE(multicast);
+  EXPECT_FALSE(multicast->usesDiscoveryServer());
+}
+
+TEST(DiscoveryServerTest, ClientsOfAServerExchangeSamples) {
+  const DiscoveryServerAddress address{"127.0.0.1",
+                                       static_cast<uint16_t>(30000 + ::getpid() % 20000)};
+  auto server = DiscoveryServer::start(address);
+  ASSERT_TRUE(server.ok()) << server.error().toString();
+  auto client = [&](const std::string& name) {
+    ParticipantOptions o{testing::isolatedDomain(), kProfileUdp, name, {}};
+    o.discovery_servers = {address.toString()};
+    auto p = Participant::create(o);
+    if (!p) ADD_FAILURE() << p.error().toString();
+    return p ? *p : nullptr;
+  };
+  auto a = client("client_a");
+  auto b = client("client_b");
+  ASSERT_TRUE(a && b);
+  EXPECT_TRUE(a->usesDiscoveryServer());
+  testing::Inbox<std::string> inbox;
+  Reader<msg::WorldObject> reader(b, topics::kWorldObjects,
+                                  [&](const msg::WorldObject& o, const SampleMeta& meta) {
+                                    if (meta.alive) inbox.push(o.id());
+                                  });
+  Writer<msg::WorldObject> writer(a, topics::kWorldObjects);
+  ASSERT_TRUE(writer.waitForReaders(Termination::after(10.0), 1));
+  msg::WorldObject o;
+  o.id("box_1");
+  o.kind(msg::OBJECT_MOVABLE);
+  o.pose().orientation().w(1.0);
+  ASSERT_TRUE(writer.write(o).ok());
+  EXPECT_TRUE(inbox.waitFor([](const std::string& id) { return id == "box_1"; }, 10.0).has_value());
+}
+
+TEST(DiscoveryServerTest, RefusesAnAddressThatIsNotLocalOrABadId) {
+  EXPECT_EQ(DiscoveryServer::start({"127.0.0.1", 11811}, 300).error().code,
+            ErrorCode::kInvalidArgument);
+  // 192.0.2.0/24 is TEST-NET-1: never an address of this host.
+  auto foreign = DiscoveryServer::start({"192.0.2.1", 11811});
+  ASSERT_FALSE(foreign.ok());
+  EXPECT_EQ(foreign.error().code, ErrorCode::kInvalidArgument);
+  EXPECT_THAT(foreign.error().message,
+              HasSubstr("192.0.2.1:11811: the address is not one of this host's"));
+  const DiscoveryServerAddress address{"127.0.0.1",
+                                       static_cast<uint16_t>(30000 + ::getpid() % 20000 + 1)};
+  auto first = DiscoveryServer::start(address);
+  ASSERT_TRUE(first.ok()) << first.error().toString();
+  auto second = DiscoveryServer::start(address);
+  ASSERT_FALSE(second.ok());
+  EXPECT_EQ(second.error().code, ErrorCode::kUnavailable);
+  EXPECT_THAT(second.error().message, HasSubstr("port is in use"));
+}
+
+}  // namespace
+}  // namespace tamp::dds

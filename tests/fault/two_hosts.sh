@@ -1,0 +1,189 @@
+#!/usr/bin/env bash
+# A mission across two hosts: two Linux network namespaces ("robot" 10.0.0.2, "workstation"
+# 10.0.0.1) joined by a veth link, each running `tamp launch config/deploy/two_hosts.yaml --host
+# ...`, the mission sent from the workstation with `tamp mission`. Needs root (ip netns).
+#
+#   tests/fault/two_hosts.sh BUILD_DIR [--discovery server|multicast] [--scenario FILE]
+#        [--netem "loss 10%"|"delay 50ms"|"duplicate 10%"|...] [--partition-at S --partition-for S]
+#        [--seed N] [--out DIR] [--run-id ID] [--one-host] [--ping N] [--loss PCT] [--duplicate PCT]
+#
+# --loss PCT / --duplicate PCT drop / duplicate that percentage of the UDP datagrams each host
+# sends on the link (nftables `numgen random` on both namespaces' output; needs `nft`, Debian
+# package nftables). --netem needs a kernel with sch_netem (CONFIG_NET_SCH_NETEM); the CI VM's
+# kernel has none, so loss and duplication go through nftables there and delay is not available.
+#
+# --one-host runs both launchers in the workstation namespace (same deployment, discovery and
+# UDP profile; traffic stays on the host), the baseline of the two-host benchmark. --ping N: after
+# the mission, N round trips of `tamp ping` from the workstation namespace to the simulator (on
+# the robot host), written to OUT/RUN_ID/ping.out. Every run gets a fresh effort-estimator store
+# (the default time models), so runs take the same decisions.
+#
+# --discovery server (default): the deployment gets `discovery: {mode: server, servers:
+# ["10.0.0.1:11811"], server_host: workstation}` and multicast is removed from the link (the veth
+# interfaces lose the MULTICAST flag and have no multicast route), so only the server path can
+# discover. --netem applies `tc qdisc ... netem ARGS` (with the seed) on both ends of the link;
+# --partition-at/--partition-for take the link down for that long, that far into the mission.
+# Exit code: `tamp mission`'s (0 succeeded, 10 failed, 20 timeout, 30 input, 40 services), and 50
+# when the run's checks fail (the simulator's final world is missing), 77 when the network
+# namespaces cannot be created (not root: tests skip on it). Whether the robot reached the goal and
+# no command id was executed twice is judged from OUT/RUN_ID/sim_final_world.json
+# (tests/fault/two_hosts_test.cc). Artefacts in OUT/RUN_ID.
+set -euo pipefail
+BUILD=${1:?usage: two_hosts.sh BUILD_DIR [options]}; shift
+ROOT=$(cd "$(dirname "$0")/../.." && pwd)
+DISCOVERY=server SCENARIO=$ROOT/config/scenarios/namo_corridor_short.yaml NETEM="" SEED=1
+PART_AT="" PART_FOR=5 OUT=${TMPDIR:-/tmp}/tamp-two-hosts RUN_ID="" ONE_HOST=0 PING=0 LOSS=0 DUP=0
+while [ $# -gt 0 ]; do
+  case $1 in
+    --discovery) DISCOVERY=$2; shift 2;;
+    --scenario) SCENARIO=$(realpath "$2"); shift 2;;
+    --netem) NETEM=$2; shift 2;;
+    --partition-at) PART_AT=$2; shift 2;;
+    --partition-for) PART_FOR=$2; shift 2;;
+    --seed) SEED=$2; shift 2;;
+    --out) OUT=$2; shift 2;;
+    --run-id) RUN_ID=$2; shift 2;;
+    --one-host) ONE_HOST=1; shift;;
+    --ping) PING=$2; shift 2;;
+    --loss) LOSS=$2; shift 2;;
+    --duplicate) DUP=$2; shift 2;;
+    *) echo "two_hosts.sh: unknown option $1" >&2; exit 30;;
+  esac
+done
+case $DISCOVERY in server|multicast) ;; *) echo "two_hosts.sh: --discovery server|multicast, got '$DISCOVERY'" >&2; exit 30;; esac
+for pct in "$LOSS" "$DUP"; do
+  if ! [[ $pct =~ ^[0-9]+$ ]] || [ "$pct" -gt 100 ]; then echo "two_hosts.sh: --loss/--duplicate take a percentage 0..100, got '$pct'" >&2; exit 30; fi
+done
+if { [ "$LOSS" -gt 0 ] || [ "$DUP" -gt 0 ]; } && ! command -v nft > /dev/null; then
+  echo "two_hosts.sh: --loss/--duplicate need nft (Debian package nftables)" >&2; exit 30
+fi
+BIN=$(realpath "$BUILD")/bin
+TAG=t$$
+RUN_ID=${RUN_ID:-twohost-$DISCOVERY-$TAG}
+NS_R=tamp-robot-$TAG NS_W=tamp-ws-$TAG
+mkdir -p "$OUT/$RUN_ID"
+OUT=$(realpath "$OUT")
+RUN_DIR=$OUT/$RUN_ID
+DEPLOY=$RUN_DIR/deployment.yaml
+# A fresh effort-estimator store per run.
+mkdir -p "$RUN_DIR/store"
+sed -E "s#^store_directory: .*#store_directory: $RUN_DIR/store#" "$ROOT/config/services/effort_estimator.yaml" \
+  > "$RUN_DIR/effort_estimator.yaml"
+sed -E "s#\{config\}/services/effort_estimator.yaml#$RUN_DIR/effort_estimator.yaml#" \
+  "$ROOT/config/deploy/two_hosts.yaml" > "$DEPLOY"
+if [ "$DISCOVERY" = server ]; then
+  printf 'discovery: {mode: server, servers: ["10.0.0.1:11811"], server_host: workstation}\n' >> "$DEPLOY"
+else
+  printf 'discovery: {mode: multicast}\n' >> "$DEPLOY"
+fi
+export TAMP_DOMAIN_ID=$(( (RANDOM % 100) + 100 )) TAMP_DDS_PROFILE=tamp_udp  # SHM would bypass the link
+
+PIDS=()
+cleanup() {
+  for p in "${PIDS[@]}"; do kill -TERM "$p" 2>/dev/null || true; done
+  for p in "${PIDS[@]}"; do wait "$p" 2>/dev/null || true; done
+  ip netns del "$NS_R" 2>/dev/null || true
+  ip netns del "$NS_W" 2>/dev/null || true
+}
+trap cleanup EXIT
+
+if ! ip netns add "$NS_R" 2> "$RUN_DIR/netns.err" || ! ip netns add "$NS_W" 2>> "$RUN_DIR/netns.err"; then
+  echo "two_hosts.sh: cannot create network namespaces (needs root or CAP_SYS_ADMIN and iproute2): $(cat "$RUN_DIR/netns.err")" >&2
+  exit 77
+fi
+ip link add veth-r-$TAG type veth peer name veth-w-$TAG
+ip link set veth-r-$TAG netns "$NS_R"
+ip link set veth-w-$TAG netns "$NS_W"
+ip -n "$NS_R" addr add 10.0.0.2/24 dev veth-r-$TAG
+ip -n "$NS_W" addr add 10.0.0.1/24 dev veth-w-$TAG
+for ns in "$NS_R" "$NS_W"; do ip -n "$ns" link set lo up; done
+ip -n "$NS_R" link set veth-r-$TAG up
+ip -n "$NS_W" link set veth-w-$TAG up
+if [ "$DISCOVERY" = server ]; then
+  ip -n "$NS_R" link set veth-r-$TAG multicast off
+  ip -n "$NS_W" link set veth-w-$TAG multicast off
+  ip -n "$NS_R" link set lo multicast off
+  ip -n "$NS_W" link set lo multicast off
+  # Prove it: no interface of either host may carry multicast.
+  for ns in "$NS_R" "$NS_W"; do
+    if ip -n "$ns" -o link show | grep -q MULTICAST; then echo "two_hosts.sh: multicast still on in $ns" >&2; exit 50; fi
+  done
+else
+  ip -n "$NS_R" route add 224.0.0.0/4 dev veth-r-$TAG
+  ip -n "$NS_W" route add 224.0.0.0/4 dev veth-w-$TAG
+fi
+if [ -n "$NETEM" ]; then
+  # netem's own random generator takes no seed on Debian 12's tc; the seed labels the run.
+  if ! ip netns exec "$NS_R" tc qdisc add dev veth-r-$TAG root netem $NETEM 2> "$RUN_DIR/netem.err"; then
+    echo "two_hosts.sh: tc netem $NETEM refused: $(cat "$RUN_DIR/netem.err") (is sch_netem in this kernel?)" >&2; exit 30
+  fi
+  ip netns exec "$NS_W" tc qdisc add dev veth-w-$TAG root netem $NETEM
+fi
+# Loss and duplication of the UDP datagrams each side sends on the link (nftables).
+link_faults() {  # NS DEV PEER_IP
+  local rules=""
+  [ "$LOSS" -gt 0 ] && rules+="oifname \"$2\" meta l4proto udp numgen random mod 100 < $LOSS counter drop"$'\n'
+  [ "$DUP" -gt 0 ] && rules+="oifname \"$2\" meta l4proto udp numgen random mod 100 < $DUP counter dup to $3 device \"$2\""$'\n'
+  [ -z "$rules" ] && return 0
+  ip netns exec "$1" nft -f - <<NFT
+table ip tamp_fault {
+  chain out {
+    type filter hook output priority 0; policy accept;
+    $rules
+  }
+}
+NFT
+}
+link_faults "$NS_R" veth-r-$TAG 10.0.0.1
+link_faults "$NS_W" veth-w-$TAG 10.0.0.2
+
+# The simulator (robot host) writes its final ground truth here.
+NS_ROBOT_SIDE=$NS_R
+[ "$ONE_HOST" = 1 ] && NS_ROBOT_SIDE=$NS_W
+ip netns exec "$NS_ROBOT_SIDE" env TAMP_SIM_FINAL_WORLD="$OUT/$RUN_ID/sim_final_world.json" \
+  "$BIN/tamp" launch "$DEPLOY" --host robot --run-id "$RUN_ID" --scenario "$SCENARIO" --out "$OUT" \
+  > "$OUT/$RUN_ID/launch-robot.out" 2>&1 &
+PIDS+=($!)
+ip netns exec "$NS_W" "$BIN/tamp" launch "$DEPLOY" --host workstation --run-id "$RUN_ID" --scenario "$SCENARIO" \
+  --out "$OUT" > "$OUT/$RUN_ID/launch-workstation.out" 2>&1 &
+PIDS+=($!)
+
+if [ -n "$PART_AT" ]; then
+  (
+    # Partition PART_AT s after the mission started (its first status line).
+    until grep -q "tamp mission: run" "$OUT/$RUN_ID/mission.out" 2>/dev/null; do sleep 0.2; done
+    sleep "$PART_AT"
+    ip -n "$NS_W" link set veth-w-$TAG down
+    echo "partition: link down at $(date -u +%T.%N)" >> "$OUT/$RUN_ID/faults.log"
+    sleep "$PART_FOR"
+    ip -n "$NS_W" link set veth-w-$TAG up
+    echo "partition: link up at $(date -u +%T.%N)" >> "$OUT/$RUN_ID/faults.log"
+  ) &
+  PIDS+=($!)
+fi
+
+START=$(date +%s.%N)
+set +e
+ip netns exec "$NS_W" "$BIN/tamp" mission "$SCENARIO" --deployment "$DEPLOY" --run-id "$RUN_ID" --seed "$SEED" \
+  --mission-timeout 400 --out "$OUT" > "$OUT/$RUN_ID/mission.out" 2>&1
+RC=$?
+END=$(date +%s.%N)
+if [ "$PING" -gt 0 ]; then
+  SERVERS=""
+  [ "$DISCOVERY" = server ] && SERVERS=10.0.0.1:11811
+  ip netns exec "$NS_W" env TAMP_DDS_DISCOVERY_SERVERS=$SERVERS "$BIN/tamp" ping sim --run-id "$RUN_ID" -c "$PING" > "$RUN_DIR/ping.out" 2>&1
+  tail -1 "$RUN_DIR/ping.out"
+fi
+set -e
+if [ "$LOSS" -gt 0 ] || [ "$DUP" -gt 0 ]; then
+  for ns in "$NS_R" "$NS_W"; do ip netns exec "$ns" nft list table ip tamp_fault | grep counter >> "$RUN_DIR/faults.log"; done
+fi
+cat "$OUT/$RUN_ID/mission.out"
+echo "two_hosts.sh: run $RUN_ID discovery=$DISCOVERY one_host=$ONE_HOST netem='${NETEM}' loss=$LOSS% duplicate=$DUP% partition_at='${PART_AT}' seed=$SEED exit=$RC mission_s=$(awk "BEGIN{print $END - $START}")"
+cleanup; trap - EXIT
+# The simulator writes its final world on a clean stop (cleanup sends SIGTERM to the launchers).
+if [ "$RC" = 0 ] && [ ! -s "$OUT/$RUN_ID/sim_final_world.json" ]; then
+  echo "two_hosts.sh: mission succeeded but the simulator wrote no final world" >&2; exit 50
+fi
+echo "$RC" > "$OUT/$RUN_ID/exit_code"
+exit "$RC"

@@ -112,6 +112,8 @@ const config::Schema<PerceptionParams>& schema() {
         .field("gone_frames", &T::gone_frames, atLeast(1))
         .field("smoothing", &T::smoothing, inRange(0, 1, Ends::kOpenClosed))
         .field("snap_distance", &T::snap_distance, positive())
+        .field("explained_margin", &T::explained_margin, positive())
+        .field("explained_fraction", &T::explained_fraction, inRange(0, 1, Ends::kOpenClosed))
         .field("update_distance", &T::update_distance, nonNegative())
         .field("update_angle", &T::update_angle, nonNegative())
         .field("move_event_distance", &T::move_event_distance, positive())

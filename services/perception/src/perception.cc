@@ -97,6 +97,14 @@ struct Track {
   bool matched{false};
 };
 
+/// Fraction of `points` inside the track's shape at its pose, grown by `margin`.
+double explainedFraction(const Track& t, const std::vector<Eigen::Vector3d>& points, double margin) {
+  if (points.empty()) return 0.0;
+  std::size_t inside = 0;
+  for (const auto& p : points) inside += pointInShape(t.shape, t.pose, p, margin) ? 1 : 0;
+  return static_cast<double>(inside) / static_cast<double>(points.size());
+}
+
 }  // namespace
 
 std::string_view toString(EventType type) {
@@ -555,7 +563,15 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
       // Refit the grown shape (anchored on the seen faces) for the pose.
       meas = fitShape(dets[i], t.shape, sensor, T, yawOf(t.pose)).pose;
     }
-    const double jump = (meas.translation() - t.pose.translation()).norm();
+    double jump = (meas.translation() - t.pose.translation()).norm();
+    // A partial view (one end hidden, the object seen edge-on) pulls a known-size fit towards
+    // the visible part. Points that the object where it stands explains are no evidence that it
+    // moved: the pose stays.
+    if (jump > T.explained_margin && t.size_known && (t.from_prior || t.hits > 2) &&
+        explainedFraction(t, dets[i].points, T.explained_margin) >= T.explained_fraction) {
+      meas = t.pose;
+      jump = 0.0;
+    }
     if (jump > T.snap_distance || t.hits <= 1) {
       t.pose = meas;
     } else {

@@ -260,28 +260,50 @@ double ExecutionMonitorNode::now() const {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count();
 }
 
-void ExecutionMonitorNode::publish(const Outputs& out) {
-  // Robot requests first: a RUNNING status is only published once the robot has been commanded.
-  for (const auto& r : out.robot) {
-    if (journal_ && r.type == RobotRequest::Type::kExecute) {
-      if (Status j = journal_->append(r.command.command_id); !j) {
-        // Not sent: a command the journal does not hold could be executed twice after a restart.
-        logger()->error("command '{}' not sent to the robot: {}", r.command.command_id,
-                        j.error().toString());
-        continue;
-      }
+void ExecutionMonitorNode::flushRobotRequests() {
+  if (unsent_.empty()) return;
+  if (trajectory_writer_->matchedReaders() == 0) {
+    if (!waiting_for_robot_) {
+      logger()->warn("{} request(s) for the robot wait: no robot driver matched on {}", unsent_.size(),
+                     dds::topics::kTrajectoryCommand.name);
     }
-    if (Status s = trajectory_writer_->write(toMsg(r)); !s) {
-      logger()->error("{} of '{}' not sent to the robot: {}",
-                      r.type == RobotRequest::Type::kCancel ? "cancel" : "command",
-                      r.command.command_id, s.error().toString());
-    } else {
-      logger()->info("{} '{}' ({})", r.type == RobotRequest::Type::kCancel ? "cancel" : "execute",
-                     r.command.command_id,
-                     r.command.pddl_action.empty() ? std::string(toString(r.command.kind))
-                                                   : r.command.pddl_action);
+    waiting_for_robot_ = true;
+    return;
+  }
+  if (waiting_for_robot_) logger()->info("robot driver matched: sending {} waiting request(s)", unsent_.size());
+  waiting_for_robot_ = false;
+  std::vector<RobotRequest> pending;
+  pending.swap(unsent_);
+  for (const auto& r : pending) sendToRobot(r);
+}
+
+void ExecutionMonitorNode::sendToRobot(const RobotRequest& r) {
+  if (journal_ && r.type == RobotRequest::Type::kExecute) {
+    if (Status j = journal_->append(r.command.command_id); !j) {
+      // Not sent: a command the journal does not hold could be executed twice after a restart.
+      logger()->error("command '{}' not sent to the robot: {}", r.command.command_id,
+                      j.error().toString());
+      return;
     }
   }
+  if (Status s = trajectory_writer_->write(toMsg(r)); !s) {
+    logger()->error("{} of '{}' not sent to the robot: {}",
+                    r.type == RobotRequest::Type::kCancel ? "cancel" : "command",
+                    r.command.command_id, s.error().toString());
+  } else {
+    logger()->info("{} '{}' ({})", r.type == RobotRequest::Type::kCancel ? "cancel" : "execute",
+                   r.command.command_id,
+                   r.command.pddl_action.empty() ? std::string(toString(r.command.kind))
+                                                 : r.command.pddl_action);
+  }
+}
+
+void ExecutionMonitorNode::publish(const Outputs& out) {
+  // Robot requests first. A command written before this writer has matched the robot's reader
+  // would be lost (the topic is VOLATILE, and a reader's match is not the writer's): requests wait
+  // in order until the robot is matched; the command's timeout still runs meanwhile.
+  for (const auto& r : out.robot) unsent_.push_back(r);
+  flushRobotRequests();
   for (const auto& f : out.failures) {
     logger()->warn("failure '{}' ({}): {}", f.command_id, toString(f.type), f.description);
     if (Status s = failure_writer_->write(toMsg(f, ++failure_seq_)); !s) {
@@ -373,6 +395,7 @@ void ExecutionMonitorNode::onRecord(const msg::ExecutionRecord& m) {
 void ExecutionMonitorNode::spinOnce() {
   try {
     std::lock_guard lock(mutex_);
+    flushRobotRequests();
     if (world_dirty_.exchange(false)) {
       const world::World w = mirror_->snapshot();
       const std::uint64_t v = mirror_->publishedVersion();

@@ -22,6 +22,7 @@
 #include <chrono>
 #include <memory>
 #include <mutex>
+#include <vector>
 
 #include "tamp/dds/service_node.h"
 #include "tamp/msg_validation/validate.h"
@@ -63,6 +64,8 @@ class ExecutionMonitorNode : public dds::ServiceNode {
   msgv::RejectLog rejects_{"execution_monitor"};  // malformed input: logged once per kind, rate-limited
   double now() const;
   void publish(const Outputs& out);
+  void flushRobotRequests();
+  void sendToRobot(const RobotRequest& r);
   void onCommand(const msg::ExecuteCommand& m);
   void onState(const msg::RobotState& m, const dds::SampleMeta& meta);
   void onResult(const msg::ActionResult& m, const dds::SampleMeta& meta);
@@ -86,6 +89,8 @@ class ExecutionMonitorNode : public dds::ServiceNode {
   std::unique_ptr<dds::Reader<msg::ExecutionRecord>> record_reader_;
   std::atomic<bool> world_dirty_{true};
   std::uint64_t failure_seq_{0};
+  std::vector<RobotRequest> unsent_;  // robot requests waiting for the robot driver's match, in order
+  bool waiting_for_robot_{false};
 };
 
 }  // namespace tamp::execution_monitor

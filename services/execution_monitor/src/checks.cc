@@ -6,6 +6,8 @@
 #include <stdexcept>
 
 #include "tamp/core/format.h"
+#include "tamp/core/geometry.h"
+#include "tamp/effort_model/features.h"
 
 namespace tamp::execution_monitor {
 namespace {
@@ -332,11 +334,41 @@ double SweptPath::project(const robot::RobotState& state, double from) const {
   return std::max(best_f, from);
 }
 
+namespace {
+
+/// The states a stop-and-turn base passes through (effort_model::baseSteps: turn in place to each
+/// straight run's heading, drive it, turn to the last heading), so that straight interpolation
+/// between them sweeps what the robot sweeps; a holonomic blend of position and yaw does not.
+std::vector<robot::RobotState> stopAndTurn(const std::vector<robot::RobotState>& states) {
+  if (states.size() < 2) return states;
+  std::vector<Pose2D> poses;
+  for (const auto& s : states) poses.push_back(s.base);
+  std::vector<robot::RobotState> out{states.front()};
+  for (const auto& step : effort_model::baseSteps(poses)) {
+    if (step.kind == effort_model::BaseStep::Kind::kTurn) {
+      robot::RobotState n = out.back();
+      n.base.theta += angleDiff(step.target_heading, n.base.theta);
+      out.push_back(n);
+      continue;
+    }
+    for (std::size_t i : step.points) {
+      robot::RobotState n = out.back();
+      n.base.x = states[i].base.x;
+      n.base.y = states[i].base.y;
+      out.push_back(n);
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
 SweptPath makePath(const ExecutionCommand& c, const robot::RobotState& current,
                    const robot::RobotModel& robot) {
   SweptPath p;
   for (std::size_t i = 0; i < c.trajectory.points.size(); ++i)
     p.states.push_back(stateAt(c, i, current, robot));
+  if (c.kind == ActionKind::kMoveBase) p.states = stopAndTurn(p.states);
   std::vector<double> cum{0.0};
   for (std::size_t i = 1; i < p.states.size(); ++i)
     cum.push_back(cum.back() + distance(p.states[i - 1], p.states[i]));

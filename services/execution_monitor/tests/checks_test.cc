@@ -155,6 +155,21 @@ TEST_F(ChecksTest, PathCheckFindsTheFirstObjectOnThePath) {
   EXPECT_EQ(checker.contactsAt(clear.at(crate_hit->fraction)), std::vector<std::string>{"crate"});
 }
 
+// The base drives stop-and-turn (as the robot does): straight through the 0.7 m corridor at its
+// heading, then the turn to the goal's yaw in the open. A blend of yaw and position would turn
+// the 0.6 m base across the corridor and touch its walls.
+TEST_F(ChecksTest, ABasePathIsCheckedAsTheRobotDrivesItStopAndTurn) {
+  PathChecker checker(robot_, {});
+  checker.setWorld(world_);
+  const double half_pi = std::numbers::pi / 2;
+  const SweptPath through = makePath(moveBase("c", {{1.5, 1.2, 0}, {7.2, 1.2, half_pi}}), start_, robot_);
+  EXPECT_NEAR(through.at(0.5).base.theta, 0.0, 1e-9) << "the base turns while driving";
+  EXPECT_NEAR(through.at(1.0).base.theta, half_pi, 1e-9);
+  EXPECT_NEAR(through.at(1.0).base.x, 7.2, 1e-9);
+  const auto hit = checker.firstContact(through, 0.0, {"box"});
+  EXPECT_FALSE(hit) << "touches " << hit->object_id << " at " << hit->fraction;
+}
+
 TEST_F(ChecksTest, SupportsOfAnObjectOnATable) {
   auto sc = world::loadScenario(configDir() / "scenarios" / "occluded_can.yaml");
   ASSERT_TRUE(sc) << sc.error().toString();

@@ -1,3 +1,4 @@
+#include <cstdio>
 #include "tamp/graph_manager/abstraction.h"
 
 #include <algorithm>
@@ -129,9 +130,19 @@ std::string Abstraction::regionOfArmconf(const std::string& armconf) const {
   return regions_.count(r) ? r : std::string{};
 }
 
-bool Abstraction::graspable(const world::Object& o) const {
-  return o.kind == world::ObjectKind::kMovable && o.graspable && o.mass <= robot_.payload() &&
-         o.mass <= params_.payload_cap_kg;
+bool Abstraction::graspable(const world::Object& o) const { return whyNotGraspable(o).empty(); }
+
+std::string Abstraction::whyNotGraspable(const world::Object& o) const {
+  auto kg = [](double m) {
+    char b[32];
+    std::snprintf(b, sizeof(b), "%.1f kg", m);
+    return std::string(b);
+  };
+  if (o.kind != world::ObjectKind::kMovable) return "'" + o.id + "' is static";
+  if (o.mass > robot_.payload()) return "'" + o.id + "' (" + kg(o.mass) + ") exceeds the robot's payload of " + kg(robot_.payload());
+  if (o.mass > params_.payload_cap_kg) return "'" + o.id + "' (" + kg(o.mass) + ") exceeds payload_cap_kg " + kg(params_.payload_cap_kg);
+  if (!o.graspable) return "'" + o.id + "' is not graspable (its scenario or world file says so)";
+  return "";
 }
 
 std::vector<std::string> Abstraction::objects() const {

@@ -839,10 +839,16 @@ void GraphManager::spawnSubtasks(EdgeId id, const BranchContext& ctx, int depth)
   }
   const double radius = abstraction_.robot().baseRadius() + params_.keep_clear_margin_m;
   int objects = 0;
+  std::vector<std::string> unmovable;  // why a crossed object spawned no sub-task (for the failure reason)
   for (const auto& crossing : motion.crossings) {
     if (objects >= params_.max_blocking_objects) break;
     const world::Object* o = abstraction_.world().findObject(crossing.object_id);
-    if (!o || !abstraction_.graspable(*o)) continue;  // findPossibleActions: only pick and place move objects
+    if (!o) continue;
+    // findPossibleActions: only pick and place move objects.
+    if (std::string why = abstraction_.whyNotGraspable(*o); !why.empty()) {
+      unmovable.push_back(why);
+      continue;
+    }
     ++objects;
     // A base pose beside the object from which the arm reaches it, on the side the robot comes
     // from: back from where the lazy path first touches the object, facing it; the grasp
@@ -883,6 +889,7 @@ void GraphManager::spawnSubtasks(EdgeId id, const BranchContext& ctx, int depth)
     }
     if (!chosen) {
       log::get("graph_manager")->info("no grasp of {} from any base pose: only the detour remains", o->id);
+      unmovable.push_back("no grasp of '" + o->id + "' from any base pose");
       continue;
     }
     const std::string near = abstraction_.locationFor(chosen->base_pose, "near_" + o->id);
@@ -937,7 +944,11 @@ void GraphManager::spawnSubtasks(EdgeId id, const BranchContext& ctx, int depth)
       }
       if (!isGoal(end)) (void)planFrom(end, goal_.atoms, origin);
     }
+    if (slots.empty()) unmovable.push_back("no placement for '" + o->id + "' off the path");
   }
+  // The edge may have moved: the graph grew.
+  Edge& e = graph_.edge(id);
+  for (const auto& why : unmovable) e.reason += "; " + why;
   (void)ctx;
   (void)depth;
 }

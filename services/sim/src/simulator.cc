@@ -22,22 +22,35 @@
 namespace tamp::sim {
 namespace {
 
-/// The rotation (rad) from `a` to `b` up to the shape's symmetries about its own z axis: a
-/// cylinder looks the same turned by any angle, a box turned by pi (pi/2 with a square
-/// footprint). A box placed "rotated by pi" is placed where it was commanded.
+/// Angle (rad) of the object's z axis from vertical, up to the shape's symmetry: a box, a
+/// cylinder or a sphere upside down stands as well as upright.
+double tiltFromUpright(const world::Shape& shape, const Eigen::Isometry3d& pose) {
+  const double c = pose.linear()(2, 2);
+  const bool flips = shape.kind == world::ShapeKind::kBox || shape.kind == world::ShapeKind::kCylinder ||
+                     shape.kind == world::ShapeKind::kSphere;
+  return std::acos(std::clamp(flips ? std::abs(c) : c, -1.0, 1.0));
+}
+
+/// The rotation (rad) from `a` to `b` up to the shape's symmetries: a cylinder looks the same
+/// turned by any angle about its axis, a box turned by pi (pi/2 with a square footprint), and
+/// both upside down. A box placed "rotated by pi" is placed where it was commanded.
 double symmetricTurn(const world::Shape& shape, const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
   const Eigen::Matrix3d rel = a.linear().transpose() * b.linear();
   if (shape.kind == world::ShapeKind::kCylinder) {
-    // Only the tilt of the z axis counts.
-    return std::acos(std::clamp(rel(2, 2), -1.0, 1.0));
+    // Only the tilt of the z axis counts; upside down is the same cylinder.
+    return std::acos(std::clamp(std::abs(rel(2, 2)), 0.0, 1.0));
   }
   double best = Eigen::AngleAxisd(rel).angle();
   if (shape.kind == world::ShapeKind::kBox) {
     const bool square = std::abs(shape.size.x() - shape.size.y()) < 1e-9;
-    for (int k = 1; k < 4; ++k) {
-      if (!square && k % 2 == 1) continue;
-      const Eigen::Matrix3d z = Eigen::AngleAxisd(k * M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-      best = std::min(best, Eigen::AngleAxisd(Eigen::Matrix3d(rel * z)).angle());
+    // Turns about z, and the same upside down (a flip about x).
+    for (const Eigen::Matrix3d& flip : {Eigen::Matrix3d(Eigen::Matrix3d::Identity()),
+                                        Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix()}) {
+      for (int k = 0; k < 4; ++k) {
+        if (!square && k % 2 == 1) continue;
+        const Eigen::Matrix3d z = Eigen::AngleAxisd(k * M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+        best = std::min(best, Eigen::AngleAxisd(Eigen::Matrix3d(rel * flip * z)).angle());
+      }
     }
   }
   return best;
@@ -174,6 +187,7 @@ struct Active {
   double end{0.0};  // relative time the action ends (total or an early stop)
   Outcome outcome{Outcome::kSucceeded};
   std::string blocking;
+  std::string blocking_part;  // the robot's link (or held object) that would touch it
   std::string reason;
   std::string failure;  // a manipulation failure found at the grasp (reported at the end)
   int gripper_phase{-1};
@@ -223,6 +237,7 @@ struct Simulator::Impl {
   std::vector<Fault> pending_fails;   // kFailAction waiting for the next (matching) action
   std::optional<Active> active;
   std::vector<Eigen::Isometry3d> link_poses;  // scratch
+  std::string last_contact_part;  // scratch: the robot part of the last contact found
   struct Riding {
     std::string id;
     int link;
@@ -346,12 +361,16 @@ struct Simulator::Impl {
       if (a) {
         for (const auto& [r, o] : a->ignore_pairs) ignored |= (c.robot == r && c.object == o);
       }
-      if (!ignored) return c.object;
+      if (!ignored) {
+        last_contact_part = c.robot;
+        return c.object;
+      }
     }
     // The floor plane: no part of the robot may go below it.
     const auto& geo = robot.collisionGeometry();
     for (const auto& part : geo.parts) {
       if (part.shape.aabb(link_poses[part.link] * part.link_T_shape).min.z() < -kFloorTolerance) {
+        last_contact_part = geo.links[part.link];
         return std::string(kFloorId);
       }
     }
@@ -406,7 +425,10 @@ struct Simulator::Impl {
       // The starting sample itself (a new object may have appeared on the robot).
       if (from > 0.0 || p.t0 > 0.0) {
         const std::string hit = contactAt(p.path.at(f_from), &a);
-        if (!hit.empty()) return std::pair{t_prev0, hit};
+        if (!hit.empty()) {
+          a.blocking_part = last_contact_part;
+          return std::pair{t_prev0, hit};
+        }
       }
       for (std::size_t j = 1; j < p.path.q.size(); ++j) {
         const double u0 = p.path.u[j - 1], u1 = p.path.u[j];
@@ -420,6 +442,7 @@ struct Simulator::Impl {
           const Vec q = p.path.q[j - 1] + w * (p.path.q[j] - p.path.q[j - 1]);
           const std::string hit = contactAt(q, &a);
           if (!hit.empty()) {
+            a.blocking_part = last_contact_part;
             const double t = f_prev <= f_from ? t_prev0
                                                : p.t0 + a.k * trapTimeAt(f_prev * p.length, p.length, p.v, p.a);
             return std::pair{t, hit};
@@ -517,7 +540,7 @@ struct Simulator::Impl {
       if (region && std::abs(region->height - surface) <= 0.02) s.region = region->id;
     }
     s.drop = bottom - surface;
-    s.tilt = std::acos(std::clamp(pose.linear()(2, 2), -1.0, 1.0));
+    s.tilt = tiltFromUpright(o.shape, pose);
     const double yaw = std::atan2(pose.linear()(1, 0), pose.linear()(0, 0));
     s.pose = Eigen::Isometry3d::Identity();
     s.pose.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
@@ -743,7 +766,8 @@ struct Simulator::Impl {
     r.progress = a.total > 0.0 ? std::clamp(a.end / a.total, 0.0, 1.0) : 1.0;
     r.blocking_object_id = a.blocking;
     r.reason = a.outcome == Outcome::kBlocked && a.reason.empty()
-                   ? "stopped before contact with '" + a.blocking + "'"
+                   ? "stopped before contact with '" + a.blocking + "'" +
+                         (a.blocking_part.empty() ? std::string() : " (of " + a.blocking_part + ")")
                    : a.reason;
     idle = stateAt(a, a.end);
     // Velocities are zero at rest: the state is exactly the stop state.

@@ -103,6 +103,8 @@ class Abstraction {
   Binding bind(const std::vector<std::string>& atoms) const;
   /// Whether the object is graspable for this robot (movable, flagged, within the payload).
   bool graspable(const world::Object& o) const;
+  /// Why the object is not graspable ("" when it is), for failure reasons.
+  std::string whyNotGraspable(const world::Object& o) const;
 
  private:
   void addReaches(const std::string& location, const Pose2D& pose);

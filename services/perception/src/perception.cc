@@ -21,6 +21,9 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
+/// A released object whose bottom is at most this far above the support below rests on it (m).
+constexpr double kRestingGap = 0.03;
+
 std::string describePose(const Eigen::Isometry3d& T) {
   const Eigen::Vector3d t = T.translation();
   char buf[96];
@@ -181,6 +184,27 @@ struct Perception::Impl {
       if (pointInShape(o.shape, o.pose, top, 0.0)) best = b.max.z();
     }
     return std::isfinite(best) ? best : floor_height;
+  }
+
+  /// The object just released (`held_id`): placed, it rests on its support already; dropped, it
+  /// is in the air where it was carried and falls onto the support below it. Often the camera
+  /// cannot see there (right in front of the base), so that is where the world model keeps it
+  /// until a view corrects it: seen elsewhere, reacquired; seen empty there, gone.
+  void settleReleased(FrameResult& result, std::int64_t stamp) {
+    auto it = tracks.find(held_id);
+    if (it == tracks.end() || it->second.state == TrackInfo::State::kGone) return;
+    Track& t = it->second;
+    const Eigen::Vector3d c = t.pose.translation();
+    const double bottom = c.z() - t.shape.halfHeight();
+    const double support = supportBelow(c.head<2>(), bottom, {});
+    if (bottom - support <= kRestingGap) return;
+    t.pose = uprightPose(c.x(), c.y(), support + t.shape.halfHeight(), yawOf(t.pose));
+    t.event_pose = t.pose;
+    (void)world.updateObject(objectOf(t));
+    char why[200];
+    std::snprintf(why, sizeof(why), "released %.2f m above its support: fell to %s", bottom - support,
+                  describePose(t.pose).c_str());
+    pushEvent(result, EventType::kMoved, t, t.pose, why, stamp);
   }
 
   /// The class a detection fits best (compatible size, least mismatch), or nullptr.
@@ -444,6 +468,7 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
   // The held object follows the gripper; a release (the state reports the gripper empty, or
   // another object) leaves it where it was last carried, tracked as any other from then on.
   if (self_filter) {
+    if (!I.held_id.empty() && (held == nullptr || held->id != I.held_id)) I.settleReleased(result, stamp);
     I.held_id = held != nullptr ? held->id : std::string();
     I.tool_T_held = held != nullptr ? tool_T_held : Eigen::Isometry3d::Identity();
   }

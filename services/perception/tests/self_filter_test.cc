@@ -278,5 +278,54 @@ TEST(SelfFilterTest, TheHeldObjectFollowsTheGripperAndIsNeverNewNorGone) {
   EXPECT_GT(count(bare.events, EventType::kAdded) + count(bare.events, EventType::kGone), 0);
 }
 
+// Carried, then dropped (the state reports the gripper empty with the parcel in the air): the world
+// model puts it on the floor below where it was released, whether the camera sees there or not,
+// and never reports it gone.
+TEST(SelfFilterTest, ADroppedObjectFallsOntoTheSupportBelowIt) {
+  const robot::RobotState ready = armReady();
+  const Eigen::Isometry3d tool = robotModel().toolPoseInWorld(ready);
+  const Eigen::Vector3d c = tool.translation();
+  world::World prior = floorOnly();
+  const double parcel_h = 0.10, stand_top = c.z() - parcel_h / 2;
+  ASSERT_TRUE(prior
+                  .addObject(testing::box("stand", 0.3, 0.3, stand_top, c.x() + 0.05, c.y(), 0.0,
+                                          0.0, world::ObjectKind::kStatic))
+                  .ok());
+  world::Object parcel = testing::box("parcel", 0.05, 0.05, parcel_h, c.x(), c.y(), 0.0, stand_top);
+  parcel.mass = 0.3;
+  parcel.graspable = true;
+  ASSERT_TRUE(prior.addObject(parcel).ok());
+  world::World truth = prior;
+  sim::DepthSensor camera = robotCamera();
+  Perception p(prior, PerceptionParams{});
+  int64_t stamp = kSecond;
+  Frames run = look(p, truth, ready, 2, true, stamp, camera);
+  // Grasped and carried off the stand (the arm turned by 0.8 rad at its base).
+  const Eigen::Isometry3d tool_T_parcel = tool.inverse() * parcel.pose;
+  (void)look(p, truth, ready, 1, true, stamp, camera, "parcel");  // grasped where it stands
+  const robot::RobotState away = armReady(0.8);
+  world::Object carried = parcel;
+  carried.pose = robotModel().toolPoseInWorld(away) * tool_T_parcel;
+  ASSERT_TRUE(truth.updateObject(carried).ok());
+  (void)look(p, truth, away, 2, true, stamp, camera, "parcel");
+  ASSERT_EQ(p.heldObject(), "parcel");
+  // Dropped: it lies on the floor below the gripper.
+  world::Object fallen = carried;
+  fallen.pose = testing::box("x", 0.05, 0.05, parcel_h, carried.pose.translation().x(),
+                             carried.pose.translation().y(), 0.0)
+                    .pose;
+  ASSERT_TRUE(truth.updateObject(fallen).ok());
+  run = look(p, truth, away, 3, true, stamp, camera);
+  std::string events;
+  for (const auto& e : run.events) events += std::string(toString(e.type)) + " " + e.object_id + ": " + e.description + "\n";
+  EXPECT_EQ(p.heldObject(), "");
+  ASSERT_NE(p.world().findObject("parcel"), nullptr) << "the dropped parcel left the world model\n" << events;
+  EXPECT_LT((p.world().object("parcel").pose.translation() - fallen.pose.translation()).norm(), 0.03)
+      << "at " << p.world().object("parcel").pose.translation().transpose();
+  EXPECT_EQ(count(run.events, EventType::kGone), 0);
+  EXPECT_EQ(count(run.events, EventType::kAdded), 0);
+  EXPECT_GE(count(run.events, EventType::kMoved), 1);
+}
+
 }  // namespace
 }  // namespace tamp::perception

@@ -361,6 +361,29 @@ std::vector<robot::RobotState> stopAndTurn(const std::vector<robot::RobotState>&
   return out;
 }
 
+/// The robot's shapes `by` smaller on each side (boxes, cylinders, spheres; never below 1 mm).
+collision::RobotGeometry shrunk(collision::RobotGeometry g, double by) {
+  if (by <= 0.0) return g;
+  for (auto& part : g.parts) {
+    world::Shape& sh = part.shape;
+    switch (sh.kind) {
+      case world::ShapeKind::kBox:
+        sh.size = (sh.size.array() - 2.0 * by).max(1e-3).matrix();
+        break;
+      case world::ShapeKind::kCylinder:
+        sh.radius = std::max(1e-3, sh.radius - by);
+        sh.height = std::max(1e-3, sh.height - 2.0 * by);
+        break;
+      case world::ShapeKind::kSphere:
+        sh.radius = std::max(1e-3, sh.radius - by);
+        break;
+      default:
+        break;  // prisms: as they are
+    }
+  }
+  return g;
+}
+
 }  // namespace
 
 SweptPath makePath(const ExecutionCommand& c, const robot::RobotState& current,
@@ -386,7 +409,7 @@ PathChecker::PathChecker(const robot::RobotModel& robot, PathCheckParams params)
                                 formatNumber(params_.step_m) + ", step_rad " +
                                 formatNumber(params_.step_rad));
   }
-  scene_.setRobot(robot.collisionGeometry());
+  scene_.setRobot(shrunk(robot.collisionGeometry(), params_.tolerance_m));
 }
 
 void PathChecker::setWorld(const world::World& world) {

@@ -59,6 +59,20 @@ class TurnDriveTurnSpace : public ob::SE2StateSpace {
     getSubspace(1)->enforceBounds(o->as<ob::SO2StateSpace::StateType>(1));
   }
 
+  /// Fractions of the motion from -> to where the first turn ends and where the drive ends: the
+  /// states that stand farthest out along the drive (a location a few cm from a table is touched
+  /// there, if anywhere); uniform samples of the motion need not fall on them.
+  std::vector<double> cornerFractions(const ob::State* from, const ob::State* to) const {
+    const Pieces p = pieces(from, to);
+    const double l1 = std::abs(p.turn1) * turn_radius_, l3 = std::abs(p.turn2) * turn_radius_;
+    const double total = l1 + p.drive + l3;
+    std::vector<double> out;
+    if (total <= 0.0) return out;
+    if (l1 > 0.0 && l1 < total) out.push_back(l1 / total);
+    if (l3 > 0.0 && p.drive > 0.0) out.push_back((l1 + p.drive) / total);
+    return out;
+  }
+
   unsigned int validSegmentCount(const ob::State* s1, const ob::State* s2) const override {
     const Pieces p = pieces(s1, s2);
     const double total = (std::abs(p.turn1) + std::abs(p.turn2)) * turn_radius_ + p.drive;
@@ -134,6 +148,52 @@ class ArmProjection : public ob::ProjectionEvaluator {
 };
 
 }  // namespace
+
+std::vector<double> turnCorners(const ob::StateSpace& space, const ob::State* a, const ob::State* b) {
+  if (const auto* tdt = dynamic_cast<const TurnDriveTurnSpace*>(&space)) return tdt->cornerFractions(a, b);
+  return {};
+}
+
+bool isStopAndTurn(const ob::StateSpace& space) { return dynamic_cast<const TurnDriveTurnSpace*>(&space) != nullptr; }
+
+bool CornerMotionValidator::checkMotion(const ob::State* s1, const ob::State* s2) const {
+  std::pair<ob::State*, double> unused{nullptr, 0.0};
+  return checkMotion(s1, s2, unused);
+}
+
+bool CornerMotionValidator::checkMotion(const ob::State* s1, const ob::State* s2,
+                                        std::pair<ob::State*, double>& last_valid) const {
+  const auto& space = si_->getStateSpace();
+  std::vector<double> at = turnCorners(*space, s1, s2);
+  const unsigned n = space->validSegmentCount(s1, s2);
+  for (unsigned j = 1; j < n; ++j) at.push_back(static_cast<double>(j) / n);
+  std::sort(at.begin(), at.end());
+  at.push_back(1.0);
+  ob::State* tmp = space->allocState();
+  double previous = 0.0;
+  bool ok = true;
+  for (double f : at) {
+    const ob::State* s = s2;
+    if (f < 1.0) {
+      space->interpolate(s1, s2, f, tmp);
+      s = tmp;
+    }
+    if (!si_->isValid(s)) {
+      ok = false;
+      break;
+    }
+    previous = f;
+  }
+  if (!ok) {
+    if (last_valid.first != nullptr) space->interpolate(s1, s2, previous, last_valid.first);
+    last_valid.second = previous;
+    ++invalid_;
+  } else {
+    ++valid_;
+  }
+  space->freeState(tmp);
+  return ok;
+}
 
 // ---- RobotBinding -----------------------------------------------------------------------------
 

@@ -161,6 +161,22 @@ class Oracle {
   std::uint64_t checks_{0};
 };
 
+/// Fractions of the motion a -> b at the corners of a stop-and-turn base's motion (where a turn
+/// ends and the drive begins, where the drive ends); empty for other spaces.
+std::vector<double> turnCorners(const ob::StateSpace& space, const ob::State* a, const ob::State* b);
+/// Whether `space` is the stop-and-turn SE(2) (sampling.base_turn_in_place).
+bool isStopAndTurn(const ob::StateSpace& space);
+
+/// OMPL's discrete motion check plus the corner states of a stop-and-turn motion: the uniform
+/// samples step over the corner, where the base stands farthest out (it missed 2 mm into a table
+/// at the final turn, which the robot then touched).
+class CornerMotionValidator : public ob::MotionValidator {
+ public:
+  explicit CornerMotionValidator(const ob::SpaceInformationPtr& si) : ob::MotionValidator(si) {}
+  bool checkMotion(const ob::State* s1, const ob::State* s2) const override;
+  bool checkMotion(const ob::State* s1, const ob::State* s2, std::pair<ob::State*, double>& last_valid) const override;
+};
+
 /// OMPL validity checker over the oracle (static only, or everything).
 class OracleValidityChecker : public ob::StateValidityChecker {
  public:

@@ -675,6 +675,7 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
     si->setStateValidityChecker(std::make_shared<detail::OracleValidityChecker>(si, oracle, full));
     si->setStateValidityCheckingResolution(
         std::min(1.0, P.sampling.validity_resolution / std::max(1e-9, space->getMaximumExtent())));
+    if (detail::isStopAndTurn(*space)) si->setMotionValidator(std::make_shared<detail::CornerMotionValidator>(si));
     si->setup();
     return si;
   };

@@ -46,6 +46,16 @@ SegmentInfo evaluateSegment(Oracle& oracle, const ob::State* a, const ob::State*
   info.length = space->distance(a, b);
   const int n = std::max(1, static_cast<int>(std::ceil(info.length / resolution)));
   ScopedState tmp(space);
+  const std::vector<double> corners = turnCorners(*space, a, b);
+  if (!static_known_valid) {
+    for (double f : corners) {
+      space->interpolate(a, b, f, tmp.get());
+      if (!oracle.staticFree(tmp.get())) {
+        info.valid = false;
+        return info;
+      }
+    }
+  }
   if (!static_known_valid && n > 1) {
     // Interior samples in bisection order (collisions tend to be found early).
     std::deque<std::pair<int, int>> q{{1, n - 1}};
@@ -68,9 +78,13 @@ SegmentInfo evaluateSegment(Oracle& oracle, const ob::State* a, const ob::State*
   if (cand.empty()) return info;
   std::vector<int> t;
   double new_cost = 0.0;
-  for (int i = 0; i <= n; ++i) {
+  const int samples = n + 1 + static_cast<int>(corners.size());
+  for (int i = 0; i < samples; ++i) {
     const ob::State* s = a;
-    if (i == n) {
+    if (i > n) {
+      space->interpolate(a, b, corners[static_cast<std::size_t>(i - n - 1)], tmp.get());  // the corners last
+      s = tmp.get();
+    } else if (i == n) {
       s = b;
     } else if (i > 0) {
       space->interpolate(a, b, static_cast<double>(i) / n, tmp.get());

@@ -194,6 +194,69 @@ TEST_F(FullTest, HeldObjectCollidesAsPartOfTheRobot) {
   }
 }
 
+// A 0.6 x 0.5 m stop-and-turn base to a pose 5 cm in front of a table, approached at an angle:
+// it turns in place at the goal, where its corners stand farthest out. Every state the base passes
+// through (turns in place to each segment's heading, forwards or backwards as the planner's space
+// turns, drives, the final turn), 1 mm and 2 mrad apart, keeps clear of the table in an
+// independent 2-D rectangle test. (Uniform motion samples stepped over the corner state: the
+// robot touched the table by 2 mm there.)
+TEST_F(FullTest, AStopAndTurnBaseKeepsItsCornersOffTheTable) {
+  world::World w("table_room");
+  const double table_x0 = 2.0;
+  ASSERT_TRUE(w.addObject(testing::box("table", table_x0 + 0.4, 0.0, 0.8, 1.2, false, 0.75)).ok());
+  ASSERT_TRUE(w.addObject(testing::box("wall_s", 1.5, -2.1, 5.2, 0.2, false)).ok());
+  ASSERT_TRUE(w.addObject(testing::box("wall_n", 1.5, 2.1, 5.2, 0.2, false)).ok());
+  ASSERT_TRUE(w.addObject(testing::box("wall_w", -1.1, 0.0, 0.2, 4.4, false)).ok());
+  ASSERT_TRUE(w.addObject(testing::box("wall_e", 4.1, 0.0, 0.2, 4.4, false)).ok());
+  MotionPlannerParams p;
+  p.sampling.base_turn_in_place = true;
+  MotionPlanner mp(collision::RobotGeometry::box(0.6, 0.5, 0.35), p);
+  mp.setWorld(w);
+  const double hx = 0.3, hy = 0.25;
+  auto touchesTable = [&](double x, double y, double th) {
+    // Separating axes of two rectangles: the table's (axis-aligned) and the base's.
+    const double c = std::cos(th), s = std::sin(th);
+    const double ex = hx * std::abs(c) + hy * std::abs(s), ey = hx * std::abs(s) + hy * std::abs(c);
+    if (x + ex <= table_x0 || x - ex >= table_x0 + 0.8 || y + ey <= -0.6 || y - ey >= 0.6) return false;
+    const double dx = table_x0 + 0.4 - x, dy = -y;
+    const double tx = 0.4 * std::abs(c) + 0.6 * std::abs(s), ty = 0.4 * std::abs(s) + 0.6 * std::abs(c);
+    return std::abs(dx * c + dy * s) < hx + tx && std::abs(-dx * s + dy * c) < hy + ty;
+  };
+  auto wrap = [](double a) { return std::remainder(a, 2.0 * M_PI); };
+  // Straight at the goal with heading h, the base's corner stands 0.3 cos h + 0.25 sin h ahead of
+  // its centre: 0.352 m at h = 0.246 (2 mm into the table, only in the last 2 mm of the drive and
+  // at the corner state), 0.355 m at h = 0.26.
+  const Pose2D goal{table_x0 - 0.35, 0.0, 0.0};
+  for (double approach : {0.246, 0.26, -0.25}) {
+    const Pose2D start{goal.x - 2.0 * std::cos(approach), goal.y - 2.0 * std::sin(approach), approach};
+    const MotionResult r = mp.plan(testing::baseRequest(start, goal, MotionMode::kFull), Termination::after(10.0));
+    ASSERT_EQ(r.status, MotionStatus::kSolved) << r.reason;
+    const auto& wp = r.path.waypoints;
+    double heading = wp.front()[2];
+    auto turn = [&](double x, double y, double to) {
+      const double d = wrap(to - heading);
+      const int n = std::max(1, static_cast<int>(std::ceil(std::abs(d) / 0.002)));
+      for (int k = 0; k <= n; ++k)
+        ASSERT_FALSE(touchesTable(x, y, heading + d * k / n)) << "turning at (" << x << ", " << y << ")";
+      heading = to;
+    };
+    for (std::size_t i = 0; i + 1 < wp.size(); ++i) {
+      const double dx = wp[i + 1][0] - wp[i][0], dy = wp[i + 1][1] - wp[i][1], len = std::hypot(dx, dy);
+      if (len < 1e-6) {
+        turn(wp[i][0], wp[i][1], wp[i + 1][2]);
+        continue;
+      }
+      double h = std::atan2(dy, dx);
+      if (std::abs(wrap(h + M_PI - wp[i][2])) < std::abs(wrap(h - wp[i][2]))) h = wrap(h + M_PI);
+      turn(wp[i][0], wp[i][1], h);
+      const int n = std::max(1, static_cast<int>(std::ceil(len / 0.001)));
+      for (int k = 0; k <= n; ++k)
+        ASSERT_FALSE(touchesTable(wp[i][0] + dx * k / n, wp[i][1] + dy * k / n, h)) << "driving segment " << i;
+      turn(wp[i + 1][0], wp[i + 1][1], wp[i + 1][2]);
+    }
+  }
+}
+
 TEST_F(FullTest, HeldObjectInAWallAtTheStartIsStartInCollision) {
   world::World w = testing::corridorWorld(false);
   world::Object bar = testing::box("bar", 2.0, 3.9, 0.1, 0.8, true, 0.2, 1.0);

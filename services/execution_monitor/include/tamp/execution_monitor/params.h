@@ -37,6 +37,11 @@ struct StartTolerance {
 struct PathCheckParams {
   double step_m{0.02};    ///< in (0, 1] m
   double step_rad{0.02};  ///< in (0, 1] rad
+  /// m, in [0, 0.05]: the robot's shapes are checked this much smaller (each side). The monitor
+  /// catches what the plan did not know (a new obstacle, a moved object), not the planner's own
+  /// millimetres: its checks sample the same motion differently, and a location a few cm from a
+  /// table otherwise fails a path the planner proved free by 2 mm at the final turn.
+  double tolerance_m{0.005};
 };
 
 /// An action overruns when its elapsed time exceeds

@@ -63,6 +63,10 @@ int main(int argc, char** argv) {
   app.add_option("--out", out_dir, "directory for run folders (OUT/RUN_ID: logs, events, reports)");
   std::string explicit_run_id;
   app.add_option("--run-id", explicit_run_id, "run id (default: generated, run-YYYYmmdd-HHMMSS-xxxx)");
+  bool fresh = false;
+  app.add_flag("--fresh", fresh,
+               "start the effort estimator from the default time models: an empty store in the run folder "
+               "(RUN/effort_store; the configured store is neither read nor changed)");
   std::string security;
   app.add_option("--security", security,
                  "DDS Security directory (deploy/security/make_certs.sh): every service and this tool run secured, "
@@ -110,6 +114,13 @@ int main(int argc, char** argv) {
 
   // The simulator writes the ground truth it ends with here (tests and reports judge by it).
   if (!scenario.empty()) setenv("TAMP_SIM_FINAL_WORLD", (fs::absolute(run_dir) / "sim_final_world.json").c_str(), 1);
+  // --fresh: the estimator keeps its store in the run folder (whatever its store_directory says).
+  if (fresh) {
+    const fs::path store = run_dir / "effort_store";
+    fs::create_directories(store);
+    setenv("TAMP_EFFORT_STORE", store.c_str(), 1);
+    std::fprintf(stderr, "tamp run: --fresh: default time models, effort store %s\n", store.c_str());
+  }
   // The services inherit the security directory; each picks its identity by its --name.
   if (!security.empty()) setenv("TAMP_DDS_SECURITY", fs::absolute(security).c_str(), 1);
   std::signal(SIGINT, onSignal);

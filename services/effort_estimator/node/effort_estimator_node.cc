@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 
 #include "tamp/core/log.h"
 #include "tamp/core/paths.h"
@@ -129,6 +130,14 @@ Result<std::unique_ptr<dds::ServiceNode>> EffortEstimatorNode::create(
                                          : std::filesystem::path(args.config_file);
   auto params = loadEstimatorParams(file);
   if (!params) return params.error();
+  // `tamp run --fresh`: a store of the run's own (the default models), whatever the config says.
+  if (const char* fresh = std::getenv("TAMP_EFFORT_STORE"); fresh != nullptr && *fresh != '\0') {
+    if (!std::filesystem::path(fresh).is_absolute()) {
+      return Error(ErrorCode::kInvalidArgument, std::string("$TAMP_EFFORT_STORE must be an absolute directory, got '") +
+                                                    fresh + "'");
+    }
+    params->store_directory = fresh;
+  }
   return std::unique_ptr<dds::ServiceNode>(
       std::make_unique<EffortEstimatorNode>(args, std::move(*params)));
 }

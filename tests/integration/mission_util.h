@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <regex>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,7 @@ struct Mission {
   std::string output;
   nlohmann::json report;
   nlohmann::json truth;
+  fs::path run_dir;  ///< OUT/RUN_ID of this run (empty when tamp run made none)
 };
 
 /// A deployment like config/deploy/local.yaml whose simulator runs `factor` times faster than
@@ -44,26 +46,38 @@ inline fs::path fastDeployment(const fs::path& dir, double factor) {
   return dir / "deploy.yaml";
 }
 
-inline Mission run(const std::string& scenario, const std::vector<std::string>& extra = {}) {
-  std::string tag = fs::path(scenario).stem().string();
-  for (const auto& a : extra) tag += "_" + fs::path(a).filename().string();
-  const fs::path out = tempFile("tamp_mission_" + tag);
-  fs::remove_all(out);
-  fs::create_directories(out / "deploy" / "store");
-  const fs::path deployment = fastDeployment(out / "deploy", 2.0);
+/// `tamp run` of `scenario` with `deployment`, its run folder under `out` (kept: several runs may
+/// share a deployment, and so an effort store).
+inline Mission runWith(const fs::path& out, const fs::path& deployment, const std::string& scenario,
+                       const std::vector<std::string>& extra = {}) {
+  std::set<fs::path> before;
+  if (fs::exists(out))
+    for (const auto& entry : fs::directory_iterator(out)) before.insert(entry.path());
   std::vector<std::string> args{(configDir() / "scenarios" / scenario).string(), "--out", out.string(), "--domain",
                                 std::to_string(isolatedDomain()), "--deployment", deployment.string()};
   args.insert(args.end(), extra.begin(), extra.end());
   Mission m;
   std::tie(m.exit_code, m.output) = runCommand(binDir() / "tamp-run", args, 600.0);
   for (const auto& entry : fs::directory_iterator(out)) {
-    if (entry.path().filename().string().rfind("run-", 0) != 0) continue;
+    if (entry.path().filename().string().rfind("run-", 0) != 0 || before.count(entry.path())) continue;
+    m.run_dir = entry.path();
     if (fs::exists(entry.path() / "report.json"))
       m.report = nlohmann::json::parse(readFile(entry.path() / "report.json"), nullptr, false);
     if (fs::exists(entry.path() / "sim_final_world.json"))
       m.truth = nlohmann::json::parse(readFile(entry.path() / "sim_final_world.json"), nullptr, false);
   }
   return m;
+}
+
+/// `tamp run` of `scenario` in a folder of its own, with a deployment of its own (a 2x simulator,
+/// an empty effort store).
+inline Mission run(const std::string& scenario, const std::vector<std::string>& extra = {}) {
+  std::string tag = fs::path(scenario).stem().string();
+  for (const auto& a : extra) tag += "_" + fs::path(a).filename().string();
+  const fs::path out = tempFile("tamp_mission_" + tag);
+  fs::remove_all(out);
+  fs::create_directories(out / "deploy" / "store");
+  return runWith(out, fastDeployment(out / "deploy", 2.0), scenario, extra);
 }
 
 inline double distance(const nlohmann::json& p, double x, double y) {

@@ -96,8 +96,7 @@ TEST(MissionTest, SecuredCorridorMissionSucceeds) {
   EXPECT_EQ(m.report["status"], "succeeded") << m.report.dump(1);
   // Whether the box is moved is the effort decision, checked unsecured by
   // CorridorEffortPolicyMovesTheLightBoxAndReachesTheGoal; here only that the secured mission
-  // reaches the goal. (Perception's estimate of the thin box sometimes strays 0.18 m; the picks
-  // there fail twice and the robot goes round: docs/reliability.md, known weakness.)
+  // reaches the goal.
 }
 
 // The gripper holds a cup at the start; it slips 2 s in (it falls in front of the base, where the

@@ -36,7 +36,7 @@ struct SamplingParams {
   /// heading, forwards or backwards, whichever turns less; drive straight; turn in place to the
   /// pose's yaw), as a differential-drive base does; false: a holonomic slide with the yaw
   /// blended in. Every motion check follows it.
-  bool base_turn_in_place{false};
+  bool base_turn_in_place{true};
   double kpiece_cell_size{0.25};          ///< KPIECE grid cell edge on the base (x, y) projection, m; > 0
   double arm_cell_size{0.3};              ///< KPIECE cell edge on the arm projection, rad; > 0
   double range{0.0};                      ///< longest tree extension, space metric; 0: OMPL's default

@@ -193,18 +193,26 @@ struct Perception::Impl {
   void settleReleased(FrameResult& result, std::int64_t stamp) {
     auto it = tracks.find(held_id);
     if (it == tracks.end() || it->second.state == TrackInfo::State::kGone) return;
-    Track& t = it->second;
+    (void)settleIfUnsupported(it->second, result, stamp, "released");
+  }
+
+  /// An object whose bottom is above the support below it falls onto that support (a MOVED
+  /// event); false when it rests. Also for an object seen empty where it was in the air: the
+  /// robot released it before perception saw it held (a drop right after start-up).
+  bool settleIfUnsupported(Track& t, FrameResult& result, std::int64_t stamp, const char* what) {
     const Eigen::Vector3d c = t.pose.translation();
     const double bottom = c.z() - t.shape.halfHeight();
     const double support = supportBelow(c.head<2>(), bottom, {});
-    if (bottom - support <= kRestingGap) return;
+    if (bottom - support <= kRestingGap) return false;
     t.pose = uprightPose(c.x(), c.y(), support + t.shape.halfHeight(), yawOf(t.pose));
     t.event_pose = t.pose;
+    t.misses = 0;
     (void)world.updateObject(objectOf(t));
     char why[200];
-    std::snprintf(why, sizeof(why), "released %.2f m above its support: fell to %s", bottom - support,
+    std::snprintf(why, sizeof(why), "%s %.2f m above its support: fell to %s", what, bottom - support,
                   describePose(t.pose).c_str());
     pushEvent(result, EventType::kMoved, t, t.pose, why, stamp);
+    return true;
   }
 
   /// The class a detection fits best (compatible size, least mismatch), or nullptr.
@@ -675,6 +683,7 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
       if (seen_empty || stamp - t.last_seen_ns > static_cast<int64_t>(T.tentative_timeout_s * 1e9)) dropped.push_back(id);
       continue;
     }
+    if (seen_empty && I.settleIfUnsupported(t, result, stamp, "seen empty in the air")) continue;
     if (seen_empty) {
       ++t.misses;
       t.confidence *= 0.5;

@@ -327,5 +327,30 @@ TEST(SelfFilterTest, ADroppedObjectFallsOntoTheSupportBelowIt) {
   EXPECT_GE(count(run.events, EventType::kMoved), 1);
 }
 
+// Dropped before perception ever saw it held (the drop came right after start-up): the prior has it
+// in the air, its place is seen empty. It fell: the world model puts it on the floor below, not gone.
+TEST(SelfFilterTest, AnObjectSeenEmptyInTheAirFellOntoTheSupportBelow) {
+  const robot::RobotState ready = armReady(0.8);
+  const Eigen::Vector3d c = robotModel().toolPoseInWorld(ready).translation();
+  world::World prior = floorOnly();
+  world::Object parcel = testing::box("parcel", 0.05, 0.05, 0.10, c.x(), c.y(), 0.0, c.z() - 0.05);
+  parcel.mass = 0.3;
+  parcel.graspable = true;
+  ASSERT_TRUE(prior.addObject(parcel).ok());
+  world::World truth = prior;
+  world::Object fallen = parcel;
+  fallen.pose = testing::box("x", 0.05, 0.05, 0.10, c.x(), c.y(), 0.0).pose;
+  ASSERT_TRUE(truth.updateObject(fallen).ok());
+  sim::DepthSensor camera = robotCamera();
+  Perception p(prior, PerceptionParams{});
+  int64_t stamp = kSecond;
+  const Frames run = look(p, truth, ready, 3, true, stamp, camera);
+  std::string events;
+  for (const auto& e : run.events) events += std::string(toString(e.type)) + " " + e.object_id + ": " + e.description + "\n";
+  ASSERT_NE(p.world().findObject("parcel"), nullptr) << events;
+  EXPECT_LT((p.world().object("parcel").pose.translation() - fallen.pose.translation()).norm(), 0.03) << events;
+  EXPECT_EQ(count(run.events, EventType::kGone), 0) << events;
+}
+
 }  // namespace
 }  // namespace tamp::perception

@@ -100,9 +100,10 @@ TEST(MissionTest, SecuredCorridorMissionSucceeds) {
 }
 
 // The gripper holds a cup at the start; it slips 2 s in (it falls in front of the base, where the
-// mast camera cannot see), a parcel appears on the table later. The robot must end holding the
-// can, with the cup on the floor where it fell (the world model put it there: the way to the
-// table is planned round it, not through it), and no command executed twice.
+// mast camera cannot see), a parcel appears on the table later, and the first pick of the can
+// misses. The robot must end holding the can, with the cup on the floor where it fell (the world
+// model put it there: the way to the table is planned round it, not through it), having replanned
+// after the failed pick, and no command executed twice.
 TEST(MissionTest, HoldingStartWithFaultsEndsHoldingTheCan) {
   const Mission m = run("holding_start_faults.yaml");
   ASSERT_EQ(m.exit_code, 0) << m.output;
@@ -112,6 +113,9 @@ TEST(MissionTest, HoldingStartWithFaultsEndsHoldingTheCan) {
   std::map<std::string, int> executions;
   for (const auto& a : m.truth["action_log"]) ++executions[a.is_object() ? a["command_id"].get<std::string>() : a.get<std::string>()];
   for (const auto& [id, n] : executions) EXPECT_EQ(n, 1) << id << " executed " << n << " times";
+  bool failed_pick_replanned = false;
+  for (const auto& r : m.report["replanning"]) failed_pick_replanned |= r["event"] == "action_failed";
+  EXPECT_TRUE(failed_pick_replanned) << m.report["replanning"].dump(1);
 }
 
 // --fresh: the estimator starts from the default models in a store of the run's own; the store the

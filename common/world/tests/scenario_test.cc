@@ -249,7 +249,7 @@ TEST(ScenarioTest, FaultsAreParsed) {
   EXPECT_EQ(sc.faults[0].kind, FaultKind::kDropHeld);
   EXPECT_DOUBLE_EQ(*sc.faults[0].at_time, 2.0);
   EXPECT_EQ(sc.faults[1].kind, FaultKind::kActionFails);
-  EXPECT_EQ(*sc.faults[1].at_step, 3);
+  EXPECT_EQ(*sc.faults[1].at_step, 2);
   EXPECT_EQ(sc.faults[1].action, "pick");
   EXPECT_EQ(sc.faults[2].kind, FaultKind::kObjectAppears);
   ASSERT_TRUE(sc.faults[2].object.has_value());

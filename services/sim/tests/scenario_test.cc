@@ -52,7 +52,7 @@ TEST(ScenarioSetupTest, ScriptedFaultsOfHoldingStartFaults) {
   EXPECT_EQ(setup->faults[0].type, FaultType::kDropHeldObject);
   EXPECT_EQ(setup->faults[1].type, FaultType::kFailAction);
   EXPECT_EQ(setup->faults[1].action, ActionKind::kPick);
-  EXPECT_EQ(setup->faults[1].trigger.step, 3);
+  EXPECT_EQ(setup->faults[1].trigger.step, 2);
   EXPECT_EQ(setup->faults[2].type, FaultType::kSpawnObject);
   Simulator sim(setup->world, setup->robot, setup->initial, params, setup->faults);
   ASSERT_TRUE(sim.world().held());

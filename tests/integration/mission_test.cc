@@ -69,6 +69,23 @@ TEST(MissionTest, CorridorShortDetourIsTakenInsteadOfMovingTheBox) {
   EXPECT_LT(distance(m.truth["objects"]["box"], 4.62, 1.2), 0.02);
 }
 
+// Every pick of the corridor box misses (scripted). The pick is tried max_action_failures (2)
+// times, then given up: no re-joining branch is left, the graph manager plans from scratch and the
+// robot goes round. The box stays where it was; the mission succeeds.
+TEST(MissionTest, APickThatKeepsFailingIsGivenUpForTheWayRound) {
+  const Mission m = run("namo_corridor_slippery.yaml", {"--policy", "effort"});
+  ASSERT_EQ(m.exit_code, 0) << m.output;
+  ASSERT_TRUE(m.truth.is_object()) << m.output;
+  EXPECT_LT(distance(m.truth["robot"], 8.5, 1.2), 0.10) << m.truth.dump();
+  EXPECT_LT(distance(m.truth["objects"]["box"], 4.62, 1.2), 0.02) << "the box was never picked";
+  int failed_picks = 0;
+  for (const auto& a : m.report["actions"])
+    if (a["action"].get<std::string>().rfind("(pick box", 0) == 0 && a["outcome"] == "failed") ++failed_picks;
+  EXPECT_EQ(failed_picks, 2) << m.report["actions"].dump(1);
+  ASSERT_FALSE(m.report["replanning"].empty());
+  EXPECT_EQ(m.report["replanning"].back()["how"], "from scratch") << m.report["replanning"].dump(1);
+}
+
 // The DDS Security profile (deploy/security/): every service with its own certificate and
 // permissions, everything encrypted; the mission must still succeed. A topic a node uses but the
 // access table does not grant it makes that node fail to start (or the call fail), so this is

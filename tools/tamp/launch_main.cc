@@ -27,11 +27,6 @@
 
 namespace fs = std::filesystem;
 
-namespace {
-volatile sig_atomic_t g_stop = 0;
-void onSignal(int) { g_stop = 1; }
-}  // namespace
-
 int main(int argc, char** argv) {
   CLI::App app{"Start and supervise the TAMP services of one host of a deployment", "tamp launch"};
   std::string file, host, run_id, profile, scenario, out_dir = "out";
@@ -108,10 +103,7 @@ int main(int argc, char** argv) {
   o.bin_dir = bin_dir;
   o.config_dir = tamp::configDir();
 
-  struct sigaction sa {};
-  sa.sa_handler = onSignal;
-  sigemptyset(&sa.sa_mask);
-  for (int sig : {SIGINT, SIGTERM, SIGHUP}) sigaction(sig, &sa, nullptr);
+  tamp::cli::stopOnSignals({SIGINT, SIGTERM, SIGHUP}, /*restart=*/false);
 
   tamp::launch::Launcher launcher(o);
   if (tamp::Status s = launcher.start(); !s.ok()) {
@@ -127,7 +119,7 @@ int main(int argc, char** argv) {
 
   bool announced = false;
   int rc = tamp::cli::kExitOk;
-  while (!g_stop) {
+  while (!tamp::cli::stopRequested()) {
     launcher.poll();
     const auto statuses = launcher.supervisor().status();
     bool all_failed = !statuses.empty();

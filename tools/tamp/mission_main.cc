@@ -23,11 +23,6 @@
 
 namespace fs = std::filesystem;
 
-namespace {
-volatile sig_atomic_t g_stop = 0;
-void onSignal(int) { g_stop = 1; }
-}  // namespace
-
 int main(int argc, char** argv) {
   CLI::App app{"Send a mission to a running deployment and follow it", "tamp mission"};
   std::string scenario, run_id, policy = "effort", out_dir = "out";
@@ -70,8 +65,7 @@ int main(int argc, char** argv) {
     std::cerr << "tamp mission: " << participant.error().toString() << "\n";
     return tamp::cli::kExitServiceError;
   }
-  std::signal(SIGINT, onSignal);
-  std::signal(SIGTERM, onSignal);
+  tamp::cli::stopOnSignals({SIGINT, SIGTERM}, /*restart=*/true);
   tamp::dds::HeartbeatMonitor monitor(*participant);
   const tamp::Termination startup = tamp::Termination::after(deployment->startup_timeout_s);
   for (const auto& s : deployment->services) {
@@ -93,7 +87,7 @@ int main(int argc, char** argv) {
   mo.out_dir = fs::absolute(fs::path(out_dir) / *rid / "mission");
   fs::create_directories(mo.out_dir);
   const tamp::Stopwatch wall;
-  const int rc = tamp::runner::runMission(*participant, mo, [] { return g_stop != 0; });
+  const int rc = tamp::runner::runMission(*participant, mo, [] { return tamp::cli::stopRequested(); });
   // From the mission sent to its end (services already alive): what benchmarks compare.
   std::printf("tamp mission: wall time %.2f s\n", wall.seconds());
   return rc;

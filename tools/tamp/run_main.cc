@@ -34,13 +34,6 @@
 
 namespace fs = std::filesystem;
 
-namespace {
-
-volatile sig_atomic_t g_stop = 0;
-void onSignal(int) { g_stop = 1; }
-
-}  // namespace
-
 int main(int argc, char** argv) {
   CLI::App app{"Run the TAMP services on this machine (one DDS domain, supervised processes)", "tamp run"};
   std::string scenario;
@@ -123,8 +116,7 @@ int main(int argc, char** argv) {
   }
   // The services inherit the security directory; each picks its identity by its --name.
   if (!security.empty()) setenv("TAMP_DDS_SECURITY", fs::absolute(security).c_str(), 1);
-  std::signal(SIGINT, onSignal);
-  std::signal(SIGTERM, onSignal);
+  tamp::cli::stopOnSignals({SIGINT, SIGTERM}, /*restart=*/true);
 
   // Every service of every host of the deployment, on this machine, attached to this process
   // (they die with it); restarted on death or freeze only when they are to keep running.
@@ -177,7 +169,7 @@ int main(int argc, char** argv) {
     while (!monitor.waitFor(name, 1, startup.tightened(tamp::Deadline::in(0.1)))) {
       launcher.poll();
       auto st = sup.status(name);
-      if (startup() || g_stop || (st && st->phase != tamp::process::ProcessPhase::kRunning &&
+      if (startup() || tamp::cli::stopRequested() || (st && st->phase != tamp::process::ProcessPhase::kRunning &&
                                    st->phase != tamp::process::ProcessPhase::kBackoff)) {
         not_alive.push_back(name);
         break;
@@ -239,13 +231,13 @@ int main(int argc, char** argv) {
     mo.out_dir = run_dir;
     rc = tamp::runner::runMission(*participant, mo, [&] {
       launcher.poll();
-      return g_stop != 0;
+      return tamp::cli::stopRequested();
     });
   }
   if (keep && rc == tamp::cli::kExitOk) {
     std::printf("tamp run: services running (supervised); Ctrl-C to stop.\n");
     std::fflush(stdout);
-    while (!g_stop) {
+    while (!tamp::cli::stopRequested()) {
       launcher.poll();
       std::this_thread::sleep_for(std::chrono::milliseconds(100));
     }

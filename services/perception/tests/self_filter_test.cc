@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <limits>
 #include <stdexcept>
+#include <utility>
 
 #include "tamp/perception/perception.h"
 #include "tamp/perception/self_filter.h"
@@ -95,6 +96,22 @@ Frames look(Perception& p, const world::World& truth, const robot::RobotState& s
 int count(const std::vector<WorldEvent>& events, EventType type) {
   return static_cast<int>(std::count_if(events.begin(), events.end(),
                                         [&](const WorldEvent& e) { return e.type == type; }));
+}
+
+/// The prior (and the truth at the start): a 5 x 5 x 10 cm parcel standing on a static stand with
+/// its centre at `at` (right between the open fingers of the arm at "ready", for the tool there).
+std::pair<world::World, world::Object> parcelOnStand(const Eigen::Vector3d& at) {
+  world::World prior = floorOnly();
+  const double parcel_h = 0.10, stand_top = at.z() - parcel_h / 2;
+  EXPECT_TRUE(prior
+                  .addObject(testing::box("stand", 0.3, 0.3, stand_top, at.x() + 0.05, at.y(), 0.0,
+                                          0.0, world::ObjectKind::kStatic))
+                  .ok());
+  world::Object parcel = testing::box("parcel", 0.05, 0.05, parcel_h, at.x(), at.y(), 0.0, stand_top);
+  parcel.mass = 0.3;
+  parcel.graspable = true;
+  EXPECT_TRUE(prior.addObject(parcel).ok());
+  return {prior, parcel};
 }
 
 TEST(SelfFilterTest, BodyPartsFollowForwardKinematics) {
@@ -206,17 +223,7 @@ TEST(SelfFilterTest, TheHeldObjectFollowsTheGripperAndIsNeverNewNorGone) {
   // A parcel standing on a stand right between the open fingers of the arm at "ready".
   const robot::RobotState ready = armReady();
   const Eigen::Isometry3d tool = robotModel().toolPoseInWorld(ready);
-  const Eigen::Vector3d c = tool.translation();
-  world::World prior = floorOnly();
-  const double parcel_h = 0.10, stand_top = c.z() - parcel_h / 2;
-  ASSERT_TRUE(prior
-                  .addObject(testing::box("stand", 0.3, 0.3, stand_top, c.x() + 0.05, c.y(), 0.0,
-                                          0.0, world::ObjectKind::kStatic))
-                  .ok());
-  world::Object parcel = testing::box("parcel", 0.05, 0.05, parcel_h, c.x(), c.y(), 0.0, stand_top);
-  parcel.mass = 0.3;
-  parcel.graspable = true;
-  ASSERT_TRUE(prior.addObject(parcel).ok());
+  const auto [prior, parcel] = parcelOnStand(tool.translation());
   world::World truth = prior;
 
   sim::DepthSensor camera = robotCamera();
@@ -284,17 +291,7 @@ TEST(SelfFilterTest, TheHeldObjectFollowsTheGripperAndIsNeverNewNorGone) {
 TEST(SelfFilterTest, ADroppedObjectFallsOntoTheSupportBelowIt) {
   const robot::RobotState ready = armReady();
   const Eigen::Isometry3d tool = robotModel().toolPoseInWorld(ready);
-  const Eigen::Vector3d c = tool.translation();
-  world::World prior = floorOnly();
-  const double parcel_h = 0.10, stand_top = c.z() - parcel_h / 2;
-  ASSERT_TRUE(prior
-                  .addObject(testing::box("stand", 0.3, 0.3, stand_top, c.x() + 0.05, c.y(), 0.0,
-                                          0.0, world::ObjectKind::kStatic))
-                  .ok());
-  world::Object parcel = testing::box("parcel", 0.05, 0.05, parcel_h, c.x(), c.y(), 0.0, stand_top);
-  parcel.mass = 0.3;
-  parcel.graspable = true;
-  ASSERT_TRUE(prior.addObject(parcel).ok());
+  const auto [prior, parcel] = parcelOnStand(tool.translation());
   world::World truth = prior;
   sim::DepthSensor camera = robotCamera();
   Perception p(prior, PerceptionParams{});
@@ -311,7 +308,7 @@ TEST(SelfFilterTest, ADroppedObjectFallsOntoTheSupportBelowIt) {
   ASSERT_EQ(p.heldObject(), "parcel");
   // Dropped: it lies on the floor below the gripper.
   world::Object fallen = carried;
-  fallen.pose = testing::box("x", 0.05, 0.05, parcel_h, carried.pose.translation().x(),
+  fallen.pose = testing::box("x", 0.05, 0.05, parcel.shape.size.z(), carried.pose.translation().x(),
                              carried.pose.translation().y(), 0.0)
                     .pose;
   ASSERT_TRUE(truth.updateObject(fallen).ok());

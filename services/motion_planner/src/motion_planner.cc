@@ -251,7 +251,10 @@ Aabb MotionPlanner::Impl::baseBounds(const std::vector<Eigen::Vector2d>& extra) 
   Aabb b = world.bounds();
   for (const auto& p : extra) b.extend(Eigen::Vector3d(p.x(), p.y(), 0.0));
   if (b.empty()) b.extend(Eigen::Vector3d::Zero());
-  const double m = params.sampling.workspace_margin;
+  // An explicit workspace (a scenario's, a NAMO map's extent) is where the robot may go: no
+  // margin beyond it (with one, a base went round a wall outside the map). Bounds derived from
+  // the objects get the margin.
+  const double m = world.workspace() ? 0.0 : params.sampling.workspace_margin;
   b.min.x() -= m;
   b.min.y() -= m;
   b.max.x() += m;

@@ -42,7 +42,7 @@ struct SamplingParams {
   double range{0.0};                      ///< longest tree extension, space metric; 0: OMPL's default
   double goal_position_tolerance{0.01};   ///< base goal x, y tolerance, m; > 0
   double goal_orientation_tolerance{0.02};///< base goal yaw and joint goal tolerance, rad; > 0
-  double workspace_margin{0.5};           ///< added around the world's bounds for the base bounds, m; >= 0
+  double workspace_margin{0.5};           ///< added around the objects' bounds for the base bounds when the world has no explicit workspace, m; >= 0
   PlannerKind lazy_planner{PlannerKind::kLbkpiece};  ///< base group, lazy mode (static geometry)
   PlannerKind full_planner{PlannerKind::kLbkpiece};  ///< base group, full mode (everything known)
   /// Arm and whole-body groups, both modes. KPIECE1 by default: LBKPIECE1 needs 0.3-3 s in the

@@ -145,6 +145,33 @@ TEST(MissionTest, HoldingStartWithFaultsEndsHoldingTheCan) {
   EXPECT_TRUE(failed_pick_replanned) << m.report["replanning"].dump(1);
 }
 
+// Conditional planning: the gripper holds a cup that the planner was not told about. The graph
+// manager plans from what it was told (the hand empty) and prebuilds the branch "gripper not
+// empty" before executing anything; the robot's report of its gripper selects that branch before
+// the first action, with no planner call. The robot ends holding the can, with the cup standing on
+// the table, and no command executed twice.
+TEST(MissionTest, AHandNotEmptyThatThePlannerDidNotKnowTakesThePrebuiltBranch) {
+  const Mission m = run("holding_unknown.yaml");
+  ASSERT_EQ(m.exit_code, 0) << m.output;
+  ASSERT_TRUE(m.truth.is_object()) << m.output;
+  EXPECT_EQ(m.truth["robot"]["held"], "can") << m.truth.dump();
+  const auto& cup = m.truth["objects"]["cup"];
+  EXPECT_GT(cup["x"].get<double>(), 1.25) << "the cup is not on the table: " << m.truth.dump();
+  EXPECT_LT(cup["x"].get<double>(), 2.05) << m.truth.dump();
+  EXPECT_NEAR(cup["z"].get<double>(), 0.75 + 0.05, 0.03) << "the cup is not standing on the table: " << m.truth.dump();
+  std::map<std::string, int> executions;
+  for (const auto& a : m.truth["action_log"]) ++executions[a.is_object() ? a["command_id"].get<std::string>() : a.get<std::string>()];
+  for (const auto& [id, n] : executions) EXPECT_EQ(n, 1) << id << " executed " << n << " times";
+  ASSERT_EQ(m.report["conditionals"].size(), 1u) << m.report.dump(1);
+  const auto& c = m.report["conditionals"][0];
+  EXPECT_TRUE(c["prebuilt"].get<bool>()) << c.dump();
+  EXPECT_EQ(c["at_node"], "n0") << c.dump();
+  EXPECT_NE(c["observation"].get<std::string>().find("cup"), std::string::npos) << c.dump();
+  ASSERT_TRUE(c["planner_calls"].is_number()) << "no command followed the observation: " << c.dump();
+  EXPECT_EQ(c["planner_calls"].get<int>(), 0) << c.dump();
+  EXPECT_EQ(m.report["replans"].get<int>(), 0) << m.report["replanning"].dump(1);
+}
+
 // --fresh: the estimator starts from the default models in a store of the run's own; the store the
 // deployment configures (which the first run taught) is neither read nor changed.
 TEST(MissionTest, FreshStartsFromTheDefaultModelsAndLeavesTheLearnedStoreAlone) {

@@ -125,10 +125,22 @@ void printSummary(const nlohmann::json& r) {
                 rp.value("planner_calls", 0), rp.value("motion_calls", 0),
                 rp["latency_s"].is_number() ? (std::to_string(rp["latency_s"].get<double>()).substr(0, 5) + " s").c_str() : "-");
   }
+  for (const auto& c : r.value("conditionals", nlohmann::json::array())) {
+    const auto calls = [&](const char* k) { return c[k].is_number() ? std::to_string(c[k].get<int>()) : std::string("-"); };
+    std::printf("conditional at %s: %s: %s, planner %s, motion %s calls\n", c.value("at_node", "").c_str(),
+                c.value("observation", "").c_str(),
+                c.value("prebuilt", false) ? ("prebuilt branch " + c.value("branch_node", std::string())).c_str()
+                                           : "no prebuilt branch, replanned",
+                calls("planner_calls").c_str(), calls("motion_calls").c_str());
+  }
   for (const auto& d : r.value("decisions", nlohmann::json::array())) {
     std::printf("decision at %s:\n", d.value("node", "").c_str());
+    const bool observed = d.value("what", "").rfind("observation:", 0) == 0;  // a conditional branch
+    if (observed) std::printf("  %s\n", d.value("what", "").c_str());
     for (const auto& a : d["alternatives"]) {
-      if (a["effort_s"].is_number())
+      if (observed)
+        std::printf("  %s %s\n", a.value("chosen", false) ? "*" : " ", a.value("alternative", "").c_str());
+      else if (a["effort_s"].is_number())
         std::printf("  %s %6.1f s  %s\n", a.value("chosen", false) ? "*" : " ", a["effort_s"].get<double>(),
                     a.value("alternative", "").c_str());
       else if (a.value("cut", false))

@@ -182,6 +182,10 @@ void GraphManagerNode::runOne(const msg::MissionCommand& c) {
     }
   }
   GraphManager gm(std::move(abs), *domain, *goal, clients_, p);
+  // What the planner is told: the scenario's planner view (a hidden object in the gripper is not
+  // in it). The robot's own report of the hand selects the conditional branch.
+  const world::World told = sc->world.plannerView();
+  gm.setBelief(Belief{told.held() ? told.held()->object_id : std::string()});
   logger()->info("mission {}: scenario {}, policy {}, goal {} atoms", id, sc->name, toString(p.policy), goal->atoms.size());
 
   MissionObserver obs;

@@ -124,6 +124,16 @@ void Abstraction::addReach(const std::string& location, const std::string& armco
 
 bool Abstraction::isRegion(const std::string& id) const { return regions_.count(id) > 0; }
 
+std::string Abstraction::addPlaceholder(const std::string& hint) {
+  auto taken = [&](const std::string& id) {
+    return world_.findObject(id) != nullptr || locations_.count(id) || regions_.count(id) || placeholders_.count(id);
+  };
+  std::string id = hint;
+  for (int k = 2; taken(id); ++k) id = hint + "_" + std::to_string(k);
+  placeholders_.insert(id);
+  return id;
+}
+
 std::string Abstraction::regionOfArmconf(const std::string& armconf) const {
   if (armconf.rfind("over_", 0) != 0) return {};
   const std::string r = armconf.substr(5);
@@ -155,6 +165,8 @@ std::vector<std::string> Abstraction::objects() const {
   for (const auto& o : world_.objects()) {
     if (o.kind == world::ObjectKind::kMovable) out.push_back(o.id + " - item");
   }
+  for (const auto& id : placeholders_)
+    if (world_.findObject(id) == nullptr) out.push_back(id + " - item");
   return out;
 }
 

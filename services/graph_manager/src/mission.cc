@@ -7,6 +7,7 @@
 
 #include "tamp/core/log.h"
 #include "tamp/graph_manager/graph_manager.h"
+#include "state_atoms.h"
 
 namespace tamp::graph_manager {
 namespace {
@@ -98,6 +99,12 @@ struct GraphManager::Run {
   bool first_action{true};
   std::optional<Clock::time_point> event_at;  ///< a replanning waiting for its next command
   std::set<NodeId> planned_from_scratch;      ///< nodes TP(node, goal) was asked for after a replanning
+  struct PendingConditional {
+    Clock::time_point at;
+    int planner_calls{0};
+    int motion_calls{0};
+  };
+  std::optional<PendingConditional> conditional_at;  ///< a conditional branch waiting for its next command
 
   MissionReport run();
 
@@ -119,6 +126,11 @@ struct GraphManager::Run {
   /// Online replanning after `ev`; false when the mission must give up (`why` says why).
   bool replan(const MissionEvent& ev, EdgeId failed, std::string& why);
   void noteCommand();
+  /// Conditional planning: before the first action and before each pick, the hand as the robot
+  /// reports it against the node's belief. A gripper that holds an object where the node has
+  /// the hand empty takes the prebuilt branch (no planner call), else online replanning.
+  enum class Hand { kAsBelieved, kSwitched, kGaveUp };
+  Hand checkHand(const std::string& before, std::string& why);
   /// Where the graph believes a movable object is: where the branch put it, else the world the
   /// graph was last built from; none for an object new to it.
   std::optional<Eigen::Isometry3d> expectedPose(const std::string& id) const {
@@ -238,6 +250,67 @@ void GraphManager::Run::noteCommand() {
   }
   if (event_at && !report.replanning.empty()) report.replanning.back().latency_s = since(*event_at);
   event_at.reset();
+  if (conditional_at && !report.conditionals.empty()) {
+    ConditionalRecord& c = report.conditionals.back();
+    c.latency_s = since(conditional_at->at);
+    c.planner_calls = gm.counters_.planner_calls - conditional_at->planner_calls;
+    c.motion_calls = gm.counters_.motion_calls - conditional_at->motion_calls;
+  }
+  conditional_at.reset();
+}
+
+GraphManager::Run::Hand GraphManager::Run::checkHand(const std::string& before, std::string& why) {
+  const Observation now = source.robot();
+  const std::vector<std::string>& believed = gm.graph_.node(current).atoms;
+  if (!now.valid || now.held_object_id.empty() ||
+      !std::binary_search(believed.begin(), believed.end(), std::string("(hand-empty)")))
+    return Hand::kAsBelieved;
+  const std::string& object = now.held_object_id;
+  // The object's geometry, if perception knows it by now (it follows the gripper).
+  if (gm.abstraction_.world().findObject(object) == nullptr) {
+    const world::World live = source.world();
+    if (const world::Object* o = live.findObject(object)) {
+      world::World w = gm.abstraction_.world();
+      (void)w.addObject(*o);
+      gm.abstraction_.setWorld(w);
+    }
+  }
+  const std::string observation = "the gripper holds '" + object + "', the node believes it empty";
+  ConditionalRecord rec;
+  rec.at_node = "n" + std::to_string(current);
+  rec.observation = observation;
+  // The prebuilt branch, unless the node places that object elsewhere (then its atoms about it
+  // are wrong too, and only replanning can say where things are).
+  bool named = false;
+  for (const auto& a : believed) named = named || detail::mentions(a, {object});
+  const auto branch_node = named ? std::nullopt : gm.takeContingency(current, object);
+  if (!branch_node) {
+    rec.prebuilt = false;
+    report.conditionals.push_back(rec);
+    log::get("graph_manager")->info("{} at {}: no prebuilt branch, online replanning", observation, rec.at_node);
+    if (!replan(MissionEvent{EventKind::kHandNotEmpty, before, object, observation}, -1, why)) return Hand::kGaveUp;
+    return Hand::kSwitched;
+  }
+  Decision d;
+  d.node = rec.at_node;
+  d.what = "observation: " + observation;
+  d.traverse = gm.traverse_count_;
+  Alternative empty;
+  empty.description = "the hand empty: on with " + before;
+  Alternative holding;
+  holding.description = "the gripper not empty: put '" + object + "' down first (prebuilt branch n" +
+                        std::to_string(*branch_node) + ")";
+  holding.chosen = true;
+  d.alternatives = {empty, holding};
+  gm.decisions_.push_back(d);
+  rec.branch_node = "n" + std::to_string(*branch_node);
+  report.conditionals.push_back(rec);
+  conditional_at = PendingConditional{Clock::now(), gm.counters_.planner_calls, gm.counters_.motion_calls};
+  log::get("graph_manager")->info("{} at {}: the prebuilt branch from {}", observation, rec.at_node, rec.branch_node);
+  current = *branch_node;
+  ctx = gm.contextOf(now);
+  branch.clear();
+  return Hand::kSwitched;
 }
 
 ExecutionReport GraphManager::Run::execute(Edge& e, EdgeCommand& cmd) {
@@ -447,7 +520,12 @@ MissionReport GraphManager::Run::run() {
   Observation robot = source.robot();
   if (!robot.valid) return finish(MissionOutcome::kUnavailable, "no robot state received");
   state("planning", "planning from the robot's state");
-  if (Status s = gm.start(source.world(), robot); !s) {
+  // Told the hand is empty, the planner plans so, and the first observation of the hand selects
+  // the conditional branch if the robot holds something. Told it holds an object, what the robot
+  // reports wins at the start (an object dropped before the mission began is simply not held).
+  Observation believed = robot;
+  if (gm.belief_.held_object_id && gm.belief_.held_object_id->empty()) believed.held_object_id.clear();
+  if (Status s = gm.start(source.world(), believed); !s) {
     const auto code = s.error().code;
     return finish(code == ErrorCode::kUnavailable       ? MissionOutcome::kUnavailable
                   : code == ErrorCode::kTimeout         ? MissionOutcome::kTimeout
@@ -456,11 +534,19 @@ MissionReport GraphManager::Run::run() {
                   s.error().message);
   }
   current = gm.root_;
-  ctx = gm.contextOf(robot);
+  ctx = gm.contextOf(believed);
   while (true) {
     if (observer.abort_requested && observer.abort_requested()) return finish(MissionOutcome::kAborted, "aborted by the user");
     if (gm.isGoal(current)) break;
     std::string why;
+    // The hand before the first action (before any motion is planned) and before each pick.
+    const bool at_start = first_action && report.conditionals.empty();
+    const bool before_pick = !branch.empty() && gm.graph_.edge(branch.front()).kind == ActionKind::kPick;
+    if (at_start || before_pick) {
+      const Hand h = checkHand(at_start ? std::string("the start") : gm.graph_.edge(branch.front()).action, why);
+      if (h == Hand::kGaveUp) return finish(MissionOutcome::kFailed, why);
+      if (h == Hand::kSwitched) continue;
+    }
     if (branch.empty() && !planBranch(why)) return finish(MissionOutcome::kFailed, why);
     const EdgeId id = branch.front();
     const EdgeId next = branch.size() > 1 ? branch[1] : -1;

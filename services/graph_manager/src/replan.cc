@@ -7,38 +7,14 @@
 
 #include "tamp/core/log.h"
 #include "tamp/graph_manager/graph_manager.h"
+#include "state_atoms.h"
 #include "tamp/world/polygon.h"
 
 namespace tamp::graph_manager {
 namespace {
-
-/// True when the ground atom names one of `ids` as an argument.
-bool mentions(const std::string& atom, const std::vector<std::string>& ids) {
-  const auto t = atomTokens(atom);
-  for (std::size_t i = 1; i < t.size(); ++i)
-    if (std::find(ids.begin(), ids.end(), t[i]) != ids.end()) return true;
-  return false;
-}
-
-/// Literals whose conjunction holds exactly in `target` (given the atoms of `from`): the target's
-/// atoms, and the negation of every atom of `from` it does not have.
-std::vector<std::string> exactly(const std::vector<std::string>& from, const std::vector<std::string>& target) {
-  std::vector<std::string> goal = target;
-  for (const auto& a : from)
-    if (!std::binary_search(target.begin(), target.end(), a)) goal.push_back("(not " + a + ")");
-  return goal;
-}
-
-/// `state` changed as `before` -> `after` changed (the frame assumption for carried atoms).
-std::vector<std::string> applyChange(const std::vector<std::string>& state, const std::vector<std::string>& before,
-                                     const std::vector<std::string>& after) {
-  std::set<std::string> s(state.begin(), state.end());
-  for (const auto& a : before)
-    if (!std::binary_search(after.begin(), after.end(), a)) s.erase(a);
-  for (const auto& a : after)
-    if (!std::binary_search(before.begin(), before.end(), a)) s.insert(a);
-  return {s.begin(), s.end()};
-}
+using detail::applyChange;
+using detail::exactly;
+using detail::mentions;
 
 double pointSegment(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
   const Eigen::Vector2d ab = b - a;
@@ -77,6 +53,7 @@ std::string_view toString(EventKind k) {
     case EventKind::kObjectMoved: return "object_moved";
     case EventKind::kOverrun: return "overrun";
     case EventKind::kNotPrepared: return "not_prepared";
+    case EventKind::kHandNotEmpty: return "hand_not_empty";
   }
   return "?";
 }
@@ -92,23 +69,7 @@ std::vector<NodeId> GraphManager::rejoin(NodeId current, const std::vector<EdgeI
     const NodeId target = graph_.edge(ahead[i]).to;
     if (!graph_.node(target).healthy) continue;
     // The branch from `target` on, in states that keep what is known now about the new objects.
-    NodeId join = target;
-    if (!carried.empty()) {
-      std::vector<std::string> actions;
-      std::vector<std::vector<std::string>> states;
-      std::vector<std::string> s = graph_.node(target).atoms;
-      s.insert(s.end(), carried.begin(), carried.end());
-      std::sort(s.begin(), s.end());
-      s.erase(std::unique(s.begin(), s.end()), s.end());
-      states.push_back(s);
-      for (std::size_t j = i + 1; j < ahead.size(); ++j) {
-        const Edge& e = graph_.edge(ahead[j]);
-        actions.push_back(e.action);
-        states.push_back(applyChange(states.back(), graph_.node(e.from).atoms, graph_.node(e.to).atoms));
-      }
-      join = graph_.addNode(states.front(), origin);
-      if (!actions.empty()) (void)graph_.addPlan(actions, states, origin + " (the branch ahead, with what is new)");
-    }
+    const NodeId join = carried.empty() ? target : carryAhead(target, ahead, i + 1, carried, origin);
     if (join == current) {
       joined.push_back(join);
       break;
@@ -124,6 +85,27 @@ std::vector<NodeId> GraphManager::rejoin(NodeId current, const std::vector<EdgeI
     joined.push_back(join);
   }
   return joined;
+}
+
+NodeId GraphManager::carryAhead(NodeId target, const std::vector<EdgeId>& ahead, std::size_t first,
+                                const std::vector<std::string>& carried, const std::string& origin,
+                                Contingency::Plan* record) {
+  std::vector<std::string> actions;
+  std::vector<std::vector<std::string>> states;
+  std::vector<std::string> s = graph_.node(target).atoms;
+  s.insert(s.end(), carried.begin(), carried.end());
+  std::sort(s.begin(), s.end());
+  s.erase(std::unique(s.begin(), s.end()), s.end());
+  states.push_back(s);
+  for (std::size_t j = first; j < ahead.size(); ++j) {
+    const Edge& e = graph_.edge(ahead[j]);
+    actions.push_back(e.action);
+    states.push_back(applyChange(states.back(), graph_.node(e.from).atoms, graph_.node(e.to).atoms));
+  }
+  const NodeId join = graph_.addNode(states.front(), origin);
+  if (!actions.empty()) (void)graph_.addPlan(actions, states, origin + " (the branch ahead, with what is new)");
+  if (record) *record = {actions, states};
+  return join;
 }
 
 int GraphManager::invalidateNear(const std::vector<world::Object>& objects) {

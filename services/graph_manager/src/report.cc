@@ -95,6 +95,18 @@ std::string reportJson(const MissionReport& r, const std::string& scenario, cons
                           {"latency_s", rp.latency_s >= 0.0 ? nlohmann::json(rp.latency_s) : nlohmann::json(nullptr)}});
   }
   j["replanning"] = replanning;
+  nlohmann::json conditionals = nlohmann::json::array();
+  auto orNull = [](auto v) { return v >= 0 ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  for (const auto& c : r.conditionals) {
+    conditionals.push_back({{"at_node", c.at_node},
+                            {"observation", c.observation},
+                            {"prebuilt", c.prebuilt},
+                            {"branch_node", c.branch_node.empty() ? nlohmann::json(nullptr) : nlohmann::json(c.branch_node)},
+                            {"planner_calls", orNull(c.planner_calls)},
+                            {"motion_calls", orNull(c.motion_calls)},
+                            {"latency_s", orNull(c.latency_s)}});
+  }
+  j["conditionals"] = conditionals;
   return j.dump(2);
 }
 

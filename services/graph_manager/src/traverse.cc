@@ -180,12 +180,15 @@ Status GraphManager::start(const world::World& live, const Observation& robot) {
   auto atoms = abstraction_.dynamicAtoms(live, robot.robot.base, armconf, robot.held_object_id);
   root_ = graph_.addNode(atoms, "start");
   auto plan = planFrom(root_, goal_.atoms, "plan 0");
-  planning_s_ += since(t0);
   if (!plan) {
+    planning_s_ += since(t0);
     if (plan.error().code == ErrorCode::kNotFound)
       return Error(ErrorCode::kNotFound, "the goal is unreachable: " + plan.error().message);
     return plan.error();
   }
+  // The contingencies known in advance, in the graph before execution starts.
+  (void)buildContingencies(*plan);
+  planning_s_ += since(t0);
   return Status::Ok();
 }
 

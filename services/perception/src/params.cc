@@ -136,7 +136,8 @@ const config::Schema<PerceptionParams>& schema() {
     using SF = SelfFilterParams;
     s.section("self_filter", &P::self_filter)
         .field("enabled", &SF::enabled)
-        .field("padding", &SF::padding, inRange(0, 0.5, Ends::kClosed, "m"));
+        .field("padding", &SF::padding, inRange(0, 0.5, Ends::kClosed, "m"))
+        .field("held_adopt_radius", &SF::held_adopt_radius, inRange(0, 1.0, Ends::kOpenClosed, "m"));
     using O = OccupancyParams;
     s.section("occupancy", &P::occupancy)
         .field("enabled", &O::enabled)

@@ -511,20 +511,31 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
       unexplained.insert(unexplained.end(), c.begin(), c.end());
     }
   }
+  // Held, but unknown to every track (the planner was not told about it): the cluster at the
+  // gripper hangs from it, it does not stand on a support, and it is the object the robot holds.
+  const bool held_unknown = self_filter && held == nullptr && !robot->held_object_id.empty() &&
+                            I.tracks.count(robot->held_object_id) == 0 &&
+                            I.world.findObject(robot->held_object_id) == nullptr;
+  const Eigen::Vector3d tool = robot != nullptr ? Eigen::Vector3d(robot->world_T_tool.translation()) : Eigen::Vector3d::Zero();
+  auto atTheGripper = [&](const Eigen::Vector2d& xy, double zmin, double zmax) {
+    const double r = P.self_filter.held_adopt_radius;
+    return held_unknown && (xy - tool.head<2>()).norm() <= r && tool.z() >= zmin - r && tool.z() <= zmax + r;
+  };
   std::vector<std::size_t> det_cluster;  // detection -> cluster index
   for (std::size_t ci = 0; ci < S.clusters.size(); ++ci) {
     const auto& c = S.clusters[ci];
     std::vector<Eigen::Vector3d> pts;
     pts.reserve(c.size());
     Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-    double zmin = kInf;
+    double zmin = kInf, zmax = -kInf;
     for (const auto& p : c) {
       pts.emplace_back(p.cast<double>());
       mean += p.head<2>().cast<double>();
       zmin = std::min(zmin, double(p.z()));
+      zmax = std::max(zmax, double(p.z()));
     }
     mean /= static_cast<double>(c.size());
-    const double support = I.supportBelow(mean, zmin, S.planes);
+    const double support = atTheGripper(mean, zmin, zmax) ? zmin : I.supportBelow(mean, zmin, S.planes);
     Detection d = describeCluster(std::move(pts), support, P.clusters);
     const double major = d.majorExtent();
     if (d.height < P.clusters.min_height || major < P.clusters.min_size) {
@@ -741,7 +752,12 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
       continue;
     }
     if (!t.size_known) I.classifyBySize(t);
-    t.id = I.newId(t.label);
+    // Held, but unknown to every track: the new object at the gripper is the one the robot holds.
+    const double half = t.shape.halfHeight();
+    const bool adopt = atTheGripper(t.pose.translation().head<2>(), t.pose.translation().z() - half,
+                                    t.pose.translation().z() + half) &&
+                       I.tracks.count(robot->held_object_id) == 0;
+    t.id = adopt ? robot->held_object_id : I.newId(t.label);
     t.state = TrackInfo::State::kActive;
     t.event_pose = t.pose;
     const world::Object o = I.objectOf(t);

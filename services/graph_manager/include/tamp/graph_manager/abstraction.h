@@ -86,6 +86,11 @@ class Abstraction {
   void addReach(const std::string& location, const std::string& armconf);
   /// True when the region or slot `id` exists.
   bool isRegion(const std::string& id) const;
+  /// A PDDL item that stands for an object not known yet (the conditional branch "the gripper
+  /// holds something the planner does not know"): `hint`, or `hint_2`, ... if a world id has it.
+  /// Listed by objects(); no static facts (it is never picked, only put down).
+  std::string addPlaceholder(const std::string& hint);
+  bool isPlaceholder(const std::string& id) const { return placeholders_.count(id) > 0; }
 
   static std::string armconfOver(const std::string& region) { return "over_" + region; }
   /// The region of an `over_<region>` configuration (empty for stow or unknown).
@@ -118,6 +123,7 @@ class Abstraction {
   std::map<std::string, world::Region> regions_;  ///< world regions and slot regions
   std::map<std::string, Slot> slots_;
   std::set<std::string> reaches_;                 ///< "(reaches l c)"
+  std::set<std::string> placeholders_;
   int slot_counter_{0};
 };
 

@@ -121,6 +121,7 @@ enum class EventKind {
   kObjectMoved,    ///< an object the branch acts on is not where the graph expects it
   kOverrun,        ///< an action took longer than predicted + k sigma
   kNotPrepared,    ///< a manipulation has no grasp or placement in the world as it is now
+  kHandNotEmpty,   ///< the gripper holds an object where the graph believes it empty, no branch prebuilt
 };
 std::string_view toString(EventKind k);
 
@@ -145,6 +146,41 @@ struct ReplanRecord {
   double latency_s{-1.0};             ///< from the event to the next command (-1: none followed)
 };
 
+/// What the planner is told before it observes anything (a scenario's planner view).
+struct Belief {
+  /// The object in the gripper at the start; unset: what the robot reports. Only "" (empty)
+  /// changes the start: the plan assumes the hand empty, and a robot that reports an object in
+  /// it takes the conditional branch. A believed object the robot does not report is not held.
+  std::optional<std::string> held_object_id;
+};
+
+/// A contingency known in advance (the paper's "Conditional Planning"): at node `at`, the
+/// observation selects the branch from `branch` on instead of the node's own edges. The branch
+/// is built before execution starts, over a placeholder item that stands for the object not
+/// known yet; the observation binds it, without a planner call.
+struct Contingency {
+  NodeId at{-1};
+  std::string observation;  ///< "gripper not empty"
+  std::string placeholder;  ///< the PDDL item standing for the unknown held object
+  NodeId branch{-1};        ///< the state of `at` with the placeholder held
+  struct Plan {
+    std::vector<std::string> actions;
+    std::vector<std::vector<std::string>> states;
+  };
+  std::vector<Plan> plans;  ///< put the object down and re-join the plan ahead; the plan from there on
+};
+
+/// A conditional branch taken at run time.
+struct ConditionalRecord {
+  std::string at_node;      ///< the node the observation was made at
+  std::string observation;  ///< what was observed, against what the node believed
+  std::string branch_node;  ///< the node it switched to
+  bool prebuilt{true};      ///< false: no branch was prebuilt for it (online replanning instead)
+  int planner_calls{-1};    ///< from the observation to the next command (-1: none followed)
+  int motion_calls{-1};
+  double latency_s{-1.0};
+};
+
 struct MissionReport {
   MissionOutcome status{MissionOutcome::kFailed};
   std::string reason;
@@ -154,6 +190,7 @@ struct MissionReport {
   double planning_time_to_first_action_s{0.0};
   int replans{0};
   std::vector<ReplanRecord> replanning;
+  std::vector<ConditionalRecord> conditionals;
   Counters counters;
   std::vector<std::string> objects_moved;
   std::vector<Decision> decisions;
@@ -191,6 +228,8 @@ class GraphManager {
   Status start(const world::World& live, const Observation& robot);
   /// Algorithm 3 from `from` with the robot in `context`.
   TraverseResult traverse(NodeId from, const BranchContext& context);
+  /// What the planner is told before it observes (default: what the robot reports at the start).
+  void setBelief(Belief b) { belief_ = std::move(b); }
   /// The whole mission: start, traverse, execute, repair.
   MissionReport runMission(WorldSource& source, Executor& executor, const MissionObserver& observer = {});
 
@@ -212,6 +251,16 @@ class GraphManager {
   /// The command that executes edge `e` from context `ctx`.
   Result<EdgeCommand> command(EdgeId e, EdgeId next, const BranchContext& ctx, const std::string& command_id);
   BranchContext contextOf(const Observation& robot) const;
+
+  // ---- conditional planning (conditional.cc) ----
+  /// Prebuilds the "gripper not empty" branches along `plan` (from the start node): at its start
+  /// and before each pick, where the hand is believed empty, at most `max_contingencies`. Each
+  /// puts the unknown object down and re-joins the plan ahead. Returns how many were built.
+  int buildContingencies(const std::vector<EdgeId>& plan);
+  const std::vector<Contingency>& contingencies() const { return contingencies_; }
+  /// The prebuilt branch at `at` bound to the observed `object`: its node, or none when no branch
+  /// was prebuilt there. No planner call.
+  std::optional<NodeId> takeContingency(NodeId at, const std::string& object);
 
   // ---- online replanning (replan.cc) ----
   /// Sub-tasks from `current` that re-join the nodes the branch `ahead` (its remaining edges)
@@ -292,6 +341,13 @@ class GraphManager {
   int failuresOf(const Edge& e) const;
   void noteFailure(Edge& e);
   std::map<std::string, int> manipulation_failures_;
+  Belief belief_;
+  std::vector<Contingency> contingencies_;
+  /// Copies the edges `ahead[first..]`, which leave `target`, into states that also hold
+  /// `carried` (the frame assumption); returns the copy of `target`. `record` gets the copy.
+  NodeId carryAhead(NodeId target, const std::vector<EdgeId>& ahead, std::size_t first,
+                    const std::vector<std::string>& carried, const std::string& origin,
+                    Contingency::Plan* record = nullptr);
 };
 
 }  // namespace tamp::graph_manager

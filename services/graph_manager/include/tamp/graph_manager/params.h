@@ -47,6 +47,10 @@ struct GraphManagerParams {
   /// Online replanning: re-join sub-tasks tried towards the next this many nodes of the branch
   /// ahead (the first reachable ones are kept, Traverse chooses among them); >= 1.
   int max_rejoin_targets{2};
+  /// Conditional planning: the nodes of the first plan given a prebuilt "the gripper is not
+  /// empty" branch before execution starts (the start and the states before each pick, in plan
+  /// order); each costs up to `max_rejoin_targets` planner calls at the start; >= 0 (0: none).
+  int max_contingencies{3};
   /// An action that failed or was blocked this many times in a mission is not tried again: the
   /// edge is infeasible and Traverse looks for another branch (going round, another placement,
   /// another grasp). A repeat of the same failure from the same state teaches nothing; >= 1.

@@ -151,6 +151,10 @@ struct SelfFilterParams {
   /// m, >= 0: the link shapes and the held object are grown by this much (state latency, encoder
   /// and calibration error, range noise).
   double padding{0.03};
+  /// m, > 0: the robot reports an object in the gripper that no track has (the planner was not
+  /// told about it): a new object confirmed with its centre this close to the tool frame is that
+  /// object, tracked under the robot's id from then on.
+  double held_adopt_radius{0.15};
 };
 
 struct PerceptionParams {

@@ -19,7 +19,10 @@
 ///    the occupancy map. The held object's track follows the gripper (its pose in the tool
 ///    frame is fixed when the grasp is first reported) and is neither associated nor tested for
 ///    being gone while held, so it is never reported as a new obstacle nor as gone from where it
-///    was picked; when the state reports the gripper empty again it is tracked as before.
+///    was picked; when the state reports the gripper empty again it is tracked as before. An
+///    object the state reports held that no track has (the planner was not told about it) is
+///    seen as a new object at the gripper: confirmed within `self_filter.held_adopt_radius` of
+///    the tool frame, it gets the robot's id for it and is filtered as held from then on.
 /// 2. **Transform and crop** to the world frame, the workspace box and the sensor's range.
 /// 3. **Voxel grid** (PCL `VoxelGrid`): the leaf size bounds the cost of everything after.
 /// 4. **Support planes** (PCL RANSAC, `SACMODEL_PERPENDICULAR_PLANE` about world z, several

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <set>
+#include <thread>
 
 #include "tamp/core/log.h"
 #include "tamp/graph_manager/graph_manager.h"
@@ -266,9 +267,18 @@ GraphManager::Run::Hand GraphManager::Run::checkHand(const std::string& before, 
       !std::binary_search(believed.begin(), believed.end(), std::string("(hand-empty)")))
     return Hand::kAsBelieved;
   const std::string& object = now.held_object_id;
-  // The object's geometry, if perception knows it by now (it follows the gripper).
+  // The object's geometry: perception learns it from the points at the gripper, a few frames
+  // after the robot reports it held; its place is planned only once it is known.
   if (gm.abstraction_.world().findObject(object) == nullptr) {
-    const world::World live = source.world();
+    const auto deadline = Clock::now() + std::chrono::duration<double>(gm.params_.held_object_wait_s);
+    world::World live = source.world();
+    while (live.findObject(object) == nullptr && Clock::now() < deadline &&
+           !(observer.abort_requested && observer.abort_requested())) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      live = source.world();
+    }
+    if (live.findObject(object) == nullptr)
+      log::get("graph_manager")->warn("the world model does not know '{}' after {} s", object, gm.params_.held_object_wait_s);
     if (const world::Object* o = live.findObject(object)) {
       world::World w = gm.abstraction_.world();
       (void)w.addObject(*o);

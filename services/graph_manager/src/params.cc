@@ -45,6 +45,7 @@ const config::Schema<GraphManagerParams>& schema() {
         .field("overrun_sigma", &P::overrun_sigma, positive())
         .field("max_rejoin_targets", &P::max_rejoin_targets, atLeast(1))
         .field("max_contingencies", &P::max_contingencies, atLeast(0))
+        .field("held_object_wait_s", &P::held_object_wait_s, positive())
         .field("max_action_failures", &P::max_action_failures, atLeast(1))
         .field("moved_object_tolerance_m", &P::moved_object_tolerance_m, positive());
     return s;

@@ -51,6 +51,10 @@ struct GraphManagerParams {
   /// empty" branch before execution starts (the start and the states before each pick, in plan
   /// order); each costs up to `max_rejoin_targets` planner calls at the start; >= 0 (0: none).
   int max_contingencies{3};
+  /// Conditional planning: how long to wait for the world model to know an object the robot
+  /// reports in its gripper (perception learns it from the points at the gripper) before
+  /// planning how to put it down; s, > 0.
+  double held_object_wait_s{5.0};
   /// An action that failed or was blocked this many times in a mission is not tried again: the
   /// edge is infeasible and Traverse looks for another branch (going round, another placement,
   /// another grasp). A repeat of the same failure from the same state teaches nothing; >= 1.

@@ -121,7 +121,7 @@ struct SearchOptions {
   /// first plan is searched for again from the start with `cost_type`'s default (cost + 1) and
   /// the time left; the anytime iterations always use cost + 1. false: cost + 1 at once.
   bool unit_cost_first{true};
-  double unit_first_time_share{0.25};  ///< must be in (0, 1]
+  double unit_first_time_share{0.1};  ///< must be in (0, 1]
 
   /// @throws std::invalid_argument naming the bad field (weight < 1, ...).
   void validate() const;

@@ -62,11 +62,12 @@ int main(int argc, char** argv) {
   double timeout = 0.0, weight = 5.0, anytime = 5.0;
   size_t memory_mb = 4096;
   bool stats = false, no_check = false, no_fallback = false, no_agenda = false, first_improvement = false,
-       no_ff_first = false, no_landmarks = false;
+       no_ff_first = false, no_landmarks = false, no_unit_first = false;
   uint64_t ff_budget = 300, second_budget = 300;
   const sp::SearchOptions defaults;
   uint64_t fallback_budget = defaults.ehc_fallback_budget_per_h, fallback_min = defaults.ehc_fallback_budget_min,
            fallback_max = defaults.ehc_fallback_budget_max;
+  double unit_first_share = defaults.unit_first_time_share;
   app.add_option("domain", domain, "PDDL domain file")->required();
   app.add_option("problem", problem, "PDDL problem file")->required();
   app.add_option("--search", search,
@@ -105,6 +106,12 @@ int main(int argc, char** argv) {
                  "tasks whose actions differ in cost: after the first plan, look for cheaper ones with "
                  "LAMA's weighted A* iterations for up to this many seconds (0 = first plan)")
       ->check(CLI::Range(0.0, 1e9));
+  app.add_flag("--no-unit-first", no_unit_first,
+               "with --anytime on tasks whose actions differ in cost: search for the first plan with "
+               "cost + 1 at once (default: first with unit costs, as LAMA 2011, then cost + 1 if that fails)");
+  app.add_option("--unit-first-share", unit_first_share,
+                 "the share of the time left that the unit-cost first run may use, in (0, 1]")
+      ->check(CLI::Range(1e-9, 1.0));
   app.add_flag("--no-landmarks", no_landmarks, "lazy: h_FF only (no landmark-count heuristic)");
   app.add_option("--ehc-fallback-min", fallback_min, "ehc: the MIN of --ehc-fallback-budget");
   app.add_option("--ehc-fallback-max", fallback_max, "ehc: at most this many evaluations before falling back (0 = no cap)");
@@ -134,6 +141,8 @@ int main(int argc, char** argv) {
   req.search.ehc_fallback_budget_max = fallback_max;
   req.search.landmarks = !no_landmarks;
   req.search.anytime_seconds = anytime;
+  req.search.unit_cost_first = !no_unit_first;
+  req.search.unit_first_time_share = unit_first_share;
   if (heuristic == "ff") req.search.heuristic = sp::HeuristicKind::kFF;
   if (heuristic == "add") req.search.heuristic = sp::HeuristicKind::kAdd;
   if (heuristic == "max") req.search.heuristic = sp::HeuristicKind::kMax;
@@ -151,7 +160,7 @@ int main(int argc, char** argv) {
   if (stats) {
     std::fprintf(stderr,
                  "; status %s; parse %.4f s, ground %.4f s, search %.4f s; facts %zu, operators %zu; "
-                 "expanded %llu, evaluated %llu, initial h %lld; anytime %llu iterations, %llu improvements%s%s%s\n",
+                 "expanded %llu, evaluated %llu, initial h %lld; anytime %llu iterations, %llu improvements%s%s%s%s\n",
                  sp::toString(reply.status).c_str(), reply.stats.parse_seconds, reply.stats.ground_seconds,
                  reply.stats.search_seconds, reply.stats.facts, reply.stats.operators,
                  static_cast<unsigned long long>(reply.stats.expanded),
@@ -162,7 +171,8 @@ int main(int argc, char** argv) {
                  reply.stats.ehc_second_won   ? "; second ehc run gave the shorter plan"
                  : reply.stats.ehc_second_ran ? "; second ehc run, first plan kept"
                                               : "",
-                 reply.stats.ehc_failed ? "; ehc failed, fell back to best-first search" : "");
+                 reply.stats.ehc_failed ? "; ehc failed, fell back to best-first search" : "",
+                 reply.stats.unit_first_failed ? "; unit-cost first run failed, first plan with cost + 1" : "");
   }
   if (reply.status != sp::PlanStatus::kSolved) {
     std::cerr << (reply.status == sp::PlanStatus::kInputError ? "error: " : "") << reply.message << "\n";

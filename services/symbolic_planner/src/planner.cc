@@ -304,6 +304,7 @@ PlanReply PlanningSession::solve(const Query& q, const Termination& term) {
   reply.stats.ehc_second_won = sr.stats.ehc_second_won;
   reply.stats.anytime_iterations = sr.stats.anytime_iterations;
   reply.stats.anytime_improvements = sr.stats.anytime_improvements;
+  reply.stats.unit_first_failed = sr.stats.unit_first_failed;
   reply.status = fromSearch(sr.status);
   if (sr.status == SearchStatus::kSolved) {
     reply.cost = sr.cost;

@@ -944,6 +944,10 @@ void SearchOptions::validate() const {
     throw std::invalid_argument("SearchOptions::anytime_seconds must be a finite number >= 0, got " +
                                 std::to_string(anytime_seconds));
   }
+  if (!(unit_first_time_share > 0.0 && unit_first_time_share <= 1.0)) {
+    throw std::invalid_argument("SearchOptions::unit_first_time_share must be in (0, 1], got " +
+                                std::to_string(unit_first_time_share));
+  }
   if (preferred_boost < 0) {
     throw std::invalid_argument("SearchOptions::preferred_boost must be >= 0, got " + std::to_string(preferred_boost));
   }
@@ -1021,6 +1025,28 @@ bool costsVary(const Task& task) {
   return false;
 }
 
+/// The first plan of the anytime phase (SearchOptions::unit_cost_first): with unit costs within a
+/// share of the time left, then, if that run ran out of time or memory or gave up, with
+/// `heuristic` (cost + 1) from the start.
+SearchResult unitCostFirstPlan(const Task& task, const StateBits& init, const Goal& goal, const SearchOptions& options,
+                               Heuristic& heuristic, const Termination& term) {
+  SearchResult unit;
+  {
+    std::unique_ptr<Heuristic> unit_h = makeHeuristic(defaultHeuristic(options), task, CostType::kUnit);
+    const double left = term.deadline().secondsLeft();
+    const Termination share =
+        std::isfinite(left) ? term.tightened(Deadline::in(options.unit_first_time_share * left)) : term;
+    unit = firstPlan(task, init, goal, options, *unit_h, share);
+  }  // the unit-cost heuristic and the run's states are freed before the second run
+  const bool retry = unit.status == SearchStatus::kOutOfMemory || unit.status == SearchStatus::kFailed ||
+                     (unit.status == SearchStatus::kTimeout && !term());
+  if (!retry) return unit;
+  SearchResult r = firstPlan(task, init, goal, options, heuristic, term);
+  r.stats.unit_first_failed = true;
+  addRunCosts(r.stats, unit.stats);
+  return r;
+}
+
 }  // namespace
 
 SearchResult search(const Task& task, const StateBits& init, const Goal& goal, const SearchOptions& options,
@@ -1030,12 +1056,15 @@ SearchResult search(const Task& task, const StateBits& init, const Goal& goal, c
     throw std::invalid_argument("search: initial state has " + std::to_string(init.size()) + " words, task needs " +
                                 std::to_string(task.numWords()));
   }
-  SearchResult best = firstPlan(task, init, goal, options, heuristic, term);
   const bool satisficing = options.algorithm == SearchAlgorithm::kEhc || options.algorithm == SearchAlgorithm::kGbfs ||
                            options.algorithm == SearchAlgorithm::kLazy;
-  if (best.status != SearchStatus::kSolved || !satisficing || options.anytime_seconds <= 0 || !costsVary(task)) {
-    return best;
-  }
+  const bool anytime = satisficing && options.anytime_seconds > 0 && costsVary(task);
+  // LAMA 2011: the first plan with unit costs (an explicit cost type is kept), the improving
+  // iterations with cost + 1.
+  SearchResult best = anytime && options.unit_cost_first && !options.cost_type
+                          ? unitCostFirstPlan(task, init, goal, options, heuristic, term)
+                          : firstPlan(task, init, goal, options, heuristic, term);
+  if (best.status != SearchStatus::kSolved || !anytime) return best;
   // Anytime phase (LAMA 2011): the lazy greedy search, then lazy weighted A* with w = 5, 3, 2, 1,
   // 1, ..., each bounded by the
   // best cost so far, until the budget or the caller's deadline; an exhausted iteration proves

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <thread>
 
 #include "tamp/symbolic_planner/landmarks.h"
@@ -210,6 +211,23 @@ TEST(Search, AnytimePhaseNeverReturnsADearerPlanAndEndsOptimalOnASmallTask) {
   ASSERT_EQ(r.status, PlanStatus::kSolved) << r.message;
   EXPECT_EQ(r.cost, 8);
   EXPECT_GE(r.stats.anytime_iterations, 1U);
+  // As LAMA 2011, the first plan is searched for with unit costs: the short way through m
+  // (cost 11); the anytime phase then finds the cheap one (8). Without the unit-cost first run,
+  // or with an explicit cost type, cost + 1 finds 8 at once and nothing improves it.
+  EXPECT_GE(r.stats.anytime_improvements, 1U);
+  EXPECT_FALSE(r.stats.unit_first_failed);
+  req.search.unit_cost_first = false;
+  PlanReply plus_one = plan(req, Termination());
+  ASSERT_EQ(plus_one.status, PlanStatus::kSolved) << plus_one.message;
+  EXPECT_EQ(plus_one.cost, 8);
+  EXPECT_EQ(plus_one.stats.anytime_improvements, 0U);
+  req.search.unit_cost_first = true;
+  req.search.cost_type = CostType::kPlusOne;
+  plus_one = plan(req, Termination());
+  ASSERT_EQ(plus_one.status, PlanStatus::kSolved) << plus_one.message;
+  EXPECT_EQ(plus_one.cost, 8);
+  EXPECT_EQ(plus_one.stats.anytime_improvements, 0U);
+  req.search.cost_type.reset();
 
   // An IPC cost task: the anytime plan (checked) costs at most the first plan.
   const auto dir = test::benchmarksDir() / "pddl-adl/elevators";
@@ -226,6 +244,52 @@ TEST(Search, AnytimePhaseNeverReturnsADearerPlanAndEndsOptimalOnASmallTask) {
   EXPECT_LE(better.cost, first.cost);
 }
 
+TEST(Search, UnitCostFirstRunFallsBackToCostPlusOneWhenOutOfTimeShareOrMemory) {
+  // pegsol-18 takes thousands of expansions with either cost type: a unit-cost run given 1e-9
+  // of the time left runs out of it at its first time check, and the first plan comes from the
+  // cost + 1 run, with the time left (checked by replaying it).
+  const auto pegsol = test::benchmarksDir() / "pddl-more/pegsol";
+  PlanRequest req;
+  req.domain_text = test::readFile(pegsol / "domain.pddl");
+  req.problem_text = test::readFile(pegsol / "instance-18.pddl");
+  req.check_plan = true;
+  req.search.anytime_seconds = 0.2;
+  req.search.unit_first_time_share = 1e-9;
+  req.timeout_seconds = 120;
+  PlanReply r = plan(req, Termination());
+  ASSERT_EQ(r.status, PlanStatus::kSolved) << r.message;
+  EXPECT_TRUE(r.stats.unit_first_failed);
+  // The whole share: the unit-cost run finds the first plan itself.
+  req.search.unit_first_time_share = 1.0;
+  r = plan(req, Termination());
+  ASSERT_EQ(r.status, PlanStatus::kSolved) << r.message;
+  EXPECT_FALSE(r.stats.unit_first_failed);
+  // No deadline: no time share, the unit-cost run is bounded by memory only.
+  req.search.unit_first_time_share = 1e-9;
+  req.timeout_seconds = 0;
+  r = plan(req, Termination());
+  ASSERT_EQ(r.status, PlanStatus::kSolved) << r.message;
+  EXPECT_FALSE(r.stats.unit_first_failed);
+  // Without the anytime phase there is no unit-cost run (TAMP queries keep cost + 1).
+  req.search.anytime_seconds = 0;
+  req.timeout_seconds = 120;
+  r = plan(req, Termination());
+  ASSERT_EQ(r.status, PlanStatus::kSolved) << r.message;
+  EXPECT_FALSE(r.stats.unit_first_failed);
+
+  // citycar-1 within 1 MiB: with unit costs the search needs about 100k evaluations and runs
+  // out of memory; with cost + 1, 3k, and it fits (the case of citycar-6 and -11 at 4 GiB).
+  const auto citycar = test::benchmarksDir() / "pddl-adl/citycar";
+  req.domain_text = test::readFile(citycar / "domain.pddl");
+  req.problem_text = test::readFile(citycar / "instance-1.pddl");
+  req.search.anytime_seconds = 0.2;
+  req.search.unit_first_time_share = 1.0;
+  req.search.memory_limit_mb = 1;
+  r = plan(req, Termination());
+  ASSERT_EQ(r.status, PlanStatus::kSolved) << r.message;
+  EXPECT_TRUE(r.stats.unit_first_failed);
+}
+
 TEST(Search, OptionsAreValidated) {
   SearchOptions o;
   o.weight = 0.5;
@@ -235,6 +299,12 @@ TEST(Search, OptionsAreValidated) {
   o.anytime_seconds = -1;
   EXPECT_THROW(o.validate(), std::invalid_argument);
   o.anytime_seconds = 0;
+  for (double bad : {0.0, -0.5, 1.5, std::nan("")}) {
+    o.unit_first_time_share = bad;
+    EXPECT_THROW(o.validate(), std::invalid_argument) << bad;
+  }
+  o.unit_first_time_share = 1.0;
+  EXPECT_NO_THROW(o.validate());
   EXPECT_EQ(parseSearchAlgorithm("astar"), SearchAlgorithm::kAstar);
   EXPECT_EQ(parseSearchAlgorithm("lazy"), SearchAlgorithm::kLazy);
   EXPECT_FALSE(parseSearchAlgorithm("dfs").has_value());

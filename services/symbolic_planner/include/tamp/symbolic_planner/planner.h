@@ -86,6 +86,7 @@ struct PlanStatistics {
   bool ehc_second_won{false};  ///< ... and its plan was the cheaper one
   uint64_t anytime_iterations{0};    ///< SearchOptions::anytime_seconds: iterations run
   uint64_t anytime_improvements{0};  ///< ... that found a cheaper plan
+  bool unit_first_failed{false};  ///< the unit-cost first run failed; see SearchOptions::unit_cost_first
 };
 
 /// A self-contained request (maps 1:1 to the plan-request message).

@@ -113,6 +113,15 @@ struct SearchOptions {
   /// pruned. 0 (the default) = return the first plan: a TAMP query keeps its latency; `tamp plan`
   /// sets 5 s.
   double anytime_seconds{0.0};
+  /// With the anytime phase on a task whose operators differ in cost (and no explicit
+  /// `cost_type`): search for the first plan with unit costs (as LAMA 2011's first iteration;
+  /// it is found faster and often cheaper than with cost + 1), within `unit_first_time_share`
+  /// of the time left (when there is a deadline) and the memory budget. When that run runs out
+  /// of its share of the time, out of memory, or gives up (ehc without fallback), the
+  /// first plan is searched for again from the start with `cost_type`'s default (cost + 1) and
+  /// the time left; the anytime iterations always use cost + 1. false: cost + 1 at once.
+  bool unit_cost_first{true};
+  double unit_first_time_share{0.1};  ///< must be in (0, 1]
 
   /// @throws std::invalid_argument naming the bad field (weight < 1, ...).
   void validate() const;
@@ -149,6 +158,9 @@ struct SearchStatistics {
   uint64_t anytime_iterations{0};    ///< weighted A* iterations of the anytime phase
   uint64_t anytime_improvements{0};  ///< ... that found a cheaper plan
   bool anytime_proved_optimal{false};  ///< an iteration exhausted its bounded space: no cheaper plan
+  /// `unit_cost_first`: the unit-cost run ran out of its time share or memory, or gave up, and the
+  /// first plan came from the cost + 1 run; its effort is included in the counters above.
+  bool unit_first_failed{false};
   double seconds{0.0};
 };
 

@@ -132,6 +132,10 @@ struct GraphManager::Run {
   /// the hand empty takes the prebuilt branch (no planner call), else online replanning.
   enum class Hand { kAsBelieved, kSwitched, kGaveUp };
   Hand checkHand(const std::string& before, std::string& why);
+  /// The geometry of an object the robot reports held: perception learns it from the points at
+  /// the gripper, a few frames after the report; waits up to `held_object_wait_s` for the world
+  /// model to have it, then adds it to the graph's world (a warning when it never came).
+  void learnHeldObject(const std::string& object);
   /// Where the graph believes a movable object is: where the branch put it, else the world the
   /// graph was last built from; none for an object new to it.
   std::optional<Eigen::Isometry3d> expectedPose(const std::string& id) const {
@@ -260,6 +264,25 @@ void GraphManager::Run::noteCommand() {
   conditional_at.reset();
 }
 
+void GraphManager::Run::learnHeldObject(const std::string& object) {
+  if (gm.abstraction_.world().findObject(object) != nullptr) return;
+  const auto deadline = Clock::now() + std::chrono::duration<double>(gm.params_.held_object_wait_s);
+  world::World live = source.world();
+  while (live.findObject(object) == nullptr && Clock::now() < deadline &&
+         !(observer.abort_requested && observer.abort_requested())) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    live = source.world();
+  }
+  const world::Object* o = live.findObject(object);
+  if (o == nullptr) {
+    log::get("graph_manager")->warn("the world model does not know '{}' after {} s", object, gm.params_.held_object_wait_s);
+    return;
+  }
+  world::World w = gm.abstraction_.world();
+  (void)w.addObject(*o);
+  gm.abstraction_.setWorld(w);
+}
+
 GraphManager::Run::Hand GraphManager::Run::checkHand(const std::string& before, std::string& why) {
   const Observation now = source.robot();
   const std::vector<std::string>& believed = gm.graph_.node(current).atoms;
@@ -267,24 +290,7 @@ GraphManager::Run::Hand GraphManager::Run::checkHand(const std::string& before, 
       !std::binary_search(believed.begin(), believed.end(), std::string("(hand-empty)")))
     return Hand::kAsBelieved;
   const std::string& object = now.held_object_id;
-  // The object's geometry: perception learns it from the points at the gripper, a few frames
-  // after the robot reports it held; its place is planned only once it is known.
-  if (gm.abstraction_.world().findObject(object) == nullptr) {
-    const auto deadline = Clock::now() + std::chrono::duration<double>(gm.params_.held_object_wait_s);
-    world::World live = source.world();
-    while (live.findObject(object) == nullptr && Clock::now() < deadline &&
-           !(observer.abort_requested && observer.abort_requested())) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(50));
-      live = source.world();
-    }
-    if (live.findObject(object) == nullptr)
-      log::get("graph_manager")->warn("the world model does not know '{}' after {} s", object, gm.params_.held_object_wait_s);
-    if (const world::Object* o = live.findObject(object)) {
-      world::World w = gm.abstraction_.world();
-      (void)w.addObject(*o);
-      gm.abstraction_.setWorld(w);
-    }
-  }
+  learnHeldObject(object);
   const std::string observation = "the gripper holds '" + object + "', the node believes it empty";
   ConditionalRecord rec;
   rec.at_node = "n" + std::to_string(current);

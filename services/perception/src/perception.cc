@@ -756,7 +756,7 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
     const double half = t.shape.halfHeight();
     const bool adopt = atTheGripper(t.pose.translation().head<2>(), t.pose.translation().z() - half,
                                     t.pose.translation().z() + half) &&
-                       I.tracks.count(robot->held_object_id) == 0;
+                       I.tracks.count(robot->held_object_id) == 0;  // not adopted earlier in this frame
     t.id = adopt ? robot->held_object_id : I.newId(t.label);
     t.state = TrackInfo::State::kActive;
     t.event_pose = t.pose;

@@ -326,6 +326,9 @@ msg::MotionReply MotionPlannerNode::handleMotion(const msg::MotionRequest& req, 
   nodeLog()->debug("motion {} on planner {}: {} {} {} in {:.1f} ms, {} blocking{}", ctx.request_id, lease->index(),
                    toString(request->group), toString(request->mode), toString(r.status), r.planning_time_s * 1e3,
                    r.blocking.size(), request->object_overrides.empty() ? "" : ", overrides");
+  for (const auto& id : r.start_contacts) {
+    nodeLog()->info("motion {}: the start touches '{}'; the path leaves it first", ctx.request_id, id);
+  }
   msg::MotionReply rep = toMsg(r);
   rep.world_version(world_version);
   if (r.status != MotionStatus::kSolved) rep.header().message(r.reason);

@@ -192,6 +192,16 @@ class OracleValidityChecker : public ob::StateValidityChecker {
   bool full_;
 };
 
+// ---- a start touching movables --------------------------------------------------------------
+
+/// Where a start that touches movable objects only can leave to: `out` is set to a state that
+/// `free_si` finds valid (it touches nothing), reached from `start` by a straight motion that
+/// `escape_si` finds valid (it checks everything but the objects touched at the start). Samples
+/// `attempts` states uniformly near `start`, in four rings of growing radius up to
+/// `max_distance` (space metric), nearest ring first. False when none is found.
+bool escapeStart(const ob::SpaceInformationPtr& free_si, const ob::SpaceInformationPtr& escape_si,
+                 const ob::State* start, double max_distance, int attempts, ob::State* out);
+
 // ---- paths ----------------------------------------------------------------------------------
 
 /// Objects touched along a straight segment and whether it is statically valid.

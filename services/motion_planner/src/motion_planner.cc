@@ -673,16 +673,16 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
   detail::Oracle oracle(impl.scene, gs, ignored, std::move(movables), reach);
   const bool lazy = req.mode == MotionMode::kLazy;
 
-  auto makeSi = [&](bool full) {
+  auto makeSi = [&](detail::Oracle& checker, bool full) {
     auto si = std::make_shared<ob::SpaceInformation>(space);
-    si->setStateValidityChecker(std::make_shared<detail::OracleValidityChecker>(si, oracle, full));
+    si->setStateValidityChecker(std::make_shared<detail::OracleValidityChecker>(si, checker, full));
     si->setStateValidityCheckingResolution(
         std::min(1.0, P.sampling.validity_resolution / std::max(1e-9, space->getMaximumExtent())));
     if (detail::isStopAndTurn(*space)) si->setMotionValidator(std::make_shared<detail::CornerMotionValidator>(si));
     si->setup();
     return si;
   };
-  const ob::SpaceInformationPtr si = makeSi(!lazy);
+  const ob::SpaceInformationPtr si = makeSi(oracle, !lazy);
   auto freeState = [&](ob::State* s) { space->freeState(s); };
   std::unique_ptr<ob::State, decltype(freeState)> start(space->allocState(), freeState);
   {
@@ -697,9 +697,37 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
     const auto self = impl.scene.selfCollisions();
     return self.empty() ? std::string() : "self:" + self.front().first + "/" + self.front().second;
   };
+  // A full-mode start that touches movables only leaves them by a short straight motion first.
+  std::unique_ptr<ob::State, decltype(freeState)> escaped(nullptr, freeState);
   if (collides(start.get())) {
     const std::string who = oracle.collidingObject(start.get(), !lazy);
-    return finish(MotionStatus::kStartInCollision, "the start state touches '" + who + "'", who);
+    std::vector<int> touching;
+    if (!lazy && oracle.staticFree(start.get())) oracle.touched(start.get(), touching);
+    if (!touching.empty() && P.sampling.start_escape_distance > 0.0) {
+      std::vector<std::string> ignore = ignored;
+      std::vector<detail::MovableInfo> others;
+      for (std::size_t i = 0; i < oracle.movables().size(); ++i) {
+        const auto& m = oracle.movables()[i];
+        if (std::binary_search(touching.begin(), touching.end(), static_cast<int>(i))) {
+          ignore.push_back(m.id);
+        } else {
+          others.push_back(m);
+        }
+      }
+      detail::Oracle escape_oracle(impl.scene, gs, ignore, std::move(others), reach);
+      escaped.reset(space->allocState());
+      if (detail::escapeStart(si, makeSi(escape_oracle, true), start.get(), P.sampling.start_escape_distance,
+                              P.sampling.start_escape_attempts, escaped.get())) {
+        for (int i : touching) res.start_contacts.push_back(oracle.movables()[static_cast<std::size_t>(i)].id);
+      } else {
+        escaped.reset();
+      }
+    }
+    if (!escaped) {
+      return finish(MotionStatus::kStartInCollision, "the start state touches '" + who + "'" +
+                                                         (touching.empty() ? "" : " (no way out of the contact found)"),
+                    who);
+    }
   }
   gs.placeRobot(start.get(), impl.scene);
   if (std::string s = selfHit(); !s.empty()) {
@@ -708,7 +736,7 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
 
   // ---- goal ----
   auto pdef = std::make_shared<ob::ProblemDefinition>(si);
-  pdef->addStartState(start.get());
+  pdef->addStartState(escaped ? escaped.get() : start.get());
   std::optional<Eigen::Vector2d> base_goal;  // for the proof
   std::vector<ob::State*> goal_states;
   struct GoalFree {
@@ -982,6 +1010,7 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
       if (!better) break;
     }
     simplifier.collapseCloseVertices(final_path);
+    if (escaped) final_path.prepend(start.get());
     if (req.group == PlanningGroup::kBase && P.sampling.base_turn_in_place) detail::alignBaseHeadings(si, final_path);
     res.stats.shortcut_ms = phase.millis();
   }

@@ -40,6 +40,8 @@ const config::Schema<MotionPlannerParams>& schema() {
         .field("goal_position_tolerance", &S::goal_position_tolerance, positive())
         .field("goal_orientation_tolerance", &S::goal_orientation_tolerance, positive())
         .field("workspace_margin", &S::workspace_margin, nonNegative())
+        .field("start_escape_distance", &S::start_escape_distance, nonNegative())
+        .field("start_escape_attempts", &S::start_escape_attempts, atLeast(1))
         .convert<std::string>("lazy_planner", &S::lazy_planner, planner)
         .convert<std::string>("full_planner", &S::full_planner, planner)
         .convert<std::string>("arm_planner", &S::arm_planner, planner);

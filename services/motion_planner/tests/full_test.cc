@@ -270,5 +270,47 @@ TEST_F(FullTest, HeldObjectInAWallAtTheStartIsStartInCollision) {
   EXPECT_EQ(r.colliding_object, "wall_north");
 }
 
+// The robot stopped 1 cm into a movable box (the belief of where it lies is off, or the robot
+// pushed it): the path leaves the contact by a short straight motion, then touches nothing.
+TEST_F(FullTest, AStartTouchingAMovableLeavesItFirst) {
+  const world::World w = testing::openRoomWorld();  // `obstacle`: x in [4.7, 5.3], y in [2.7, 3.3]
+  MotionPlanner mp = planner(w);
+  const Pose2D from{4.7 - kRadius + 0.01, 3.0, 0.0};
+  const MotionResult r = mp.plan(request(from, {2, 3, 0}), Termination::after(5.0));
+  ASSERT_EQ(r.status, MotionStatus::kSolved) << r.reason;
+  EXPECT_EQ(r.start_contacts, std::vector<std::string>{"obstacle"});
+  ASSERT_GE(r.path.waypoints.size(), 3u);
+  EXPECT_NEAR(r.path.waypoints.front()[0], from.x, 1e-9);
+  EXPECT_NEAR(r.path.waypoints.front()[1], from.y, 1e-9);
+  EXPECT_LT(discClearance(w, r.path, kRadius, 0.002), 0.0);  // it did start in contact
+  // From the end of the escape on, clear of everything; the escape is short.
+  JointPath rest = r.path;
+  rest.waypoints.erase(rest.waypoints.begin());
+  EXPECT_GE(discClearance(w, rest, kRadius, 0.002), 0.0);
+  const auto& e = rest.waypoints.front();
+  EXPECT_LE(std::hypot(e[0] - from.x, e[1] - from.y), MotionPlannerParams{}.sampling.start_escape_distance + 1e-9);
+}
+
+TEST_F(FullTest, AStartTouchingAStaticWallOrDeepInAMovableIsStartInCollision) {
+  const world::World w = testing::openRoomWorld();
+  MotionPlanner mp = planner(w);
+  MotionResult r = mp.plan(request({kRadius - 0.01, 3.0, 0.0}, {2, 3, 0}), Termination::after(2.0));
+  EXPECT_EQ(r.status, MotionStatus::kStartInCollision) << r.reason;
+  EXPECT_TRUE(r.start_contacts.empty());
+  r = mp.plan(request({5.0, 3.0, 0.0}, {2, 3, 0}), Termination::after(2.0));  // the disc's centre in the box
+  EXPECT_EQ(r.status, MotionStatus::kStartInCollision) << r.reason;
+  EXPECT_EQ(r.colliding_object, "obstacle");
+  EXPECT_NE(r.reason.find("no way out"), std::string::npos) << r.reason;
+}
+
+TEST_F(FullTest, WithoutAnEscapeDistanceAStartTouchingAMovableIsStartInCollision) {
+  MotionPlannerParams p;
+  p.sampling.start_escape_distance = 0.0;
+  MotionPlanner mp = planner(testing::openRoomWorld(), p);
+  const MotionResult r = mp.plan(request({4.7 - kRadius + 0.01, 3.0, 0.0}, {2, 3, 0}), Termination::after(2.0));
+  EXPECT_EQ(r.status, MotionStatus::kStartInCollision) << r.reason;
+  EXPECT_EQ(r.colliding_object, "obstacle");
+}
+
 }  // namespace
 }  // namespace tamp::motion_planner

@@ -208,6 +208,9 @@ struct MotionResult {
   double path_length{0.0};       ///< base: xy length (m); arm: joint-space length (rad); whole body: space metric
   double cost_s{0.0};            ///< J of the returned path (lazy mode), seconds
   double planning_time_s{0.0};
+  /// Full mode: the movables the start touched, which the path leaves first by a straight
+  /// motion (SamplingParams::start_escape_distance); empty when the start touched nothing.
+  std::vector<std::string> start_contacts;
   PlanningStats stats;
   bool ok() const { return status == MotionStatus::kSolved; }
 };

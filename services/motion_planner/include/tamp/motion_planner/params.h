@@ -49,6 +49,14 @@ struct SamplingParams {
   /// arm's joint space from the folded `stow` configuration where KPIECE1 needs ~15 ms
   /// (docs/benchmarks.md); the lazy mode's laziness is then in the movables, not in the edges.
   PlannerKind arm_planner{PlannerKind::kKpiece};
+  /// Full mode, a start that touches movable objects only (the robot stopped against one: a
+  /// missed grasp, an object dropped against the base; the belief of where it lies is off by
+  /// centimetres): the plan leaves by a straight motion that may touch those objects only, to
+  /// the nearest state found within this distance (space metric) that touches nothing. Sampled
+  /// in `start_escape_attempts` states over growing radii (MoveIt's FixStartStateCollision does
+  /// the same). 0: such a start is kStartInCollision. >= 0.
+  double start_escape_distance{0.15};
+  int start_escape_attempts{400};  ///< >= 1
 };
 
 /// Lazy mode: making the lazy path worth executing (see motion_planner.h). The roadmap of the

@@ -9,8 +9,10 @@
 // unavailable. Without a scenario it only starts and checks the services.
 //
 // Each run has its own run id (printed; the run folder is OUT/RUN_ID): every service gets it and
-// talks only to services of the same run, so two `tamp run`s on one DDS domain do not mix. With
-// --keep-running a service that dies or freezes is restarted (events.jsonl in the run folder).
+// talks only to services of the same run, so two `tamp run`s on one DDS domain do not mix. A
+// service that dies is restarted with back-off (events.jsonl in the run folder); a restarted graph
+// manager takes the mission up from its journal (graph_manager.journal.json in the run folder).
+// With --keep-running a service that freezes (no heartbeat) is killed and restarted too.
 #include <signal.h>
 #include <unistd.h>
 
@@ -119,7 +121,8 @@ int main(int argc, char** argv) {
   tamp::cli::stopOnSignals({SIGINT, SIGTERM}, /*restart=*/true);
 
   // Every service of every host of the deployment, on this machine, attached to this process
-  // (they die with it); restarted on death or freeze only when they are to keep running.
+  // (they die with it); restarted when they die, and on a freeze when they are to keep running
+  // (a mission's services may be busy: motion planning, a Traverse, are not frozen).
   tamp::deploy::Deployment local = *deployment;
   std::vector<std::string> started, optional_names;
   for (auto& s : local.services) {
@@ -144,7 +147,7 @@ int main(int argc, char** argv) {
   lo.bin_dir = bin_dir;
   lo.config_dir = tamp::configDir();
   lo.detach = false;
-  lo.restart = keep;
+  lo.restart = true;
   lo.liveness = keep;
   lo.adopt = false;
   tamp::launch::Launcher launcher(lo);

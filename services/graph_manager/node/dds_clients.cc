@@ -308,12 +308,25 @@ ExecutionReport DdsExecutor::execute(const EdgeCommand& c, double budget_s) {
     return r;
   }
   std::unique_lock lock(mutex_);
-  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(budget_s));
-  if (!cv_.wait_until(lock, deadline, [&] { return final_.count(wire) > 0; })) {
+  r = finalOf(lock, wire, budget_s);
+  if (r.outcome == ExecOutcome::kTimeout) {
     lock.unlock();
     msg::ExecuteCommand cancel = m;
     cancel.cancel(true);
     (void)writer_.write(cancel);
+  }
+  return r;
+}
+
+ExecutionReport DdsExecutor::await(const std::string& command_id, double budget_s) {
+  std::unique_lock lock(mutex_);
+  return finalOf(lock, wireId(command_id), budget_s);
+}
+
+ExecutionReport DdsExecutor::finalOf(std::unique_lock<std::mutex>& lock, const std::string& wire, double budget_s) {
+  ExecutionReport r;
+  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(budget_s));
+  if (!cv_.wait_until(lock, deadline, [&] { return final_.count(wire) > 0; })) {
     r.outcome = ExecOutcome::kTimeout;
     r.reason = "no result within " + std::to_string(budget_s) + " s";
     return r;

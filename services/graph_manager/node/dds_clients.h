@@ -45,12 +45,19 @@ class DdsExecutor : public Executor {
  public:
   DdsExecutor(std::shared_ptr<dds::Participant> p, std::string mission_id);
   ExecutionReport execute(const EdgeCommand& command, double budget_s) override;
+  /// The monitor's final status of a command sent before this node (re)started: the status topic
+  /// keeps the last ones (transient-local), so an outcome that came while the node was down is
+  /// read here.
+  ExecutionReport await(const std::string& command_id, double budget_s) override;
   void setMission(const std::string& id) { mission_id_ = id; }
   /// The id a command of the current mission has on the wire.
   std::string wireId(const std::string& command_id) const { return mission_id_ + "/" + command_id; }
 
  private:
   void onStatus(const msg::ExecuteStatus& s);
+  /// Waits (lock held) up to `budget_s` for the final status of `wire`; the report from it, or
+  /// kTimeout.
+  ExecutionReport finalOf(std::unique_lock<std::mutex>& lock, const std::string& wire, double budget_s);
   std::string mission_id_;
   dds::Writer<msg::ExecuteCommand> writer_;
   std::mutex mutex_;

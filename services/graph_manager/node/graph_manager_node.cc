@@ -1,6 +1,8 @@
 #include "graph_manager_node.h"
 
 #include <chrono>
+#include <cstdlib>
+#include <filesystem>
 
 #include "tamp/core/log.h"
 #include "tamp/core/paths.h"
@@ -69,6 +71,7 @@ GraphManagerNode::GraphManagerNode(const dds::ServiceArgs& args, GraphManagerPar
       clients_(participant(), robot),
       executor_(participant(), ""),
       source_(participant(), robot) {
+  openJournal();
   thread_ = std::jthread([this](std::stop_token st) { worker(st); });
   commands_ = std::make_unique<dds::Reader<msg::MissionCommand>>(
       participant(), dds::topics::kMissionCommand,
@@ -107,7 +110,53 @@ void GraphManagerNode::onCommand(const msg::MissionCommand& c) {
   cv_.notify_all();
 }
 
+void GraphManagerNode::openJournal() {
+  const char* run_dir = std::getenv("TAMP_RUN_DIR");
+  if (run_dir == nullptr || *run_dir == '\0') return;
+  journal_.emplace(std::filesystem::path(run_dir) / "graph_manager.journal.json");
+  auto record = journal_->read();
+  if (!record) {
+    // Not taken up, and kept for a person to read: the next mission's record goes beside it.
+    logger()->error("mission journal unreadable, no mission resumed: {}", record.error().toString());
+    std::error_code ec;
+    std::filesystem::rename(journal_->file(), journal_->file().string() + ".unreadable", ec);
+    return;
+  }
+  if (!record->has_value()) return;
+  seen_.insert((*record)->mission_id);
+  if ((*record)->finished) return;
+  logger()->warn("mission {} was running when this graph manager stopped ({} actions done{}): resuming it",
+                 (*record)->mission_id, (*record)->actions.size(),
+                 (*record)->in_flight.empty() ? "" : ", " + (*record)->in_flight + " in flight");
+  resume_ = std::move(**record);
+}
+
+void GraphManagerNode::journal(const MissionRecord& record) {
+  if (!journal_) return;
+  if (Status s = journal_->write(record); !s) logger()->warn("mission journal: {}", s.error().toString());
+}
+
+namespace {
+
+/// The command a journal's unfinished mission was started with.
+msg::MissionCommand commandOf(const MissionRecord& r) {
+  msg::MissionCommand c;
+  c.mission_id(r.mission_id);
+  c.scenario_path(r.scenario_path);
+  c.policy(r.policy == "infeasible" ? msg::EffortPolicy::POLICY_INFEASIBILITY_ONLY : msg::EffortPolicy::POLICY_EFFORT_BASED);
+  c.seed(r.seed);
+  c.max_replans(static_cast<uint32_t>(std::max(0, r.max_replans)));
+  c.goal(std::vector<std::string>(r.goal.begin(), r.goal.end()));
+  return c;
+}
+
+}  // namespace
+
 void GraphManagerNode::worker(std::stop_token stop) {
+  if (resume_) {
+    runGuarded(commandOf(*resume_), &*resume_);
+    resume_.reset();
+  }
   while (!stop.stop_requested()) {
     msg::MissionCommand c;
     {
@@ -116,15 +165,24 @@ void GraphManagerNode::worker(std::stop_token stop) {
       if (stop.stop_requested()) return;
       c = queue_.front();
       queue_.pop_front();
-      running_ = c.mission_id();
+      running_ = c.mission_id();  // with the dequeue: an abort from now on reaches it
       abort_ = false;
     }
-    try {
-      runOne(c);
-    } catch (const std::exception& e) {
-      logger()->error("mission {}: {}", c.mission_id(), e.what());
-      publish(c.mission_id(), msg::MissionState::MISSION_FAILED, std::string("internal error: ") + e.what());
-    }
+    runGuarded(c, nullptr);
+  }
+}
+
+void GraphManagerNode::runGuarded(const msg::MissionCommand& c, const MissionRecord* resumed) {
+  if (resumed) {
+    std::lock_guard g(mutex_);
+    running_ = c.mission_id();
+    abort_ = false;
+  }
+  try {
+    runOne(c, resumed);
+  } catch (const std::exception& e) {
+    logger()->error("mission {}: {}", c.mission_id(), e.what());
+    publish(c.mission_id(), msg::MissionState::MISSION_FAILED, std::string("internal error: ") + e.what());
   }
 }
 
@@ -136,15 +194,33 @@ void GraphManagerNode::publish(const std::string& mission, msg::MissionState sta
   if (Status s = status_.write(current_); !s) logger()->warn("mission status: {}", s.error().message);
 }
 
-void GraphManagerNode::runOne(const msg::MissionCommand& c) {
+void GraphManagerNode::runOne(const msg::MissionCommand& c, const MissionRecord* resumed) {
   const auto t0 = std::chrono::steady_clock::now();
   current_ = msg::MissionStatus{};
   const std::string id = c.mission_id();
+  MissionRecord record;
+  if (resumed) {
+    record = *resumed;
+    ++record.resumptions;
+  } else {
+    record.mission_id = id;
+    record.scenario_path = c.scenario_path();
+    record.policy = std::string(toString(fromMsg(c.policy(), params_.policy)));
+    record.seed = c.seed();
+    record.max_replans = static_cast<int>(c.max_replans());
+    record.goal.assign(c.goal().begin(), c.goal().end());
+  }
+  journal(record);
   auto fail = [&](MissionOutcome o, const std::string& why) {
     MissionReport r;
     r.status = o;
     r.reason = why;
+    r.resumptions = record.resumptions;
     current_.report_json(reportJson(r, c.scenario_path(), "", c.seed()));
+    record.finished = true;
+    record.outcome = std::string(toString(o));
+    record.reason = why;
+    journal(record);
     publish(id, msg::MissionState::MISSION_FAILED, why);
   };
   const std::string scenario_path = c.scenario_path().empty() ? args_.scenario_file : c.scenario_path();
@@ -184,8 +260,9 @@ void GraphManagerNode::runOne(const msg::MissionCommand& c) {
   GraphManager gm(std::move(abs), *domain, *goal, clients_, p);
   // What the planner is told: the scenario's planner view (a hidden object in the gripper is not
   // in it). The robot's own report of the hand selects the conditional branch.
+  // A resumed mission believes what the robot reports.
   const world::World told = sc->world.plannerView();
-  gm.setBelief(Belief{told.held() ? told.held()->object_id : std::string()});
+  if (!resumed) gm.setBelief(Belief{told.held() ? told.held()->object_id : std::string()});
   logger()->info("mission {}: scenario {}, policy {}, goal {} atoms", id, sc->name, toString(p.policy), goal->atoms.size());
 
   MissionObserver obs;
@@ -244,7 +321,26 @@ void GraphManagerNode::runOne(const msg::MissionCommand& c) {
   };
   obs.abort_requested = [&] { return abort_.load(); };
 
-  MissionReport r = gm.runMission(source_, executor_, obs);
+  std::optional<JournalingExecutor> journaled;
+  if (journal_) journaled.emplace(executor_, *journal_, record);
+  Executor& executor = journaled ? static_cast<Executor&>(*journaled) : executor_;
+  MissionReport r;
+  if (resumed) {
+    ResumePoint at;
+    at.resumptions = record.resumptions;
+    at.actions = resumed->actions;
+    at.in_flight = resumed->in_flight;
+    at.in_flight_action = resumed->in_flight_action;
+    at.in_flight_budget_s = resumed->in_flight_budget_s;
+    publish(id, msg::MissionState::MISSION_PLANNING, "resuming after a restart of the graph manager");
+    r = gm.resumeMission(at, source_, executor, obs);
+  } else {
+    r = gm.runMission(source_, executor, obs);
+  }
+  record.finished = true;
+  record.outcome = std::string(toString(r.status));
+  record.reason = r.reason;
+  journal(record);
   current_.elapsed_s(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   current_.replans(static_cast<uint32_t>(r.replans));
   current_.report_json(reportJson(r, scenario_path, std::string(toString(p.policy)), p.seed));

@@ -16,6 +16,7 @@
 #include "dds_clients.h"
 #include "tamp/dds/service_node.h"
 #include "tamp/msg_validation/validate.h"
+#include "tamp/graph_manager/journal.h"
 #include "tamp/graph_manager/params.h"
 
 namespace tamp::graph_manager {
@@ -32,7 +33,15 @@ class GraphManagerNode : public dds::ServiceNode {
   msgv::RejectLog rejects_{"graph_manager"};  // malformed input: logged once per kind, rate-limited
   void onCommand(const msg::MissionCommand& c);
   void worker(std::stop_token stop);
-  void runOne(const msg::MissionCommand& c);
+  /// runOne, a failure of it (an exception) published as the mission's failure.
+  void runGuarded(const msg::MissionCommand& c, const MissionRecord* resumed);
+  /// `resumed`: the journal's record of a mission this node takes up after a restart.
+  void runOne(const msg::MissionCommand& c, const MissionRecord* resumed = nullptr);
+  /// Reads the journal ($TAMP_RUN_DIR/graph_manager.journal.json): a mission it left unfinished
+  /// is taken up first; its id (finished or not) is never started anew.
+  void openJournal();
+  /// Journals `record` (a warning when it cannot be written: the executor then refuses to send).
+  void journal(const MissionRecord& record);
   void publish(const std::string& mission, msg::MissionState state, const std::string& message);
 
   dds::ServiceArgs args_;
@@ -46,6 +55,8 @@ class GraphManagerNode : public dds::ServiceNode {
   std::atomic<bool> abort_{false};
   std::string running_;
   msg::MissionStatus current_;
+  std::optional<MissionJournal> journal_;  // none without a run folder
+  std::optional<MissionRecord> resume_;    // an unfinished mission of the journal, taken up first
   // The node's reach into the other services lives as long as the node: its readers and writers
   // are matched (and, under DDS Security, their crypto tokens exchanged) before the first mission
   // arrives, not at the start of each one. Used by the worker thread only.

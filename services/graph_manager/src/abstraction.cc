@@ -124,13 +124,31 @@ void Abstraction::addReach(const std::string& location, const std::string& armco
 
 bool Abstraction::isRegion(const std::string& id) const { return regions_.count(id) > 0; }
 
-std::string Abstraction::addPlaceholder(const std::string& hint) {
-  auto taken = [&](const std::string& id) {
-    return world_.findObject(id) != nullptr || locations_.count(id) || regions_.count(id) || placeholders_.count(id);
-  };
+namespace {
+/// `hint`, or `hint_2`, ... the first that `taken` does not know.
+template <typename Taken>
+std::string freeName(const std::string& hint, Taken taken) {
   std::string id = hint;
   for (int k = 2; taken(id); ++k) id = hint + "_" + std::to_string(k);
+  return id;
+}
+}  // namespace
+
+std::string Abstraction::addPlaceholder(const std::string& hint) {
+  const std::string id = freeName(hint, [&](const std::string& x) {
+    return world_.findObject(x) != nullptr || locations_.count(x) || regions_.count(x) || placeholders_.count(x) ||
+           observed_armconfs_.count(x);
+  });
   placeholders_.insert(id);
+  return id;
+}
+
+std::string Abstraction::addObservedArmconf(const std::string& hint) {
+  const std::string id = freeName(hint, [&](const std::string& x) {
+    return x == "stow" || world_.findObject(x) != nullptr || locations_.count(x) || regions_.count(x) ||
+           placeholders_.count(x) || observed_armconfs_.count(x) || !regionOfArmconf(x).empty();
+  });
+  observed_armconfs_.insert(id);
   return id;
 }
 
@@ -167,6 +185,7 @@ std::vector<std::string> Abstraction::objects() const {
   }
   for (const auto& id : placeholders_)
     if (world_.findObject(id) == nullptr) out.push_back(id + " - item");
+  for (const auto& id : observed_armconfs_) out.push_back(id + " - armconf");
   return out;
 }
 

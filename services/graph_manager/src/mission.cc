@@ -97,6 +97,7 @@ struct GraphManager::Run {
   double done_effort{0.0};
   int attempts{0};  ///< replanning attempts after failures (bounded by max_replans)
   int step{0};
+  std::string id_prefix;  ///< "r<n>-" in a resumed mission: its command ids differ from the earlier runs'
   bool first_action{true};
   std::optional<Clock::time_point> event_at;  ///< a replanning waiting for its next command
   std::set<NodeId> planned_from_scratch;      ///< nodes TP(node, goal) was asked for after a replanning
@@ -108,6 +109,11 @@ struct GraphManager::Run {
   std::optional<PendingConditional> conditional_at;  ///< a conditional branch waiting for its next command
 
   MissionReport run();
+  /// Takes up the report of the runs before a restart, and the outcome of the command that was
+  /// in flight (awaited, not sent again).
+  void resumeFrom(const ResumePoint& resume);
+  /// The command in flight at the restart, with the outcome the robot reported for it.
+  ExecutedAction awaitInFlight(const ResumePoint& resume);
 
  private:
   void state(const std::string& s, const std::string& msg) {
@@ -230,7 +236,7 @@ GraphManager::Run::Prepared GraphManager::Run::prepare(EdgeId id, EdgeId next) {
 
 Result<EdgeCommand> GraphManager::Run::commandFor(EdgeId id, EdgeId next) {
   Edge& e = gm.graph_.edge(id);
-  const std::string command_id = "m" + std::to_string(step) + "-e" + std::to_string(id);
+  const std::string command_id = id_prefix + "m" + std::to_string(step) + "-e" + std::to_string(id);
   auto cmd = gm.command(id, next, ctx, command_id);
   // The robot must be where the edge's motion starts; otherwise plan the motion again from it.
   if (cmd && e.kind != ActionKind::kPick && e.kind != ActionKind::kPlace &&
@@ -497,13 +503,11 @@ bool GraphManager::Run::replan(const MissionEvent& ev, EdgeId failed, std::strin
     gm.reprice();
     rec.how = "re-traverse";
   } else {
+    // The arm out of its driving configuration: where the node before the event had it.
     std::string armconf = "stow";
-    if (auto stow = gm.abstraction_.robot().namedConfiguration("stow"); stow && ctx.state.arm.size() == stow->size()) {
-      double d = 0.0;
-      for (std::size_t i = 0; i < stow->size(); ++i) d = std::max(d, std::abs((*stow)[i] - ctx.state.arm[i]));
-      const NodeId was = failed >= 0 ? gm.graph_.edge(failed).from : current;
-      if (d > 0.05) armconf = gm.graph_.node(was).atoms.empty() ? "stow" : gm.abstraction_.bind(gm.graph_.node(was).atoms).armconf;
-    }
+    const NodeId was = failed >= 0 ? gm.graph_.edge(failed).from : current;
+    if (!gm.armStowed(ctx.state.arm) && !gm.graph_.node(was).atoms.empty())
+      armconf = gm.abstraction_.bind(gm.graph_.node(was).atoms).armconf;
     const auto atoms = gm.abstraction_.dynamicAtoms(live, ctx.state.base, armconf, now.valid ? now.held_object_id : "");
     current = gm.graph_.addNode(atoms, "observed after " + ev.action);
     const auto joined = gm.rejoin(current, ahead, fresh, "re-join after " + std::string(toString(ev.kind)));
@@ -601,8 +605,45 @@ MissionReport GraphManager::Run::run() {
   return report;
 }
 
+void GraphManager::Run::resumeFrom(const ResumePoint& resume) {
+  report.resumptions = resume.resumptions;
+  id_prefix = "r" + std::to_string(resume.resumptions) + "-";
+  auto take = [&](const ExecutedAction& a) {
+    report.actions.push_back(a);
+    report.executed_effort_s += a.measured_s;
+    const auto tokens = atomTokens(a.action);
+    if (a.outcome == "succeeded" && tokens.size() > 1 && tokens[0] == "place") report.objects_moved.push_back(tokens[1]);
+  };
+  for (const auto& a : resume.actions) take(a);
+  if (!resume.in_flight.empty()) take(awaitInFlight(resume));
+  // An arm left out by the last action gets a symbol of its own (start()), not the pre-grasp the
+  // action named: a new graph chooses its own grasp, and the motion from the old pre-grasp to the
+  // new one, close to the object, was stopped by the robot twice in a trial; from `stow` the
+  // approach is the one every mission makes.
+}
+
+ExecutedAction GraphManager::Run::awaitInFlight(const ResumePoint& resume) {
+  state("planning", "waiting for the outcome of " + resume.in_flight + ", sent before the restart");
+  const ExecutionReport rep = executor.await(resume.in_flight, resume.in_flight_budget_s);
+  ExecutedAction a;
+  a.command_id = resume.in_flight;
+  a.action = resume.in_flight_action;
+  a.measured_s = rep.measured_s;
+  a.outcome = std::string(toString(rep.outcome));
+  a.reason = rep.outcome == ExecOutcome::kTimeout ? "no outcome after the restart: " + rep.reason : rep.reason;
+  log::get("graph_manager")->info("resumed: {} {} {}", a.command_id, a.action, a.outcome);
+  return a;
+}
+
 MissionReport GraphManager::runMission(WorldSource& source, Executor& executor, const MissionObserver& observer) {
   Run r(*this, source, executor, observer);
+  return r.run();
+}
+
+MissionReport GraphManager::resumeMission(const ResumePoint& resume, WorldSource& source, Executor& executor,
+                                          const MissionObserver& observer) {
+  Run r(*this, source, executor, observer);
+  r.resumeFrom(resume);
   return r.run();
 }
 

@@ -34,6 +34,7 @@ std::string reportJson(const MissionReport& r, const std::string& scenario, cons
   j["planning_time_s"] = r.planning_time_s;
   j["planning_time_to_first_action_s"] = r.planning_time_to_first_action_s;
   j["replans"] = r.replans;
+  j["resumptions"] = r.resumptions;
   j["planner_calls"] = r.counters.planner_calls;
   j["motion_calls"] = r.counters.motion_calls;
   j["placement_calls"] = r.counters.placement_calls;

@@ -173,10 +173,25 @@ Result<std::vector<EdgeId>> GraphManager::planFrom(NodeId from, const std::vecto
   return graph_.addPlan(p.actions, states, origin);
 }
 
+bool GraphManager::armStowed(const std::vector<double>& arm) const {
+  // `stow` binds to the folded arm, or to `carry` while holding: both are driving configurations.
+  for (const char* name : {"stow", "carry"}) {
+    const auto q = abstraction_.robot().namedConfiguration(name);
+    if (!q || q->size() != arm.size()) continue;
+    double d = 0.0;
+    for (std::size_t i = 0; i < q->size(); ++i) d = std::max(d, std::abs((*q)[i] - arm[i]));
+    if (d <= params_.stowed_tolerance_rad) return true;
+  }
+  return false;
+}
+
 Status GraphManager::start(const world::World& live, const Observation& robot) {
   const auto t0 = Clock::now();
   abstraction_.setWorld(live);
-  const std::string armconf = "stow";
+  // The arm as the robot reports it: stowed, or out (a mission taken up after a restart, a robot
+  // handed over mid-task): then a symbol of its own, which a plan can only leave.
+  const std::string armconf =
+      !robot.valid || armStowed(robot.robot.arm) ? std::string("stow") : abstraction_.addObservedArmconf("arm_observed");
   auto atoms = abstraction_.dynamicAtoms(live, robot.robot.base, armconf, robot.held_object_id);
   root_ = graph_.addNode(atoms, "start");
   auto plan = planFrom(root_, goal_.atoms, "plan 0");

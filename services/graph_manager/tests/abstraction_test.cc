@@ -85,5 +85,19 @@ TEST(AbstractionTest, AtomTokensNormalise) {
   EXPECT_EQ(atomTokens("( On  Box\tfree_patch )"), (std::vector<std::string>{"on", "box", "free_patch"}));
 }
 
+TEST(AbstractionTest, AnObservedArmConfigurationIsASymbolOfItsOwnThatNoFactReaches) {
+  auto f = load("occluded_can");
+  Abstraction a(f.sc.plannerWorld(), f.robot);
+  const std::string c = a.addObservedArmconf("arm_observed");
+  EXPECT_EQ(c, "arm_observed");
+  EXPECT_EQ(a.addObservedArmconf("arm_observed"), "arm_observed_2");
+  EXPECT_NE(a.addObservedArmconf("stow"), "stow");
+  EXPECT_TRUE(has(a.objects(), "arm_observed - armconf"));
+  const auto atoms = a.dynamicAtoms(f.sc.plannerWorld(), f.sc.robot.start, c, "");
+  EXPECT_TRUE(has(atoms, "(arm-at arm_observed)"));
+  for (const auto& s : a.staticAtoms()) EXPECT_EQ(s.find("arm_observed"), std::string::npos) << s;
+  EXPECT_TRUE(a.regionOfArmconf(c).empty());
+}
+
 }  // namespace
 }  // namespace tamp::graph_manager

@@ -91,6 +91,10 @@ class Abstraction {
   /// Listed by objects(); no static facts (it is never picked, only put down).
   std::string addPlaceholder(const std::string& hint);
   bool isPlaceholder(const std::string& id) const { return placeholders_.count(id) > 0; }
+  /// An arm configuration symbol for an arm that is neither stowed nor at a known pre-grasp (a
+  /// mission taken up after a restart, a robot handed over with its arm out): `hint`, or
+  /// `hint_2`, ... Listed by objects(); no static facts, so a plan can only leave it.
+  std::string addObservedArmconf(const std::string& hint);
 
   static std::string armconfOver(const std::string& region) { return "over_" + region; }
   /// The region of an `over_<region>` configuration (empty for stow or unknown).
@@ -124,6 +128,7 @@ class Abstraction {
   std::map<std::string, Slot> slots_;
   std::set<std::string> reaches_;                 ///< "(reaches l c)"
   std::set<std::string> placeholders_;
+  std::set<std::string> observed_armconfs_;
   int slot_counter_{0};
 };
 

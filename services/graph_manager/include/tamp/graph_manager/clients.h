@@ -199,6 +199,16 @@ class Executor {
  public:
   virtual ~Executor() = default;
   virtual ExecutionReport execute(const EdgeCommand& command, double budget_s) = 0;
+  /// The outcome of a command sent earlier (by a graph manager that then crashed), without
+  /// sending it again; blocks up to `budget_s`. kTimeout when none came (the command never
+  /// reached the robot, or is still running); kUnavailable when this executor cannot tell.
+  virtual ExecutionReport await(const std::string& command_id, double budget_s) {
+    (void)budget_s;
+    ExecutionReport r;
+    r.outcome = ExecOutcome::kUnavailable;
+    r.reason = "this executor cannot await '" + command_id + "'";
+    return r;
+  }
 };
 
 /// The robot and world as the graph manager last saw them.

@@ -181,9 +181,19 @@ struct ConditionalRecord {
   double latency_s{-1.0};
 };
 
+/// Where a mission taken up by a restarted graph manager stood (from its journal, journal.h).
+struct ResumePoint {
+  int resumptions{1};                   ///< this is the n-th time the mission is taken up
+  std::vector<ExecutedAction> actions;  ///< executed before, with their outcomes
+  std::string in_flight;                ///< sent before the restart, no outcome known: awaited
+  std::string in_flight_action;
+  double in_flight_budget_s{0.0};
+};
+
 struct MissionReport {
   MissionOutcome status{MissionOutcome::kFailed};
   std::string reason;
+  int resumptions{0};  ///< times a restarted graph manager took the mission up (ResumePoint)
   double executed_effort_s{0.0};
   double predicted_effort_s{0.0};
   double planning_time_s{0.0};
@@ -225,6 +235,8 @@ class GraphManager {
   /// Builds the root node from the live state and the first plan. Errors: kInvalidArgument (goal
   /// names unknown symbols), kNotFound (the planner proves the goal unreachable: the message says
   /// so), kTimeout, kUnavailable.
+  /// An arm out of its driving configuration (stowed_tolerance_rad) gets a configuration symbol
+  /// of its own (Abstraction::addObservedArmconf), which a plan can only leave.
   Status start(const world::World& live, const Observation& robot);
   /// Algorithm 3 from `from` with the robot in `context`.
   TraverseResult traverse(NodeId from, const BranchContext& context);
@@ -232,6 +244,11 @@ class GraphManager {
   void setBelief(Belief b) { belief_ = std::move(b); }
   /// The whole mission: start, traverse, execute, repair.
   MissionReport runMission(WorldSource& source, Executor& executor, const MissionObserver& observer = {});
+  /// The mission taken up again after a restart: the command in flight is awaited (never sent
+  /// again), the graph is built from the live state, commands are numbered apart from the
+  /// earlier runs' ("r<n>-m<step>-..."), and the report goes on from the actions before.
+  MissionReport resumeMission(const ResumePoint& resume, WorldSource& source, Executor& executor,
+                              const MissionObserver& observer = {});
 
   const ReachabilityGraph& graph() const { return graph_; }
   const Abstraction& abstraction() const { return abstraction_; }
@@ -283,6 +300,9 @@ class GraphManager {
   struct Run;
   /// The held object's mass in the node's state (0 when the hand is empty).
   double heldMassAt(NodeId n) const;
+  /// Whether the arm is in a driving configuration (`stow` or `carry`, within
+  /// stowed_tolerance_rad): what the symbol `stow` stands for.
+  bool armStowed(const std::vector<double>& arm) const;
   double lowerBound(const Edge& e) const;
   void spawnSubtasks(EdgeId e, const BranchContext& ctx, int depth);
   double evaluateBase(Edge& e, const BranchContext& ctx, int depth);

@@ -35,6 +35,9 @@ struct GraphManagerParams {
   double motion_budget_s{8.0};     ///< per motion call; > 0
   double execution_margin_s{30.0}; ///< execution budget = prediction + k sigma + this; > 0
   double start_tolerance{0.02};    ///< re-plan a motion whose start is farther from the robot; > 0
+  /// An arm whose joints are all within this of `stow` is stowed; otherwise, at the start of a
+  /// mission and after an event, it is out (a configuration symbol of its own or the node's); > 0
+  double stowed_tolerance_rad{0.05};
   /// A lazy path crossing movables is replaced by a clear effort-aware one at most this much
   /// longer (the objects are then beside the way, not in it); >= 1.
   double clear_path_stretch{1.25};

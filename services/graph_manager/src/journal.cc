@@ -1,0 +1,190 @@
+#include "tamp/graph_manager/journal.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
+#include <nlohmann/json.hpp>
+
+#include "tamp/core/paths.h"
+
+namespace tamp::graph_manager {
+namespace {
+
+using nlohmann::json;
+
+Error ioError(const std::filesystem::path& path, const std::string& what) {
+  return Error(ErrorCode::kIo, what + ": " + std::strerror(errno), SourceLocation{path.string()});
+}
+
+/// Writes all of `text` to `fd`; false on an error.
+bool writeAll(int fd, const std::string& text) {
+  std::size_t done = 0;
+  while (done < text.size()) {
+    const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return false;
+    done += static_cast<std::size_t>(n);
+  }
+  return true;
+}
+
+json toJson(const ExecutedAction& a) {
+  return json{{"command_id", a.command_id}, {"action", a.action},       {"variant", a.variant},
+              {"predicted_s", a.predicted_s}, {"predicted_stddev_s", a.predicted_stddev_s},
+              {"measured_s", a.measured_s}, {"outcome", a.outcome},     {"reason", a.reason}};
+}
+
+json toJson(const MissionRecord& r) {
+  json actions = json::array();
+  for (const auto& a : r.actions) actions.push_back(toJson(a));
+  return json{{"format", "tamp-mission-journal-1"},
+              {"mission_id", r.mission_id},
+              {"scenario_path", r.scenario_path},
+              {"policy", r.policy},
+              {"seed", r.seed},
+              {"max_replans", r.max_replans},
+              {"goal", r.goal},
+              {"finished", r.finished},
+              {"outcome", r.outcome},
+              {"reason", r.reason},
+              {"resumptions", r.resumptions},
+              {"actions", actions},
+              {"in_flight", r.in_flight},
+              {"in_flight_action", r.in_flight_action},
+              {"in_flight_budget_s", r.in_flight_budget_s}};
+}
+
+/// Reads field `key` of `j` into `out`; the error names the file and the field.
+template <typename T>
+Status field(const json& j, const std::string& key, T& out, const std::filesystem::path& file, const std::string& where) {
+  const std::string name = where.empty() ? key : where + "." + key;
+  if (!j.contains(key))
+    return Error(ErrorCode::kParseError, "missing field", SourceLocation{file.string(), 0, 0, name});
+  try {
+    out = j.at(key).get<T>();
+  } catch (const json::exception& e) {
+    return Error(ErrorCode::kParseError, std::string("wrong type: ") + e.what(), SourceLocation{file.string(), 0, 0, name});
+  }
+  return Status::Ok();
+}
+
+Result<MissionRecord> fromJson(const json& j, const std::filesystem::path& file) {
+  MissionRecord r;
+  std::string format;
+  if (Status s = field(j, "format", format, file, ""); !s) return s.error();
+  if (format != "tamp-mission-journal-1")
+    return Error(ErrorCode::kParseError, "unknown journal format '" + format + "'", SourceLocation{file.string(), 0, 0, "format"});
+  Status s = field(j, "mission_id", r.mission_id, file, "");
+  if (s) s = field(j, "scenario_path", r.scenario_path, file, "");
+  if (s) s = field(j, "policy", r.policy, file, "");
+  if (s) s = field(j, "seed", r.seed, file, "");
+  if (s) s = field(j, "max_replans", r.max_replans, file, "");
+  if (s) s = field(j, "goal", r.goal, file, "");
+  if (s) s = field(j, "finished", r.finished, file, "");
+  if (s) s = field(j, "outcome", r.outcome, file, "");
+  if (s) s = field(j, "reason", r.reason, file, "");
+  if (s) s = field(j, "resumptions", r.resumptions, file, "");
+  if (s) s = field(j, "in_flight", r.in_flight, file, "");
+  if (s) s = field(j, "in_flight_action", r.in_flight_action, file, "");
+  if (s) s = field(j, "in_flight_budget_s", r.in_flight_budget_s, file, "");
+  if (!s) return s.error();
+  if (r.mission_id.empty())
+    return Error(ErrorCode::kParseError, "empty mission id", SourceLocation{file.string(), 0, 0, "mission_id"});
+  if (!j.contains("actions") || !j["actions"].is_array())
+    return Error(ErrorCode::kParseError, "missing or not a list", SourceLocation{file.string(), 0, 0, "actions"});
+  for (std::size_t i = 0; i < j["actions"].size(); ++i) {
+    const json& a = j["actions"][i];
+    const std::string where = "actions[" + std::to_string(i) + "]";
+    ExecutedAction x;
+    Status t = field(a, "command_id", x.command_id, file, where);
+    if (t) t = field(a, "action", x.action, file, where);
+    if (t) t = field(a, "variant", x.variant, file, where);
+    if (t) t = field(a, "predicted_s", x.predicted_s, file, where);
+    if (t) t = field(a, "predicted_stddev_s", x.predicted_stddev_s, file, where);
+    if (t) t = field(a, "measured_s", x.measured_s, file, where);
+    if (t) t = field(a, "outcome", x.outcome, file, where);
+    if (t) t = field(a, "reason", x.reason, file, where);
+    if (!t) return t.error();
+    r.actions.push_back(std::move(x));
+  }
+  return r;
+}
+
+}  // namespace
+
+Status MissionJournal::write(const MissionRecord& record) const {
+  const std::filesystem::path tmp = file_.string() + ".tmp";
+  const std::string text = toJson(record).dump(1) + "\n";
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) return ioError(tmp, "cannot write the mission journal");
+  const bool ok = writeAll(fd, text) && ::fsync(fd) == 0;
+  ::close(fd);
+  if (!ok) return ioError(tmp, "cannot write the mission journal");
+  if (::rename(tmp.c_str(), file_.c_str()) != 0) return ioError(file_, "cannot replace the mission journal");
+  const std::filesystem::path dir = file_.parent_path();
+  const int d = ::open(dir.empty() ? "." : dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (d < 0) return ioError(dir, "cannot open the mission journal's folder");
+  const bool synced = ::fsync(d) == 0;
+  ::close(d);
+  if (!synced) return ioError(dir, "cannot sync the mission journal's folder");
+  return Status::Ok();
+}
+
+Result<std::optional<MissionRecord>> MissionJournal::read() const {
+  std::error_code ec;
+  if (!std::filesystem::exists(file_, ec)) return std::optional<MissionRecord>{};
+  auto text = readTextFile(file_);
+  if (!text) return text.error();
+  const json j = json::parse(*text, nullptr, false);
+  if (j.is_discarded() || !j.is_object())
+    return Error(ErrorCode::kParseError, "not a JSON object", SourceLocation{file_.string()});
+  auto r = fromJson(j, file_);
+  if (!r) return r.error();
+  return std::optional<MissionRecord>(std::move(*r));
+}
+
+ExecutionReport JournalingExecutor::record(const std::string& command_id, const std::string& action,
+                                           ExecutionReport rep) {
+  ExecutedAction a;
+  a.command_id = command_id;
+  a.action = action;
+  a.measured_s = rep.measured_s;
+  a.outcome = std::string(toString(rep.outcome));
+  a.reason = rep.reason;
+  record_.actions.push_back(std::move(a));
+  record_.in_flight.clear();
+  record_.in_flight_action.clear();
+  record_.in_flight_budget_s = 0.0;
+  if (Status s = journal_.write(record_); !s) {
+    // The outcome stands (the robot did it); the next command will not go out unjournaled.
+    rep.reason += rep.reason.empty() ? "" : "; ";
+    rep.reason += "journal: " + s.error().message;
+  }
+  return rep;
+}
+
+ExecutionReport JournalingExecutor::execute(const EdgeCommand& command, double budget_s) {
+  record_.in_flight = command.command_id;
+  record_.in_flight_action = command.action;
+  record_.in_flight_budget_s = budget_s;
+  if (Status s = journal_.write(record_); !s) {
+    ExecutionReport r;
+    r.outcome = ExecOutcome::kUnavailable;
+    r.reason = "not sent: the mission journal cannot be written: " + s.error().message;
+    record_.in_flight.clear();
+    return r;
+  }
+  ExecutionReport rep = inner_.execute(command, budget_s);
+  // predicted_s is the Run's to record in its report; the journal keeps what happened.
+  return record(command.command_id, command.action, std::move(rep));
+}
+
+ExecutionReport JournalingExecutor::await(const std::string& command_id, double budget_s) {
+  const std::string action = record_.in_flight == command_id ? record_.in_flight_action : std::string();
+  return record(command_id, action, inner_.await(command_id, budget_s));
+}
+
+}  // namespace tamp::graph_manager

@@ -1,0 +1,131 @@
+#!/usr/bin/env bash
+# kill -9 fault matrix (issue 13, part 4): for each service in turn and each seed, a mission with
+# `tamp run` (every service its own process, restarted by tamp run's supervisor when it dies), and a
+# SIGKILL to that service at a seeded random point of the mission: the k-th command the robot
+# starts (k drawn from the seed among the first --max-step commands), a seeded delay after it
+# started, so mid-action kills are the rule. The simulator is not in the matrix by default: it
+# stands in for the physical world, which does not restart (a restarted simulator starts its world
+# from the scenario again).
+#
+#   tests/fault/kill_matrix.sh BUILD_DIR [--scenario FILE] [--services "a b ..."] [--seeds "1 2 ..."]
+#        [--max-step K] [--out DIR] [--speed F]
+#
+# Each run is judged from its run folder: exit code and reason (report.json), the robot's final
+# pose and the objects (sim_final_world.json), every command id at most once in the simulator's
+# action log, the service's restart in events.jsonl. One line per run goes to OUT/matrix.tsv:
+#   service seed kill_at_command delay_s killed(yes/no) exit status resumptions repeated_ids restarts reason
+# Exit 0 when every run ended succeeded or failed with a reason and no command id was executed
+# twice; 1 otherwise; 30 on bad arguments.
+set -uo pipefail
+BUILD=${1:?usage: kill_matrix.sh BUILD_DIR [options]}; shift
+ROOT=$(cd "$(dirname "$0")/../.." && pwd)
+SCENARIO=$ROOT/config/scenarios/namo_corridor.yaml
+SERVICES="graph_manager execution_monitor motion_planner symbolic_planner effort_estimator perception"
+SEEDS="1 2"
+MAX_STEP=4
+OUT=${TMPDIR:-/tmp}/tamp-kill-matrix
+SPEED=2.0
+while [ $# -gt 0 ]; do
+  case $1 in
+    --scenario) SCENARIO=$(realpath "$2"); shift 2;;
+    --services) SERVICES=$2; shift 2;;
+    --seeds) SEEDS=$2; shift 2;;
+    --max-step) MAX_STEP=$2; shift 2;;
+    --out) OUT=$2; shift 2;;
+    --speed) SPEED=$2; shift 2;;
+    *) echo "kill_matrix.sh: unknown option $1" >&2; exit 30;;
+  esac
+done
+BIN=$(realpath "$BUILD")/bin
+[ -x "$BIN/tamp-run" ] || { echo "kill_matrix.sh: no $BIN/tamp-run (build first)" >&2; exit 30; }
+[ -f "$SCENARIO" ] || { echo "kill_matrix.sh: no scenario $SCENARIO" >&2; exit 30; }
+if ! [[ $MAX_STEP =~ ^[1-9][0-9]*$ ]]; then echo "kill_matrix.sh: --max-step takes a positive integer, got '$MAX_STEP'" >&2; exit 30; fi
+mkdir -p "$OUT/deploy/store"
+# A deployment like local.yaml with a faster simulator and a fresh effort store (the decisions
+# start from the default time models in every run).
+sed -E "s/realtime_factor: [0-9.]+/realtime_factor: $SPEED/" "$ROOT/config/services/sim.yaml" > "$OUT/deploy/sim.yaml"
+TSV=$OUT/matrix.tsv
+printf 'service\tseed\tkill_at_command\tdelay_s\tkilled\texit\tstatus\tresumptions\trepeated_ids\trestarts\treason\n' > "$TSV"
+bad=0
+runs=0
+for svc in $SERVICES; do
+  for seed in $SEEDS; do
+    runs=$((runs + 1))
+    RANDOM=$((seed * 7919 + ${#svc}))
+    k=$((RANDOM % MAX_STEP + 1))
+    delay_ms=$((RANDOM % 2000))
+    delay=$(printf '%d.%03d' $((delay_ms / 1000)) $((delay_ms % 1000)))
+    rid="km-$svc-$seed-$$"
+    store=$OUT/deploy/store-$rid
+    mkdir -p "$store"
+    sed -E "s|store_directory: [^#]+|store_directory: $store |" "$ROOT/config/services/effort_estimator.yaml" > "$OUT/deploy/est-$rid.yaml"
+    sed -e "s|{config}/services/sim.yaml|$OUT/deploy/sim.yaml|" -e "s|{config}/services/effort_estimator.yaml|$OUT/deploy/est-$rid.yaml|" \
+      "$ROOT/config/deploy/local.yaml" > "$OUT/deploy/deploy-$rid.yaml"
+    domain=$(( (seed * 13 + runs * 7) % 200 + 20 ))
+    log=$OUT/$rid.out
+    "$BIN/tamp-run" "$SCENARIO" --out "$OUT" --run-id "$rid" --domain "$domain" --deployment "$OUT/deploy/deploy-$rid.yaml" \
+      --mission-timeout 400 > "$log" 2>&1 &
+    runner=$!
+    # The k-th command: once tamp run has printed k-1 finished actions, a seeded delay, then SIGKILL.
+    killed=no
+    while kill -0 "$runner" 2> /dev/null; do
+      finished=$(grep -c '^  (' "$log" 2> /dev/null || true)
+      if [ "${finished:-0}" -ge $((k - 1)) ] && grep -q 'tamp run: mission' "$log" 2> /dev/null; then
+        sleep "$delay"
+        pid=$(pgrep -f -- "tamp_${svc}_service.*$rid" | head -1)
+        if [ -n "$pid" ] && kill -9 "$pid" 2> /dev/null; then killed=yes; fi
+        break
+      fi
+      sleep 0.1
+    done
+    wait "$runner"
+    rc=$?
+    dir=$OUT/$rid
+    read -r status resumptions reason < <(python3 - "$dir/report.json" << 'EOF'
+import json, sys
+try:
+    r = json.load(open(sys.argv[1]))
+    print(r.get("status", "?"), r.get("resumptions", 0), (r.get("reason") or "-").replace("\t", " ").replace("\n", " ")[:160])
+except Exception as e:
+    print("no-report", 0, "no report.json: " + str(e)[:100])
+EOF
+)
+    repeated=$(python3 - "$dir/sim_final_world.json" << 'EOF'
+import collections, json, sys
+try:
+    w = json.load(open(sys.argv[1]))
+except Exception:
+    print("no-world"); sys.exit()
+ids = [a["command_id"] if isinstance(a, dict) else a for a in w.get("action_log", [])]
+rep = [i for i, n in collections.Counter(ids).items() if n > 1]
+print(",".join(rep) if rep else "none")
+EOF
+)
+    restarts=$(python3 - "$dir/events.jsonl" "$svc" << 'EOF'
+import json, sys
+n = 0
+try:
+    for line in open(sys.argv[1]):
+        try:
+            e = json.loads(line)
+        except ValueError:
+            continue
+        if e.get("service") == sys.argv[2] and e.get("event") == "restarted":
+            n += 1
+except OSError:
+    pass
+print(n)
+EOF
+)
+    printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$svc" "$seed" "$k" "$delay" "$killed" "$rc" "$status" \
+      "$resumptions" "$repeated" "${restarts:-0}" "$reason" >> "$TSV"
+    echo "$svc seed $seed: kill at command $k +${delay}s killed=$killed exit $rc $status repeated=$repeated restarts=${restarts:-0}"
+    if [ "$repeated" != "none" ] || { [ "$status" != "succeeded" ] && [ "$status" != "failed" ]; } || \
+       { [ "$status" = "failed" ] && [ "$reason" = "-" ]; }; then
+      bad=$((bad + 1))
+    fi
+  done
+done
+echo "kill_matrix: $runs runs, $bad bad (table: $TSV)"
+[ "$runs" -gt 0 ] || exit 1
+[ "$bad" -eq 0 ]

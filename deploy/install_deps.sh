@@ -15,8 +15,9 @@ PACKAGES=(
   libsqlite3-dev libcairo2-dev graphviz
   # DDS Security test material (deploy/security/make_certs.sh)
   openssl
-  # tests and benchmarks (iproute2 + nftables: tests/fault/two_hosts.sh namespaces, loss, duplication)
-  libgtest-dev libgmock-dev libbenchmark-dev iproute2 nftables
+  # tests and benchmarks (iproute2 + nftables: tests/fault/two_hosts.sh namespaces, loss, duplication;
+  # procps + python3: tests/fault/kill_matrix.sh, tools/evaluation)
+  libgtest-dev libgmock-dev libbenchmark-dev iproute2 nftables procps python3
 )
 
 missing=()

@@ -12,10 +12,13 @@
 #
 # Each run is judged from its run folder: exit code and reason (report.json), the robot's final
 # pose and the objects (sim_final_world.json), every command id at most once in the simulator's
-# action log, the service's restart in events.jsonl. One line per run goes to OUT/matrix.tsv:
-#   service seed kill_at_command delay_s killed(yes/no) exit status resumptions repeated_ids restarts reason
-# Exit 0 when every run ended succeeded or failed with a reason and no command id was executed
-# twice; 1 otherwise; 30 on bad arguments.
+# action log, the execution records in the effort estimator's store (one per succeeded action:
+# none lost, none twice), the service's restart in events.jsonl. One line per run goes to
+# OUT/matrix.tsv:
+#   service seed kill_at_command delay_s killed(yes/no) exit status resumptions repeated_ids
+#   succeeded_actions stored_records restarts reason
+# Exit 0 when every run ended succeeded or failed with a reason, no command id was executed twice
+# and no record was lost; 1 otherwise (or when nothing ran); 30 on bad arguments.
 set -uo pipefail
 BUILD=${1:?usage: kill_matrix.sh BUILD_DIR [options]}; shift
 ROOT=$(cd "$(dirname "$0")/../.." && pwd)
@@ -45,7 +48,7 @@ mkdir -p "$OUT/deploy/store"
 # start from the default time models in every run).
 sed -E "s/realtime_factor: [0-9.]+/realtime_factor: $SPEED/" "$ROOT/config/services/sim.yaml" > "$OUT/deploy/sim.yaml"
 TSV=$OUT/matrix.tsv
-printf 'service\tseed\tkill_at_command\tdelay_s\tkilled\texit\tstatus\tresumptions\trepeated_ids\trestarts\treason\n' > "$TSV"
+printf 'service\tseed\tkill_at_command\tdelay_s\tkilled\texit\tstatus\tresumptions\trepeated_ids\tsucceeded_actions\tstored_records\trestarts\treason\n' > "$TSV"
 bad=0
 runs=0
 for svc in $SERVICES; do
@@ -90,15 +93,24 @@ except Exception as e:
     print("no-report", 0, "no report.json: " + str(e)[:100])
 EOF
 )
-    repeated=$(python3 - "$dir/sim_final_world.json" << 'EOF'
-import collections, json, sys
+    # What physically happened (the simulator's action log) against the estimator's store: every
+    # command id once in the log, and a record in the store for every succeeded action (records
+    # are de-duplicated by id: a resent one is not stored twice).
+    read -r repeated succeeded records < <(python3 - "$dir/sim_final_world.json" "$store/effort_store.sqlite" << 'EOF'
+import collections, json, sqlite3, sys
 try:
     w = json.load(open(sys.argv[1]))
 except Exception:
-    print("no-world"); sys.exit()
-ids = [a["command_id"] if isinstance(a, dict) else a for a in w.get("action_log", [])]
+    print("no-world 0 0"); sys.exit()
+log = w.get("action_log", [])
+ids = [a["command_id"] if isinstance(a, dict) else a for a in log]
 rep = [i for i, n in collections.Counter(ids).items() if n > 1]
-print(",".join(rep) if rep else "none")
+ok = sum(1 for a in log if isinstance(a, dict) and a.get("outcome") == "succeeded")
+try:
+    n = sqlite3.connect(sys.argv[2]).execute("select count(distinct record_id) from records").fetchone()[0]
+except Exception:
+    n = -1
+print(",".join(rep) if rep else "none", ok, n)
 EOF
 )
     restarts=$(python3 - "$dir/events.jsonl" "$svc" << 'EOF'
@@ -117,11 +129,12 @@ except OSError:
 print(n)
 EOF
 )
-    printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$svc" "$seed" "$k" "$delay" "$killed" "$rc" "$status" \
-      "$resumptions" "$repeated" "${restarts:-0}" "$reason" >> "$TSV"
-    echo "$svc seed $seed: kill at command $k +${delay}s killed=$killed exit $rc $status repeated=$repeated restarts=${restarts:-0}"
+    printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$svc" "$seed" "$k" "$delay" "$killed" "$rc" "$status" \
+      "$resumptions" "$repeated" "$succeeded" "$records" "${restarts:-0}" "$reason" >> "$TSV"
+    echo "$svc seed $seed: kill at command $k +${delay}s killed=$killed exit $rc $status repeated=$repeated" \
+      "records=$records/$succeeded restarts=${restarts:-0}"
     if [ "$repeated" != "none" ] || { [ "$status" != "succeeded" ] && [ "$status" != "failed" ]; } || \
-       { [ "$status" = "failed" ] && [ "$reason" = "-" ]; }; then
+       { [ "$status" = "failed" ] && [ "$reason" = "-" ]; } || [ "$records" -lt "$succeeded" ]; then
       bad=$((bad + 1))
     fi
   done

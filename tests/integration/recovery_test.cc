@@ -6,6 +6,7 @@
 #include <signal.h>
 
 #include <atomic>
+#include <fstream>
 #include <chrono>
 #include <map>
 #include <mutex>
@@ -142,6 +143,42 @@ TEST(RecoveryTest, AGraphManagerKilledMidActionTakesTheMissionUpWithoutRepeating
   EXPECT_EQ(journal["in_flight"], "");
   sup.stopAll(5.0);
   if (!HasFailure()) fs::remove_all(out);
+}
+
+// A deployment started again long after its graph manager stopped must not set the robot moving
+// on the old mission: a journal older than resume_max_age_s is closed as aborted, not resumed.
+TEST(RecoveryTest, AnOldUnfinishedMissionIsClosedNotResumed) {
+  const fs::path dir = tempFile("tamp_recovery_old");
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path journal = dir / "graph_manager.journal.json";
+  nlohmann::json j{{"format", "tamp-mission-journal-1"}, {"mission_id", "mission-old"},
+                   {"scenario_path", (configDir() / "scenarios" / "namo_corridor.yaml").string()},
+                   {"policy", "effort"}, {"seed", 0}, {"max_replans", 0}, {"goal", nlohmann::json::array()},
+                   {"finished", false}, {"outcome", ""}, {"reason", ""}, {"resumptions", 0},
+                   {"actions", nlohmann::json::array()}, {"in_flight", "m0-e1"}, {"in_flight_action", "(move_base a b)"},
+                   {"in_flight_budget_s", 30.0}};
+  std::ofstream(journal) << j.dump(1);
+  fs::last_write_time(journal, fs::file_time_type::clock::now() - std::chrono::hours(1));
+
+  process::Supervisor sup;
+  process::ProcessSpec gm = serviceSpec("tamp_graph_manager_service", "graph_manager", isolatedDomain());
+  gm.env["TAMP_RUN_DIR"] = dir.string();
+  sup.add(gm);
+  ASSERT_TRUE(sup.startAll().ok());
+  nlohmann::json back;
+  ASSERT_TRUE(waitUntil(
+      [&] {
+        back = nlohmann::json::parse(readFile(journal), nullptr, false);
+        return back.is_object() && back.value("finished", false);
+      },
+      30.0, sup))
+      << readFile(gm.log_file);
+  EXPECT_EQ(back["outcome"], "aborted");
+  EXPECT_NE(back["reason"].get<std::string>().find("not resumed"), std::string::npos) << back.dump(1);
+  EXPECT_EQ(readFile(gm.log_file).find("resuming it"), std::string::npos) << readFile(gm.log_file);
+  sup.stopAll(5.0);
+  fs::remove_all(dir);
 }
 
 }  // namespace

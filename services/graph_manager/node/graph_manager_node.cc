@@ -125,6 +125,18 @@ void GraphManagerNode::openJournal() {
   if (!record->has_value()) return;
   seen_.insert((*record)->mission_id);
   if ((*record)->finished) return;
+  std::error_code ec;
+  const auto written = std::filesystem::last_write_time(journal_->file(), ec);
+  const double age = ec ? 0.0 : std::chrono::duration<double>(std::filesystem::file_time_type::clock::now() - written).count();
+  if (age > params_.resume_max_age_s) {
+    (*record)->finished = true;
+    (*record)->outcome = "aborted";
+    (*record)->reason = "not resumed: the journal was written " + std::to_string(static_cast<long>(age)) +
+                        " s ago (resume_max_age_s " + std::to_string(params_.resume_max_age_s) + ")";
+    logger()->warn("mission {}: {}", (*record)->mission_id, (*record)->reason);
+    journal(**record);
+    return;
+  }
   logger()->warn("mission {} was running when this graph manager stopped ({} actions done{}): resuming it",
                  (*record)->mission_id, (*record)->actions.size(),
                  (*record)->in_flight.empty() ? "" : ", " + (*record)->in_flight + " in flight");

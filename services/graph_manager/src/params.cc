@@ -41,6 +41,7 @@ const config::Schema<GraphManagerParams>& schema() {
         .field("execution_margin_s", &P::execution_margin_s, positive())
         .field("start_tolerance", &P::start_tolerance, positive())
         .field("stowed_tolerance_rad", &P::stowed_tolerance_rad, positive())
+        .field("resume_max_age_s", &P::resume_max_age_s, positive())
         .field("clear_path_stretch", &P::clear_path_stretch, config::atLeast(1.0))
         .field("turn_first_ratio", &P::turn_first_ratio, config::atLeast(1.0))
         .field("overrun_sigma", &P::overrun_sigma, positive())

@@ -67,6 +67,10 @@ struct GraphManagerParams {
   /// box, the estimate strays about 0.09 m (namo_corridor, measured), and a false event replaces
   /// a good prior with that estimate.
   double moved_object_tolerance_m{0.15};
+  /// A restarted graph manager takes up an unfinished mission of its journal only when the
+  /// journal was written at most this long ago (s, > 0): a deployment started again hours later
+  /// must not set the robot moving on an old mission. An older one is closed as aborted.
+  double resume_max_age_s{120.0};
 
   /// Empty when valid; else the field and why.
   std::optional<std::string> invalidReason() const;

@@ -10,10 +10,7 @@
 namespace tamp::sim {
 namespace {
 
-constexpr double kMinTranslationM = 1e-4;  // base segments shorter than this only turn
-constexpr double kMinTurnRad = 1e-3;       // smaller turns are not made
-constexpr double kMinJointMove = 1e-6;     // arm segments below this are dropped
-constexpr double kArmCornerCos = 1e-4;     // arm runs break where the direction changes more
+constexpr double kMinJointMove = 1e-6;  // arm runs whose joints all move less are dropped
 
 bool finitePositive(double v) { return std::isfinite(v) && v > 0.0; }
 
@@ -113,9 +110,6 @@ Status DynamicsParams::validate() const {
   checkPositive(bad, b + "angular_speed", base.angular_speed);
   checkPositive(bad, b + "angular_accel", base.angular_accel);
   checkPositive(bad, b + "angular_jerk", base.angular_jerk);
-  if (!(base.corner_threshold_rad > 0.0 && base.corner_threshold_rad < M_PI)) {
-    bad.push_back(b + "corner_threshold_rad: must be in (0, pi), got " + formatNumber(base.corner_threshold_rad, 4));
-  }
   checkNonNegative(bad, b + "settle_s", base.settle_s);
   checkNonNegative(bad, b + "latency_s", base.latency_s);
   const std::string a = "dynamics.arm.";
@@ -125,6 +119,9 @@ Status DynamicsParams::validate() const {
   checkPositive(bad, a + "max_speed", arm.max_speed);
   checkPositive(bad, a + "accel", arm.accel);
   checkPositive(bad, a + "jerk", arm.jerk);
+  if (!(arm.corner_threshold_rad > 0.0 && arm.corner_threshold_rad < M_PI)) {
+    bad.push_back(a + "corner_threshold_rad: must be in (0, pi), got " + formatNumber(arm.corner_threshold_rad, 4));
+  }
   checkNonNegative(bad, a + "settle_s", arm.settle_s);
   checkNonNegative(bad, a + "latency_s", arm.latency_s);
   const std::string h = "dynamics.hand.";
@@ -148,55 +145,6 @@ Status DynamicsParams::validate() const {
   return Error(ErrorCode::kInvalidArgument, msg, SourceLocation{"", 0, 0, field});
 }
 
-std::vector<BaseRun> baseRuns(const std::vector<Pose2D>& poses, double corner_threshold_rad) {
-  std::vector<BaseRun> runs;
-  if (poses.empty()) return runs;
-  double heading = poses.front().theta;
-  BaseRun run{BaseRun::Kind::kDrive, 0.0, 0.0, {}};
-  auto turnTo = [&](double target) {
-    const double turn = std::abs(angleDiff(target, heading));
-    if (turn > kMinTurnRad) runs.push_back(BaseRun{BaseRun::Kind::kTurn, target, turn, {}});
-    heading = target;
-  };
-  auto flush = [&]() {
-    if (run.amount > 0.0) runs.push_back(std::move(run));
-    run = BaseRun{BaseRun::Kind::kDrive, 0.0, 0.0, {}};
-  };
-  // The direction of the segment before: a corner is a change of direction between consecutive
-  // segments (not from the start of the run), so a gently curving path is driven through.
-  double ux = 0.0, uy = 0.0;
-  const double cos_tol = std::cos(corner_threshold_rad);
-  for (std::size_t i = 1; i < poses.size(); ++i) {
-    const double dx = poses[i].x - poses[i - 1].x, dy = poses[i].y - poses[i - 1].y;
-    const double d = std::hypot(dx, dy);
-    if (d < kMinTranslationM) {
-      if (std::abs(angleDiff(poses[i].theta, heading)) > kMinTurnRad) {
-        flush();
-        turnTo(poses[i].theta);
-      }
-      continue;
-    }
-    if (run.amount > 0.0 && (ux * dx + uy * dy) >= cos_tol * d) {
-      run.amount += d;
-      run.points.push_back(i);
-      ux = dx / d;
-      uy = dy / d;
-      continue;
-    }
-    flush();
-    const double forwards = std::atan2(dy, dx);
-    const double backwards = std::remainder(forwards + M_PI, 2.0 * M_PI);
-    turnTo(std::abs(angleDiff(backwards, heading)) < std::abs(angleDiff(forwards, heading)) ? backwards : forwards);
-    ux = dx / d;
-    uy = dy / d;
-    run.amount = d;
-    run.points = {i};
-  }
-  flush();
-  turnTo(poses.back().theta);
-  return runs;
-}
-
 double loadFactor(const DynamicsParams& d, double mass_kg) { return 1.0 + d.load.per_kg * std::max(0.0, mass_kg); }
 
 Limits scaled(const Limits& l, double f) { return Limits{l.speed / f, l.accel / f, l.jerk}; }
@@ -206,45 +154,69 @@ std::vector<ArmRun> armRuns(const std::vector<std::vector<double>>& waypoints,
                             const std::unordered_map<std::string, double>& joint_speed, const ArmDynamics& arm,
                             double load_factor) {
   const std::size_t n = joint_names.size();
-  std::vector<double> vmax(n, 1.0);
+  std::vector<double> w(n, 1.0);  // each joint's speed limit
   for (std::size_t j = 0; j < n; ++j) {
     const auto it = joint_speed.find(joint_names[j]);
-    if (it != joint_speed.end() && it->second > 0.0) vmax[j] = it->second;
+    const double urdf = it != joint_speed.end() && it->second > 0.0 ? it->second : 1.0;
+    w[j] = std::min(arm.max_speed, arm.speed_fraction * urdf);
   }
   std::vector<ArmRun> runs;
-  std::vector<double> run_delta(n, 0.0), last_dir, delta(n);
-  auto flush = [&]() {
-    double largest = 0.0;
-    constexpr double inf = std::numeric_limits<double>::infinity();
-    Limits lim{inf, inf, inf};
-    for (std::size_t j = 0; j < n; ++j) {
-      const double d = std::abs(run_delta[j]);
-      largest = std::max(largest, d);
-      if (d <= 0.0) continue;
-      lim.speed = std::min(lim.speed, std::min(arm.max_speed, arm.speed_fraction * vmax[j]) / (d * load_factor));
-      lim.accel = std::min(lim.accel, arm.accel / (d * load_factor));
-      lim.jerk = std::min(lim.jerk, arm.jerk / d);
-    }
-    if (largest >= kMinJointMove) runs.push_back(ArmRun{run_delta, lim});
-    std::fill(run_delta.begin(), run_delta.end(), 0.0);
+  if (waypoints.empty()) return runs;
+  const double cos_tol = std::cos(arm.corner_threshold_rad);
+  ArmRun run;
+  std::vector<double> rate(n, 0.0);    // per joint: the largest |dq_j / du| over the run
+  std::vector<double> moved(n, 0.0);   // per joint: total |dq_j| over the run
+  std::vector<double> last_dir, dir(n), delta(n);
+  auto start = [&](std::size_t i) {
+    run = ArmRun{};
+    run.points = {i};
+    run.u = {0.0};
+    std::fill(rate.begin(), rate.end(), 0.0);
+    std::fill(moved.begin(), moved.end(), 0.0);
     last_dir.clear();
   };
+  auto flush = [&]() {
+    if (*std::max_element(moved.begin(), moved.end()) >= kMinJointMove && run.length() > 0.0) {
+      constexpr double inf = std::numeric_limits<double>::infinity();
+      run.limits = Limits{1.0 / load_factor, inf, inf};
+      for (std::size_t j = 0; j < n; ++j) {
+        if (rate[j] <= 0.0) continue;
+        run.limits.accel = std::min(run.limits.accel, arm.accel / (load_factor * rate[j]));
+        run.limits.jerk = std::min(run.limits.jerk, arm.jerk / rate[j]);
+      }
+      runs.push_back(std::move(run));
+    }
+  };
+  start(0);
   for (std::size_t i = 1; i < waypoints.size(); ++i) {
-    double largest = 0.0, norm2 = 0.0;
+    double largest = 0.0, norm2 = 0.0, du = 0.0;
     for (std::size_t j = 0; j < n; ++j) {
       delta[j] = waypoints[i][j] - waypoints[i - 1][j];
       largest = std::max(largest, std::abs(delta[j]));
       norm2 += delta[j] * delta[j];
+      du = std::max(du, std::abs(delta[j]) / w[j]);
     }
-    if (largest < kMinJointMove) continue;
-    const double norm = std::sqrt(norm2);
-    double dot = 0.0;
-    for (std::size_t j = 0; j < last_dir.size(); ++j) dot += last_dir[j] * delta[j] / norm;
-    if (last_dir.empty() || dot < 1.0 - kArmCornerCos) flush();
-    last_dir.resize(n);
+    if (largest >= kMinJointMove) {
+      // A corner above the threshold ends the run at waypoint i - 1 (direction in joint space).
+      const double norm = std::sqrt(norm2);
+      double dot = 0.0;
+      for (std::size_t j = 0; j < n; ++j) {
+        dir[j] = delta[j] / norm;
+        if (!last_dir.empty()) dot += last_dir[j] * dir[j];
+      }
+      if (!last_dir.empty() && dot < cos_tol) {
+        flush();
+        start(i - 1);
+      }
+      last_dir = dir;
+    }
+    // Every waypoint stays on the run's path, even one that barely moves (a tiny segment does not
+    // change the direction the next one is compared with).
+    run.points.push_back(i);
+    run.u.push_back(run.u.back() + du);
     for (std::size_t j = 0; j < n; ++j) {
-      run_delta[j] += delta[j];
-      last_dir[j] = delta[j] / norm;
+      moved[j] += std::abs(delta[j]);
+      if (du > 0.0) rate[j] = std::max(rate[j], std::abs(delta[j]) / du);
     }
   }
   flush();
@@ -277,8 +249,8 @@ double baseDuration(const DynamicsParams& d, const JointPath& p, double f) {
   std::vector<Pose2D> poses;
   for (const auto& w : p.waypoints) poses.push_back(Pose2D{w[ix], w[iy], w[it]});
   double t = d.base.latency_s;
-  for (const BaseRun& r : baseRuns(poses, d.base.corner_threshold_rad)) {
-    const Limits l = scaled(r.kind == BaseRun::Kind::kTurn ? d.base.angular() : d.base.linear(), f);
+  for (const effort_model::BaseStep& r : effort_model::baseSteps(poses)) {
+    const Limits l = scaled(r.kind == effort_model::BaseStep::Kind::kTurn ? d.base.angular() : d.base.linear(), f);
     t += MotionProfile::restToRest(r.amount, l.speed, l.accel, l.jerk).duration() + d.base.settle_s;
   }
   return t;
@@ -308,7 +280,7 @@ Result<double> nominalDuration(const DynamicsParams& d, const std::unordered_map
       }
       double t = d.arm.latency_s;
       for (const ArmRun& r : armRuns(q.path.waypoints, q.path.joint_names, joint_speed, d.arm, f)) {
-        t += MotionProfile::restToRest(1.0, r.limits.speed, r.limits.accel, r.limits.jerk).duration() +
+        t += MotionProfile::restToRest(r.length(), r.limits.speed, r.limits.accel, r.limits.jerk).duration() +
              d.arm.settle_s;
       }
       return t;

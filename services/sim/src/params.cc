@@ -66,8 +66,6 @@ const config::Schema<DynamicsParams>& dynamicsSchema() {
         .field("angular_speed", &BaseDynamics::angular_speed, positive())
         .field("angular_accel", &BaseDynamics::angular_accel, positive())
         .field("angular_jerk", &BaseDynamics::angular_jerk, positive())
-        .field("corner_threshold_rad", &BaseDynamics::corner_threshold_rad,
-               inRange(0, std::numbers::pi, Ends::kOpen, "rad"))
         .field("settle_s", &BaseDynamics::settle_s, nonNegative("s"))
         .field("latency_s", &BaseDynamics::latency_s, nonNegative("s"));
     s.section("arm", &D::arm)
@@ -75,6 +73,8 @@ const config::Schema<DynamicsParams>& dynamicsSchema() {
         .field("max_speed", &ArmDynamics::max_speed, positive())
         .field("accel", &ArmDynamics::accel, positive())
         .field("jerk", &ArmDynamics::jerk, positive())
+        .field("corner_threshold_rad", &ArmDynamics::corner_threshold_rad,
+               inRange(0, std::numbers::pi, Ends::kOpen, "rad"))
         .field("settle_s", &ArmDynamics::settle_s, nonNegative("s"))
         .field("latency_s", &ArmDynamics::latency_s, nonNegative("s"));
     s.section("hand", &D::hand)

@@ -656,6 +656,30 @@ struct Simulator::Impl {
     return "";
   }
 
+  /// Where a parallel-jaw gripper closing at `world_T_tool` leaves `o`: the fingers close along
+  /// the tool's y axis until both touch, so the object ends centred between them along that axis
+  /// (it slides), and a box whose faces are within kMaxSquareRad of the finger pads is turned
+  /// flat against them (about its centre). Along the other axes the object stays where it was.
+  Eigen::Isometry3d squeezed(const world::Object& o, const Eigen::Isometry3d& world_T_tool) const {
+    constexpr double kMaxSquareRad = 0.35;
+    Eigen::Isometry3d tool_T_obj = world_T_tool.inverse() * o.pose;
+    if (o.shape.kind == world::ShapeKind::kBox) {
+      int best = 0;  // the box axis closest to the closing direction
+      for (int k = 1; k < 3; ++k) {
+        if (std::abs(tool_T_obj.linear()(1, k)) > std::abs(tool_T_obj.linear()(1, best))) best = k;
+      }
+      Eigen::Vector3d normal = tool_T_obj.linear().col(best);
+      if (normal.y() < 0.0) normal = -normal;
+      if (std::acos(std::clamp(normal.y(), -1.0, 1.0)) <= kMaxSquareRad) {
+        const Eigen::Quaterniond turn = Eigen::Quaterniond::FromTwoVectors(normal, Eigen::Vector3d::UnitY());
+        tool_T_obj.linear() = turn.toRotationMatrix() * tool_T_obj.linear();
+      }
+    }
+    const Aabb extent = o.shape.aabb(tool_T_obj);  // in the tool frame
+    tool_T_obj.translation().y() -= 0.5 * (extent.min.y() + extent.max.y());
+    return world_T_tool * tool_T_obj;
+  }
+
   void gripperEvent(Active& a, StepEvents& ev) {
     a.gripper_done = true;
     const Vec q = stateAt(a, now - a.start);
@@ -669,6 +693,7 @@ struct Simulator::Impl {
       stopRiding(c.object_id);
       world::Object o = world.object(c.object_id);
       o.region.clear();
+      o.pose = squeezed(o, robot.toolPoseInWorld(toState(q)));
       (void)world.updateObject(o);
       (void)world.setHeld(robot.hold(o.id, toState(q), o.pose));
       syncScene();
@@ -907,15 +932,17 @@ Result<Active> Simulator::Impl::plan(const ActionCommand& c, const std::vector<i
   };
 
   if (c.kind == ActionKind::kMoveBase) {
-    // Stop and turn in place at corners above the threshold, drive through gentler bends.
+    // Stop-and-turn along the steps the motion planner and the execution monitor check
+    // (effort_model::baseSteps: the geometry); each turn and drive timed by the robot's own
+    // S-curve.
     a.mass = heldMass();
     const double f = loadFactor(dyn, a.mass);
     pause(dyn.base.latency_s);
     std::vector<Pose2D> poses;
     for (const Vec& q : wp) poses.push_back(Pose2D{q[0], q[1], q[2]});
-    for (const auto& step : baseRuns(poses, dyn.base.corner_threshold_rad)) {
+    for (const auto& step : effort_model::baseSteps(poses)) {
       GeoPath g;
-      if (step.kind == BaseRun::Kind::kTurn) {
+      if (step.kind == effort_model::BaseStep::Kind::kTurn) {
         Vec end = cur;
         end[2] = cur[2] + angleDiff(step.target_heading, cur[2]);
         g.q = {cur, end};
@@ -945,14 +972,18 @@ Result<Active> Simulator::Impl::plan(const ActionCommand& c, const std::vector<i
     for (std::size_t i = 0; i < wp.size(); ++i) {
       for (std::size_t j = 0; j < n; ++j) arm[i][j] = wp[i][cols[j]];
     }
-    // Each straight run in joint space one synchronized jerk-limited move, then a settle pause.
+    // Each run one jerk-limited S-curve along the commanded polyline (through every waypoint, as
+    // the planner checked it), then a settle pause.
     for (const auto& run : armRuns(arm, c.trajectory.joint_names, joint_speed, dyn.arm, loadFactor(dyn, a.mass))) {
       GeoPath g;
-      Vec end = cur;
-      for (std::size_t j = 0; j < n; ++j) end[cols[j]] += run.delta[j];
-      g.q = {cur, end};
-      g.u = {0.0, 1.0};
-      motion(std::move(g), 1.0, run.limits);
+      g.q = {cur};
+      g.u = {0.0};
+      for (std::size_t k = 1; k < run.points.size(); ++k) {
+        g.q.push_back(wp[run.points[k]]);
+        g.u.push_back(run.u[k]);
+      }
+      const double length = g.u.back();
+      motion(std::move(g), length, run.limits);
       pause(dyn.arm.settle_s);
     }
   } else {

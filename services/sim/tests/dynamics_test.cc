@@ -1,4 +1,5 @@
 // The simulator's own dynamics (dynamics.h) and the oracle's nominal duration.
+#include <algorithm>
 #include <cmath>
 
 #include <gtest/gtest.h>
@@ -47,15 +48,89 @@ TEST(MotionProfileTest, JerkLimitedTakesLongerThanTheTrapezoidAndApproachesItFor
   EXPECT_THROW(MotionProfile::restToRest(-1.0, 1, 1, 1), std::invalid_argument);
 }
 
-TEST(BaseRunsTest, StopsAndTurnsOnlyAtCornersAboveTheThreshold) {
-  // A bend of 0.03 rad is driven through, a right angle stops and turns.
-  const std::vector<Pose2D> gentle{{0, 0, 0}, {1, 0, 0}, {2, 0.03, 0}};
-  EXPECT_EQ(baseRuns(gentle, 0.05).size(), 1u);
-  EXPECT_GT(baseRuns(gentle, 0.01).size(), 1u);
-  const auto corner = baseRuns({{0, 0, 0}, {1, 0, 0}, {1, 1, M_PI / 2}}, 0.05);
-  ASSERT_EQ(corner.size(), 3u);
-  EXPECT_EQ(corner[1].kind, BaseRun::Kind::kTurn);
-  EXPECT_NEAR(corner[1].amount, M_PI / 2, 1e-9);
+/// An arc in the plane of the first two arm joints: radius `r` (rad), `n` segments of `step` rad of
+/// bend each, from the upright arm.
+std::vector<std::vector<double>> armArc(double r, int n, double step) {
+  std::vector<std::vector<double>> out;
+  for (int i = 0; i <= n; ++i) {
+    std::vector<double> q(robotModel().armDof(), 0.0);
+    q[0] = r * std::sin(i * step);
+    q[1] = r * (1.0 - std::cos(i * step));
+    out.push_back(q);
+  }
+  return out;
+}
+
+double distanceToPolyline(const std::vector<double>& x, const std::vector<std::vector<double>>& poly) {
+  double best = 1e300;
+  for (std::size_t k = 1; k < poly.size(); ++k) {
+    double dd = 0.0, xd = 0.0;
+    for (std::size_t j = 0; j < x.size(); ++j) {
+      const double d = poly[k][j] - poly[k - 1][j];
+      dd += d * d;
+      xd += (x[j] - poly[k - 1][j]) * d;
+    }
+    const double w = dd > 0.0 ? std::clamp(xd / dd, 0.0, 1.0) : 0.0;
+    double e = 0.0;
+    for (std::size_t j = 0; j < x.size(); ++j) {
+      const double p = poly[k - 1][j] + w * (poly[k][j] - poly[k - 1][j]) - x[j];
+      e += p * p;
+    }
+    best = std::min(best, std::sqrt(e));
+  }
+  return best;
+}
+
+TEST(ArmRunsTest, GentleBendsAreOneRunThroughEveryWaypointAndCornersStop) {
+  const ArmDynamics arm;  // corner_threshold_rad 0.05
+  const auto speeds = armSpeedLimits(robotModel());
+  const auto names = robotModel().armJointNames();
+  // 45 bends of 0.02 rad: one run through all 46 waypoints (not a chord of them).
+  const auto arc = armArc(1.0, 45, 0.02);
+  const auto runs = armRuns(arc, names, speeds, arm, 1.0);
+  ASSERT_EQ(runs.size(), 1u);
+  ASSERT_EQ(runs[0].points.size(), arc.size());
+  for (std::size_t k = 0; k < arc.size(); ++k) EXPECT_EQ(runs[0].points[k], k);
+  for (std::size_t k = 1; k < runs[0].u.size(); ++k) EXPECT_GT(runs[0].u[k], runs[0].u[k - 1]);
+  // Bends of 0.1 rad stop at every waypoint.
+  EXPECT_EQ(armRuns(armArc(1.0, 6, 0.1), names, speeds, arm, 1.0).size(), 6u);
+  // One straight segment: u is the slowest joint's time at its speed limit; a load divides the
+  // speed and acceleration limits, not the jerk.
+  std::vector<std::vector<double>> line{std::vector<double>(names.size(), 0.0), std::vector<double>(names.size(), 0.0)};
+  line[1][0] = 0.4;
+  line[1][1] = -0.2;
+  const double w0 = std::min(arm.max_speed, arm.speed_fraction * speeds.at(names[0]));
+  const double w1 = std::min(arm.max_speed, arm.speed_fraction * speeds.at(names[1]));
+  const auto one = armRuns(line, names, speeds, arm, 1.0);
+  ASSERT_EQ(one.size(), 1u);
+  EXPECT_NEAR(one[0].length(), std::max(0.4 / w0, 0.2 / w1), 1e-12);
+  const auto loaded = armRuns(line, names, speeds, arm, 2.0);
+  EXPECT_NEAR(loaded[0].limits.speed, 0.5 * one[0].limits.speed, 1e-12);
+  EXPECT_NEAR(loaded[0].limits.accel, 0.5 * one[0].limits.accel, 1e-12);
+  EXPECT_NEAR(loaded[0].limits.jerk, one[0].limits.jerk, 1e-12);
+}
+
+// The simulator's timing is its own, its geometry the commanded one: through gentle bends the
+// arm does not stop, and every state it passes lies on the commanded polyline (a chord of the
+// arc would leave it by 0.1 rad, into whatever the planner went round).
+TEST(SimulatorDynamicsTest, TheArmFollowsTheCommandedPolylineThroughGentleBends) {
+  const auto arc = armArc(1.0, 45, 0.02);
+  std::vector<double> chord_mid(arc.front().size());
+  for (std::size_t j = 0; j < chord_mid.size(); ++j) chord_mid[j] = 0.5 * (arc.front()[j] + arc.back()[j]);
+  ASSERT_GT(distanceToPolyline(chord_mid, arc), 0.09);  // the premise: the chord cuts the arc
+  Simulator sim(emptyRoom(), robotModel(), upright(), exactParams());
+  ASSERT_TRUE(sim.submit(testing::armCommand("arc", ActionKind::kMoveArm, arc)));
+  double worst = 0.0;
+  int samples = 0;
+  while (sim.busy()) {
+    const StepEvents e = sim.step(0.01);
+    for (const auto& r : e.results) EXPECT_EQ(r.outcome, Outcome::kSucceeded) << r.reason;
+    worst = std::max(worst, distanceToPolyline(sim.robotState().state.arm, arc));
+    ++samples;
+  }
+  EXPECT_GT(samples, 50);
+  EXPECT_LT(worst, 1e-9);
+  for (std::size_t j = 0; j < arc.back().size(); ++j) EXPECT_NEAR(sim.robotState().state.arm[j], arc.back()[j], 1e-9);
 }
 
 NominalQuery baseQuery(double mass) {

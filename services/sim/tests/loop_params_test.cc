@@ -66,7 +66,11 @@ TEST(SimParamsTest, ErrorsNameFileLineAndField) {
       {"dynamics:\n  fly: {speed: 1}\n", "unknown key 'fly'"},
       {"dynamics:\n  hand: {approach_sped: 1}\n", "unknown key 'approach_sped'"},
       {"dynamics:\n  stall: {probability: 2}\n", "probability"},
-      {"time_parameters:\n  pick: {gripper_time: 1}\n", "unknown key 'time_parameters'"},
+      // The effort-model parameters of before the simulator's own dynamics: refused, with the file,
+      // line, column and field.
+      {"realtime_factor: 1\ntime_parameters:\n  pick: {gripper_time: 1}\n",
+       "sim.yaml:2:1: field 'time_parameters': unknown key 'time_parameters'"},
+      {"dynamics:\n  base: {corner_threshold_rad: 0.05}\n", "field 'dynamics.base.corner_threshold_rad': unknown key"},
       {"sensor:\n  width: 0\n", "sim.yaml:2:"},
       {"duration_noise: abc\n", "field 'duration_noise'"},
   };

@@ -3,11 +3,18 @@
 /// The simulated robot's own execution dynamics (issue 12 part 3): how long the TRUE robot takes
 /// to execute a commanded trajectory. Deliberately not the effort estimator's model family
 /// (common/effort_model: trapezoidal stop-to-stop moves): here every move is a jerk-limited
-/// rest-to-rest S-curve with its own speed, acceleration and jerk limits, a base turns in place
-/// only at corners sharper than a threshold, a held mass slows every motion, the robot stalls
+/// rest-to-rest S-curve with its own speed, acceleration and jerk limits, the arm passes through
+/// gentle bends of its path without stopping, a held mass slows every motion, the robot stalls
 /// now and then (seeded random pauses), and the gripper has its own close/open times. The
 /// estimator's models are therefore misspecified against it, as they would be against a real
 /// robot. Pure functions, no DDS.
+///
+/// Only the *timing* is the simulator's own. The *geometry* is the commanded one: the robot is
+/// position-controlled and passes through every commanded waypoint on the straight joint-space
+/// segments between them, which is what the motion planner checked (a run through several
+/// waypoints is one S-curve along the polyline, never a chord cutting its bends). The base path
+/// is executed stop-and-turn as `effort_model::baseSteps` segments it (the base model shared with
+/// the motion planner and the execution monitor).
 ///
 /// Units: metres, radians, seconds, kilograms.
 
@@ -19,6 +26,7 @@
 #include "tamp/core/error.h"
 #include "tamp/core/geometry.h"
 #include "tamp/core/trajectory.h"
+#include "tamp/effort_model/features.h"
 
 namespace tamp::sim {
 
@@ -60,9 +68,6 @@ struct BaseDynamics {
   double angular_speed{1.1};   ///< rad/s
   double angular_accel{1.4};   ///< rad/s^2
   double angular_jerk{4.0};    ///< rad/s^3
-  /// A change of driving direction above this stops the base and turns it in place; below it
-  /// the segments are driven as one run (rad, in (0, pi)).
-  double corner_threshold_rad{0.05};
   double settle_s{0.25};   ///< pause after each drive or turn
   double latency_s{0.6};   ///< command latency before the base moves
   Limits linear() const { return {linear_speed, linear_accel, linear_jerk}; }
@@ -75,7 +80,11 @@ struct ArmDynamics {
   double max_speed{2.0};    ///< cap of every joint's speed limit (rad/s or m/s)
   double accel{1.8};        ///< rad/s^2 (m/s^2 for prismatic joints), every joint
   double jerk{6.0};         ///< rad/s^3, every joint
-  double settle_s{0.12};    ///< pause after each straight run
+  /// Where the joint-space direction of the path changes by more than this, the arm stops (one
+  /// S-curve ends, the next starts); gentler bends are passed through at speed (rad, in (0, pi)).
+  /// Only the timing depends on it: the path followed is the commanded polyline either way.
+  double corner_threshold_rad{0.05};
+  double settle_s{0.12};    ///< pause after each run (at each stop)
   double latency_s{0.4};
 };
 
@@ -112,27 +121,25 @@ struct DynamicsParams {
   Status validate() const;
 };
 
-/// One step of a base path: a turn in place to `target_heading` or a drive through `points`.
-struct BaseRun {
-  enum class Kind { kTurn, kDrive };
-  Kind kind{Kind::kTurn};
-  double target_heading{0.0};
-  double amount{0.0};  ///< rad or m
-  std::vector<std::size_t> points;
-};
-/// The base path's runs with stops only at corners above `corner_threshold_rad` (driven forwards
-/// or backwards, whichever turns less), final turn to the last heading.
-std::vector<BaseRun> baseRuns(const std::vector<Pose2D>& poses, double corner_threshold_rad);
+/// The base executes its path as `effort_model::baseSteps(poses)` segments it (stop-and-turn:
+/// the geometry the motion planner and the execution monitor check); each turn and each drive is
+/// one S-curve of the base's angular or linear limits.
 
-/// A straight run of an arm path: joint displacement and the synchronized time-scale length.
+/// A run of an arm path: consecutive segments whose joint-space direction changes by at most
+/// `ArmDynamics::corner_threshold_rad` from one to the next, executed as one rest-to-rest S-curve
+/// *along the polyline* through their waypoints (the arm passes every waypoint exactly).
+/// The path parameter u is the time each segment takes at full speed: segment k adds
+/// max_j |dq_kj| / w_j (w_j = min(max_speed, speed_fraction x URDF limit of joint j)), so that
+/// du/dt <= 1 / load_factor keeps every joint within w_j / load_factor.
 struct ArmRun {
-  std::vector<double> delta;
-  /// Path parameter length: the run goes from 0 to 1 (`delta` fully); limits below are of it.
-  Limits limits;
+  std::vector<std::size_t> points;  ///< waypoint indices in order, the run's start included
+  std::vector<double> u;            ///< path parameter at each of `points` (u.front() = 0), s
+  Limits limits;                    ///< of du/dt, d2u/dt2, d3u/dt3
+  double length() const { return u.empty() ? 0.0 : u.back(); }
 };
-/// The straight runs of an arm path (waypoints over `joint_names`), each with the limits of its
-/// path parameter from the per-joint `joint_speed` (already scaled) and the arm's accel/jerk,
-/// divided by `load_factor`.
+/// The runs of an arm path (waypoints over `joint_names`; `joint_speed`: the URDF velocity limit
+/// by joint name, 1 for joints not listed), limits divided by `load_factor` (jerk excepted).
+/// Runs whose joints all move less than 1e-6 are dropped.
 std::vector<ArmRun> armRuns(const std::vector<std::vector<double>>& waypoints,
                             const std::vector<std::string>& joint_names,
                             const std::unordered_map<std::string, double>& joint_speed, const ArmDynamics& arm,

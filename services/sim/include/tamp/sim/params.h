@@ -18,7 +18,7 @@
 ///           max_tilt_rad: 0.1}
 ///   dynamics:                    # the true robot (DynamicsParams, dynamics.h)
 ///     base: {linear_speed: 0.45, linear_accel: 0.35, linear_jerk: 0.8, angular_speed: 1.1, ...}
-///     arm: {speed_fraction: 0.55, max_speed: 2.0, accel: 1.8, jerk: 6.0, settle_s: 0.12, latency_s: 0.4}
+///     arm: {speed_fraction: 0.55, max_speed: 2.0, accel: 1.8, jerk: 6.0, corner_threshold_rad: 0.05, ...}
 ///     hand: {approach_speed: 0.05, approach_accel: 0.1, approach_jerk: 0.5, close_s: 1.9, open_s: 1.1}
 ///     load: {per_kg: 0.12}
 ///     stall: {probability: 0.08, min_s: 0.3, max_s: 1.5}

@@ -14,16 +14,19 @@
 ///   estimator's models: every move a jerk-limited S-curve, a held mass slowing it, seeded random
 ///   stalls after a move, the whole timeline times a log-normal factor exp(sigma * N(0, 1))
 ///   (sigma = `SimParams::duration_noise`, median 1). The motion follows the commanded path:
-///   - move_base: latency, then for each run of the path (segments merged while the direction
-///     changes by at most `corner_threshold_rad`) a turn in place to the run's heading and a
-///     drive along the run's waypoints, a settle pause after each, and a final turn to the last
-///     waypoint's heading;
-///   - move_arm: latency, then each straight run in joint space as one synchronized move (each
-///     joint within min(max_speed, speed_fraction * URDF limit) / f, f = 1 + per_kg * held mass)
-///     and a settle pause;
+///   The geometry is the commanded one (the robot is position-controlled): only the timing is
+///   the simulator's own.
+///   - move_base: latency, then stop-and-turn along `effort_model::baseSteps` (the segmentation
+///     the motion planner and the execution monitor check): a turn in place to each straight
+///     run's heading and a drive along the run's waypoints, a settle pause after each, and a
+///     final turn to the last waypoint's heading;
+///   - move_arm: latency, then each run (consecutive segments bending by at most
+///     `ArmDynamics::corner_threshold_rad`) as one S-curve along the commanded polyline, through
+///     every waypoint (each joint within min(max_speed, speed_fraction * URDF limit) / f,
+///     f = 1 + per_kg * held mass), and a settle pause;
 ///   - pick/place: the trajectory's waypoints up to the *grasp waypoint* (the one whose tool
 ///     position is farthest from the first waypoint's) are the approach, travelled at the
-///     approach speed along the tool path; then the gripper acts (`gripper_time`); the rest is
+///     approach speed along the tool path; then the gripper acts (`hand.close_s`/`open_s`); the rest is
 ///     the retreat. approach_m / retreat_m are the tool-path lengths.
 ///   The commanded times are validated but not followed: the robot runs at its own true speed.
 /// - **Contacts.** Before (and, if the world changes, during) an action, the whole motion is
@@ -36,8 +39,9 @@
 ///   z = 0 blocks too (reported as `kFloorId`). Self-collisions of the arm are not simulated.
 /// - **Manipulation.** A pick succeeds when, at the grasp waypoint, the object exists, is movable
 ///   and graspable, is where the command says (within tolerance), the tool centre point is at it,
-///   it fits between the fingers and is not too heavy; it is then attached to the tool link and
-///   removed from its support region. Otherwise the gripper closes on nothing and the action
+///   it fits between the fingers and is not too heavy; the closing fingers then centre it between
+///   them along the tool's y axis (and turn a box that is within 0.35 rad of square flat against
+///   the pads), and it is attached to the tool link and removed from its support region. Otherwise the gripper closes on nothing and the action
 ///   fails after its retreat. A place releases the held object where the gripper is; it settles
 ///   onto the support below (a table region or the floor) and the action succeeds when it ends
 ///   upright, on a region, near the commanded pose and not in collision.

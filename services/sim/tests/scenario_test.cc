@@ -43,6 +43,35 @@ TEST(ScenarioSetupTest, TakesTheTrueParametersFromTheScenario) {
   EXPECT_EQ(sim.world().objectCount(), scenario->world.objectCount());
 }
 
+// Every shipped scenario (config/scenarios/*.yaml) builds a simulator whose dynamics are valid
+// and carry the scenario's `sim` values, and executes a short base motion.
+TEST(ScenarioSetupTest, EveryShippedScenarioLoadsIntoTheSimulatorsDynamics) {
+  int loaded = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(std::filesystem::path(TAMP_SOURCE_DIR) / "config/scenarios")) {
+    if (entry.path().extension() != ".yaml") continue;
+    SCOPED_TRACE(entry.path().string());
+    SimParams params = exactParams();
+    params.scenario = entry.path().string();
+    auto setup = loadSetup(params);
+    ASSERT_TRUE(setup) << setup.error().toString();
+    ASSERT_TRUE(params.validate()) << params.validate().error().toString();
+    auto scenario = world::loadScenario(params.scenario);
+    ASSERT_TRUE(scenario);
+    EXPECT_EQ(params.dynamics.base.linear_speed, scenario->sim.base_max_linear_speed);
+    EXPECT_EQ(params.dynamics.arm.max_speed, scenario->sim.arm_max_joint_speed);
+    EXPECT_EQ(params.dynamics.hand.close_s, scenario->sim.grasp_duration);
+    EXPECT_EQ(params.seed, scenario->sim.seed);
+    Simulator sim(setup->world, setup->robot, setup->initial, params, setup->faults);
+    const Pose2D from = setup->initial.base;
+    auto turn = moveBase("turn", {from, Pose2D{from.x, from.y, from.theta + 0.2}});
+    auto oracle = sim.nominalDuration(turn);
+    ASSERT_TRUE(oracle) << oracle.error().toString();
+    EXPECT_GT(*oracle, 0.0);
+    ++loaded;
+  }
+  EXPECT_GE(loaded, 12);
+}
+
 TEST(ScenarioSetupTest, ScriptedFaultsOfHoldingStartFaults) {
   SimParams params = exactParams();
   params.scenario = scenarioPath("holding_start_faults");

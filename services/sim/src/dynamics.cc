@@ -33,9 +33,10 @@ double rampDistance(double vp, double a, double j) {
 MotionProfile MotionProfile::restToRest(double length, double v, double a, double j) {
   if (!(std::isfinite(length) && length >= 0.0) || !finitePositive(v) || !finitePositive(a) ||
       !finitePositive(j)) {
-    throw std::invalid_argument("MotionProfile: length must be >= 0 and limits finite and > 0 (length " +
-                                formatNumber(length, 4) + ", v " + formatNumber(v, 4) + ", a " +
-                                formatNumber(a, 4) + ", j " + formatNumber(j, 4) + ")");
+    throw std::invalid_argument(
+        "MotionProfile: length must be >= 0 and limits finite and > 0 (length " +
+        formatNumber(length, 4) + ", v " + formatNumber(v, 4) + ", a " + formatNumber(a, 4) +
+        ", j " + formatNumber(j, 4) + ")");
   }
   MotionProfile p;
   p.length_ = length;
@@ -54,7 +55,8 @@ MotionProfile MotionProfile::restToRest(double length, double v, double a, doubl
   }
   double tj = 0.0, tc = 0.0;
   accelPhase(vp, a, j, tj, tc);
-  const double plan[7][2] = {{j, tj}, {0.0, tc}, {-j, tj}, {0.0, cruise}, {-j, tj}, {0.0, tc}, {j, tj}};
+  const double plan[7][2] = {{j, tj},  {0.0, tc}, {-j, tj}, {0.0, cruise},
+                             {-j, tj}, {0.0, tc}, {j, tj}};
   double t = 0.0, s = 0.0, vel = 0.0, acc = 0.0;
   for (const auto& [jerk, dt] : plan) {
     if (dt <= 0.0) continue;
@@ -93,10 +95,12 @@ double MotionProfile::timeAt(double s) const {
 namespace {
 
 void checkPositive(std::vector<std::string>& bad, const std::string& field, double v) {
-  if (!finitePositive(v)) bad.push_back(field + ": must be finite and > 0, got " + formatNumber(v, 4));
+  if (!finitePositive(v))
+    bad.push_back(field + ": must be finite and > 0, got " + formatNumber(v, 4));
 }
 void checkNonNegative(std::vector<std::string>& bad, const std::string& field, double v) {
-  if (!(std::isfinite(v) && v >= 0.0)) bad.push_back(field + ": must be finite and >= 0, got " + formatNumber(v, 4));
+  if (!(std::isfinite(v) && v >= 0.0))
+    bad.push_back(field + ": must be finite and >= 0, got " + formatNumber(v, 4));
 }
 
 }  // namespace
@@ -114,13 +118,15 @@ Status DynamicsParams::validate() const {
   checkNonNegative(bad, b + "latency_s", base.latency_s);
   const std::string a = "dynamics.arm.";
   if (!(arm.speed_fraction > 0.0 && arm.speed_fraction <= 1.0)) {
-    bad.push_back(a + "speed_fraction: must be in (0, 1], got " + formatNumber(arm.speed_fraction, 4));
+    bad.push_back(a + "speed_fraction: must be in (0, 1], got " +
+                  formatNumber(arm.speed_fraction, 4));
   }
   checkPositive(bad, a + "max_speed", arm.max_speed);
   checkPositive(bad, a + "accel", arm.accel);
   checkPositive(bad, a + "jerk", arm.jerk);
   if (!(arm.corner_threshold_rad > 0.0 && arm.corner_threshold_rad < M_PI)) {
-    bad.push_back(a + "corner_threshold_rad: must be in (0, pi), got " + formatNumber(arm.corner_threshold_rad, 4));
+    bad.push_back(a + "corner_threshold_rad: must be in (0, pi), got " +
+                  formatNumber(arm.corner_threshold_rad, 4));
   }
   checkNonNegative(bad, a + "settle_s", arm.settle_s);
   checkNonNegative(bad, a + "latency_s", arm.latency_s);
@@ -132,11 +138,13 @@ Status DynamicsParams::validate() const {
   checkNonNegative(bad, h + "open_s", hand.open_s);
   checkNonNegative(bad, "dynamics.load.per_kg", load.per_kg);
   if (!(stall.probability >= 0.0 && stall.probability <= 1.0)) {
-    bad.push_back("dynamics.stall.probability: must be in [0, 1], got " + formatNumber(stall.probability, 4));
+    bad.push_back("dynamics.stall.probability: must be in [0, 1], got " +
+                  formatNumber(stall.probability, 4));
   }
   checkNonNegative(bad, "dynamics.stall.min_s", stall.min_s);
   if (!(std::isfinite(stall.max_s) && stall.max_s >= stall.min_s)) {
-    bad.push_back("dynamics.stall.max_s: must be finite and >= min_s, got " + formatNumber(stall.max_s, 4));
+    bad.push_back("dynamics.stall.max_s: must be finite and >= min_s, got " +
+                  formatNumber(stall.max_s, 4));
   }
   if (bad.empty()) return Status::Ok();
   std::string msg;
@@ -145,14 +153,16 @@ Status DynamicsParams::validate() const {
   return Error(ErrorCode::kInvalidArgument, msg, SourceLocation{"", 0, 0, field});
 }
 
-double loadFactor(const DynamicsParams& d, double mass_kg) { return 1.0 + d.load.per_kg * std::max(0.0, mass_kg); }
+double loadFactor(const DynamicsParams& d, double mass_kg) {
+  return 1.0 + d.load.per_kg * std::max(0.0, mass_kg);
+}
 
 Limits scaled(const Limits& l, double f) { return Limits{l.speed / f, l.accel / f, l.jerk}; }
 
 std::vector<ArmRun> armRuns(const std::vector<std::vector<double>>& waypoints,
                             const std::vector<std::string>& joint_names,
-                            const std::unordered_map<std::string, double>& joint_speed, const ArmDynamics& arm,
-                            double load_factor) {
+                            const std::unordered_map<std::string, double>& joint_speed,
+                            const ArmDynamics& arm, double load_factor) {
   const std::size_t n = joint_names.size();
   std::vector<double> w(n, 1.0);  // each joint's speed limit
   for (std::size_t j = 0; j < n; ++j) {
@@ -164,8 +174,8 @@ std::vector<ArmRun> armRuns(const std::vector<std::vector<double>>& waypoints,
   if (waypoints.empty()) return runs;
   const double cos_tol = std::cos(arm.corner_threshold_rad);
   ArmRun run;
-  std::vector<double> rate(n, 0.0);    // per joint: the largest |dq_j / du| over the run
-  std::vector<double> moved(n, 0.0);   // per joint: total |dq_j| over the run
+  std::vector<double> rate(n, 0.0);   // per joint: the largest |dq_j / du| over the run
+  std::vector<double> moved(n, 0.0);  // per joint: total |dq_j| over the run
   std::vector<double> last_dir, dir(n), delta(n);
   auto start = [&](std::size_t i) {
     run = ArmRun{};
@@ -226,7 +236,8 @@ std::vector<ArmRun> armRuns(const std::vector<std::vector<double>>& waypoints,
 namespace {
 
 Error bad(const std::string& field, const std::string& message) {
-  return Error(ErrorCode::kInvalidArgument, field + ": " + message, SourceLocation{"", 0, 0, field});
+  return Error(ErrorCode::kInvalidArgument, field + ": " + message,
+               SourceLocation{"", 0, 0, field});
 }
 
 Status checkPath(const JointPath& p) {
@@ -250,7 +261,8 @@ double baseDuration(const DynamicsParams& d, const JointPath& p, double f) {
   for (const auto& w : p.waypoints) poses.push_back(Pose2D{w[ix], w[iy], w[it]});
   double t = d.base.latency_s;
   for (const effort_model::BaseStep& r : effort_model::baseSteps(poses)) {
-    const Limits l = scaled(r.kind == effort_model::BaseStep::Kind::kTurn ? d.base.angular() : d.base.linear(), f);
+    const Limits l = scaled(
+        r.kind == effort_model::BaseStep::Kind::kTurn ? d.base.angular() : d.base.linear(), f);
     t += MotionProfile::restToRest(r.amount, l.speed, l.accel, l.jerk).duration() + d.base.settle_s;
   }
   return t;
@@ -258,37 +270,44 @@ double baseDuration(const DynamicsParams& d, const JointPath& p, double f) {
 
 }  // namespace
 
-Result<double> nominalDuration(const DynamicsParams& d, const std::unordered_map<std::string, double>& joint_speed,
+Result<double> nominalDuration(const DynamicsParams& d,
+                               const std::unordered_map<std::string, double>& joint_speed,
                                const NominalQuery& q) {
   if (Status s = d.validate(); !s) return s.error();
   if (!(std::isfinite(q.object_mass_kg) && q.object_mass_kg >= 0.0)) {
-    return bad("object_mass_kg", "must be finite and >= 0, got " + formatNumber(q.object_mass_kg, 4));
+    return bad("object_mass_kg",
+               "must be finite and >= 0, got " + formatNumber(q.object_mass_kg, 4));
   }
   const double f = loadFactor(d, q.object_mass_kg);
   switch (q.kind) {
     case ActionKind::kMoveBase: {
       if (Status s = checkPath(q.path); !s) return s.error();
       for (const char* j : {"base_x", "base_y", "base_theta"}) {
-        if (q.path.indexOf(j) < 0) return bad("path.joint_names", std::string("move_base needs ") + j);
+        if (q.path.indexOf(j) < 0)
+          return bad("path.joint_names", std::string("move_base needs ") + j);
       }
       return baseDuration(d, q.path, f);
     }
     case ActionKind::kMoveArm: {
       if (Status s = checkPath(q.path); !s) return s.error();
       for (const auto& name : q.path.joint_names) {
-        if (name.rfind("base_", 0) == 0) return bad("path.joint_names", "move_arm moves no base joint ('" + name + "')");
+        if (name.rfind("base_", 0) == 0)
+          return bad("path.joint_names", "move_arm moves no base joint ('" + name + "')");
       }
       double t = d.arm.latency_s;
       for (const ArmRun& r : armRuns(q.path.waypoints, q.path.joint_names, joint_speed, d.arm, f)) {
-        t += MotionProfile::restToRest(r.length(), r.limits.speed, r.limits.accel, r.limits.jerk).duration() +
+        t += MotionProfile::restToRest(r.length(), r.limits.speed, r.limits.accel, r.limits.jerk)
+                 .duration() +
              d.arm.settle_s;
       }
       return t;
     }
     case ActionKind::kPick:
     case ActionKind::kPlace: {
-      for (auto [field, v] : {std::pair{"approach_m", q.approach_m}, std::pair{"retreat_m", q.retreat_m}}) {
-        if (!(std::isfinite(v) && v >= 0.0)) return bad(field, "must be finite and >= 0, got " + formatNumber(v, 4));
+      for (auto [field, v] :
+           {std::pair{"approach_m", q.approach_m}, std::pair{"retreat_m", q.retreat_m}}) {
+        if (!(std::isfinite(v) && v >= 0.0))
+          return bad(field, "must be finite and >= 0, got " + formatNumber(v, 4));
       }
       const bool pick = q.kind == ActionKind::kPick;
       // A pick carries the mass on its retreat, a place on its approach.

@@ -16,7 +16,9 @@ using testing::robotModel;
 using testing::runToEnd;
 using testing::upright;
 
-double trapezoid(double L, double v, double a) { return L >= v * v / a ? L / v + v / a : 2.0 * std::sqrt(L / a); }
+double trapezoid(double L, double v, double a) {
+  return L >= v * v / a ? L / v + v / a : 2.0 * std::sqrt(L / a);
+}
 
 TEST(MotionProfileTest, ReachesTheLengthAndRespectsTheLimits) {
   for (double L : {0.01, 0.3, 1.0, 7.5}) {
@@ -61,7 +63,8 @@ std::vector<std::vector<double>> armArc(double r, int n, double step) {
   return out;
 }
 
-double distanceToPolyline(const std::vector<double>& x, const std::vector<std::vector<double>>& poly) {
+double distanceToPolyline(const std::vector<double>& x,
+                          const std::vector<std::vector<double>>& poly) {
   double best = 1e300;
   for (std::size_t k = 1; k < poly.size(); ++k) {
     double dd = 0.0, xd = 0.0;
@@ -96,7 +99,8 @@ TEST(ArmRunsTest, GentleBendsAreOneRunThroughEveryWaypointAndCornersStop) {
   EXPECT_EQ(armRuns(armArc(1.0, 6, 0.1), names, speeds, arm, 1.0).size(), 6u);
   // One straight segment: u is the slowest joint's time at its speed limit; a load divides the
   // speed and acceleration limits, not the jerk.
-  std::vector<std::vector<double>> line{std::vector<double>(names.size(), 0.0), std::vector<double>(names.size(), 0.0)};
+  std::vector<std::vector<double>> line{std::vector<double>(names.size(), 0.0),
+                                        std::vector<double>(names.size(), 0.0)};
   line[1][0] = 0.4;
   line[1][1] = -0.2;
   const double w0 = std::min(arm.max_speed, arm.speed_fraction * speeds.at(names[0]));
@@ -116,7 +120,8 @@ TEST(ArmRunsTest, GentleBendsAreOneRunThroughEveryWaypointAndCornersStop) {
 TEST(SimulatorDynamicsTest, TheArmFollowsTheCommandedPolylineThroughGentleBends) {
   const auto arc = armArc(1.0, 45, 0.02);
   std::vector<double> chord_mid(arc.front().size());
-  for (std::size_t j = 0; j < chord_mid.size(); ++j) chord_mid[j] = 0.5 * (arc.front()[j] + arc.back()[j]);
+  for (std::size_t j = 0; j < chord_mid.size(); ++j)
+    chord_mid[j] = 0.5 * (arc.front()[j] + arc.back()[j]);
   ASSERT_GT(distanceToPolyline(chord_mid, arc), 0.09);  // the premise: the chord cuts the arc
   Simulator sim(emptyRoom(), robotModel(), upright(), exactParams());
   ASSERT_TRUE(sim.submit(testing::armCommand("arc", ActionKind::kMoveArm, arc)));
@@ -130,7 +135,8 @@ TEST(SimulatorDynamicsTest, TheArmFollowsTheCommandedPolylineThroughGentleBends)
   }
   EXPECT_GT(samples, 50);
   EXPECT_LT(worst, 1e-9);
-  for (std::size_t j = 0; j < arc.back().size(); ++j) EXPECT_NEAR(sim.robotState().state.arm[j], arc.back()[j], 1e-9);
+  for (std::size_t j = 0; j < arc.back().size(); ++j)
+    EXPECT_NEAR(sim.robotState().state.arm[j], arc.back()[j], 1e-9);
 }
 
 NominalQuery baseQuery(double mass) {
@@ -145,7 +151,8 @@ NominalQuery baseQuery(double mass) {
 TEST(NominalDurationTest, ALoadSlowsEveryKind) {
   const DynamicsParams d;
   const auto speeds = armSpeedLimits(robotModel());
-  EXPECT_GT(*nominalDuration(d, speeds, baseQuery(3.0)), *nominalDuration(d, speeds, baseQuery(0.0)) + 0.1);
+  EXPECT_GT(*nominalDuration(d, speeds, baseQuery(3.0)),
+            *nominalDuration(d, speeds, baseQuery(0.0)) + 0.1);
   NominalQuery arm;
   arm.kind = ActionKind::kMoveArm;
   arm.path.joint_names = robotModel().armJointNames();
@@ -169,7 +176,8 @@ TEST(NominalDurationTest, MalformedQueriesNameTheField) {
   q.path.waypoints[1].pop_back();
   auto r = nominalDuration(d, {}, q);
   ASSERT_FALSE(r);
-  EXPECT_NE(r.error().toString().find("path.waypoints[1]"), std::string::npos) << r.error().toString();
+  EXPECT_NE(r.error().toString().find("path.waypoints[1]"), std::string::npos)
+      << r.error().toString();
   q = baseQuery(-1.0);
   EXPECT_FALSE(nominalDuration(d, {}, q));
   q = baseQuery(0.0);

@@ -62,14 +62,14 @@ struct Limits {
 };
 
 struct BaseDynamics {
-  double linear_speed{0.45};   ///< m/s
-  double linear_accel{0.35};   ///< m/s^2
-  double linear_jerk{0.8};     ///< m/s^3
-  double angular_speed{1.1};   ///< rad/s
-  double angular_accel{1.4};   ///< rad/s^2
-  double angular_jerk{4.0};    ///< rad/s^3
-  double settle_s{0.25};   ///< pause after each drive or turn
-  double latency_s{0.6};   ///< command latency before the base moves
+  double linear_speed{0.45};  ///< m/s
+  double linear_accel{0.35};  ///< m/s^2
+  double linear_jerk{0.8};    ///< m/s^3
+  double angular_speed{1.1};  ///< rad/s
+  double angular_accel{1.4};  ///< rad/s^2
+  double angular_jerk{4.0};   ///< rad/s^3
+  double settle_s{0.25};      ///< pause after each drive or turn
+  double latency_s{0.6};      ///< command latency before the base moves
   Limits linear() const { return {linear_speed, linear_accel, linear_jerk}; }
   Limits angular() const { return {angular_speed, angular_accel, angular_jerk}; }
 };
@@ -77,14 +77,14 @@ struct BaseDynamics {
 struct ArmDynamics {
   /// Each joint's speed limit is this fraction of its URDF velocity limit (in (0, 1]).
   double speed_fraction{0.55};
-  double max_speed{2.0};    ///< cap of every joint's speed limit (rad/s or m/s)
-  double accel{1.8};        ///< rad/s^2 (m/s^2 for prismatic joints), every joint
-  double jerk{6.0};         ///< rad/s^3, every joint
+  double max_speed{2.0};  ///< cap of every joint's speed limit (rad/s or m/s)
+  double accel{1.8};      ///< rad/s^2 (m/s^2 for prismatic joints), every joint
+  double jerk{6.0};       ///< rad/s^3, every joint
   /// Where the joint-space direction of the path changes by more than this, the arm stops (one
   /// S-curve ends, the next starts); gentler bends are passed through at speed (rad, in (0, pi)).
   /// Only the timing depends on it: the path followed is the commanded polyline either way.
   double corner_threshold_rad{0.05};
-  double settle_s{0.12};    ///< pause after each run (at each stop)
+  double settle_s{0.12};  ///< pause after each run (at each stop)
   double latency_s{0.4};
 };
 
@@ -142,8 +142,8 @@ struct ArmRun {
 /// Runs whose joints all move less than 1e-6 are dropped.
 std::vector<ArmRun> armRuns(const std::vector<std::vector<double>>& waypoints,
                             const std::vector<std::string>& joint_names,
-                            const std::unordered_map<std::string, double>& joint_speed, const ArmDynamics& arm,
-                            double load_factor);
+                            const std::unordered_map<std::string, double>& joint_speed,
+                            const ArmDynamics& arm, double load_factor);
 
 /// 1 + per_kg * mass.
 double loadFactor(const DynamicsParams& d, double mass_kg);
@@ -153,8 +153,8 @@ Limits scaled(const Limits& l, double load_factor);
 /// query: the path for motions, the tool-path distances for pick/place, the held mass).
 struct NominalQuery {
   ActionKind kind{ActionKind::kMoveBase};
-  JointPath path;           ///< move_base: base_x, base_y, base_theta; move_arm: arm joints
-  double approach_m{0.0};   ///< pick/place
+  JointPath path;          ///< move_base: base_x, base_y, base_theta; move_arm: arm joints
+  double approach_m{0.0};  ///< pick/place
   double retreat_m{0.0};
   double object_mass_kg{0.0};
 };

@@ -8,18 +8,9 @@
 
 #include "tamp/config/schema.h"
 #include "tamp/core/paths.h"
-#include "tamp/effort_model/models.h"
 
 namespace tamp::sim {
 namespace {
-
-int kindIndex(ActionKind kind) {
-  const auto it = std::find(kAllActionKinds.begin(), kAllActionKinds.end(), kind);
-  if (it == kAllActionKinds.end()) {
-    throw std::invalid_argument("sim: unknown action kind " + std::to_string(static_cast<int>(kind)));
-  }
-  return static_cast<int>(it - kAllActionKinds.begin());
-}
 
 using config::Ends;
 using config::inRange;
@@ -64,86 +55,49 @@ const config::Schema<SimParams>& schema() {
   return kSchema;
 }
 
+const config::Schema<DynamicsParams>& dynamicsSchema() {
+  using D = DynamicsParams;
+  static const config::Schema<D> kSchema = [] {
+    config::Schema<D> s;
+    s.section("base", &D::base)
+        .field("linear_speed", &BaseDynamics::linear_speed, positive())
+        .field("linear_accel", &BaseDynamics::linear_accel, positive())
+        .field("linear_jerk", &BaseDynamics::linear_jerk, positive())
+        .field("angular_speed", &BaseDynamics::angular_speed, positive())
+        .field("angular_accel", &BaseDynamics::angular_accel, positive())
+        .field("angular_jerk", &BaseDynamics::angular_jerk, positive())
+        .field("settle_s", &BaseDynamics::settle_s, nonNegative("s"))
+        .field("latency_s", &BaseDynamics::latency_s, nonNegative("s"));
+    s.section("arm", &D::arm)
+        .field("speed_fraction", &ArmDynamics::speed_fraction, inRange(0, 1, Ends::kOpenClosed, "(of the URDF limit)"))
+        .field("max_speed", &ArmDynamics::max_speed, positive())
+        .field("accel", &ArmDynamics::accel, positive())
+        .field("jerk", &ArmDynamics::jerk, positive())
+        .field("corner_threshold_rad", &ArmDynamics::corner_threshold_rad,
+               inRange(0, std::numbers::pi, Ends::kOpen, "rad"))
+        .field("settle_s", &ArmDynamics::settle_s, nonNegative("s"))
+        .field("latency_s", &ArmDynamics::latency_s, nonNegative("s"));
+    s.section("hand", &D::hand)
+        .field("approach_speed", &HandDynamics::approach_speed, positive())
+        .field("approach_accel", &HandDynamics::approach_accel, positive())
+        .field("approach_jerk", &HandDynamics::approach_jerk, positive())
+        .field("close_s", &HandDynamics::close_s, nonNegative("s"))
+        .field("open_s", &HandDynamics::open_s, nonNegative("s"));
+    s.section("load", &D::load).field("per_kg", &LoadDynamics::per_kg, nonNegative("1/kg"));
+    s.section("stall", &D::stall)
+        .field("probability", &StallDynamics::probability, inRange(0, 1, Ends::kClosed))
+        .field("min_s", &StallDynamics::min_s, nonNegative("s"))
+        .field("max_s", &StallDynamics::max_s, nonNegative("s"));
+    return s;
+  }();
+  return kSchema;
+}
+
 }  // namespace
-
-TimeParameters TimeParameters::simulatedRobot() {
-  TimeParameters t;
-  for (ActionKind k : kAllActionKinds) t.of(k) = effort_model::modelSpec(k).defaults();
-  using K = ActionKind;
-  t.set(K::kMoveBase, "max_linear_speed", 0.4);
-  t.set(K::kMoveBase, "max_linear_accel", 0.3);
-  t.set(K::kMoveBase, "max_angular_speed", 1.2);
-  t.set(K::kMoveBase, "max_angular_accel", 1.0);
-  t.set(K::kMoveBase, "settle_time", 0.35);
-  t.set(K::kMoveBase, "overhead", 0.8);
-  t.set(K::kMoveArm, "max_joint_speed", 0.8);
-  t.set(K::kMoveArm, "max_joint_accel", 1.5);
-  t.set(K::kMoveArm, "settle_time", 0.15);
-  t.set(K::kMoveArm, "overhead", 0.5);
-  t.set(K::kMoveArm, "payload_slowdown", 0.15);
-  t.set(K::kPick, "approach_speed", 0.04);
-  t.set(K::kPick, "gripper_time", 2.2);
-  t.set(K::kPick, "payload_slowdown", 0.3);
-  t.set(K::kPlace, "approach_speed", 0.04);
-  t.set(K::kPlace, "gripper_time", 1.4);
-  t.set(K::kPlace, "payload_slowdown", 0.3);
-  return t;
-}
-
-const std::vector<double>& TimeParameters::of(ActionKind kind) const { return values[kindIndex(kind)]; }
-std::vector<double>& TimeParameters::of(ActionKind kind) { return values[kindIndex(kind)]; }
-
-double TimeParameters::get(ActionKind kind, const std::string& name) const {
-  const int i = effort_model::modelSpec(kind).indexOf(name);
-  if (i < 0 || i >= static_cast<int>(of(kind).size())) {
-    throw std::invalid_argument("TimeParameters: no parameter '" + name + "' for " +
-                                std::string(toString(kind)));
-  }
-  return of(kind)[i];
-}
-
-void TimeParameters::set(ActionKind kind, const std::string& name, double value) {
-  const auto& spec = effort_model::modelSpec(kind);
-  const int i = spec.indexOf(name);
-  if (i < 0) {
-    throw std::invalid_argument("TimeParameters: no parameter '" + name + "' for " +
-                                std::string(toString(kind)));
-  }
-  auto& v = of(kind);
-  if (v.size() != static_cast<std::size_t>(spec.size())) v = spec.defaults();
-  v[i] = value;
-}
-
-Status TimeParameters::validate() const {
-  std::vector<Error> errors;
-  for (ActionKind k : kAllActionKinds) {
-    const auto& spec = effort_model::modelSpec(k);
-    const auto& v = of(k);
-    const std::string base = "time_parameters." + std::string(toString(k));
-    if (v.size() != static_cast<std::size_t>(spec.size())) {
-      errors.emplace_back(ErrorCode::kInvalidArgument,
-                          "expected " + std::to_string(spec.size()) + " values, got " + std::to_string(v.size()),
-                          SourceLocation{"", 0, 0, base});
-      continue;
-    }
-    for (int i = 0; i < spec.size(); ++i) {
-      const auto& ps = spec.parameters[i];
-      if (!(std::isfinite(v[i]) && v[i] >= ps.lower && v[i] <= ps.upper)) {
-        errors.emplace_back(ErrorCode::kInvalidArgument,
-                            "must be within [" + formatNumber(ps.lower) + ", " + formatNumber(ps.upper) + "] " + ps.unit +
-                                ", got " + formatNumber(v[i]),
-                            SourceLocation{"", 0, 0, base + "." + ps.name});
-      }
-    }
-  }
-  if (errors.empty()) return Status::Ok();
-  Error e(ErrorCode::kInvalidArgument, joinErrors(errors), errors.front().where);
-  return e;
-}
 
 Status SimParams::validate() const {
   std::vector<Error> errors = schema().errors(*this);
-  if (Status s = time_parameters.validate(); !s) errors.push_back(s.error());
+  if (Status s = dynamics.validate(); !s) errors.push_back(s.error());
   if (Status s = sensor.validate(); !s) errors.push_back(s.error());
   if (errors.empty()) return Status::Ok();
   return Error(ErrorCode::kInvalidArgument, "invalid simulator parameters:\n" + joinErrors(errors),
@@ -160,24 +114,14 @@ Result<SimParams> parseSimParams(const std::string& yaml_text, const std::string
     return Error(ErrorCode::kParseError, "expected a mapping of simulator parameters", SourceLocation{name});
   }
   schema().read(r, p);
-  for (auto& [kind_name, kr] : r.entries("time_parameters", false)) {
-    const auto kind = actionKindFromString(kind_name);
-    if (!kind) {
-      r.child("time_parameters").fail(kind_name, "unknown action kind '" + kind_name +
-                                                     "' (expected one of: move_base, move_arm, pick, place)");
-      continue;
+  {
+    auto d = r.child("dynamics", false);
+    if (d.isMap()) {
+      dynamicsSchema().read(d, p.dynamics);
+      d.refuseUnknownKeys();
+    } else if (r.has("dynamics")) {
+      r.fail("dynamics", "expected a mapping (base, arm, hand, load, stall)");
     }
-    const auto& spec = effort_model::modelSpec(*kind);
-    for (int i = 0; i < spec.size(); ++i) {
-      const auto& ps = spec.parameters[i];
-      double v = p.time_parameters.of(*kind)[i];
-      if (kr.optional(ps.name, v) &&
-          kr.check(std::isfinite(v) && v >= ps.lower && v <= ps.upper, ps.name,
-                   "must be within [" + formatNumber(ps.lower) + ", " + formatNumber(ps.upper) + "] " + ps.unit + ", got " + formatNumber(v))) {
-        p.time_parameters.of(*kind)[i] = v;
-      }
-    }
-    kr.refuseUnknownKeys();
   }
   {
     auto c = r.child("sensor", false);

@@ -17,18 +17,19 @@ world::World emptyRoom(double size_m) {
 }
 
 SimParams withScenarioParameters(SimParams p, const world::SimParameters& s) {
-  using K = ActionKind;
-  TimeParameters& t = p.time_parameters;
-  t.set(K::kMoveBase, "max_linear_speed", s.base_max_linear_speed);
-  t.set(K::kMoveBase, "max_linear_accel", s.base_linear_accel);
-  t.set(K::kMoveBase, "max_angular_speed", s.base_max_angular_speed);
-  t.set(K::kMoveBase, "max_angular_accel", s.base_angular_accel);
-  t.set(K::kMoveBase, "settle_time", s.segment_stop_time);
-  t.set(K::kMoveArm, "max_joint_speed", s.arm_max_joint_speed);
-  t.set(K::kMoveArm, "max_joint_accel", s.arm_joint_accel);
-  t.set(K::kMoveArm, "settle_time", s.segment_stop_time);
-  t.set(K::kPick, "gripper_time", s.grasp_duration);
-  t.set(K::kPlace, "gripper_time", s.release_duration);
+  // The scenario's robot speeds are the true robot's limits; jerk, latency, stalls and the load
+  // effect keep the simulator's own values.
+  DynamicsParams& d = p.dynamics;
+  d.base.linear_speed = s.base_max_linear_speed;
+  d.base.linear_accel = s.base_linear_accel;
+  d.base.angular_speed = s.base_max_angular_speed;
+  d.base.angular_accel = s.base_angular_accel;
+  d.base.settle_s = s.segment_stop_time;
+  d.arm.max_speed = s.arm_max_joint_speed;
+  d.arm.accel = s.arm_joint_accel;
+  d.arm.settle_s = s.segment_stop_time;
+  d.hand.close_s = s.grasp_duration;
+  d.hand.open_s = s.release_duration;
   p.duration_noise = s.duration_noise_stddev;
   p.seed = s.seed;
   return p;

@@ -9,13 +9,14 @@
 #include <map>
 #include <random>
 #include <set>
+#include <unordered_map>
 #include <stdexcept>
 
 #include "tamp/collision/scene.h"
 #include "tamp/core/geometry.h"
 #include "tamp/core/log.h"
 #include "tamp/effort_model/features.h"
-#include "tamp/effort_model/models.h"
+#include "tamp/sim/dynamics.h"
 #include "tamp/sim/depth_sensor.h"
 #include "tamp/sim/ray_scene.h"
 
@@ -57,7 +58,6 @@ double symmetricTurn(const world::Shape& shape, const Eigen::Isometry3d& a, cons
 }
 
 using Vec = Eigen::VectorXd;
-using effort_model::FeatureTolerances;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kFloorTolerance = 1e-4;
 constexpr double kSupportProbe = 0.005;  // m: how far below an object its supports are looked for  // m below z = 0 that counts as touching the floor
@@ -69,40 +69,6 @@ const std::shared_ptr<spdlog::logger>& logger() {
 
 Error invalid(const std::string& field, const std::string& message) {
   return Error(ErrorCode::kInvalidArgument, field + ": " + message, SourceLocation{"", 0, 0, field});
-}
-
-// ---- trapezoidal stop-to-stop profile (effort_model/models.h) -------------------------------
-
-/// Distance covered after time tau of a move of length L (max speed v, max acceleration a).
-double trapPosition(double tau, double L, double v, double a) {
-  if (L <= 0.0 || tau <= 0.0) return 0.0;
-  const double T = effort_model::trapezoidTime(L, v, a);
-  if (tau >= T) return L;
-  if (L >= v * v / a) {
-    const double ta = v / a;
-    const double da = 0.5 * v * ta;
-    if (tau < ta) return 0.5 * a * tau * tau;
-    if (tau < T - ta) return da + v * (tau - ta);
-    return L - 0.5 * a * (T - tau) * (T - tau);
-  }
-  if (tau < 0.5 * T) return 0.5 * a * tau * tau;
-  return L - 0.5 * a * (T - tau) * (T - tau);
-}
-
-/// Inverse of trapPosition: the time at which distance s is reached.
-double trapTimeAt(double s, double L, double v, double a) {
-  if (L <= 0.0 || s <= 0.0) return 0.0;
-  const double T = effort_model::trapezoidTime(L, v, a);
-  if (s >= L) return T;
-  if (L >= v * v / a) {
-    const double ta = v / a;
-    const double da = 0.5 * v * ta;
-    if (s < da) return std::sqrt(2.0 * s / a);
-    if (s < L - da) return ta + (s - da) / v;
-    return T - std::sqrt(2.0 * (L - s) / a);
-  }
-  if (s < 0.5 * L) return std::sqrt(2.0 * s / a);
-  return T - std::sqrt(2.0 * (L - s) / a);
 }
 
 double boundingRadius(const world::Shape& s) {
@@ -167,7 +133,8 @@ struct Phase {
   double nominal{0.0};  // model duration, s (before the noise factor)
   double t0{0.0}, t1{0.0};  // actual times relative to the action start
   GeoPath path;             // kMotion
-  double length{0.0}, v{1.0}, a{1.0};
+  double length{0.0};
+  MotionProfile profile;    // kMotion: the true timing along path.u
   Vec start, end;
 };
 
@@ -218,7 +185,7 @@ struct Simulator::Impl {
   SimParams params;
   collision::Scene scene;
   DepthSensor sensor;
-  effort_model::FeatureOptions feature_options;
+  std::unordered_map<std::string, double> joint_speed;  // URDF velocity limit per arm joint
   std::vector<std::string> full_names;
   int dof{0};
   bool has_gripper{false};
@@ -399,7 +366,7 @@ struct Simulator::Impl {
 
   double fractionAt(const Phase& p, double rel, double k) const {
     if (p.length <= 0.0) return rel >= p.t1 ? 1.0 : 0.0;
-    const double s = trapPosition((rel - p.t0) / k, p.length, p.v, p.a);
+    const double s = p.profile.positionAt((rel - p.t0) / k);
     return s / p.length;
   }
 
@@ -444,7 +411,7 @@ struct Simulator::Impl {
           if (!hit.empty()) {
             a.blocking_part = last_contact_part;
             const double t = f_prev <= f_from ? t_prev0
-                                               : p.t0 + a.k * trapTimeAt(f_prev * p.length, p.length, p.v, p.a);
+                                               : p.t0 + a.k * p.profile.timeAt(f_prev * p.length);
             return std::pair{t, hit};
           }
           f_prev = f;
@@ -689,6 +656,30 @@ struct Simulator::Impl {
     return "";
   }
 
+  /// Where a parallel-jaw gripper closing at `world_T_tool` leaves `o`: the fingers close along
+  /// the tool's y axis until both touch, so the object ends centred between them along that axis
+  /// (it slides), and a box whose faces are within kMaxSquareRad of the finger pads is turned
+  /// flat against them (about its centre). Along the other axes the object stays where it was.
+  Eigen::Isometry3d squeezed(const world::Object& o, const Eigen::Isometry3d& world_T_tool) const {
+    constexpr double kMaxSquareRad = 0.35;
+    Eigen::Isometry3d tool_T_obj = world_T_tool.inverse() * o.pose;
+    if (o.shape.kind == world::ShapeKind::kBox) {
+      int best = 0;  // the box axis closest to the closing direction
+      for (int k = 1; k < 3; ++k) {
+        if (std::abs(tool_T_obj.linear()(1, k)) > std::abs(tool_T_obj.linear()(1, best))) best = k;
+      }
+      Eigen::Vector3d normal = tool_T_obj.linear().col(best);
+      if (normal.y() < 0.0) normal = -normal;
+      if (std::acos(std::clamp(normal.y(), -1.0, 1.0)) <= kMaxSquareRad) {
+        const Eigen::Quaterniond turn = Eigen::Quaterniond::FromTwoVectors(normal, Eigen::Vector3d::UnitY());
+        tool_T_obj.linear() = turn.toRotationMatrix() * tool_T_obj.linear();
+      }
+    }
+    const Aabb extent = o.shape.aabb(tool_T_obj);  // in the tool frame
+    tool_T_obj.translation().y() -= 0.5 * (extent.min.y() + extent.max.y());
+    return world_T_tool * tool_T_obj;
+  }
+
   void gripperEvent(Active& a, StepEvents& ev) {
     a.gripper_done = true;
     const Vec q = stateAt(a, now - a.start);
@@ -702,6 +693,7 @@ struct Simulator::Impl {
       stopRiding(c.object_id);
       world::Object o = world.object(c.object_id);
       o.region.clear();
+      o.pose = squeezed(o, robot.toolPoseInWorld(toState(q)));
       (void)world.updateObject(o);
       (void)world.setHeld(robot.hold(o.id, toState(q), o.pose));
       syncScene();
@@ -796,7 +788,8 @@ struct Simulator::Impl {
 
   // ---- command validation and planning ----------------------------------------------------------
   Result<std::vector<int>> validate(const ActionCommand& c) const;
-  Result<Active> plan(const ActionCommand& c, const std::vector<int>& columns);
+  /// The action's timeline; `nominal`: no noise and no stall, the random stream untouched.
+  Result<Active> plan(const ActionCommand& c, const std::vector<int>& columns, bool nominal = false);
 };
 
 Result<std::vector<int>> Simulator::Impl::validate(const ActionCommand& c) const {
@@ -900,9 +893,8 @@ Result<std::vector<int>> Simulator::Impl::validate(const ActionCommand& c) const
   return cols;
 }
 
-Result<Active> Simulator::Impl::plan(const ActionCommand& c, const std::vector<int>& cols) {
-  const TimeParameters& tp = params.time_parameters;
-  const std::vector<double>& P = tp.of(c.kind);
+Result<Active> Simulator::Impl::plan(const ActionCommand& c, const std::vector<int>& cols, bool nominal) {
+  const DynamicsParams& dyn = params.dynamics;
   Active a;
   a.cmd = c;
   Vec cur = current();
@@ -921,27 +913,31 @@ Result<Active> Simulator::Impl::plan(const ActionCommand& c, const std::vector<i
     ph.start = ph.end = cur;
     a.phases.push_back(std::move(ph));
   };
-  auto motion = [&](GeoPath path, double length, double v, double acc) {
+  // A jerk-limited move along `path` (parameter length `length`), then now and then a stall.
+  auto motion = [&](GeoPath path, double length, const Limits& lim) {
     Phase ph;
     ph.kind = Phase::Kind::kMotion;
     ph.length = length;
-    ph.v = v;
-    ph.a = acc;
-    ph.nominal = effort_model::trapezoidTime(length, v, acc);
+    ph.profile = MotionProfile::restToRest(length, lim.speed, lim.accel, lim.jerk);
+    ph.nominal = ph.profile.duration();
     ph.start = path.q.front();
     ph.end = path.q.back();
     ph.path = std::move(path);
     cur = ph.end;
     a.phases.push_back(std::move(ph));
+    if (!nominal && dyn.stall.probability > 0.0 &&
+        std::uniform_real_distribution<double>(0.0, 1.0)(rng) < dyn.stall.probability) {
+      pause(std::uniform_real_distribution<double>(dyn.stall.min_s, dyn.stall.max_s)(rng));
+    }
   };
 
-  effort_model::ActionDescription desc;
-  desc.kind = c.kind;
   if (c.kind == ActionKind::kMoveBase) {
-    // Stop-and-turn exactly as effort_model::extractFeatures reduces the path.
-    const double v = P[0], acc = P[1], w = P[2], alpha = P[3], settle = P[4], overhead = P[5];
+    // Stop-and-turn along the steps the motion planner and the execution monitor check
+    // (effort_model::baseSteps: the geometry); each turn and drive timed by the robot's own
+    // S-curve.
     a.mass = heldMass();
-    pause(overhead);
+    const double f = loadFactor(dyn, a.mass);
+    pause(dyn.base.latency_s);
     std::vector<Pose2D> poses;
     for (const Vec& q : wp) poses.push_back(Pose2D{q[0], q[1], q[2]});
     for (const auto& step : effort_model::baseSteps(poses)) {
@@ -951,7 +947,8 @@ Result<Active> Simulator::Impl::plan(const ActionCommand& c, const std::vector<i
         end[2] = cur[2] + angleDiff(step.target_heading, cur[2]);
         g.q = {cur, end};
         g.u = {0.0, std::abs(end[2] - cur[2])};
-        motion(std::move(g), step.amount, w, alpha);
+        const double turn = g.u.back();
+        motion(std::move(g), turn, scaled(dyn.base.angular(), f));
       } else {
         g.q = {cur};
         g.u = {0.0};
@@ -962,36 +959,35 @@ Result<Active> Simulator::Impl::plan(const ActionCommand& c, const std::vector<i
           g.u.push_back(g.u.back() + std::hypot(n[0] - g.q.back()[0], n[1] - g.q.back()[1]));
           g.q.push_back(n);
         }
-        motion(std::move(g), step.amount, v, acc);
+        const double length = g.u.back();
+        motion(std::move(g), length, scaled(dyn.base.linear(), f));
       }
-      pause(settle);
+      pause(dyn.base.settle_s);
     }
-    desc.path = c.trajectory.path();
   } else if (c.kind == ActionKind::kMoveArm) {
-    const double f = 1.0 + P[4] * heldMass();
-    const double v = P[0] / f, acc = P[1] / f, settle = P[2], overhead = P[3];
     a.mass = heldMass();
-    pause(overhead);
-    // The same straight runs the effort features see (effort_model::armRuns), each one
-    // synchronized move followed by a settle pause.
+    pause(dyn.arm.latency_s);
     const std::size_t n = cols.size();
     std::vector<std::vector<double>> arm(wp.size(), std::vector<double>(n));
     for (std::size_t i = 0; i < wp.size(); ++i) {
       for (std::size_t j = 0; j < n; ++j) arm[i][j] = wp[i][cols[j]];
     }
-    for (const auto& run : effort_model::armRuns(arm, c.trajectory.joint_names, feature_options)) {
+    // Each run one jerk-limited S-curve along the commanded polyline (through every waypoint, as
+    // the planner checked it), then a settle pause.
+    for (const auto& run : armRuns(arm, c.trajectory.joint_names, joint_speed, dyn.arm, loadFactor(dyn, a.mass))) {
       GeoPath g;
-      Vec end = cur;
-      for (std::size_t j = 0; j < n; ++j) end[cols[j]] += run.delta[j];
-      g.q = {cur, end};
-      g.u = {0.0, run.length};
-      motion(std::move(g), run.length, v, acc);
-      pause(settle);
+      g.q = {cur};
+      g.u = {0.0};
+      for (std::size_t k = 1; k < run.points.size(); ++k) {
+        g.q.push_back(wp[run.points[k]]);
+        g.u.push_back(run.u[k]);
+      }
+      const double length = g.u.back();
+      motion(std::move(g), length, run.limits);
+      pause(dyn.arm.settle_s);
     }
-    desc.path = c.trajectory.path();
   } else {
     // Pick / place: approach to the grasp waypoint along the tool path, gripper, retreat.
-    const double speed = P[0], acc = P[1], gripper_time = P[2], slowdown = P[3];
     const world::Object* obj = world.findObject(c.object_id);
     wp.front() = cur;
     std::vector<Eigen::Vector3d> tool;
@@ -1016,7 +1012,7 @@ Result<Active> Simulator::Impl::plan(const ActionCommand& c, const std::vector<i
     } else {
       a.mass = world.held() && world.held()->object_id == c.object_id ? heldMass() : 0.0;
     }
-    const double f = 1.0 + slowdown * a.mass;
+    const double f = loadFactor(dyn, a.mass);
     // Dense tool path of waypoints [from, to].
     auto toolPath = [&](std::size_t from, std::size_t to) {
       GeoPath p;
@@ -1042,16 +1038,14 @@ Result<Active> Simulator::Impl::plan(const ActionCommand& c, const std::vector<i
     a.retreat_m = retreat.u.back();
     const bool pick = c.kind == ActionKind::kPick;
     const double fa = pick ? 1.0 : f, fr = pick ? f : 1.0;
-    if (approach.q.size() > 1) motion(std::move(approach), a.approach_m, speed / fa, acc / fa);
+    if (approach.q.size() > 1) motion(std::move(approach), a.approach_m, scaled(dyn.hand.approach(), fa));
     Phase grip;
     grip.kind = Phase::Kind::kGripper;
-    grip.nominal = gripper_time;
+    grip.nominal = pick ? dyn.hand.close_s : dyn.hand.open_s;
     grip.start = grip.end = cur;
     a.gripper_phase = static_cast<int>(a.phases.size());
     a.phases.push_back(std::move(grip));
-    if (retreat.q.size() > 1) motion(std::move(retreat), a.retreat_m, speed / fr, acc / fr);
-    desc.approach_m = a.approach_m;
-    desc.retreat_m = a.retreat_m;
+    if (retreat.q.size() > 1) motion(std::move(retreat), a.retreat_m, scaled(dyn.hand.approach(), fr));
     // Contacts that belong to the task.
     if (pick) {
       a.ignore_objects.push_back(c.object_id);
@@ -1062,19 +1056,8 @@ Result<Active> Simulator::Impl::plan(const ActionCommand& c, const std::vector<i
       for (const auto& s : supportsOf(*obj, *c.object_pose)) a.ignore_pairs.emplace_back(obj->id, s);
     }
   }
-  desc.object_mass_kg = a.mass;
-
-  // The timeline: nominal model times stretched by the execution noise.
-  const auto features = effort_model::extractFeatures(desc, feature_options);
-  if (!features) return Error(ErrorCode::kInvalidArgument, features.error().message, features.error().where);
-  const double model = effort_model::predictDuration(*features, P);
-  double nominal = 0.0;
-  for (const Phase& p : a.phases) nominal += p.nominal;
-  if (std::abs(nominal - model) > 1e-6 * std::max(1.0, model)) {
-    return Error(ErrorCode::kInternal, "sim: execution timeline (" + formatNumber(nominal, 4) +
-                                           " s) disagrees with the time model (" + formatNumber(model, 4) + " s)");
-  }
-  a.k = params.duration_noise > 0.0
+  // The timeline: the true timing stretched by the execution noise (none for the nominal one).
+  a.k = !nominal && params.duration_noise > 0.0
             ? std::exp(params.duration_noise * std::normal_distribution<double>(0.0, 1.0)(rng))
             : 1.0;
   double t = 0.0;
@@ -1115,15 +1098,7 @@ Simulator::Simulator(world::World truth, robot::RobotModel robot, robot::RobotSt
     throw std::invalid_argument("Simulator: initial state has " + std::to_string(initial.arm.size()) +
                                 " arm values, the robot has " + std::to_string(m.dof) + " arm joints");
   }
-  // Per-joint speed scales from the URDF (the true robot's joints are not all equally fast).
-  double fastest = 0.0;
-  for (const auto& l : m.robot.armLimits()) fastest = std::max(fastest, l.velocity);
-  if (fastest > 0.0) {
-    for (int j = 0; j < m.dof; ++j) {
-      const double vj = m.robot.armLimits()[j].velocity;
-      if (vj > 0.0) m.feature_options.joint_scales[m.robot.armJointNames()[j]] = vj / fastest;
-    }
-  }
+  m.joint_speed = armSpeedLimits(m.robot);  // the true robot's joints are not all equally fast
   m.computeBounds();
   m.idle = m.toVec(initial);
   if (!m.idle.allFinite()) throw std::invalid_argument("Simulator: initial state is not finite");
@@ -1204,6 +1179,23 @@ Status Simulator::submit(const ActionCommand& command) {
                 m.active->total,
                 m.active->outcome == Outcome::kBlocked ? ", will stop before '" + m.active->blocking + "'" : "");
   return Status::Ok();
+}
+
+Result<double> Simulator::nominalDuration(const ActionCommand& command) {
+  Impl& m = *impl_;
+  auto cols = m.validate(command);
+  if (!cols) return cols.error();
+  auto planned = m.plan(command, *cols, true);
+  if (!planned) return planned.error();
+  return planned->total;
+}
+
+std::unordered_map<std::string, double> armSpeedLimits(const robot::RobotModel& robot) {
+  std::unordered_map<std::string, double> out;
+  for (std::size_t j = 0; j < robot.armDof(); ++j) {
+    if (robot.armLimits()[j].velocity > 0.0) out[robot.armJointNames()[j]] = robot.armLimits()[j].velocity;
+  }
+  return out;
 }
 
 Status Simulator::cancel(const std::string& command_id) {

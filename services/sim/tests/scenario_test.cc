@@ -19,21 +19,21 @@ TEST(ScenarioSetupTest, TakesTheTrueParametersFromTheScenario) {
   params.scenario = scenarioPath("occluded_can");
   auto setup = loadSetup(params);
   ASSERT_TRUE(setup) << setup.error().toString();
-  const TimeParameters& t = params.time_parameters;
-  EXPECT_EQ(t.get(ActionKind::kMoveBase, "max_linear_speed"), 0.45);
-  EXPECT_EQ(t.get(ActionKind::kMoveBase, "max_linear_accel"), 0.4);
-  EXPECT_EQ(t.get(ActionKind::kMoveBase, "max_angular_speed"), 0.9);
-  EXPECT_EQ(t.get(ActionKind::kMoveBase, "max_angular_accel"), 1.2);
-  EXPECT_EQ(t.get(ActionKind::kMoveBase, "settle_time"), 0.25);
-  EXPECT_EQ(t.get(ActionKind::kMoveArm, "max_joint_speed"), 0.8);
-  EXPECT_EQ(t.get(ActionKind::kMoveArm, "settle_time"), 0.25);
-  EXPECT_EQ(t.get(ActionKind::kPick, "gripper_time"), 1.8);
-  EXPECT_EQ(t.get(ActionKind::kPlace, "gripper_time"), 1.2);
+  const DynamicsParams& d = params.dynamics;
+  EXPECT_EQ(d.base.linear_speed, 0.45);
+  EXPECT_EQ(d.base.linear_accel, 0.4);
+  EXPECT_EQ(d.base.angular_speed, 0.9);
+  EXPECT_EQ(d.base.angular_accel, 1.2);
+  EXPECT_EQ(d.base.settle_s, 0.25);
+  EXPECT_EQ(d.arm.max_speed, 0.8);
+  EXPECT_EQ(d.arm.settle_s, 0.25);
+  EXPECT_EQ(d.hand.close_s, 1.8);
+  EXPECT_EQ(d.hand.open_s, 1.2);
   EXPECT_EQ(params.duration_noise, 0.05);
   EXPECT_EQ(params.seed, 11u);
-  // Not in the scenario schema: the configured simulated robot's values.
-  EXPECT_EQ(t.get(ActionKind::kMoveBase, "overhead"),
-            TimeParameters::simulatedRobot().get(ActionKind::kMoveBase, "overhead"));
+  // Not in the scenario schema: the simulator's own values.
+  EXPECT_EQ(d.base.latency_s, DynamicsParams{}.base.latency_s);
+  EXPECT_EQ(d.base.linear_jerk, DynamicsParams{}.base.linear_jerk);
   // The ground truth keeps what the planner does not see.
   auto scenario = world::loadScenario(params.scenario);
   ASSERT_TRUE(scenario);
@@ -41,6 +41,35 @@ TEST(ScenarioSetupTest, TakesTheTrueParametersFromTheScenario) {
   EXPECT_TRUE(setup->initial.base == scenario->startState().base);
   Simulator sim(setup->world, setup->robot, setup->initial, params, setup->faults);
   EXPECT_EQ(sim.world().objectCount(), scenario->world.objectCount());
+}
+
+// Every shipped scenario (config/scenarios/*.yaml) builds a simulator whose dynamics are valid
+// and carry the scenario's `sim` values, and executes a short base motion.
+TEST(ScenarioSetupTest, EveryShippedScenarioLoadsIntoTheSimulatorsDynamics) {
+  int loaded = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(std::filesystem::path(TAMP_SOURCE_DIR) / "config/scenarios")) {
+    if (entry.path().extension() != ".yaml") continue;
+    SCOPED_TRACE(entry.path().string());
+    SimParams params = exactParams();
+    params.scenario = entry.path().string();
+    auto setup = loadSetup(params);
+    ASSERT_TRUE(setup) << setup.error().toString();
+    ASSERT_TRUE(params.validate()) << params.validate().error().toString();
+    auto scenario = world::loadScenario(params.scenario);
+    ASSERT_TRUE(scenario);
+    EXPECT_EQ(params.dynamics.base.linear_speed, scenario->sim.base_max_linear_speed);
+    EXPECT_EQ(params.dynamics.arm.max_speed, scenario->sim.arm_max_joint_speed);
+    EXPECT_EQ(params.dynamics.hand.close_s, scenario->sim.grasp_duration);
+    EXPECT_EQ(params.seed, scenario->sim.seed);
+    Simulator sim(setup->world, setup->robot, setup->initial, params, setup->faults);
+    const Pose2D from = setup->initial.base;
+    auto turn = moveBase("turn", {from, Pose2D{from.x, from.y, from.theta + 0.2}});
+    auto oracle = sim.nominalDuration(turn);
+    ASSERT_TRUE(oracle) << oracle.error().toString();
+    EXPECT_GT(*oracle, 0.0);
+    ++loaded;
+  }
+  EXPECT_GE(loaded, 12);
 }
 
 TEST(ScenarioSetupTest, ScriptedFaultsOfHoldingStartFaults) {

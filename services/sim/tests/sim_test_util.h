@@ -37,6 +37,7 @@ inline SimParams exactParams() {
   p.duration_noise = 0.0;
   p.realtime_factor = 0.0;
   p.cloud_period_s = 0.0;
+  p.dynamics.stall.probability = 0.0;
   return p;
 }
 
@@ -116,4 +117,16 @@ inline double modelTime(const effort_model::ExecutionRecord& r, std::span<const 
   return effort_model::predictDuration(*f, params);
 }
 
+/// The simulator's own true nominal duration (dynamics.h) of the action a record describes.
+inline double trueTime(const effort_model::ExecutionRecord& r, const SimParams& p) {
+  NominalQuery q;
+  q.kind = r.action.kind;
+  q.path = r.action.path;
+  q.approach_m = r.action.approach_m;
+  q.retreat_m = r.action.retreat_m;
+  q.object_mass_kg = r.action.object_mass_kg;
+  auto t = nominalDuration(p.dynamics, armSpeedLimits(robotModel()), q);
+  if (!t) throw std::runtime_error(t.error().toString());
+  return *t;
+}
 }  // namespace tamp::sim::testing

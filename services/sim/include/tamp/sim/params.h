@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Parameters of the simulator: the robot's TRUE execution-time parameters (what the effort
+/// Parameters of the simulator: the robot's TRUE execution dynamics (what the effort
 /// estimator has to discover), execution noise, pacing, the resolution of the swept collision
 /// check, the physical tolerances of grasping and placing, and the depth sensor. Loaded from YAML
 /// (config/services/sim.yaml; every key optional, unknown keys refused):
@@ -16,8 +16,12 @@
 ///   grasp: {position_tolerance_m: 0.03, tcp_tolerance_m: 0.02, max_payload_kg: 5.0}
 ///   place: {position_tolerance_m: 0.03, angle_tolerance_rad: 0.1, max_drop_m: 0.05,
 ///           max_tilt_rad: 0.1}
-///   time_parameters:             # per action kind, parameter names of effort_model/models.h
-///     move_base: {max_linear_speed: 0.4, ...}
+///   dynamics:                    # the true robot (DynamicsParams, dynamics.h)
+///     base: {linear_speed: 0.45, linear_accel: 0.35, linear_jerk: 0.8, angular_speed: 1.1, ...}
+///     arm: {speed_fraction: 0.55, max_speed: 2.0, accel: 1.8, jerk: 6.0, corner_threshold_rad: 0.05, ...}
+///     hand: {approach_speed: 0.05, approach_accel: 0.1, approach_jerk: 0.5, close_s: 1.9, open_s: 1.1}
+///     load: {per_kg: 0.12}
+///     stall: {probability: 0.08, min_s: 0.3, max_s: 1.5}
 ///   sensor: {width: 320, height: 240, ...}                 # DepthSensorParams
 ///
 /// Units: metres, radians, seconds, kilograms.
@@ -31,29 +35,9 @@
 #include "tamp/core/error.h"
 #include "tamp/core/trajectory.h"
 #include "tamp/sim/depth_sensor.h"
+#include "tamp/sim/dynamics.h"
 
 namespace tamp::sim {
-
-/// The simulated robot's true time parameters: for each action kind, values in physical units in
-/// the order of `effort_model::modelSpec(kind).parameters`. The simulator times every action
-/// with `effort_model::predictDuration(features, values)` (plus noise); the planner never
-/// sees these values.
-struct TimeParameters {
-  std::array<std::vector<double>, 4> values;  ///< indexed by `static_cast<int>(ActionKind)`
-
-  /// A robot that is deliberately *not* the estimator's prior: 20 % slower drives, faster turns,
-  /// longer settling and gripper times, heavier payload effect. Tests and examples use it; a
-  /// scenario gives its own.
-  static TimeParameters simulatedRobot();
-  const std::vector<double>& of(ActionKind kind) const;
-  std::vector<double>& of(ActionKind kind);
-  /// Value of a named parameter; throws std::invalid_argument for an unknown name.
-  double get(ActionKind kind, const std::string& name) const;
-  void set(ActionKind kind, const std::string& name, double value);
-  /// Ok, or kInvalidArgument naming "time_parameters.<kind>.<name>": sizes match the model
-  /// specs, values finite, within the specs' [lower, upper] bounds.
-  Status validate() const;
-};
 
 struct StartTolerance {
   double position_m{0.05};  ///< base position and prismatic joints
@@ -89,7 +73,7 @@ struct SimParams {
   StartTolerance start_tolerance;
   GraspParams grasp;
   PlaceParams place;
-  TimeParameters time_parameters{TimeParameters::simulatedRobot()};
+  DynamicsParams dynamics;         ///< the true robot's execution dynamics (dynamics.h)
   DepthSensorParams sensor;
 
   /// Ok, or one kInvalidArgument error listing every bad field (field paths as in the YAML).

@@ -10,20 +10,23 @@
 ///   a `collision::Scene` over all of it; the planner only ever sees `plannerView()`.
 /// - **Kinematics.** The robot is the URDF `robot::RobotModel`: link poses by FK, collision
 ///   geometry from the URDF, held objects attached to the tool link.
-/// - **Time.** An action's duration is `effort_model::predictDuration(features, true_params)`
-///   times a log-normal factor exp(sigma * N(0, 1)) (sigma = `SimParams::duration_noise`, median
-///   1), with the features extracted from the command exactly as the estimator does. The motion
-///   follows the commanded path re-timed by the same physical model:
-///   - move_base: stop-and-turn, as the model assumes: overhead, then for each straight run of
-///     the path (merged as in `extractFeatures`) a turn in place to the run's heading and a
-///     trapezoidal drive along the run's waypoints, a settle pause after each, and a final turn
-///     to the last waypoint's heading;
-///   - move_arm: overhead, then each straight run in joint space as one synchronized trapezoid
-///     (slowest joint at `max_joint_speed / f`, f = 1 + payload_slowdown * held mass) and a settle
-///     pause;
+/// - **Time.** The simulator's own dynamics (dynamics.h, `SimParams::dynamics`), not the effort
+///   estimator's models: every move a jerk-limited S-curve, a held mass slowing it, seeded random
+///   stalls after a move, the whole timeline times a log-normal factor exp(sigma * N(0, 1))
+///   (sigma = `SimParams::duration_noise`, median 1). The motion follows the commanded path:
+///   The geometry is the commanded one (the robot is position-controlled): only the timing is
+///   the simulator's own.
+///   - move_base: latency, then stop-and-turn along `effort_model::baseSteps` (the segmentation
+///     the motion planner and the execution monitor check): a turn in place to each straight
+///     run's heading and a drive along the run's waypoints, a settle pause after each, and a
+///     final turn to the last waypoint's heading;
+///   - move_arm: latency, then each run (consecutive segments bending by at most
+///     `ArmDynamics::corner_threshold_rad`) as one S-curve along the commanded polyline, through
+///     every waypoint (each joint within min(max_speed, speed_fraction * URDF limit) / f,
+///     f = 1 + per_kg * held mass), and a settle pause;
 ///   - pick/place: the trajectory's waypoints up to the *grasp waypoint* (the one whose tool
 ///     position is farthest from the first waypoint's) are the approach, travelled at the
-///     approach speed along the tool path; then the gripper acts (`gripper_time`); the rest is
+///     approach speed along the tool path; then the gripper acts (`hand.close_s`/`open_s`); the rest is
 ///     the retreat. approach_m / retreat_m are the tool-path lengths.
 ///   The commanded times are validated but not followed: the robot runs at its own true speed.
 /// - **Contacts.** Before (and, if the world changes, during) an action, the whole motion is
@@ -36,8 +39,9 @@
 ///   z = 0 blocks too (reported as `kFloorId`). Self-collisions of the arm are not simulated.
 /// - **Manipulation.** A pick succeeds when, at the grasp waypoint, the object exists, is movable
 ///   and graspable, is where the command says (within tolerance), the tool centre point is at it,
-///   it fits between the fingers and is not too heavy; it is then attached to the tool link and
-///   removed from its support region. Otherwise the gripper closes on nothing and the action
+///   it fits between the fingers and is not too heavy; the closing fingers then centre it between
+///   them along the tool's y axis (and turn a box that is within 0.35 rad of square flat against
+///   the pads), and it is attached to the tool link and removed from its support region. Otherwise the gripper closes on nothing and the action
 ///   fails after its retreat. A place releases the held object where the gripper is; it settles
 ///   onto the support below (a table region or the floor) and the action succeeds when it ends
 ///   upright, on a region, near the commanded pose and not in collision.
@@ -53,6 +57,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -123,6 +128,9 @@ struct StepEvents {
   bool world_changed{false};  ///< objects moved, appeared or disappeared (not just the robot)
 };
 
+/// The URDF velocity limit of each arm joint, by name (the `joint_speed` of dynamics.h).
+std::unordered_map<std::string, double> armSpeedLimits(const robot::RobotModel& robot);
+
 class Simulator {
  public:
   /// @param truth the ground-truth world (hidden objects included). Its `held()` object, if any,
@@ -144,6 +152,9 @@ class Simulator {
   /// object pose, joint limits; kUnavailable while another action runs) leave the robot idle and
   /// produce no record. An accepted command's outcome comes from later `step()` calls.
   Status submit(const ActionCommand& command);
+  /// The true nominal duration of `command` started now (no noise, no stall; deterministic and
+  /// without touching the random streams): the oracle's answer. The same validation as submit().
+  Result<double> nominalDuration(const ActionCommand& command);
   /// Stops the action `command_id` where the robot is; its result (kCancelled) comes with the
   /// next `step()`. kNotFound when it is not the action in progress.
   Status cancel(const std::string& command_id);

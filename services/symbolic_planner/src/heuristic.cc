@@ -153,36 +153,47 @@ struct RelaxedOps {
   /// differing precondition (first on ties); groups that end with one operator are dropped.
   static void findGroups(const Task& task, std::vector<uint32_t>& group, std::vector<FactId>& varying,
                          std::vector<std::vector<OpId>>& groups) {
-    struct KeyHash {
-      size_t operator()(const std::vector<uint32_t>& k) const {
-        uint64_t h = 0x9E3779B97F4A7C15ULL;
-        for (uint32_t x : k) h = (h ^ x) * 0x100000001B3ULL;
-        return static_cast<size_t>(h ^ (h >> 29));
-      }
-    };
-    std::unordered_map<std::vector<uint32_t>, uint32_t, KeyHash> key_id;
-    std::vector<uint32_t> key_count;
-    // Key of (operator, index of the differing precondition): adds, a separator, the other preconditions.
-    auto key = [&](const Operator& x, size_t skip, std::vector<uint32_t>& k) {
-      k.assign(x.add.begin(), x.add.end());
-      k.push_back(kNone);
+    // Key of (operator, index `skip` of the differing precondition): its adds and its other
+    // preconditions, hashed without building it; equal hashes are checked against the key's
+    // first (operator, skip) and a colliding key is not merged.
+    auto hash = [](const Operator& x, size_t skip) {
+      uint64_t h = 0x9E3779B97F4A7C15ULL;
+      for (FactId f : x.add) h = (h ^ f) * 0x100000001B3ULL;
+      h = (h ^ kNone) * 0x100000001B3ULL;
       for (size_t i = 0; i < x.pre.size(); ++i) {
-        if (i != skip) k.push_back(x.pre[i]);
+        if (i != skip) h = (h ^ x.pre[i]) * 0x100000001B3ULL;
       }
+      return h ^ (h >> 29);
+    };
+    auto same = [](const Operator& a, size_t sa, const Operator& b, size_t sb) {
+      if (a.add != b.add || a.pre.size() != b.pre.size()) return false;
+      for (size_t k = 0; k + 1 < a.pre.size(); ++k) {  // the preconditions but the skipped one
+        if (a.pre[k + (k >= sa ? 1 : 0)] != b.pre[k + (k >= sb ? 1 : 0)]) return false;
+      }
+      return true;
     };
     auto eligible = [](const Operator& x) { return x.cond_effects.empty() && !x.add.empty() && !x.pre.empty(); };
-    std::vector<uint32_t> k;
+    std::unordered_map<uint64_t, uint32_t> key_id;
+    std::vector<uint32_t> key_count;
+    std::vector<std::pair<OpId, uint32_t>> key_rep;  // key -> its first (operator, skip)
     std::vector<uint32_t> first_key(task.ops.size() + 1, 0), keys;  // per operator, its keys' ids
     for (OpId o = 0; o < task.ops.size(); ++o) {
       first_key[o] = static_cast<uint32_t>(keys.size());
       const Operator& x = task.ops[o];
       if (!eligible(x)) continue;
       for (size_t i = 0; i < x.pre.size(); ++i) {
-        key(x, i, k);
-        auto [it, inserted] = key_id.try_emplace(k, static_cast<uint32_t>(key_count.size()));
-        if (inserted) key_count.push_back(0);
-        ++key_count[it->second];
-        keys.push_back(it->second);
+        auto [it, inserted] = key_id.try_emplace(hash(x, i), static_cast<uint32_t>(key_count.size()));
+        uint32_t id = it->second;
+        if (inserted) {
+          key_count.push_back(0);
+          key_rep.push_back({o, static_cast<uint32_t>(i)});
+        } else if (!same(task.ops[key_rep[id].first], key_rep[id].second, x, i)) {
+          id = static_cast<uint32_t>(key_count.size());  // a hash collision: a key of its own
+          key_count.push_back(0);
+          key_rep.push_back({o, static_cast<uint32_t>(i)});
+        }
+        ++key_count[id];
+        keys.push_back(id);
       }
     }
     first_key[task.ops.size()] = static_cast<uint32_t>(keys.size());

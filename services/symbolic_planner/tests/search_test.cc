@@ -220,10 +220,11 @@ TEST(Search, EhcFirstRunContinuesFromTheFirstBetterState) {
   req.domain_text = test::readFile(dir / "domain.pddl");
   req.problem_text = test::readFile(dir / "instance-12.pddl");
   req.timeout_seconds = 120;
+  req.search.ehc_ff_first_improvement = true;
   PlanReply first = plan(req, Termination());
   ASSERT_EQ(first.status, PlanStatus::kSolved) << first.message;
   EXPECT_FALSE(first.stats.ehc_ff_failed);
-  req.search.ehc_ff_first_improvement = false;
+  req.search.ehc_ff_first_improvement = false;  // the default
   PlanReply best = plan(req, Termination());
   ASSERT_EQ(best.status, PlanStatus::kSolved) << best.message;
   EXPECT_FALSE(best.stats.ehc_ff_failed);

@@ -76,9 +76,10 @@ struct SearchOptions {
   bool ehc_ff_first{true};
   uint64_t ehc_ff_budget_per_h{300};
   /// ehc: that first run continues from the first better state, as FF does, whatever
-  /// `ehc_best_sibling` says (which then applies to the default run only): on large groundings
-  /// most of the hill-climbing's evaluations are the siblings evaluated after the better state.
-  bool ehc_ff_first_improvement{true};
+  /// `ehc_best_sibling` says (which then applies to the default run only): 2-6x fewer
+  /// evaluations on many domains, but the first run then fails on maintenance-4, which only the
+  /// first run with the best sibling solves (docs/benchmarks.md, issue 14, fifth round): off.
+  bool ehc_ff_first_improvement{false};
   /// ehc: give up (kFailed, no fallback) after this many evaluations per unit of the initial
   /// state's h (at least 2 units; with the goal agenda, h of the first entry); 0 = unlimited.
   uint64_t ehc_eval_budget_per_h{0};

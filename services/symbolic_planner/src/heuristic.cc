@@ -459,6 +459,7 @@ class LayeredFF : public Heuristic {
         const FactId g = goals_at_[time][i];
         if (isTrue(g, time)) continue;  // added by an achiever selected at this layer or above
         uint32_t best = kNone, best_member = kNone;
+        OpId best_op = kNone;
         uint64_t best_d = UINT64_MAX;
         for (uint32_t k = R_.adders_begin[g]; k < R_.adders_begin[g + 1]; ++k) {
           const uint32_t r = R_.adders[k];
@@ -470,10 +471,14 @@ class LayeredFF : public Heuristic {
             m = easiestMember(r);
             d += level_[R_.members[m].first];
           }
-          if (d < best_d) {
+          // Ties go to the lowest operator, as they would with the operators apart (adders are
+          // in operator order; a merged rop stands at its first member's place).
+          const OpId ro = m == kNone ? R_.op[r] : R_.members[m].second;
+          if (d < best_d || (d == best_d && ro < best_op)) {
             best_d = d;
             best = r;
             best_member = m;
+            best_op = ro;
           }
         }
         if (best == kNone) continue;  // cannot happen: g has level `time`
@@ -483,14 +488,14 @@ class LayeredFF : public Heuristic {
           ++h;
           if (time == 1) plan_first_.push_back(o);
         }
-        for (uint32_t p = R_.pre_begin[best]; p < R_.pre_begin[best + 1]; ++p) {
-          const FactId q = R_.pre[p];
-          if (goal_mark_[q] == epoch_ || isTrue(q, time - 1)) continue;
-          addSubgoal(q);
-        }
-        if (best_member != kNone) {
-          const FactId q = R_.members[best_member].first;
+        // Sub-goals in precondition order (a merged rop: its concrete operator's, member included).
+        const auto subgoal = [&](FactId q) {
           if (goal_mark_[q] != epoch_ && !isTrue(q, time - 1)) addSubgoal(q);
+        };
+        if (best_member == kNone) {
+          for (uint32_t p = R_.pre_begin[best]; p < R_.pre_begin[best + 1]; ++p) subgoal(R_.pre[p]);
+        } else {
+          for (FactId q : task_.ops[o].pre) subgoal(q);
         }
         markTrue(best, time);
         for (uint32_t k = R_.implied_begin[best]; k < R_.implied_begin[best + 1]; ++k) markTrue(R_.implied[k], time);
@@ -547,6 +552,8 @@ class LayeredFF : public Heuristic {
   void collectHelpfulFF(const uint64_t* s) {
     cand_.clear();
     for (FactId g : goals_at_[1]) {
+      // This sub-goal's candidates in operator order (as with the operators apart).
+      const size_t batch = cand_.size();
       for (uint32_t k = R_.adders_begin[g]; k < R_.adders_begin[g + 1]; ++k) {
         const uint32_t r = R_.adders[k];
         if (rop_level_[r] != 0) continue;
@@ -564,6 +571,8 @@ class LayeredFF : public Heuristic {
         op_mark_[o] = epoch_;
         cand_.push_back({0, o});
       }
+      std::sort(cand_.begin() + static_cast<std::ptrdiff_t>(batch), cand_.end(),
+                [](const std::pair<uint32_t, OpId>& a, const std::pair<uint32_t, OpId>& b) { return a.second < b.second; });
     }
     for (auto& [d, o] : cand_) {
       const Operator& op = task_.ops[o];

@@ -62,12 +62,14 @@ int main(int argc, char** argv) {
   double timeout = 0.0, weight = 5.0, anytime = 5.0;
   size_t memory_mb = 4096;
   bool stats = false, no_check = false, no_fallback = false, no_agenda = false, first_improvement = false,
-       no_ff_first = false, no_landmarks = false, no_unit_first = false;
+       no_ff_first = false, no_landmarks = false, no_unit_first = false,
+       no_full_retry = false, ff_first_improvement = false;
   uint64_t ff_budget = 300, second_budget = 300;
   const sp::SearchOptions defaults;
   uint64_t fallback_budget = defaults.ehc_fallback_budget_per_h, fallback_min = defaults.ehc_fallback_budget_min,
            fallback_max = defaults.ehc_fallback_budget_max;
   double unit_first_share = defaults.unit_first_time_share;
+  double retry_share = defaults.ehc_retry_budget_share;
   app.add_option("domain", domain, "PDDL domain file")->required();
   app.add_option("problem", problem, "PDDL problem file")->required();
   app.add_option("--search", search,
@@ -92,6 +94,16 @@ int main(int argc, char** argv) {
   app.add_flag("--no-goal-agenda", no_agenda, "ehc: pursue all goals at once (no FF goal agenda)");
   app.add_flag("--ehc-first-improvement", first_improvement,
                "ehc: continue from the first better state (FF) instead of the best sibling");
+  app.add_flag("--no-ehc-full-retry", no_full_retry,
+               "ehc: fall back as soon as a plateau is exhausted with helpful actions (FF), instead of searching "
+               "it again with every applicable action");
+  app.add_option("--ehc-retry-share", retry_share,
+                 "ehc: a plateau searched again with every applicable action may use this share of the "
+                 "hill-climbing budget before the complete search starts (0 = unbounded)")
+      ->check(CLI::Range(0.0, 1.0));
+  app.add_flag("--ehc-ff-first-improvement", ff_first_improvement,
+               "ehc: the first run (FF-v2.3 variant) continues from the first better state, as FF (default: from "
+               "the best sibling, as the default run)");
   app.add_flag("--no-ehc-ff-first", no_ff_first,
                "ehc: no first hill-climbing run with FF-v2.3's variant of the relaxed plan");
   app.add_option("--ehc-ff-budget", ff_budget,
@@ -133,6 +145,9 @@ int main(int argc, char** argv) {
   req.search.ehc_fallback = !no_fallback;
   req.search.goal_agenda = !no_agenda;
   req.search.ehc_best_sibling = !first_improvement;
+  req.search.ehc_full_retry = !no_full_retry;
+  req.search.ehc_retry_budget_share = retry_share;
+  req.search.ehc_ff_first_improvement = ff_first_improvement;
   req.search.ehc_ff_first = !no_ff_first;
   req.search.ehc_ff_budget_per_h = ff_budget;
   req.search.ehc_second_budget_per_step = second_budget;
@@ -160,11 +175,14 @@ int main(int argc, char** argv) {
   if (stats) {
     std::fprintf(stderr,
                  "; status %s; parse %.4f s, ground %.4f s, search %.4f s; facts %zu, operators %zu; "
-                 "expanded %llu, evaluated %llu, initial h %lld; anytime %llu iterations, %llu improvements%s%s%s%s\n",
+                 "expanded %llu, evaluated %llu, initial h %lld; ehc plateau retries %llu (%llu abandoned); anytime %llu "
+                 "iterations, %llu improvements%s%s%s%s\n",
                  sp::toString(reply.status).c_str(), reply.stats.parse_seconds, reply.stats.ground_seconds,
                  reply.stats.search_seconds, reply.stats.facts, reply.stats.operators,
                  static_cast<unsigned long long>(reply.stats.expanded),
                  static_cast<unsigned long long>(reply.stats.evaluated), static_cast<long long>(reply.stats.initial_h),
+                 static_cast<unsigned long long>(reply.stats.ehc_retries),
+                 static_cast<unsigned long long>(reply.stats.ehc_retries_abandoned),
                  static_cast<unsigned long long>(reply.stats.anytime_iterations),
                  static_cast<unsigned long long>(reply.stats.anytime_improvements),
                  reply.stats.ehc_ff_failed ? "; ehc with FF-v2.3's relaxed plan failed, restarted" : "",

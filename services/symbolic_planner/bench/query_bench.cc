@@ -100,17 +100,19 @@ void BM_CachedQuery(benchmark::State& state) {
     }
   }
   size_t k = 0;
-  double plan_len = 0, reused = 0;
+  double plan_len = 0, reused = 0, evaluated = 0;
   int64_t runs = 0;
   for (auto _ : state) {
     sp::PlanReply r = sc.session->solve(sc.queries[k++ % sc.queries.size()], tamp::Termination());
     benchmark::DoNotOptimize(r.plan.data());
     plan_len += static_cast<double>(r.plan.size());
+    evaluated += static_cast<double>(r.stats.evaluated);
     reused += r.stats.grounding_reused ? 1 : 0;
     ++runs;
   }
   state.counters["plan_len"] = plan_len / static_cast<double>(runs);
   state.counters["reused"] = reused / static_cast<double>(runs);
+  state.counters["evaluated"] = evaluated / static_cast<double>(runs);
   state.counters["operators"] = static_cast<double>(sc.session->task()->ops.size());
   state.counters["facts"] = static_cast<double>(sc.session->task()->numFacts());
 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <stdexcept>
+#include <unordered_map>
 
 namespace tamp::symbolic_planner {
 namespace {
@@ -25,15 +26,31 @@ struct RelaxedOps {
   /// rop -> other rops of the same operator that fire whenever it fires (their condition is a
   /// subset of its condition; FF's "implied effects").
   std::vector<uint32_t> implied_begin, implied;
+  /// Merged rops (`build(..., merge = true)`): operators that differ in one precondition fact
+  /// only (same adds, same other preconditions, no conditional effects) are one rop whose
+  /// precondition is the common part plus *one of* the differing facts (its "members"); `count`
+  /// counts that disjunction as one precondition. The relaxation of the group is exactly that
+  /// of its operators: the rop fires when the first of them would. rop -> members (fact, operator)
+  /// in operator order (empty: not merged); fact -> merged rops with a member on it.
+  std::vector<uint32_t> member_begin;
+  std::vector<std::pair<FactId, OpId>> members;
+  std::vector<uint32_t> member_of_begin, member_of;
 
   size_t size() const { return op.size(); }
+  bool merged(uint32_t r) const { return member_begin[r] != member_begin[r + 1]; }
 
-  /// `implied`: also the implied effects (only FF's layered extraction needs them).
-  void build(const Task& task, CostType ct, bool implied_effects = true) {
+  /// `implied`: also the implied effects (only FF's layered extraction needs them). `merge`:
+  /// merge operators as above (only where every operator costs the same).
+  void build(const Task& task, CostType ct, bool implied_effects = true, bool merge = false) {
     const size_t nf = task.numFacts();
-    std::vector<uint32_t> pre_count(nf + 1, 0), add_count(nf + 1, 0);
+    std::vector<uint32_t> pre_count(nf + 1, 0), add_count(nf + 1, 0), member_count(nf + 1, 0);
     std::vector<FactId> tmp;
     std::vector<uint32_t> op_first(task.ops.size() + 1, 0);
+    // Groups of operators to merge: group id per operator (kNone: alone), the differing fact.
+    std::vector<uint32_t> group(task.ops.size(), kNone);
+    std::vector<FactId> varying(task.ops.size(), 0);
+    std::vector<std::vector<OpId>> groups;
+    if (merge) findGroups(task, group, varying, groups);
     auto addRop = [&](OpId o, int32_t c, const std::vector<FactId>& p1, const std::vector<FactId>* p2,
                       const std::vector<FactId>& adds) {
       if (adds.empty()) return;
@@ -54,13 +71,32 @@ struct RelaxedOps {
       for (FactId f : tmp) ++pre_count[f];
       for (FactId f : adds) ++add_count[f];
     };
+    member_begin.push_back(0);
     for (OpId o = 0; o < task.ops.size(); ++o) {
       const Operator& x = task.ops[o];
       op_first[o] = static_cast<uint32_t>(op.size());
+      if (group[o] != kNone) {
+        const std::vector<OpId>& g = groups[group[o]];
+        if (g.front() != o) continue;  // merged into the rop of the group's first operator
+        std::vector<FactId> common;
+        for (FactId f : x.pre) {
+          if (f != varying[o]) common.push_back(f);
+        }
+        addRop(o, -1, common, nullptr, x.add);
+        ++count.back();  // the disjunction of the members
+        for (OpId m : g) {
+          members.push_back({varying[m], m});
+          ++member_count[varying[m]];
+        }
+        member_begin.push_back(static_cast<uint32_t>(members.size()));
+        continue;
+      }
       addRop(o, -1, x.pre, nullptr, x.add);
+      while (member_begin.size() < op.size() + 1) member_begin.push_back(static_cast<uint32_t>(members.size()));
       for (size_t c = 0; c < x.cond_effects.size(); ++c) {
         addRop(o, static_cast<int32_t>(c), x.pre, &x.cond_effects[c].cond, x.cond_effects[c].add);
       }
+      while (member_begin.size() < op.size() + 1) member_begin.push_back(static_cast<uint32_t>(members.size()));
     }
     op_first[task.ops.size()] = static_cast<uint32_t>(op.size());
     const uint32_t n = static_cast<uint32_t>(op.size());
@@ -80,6 +116,11 @@ struct RelaxedOps {
     };
     invert(pre_count, pre_begin, pre, pre_of_begin, pre_of);
     invert(add_count, add_begin, add, adders_begin, adders);
+    {
+      std::vector<uint32_t> member_facts(members.size());
+      for (size_t i = 0; i < members.size(); ++i) member_facts[i] = members[i].first;
+      invert(member_count, member_begin, member_facts, member_of_begin, member_of);
+    }
     for (uint32_t r = 0; r < n; ++r) {
       if (count[r] == 0) no_pre.push_back(r);
     }
@@ -105,6 +146,83 @@ struct RelaxedOps {
       }
     }
     implied_begin[n] = static_cast<uint32_t>(implied.size());
+  }
+
+  /// Operators without conditional effects that share their adds and all preconditions but one
+  /// (at least two of them): each operator joins the largest such group over its choices of the
+  /// differing precondition (first on ties); groups that end with one operator are dropped.
+  static void findGroups(const Task& task, std::vector<uint32_t>& group, std::vector<FactId>& varying,
+                         std::vector<std::vector<OpId>>& groups) {
+    // Key of (operator, index `skip` of the differing precondition): its adds and its other
+    // preconditions, hashed without building it; equal hashes are checked against the key's
+    // first (operator, skip) and a colliding key is not merged.
+    auto hash = [](const Operator& x, size_t skip) {
+      uint64_t h = 0x9E3779B97F4A7C15ULL;
+      for (FactId f : x.add) h = (h ^ f) * 0x100000001B3ULL;
+      h = (h ^ kNone) * 0x100000001B3ULL;
+      for (size_t i = 0; i < x.pre.size(); ++i) {
+        if (i != skip) h = (h ^ x.pre[i]) * 0x100000001B3ULL;
+      }
+      return h ^ (h >> 29);
+    };
+    auto same = [](const Operator& a, size_t sa, const Operator& b, size_t sb) {
+      if (a.add != b.add || a.pre.size() != b.pre.size()) return false;
+      for (size_t k = 0; k + 1 < a.pre.size(); ++k) {  // the preconditions but the skipped one
+        if (a.pre[k + (k >= sa ? 1 : 0)] != b.pre[k + (k >= sb ? 1 : 0)]) return false;
+      }
+      return true;
+    };
+    auto eligible = [](const Operator& x) { return x.cond_effects.empty() && !x.add.empty() && !x.pre.empty(); };
+    std::unordered_map<uint64_t, uint32_t> key_id;
+    std::vector<uint32_t> key_count;
+    std::vector<std::pair<OpId, uint32_t>> key_rep;  // key -> its first (operator, skip)
+    std::vector<uint32_t> first_key(task.ops.size() + 1, 0), keys;  // per operator, its keys' ids
+    for (OpId o = 0; o < task.ops.size(); ++o) {
+      first_key[o] = static_cast<uint32_t>(keys.size());
+      const Operator& x = task.ops[o];
+      if (!eligible(x)) continue;
+      for (size_t i = 0; i < x.pre.size(); ++i) {
+        auto [it, inserted] = key_id.try_emplace(hash(x, i), static_cast<uint32_t>(key_count.size()));
+        uint32_t id = it->second;
+        if (inserted) {
+          key_count.push_back(0);
+          key_rep.push_back({o, static_cast<uint32_t>(i)});
+        } else if (!same(task.ops[key_rep[id].first], key_rep[id].second, x, i)) {
+          id = static_cast<uint32_t>(key_count.size());  // a hash collision: a key of its own
+          key_count.push_back(0);
+          key_rep.push_back({o, static_cast<uint32_t>(i)});
+        }
+        ++key_count[id];
+        keys.push_back(id);
+      }
+    }
+    first_key[task.ops.size()] = static_cast<uint32_t>(keys.size());
+    std::vector<uint32_t> chosen(task.ops.size(), kNone), group_of_key(key_count.size(), kNone);
+    std::vector<uint32_t> members_of_key(key_count.size(), 0);
+    for (OpId o = 0; o < task.ops.size(); ++o) {
+      uint32_t best = kNone, best_n = 1;
+      for (uint32_t i = first_key[o]; i < first_key[o + 1]; ++i) {
+        if (key_count[keys[i]] > best_n) {
+          best_n = key_count[keys[i]];
+          best = i;
+        }
+      }
+      if (best == kNone) continue;
+      chosen[o] = best;
+      ++members_of_key[keys[best]];
+    }
+    for (OpId o = 0; o < task.ops.size(); ++o) {
+      if (chosen[o] == kNone) continue;
+      const uint32_t kid = keys[chosen[o]];
+      if (members_of_key[kid] < 2) continue;
+      if (group_of_key[kid] == kNone) {
+        group_of_key[kid] = static_cast<uint32_t>(groups.size());
+        groups.emplace_back();
+      }
+      group[o] = group_of_key[kid];
+      groups[group[o]].push_back(o);
+      varying[o] = task.ops[o].pre[chosen[o] - first_key[o]];
+    }
   }
 };
 
@@ -171,7 +289,8 @@ bool holdsAll(const uint64_t* s, const std::vector<FactId>& facts) {
 class LayeredFF : public Heuristic {
  public:
   LayeredFF(const Task& task, CostType ct, Cost unit) : task_(task), unit_(unit) {
-    R_.build(task, ct);
+    R_.build(task, ct, /*implied=*/true, /*merge=*/true);
+    group_done_.assign(R_.size(), 0);
     const size_t nf = task.numFacts(), nr = R_.size();
     level_.assign(nf, kNone);
     ctr_.resize(nr);
@@ -213,7 +332,10 @@ class LayeredFF : public Heuristic {
   void reset() {
     for (size_t i = 0; i < num_facts_; ++i) level_[facts_[i]] = kNone;
     for (size_t i = 0; i < num_active_; ++i) rop_level_[active_[i]] = kNone;
-    for (size_t i = 0; i < num_touched_; ++i) ctr_[touched_[i]].unsat = ctr_[touched_[i]].count;
+    for (size_t i = 0; i < num_touched_; ++i) {
+      ctr_[touched_[i]].unsat = ctr_[touched_[i]].count;
+      group_done_[touched_[i]] = 0;
+    }
     num_facts_ = num_active_ = num_touched_ = 0;
   }
 
@@ -237,6 +359,9 @@ class LayeredFF : public Heuristic {
     const uint32_t* const pre_of_begin = R_.pre_of_begin.data();
     const uint32_t* const add = R_.add.data();
     const uint32_t* const add_begin = R_.add_begin.data();
+    const uint32_t* const member_of = R_.member_of.data();
+    const uint32_t* const member_of_begin = R_.member_of_begin.data();
+    uint8_t* const group_done = group_done_.data();
     size_t nfacts = 0, nactive = 0, ntouched = 0;
     auto reach = [&](FactId f, uint32_t lvl) {
       level[f] = lvl;
@@ -259,6 +384,18 @@ class LayeredFF : public Heuristic {
         const FactId f = facts[i];
         for (uint32_t k = pre_of_begin[f], e = pre_of_begin[f + 1]; k < e; ++k) {
           const uint32_t r = pre_of[k];
+          const uint32_t u = ctr[r].unsat;
+          touched[ntouched] = r;
+          ntouched += u == ctr[r].count;
+          ctr[r].unsat = u - 1;
+          active[nactive] = r;
+          nactive += u == 1;
+        }
+        // Merged rops: their disjunction of members counts once, when its first fact is reached.
+        for (uint32_t k = member_of_begin[f], e = member_of_begin[f + 1]; k < e; ++k) {
+          const uint32_t r = member_of[k];
+          if (group_done[r]) continue;
+          group_done[r] = 1;
           const uint32_t u = ctr[r].unsat;
           touched[ntouched] = r;
           ntouched += u == ctr[r].count;
@@ -321,29 +458,44 @@ class LayeredFF : public Heuristic {
       for (size_t i = 0; i < goals_at_[time].size(); ++i) {
         const FactId g = goals_at_[time][i];
         if (isTrue(g, time)) continue;  // added by an achiever selected at this layer or above
-        uint32_t best = kNone;
+        uint32_t best = kNone, best_member = kNone;
+        OpId best_op = kNone;
         uint64_t best_d = UINT64_MAX;
         for (uint32_t k = R_.adders_begin[g]; k < R_.adders_begin[g + 1]; ++k) {
           const uint32_t r = R_.adders[k];
           if (rop_level_[r] != time - 1) continue;
           uint64_t d = 0;
           for (uint32_t p = R_.pre_begin[r]; p < R_.pre_begin[r + 1]; ++p) d += level_[R_.pre[p]];
-          if (d < best_d) {
+          uint32_t m = kNone;
+          if (R_.merged(r)) {  // the member (operator) whose differing fact is reached first
+            m = easiestMember(r);
+            d += level_[R_.members[m].first];
+          }
+          // Ties go to the lowest operator, as they would with the operators apart (adders are
+          // in operator order; a merged rop stands at its first member's place).
+          const OpId ro = m == kNone ? R_.op[r] : R_.members[m].second;
+          if (d < best_d || (d == best_d && ro < best_op)) {
             best_d = d;
             best = r;
+            best_member = m;
+            best_op = ro;
           }
         }
         if (best == kNone) continue;  // cannot happen: g has level `time`
-        const OpId o = R_.op[best];
+        const OpId o = best_member == kNone ? R_.op[best] : R_.members[best_member].second;
         if (op_used_[o] != epoch_) {  // an operator counts once per relaxed plan
           op_used_[o] = epoch_;
           ++h;
           if (time == 1) plan_first_.push_back(o);
         }
-        for (uint32_t p = R_.pre_begin[best]; p < R_.pre_begin[best + 1]; ++p) {
-          const FactId q = R_.pre[p];
-          if (goal_mark_[q] == epoch_ || isTrue(q, time - 1)) continue;
-          addSubgoal(q);
+        // Sub-goals in precondition order (a merged rop: its concrete operator's, member included).
+        const auto subgoal = [&](FactId q) {
+          if (goal_mark_[q] != epoch_ && !isTrue(q, time - 1)) addSubgoal(q);
+        };
+        if (best_member == kNone) {
+          for (uint32_t p = R_.pre_begin[best]; p < R_.pre_begin[best + 1]; ++p) subgoal(R_.pre[p]);
+        } else {
+          for (FactId q : task_.ops[o].pre) subgoal(q);
         }
         markTrue(best, time);
         for (uint32_t k = R_.implied_begin[best]; k < R_.implied_begin[best + 1]; ++k) markTrue(R_.implied[k], time);
@@ -351,6 +503,16 @@ class LayeredFF : public Heuristic {
     }
     collectHelpful(s);
     return h;
+  }
+
+  /// Index (in R_.members) of the member of merged rop `r` whose fact has the lowest level
+  /// (the first on ties; unreached facts have level kNone).
+  uint32_t easiestMember(uint32_t r) const {
+    uint32_t best = R_.member_begin[r];
+    for (uint32_t i = best + 1; i < R_.member_begin[r + 1]; ++i) {
+      if (level_[R_.members[i].first] < level_[R_.members[best].first]) best = i;
+    }
+    return best;
   }
 
   bool isTrue(FactId f, uint32_t t) const { return true_a_[f] == stamp(t) || true_b_[f] == stamp(t); }
@@ -390,14 +552,27 @@ class LayeredFF : public Heuristic {
   void collectHelpfulFF(const uint64_t* s) {
     cand_.clear();
     for (FactId g : goals_at_[1]) {
+      // This sub-goal's candidates in operator order (as with the operators apart).
+      const size_t batch = cand_.size();
       for (uint32_t k = R_.adders_begin[g]; k < R_.adders_begin[g + 1]; ++k) {
         const uint32_t r = R_.adders[k];
         if (rop_level_[r] != 0) continue;
+        if (R_.merged(r)) {  // every member applicable in s
+          for (uint32_t i = R_.member_begin[r]; i < R_.member_begin[r + 1]; ++i) {
+            const OpId o = R_.members[i].second;
+            if (level_[R_.members[i].first] != 0 || op_mark_[o] == epoch_) continue;
+            op_mark_[o] = epoch_;
+            cand_.push_back({0, o});
+          }
+          continue;
+        }
         const OpId o = R_.op[r];
         if (op_mark_[o] == epoch_) continue;
         op_mark_[o] = epoch_;
         cand_.push_back({0, o});
       }
+      std::sort(cand_.begin() + static_cast<std::ptrdiff_t>(batch), cand_.end(),
+                [](const std::pair<uint32_t, OpId>& a, const std::pair<uint32_t, OpId>& b) { return a.second < b.second; });
     }
     for (auto& [d, o] : cand_) {
       const Operator& op = task_.ops[o];
@@ -437,6 +612,7 @@ class LayeredFF : public Heuristic {
     uint32_t unsat, count;
   };
   std::vector<Counter> ctr_;
+  std::vector<uint8_t> group_done_;  ///< merged rop: a member fact was reached
   std::vector<uint32_t> level_, rop_level_;
   std::vector<FactId> facts_;
   std::vector<uint32_t> active_, touched_;

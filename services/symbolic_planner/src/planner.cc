@@ -302,6 +302,8 @@ PlanReply PlanningSession::solve(const Query& q, const Termination& term) {
   reply.stats.ehc_ff_failed = sr.stats.ehc_ff_failed;
   reply.stats.ehc_second_ran = sr.stats.ehc_second_ran;
   reply.stats.ehc_second_won = sr.stats.ehc_second_won;
+  reply.stats.ehc_retries = sr.stats.ehc_retries;
+  reply.stats.ehc_retries_abandoned = sr.stats.ehc_retries_abandoned;
   reply.stats.anytime_iterations = sr.stats.anytime_iterations;
   reply.stats.anytime_improvements = sr.stats.anytime_improvements;
   reply.stats.unit_first_failed = sr.stats.unit_first_failed;

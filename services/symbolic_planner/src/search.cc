@@ -428,6 +428,11 @@ class Searcher {
     std::vector<uint32_t> queue;
     std::vector<OpId> all_ops;
     bool helpful_only = true;
+    // Evaluations a plateau searched again without pruning may use (0 = unbounded).
+    const uint64_t retry_budget =
+        opt_.ehc_retry_budget_share > 0 && fallback_budget_ > 0
+            ? std::max<uint64_t>(1, static_cast<uint64_t>(opt_.ehc_retry_budget_share * static_cast<double>(fallback_budget_)))
+            : 0;
     for (;;) {
       ++iter_;
       queue.clear();
@@ -435,9 +440,16 @@ class Searcher {
       stamp_.resize(reg_.size(), 0);
       stamp_[cur] = iter_;
       uint32_t found = kNone;
+      const uint64_t bfs_evals0 = stats_.evaluated;
       for (size_t head = 0; head < queue.size() && found == kNone; ++head) {
         if (auto st = checkLimits()) return finish(*st);
         if (eval_budget_ > 0 && stats_.evaluated > eval_budget_) return finish(SearchStatus::kFailed);
+        if (!helpful_only && retry_budget > 0 && stats_.evaluated - bfs_evals0 > retry_budget) {
+          // The plateau searched again without helpful-action pruning is too large: treat it as
+          // a failed hill-climbing.
+          ++stats_.ehc_retries_abandoned;
+          return fallback();
+        }
         if (fallback_budget_ > 0 && stats_.evaluated + opt_.ehc_fallback_budget_spent > fallback_budget_) {
           return fallback();
         }
@@ -898,6 +910,8 @@ void addRunCosts(SearchStatistics& into, const SearchStatistics& from) {
   into.expanded += from.expanded;
   into.generated += from.generated;
   into.evaluated += from.evaluated;
+  into.ehc_retries += from.ehc_retries;
+  into.ehc_retries_abandoned += from.ehc_retries_abandoned;
   into.registered_states += from.registered_states;
   into.seconds += from.seconds;
 }
@@ -948,6 +962,10 @@ void SearchOptions::validate() const {
     throw std::invalid_argument("SearchOptions::unit_first_time_share must be in (0, 1], got " +
                                 std::to_string(unit_first_time_share));
   }
+  if (!(ehc_retry_budget_share >= 0.0 && ehc_retry_budget_share <= 1.0)) {
+    throw std::invalid_argument("SearchOptions::ehc_retry_budget_share must be in [0, 1], got " +
+                                std::to_string(ehc_retry_budget_share));
+  }
   if (preferred_boost < 0) {
     throw std::invalid_argument("SearchOptions::preferred_boost must be >= 0, got " + std::to_string(preferred_boost));
   }
@@ -968,6 +986,7 @@ SearchResult firstPlan(const Task& task, const StateBits& init, const Goal& goal
     SearchOptions first = options;
     first.ehc_fallback = false;
     first.ehc_eval_budget_per_h = options.ehc_ff_budget_per_h;
+    if (options.ehc_ff_first_improvement) first.ehc_best_sibling = false;
     SearchResult r1;
     try {
       Searcher s1(task, init, goal, first, heuristic, term);

@@ -1,6 +1,7 @@
 // Contract suite over every heuristic: h(goal) = 0, h >= 0, dead ends, admissibility of h_max.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 #include "tamp/symbolic_planner/heuristic.h"
@@ -84,6 +85,56 @@ INSTANTIATE_TEST_SUITE_P(
     All, HeuristicContract,
     ::testing::Combine(::testing::Values(HeuristicKind::kFF, HeuristicKind::kAdd, HeuristicKind::kMax, HeuristicKind::kBlind),
                        ::testing::Values(CostType::kUnit, CostType::kCost, CostType::kPlusOne)));
+
+TEST(Heuristic, OperatorsThatDifferInOnePreconditionGiveTheRelaxedPlanAndHelpfulActionsOfEach) {
+  // go-x (x = a, b, c) moves from x to g: the same add, one precondition each (h_FF's layered
+  // graph merges them into one relaxed operator with a disjunctive precondition); walk moves
+  // from w to a; open needs g. Goal: k. Whatever the merging, h_FF counts the concrete operators
+  // and the helpful actions are the applicable ones.
+  Task t;
+  t.fact_names = {"(at a)", "(at b)", "(at c)", "(at g)", "(at w)", "(k)"};
+  t.complement.assign(t.fact_names.size(), -1);
+  auto op = [&](const char* name, std::vector<FactId> pre, std::vector<FactId> add, std::vector<FactId> del) {
+    Operator o;
+    o.name = name;
+    o.pre = std::move(pre);
+    o.add = std::move(add);
+    o.del = std::move(del);
+    t.ops.push_back(o);
+  };
+  op("(go-a)", {0}, {3}, {0});  // 0
+  op("(go-b)", {1}, {3}, {1});  // 1
+  op("(go-c)", {2}, {3}, {2});  // 2
+  op("(walk)", {4}, {0}, {4});  // 3
+  op("(open)", {3}, {5}, {});   // 4
+  t.finalize();
+  Goal goal;
+  goal.conjuncts.push_back(GoalConjunct{{5}, {}});
+  auto sorted = [](std::vector<OpId> v) {
+    std::sort(v.begin(), v.end());
+    return v;
+  };
+  auto h = makeHeuristic(HeuristicKind::kFF, t, CostType::kUnit);
+  h->setGoal(goal);
+  for (bool ff_style : {false, true}) {
+    ASSERT_TRUE(h->setFFStyle(ff_style));
+    for (FactId at : {0U, 1U, 2U}) {  // at a, b or c: go-x then open
+      StateBits s(t.numWords(), 0);
+      setBit(s.data(), at);
+      EXPECT_EQ(h->evaluate(s.data()), 2) << at;
+      EXPECT_EQ(h->preferred(), std::vector<OpId>{at}) << at << " " << ff_style;
+    }
+    StateBits w(t.numWords(), 0);
+    setBit(w.data(), 4);  // at w: walk, go-a, open (the member's own precondition is a sub-goal)
+    EXPECT_EQ(h->evaluate(w.data()), 3);
+    EXPECT_EQ(h->preferred(), std::vector<OpId>{3});
+    StateBits ac(t.numWords(), 0);
+    setBit(ac.data(), 0);
+    setBit(ac.data(), 2);  // at a and at c: go-a or go-c, then open; both helpful
+    EXPECT_EQ(h->evaluate(ac.data()), 2);
+    EXPECT_EQ(sorted(h->preferred()), (std::vector<OpId>{0, 2}));
+  }
+}
 
 TEST(Heuristic, RelaxedDeadEndProvesUnsolvable) {
   const std::string dom = R"((define (domain d) (:predicates (a) (b) (g))

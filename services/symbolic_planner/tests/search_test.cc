@@ -189,6 +189,48 @@ TEST(Search, LazySearchWithAndWithoutLandmarksAndEhcFallbackBudgetGiveCheckedPla
   }
 }
 
+TEST(Search, EhcPlateauSearchedAgainWithoutPruningIsBoundedByItsShareOfTheBudget) {
+  // psr-small-40: the helpful actions exhaust a plateau, and searched again with every action the
+  // plateaus are large (tens of thousands of evaluations). Bounded, the hill-climbing gives up
+  // on the first such plateau and the plan comes from the complete search; unbounded, it
+  // wanders until the whole fallback budget is spent. Both plans are replayed by the checker.
+  const auto dir = test::benchmarksDir() / "pddl-more/psr-small/instance-40";
+  PlanRequest req;
+  req.domain_text = test::readFile(dir / "domain.pddl");
+  req.problem_text = test::readFile(dir / "instance-40.pddl");
+  req.timeout_seconds = 120;
+  PlanReply bounded = plan(req, Termination());
+  ASSERT_EQ(bounded.status, PlanStatus::kSolved) << bounded.message;
+  EXPECT_GE(bounded.stats.ehc_retries_abandoned, 1U);
+  EXPECT_TRUE(bounded.stats.ehc_failed);
+  req.search.ehc_retry_budget_share = 0;
+  PlanReply unbounded = plan(req, Termination());
+  ASSERT_EQ(unbounded.status, PlanStatus::kSolved) << unbounded.message;
+  EXPECT_EQ(unbounded.stats.ehc_retries_abandoned, 0U);
+  EXPECT_GE(unbounded.stats.ehc_retries, 1U);
+  EXPECT_TRUE(unbounded.stats.ehc_failed);  // out of the fallback budget instead
+  EXPECT_GT(unbounded.stats.evaluated, bounded.stats.evaluated);
+}
+
+TEST(Search, EhcFirstRunContinuesFromTheFirstBetterState) {
+  // openstacks-12: the first run (FF-v2.3 variant) solves it; continuing from the first better
+  // state instead of evaluating every sibling needs fewer evaluations. Both plans are checked.
+  const auto dir = test::benchmarksDir() / "pddl-more/openstacks";
+  PlanRequest req;
+  req.domain_text = test::readFile(dir / "domain.pddl");
+  req.problem_text = test::readFile(dir / "instance-12.pddl");
+  req.timeout_seconds = 120;
+  req.search.ehc_ff_first_improvement = true;
+  PlanReply first = plan(req, Termination());
+  ASSERT_EQ(first.status, PlanStatus::kSolved) << first.message;
+  EXPECT_FALSE(first.stats.ehc_ff_failed);
+  req.search.ehc_ff_first_improvement = false;  // the default
+  PlanReply best = plan(req, Termination());
+  ASSERT_EQ(best.status, PlanStatus::kSolved) << best.message;
+  EXPECT_FALSE(best.stats.ehc_ff_failed);
+  EXPECT_LT(first.stats.evaluated, best.stats.evaluated);
+}
+
 TEST(Search, AnytimePhaseNeverReturnsADearerPlanAndEndsOptimalOnASmallTask) {
   // The cost trap of AstarIsCostOptimalAndWastarWithinItsBound: whatever the first plan, the
   // bounded iterations exhaust the small space and end at the optimum (cost 4).
@@ -304,6 +346,12 @@ TEST(Search, OptionsAreValidated) {
     EXPECT_THROW(o.validate(), std::invalid_argument) << bad;
   }
   o.unit_first_time_share = 1.0;
+  EXPECT_NO_THROW(o.validate());
+  for (double bad : {-0.1, 1.5, std::nan("")}) {
+    o.ehc_retry_budget_share = bad;
+    EXPECT_THROW(o.validate(), std::invalid_argument) << bad;
+  }
+  o.ehc_retry_budget_share = 0;  // unbounded
   EXPECT_NO_THROW(o.validate());
   EXPECT_EQ(parseSearchAlgorithm("astar"), SearchAlgorithm::kAstar);
   EXPECT_EQ(parseSearchAlgorithm("lazy"), SearchAlgorithm::kLazy);

@@ -84,6 +84,8 @@ struct PlanStatistics {
   bool ehc_ff_failed{false};  ///< the first EHC run (FF-v2.3 heuristic variant) failed; see SearchOptions
   bool ehc_second_ran{false};  ///< the default EHC also ran after the first run's long plan; see SearchOptions
   bool ehc_second_won{false};  ///< ... and its plan was the cheaper one
+  uint64_t ehc_retries{0};  ///< plateaus searched again without helpful-action pruning (every run)
+  uint64_t ehc_retries_abandoned{0};  ///< ... given up at SearchOptions::ehc_retry_budget_share
   uint64_t anytime_iterations{0};    ///< SearchOptions::anytime_seconds: iterations run
   uint64_t anytime_improvements{0};  ///< ... that found a cheaper plan
   bool unit_first_failed{false};  ///< the unit-cost first run failed; see SearchOptions::unit_cost_first

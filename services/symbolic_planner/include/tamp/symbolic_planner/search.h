@@ -63,6 +63,11 @@ struct SearchOptions {
   /// ehc: when the breadth-first search over helpful actions exhausts a plateau, search it again
   /// with all applicable actions before falling back (FF gives up at once).
   bool ehc_full_retry{true};
+  /// ehc: that search again may use at most this share of the hill-climbing's fallback budget
+  /// (`ehc_fallback_budget_*`) in evaluations; past it, hill-climbing counts as failed and the
+  /// complete search starts (a plateau too large without pruning is where hill-climbing
+  /// wanders). 0 = unbounded; must be in [0, 1]. Unbounded when the fallback budget is.
+  double ehc_retry_budget_share{0.1};
   /// ehc: when a better state is found, evaluate the remaining successors of the same node and
   /// continue from the best (FF continues from the first).
   bool ehc_best_sibling{true};
@@ -70,6 +75,11 @@ struct SearchOptions {
   /// `ehc_ff_budget_per_h` evaluations per unit of the initial state's h (0 disables the first run).
   bool ehc_ff_first{true};
   uint64_t ehc_ff_budget_per_h{300};
+  /// ehc: that first run continues from the first better state, as FF does, whatever
+  /// `ehc_best_sibling` says (which then applies to the default run only): 2-6x fewer
+  /// evaluations on many domains, but the first run then fails on maintenance-4, which only the
+  /// first run with the best sibling solves (docs/benchmarks.md, issue 14, fifth round): off.
+  bool ehc_ff_first_improvement{false};
   /// ehc: give up (kFailed, no fallback) after this many evaluations per unit of the initial
   /// state's h (at least 2 units; with the goal agenda, h of the first entry); 0 = unlimited.
   uint64_t ehc_eval_budget_per_h{0};
@@ -153,6 +163,7 @@ struct SearchStatistics {
   bool ehc_second_ran{false};
   bool ehc_second_won{false};
   uint64_t ehc_retries{0};  ///< plateaus searched again without helpful-action pruning
+  uint64_t ehc_retries_abandoned{0};  ///< ... given up at `ehc_retry_budget_share`
   uint64_t landmarks{0};    ///< lazy: number of fact landmarks found (0: landmark count not used)
   uint64_t eliminated_actions{0};  ///< removed by action elimination
   uint64_t anytime_iterations{0};    ///< weighted A* iterations of the anytime phase

@@ -57,57 +57,60 @@ json toJson(const MissionRecord& r) {
               {"in_flight_budget_s", r.in_flight_budget_s}};
 }
 
-/// Reads field `key` of `j` into `out`; the error names the file and the field.
-template <typename T>
-Status field(const json& j, const std::string& key, T& out, const std::filesystem::path& file, const std::string& where) {
-  const std::string name = where.empty() ? key : where + "." + key;
-  if (!j.contains(key))
-    return Error(ErrorCode::kParseError, "missing field", SourceLocation{file.string(), 0, 0, name});
-  try {
-    out = j.at(key).get<T>();
-  } catch (const json::exception& e) {
-    return Error(ErrorCode::kParseError, std::string("wrong type: ") + e.what(), SourceLocation{file.string(), 0, 0, name});
+/// Reads fields of one JSON object in turn; the first error (naming the file and the field) is
+/// kept and the later reads are skipped.
+class FieldReader {
+ public:
+  FieldReader(const json& j, const std::filesystem::path& file, std::string where)
+      : j_(j), file_(file), where_(std::move(where)) {}
+  template <typename T>
+  FieldReader& get(const std::string& key, T& out) {
+    if (!status_) return *this;
+    const std::string name = where_.empty() ? key : where_ + "." + key;
+    if (!j_.contains(key)) {
+      status_ = Error(ErrorCode::kParseError, "missing field", SourceLocation{file_.string(), 0, 0, name});
+      return *this;
+    }
+    try {
+      out = j_.at(key).get<T>();
+    } catch (const json::exception& e) {
+      status_ = Error(ErrorCode::kParseError, std::string("wrong type: ") + e.what(),
+                      SourceLocation{file_.string(), 0, 0, name});
+    }
+    return *this;
   }
-  return Status::Ok();
-}
+  const Status& status() const { return status_; }
+
+ private:
+  const json& j_;
+  const std::filesystem::path& file_;
+  std::string where_;
+  Status status_ = Status::Ok();
+};
 
 Result<MissionRecord> fromJson(const json& j, const std::filesystem::path& file) {
   MissionRecord r;
   std::string format;
-  if (Status s = field(j, "format", format, file, ""); !s) return s.error();
+  if (Status s = FieldReader(j, file, "").get("format", format).status(); !s) return s.error();
   if (format != "tamp-mission-journal-1")
     return Error(ErrorCode::kParseError, "unknown journal format '" + format + "'", SourceLocation{file.string(), 0, 0, "format"});
-  Status s = field(j, "mission_id", r.mission_id, file, "");
-  if (s) s = field(j, "scenario_path", r.scenario_path, file, "");
-  if (s) s = field(j, "policy", r.policy, file, "");
-  if (s) s = field(j, "seed", r.seed, file, "");
-  if (s) s = field(j, "max_replans", r.max_replans, file, "");
-  if (s) s = field(j, "goal", r.goal, file, "");
-  if (s) s = field(j, "finished", r.finished, file, "");
-  if (s) s = field(j, "outcome", r.outcome, file, "");
-  if (s) s = field(j, "reason", r.reason, file, "");
-  if (s) s = field(j, "resumptions", r.resumptions, file, "");
-  if (s) s = field(j, "in_flight", r.in_flight, file, "");
-  if (s) s = field(j, "in_flight_action", r.in_flight_action, file, "");
-  if (s) s = field(j, "in_flight_budget_s", r.in_flight_budget_s, file, "");
-  if (!s) return s.error();
+  FieldReader f(j, file, "");
+  f.get("mission_id", r.mission_id).get("scenario_path", r.scenario_path).get("policy", r.policy).get("seed", r.seed);
+  f.get("max_replans", r.max_replans).get("goal", r.goal).get("finished", r.finished).get("outcome", r.outcome);
+  f.get("reason", r.reason).get("resumptions", r.resumptions).get("in_flight", r.in_flight);
+  f.get("in_flight_action", r.in_flight_action).get("in_flight_budget_s", r.in_flight_budget_s);
+  if (!f.status()) return f.status().error();
   if (r.mission_id.empty())
     return Error(ErrorCode::kParseError, "empty mission id", SourceLocation{file.string(), 0, 0, "mission_id"});
   if (!j.contains("actions") || !j["actions"].is_array())
     return Error(ErrorCode::kParseError, "missing or not a list", SourceLocation{file.string(), 0, 0, "actions"});
   for (std::size_t i = 0; i < j["actions"].size(); ++i) {
-    const json& a = j["actions"][i];
-    const std::string where = "actions[" + std::to_string(i) + "]";
     ExecutedAction x;
-    Status t = field(a, "command_id", x.command_id, file, where);
-    if (t) t = field(a, "action", x.action, file, where);
-    if (t) t = field(a, "variant", x.variant, file, where);
-    if (t) t = field(a, "predicted_s", x.predicted_s, file, where);
-    if (t) t = field(a, "predicted_stddev_s", x.predicted_stddev_s, file, where);
-    if (t) t = field(a, "measured_s", x.measured_s, file, where);
-    if (t) t = field(a, "outcome", x.outcome, file, where);
-    if (t) t = field(a, "reason", x.reason, file, where);
-    if (!t) return t.error();
+    FieldReader a(j["actions"][i], file, "actions[" + std::to_string(i) + "]");
+    a.get("command_id", x.command_id).get("action", x.action).get("variant", x.variant).get("predicted_s", x.predicted_s);
+    a.get("predicted_stddev_s", x.predicted_stddev_s).get("measured_s", x.measured_s).get("outcome", x.outcome);
+    a.get("reason", x.reason);
+    if (!a.status()) return a.status().error();
     r.actions.push_back(std::move(x));
   }
   return r;

@@ -59,7 +59,7 @@ int GraphManager::buildContingencies(const std::vector<EdgeId>& plan) {
     c.observation = "gripper not empty";
     c.placeholder = ph;
     c.branch = graph_.addNode(atoms, "conditional: gripper not empty at n" + std::to_string(n));
-    const std::vector<std::string>& from = graph_.node(c.branch).atoms;
+    const std::vector<std::string> from = graph_.node(c.branch).atoms;  // a copy: planning grows the graph
     // Put it down, then re-join the plan with the hand empty: at the state before the next pick
     // (or the end) and the ones before it, back to this node, at most `max_rejoin_targets`.
     std::size_t last = k + 1;

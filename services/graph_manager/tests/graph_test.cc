@@ -21,6 +21,26 @@ TEST(GraphTest, EqualStatesAreOneNodeAndPlansMergeWhereTheyMeet) {
   EXPECT_EQ(g.edge(p1[0]).tokens, (std::vector<std::string>{"move_base", "a", "c"}));
 }
 
+// Traverse and the conditional branches hold a node's atoms or an edge while they plan sub-tasks
+// that grow the graph (a graph manager crashed on occluded_can when this did not hold).
+TEST(GraphTest, ReferencesToNodesAndEdgesStayValidWhileTheGraphGrows) {
+  ReachabilityGraph g;
+  auto first = g.addPlan({"(move_base l0 l1)"}, {{"(robot-at l0)"}, {"(robot-at l1)"}}, "plan 0");
+  const Node& n0 = g.node(g.edge(first[0]).from);
+  const Edge& e0 = g.edge(first[0]);
+  const std::vector<std::string>* atoms = &n0.atoms;
+  for (int i = 1; i < 2000; ++i) {
+    const std::string a = "l" + std::to_string(i), b = "l" + std::to_string(i + 1);
+    g.addPlan({"(move_base " + a + " " + b + ")"}, {{"(robot-at " + a + ")"}, {"(robot-at " + b + ")"}}, "grow");
+  }
+  ASSERT_EQ(g.nodes().size(), 2001u);
+  EXPECT_EQ(&g.node(g.edge(first[0]).from), &n0);
+  EXPECT_EQ(&g.edge(first[0]), &e0);
+  EXPECT_EQ(&g.node(g.edge(first[0]).from).atoms, atoms);
+  EXPECT_EQ(e0.action, "(move_base l0 l1)");
+  EXPECT_EQ(n0.atoms, (std::vector<std::string>{"(robot-at l0)"}));
+}
+
 TEST(GraphTest, AtomOrderDoesNotMatter) {
   ReachabilityGraph g;
   const NodeId a = g.addNode({"(b)", "(a)"}, "x");

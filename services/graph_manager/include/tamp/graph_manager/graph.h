@@ -6,6 +6,7 @@
 /// states are one node, so plans found from different places merge where they meet.
 
 #include <cstdint>
+#include <deque>
 #include <limits>
 #include <map>
 #include <optional>
@@ -109,8 +110,8 @@ class ReachabilityGraph {
   Node& node(NodeId id) { return nodes_.at(static_cast<std::size_t>(id)); }
   const Edge& edge(EdgeId id) const { return edges_.at(static_cast<std::size_t>(id)); }
   Edge& edge(EdgeId id) { return edges_.at(static_cast<std::size_t>(id)); }
-  const std::vector<Node>& nodes() const { return nodes_; }
-  const std::vector<Edge>& edges() const { return edges_; }
+  const std::deque<Node>& nodes() const { return nodes_; }
+  const std::deque<Edge>& edges() const { return edges_; }
   /// Out-edges of a node, in insertion order.
   const std::vector<EdgeId>& out(NodeId n) const;
   std::uint64_t version() const { return version_; }
@@ -119,8 +120,10 @@ class ReachabilityGraph {
   std::string toDot(const std::vector<EdgeId>& chosen, NodeId current) const;
 
  private:
-  std::vector<Node> nodes_;
-  std::vector<Edge> edges_;
+  // Deques: a reference to a node or an edge stays valid while the graph grows (Traverse and the
+  // conditional branches hold them across sub-task insertions).
+  std::deque<Node> nodes_;
+  std::deque<Edge> edges_;
   std::map<std::vector<std::string>, NodeId> index_;
   std::map<NodeId, std::vector<EdgeId>> out_;
   std::uint64_t version_{0};

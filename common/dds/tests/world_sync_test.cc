@@ -149,5 +149,33 @@ TEST(WorldSyncTest, VersionIsHeldOnlyWhenEveryObjectOfTheManifestHasArrived) {
   EXPECT_EQ(mirror.snapshot().findObject("can"), nullptr);
 }
 
+// A service that joins late (a restarted graph manager) must assemble the world even when objects
+// were removed before it joined, from another participant, many times over.
+TEST(WorldSyncTest, ALateJoinerAssemblesAWorldFromWhichObjectsWereRemoved) {
+  auto pp = testing::makeParticipant();
+  ASSERT_TRUE(pp);
+  WorldPublisher pub(pp);
+  world::World w = sampleWorld();
+  ASSERT_TRUE(pub.publish(w).ok());
+  for (int i = 0; i < 20; ++i) {
+    world::Object o = w.object("can");
+    o.id = "track_" + std::to_string(i);
+    o.pose.translation().y() += 0.1 * i;
+    ASSERT_TRUE(w.addObject(o).ok());
+    ASSERT_TRUE(pub.publish(w).ok());
+    if (i % 2 == 0) {
+      ASSERT_TRUE(w.removeObject(o.id).ok());
+      ASSERT_TRUE(pub.publish(w).ok());
+    }
+  }
+  for (int round = 0; round < 5; ++round) {
+    auto pm = testing::makeParticipant();
+    ASSERT_TRUE(pm);
+    WorldMirror mirror(pm);
+    ASSERT_TRUE(mirror.waitForPublishedVersion(w.version(), Termination::after(10.0))) << "round " << round;
+    EXPECT_EQ(mirror.snapshot().objectCount(), w.objectCount()) << "round " << round;
+  }
+}
+
 }  // namespace
 }  // namespace tamp::dds

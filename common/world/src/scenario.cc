@@ -931,13 +931,16 @@ Result<Scenario> parseScenarioImpl(const std::string& yaml_text, const std::stri
       f.ignore("object");
       if (f.has("object")) f.fail("object", "only for object_appears");
     }
-    if (f.optional("action", fault.action) && fault.kind == FaultKind::kActionFails) {
+    const bool filtered = fault.kind == FaultKind::kActionFails || fault.kind == FaultKind::kDropHeld;
+    if (f.optional("action", fault.action) && filtered) {
       if (!actionKindFromString(fault.action)) {
         f.fail("action", "unknown action '" + fault.action +
                              "' (expected move_base, move_arm, pick or place)");
+      } else if (fault.kind == FaultKind::kDropHeld && !fault.at_step) {
+        f.fail("action", "a drop waits for an action of a kind only with at_step");
       }
     } else if (!fault.action.empty()) {
-      f.fail("action", "only for action_fails");
+      f.fail("action", "only for action_fails and drop_held");
     }
     f.refuseUnknownKeys();
     sc.faults.push_back(std::move(fault));

@@ -52,6 +52,12 @@ Status Fault::validate(bool scripted) const {
   if (!(trigger.fraction >= 0.0 && trigger.fraction <= 1.0)) {
     return invalid("trigger.fraction", "must be in [0, 1], got " + std::to_string(trigger.fraction));
   }
+  if (action && type != FaultType::kFailAction && type != FaultType::kDropHeldObject) {
+    return invalid("action", "only for a failing action or a drop");
+  }
+  if (scripted && action && type == FaultType::kDropHeldObject && !trigger.step) {
+    return invalid("action", "a drop waits for an action of a kind only with a step trigger");
+  }
   if (type == FaultType::kSpawnObject) {
     if (auto why = object.invalidReason()) return invalid("object", *why);
   }

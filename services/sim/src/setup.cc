@@ -48,6 +48,13 @@ Result<std::vector<Fault>> scenarioFaults(const world::Scenario& scenario) {
     switch (sf.kind) {
       case world::FaultKind::kDropHeld:
         f.type = FaultType::kDropHeldObject;
+        if (!sf.action.empty()) {
+          f.action = actionKindFromString(sf.action);
+          if (!f.action) {
+            return Error(ErrorCode::kInvalidArgument, field + ": unknown action kind '" + sf.action + "'",
+                         SourceLocation{scenario.file.string(), 0, 0, field + ".action"});
+          }
+        }
         break;
       case world::FaultKind::kObjectAppears:
         f.type = FaultType::kSpawnObject;

@@ -1153,7 +1153,15 @@ Status Simulator::submit(const ActionCommand& command) {
   a.start = m.now;
   for (std::size_t i = 0; i < m.scripted.size(); ++i) {
     const Fault& f = m.scripted[i];
-    if (m.fired[i] || f.trigger.step != a.step) continue;
+    if (m.fired[i] || !f.trigger.step) continue;
+    if (f.type == FaultType::kDropHeldObject && f.action) {
+      // Waits for the first carrying action of its kind (an action that ended before it fired
+      // leaves it waiting for the next one).
+      if (*f.trigger.step <= a.step && *f.action == a.cmd.kind && m.world.held())
+        a.faults.push_back({i, f.trigger.fraction * a.total});
+      continue;
+    }
+    if (f.trigger.step != a.step) continue;
     if (f.type == FaultType::kFailAction && f.action && *f.action != a.cmd.kind) {
       m.fired[i] = true;  // another kind: the first matching action from here on fails
       m.pending_fails.push_back(f);

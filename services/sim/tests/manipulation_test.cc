@@ -279,5 +279,55 @@ TEST(ManipulationTest, ScriptedDropDuringACarryPutsTheObjectOnTheFloor) {
   EXPECT_EQ(e.results[0].blocking_object_id, "can");
 }
 
+// "It slips while carried": a drop filtered by action kind waits for the first action of that kind
+// that starts with something in the gripper (a move_base with an empty gripper does not count).
+TEST(ManipulationTest, ADropFilteredByActionWaitsForTheFirstCarryingActionOfThatKind) {
+  Fault drop;
+  drop.id = "slip";
+  drop.type = FaultType::kDropHeldObject;
+  drop.trigger.step = 0;
+  drop.trigger.fraction = 0.6;
+  drop.action = ActionKind::kMoveBase;
+  Simulator sim(kitchen(), robotModel(), upright(), exactParams(), {drop});
+  // Step 0: a move_base with an empty gripper (a turn there and back): no drop.
+  ASSERT_TRUE(sim.submit(moveBase("turn", {{0, 0, 0}, {0, 0, 0.3}, {0, 0, 0}})));
+  StepEvents e = runToEnd(sim);
+  ASSERT_EQ(e.results.at(0).outcome, Outcome::kSucceeded);
+  EXPECT_TRUE(e.faults.empty());
+  const PickSetup ps = pickSetup(sim.world().object("can").pose.translation());
+  moveArmTo(sim, ps.pregrasp, "to_pregrasp");
+  ActionCommand pick = armCommand("pick", ActionKind::kPick, {ps.pregrasp, ps.grasp, ps.pregrasp});
+  pick.object_id = "can";
+  ASSERT_TRUE(sim.submit(pick));
+  e = runToEnd(sim);
+  ASSERT_EQ(e.results.at(0).outcome, Outcome::kSucceeded);
+  EXPECT_TRUE(e.faults.empty()) << "a pick is not a move_base";
+  ASSERT_TRUE(sim.world().held());
+  ASSERT_TRUE(sim.submit(moveBase("carry", {{0, 0, 0}, {0, 0, -M_PI / 2}, {0, -2, -M_PI / 2}})));
+  e = runToEnd(sim);
+  ASSERT_EQ(e.faults.size(), 1u);
+  EXPECT_EQ(e.faults[0].object_id, "can");
+  EXPECT_FALSE(sim.world().held());
+  EXPECT_EQ(sim.world().object("can").region, "floor");
+}
+
+TEST(ManipulationTest, ADropFilteredByActionNeedsAStepTrigger) {
+  Fault drop;
+  drop.type = FaultType::kDropHeldObject;
+  drop.trigger.time_s = 1.0;
+  drop.action = ActionKind::kMoveBase;
+  const Status s = drop.validate(true);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.error().message.find("action"), std::string::npos) << s.error().message;
+  drop.trigger.time_s.reset();
+  drop.trigger.step = 1;
+  EXPECT_TRUE(drop.validate(true).ok());
+  Fault spawn;
+  spawn.type = FaultType::kRemoveObject;
+  spawn.object_id = "can";
+  spawn.action = ActionKind::kPick;
+  EXPECT_FALSE(spawn.validate(false).ok()) << "only failing actions and drops take an action kind";
+}
+
 }  // namespace
 }  // namespace tamp::sim

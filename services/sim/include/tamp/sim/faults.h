@@ -43,6 +43,9 @@ struct Fault {
   std::string object_id;     ///< kRemoveObject: which object
   /// kFailAction: only an action of this kind fails; when the action at the trigger is another
   /// kind (or none runs), the first matching action at or after the trigger fails.
+  /// kDropHeldObject (step trigger only): the drop waits for the first action of this kind, at or
+  /// after the trigger's step, that starts with an object in the gripper ("it slips while
+  /// carried"), and fires at `fraction` of it.
   std::optional<ActionKind> action;
   std::string reason;        ///< free text reported with the failure
 

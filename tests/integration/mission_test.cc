@@ -55,6 +55,26 @@ TEST(MissionTest, CorridorEffortPolicyMovesTheLightBoxAndReachesTheGoal) {
   EXPECT_NEAR(measured, m.report["executed_effort_s"].get<double>(), 1e-6);
 }
 
+// A hall that is one large floor region: the first plan picks the parcel from wherever "reaches"
+// the hall; the grasp service refutes it and the abstraction is refined (the parcel on a slot of
+// its own), so the mission picks it from where the arm reaches it and brings it to the dock.
+TEST(MissionTest, AParcelOnALargeFloorRegionIsPickedWhereTheArmReachesItAndDocked) {
+  const Mission m = run("hall_transport.yaml", {"--policy", "effort"});
+  ASSERT_EQ(m.exit_code, 0) << m.output;
+  ASSERT_TRUE(m.truth.is_object()) << m.output;
+  const auto& box = m.truth["objects"]["box"];
+  EXPECT_GT(box["x"].get<double>(), 6.1) << box.dump();
+  EXPECT_LT(box["x"].get<double>(), 6.8) << box.dump();
+  EXPECT_GT(box["y"].get<double>(), 1.5) << box.dump();
+  EXPECT_LT(box["y"].get<double>(), 2.5) << box.dump();
+  bool picked_from_slot = false;
+  for (const auto& a : m.report["actions"]) {
+    const std::string action = a["action"].get<std::string>();
+    if (action.rfind("(pick box slot_box", 0) == 0) picked_from_slot = true;
+  }
+  EXPECT_TRUE(picked_from_slot) << m.report["actions"].dump(1);
+}
+
 TEST(MissionTest, CorridorInfeasibilityPolicyGoesRoundAndLeavesTheBox) {
   const Mission m = run("namo_corridor.yaml", {"--policy", "infeasible"});
   ASSERT_EQ(m.exit_code, 0) << m.output;

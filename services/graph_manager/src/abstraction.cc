@@ -112,6 +112,33 @@ std::string Abstraction::addSlot(const std::string& object_id, const std::string
   return s.id;
 }
 
+bool Abstraction::isReached(const std::string& armconf) const {
+  const std::string tail = " " + armconf + ")";
+  for (const auto& r : reaches_)
+    if (r.size() > tail.size() && r.compare(r.size() - tail.size(), tail.size(), tail) == 0) return true;
+  return false;
+}
+
+std::vector<std::string> Abstraction::refinedSupports(const std::vector<std::string>& atoms) const {
+  std::vector<std::string> out;
+  out.reserve(atoms.size());
+  for (const auto& a : atoms) {
+    const auto t = atomTokens(a);
+    std::string replaced;
+    if (t.size() == 3 && t[0] == "on" && slots_.count(t[2]) == 0) {
+      if (const world::Object* o = world_.findObject(t[1])) {
+        for (const auto& [id, s] : slots_) {
+          if (s.object_id == t[1] && s.parent_region == t[2] &&
+              (s.pose.translation().head<2>() - o->pose.translation().head<2>()).norm() <= params_.slot_tolerance_m)
+            replaced = "(on " + t[1] + " " + id + ")";
+        }
+      }
+    }
+    out.push_back(replaced.empty() ? a : replaced);
+  }
+  return out;
+}
+
 const Slot* Abstraction::slot(const std::string& id) const {
   auto it = slots_.find(id);
   return it == slots_.end() ? nullptr : &it->second;

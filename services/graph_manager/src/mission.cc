@@ -162,9 +162,26 @@ MissionReport GraphManager::Run::finish(MissionOutcome o, const std::string& rea
   return report;
 }
 
+namespace {
+/// Abstraction refinements in a row before a plan is given up (each adds at least one slot).
+constexpr int kMaxRefinements = 8;
+}  // namespace
+
 bool GraphManager::Run::planBranch(std::string& why) {
   state(attempts ? "replanning" : "planning", "traverse from n" + std::to_string(current));
   TraverseResult t = gm.traverse(current, ctx);
+  // The geometry refuted a region-level reach (a pick from too far on a large region): plan again
+  // from the refined state, where those objects are on slots of their own. Each round adds at
+  // least one slot, so this ends; the bound keeps it short.
+  for (int round = 0; !t.found && round < kMaxRefinements && gm.takeRefinement(); ++round) {
+    const NodeId refined = gm.refinedNode(current);
+    if (refined == current) break;
+    current = refined;
+    if (gm.graph_.out(current).empty() && !gm.isGoal(current)) {
+      if (!gm.planFrom(current, gm.goal_.atoms, "plan after refining the abstraction")) break;
+    }
+    t = gm.traverse(current, ctx);
+  }
   if (!t.found && attempts > 0 && planned_from_scratch.insert(current).second) {
     // Every re-joining branch goes through an action that can no longer be done (it failed too
     // often): the goal from here, from scratch, merged into the graph; Traverse again.

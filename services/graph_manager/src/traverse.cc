@@ -540,7 +540,10 @@ std::optional<EdgeMotion> GraphManager::armTarget(const Edge& arm_edge, EdgeId n
           return m;
         }
       }
-      if (why.empty()) why = "no grasp of " + object + " from the base pose of " + arm_edge.tokens[1];
+      if (why.empty()) {
+        why = "no grasp of " + object + " from the base pose of " + arm_edge.tokens[1];
+        (void)refineSupport(object, region, ctx);
+      }
       return std::nullopt;
     }
     if (alternative >= static_cast<int>(it->second.size())) {
@@ -869,42 +872,9 @@ void GraphManager::spawnSubtasks(EdgeId id, const BranchContext& ctx, int depth)
     }
     ++objects;
     // A base pose beside the object from which the arm reaches it, on the side the robot comes
-    // from: back from where the lazy path first touches the object, facing it; the grasp
-    // service's own samples only when none of those reaches.
+    // from: back from where the lazy path first touches the object.
     const Pose2D entry = crossing.swept_base.empty() ? ctx.state.base : crossing.swept_base.front();
-    const Eigen::Vector2d oc = o->pose.translation().head<2>();
-    Eigen::Vector2d away = Eigen::Vector2d(entry.x, entry.y) - oc;
-    if (away.norm() < 1e-6) away = Eigen::Vector2d(ctx.state.base.x, ctx.state.base.y) - oc;
-    if (away.norm() < 1e-6) away = Eigen::Vector2d(-1.0, 0.0);
-    away.normalize();
-    std::optional<GraspOption> chosen;
-    for (double d : {0.60, 0.70, 0.50, 0.80}) {
-      const Eigen::Vector2d b = oc + d * away;
-      GraspQuery gq;
-      gq.object_id = o->id;
-      gq.base = Pose2D{b.x(), b.y(), std::atan2(-away.y(), -away.x())};
-      ++counters_.grasp_calls;
-      auto g = services_.grasps(gq);
-      if (g && !g->empty()) {
-        chosen = g->front();
-        chosen->base_pose = *gq.base;
-        break;
-      }
-    }
-    if (!chosen) {
-      GraspQuery gq;
-      gq.object_id = o->id;
-      gq.max_grasps = 8;
-      ++counters_.grasp_calls;
-      auto g = services_.grasps(gq);
-      if (g) {
-        for (const auto& x : *g) {
-          if (!chosen || std::hypot(x.base_pose.x - entry.x, x.base_pose.y - entry.y) <
-                             std::hypot(chosen->base_pose.x - entry.x, chosen->base_pose.y - entry.y))
-            chosen = x;
-        }
-      }
-    }
+    const std::optional<GraspOption> chosen = standBeside(*o, entry, ctx.state.base);
     if (!chosen) {
       log::get("graph_manager")->info("no grasp of {} from any base pose: only the detour remains", o->id);
       unmovable.push_back("no grasp of '" + o->id + "' from any base pose");

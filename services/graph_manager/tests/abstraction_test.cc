@@ -52,6 +52,38 @@ TEST(AbstractionTest, ACurrentBasePoseAwayFromEveryLocationBecomesALocation) {
   EXPECT_TRUE(has(at_start, "(robot-at start)"));
 }
 
+// A large floor region is "reached" from every base pose, the parcel on it only from near_box: a
+// slot at the parcel's pose carries the object-level reach facts (the lazy refinement).
+TEST(AbstractionTest, AnObjectOnALargeRegionRefinedToASlotIsReachedOnlyWhereTheArmReachesIt) {
+  auto f = load("hall_transport");
+  Abstraction a(f.sc.plannerWorld(), f.robot);
+  const auto statics = a.staticAtoms();
+  EXPECT_TRUE(has(statics, "(reaches near_box over_hall)"));
+  EXPECT_TRUE(has(statics, "(reaches near_dock over_hall)")) << "the region-level fact the refinement corrects";
+  const auto atoms = a.dynamicAtoms(f.sc.plannerWorld(), f.sc.robot.start, "stow", "");
+  ASSERT_TRUE(has(atoms, "(on box hall)"));
+  EXPECT_EQ(a.refinedSupports(atoms), atoms) << "no slot yet: nothing to refine";
+  const std::string s = a.addSlot("box", "hall", f.sc.world.object("box").pose);
+  EXPECT_FALSE(has(a.staticAtoms(), "(reaches near_dock " + Abstraction::armconfOver(s) + ")"));
+  EXPECT_FALSE(has(a.staticAtoms(), "(reaches start " + Abstraction::armconfOver(s) + ")"));
+  // The graph manager adds the stand a grasp proves (GraphManager::standBeside).
+  if (!a.isReached(Abstraction::armconfOver(s))) a.addReach("near_box", Abstraction::armconfOver(s));
+  EXPECT_TRUE(a.isReached(Abstraction::armconfOver(s)));
+  EXPECT_TRUE(has(a.staticAtoms(), "(reaches near_box " + Abstraction::armconfOver(s) + ")"));
+  const auto refined = a.refinedSupports(atoms);
+  EXPECT_TRUE(has(refined, "(on box " + s + ")"));
+  EXPECT_FALSE(has(refined, "(on box hall)"));
+  EXPECT_EQ(refined.size(), atoms.size());
+  // The parcel moved away from the slot: its region again.
+  world::World moved = f.sc.plannerWorld();
+  Eigen::Isometry3d pose = moved.object("box").pose;
+  pose.translation().x() += 1.0;
+  ASSERT_TRUE(moved.setObjectPose("box", pose).ok());
+  a.setWorld(moved);
+  EXPECT_EQ(a.refinedSupports(atoms), atoms);
+  EXPECT_FALSE(a.isReached("over_nowhere"));
+}
+
 TEST(AbstractionTest, ASlotIsARegionWithItsOwnConfigurationAndBindsTheObjectPose) {
   auto f = load("namo_corridor");
   Abstraction a(f.sc.plannerWorld(), f.robot);

@@ -82,6 +82,12 @@ class Abstraction {
   std::string addSlot(const std::string& object_id, const std::string& parent_region,
                       const Eigen::Isometry3d& pose);
   const Slot* slot(const std::string& id) const;
+  std::size_t slotCount() const { return slots_.size(); }
+  /// Whether some location reaches `armconf`.
+  bool isReached(const std::string& armconf) const;
+  /// `atoms` with every `(on o r)` whose object stands on a slot of r (within slot_tolerance_m,
+  /// in the current world) replaced by `(on o slot)`.
+  std::vector<std::string> refinedSupports(const std::vector<std::string>& atoms) const;
   /// Records that from `location` the arm reaches `armconf` (proved by a grasp or IK elsewhere).
   void addReach(const std::string& location, const std::string& armconf);
   /// True when the region or slot `id` exists.

@@ -295,6 +295,23 @@ class GraphManager {
   /// The key of an arm edge's motion: the manipulation `next` it prepares, or -1 (stow, none).
   EdgeId armKey(EdgeId arm, EdgeId next) const;
 
+  // ---- abstraction refinement (refine.cc) ----
+  /// `(reaches l over_r)` says that the arm reaches some of region r from l, not every object on
+  /// it: on a large region (a hall floor) a plan may pick an object from a base pose too far from
+  /// it. When the grasp service refutes such a pick, the object gets a slot of its own at its pose
+  /// (reached only where inverse kinematics says so): a lazy refinement of the abstraction, made
+  /// only where the geometry disagrees with it. True when a slot was added.
+  bool refineSupport(const std::string& object, const std::string& region, const BranchContext& ctx);
+  /// The node of `n`'s state with the refined objects on their slots (`n` itself when none
+  /// applies). Planning from it sees the object-level reach facts.
+  NodeId refinedNode(NodeId n);
+  /// Whether a refinement happened since the last call (and clears it).
+  bool takeRefinement();
+  /// A base pose beside `o` from which the arm grasps it, facing it from the side of `entry`
+  /// (`fallback` when `entry` is on the object): 0.5-0.8 m back first, else the grasp service's
+  /// own samples nearest to `entry`. None when no base pose reaches it.
+  std::optional<GraspOption> standBeside(const world::Object& o, const Pose2D& entry, const Pose2D& fallback);
+
  private:
   struct Search;
   struct Run;
@@ -361,6 +378,7 @@ class GraphManager {
   int failuresOf(const Edge& e) const;
   void noteFailure(Edge& e);
   std::map<std::string, int> manipulation_failures_;
+  bool refined_{false};  ///< refineSupport added a slot since takeRefinement()
   Belief belief_;
   std::vector<Contingency> contingencies_;
   /// Copies the edges `ahead[first..]`, which leave `target`, into states that also hold

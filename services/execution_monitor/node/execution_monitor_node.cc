@@ -449,6 +449,7 @@ void ExecutionMonitorNode::onRecord(const msg::ExecutionRecord& m) {
 
 void ExecutionMonitorNode::onRecordAck(const msg::RecordAck& m) {
   try {
+    if (!msgv::accept(m, dds::topics::kRecordAcks.name, rejects_)) return;
     std::lock_guard lock(records_mu_);
     if (!outbox_.acknowledge(m.record_id())) return;  // a repeat, or not ours
     if (!m.stored()) {

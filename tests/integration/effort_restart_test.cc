@@ -101,8 +101,9 @@ class EffortRestartTest : public ::testing::Test {
 
 // The root of the matrix failure: a restarted service is not reachable through shared memory
 // while its peers still hold the killed process (until its 5 s lease ends), when it took over the
-// killed process's transport ports. Once the restarted estimator says it is up (its heartbeat),
-// a call resent every 0.25 s is answered within 1.5 s (before the fix: ~4 s, at the lease's end).
+// killed process's transport ports. Restarted 0.5 s after the kill, the estimator's heartbeat
+// reaches the client and a call resent every 0.25 s is answered within 2 s of the kill (with the
+// ports taken over: its heartbeat came 2.6 s and 4.6 s after the kill; now ~0.75 s).
 TEST_F(EffortRestartTest, ARestartedEstimatorIsReachableAsSoonAsItIsUp) {
   std::mutex m;
   std::condition_variable cv;
@@ -129,13 +130,13 @@ TEST_F(EffortRestartTest, ARestartedEstimatorIsReachableAsSoonAsItIsUp) {
   }
   const auto up = Clock::now();
   auto rep = client.call(pickQuery(), dds::CallOptions{kEffortDeadlineS, {}});
-  const double took = std::chrono::duration<double>(Clock::now() - up).count();
   const double up_after = std::chrono::duration<double>(up - killed).count();
+  const double answered_after = std::chrono::duration<double>(Clock::now() - killed).count();
   ASSERT_TRUE(rep.ok()) << rep.error().toString();
-  EXPECT_LT(took, 1.5) << "answered " << took << " s after the restarted estimator was up (" << up_after
-                       << " s after the kill)";
+  EXPECT_LT(answered_after, 2.0) << "its heartbeat came " << up_after << " s after the kill, the answer "
+                                 << answered_after << " s after it";
   if (std::getenv("TAMP_RESTART_DEBUG") != nullptr) {
-    std::cerr << "up " << up_after << " s after the kill, answered " << took << " s later\n";
+    std::cerr << "up " << up_after << " s after the kill, answered " << answered_after << " s after it\n";
   }
 }
 

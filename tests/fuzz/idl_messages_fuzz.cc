@@ -57,6 +57,7 @@ const Fn kTypes[] = {
     TAMP_FUZZ_TYPE(FailureEvent),     TAMP_FUZZ_TYPE(FaultInjection),      TAMP_FUZZ_TYPE(ExecutionRecord),
     TAMP_FUZZ_TYPE(EffortModelSnapshot), TAMP_FUZZ_TYPE(RobotState),       TAMP_FUZZ_TYPE(PointCloudFrame),
     TAMP_FUZZ_TYPE(WorldObject),      TAMP_FUZZ_TYPE(WorldMeta),           TAMP_FUZZ_TYPE(WorldEvent),
+    TAMP_FUZZ_TYPE(RecordAck),
 };
 #undef TAMP_FUZZ_TYPE
 constexpr size_t kTypeCount = sizeof(kTypes) / sizeof(kTypes[0]);
@@ -331,6 +332,13 @@ extern "C" int TampFuzzWriteSeeds(const char* dir_name) {
     msg::WorldEvent m;
     m.object_id("can");
     writeSeed<msg::WorldEvent, msg::WorldEventPubSubType>(dir, 23, "WorldEvent", m);
+  }
+  {
+    msg::RecordAck m;
+    m.record_id("r1");
+    m.estimator("effort_estimator");
+    m.stored(true);
+    writeSeed<msg::RecordAck, msg::RecordAckPubSubType>(dir, 24, "RecordAck", m);
   }
   return 0;
 }

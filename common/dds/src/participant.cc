@@ -1,6 +1,9 @@
 #include "tamp/dds/participant.h"
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <cstdlib>
 #include <set>
@@ -101,6 +104,21 @@ void useDiscoveryServers(fdds::DomainParticipantQos& qos, const std::vector<Disc
 }
 
 std::string fileUri(const std::filesystem::path& p) { return "file://" + std::filesystem::absolute(p).string(); }
+
+/// Participant ids this process tries, in turn: from one drawn from its pid, so that a service
+/// restarted after a crash does not take over the transport ports of the process it replaces.
+/// Peers keep that process until its lease ends (tamp_profiles.xml: 5 s), and their shared-memory
+/// transport keeps writing into the segment of its old port, which the restarted process has
+/// replaced: requests to the restarted service were lost until the lease ended, or for good
+/// (kill -9 matrix, effort estimator, seed 1; EffortRestartTest). Ids 0..99 keep every port of a
+/// domain inside its 250-port block; Fast DDS moves on to a free port when one is taken.
+constexpr int kSpreadIds = 100;
+
+int32_t nextParticipantId() {
+  static const int base = static_cast<int>(::getpid() % kSpreadIds);
+  static std::atomic<int> created{0};
+  return static_cast<int32_t>((base + created.fetch_add(1)) % kSpreadIds);
+}
 
 }  // namespace
 
@@ -219,7 +237,17 @@ Result<std::shared_ptr<Participant>> Participant::create(const ParticipantOption
   p->domain_id_ = *domain;
   p->name_ = qos.name().to_string();
   p->profile_ = profile;
-  p->participant_ = factory->create_participant(static_cast<fdds::DomainId_t>(*domain), qos);
+  if (qos.wire_protocol().participant_id < 0) {
+    // An id already used in this process is refused: the next one, then Fast DDS's own choice.
+    for (int attempt = 0; attempt < 8 && p->participant_ == nullptr; ++attempt) {
+      qos.wire_protocol().participant_id = nextParticipantId();
+      p->participant_ = factory->create_participant(static_cast<fdds::DomainId_t>(*domain), qos);
+    }
+    qos.wire_protocol().participant_id = -1;
+  }
+  if (p->participant_ == nullptr) {
+    p->participant_ = factory->create_participant(static_cast<fdds::DomainId_t>(*domain), qos);
+  }
   if (p->participant_ == nullptr) {
     return Error(ErrorCode::kInternal,
                  "Fast DDS could not create a participant on domain " + std::to_string(*domain) + " with profile '" +

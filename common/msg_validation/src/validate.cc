@@ -580,6 +580,13 @@ Status validate(const msg::ExecutionRecord& m, const Limits& limits) {
   return c.status();
 }
 
+Status validate(const msg::RecordAck& m, const Limits& limits) {
+  Check c("RecordAck", limits);
+  c.id("record_id", m.record_id(), true);
+  c.id("estimator", m.estimator(), false);
+  return c.status();
+}
+
 Status validate(const msg::EffortModelSnapshot& m, const Limits& limits) {
   Check c("EffortModelSnapshot", limits);
   c.id("model_id", m.model_id(), true);

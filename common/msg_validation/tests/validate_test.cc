@@ -261,6 +261,12 @@ TEST(MsgValidation, StatesCloudsRecordsAndModels) {
   rec.duration_s(kNaN);
   EXPECT_EQ(why(rec), "ExecutionRecord.duration_s: NaN");
 
+  msg::RecordAck ack;
+  ack.record_id("r1");
+  EXPECT_EQ(why(ack), "(ok)");
+  ack.record_id("");
+  EXPECT_NE(why(ack).find("RecordAck.record_id"), std::string::npos) << why(ack);
+
   msg::EffortModelSnapshot snap;
   snap.model_id("effort");
   snap.models().resize(1);

@@ -152,9 +152,10 @@ EffortEstimatorNode::EffortEstimatorNode(const dds::ServiceArgs& args, Estimator
   // The start-up snapshot (stored models or priors); a refit of records loaded from the store may
   // already have published a newer one, which publishSnapshot() keeps.
   publishSnapshot(estimator_->snapshotPtr());
+  ack_writer_ = std::make_unique<dds::Writer<msg::RecordAck>>(participant(), dds::topics::kRecordAcks);
   record_reader_ = std::make_unique<dds::Reader<msg::ExecutionRecord>>(
       participant(), dds::topics::kExecutionRecords,
-      [this](const msg::ExecutionRecord& m, const dds::SampleMeta&) { (void)handleRecord(m); });
+      [this](const msg::ExecutionRecord& m, const dds::SampleMeta&) { onRecord(m); });
   server_ = std::make_unique<dds::RpcServer<msg::EffortRequest, msg::EffortReply>>(
       participant(), dds::services::kEffort,
       [this](const msg::EffortRequest& req, const dds::RequestContext& ctx) {
@@ -165,6 +166,7 @@ EffortEstimatorNode::EffortEstimatorNode(const dds::ServiceArgs& args, Estimator
 EffortEstimatorNode::~EffortEstimatorNode() {
   server_.reset();
   record_reader_.reset();
+  ack_writer_.reset();
   estimator_.reset();  // joins the refit worker, whose callback publishes with model_writer_
   model_writer_.reset();
 }
@@ -236,6 +238,20 @@ Status EffortEstimatorNode::handleRecord(const msg::ExecutionRecord& m) {
       ->warn("rejected execution record '{}' from '{}': {}", m.record_id(), m.source(),
              e.toString());
   return e;
+}
+
+void EffortEstimatorNode::onRecord(const msg::ExecutionRecord& m) {
+  const Status held = handleRecord(m);  // ok: stored now or before
+  if (m.record_id().empty() || m.record_id().size() > msgv::Limits{}.max_id_length) return;
+  msg::RecordAck ack;
+  ack.record_id(m.record_id());
+  ack.estimator(name());
+  ack.stored(held.ok());
+  if (Status s = ack_writer_->write(ack); !s) {
+    tamp::log::get("effort_estimator")
+        ->warn("acknowledgement of record '{}' not sent (it will come again): {}", m.record_id(),
+               s.error().toString());
+  }
 }
 
 void EffortEstimatorNode::publishSnapshot(const std::shared_ptr<const ModelSnapshot>& snapshot) {

@@ -15,6 +15,9 @@
 ///   is stored (SQLite under the params' `store_directory`) and queued. The library's worker thread
 ///   refits in batches (`refit_batch_size` records of a kind, or `refit_period_s`), never on a DDS
 ///   thread.
+/// - Acknowledges every record with an id on `topics::kRecordAcks` once it holds it (stored now,
+///   or before: the store keeps an id once) or refuses it for good (invalid): the execution
+///   monitor sends a record again until then, so records arrive exactly once across restarts.
 /// - Publishes `topics::kEffortModel` ("tamp/effort/model", RELIABLE + TRANSIENT_LOCAL, keyed by
 ///   `model_id` = the node name): once at start-up (the models loaded from the store, or the
 ///   priors) and after every refit, from the refit worker. Late joiners get the current snapshot.
@@ -77,6 +80,8 @@ class EffortEstimatorNode : public dds::ServiceNode {
  private:
   msgv::RejectLog rejects_{"effort_estimator"};  // malformed input: logged once per kind, rate-limited
   void publishSnapshot(const std::shared_ptr<const ModelSnapshot>& snapshot);
+  /// The record topic's callback: handleRecord, then the acknowledgement.
+  void onRecord(const msg::ExecutionRecord& m);
 
   // Destroyed in reverse order: the server and the record reader first (their threads call the
   // estimator), then the estimator (its worker calls publishSnapshot), then the writer.
@@ -86,6 +91,7 @@ class EffortEstimatorNode : public dds::ServiceNode {
   bool published_any_{false};
   std::atomic<std::uint64_t> records_rejected_{0};
   std::unique_ptr<EffortEstimator> estimator_;
+  std::unique_ptr<dds::Writer<msg::RecordAck>> ack_writer_;
   std::unique_ptr<dds::Reader<msg::ExecutionRecord>> record_reader_;
   std::unique_ptr<dds::RpcServer<msg::EffortRequest, msg::EffortReply>> server_;
 };

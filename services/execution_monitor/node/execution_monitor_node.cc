@@ -1,7 +1,12 @@
 #include "execution_monitor_node.h"
 
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
+#include <optional>
+#include <stdexcept>
+
+#include <fastrtps/rtps/common/SerializedPayload.h>
 
 #include "tamp/core/log.h"
 #include "tamp/core/paths.h"
@@ -19,6 +24,30 @@ const std::shared_ptr<spdlog::logger>& logger() {
 Error bad(const std::string& field, const std::string& message) {
   return Error(ErrorCode::kInvalidArgument, field + ": " + message,
                SourceLocation{"", 0, 0, field});
+}
+
+/// A record not acknowledged by the effort estimator is sent again after this long (s).
+constexpr double kRecordResendPeriodS = 2.0;
+
+/// A record as CDR bytes, the outbox's opaque payload.
+std::string serialize(const msg::ExecutionRecord& m) {
+  dds::TypeSupport<msg::ExecutionRecord>::type type;
+  auto* data = const_cast<msg::ExecutionRecord*>(&m);
+  eprosima::fastrtps::rtps::SerializedPayload_t payload(type.getSerializedSizeProvider(data)());
+  if (!type.serialize(data, &payload)) {
+    throw std::runtime_error("cannot serialize execution record '" + m.record_id() + "'");
+  }
+  return std::string(reinterpret_cast<const char*>(payload.data), payload.length);
+}
+
+std::optional<msg::ExecutionRecord> deserialize(const std::string& bytes) {
+  dds::TypeSupport<msg::ExecutionRecord>::type type;
+  eprosima::fastrtps::rtps::SerializedPayload_t payload(static_cast<uint32_t>(bytes.size()));
+  std::memcpy(payload.data, bytes.data(), bytes.size());
+  payload.length = static_cast<uint32_t>(bytes.size());
+  msg::ExecutionRecord m;
+  if (!type.deserialize(&payload, &m)) return std::nullopt;
+  return m;
 }
 
 }  // namespace
@@ -209,6 +238,7 @@ ExecutionMonitorNode::ExecutionMonitorNode(const dds::ServiceArgs& args, Monitor
   const std::string world_id = params.world_id;
   monitor_ = std::make_unique<ExecutionMonitor>(std::move(params), std::move(robot));
   openJournal();
+  openOutbox();
   const auto& p = participant();
   status_writer_ =
       std::make_unique<dds::Writer<msg::ExecuteStatus>>(p, dds::topics::kExecuteStatus);
@@ -226,6 +256,8 @@ ExecutionMonitorNode::ExecutionMonitorNode(const dds::ServiceArgs& args, Monitor
   result_reader_ = std::make_unique<dds::Reader<msg::ActionResult>>(
       p, dds::topics::kActionResult,
       [this](const msg::ActionResult& m, const dds::SampleMeta& meta) { onResult(m, meta); });
+  ack_reader_ = std::make_unique<dds::Reader<msg::RecordAck>>(
+      p, dds::topics::kRecordAcks, [this](const msg::RecordAck& m, const dds::SampleMeta&) { onRecordAck(m); });
   record_reader_ = std::make_unique<dds::Reader<msg::ExecutionRecord>>(
       p, dds::topics::kRobotRecords,
       [this](const msg::ExecutionRecord& m, const dds::SampleMeta&) { onRecord(m); });
@@ -247,9 +279,22 @@ void ExecutionMonitorNode::openJournal() {
   monitor_->resume(journal_->previous());
 }
 
+void ExecutionMonitorNode::openOutbox() {
+  const char* run_dir = std::getenv("TAMP_RUN_DIR");
+  if (!run_dir || !*run_dir) return;  // in memory: records survive the estimator's restarts only
+  auto box = RecordOutbox::open(std::filesystem::path(run_dir) / "execution_monitor.records");
+  if (!box) throw std::runtime_error("execution monitor: " + box.error().toString());
+  outbox_ = std::move(box).value();
+  if (outbox_.pending() > 0) {
+    logger()->info("outbox {}: {} execution record(s) not acknowledged by the effort estimator yet; sending "
+                   "them again", outbox_.path().string(), outbox_.pending());
+  }
+}
+
 ExecutionMonitorNode::~ExecutionMonitorNode() {
   // Input first (callbacks use the monitor and the writers), then the mirror.
   command_reader_.reset();
+  ack_reader_.reset();
   record_reader_.reset();
   result_reader_.reset();
   state_reader_.reset();
@@ -383,16 +428,61 @@ void ExecutionMonitorNode::onRecord(const msg::ExecutionRecord& m) {
     out.predicted_stddev_s(a->predicted_stddev_s);
     out.command_id(a->command_id);
     out.mission_id(a->mission_id);
-    if (Status s = record_writer_->write(out); !s) {
-      logger()->error("execution record '{}' not forwarded: {}", m.record_id(),
-                      s.error().toString());
+    {
+      std::lock_guard lock(records_mu_);
+      auto added = outbox_.add(out.record_id(), serialize(out));
+      if (!added) {
+        // Sent once all the same; a restart of the monitor before its acknowledgement loses it.
+        logger()->error("execution record '{}' not kept until acknowledged: {}", m.record_id(),
+                        added.error().toString());
+        if (Status s = record_writer_->write(out); !s) {
+          logger()->error("execution record '{}' not forwarded: {}", m.record_id(), s.error().toString());
+        }
+        return;
+      }
     }
+    sendDueRecords();
   } catch (const std::exception& e) {
     logger()->error("record '{}': {}", m.record_id(), e.what());
   }
 }
 
+void ExecutionMonitorNode::onRecordAck(const msg::RecordAck& m) {
+  try {
+    if (!msgv::accept(m, dds::topics::kRecordAcks.name, rejects_)) return;
+    std::lock_guard lock(records_mu_);
+    if (!outbox_.acknowledge(m.record_id())) return;  // a repeat, or not ours
+    if (!m.stored()) {
+      logger()->warn("execution record '{}' refused by '{}' for good; not sent again", m.record_id(),
+                     m.estimator());
+    }
+  } catch (const std::exception& e) {
+    logger()->error("acknowledgement of '{}': {}", m.record_id(), e.what());
+  }
+}
+
+void ExecutionMonitorNode::sendDueRecords() {
+  std::lock_guard lock(records_mu_);
+  for (const auto& e : outbox_.due(now(), kRecordResendPeriodS)) {
+    auto record = deserialize(e.payload);
+    if (!record) {
+      logger()->error("execution record '{}' in the outbox cannot be read back; dropped", e.record_id);
+      (void)outbox_.acknowledge(e.record_id);
+      continue;
+    }
+    if (e.sends > 1) logger()->info("execution record '{}' sent again (send {})", e.record_id, e.sends);
+    if (Status s = record_writer_->write(*record); !s) {
+      logger()->error("execution record '{}' not forwarded: {}", e.record_id, s.error().toString());
+    }
+  }
+}
+
 void ExecutionMonitorNode::spinOnce() {
+  try {
+    sendDueRecords();
+  } catch (const std::exception& e) {
+    logger()->error("records: {}", e.what());
+  }
   try {
     std::lock_guard lock(mutex_);
     flushRobotRequests();

@@ -9,7 +9,10 @@
 /// Publishes: tamp/execute/status (ExecuteStatus, keyed by command id), tamp/execute/failure
 /// (FailureEvent), tamp/robot/trajectory (TrajectoryCommand: execute, or `cancel`),
 /// tamp/execution/record (ExecutionRecord with predicted_s, predicted_stddev_s, command_id,
-/// mission_id filled; once per record id).
+/// mission_id filled). Each forwarded record is kept (`RecordOutbox`, on disk in the run folder)
+/// and sent again every kRecordResendPeriodS until the effort estimator acknowledges its id on
+/// tamp/execution/record_ack; the estimator stores an id once, so records arrive exactly once
+/// across restarts of either side.
 ///
 /// Every callback takes one mutex around the library and publishes what it returns; a periodic
 /// spin (every 50 ms) feeds world model changes and ticks. Nothing escapes a callback: malformed
@@ -29,6 +32,7 @@
 #include "tamp/dds/topics.h"
 #include "tamp/dds/world_sync.h"
 #include "tamp/execution_monitor/monitor.h"
+#include "tamp/execution_monitor/record_outbox.h"
 #include "tamp/execution_monitor/sent_journal.h"
 
 namespace tamp::execution_monitor {
@@ -70,14 +74,22 @@ class ExecutionMonitorNode : public dds::ServiceNode {
   void onState(const msg::RobotState& m, const dds::SampleMeta& meta);
   void onResult(const msg::ActionResult& m, const dds::SampleMeta& meta);
   void onRecord(const msg::ExecutionRecord& m);
+  void onRecordAck(const msg::RecordAck& m);
+  /// Sends the records the estimator has not acknowledged: new ones, and the others every
+  /// kRecordResendPeriodS.
+  void sendDueRecords();
   /// With $TAMP_RUN_DIR (set by `tamp launch`): <run_dir>/execution_monitor.sent, read back into
   /// the monitor (`resume`) and appended before every command sent to the robot.
   void openJournal();
+  /// <run_dir>/execution_monitor.records with $TAMP_RUN_DIR, else in memory (record_outbox.h).
+  void openOutbox();
 
   std::chrono::steady_clock::time_point t0_{std::chrono::steady_clock::now()};
   std::mutex mutex_;  // guards monitor_ and the writers' ordering
   std::unique_ptr<ExecutionMonitor> monitor_;
   std::unique_ptr<SentJournal> journal_;
+  std::mutex records_mu_;  // guards outbox_ (record and acknowledgement callbacks, the spin)
+  RecordOutbox outbox_;
   std::unique_ptr<dds::Writer<msg::ExecuteStatus>> status_writer_;
   std::unique_ptr<dds::Writer<msg::FailureEvent>> failure_writer_;
   std::unique_ptr<dds::Writer<msg::TrajectoryCommand>> trajectory_writer_;
@@ -87,6 +99,7 @@ class ExecutionMonitorNode : public dds::ServiceNode {
   std::unique_ptr<dds::Reader<msg::RobotState>> state_reader_;
   std::unique_ptr<dds::Reader<msg::ActionResult>> result_reader_;
   std::unique_ptr<dds::Reader<msg::ExecutionRecord>> record_reader_;
+  std::unique_ptr<dds::Reader<msg::RecordAck>> ack_reader_;
   std::atomic<bool> world_dirty_{true};
   std::uint64_t failure_seq_{0};
   std::vector<RobotRequest> unsent_;  // robot requests waiting for the robot driver's match, in order

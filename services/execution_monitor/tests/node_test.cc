@@ -140,9 +140,19 @@ class MonitorNodeTest : public ::testing::Test {
     states_ = std::make_unique<dds::Reader<msg::RobotState>>(
         participant_, dds::topics::kRobotState,
         [this](const msg::RobotState& m, const dds::SampleMeta&) { state_log_.push(m); });
+    // The test is the effort estimator too: it acknowledges each record (the monitor sends a
+    // record again until then).
+    acks_ = std::make_unique<dds::Writer<msg::RecordAck>>(participant_, dds::topics::kRecordAcks);
     records_ = std::make_unique<dds::Reader<msg::ExecutionRecord>>(
         participant_, dds::topics::kExecutionRecords,
-        [this](const msg::ExecutionRecord& m, const dds::SampleMeta&) { record_log_.push(m); });
+        [this](const msg::ExecutionRecord& m, const dds::SampleMeta&) {
+          record_log_.push(m);
+          msg::RecordAck ack;
+          ack.record_id(m.record_id());
+          ack.estimator("test");
+          ack.stored(true);
+          (void)acks_->write(ack);
+        });
     robot_records_ = std::make_unique<dds::Reader<msg::ExecutionRecord>>(
         participant_, dds::topics::kRobotRecords,
         [this](const msg::ExecutionRecord& m, const dds::SampleMeta&) {
@@ -164,6 +174,7 @@ class MonitorNodeTest : public ::testing::Test {
     ASSERT_TRUE(statuses_->waitForWriters(Termination::after(30.0)))
         << "the monitor publishes no status";
     ASSERT_TRUE(faults_->waitForReaders(Termination::after(30.0)));
+    ASSERT_TRUE(acks_->waitForReaders(Termination::after(30.0))) << "the monitor reads no acknowledgements";
   }
 
   void TearDown() override {
@@ -255,6 +266,7 @@ class MonitorNodeTest : public ::testing::Test {
   std::unique_ptr<dds::Reader<msg::FailureEvent>> failures_;
   std::unique_ptr<dds::Reader<msg::ActionResult>> results_;
   std::unique_ptr<dds::Reader<msg::RobotState>> states_;
+  std::unique_ptr<dds::Writer<msg::RecordAck>> acks_;
   std::unique_ptr<dds::Reader<msg::ExecutionRecord>> records_, robot_records_;
   std::unique_ptr<dds::WorldPublisher> publisher_;
   std::unique_ptr<dds::Writer<msg::ExecuteCommand>> commands_;

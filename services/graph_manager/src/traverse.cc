@@ -212,7 +212,12 @@ Status GraphManager::start(const world::World& live, const Observation& robot) {
 std::pair<double, double> GraphManager::price(const EffortQuery& q) {
   ++counters_.effort_calls;
   auto a = services_.effort({q});
-  if (a.empty() || !a[0].ok) return {kInfinity, 0.0};
+  if (a.empty() || !a[0].ok) {
+    // Unpriced is unusable: say why (an estimator that does not answer looks like "no branch").
+    log::get("graph_manager")
+        ->warn("no effort estimate for {}: {}", toString(q.kind), a.empty() ? std::string("no answer") : a[0].message);
+    return {kInfinity, 0.0};
+  }
   return {a[0].mean_s, a[0].stddev_s};
 }
 

@@ -251,6 +251,28 @@ struct Perception::Impl {
     return o;
   }
 
+  /// `held`, reported in the gripper but tracked elsewhere, is the confirmed new object `seen` at
+  /// the gripper: moved there (a MOVED event), its grasp fixed from the next frame on.
+  void relearnHeld(Track& held, const Track& seen, FrameResult& result, std::int64_t stamp) {
+    const Eigen::Isometry3d was = held.pose;
+    held.pose = seen.pose;
+    held.event_pose = seen.pose;
+    held.hits += seen.hits;
+    held.misses = 0;
+    held.last_seen_ns = stamp;
+    held.confidence = std::max(held.confidence, seen.confidence);
+    if (held.state == TrackInfo::State::kGone) {
+      held.state = TrackInfo::State::kActive;
+      (void)world.addObject(objectOf(held));
+    } else {
+      (void)world.updateObject(objectOf(held));
+    }
+    char why[200];
+    std::snprintf(why, sizeof(why), "held by the robot: relearned at the gripper at %s, %.2f m from where it was tracked",
+                  describePose(held.pose).c_str(), (held.pose.translation() - was.translation()).norm());
+    pushEvent(result, EventType::kMoved, held, held.pose, why, stamp);
+  }
+
   /// Mass, graspability and kind of a track without a class (size thresholds).
   void classifyBySize(Track& t) const {
     const ClassifyParams& c = params.classify;
@@ -423,6 +445,10 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
   watch.reset();
   const bool self_filter = robot != nullptr && P.self_filter.enabled;
   Track* held = nullptr;
+  // Reported held, but tracked implausibly far from the gripper (perception restarted from the
+  // prior while the robot carries it): no grasp to fix yet; it is relearned from the points at
+  // the gripper, as an object held but unknown is (below).
+  Track* held_elsewhere = nullptr;
   Eigen::Isometry3d tool_T_held = I.tool_T_held;
   std::optional<PointCloudFrame> filtered;
   if (self_filter) {
@@ -430,8 +456,16 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
         !robot->held_object_id.empty() && it != I.tracks.end() &&
         it->second.state != TrackInfo::State::kTentative) {
       held = &it->second;
-      // A new grasp: the object is where it was last tracked, now rigidly on the tool link.
-      if (I.held_id != held->id) tool_T_held = robot->world_T_tool.inverse() * held->pose;
+      // A new grasp: the object is where it was last tracked, now rigidly on the tool link --
+      // when that is at the gripper at all.
+      if (I.held_id != held->id) {
+        if (pointInShape(held->shape, held->pose, robot->world_T_tool.translation(), P.self_filter.held_adopt_radius)) {
+          tool_T_held = robot->world_T_tool.inverse() * held->pose;
+        } else {
+          held_elsewhere = held;
+          held = nullptr;
+        }
+      }
     }
     world::Object held_solid;
     if (held != nullptr) {
@@ -514,8 +548,8 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
   // Held, but unknown to every track (the planner was not told about it): the cluster at the
   // gripper hangs from it, it does not stand on a support, and it is the object the robot holds.
   const bool held_unknown = self_filter && held == nullptr && !robot->held_object_id.empty() &&
-                            I.tracks.count(robot->held_object_id) == 0 &&
-                            I.world.findObject(robot->held_object_id) == nullptr;
+                            (held_elsewhere != nullptr || (I.tracks.count(robot->held_object_id) == 0 &&
+                                                           I.world.findObject(robot->held_object_id) == nullptr));
   const Eigen::Vector3d tool = robot != nullptr ? Eigen::Vector3d(robot->world_T_tool.translation()) : Eigen::Vector3d::Zero();
   auto atTheGripper = [&](const Eigen::Vector2d& xy, double zmin, double zmax) {
     const double r = P.self_filter.held_adopt_radius;
@@ -682,7 +716,7 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
   std::optional<RangeImage> image;
   std::vector<std::string> dropped;
   for (auto& [id, t] : I.tracks) {
-    if (t.matched || t.state == TrackInfo::State::kGone || id == I.held_id) continue;
+    if (t.matched || t.state == TrackInfo::State::kGone || id == I.held_id || &t == held_elsewhere) continue;
     if (!image) image.emplace(frame, T.visibility_bin);
     world::Object o;
     o.shape = t.shape;
@@ -722,6 +756,13 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
   for (const auto& tid : confirmed) {
     Track t = std::move(I.tracks.at(tid));
     I.tracks.erase(tid);
+    if (held_elsewhere != nullptr &&
+        atTheGripper(t.pose.translation().head<2>(), t.pose.translation().z() - t.shape.halfHeight(),
+                     t.pose.translation().z() + t.shape.halfHeight())) {
+      I.relearnHeld(*held_elsewhere, t, result, stamp);
+      held_elsewhere = nullptr;  // once per frame
+      continue;
+    }
     // A gone object of the same shape: reacquired under its id.
     Track* lost = nullptr;
     if (T.reacquire) {

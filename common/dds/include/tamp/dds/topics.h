@@ -42,6 +42,7 @@ TAMP_DDS_TYPE(EffortRequest)
 TAMP_DDS_TYPE(EffortReply)
 TAMP_DDS_TYPE(EffortModelSnapshot)
 TAMP_DDS_TYPE(ExecutionRecord)
+TAMP_DDS_TYPE(RecordAck)
 TAMP_DDS_TYPE(ExecuteCommand)
 TAMP_DDS_TYPE(ExecuteStatus)
 TAMP_DDS_TYPE(TrajectoryCommand)
@@ -85,6 +86,9 @@ inline constexpr TopicSpec<msg::EffortModelSnapshot> kEffortModel{"tamp/effort/m
 // monitor adds the prediction and the command it executed and forwards it on kExecutionRecords.
 inline constexpr TopicSpec<msg::ExecutionRecord> kRobotRecords{"tamp/robot/record", QosClass::kEvent};
 inline constexpr TopicSpec<msg::ExecutionRecord> kExecutionRecords{"tamp/execution/record", QosClass::kEvent};
+// The estimator acknowledges each record it holds (stored now or before); the monitor resends a
+// record until then. VOLATILE: a lost acknowledgement costs a resend, which is acknowledged again.
+inline constexpr TopicSpec<msg::RecordAck> kRecordAcks{"tamp/execution/record_ack", QosClass::kCommand};
 // Execution
 inline constexpr TopicSpec<msg::ExecuteCommand> kExecuteCommand{"tamp/execute/command", QosClass::kCommand};
 inline constexpr TopicSpec<msg::ExecuteStatus> kExecuteStatus{"tamp/execute/status", QosClass::kEvent};  // as results

@@ -77,6 +77,7 @@ Status validate(const msg::ActionResult& m, const Limits& limits = {});
 Status validate(const msg::FailureEvent& m, const Limits& limits = {});
 Status validate(const msg::FaultInjection& m, const Limits& limits = {});
 Status validate(const msg::ExecutionRecord& m, const Limits& limits = {});
+Status validate(const msg::RecordAck& m, const Limits& limits = {});
 Status validate(const msg::EffortModelSnapshot& m, const Limits& limits = {});
 Status validate(const msg::RobotState& m, const Limits& limits = {});
 Status validate(const msg::PointCloudFrame& m, const Limits& limits = {});

@@ -153,7 +153,8 @@ struct SelfFilterParams {
   double padding{0.03};
   /// m, > 0: the robot reports an object in the gripper that no track has (the planner was not
   /// told about it): a new object confirmed with its centre this close to the tool frame is that
-  /// object, tracked under the robot's id from then on.
+  /// object, tracked under the robot's id from then on. Also the plausibility of a new grasp: a
+  /// held object tracked farther than this from the tool frame is relearned at the gripper.
   double held_adopt_radius{0.15};
 };
 

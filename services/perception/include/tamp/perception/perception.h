@@ -22,7 +22,10 @@
 ///    was picked; when the state reports the gripper empty again it is tracked as before. An
 ///    object the state reports held that no track has (the planner was not told about it) is
 ///    seen as a new object at the gripper: confirmed within `self_filter.held_adopt_radius` of
-///    the tool frame, it gets the robot's id for it and is filtered as held from then on.
+///    the tool frame, it gets the robot's id for it and is filtered as held from then on. So is
+///    an object reported held whose track is farther than that from the tool frame (perception
+///    restarted from the prior while the robot carries it): its track is moved to the object seen
+///    at the gripper, a grasp is fixed only from a plausible pose.
 /// 2. **Transform and crop** to the world frame, the workspace box and the sensor's range.
 /// 3. **Voxel grid** (PCL `VoxelGrid`): the leaf size bounds the cost of everything after.
 /// 4. **Support planes** (PCL RANSAC, `SACMODEL_PERPENDICULAR_PLANE` about world z, several

@@ -305,6 +305,19 @@ class GraphManager {
   bool armStowed(const std::vector<double>& arm) const;
   double lowerBound(const Edge& e) const;
   void spawnSubtasks(EdgeId e, const BranchContext& ctx, int depth);
+  // ---- policy oracle (oracle.cc) ----
+  /// Blocking objects of one edge given removal sub-tasks under the current policy.
+  int blockingObjectsConsidered() const;
+  /// Policy oracle: sub-tasks that remove every subset of 2 to `oracle_max_objects` of the
+  /// objects in `slots` (object, its first slot) together, from `v`, then achieve what the
+  /// blocked edge `v -> child` achieved, then the goal. Single objects are spawnSubtasks' own.
+  void spawnSubsetSubtasks(NodeId v, NodeId child, const std::vector<std::pair<std::string, std::string>>& slots);
+  /// Policy oracle: asks the simulator's truth again (before each Traverse: the fault schedule
+  /// is counted in the simulator's accepted commands). Keeps the last answer on failure.
+  void refreshOracle();
+  /// Policy oracle: what the scripted failures cost `steps` (0 for the other policies).
+  double oraclePenalty(const std::vector<BranchStep>& steps) const;
+  std::optional<OracleKnowledge> oracle_;
   double evaluateBase(Edge& e, const BranchContext& ctx, int depth);
   MotionAnswer planBase(const MotionQuery& q);
   MotionAnswer lazyOrFull(const MotionQuery& q);

@@ -29,6 +29,13 @@
 ///    motion whose start no longer matches the robot, and re-running `traverse()` from the
 ///    robot's node after a failed or blocked action (bounded by `max_replans`).
 ///
+/// 4. Policies (params.h): `effort` as above; `infeasible` spawns removal sub-tasks only when the
+///    detour is proven impossible; `oracle` (oracle.h, the lower bound of the evaluation) takes
+///    its efforts and its knowledge of hidden objects and scripted faults from
+///    `ServiceClients::effort()`/`oracle()` (the simulator's truth, at the node), adds a sub-task
+///    per subset of up to `oracle_max_objects` blocking objects, cuts no branch on its bound and
+///    charges each complete branch the retries its scripted failures will cost.
+///
 /// The library knows nothing of DDS: the services are reached through `ServiceClients` and the
 /// robot through `Executor` (clients.h).
 

@@ -52,7 +52,8 @@ TEST(OracleMissionTest, CorridorOracleReachesTheGoalPricingBothRemovalAndDetourI
   // execution noise (3 % log-normal) and one stall (at most 1.5 s).
   for (const auto& a : m.report["actions"]) {
     if (a["outcome"] != "succeeded") continue;
-    const double predicted = a["predicted_s"].get<double>(), measured = a["measured_s"].get<double>();
+    const double predicted = a["predicted_s"].get<double>(),
+                 measured = a["measured_s"].get<double>();
     EXPECT_NEAR(measured, predicted, 0.15 * predicted + 1.6) << a.dump();
   }
 }

@@ -21,16 +21,21 @@ msgv::RejectLog& oracleRejects() {
 
 OracleFault::Type typeOf(msg::FaultType t) {
   switch (t) {
-    case msg::FaultType::FAULT_DROP_HELD_OBJECT: return OracleFault::Type::kDropHeldObject;
-    case msg::FaultType::FAULT_SPAWN_OBJECT: return OracleFault::Type::kSpawnObject;
-    case msg::FaultType::FAULT_REMOVE_OBJECT: return OracleFault::Type::kRemoveObject;
-    default: return OracleFault::Type::kFailAction;
+    case msg::FaultType::FAULT_DROP_HELD_OBJECT:
+      return OracleFault::Type::kDropHeldObject;
+    case msg::FaultType::FAULT_SPAWN_OBJECT:
+      return OracleFault::Type::kSpawnObject;
+    case msg::FaultType::FAULT_REMOVE_OBJECT:
+      return OracleFault::Type::kRemoveObject;
+    default:
+      return OracleFault::Type::kFailAction;
   }
 }
 
 }  // namespace
 
-OracleServiceClients::OracleServiceClients(std::shared_ptr<dds::Participant> p, ServiceClients& base)
+OracleServiceClients::OracleServiceClients(std::shared_ptr<dds::Participant> p,
+                                           ServiceClients& base)
     : base_(base), oracle_(std::move(p), dds::services::kOracle, oracleRpcOptions()) {}
 
 std::vector<EffortAnswer> OracleServiceClients::effort(const std::vector<EffortQuery>& qs) {
@@ -48,7 +53,8 @@ std::vector<EffortAnswer> OracleServiceClients::effort(const std::vector<EffortQ
   std::vector<EffortAnswer> out(qs.size());
   auto rep = oracle_.call(req, dds::CallOptions{5.0, {}});
   if (rep) {
-    if (Status bad = msgv::screen(*rep, dds::services::kOracle.name, oracleRejects()); !bad.ok()) rep = bad.error();
+    if (Status bad = msgv::screen(*rep, dds::services::kOracle.name, oracleRejects()); !bad.ok())
+      rep = bad.error();
   }
   if (!rep) {
     for (auto& a : out) a.message = "oracle: " + rep.error().message;
@@ -68,20 +74,26 @@ Result<OracleKnowledge> OracleServiceClients::oracle() {
   msg::OracleRequest req;
   req.want_truth(true);
   auto rep = oracle_.call(req, dds::CallOptions{5.0, {}});
-  if (!rep) return Error(rep.error().code, "oracle (" + std::string(dds::services::kOracle.name) + "): " + rep.error().message);
-  if (Status bad = msgv::screen(*rep, dds::services::kOracle.name, oracleRejects()); !bad.ok()) return bad.error();
+  if (!rep)
+    return Error(rep.error().code, "oracle (" + std::string(dds::services::kOracle.name) +
+                                       "): " + rep.error().message);
+  if (Status bad = msgv::screen(*rep, dds::services::kOracle.name, oracleRejects()); !bad.ok())
+    return bad.error();
   OracleKnowledge k;
   for (const auto& m : rep->hidden_objects()) {
     auto o = dds::fromMsg(m);
-    if (!o) return Error(ErrorCode::kInvalidArgument, "oracle: hidden object: " + o.error().message);
+    if (!o)
+      return Error(ErrorCode::kInvalidArgument, "oracle: hidden object: " + o.error().message);
     k.hidden.push_back(std::move(o).value());
   }
   for (const auto& m : rep->faults()) {
     OracleFault f;
     f.id = m.fault_id();
     f.type = typeOf(m.type());
-    if (m.at_time()) f.time_s = m.time_s();
-    else if (m.step() >= 0) f.step = m.step();
+    if (m.at_time())
+      f.time_s = m.time_s();
+    else if (m.step() >= 0)
+      f.step = m.step();
     if (!m.any_action()) f.action = dds::fromMsg(m.action());
     f.object_id = m.object_id();
     k.faults.push_back(f);

@@ -18,7 +18,9 @@ class OracleServiceClients : public ServiceClients {
   OracleServiceClients(std::shared_ptr<dds::Participant> p, ServiceClients& base);
   TaskPlan plan(const TaskQuery& q) override { return base_.plan(q); }
   MotionAnswer motion(const MotionQuery& q) override { return base_.motion(q); }
-  Result<std::vector<PlacementOption>> placements(const PlacementQuery& q) override { return base_.placements(q); }
+  Result<std::vector<PlacementOption>> placements(const PlacementQuery& q) override {
+    return base_.placements(q);
+  }
   Result<std::vector<GraspOption>> grasps(const GraspQuery& q) override { return base_.grasps(q); }
   /// The true nominal durations (stddev: the simulator's execution noise), from the simulator.
   std::vector<EffortAnswer> effort(const std::vector<EffortQuery>& q) override;

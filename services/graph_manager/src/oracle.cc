@@ -11,7 +11,8 @@ namespace tamp::graph_manager {
 
 std::vector<std::vector<std::size_t>> removalSubsets(std::size_t n, int max_size) {
   std::vector<std::vector<std::size_t>> out;
-  const std::size_t k_max = std::min<std::size_t>(n, max_size < 0 ? 0 : static_cast<std::size_t>(max_size));
+  const std::size_t k_max =
+      std::min<std::size_t>(n, max_size < 0 ? 0 : static_cast<std::size_t>(max_size));
   for (std::size_t k = 1; k <= k_max; ++k) {
     // Lexicographic k-combinations of {0..n-1}.
     std::vector<std::size_t> c(k);
@@ -51,30 +52,35 @@ world::World withHidden(const world::World& live, const std::vector<world::Objec
   for (world::Object o : hidden) {
     if (out.findObject(o.id) != nullptr) continue;
     const Aabb box = o.shape.aabb(o.pose);
-    const bool seen = std::any_of(live.objects().begin(), live.objects().end(), [&](const world::Object& x) {
-      const Eigen::Vector3d c = x.pose.translation();
-      return c.x() >= box.min.x() && c.x() <= box.max.x() && c.y() >= box.min.y() && c.y() <= box.max.y();
-    });
+    const bool seen =
+        std::any_of(live.objects().begin(), live.objects().end(), [&](const world::Object& x) {
+          const Eigen::Vector3d c = x.pose.translation();
+          return c.x() >= box.min.x() && c.x() <= box.max.x() && c.y() >= box.min.y() &&
+                 c.y() <= box.max.y();
+        });
     if (seen) continue;
     o.hidden = false;
     if (Status s = out.addObject(o); !s)
-      log::get("graph_manager")->warn("oracle: hidden object '{}' not added: {}", o.id, s.error().message);
+      log::get("graph_manager")
+          ->warn("oracle: hidden object '{}' not added: {}", o.id, s.error().message);
   }
   return out;
 }
 
-// ---- the graph manager under policy oracle ----------------------------------------------------------
+// ---- the graph manager under policy oracle ----------------------------------------------
 
 int GraphManager::blockingObjectsConsidered() const {
-  return params_.policy == Policy::kOracle ? std::max(params_.max_blocking_objects, params_.oracle_max_objects)
-                                           : params_.max_blocking_objects;
+  return params_.policy == Policy::kOracle
+             ? std::max(params_.max_blocking_objects, params_.oracle_max_objects)
+             : params_.max_blocking_objects;
 }
 
 void GraphManager::refreshOracle() {
   auto k = services_.oracle();
   if (!k) {
-    log::get("graph_manager")->warn("oracle: {} (going on with {})", k.error().message,
-                                    oracle_ ? "the last answer" : "no fault knowledge");
+    log::get("graph_manager")
+        ->warn("oracle: {} (going on with {})", k.error().message,
+               oracle_ ? "the last answer" : "no fault knowledge");
     return;
   }
   oracle_ = std::move(k).value();
@@ -85,8 +91,8 @@ double GraphManager::oraclePenalty(const std::vector<BranchStep>& steps) const {
   return faultRetryPenalty(oracle_->faults, oracle_->action_count, steps);
 }
 
-void GraphManager::spawnSubsetSubtasks(NodeId v, NodeId child,
-                                       const std::vector<std::pair<std::string, std::string>>& slots) {
+void GraphManager::spawnSubsetSubtasks(
+    NodeId v, NodeId child, const std::vector<std::pair<std::string, std::string>>& slots) {
   // What the blocked action achieved: each sub-task's second plan must achieve it too.
   const auto& va = graph_.node(v).atoms;
   std::vector<std::string> progress;

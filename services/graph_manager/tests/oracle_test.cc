@@ -14,8 +14,8 @@ using Subsets = std::vector<std::vector<std::size_t>>;
 TEST(OracleTest, RemovalSubsetsAreEverySubsetUpToTheStatedSizeSmallestFirst) {
   EXPECT_EQ(removalSubsets(3, 2), (Subsets{{0}, {1}, {2}, {0, 1}, {0, 2}, {1, 2}}));
   EXPECT_EQ(removalSubsets(3, 3), (Subsets{{0}, {1}, {2}, {0, 1}, {0, 2}, {1, 2}, {0, 1, 2}}));
-  EXPECT_EQ(removalSubsets(4, 4).size(), 15u);  // 2^4 - 1
-  EXPECT_EQ(removalSubsets(4, 2).size(), 10u);  // 4 + 6
+  EXPECT_EQ(removalSubsets(4, 4).size(), 15u);                   // 2^4 - 1
+  EXPECT_EQ(removalSubsets(4, 2).size(), 10u);                   // 4 + 6
   EXPECT_EQ(removalSubsets(2, 9), (Subsets{{0}, {1}, {0, 1}}));  // capped by n
   EXPECT_TRUE(removalSubsets(0, 3).empty());
   EXPECT_TRUE(removalSubsets(3, 0).empty());
@@ -54,8 +54,10 @@ TEST(OracleTest, AFailingPickIsPricedAsTheRetryItCosts) {
   // No pick in the branch: nothing to pay.
   EXPECT_DOUBLE_EQ(faultRetryPenalty({failAt(0, ActionKind::kPlace)}, 0, kBranch), 0.0);
   // Two faults, two retries.
-  EXPECT_DOUBLE_EQ(faultRetryPenalty({failAt(0, ActionKind::kPick), failAt(0, ActionKind::kMoveBase)}, 0, kBranch),
-                   15.0);
+  EXPECT_DOUBLE_EQ(
+      faultRetryPenalty({failAt(0, ActionKind::kPick), failAt(0, ActionKind::kMoveBase)}, 0,
+                        kBranch),
+      15.0);
   // A time trigger or another fault type has no fixed price.
   OracleFault timed = failAt(0, ActionKind::kPick);
   timed.step.reset();
@@ -110,7 +112,8 @@ TEST(OracleTest, ThePolicyAndItsBoundAreValidatedParameters) {
   auto bad = parseParams("policy: oracle\noracle_max_objects: 5\n", "gm.yaml");
   ASSERT_FALSE(bad.ok());
   EXPECT_NE(bad.error().toString().find("gm.yaml:2"), std::string::npos) << bad.error().toString();
-  EXPECT_NE(bad.error().toString().find("oracle_max_objects"), std::string::npos) << bad.error().toString();
+  EXPECT_NE(bad.error().toString().find("oracle_max_objects"), std::string::npos)
+      << bad.error().toString();
   GraphManagerParams q;
   q.oracle_max_objects = 0;
   ASSERT_TRUE(q.invalidReason());

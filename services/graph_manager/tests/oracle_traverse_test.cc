@@ -70,11 +70,13 @@ class ScriptedServices : public ServiceClients {
     // A path of that length: up by h, along, down by h.
     const double h = std::max(0.0, (len - straight) / 2.0);
     a.path.joint_names = {"base_x", "base_y", "base_theta"};
-    a.path.waypoints = {{s.x, s.y, 0.0}, {s.x, s.y + h, 0.0}, {g.x, g.y + h, 0.0}, {g.x, g.y, g.theta}};
+    a.path.waypoints = {
+        {s.x, s.y, 0.0}, {s.x, s.y + h, 0.0}, {g.x, g.y + h, 0.0}, {g.x, g.y, g.theta}};
     a.path_length = len;
     a.trajectory.joint_names = a.path.joint_names;
     for (std::size_t i = 0; i < a.path.waypoints.size(); ++i)
-      a.trajectory.points.push_back(TrajectoryPoint{static_cast<double>(i), a.path.waypoints[i], {}});
+      a.trajectory.points.push_back(
+          TrajectoryPoint{static_cast<double>(i), a.path.waypoints[i], {}});
     if (start_to_goal && q.mode == Mode::kLazy) {
       for (const auto& id : blocking) {
         Crossing c;
@@ -155,8 +157,8 @@ Outcome traverseWith(Policy policy, ScriptedServices& services, bool with_crate 
   p.max_contingencies = 0;
   p.placements_per_object = 1;
   const world::World told = c.sc.plannerWorld();
-  GraphManager gm(Abstraction(told, c.robot), "(define (domain scripted))", MissionGoal{{"(robot-at goal)"}}, services,
-                  p);
+  GraphManager gm(Abstraction(told, c.robot), "(define (domain scripted))",
+                  MissionGoal{{"(robot-at goal)"}}, services, p);
   Observation obs;
   obs.robot = c.sc.startState();
   obs.valid = true;
@@ -235,7 +237,9 @@ TEST(OracleTraverseTest, TwoBlockingObjectsAreAlsoRemovedTogether) {
   ScriptedServices e;
   e.blocking = {"box", "crate"};
   ASSERT_TRUE(traverseWith(Policy::kEffort, e, true).result.found);
-  for (const auto& g : e.removal_goals) EXPECT_EQ(g.size(), 1u) << "policy effort removes one object per sub-task";
+  EXPECT_EQ(e.removal_goals.size(), 2u) << "one sub-task per object";
+  for (const auto& g : e.removal_goals)
+    EXPECT_EQ(g.size(), 1u) << "policy effort removes one object per sub-task";
 }
 
 }  // namespace

@@ -31,10 +31,10 @@ struct OracleFault {
   enum class Type { kDropHeldObject, kSpawnObject, kFailAction, kRemoveObject };
   std::string id;
   Type type{Type::kFailAction};
-  std::optional<double> time_s;   ///< fires at this simulated time, or
-  std::optional<int> step;        ///< during the step-th command the simulator accepts (0-based)
+  std::optional<double> time_s;      ///< fires at this simulated time, or
+  std::optional<int> step;           ///< during the step-th command the simulator accepts (0-based)
   std::optional<ActionKind> action;  ///< kFailAction: only this kind (none: any)
-  std::string object_id;          ///< spawn/remove
+  std::string object_id;             ///< spawn/remove
 };
 
 /// What the simulator knows and the planner's view does not.

@@ -34,7 +34,8 @@ int main(int argc, char** argv) {
   app.add_option("--run-id", run_id, "run id of the running services (default: $TAMP_RUN_ID)");
   app.add_option("--deployment", deployment_file, "deployment the services run (its services and discovery)");
   app.add_option("--domain", domain, "DDS domain id (default: $TAMP_DOMAIN_ID or 0)")->check(CLI::Range(0, 232));
-  app.add_option("--policy", policy, "effort or infeasible")->check(CLI::IsMember({"effort", "infeasible"}));
+  app.add_option("--policy", policy, "effort, infeasible or oracle (oracle: the deployment's simulator must run with TAMP_ORACLE=1)")
+      ->check(CLI::IsMember({"effort", "infeasible", "oracle"}));
   app.add_option("--seed", seed, "seed of the mission's sampling (0: the graph manager's)");
   app.add_option("--mission-timeout", mission_timeout, "give up after this many seconds")->check(CLI::PositiveNumber);
   app.add_option("--out", out_dir, "report folder root: OUT/RUN_ID/mission");

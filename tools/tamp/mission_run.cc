@@ -197,7 +197,9 @@ int runMission(const std::shared_ptr<dds::Participant>& p, const MissionOptions&
   msg::MissionCommand c;
   c.mission_id(id);
   c.scenario_path(o.scenario);
-  c.policy(o.policy == "infeasible" ? msg::EffortPolicy::POLICY_INFEASIBILITY_ONLY : msg::EffortPolicy::POLICY_EFFORT_BASED);
+  c.policy(o.policy == "infeasible" ? msg::EffortPolicy::POLICY_INFEASIBILITY_ONLY
+           : o.policy == "oracle"   ? msg::EffortPolicy::POLICY_ORACLE
+                                    : msg::EffortPolicy::POLICY_EFFORT_BASED);
   c.seed(o.seed);
   std::printf("\ntamp run: mission %s, scenario %s, policy %s\n", id.c_str(), o.scenario.c_str(), o.policy.c_str());
   std::fflush(stdout);

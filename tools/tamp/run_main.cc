@@ -1,4 +1,4 @@
-// `tamp run [SCENARIO] [--policy effort|infeasible] [--out DIR] [--seed N]`: the main job. Starts
+// `tamp run [SCENARIO] [--policy effort|infeasible|oracle] [--out DIR] [--seed N]`: the main job. Starts
 // every service of a deployment (config/deploy/local.yaml by default) as supervised processes on
 // one DDS domain, waits until each is alive (heartbeats) and answers a request (echo), then sends
 // the scenario's mission to the graph manager and follows it: one line per executed action
@@ -47,8 +47,10 @@ int main(int argc, char** argv) {
   unsigned seed = 0;
   double mission_timeout = 900.0;
   app.add_option("scenario", scenario, "scenario YAML (config/scenarios/...) or NAMO world file");
-  app.add_option("--policy", policy, "effort (revise whenever cheaper) or infeasible (move objects only when no way around)")
-      ->check(CLI::IsMember({"effort", "infeasible"}));
+  app.add_option("--policy", policy,
+                 "effort (revise whenever cheaper), infeasible (move objects only when no way around) or oracle "
+                 "(evaluation only: the simulator's truth, the lower bound)")
+      ->check(CLI::IsMember({"effort", "infeasible", "oracle"}));
   app.add_option("--seed", seed, "seed of the mission's sampling (0: the graph manager's configured seed)");
   app.add_option("--mission-timeout", mission_timeout, "give up on the mission after this many seconds")
       ->check(CLI::PositiveNumber);
@@ -116,6 +118,10 @@ int main(int argc, char** argv) {
     setenv("TAMP_EFFORT_STORE", store.c_str(), 1);
     std::fprintf(stderr, "tamp run: --fresh: default time models, effort store %s\n", store.c_str());
   }
+  // --policy oracle: the simulator serves its truth (true durations, hidden objects, scripted
+  // faults) to the graph manager for this run only; a normal run does not expose it.
+  if (policy == "oracle") setenv("TAMP_ORACLE", "1", 1);
+  else unsetenv("TAMP_ORACLE");
   // The services inherit the security directory; each picks its identity by its --name.
   if (!security.empty()) setenv("TAMP_DDS_SECURITY", fs::absolute(security).c_str(), 1);
   tamp::cli::stopOnSignals({SIGINT, SIGTERM}, /*restart=*/true);

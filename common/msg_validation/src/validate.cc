@@ -472,6 +472,51 @@ Status validate(const msg::EffortReply& m, const Limits& limits) {
   return c.status();
 }
 
+Status validateEnvelope(const msg::OracleRequest& m, const Limits& limits) {
+  Check c("OracleRequest", limits);
+  if (!c.requestHeader(m.header())) return c.status();
+  c.size("queries", m.queries(), limits.max_items);
+  return c.status();
+}
+
+Status validate(const msg::OracleReply& m, const Limits& limits) {
+  Check c("OracleReply", limits);
+  if (!c.replyHeader(m.header())) return c.status();
+  if (!c.size("durations", m.durations(), limits.max_items)) return c.status();
+  for (std::size_t i = 0; i < m.durations().size() && c.ok(); ++i) {
+    const auto& e = m.durations()[i];
+    Scope s(c, "durations", i);
+    c.enumIn("code", e.code(), msg::STATUS_INTERNAL);
+    if (e.code() == msg::STATUS_OK) {
+      c.nonNegative("mean_s", e.mean_s());
+      c.nonNegative("stddev_s", e.stddev_s());
+    }
+  }
+  if (!c.size("hidden_objects", m.hidden_objects(), limits.max_items)) return c.status();
+  for (std::size_t i = 0; i < m.hidden_objects().size() && c.ok(); ++i) {
+    const auto& o = m.hidden_objects()[i];
+    Scope s(c, "hidden_objects", i);
+    c.id("id", o.id(), true);
+    c.enumIn("kind", o.kind(), msg::OBJECT_HIDDEN);
+    c.shape("shape", o.shape());
+    c.pose3("pose", o.pose(), true);
+    c.nonNegative("mass", o.mass());
+  }
+  if (!c.size("faults", m.faults(), limits.max_items)) return c.status();
+  for (std::size_t i = 0; i < m.faults().size() && c.ok(); ++i) {
+    const auto& f = m.faults()[i];
+    Scope s(c, "faults", i);
+    c.id("fault_id", f.fault_id(), false);
+    c.enumIn("type", f.type(), msg::FAULT_REMOVE_OBJECT);
+    c.nonNegative("time_s", f.time_s());
+    c.inRange("fraction", f.fraction(), 0.0, 1.0);
+    c.enumIn("action", f.action(), msg::ACTION_PLACE);
+    c.id("object_id", f.object_id(), false);
+  }
+  c.nonNegative("sim_time_s", m.sim_time_s());
+  return c.status();
+}
+
 // ---- streams and commands ----------------------------------------------------------------------
 
 Status validate(const msg::MissionCommand& m, const Limits& limits) {

@@ -22,6 +22,7 @@ Policy fromMsg(msg::EffortPolicy p, Policy fallback) {
   switch (p) {
     case msg::EffortPolicy::POLICY_EFFORT_BASED: return Policy::kEffort;
     case msg::EffortPolicy::POLICY_INFEASIBILITY_ONLY: return Policy::kInfeasible;
+    case msg::EffortPolicy::POLICY_ORACLE: return Policy::kOracle;
     default: return fallback;
   }
 }
@@ -69,6 +70,7 @@ GraphManagerNode::GraphManagerNode(const dds::ServiceArgs& args, GraphManagerPar
       status_(participant(), dds::topics::kMissionStatus),
       graph_(participant(), dds::topics::kGraph),
       clients_(participant(), robot),
+      oracle_clients_(participant(), clients_),
       executor_(participant(), ""),
       source_(participant(), robot) {
   openJournal();
@@ -155,7 +157,9 @@ msg::MissionCommand commandOf(const MissionRecord& r) {
   msg::MissionCommand c;
   c.mission_id(r.mission_id);
   c.scenario_path(r.scenario_path);
-  c.policy(r.policy == "infeasible" ? msg::EffortPolicy::POLICY_INFEASIBILITY_ONLY : msg::EffortPolicy::POLICY_EFFORT_BASED);
+  c.policy(r.policy == "infeasible" ? msg::EffortPolicy::POLICY_INFEASIBILITY_ONLY
+           : r.policy == "oracle"   ? msg::EffortPolicy::POLICY_ORACLE
+                                    : msg::EffortPolicy::POLICY_EFFORT_BASED);
   c.seed(r.seed);
   c.max_replans(static_cast<uint32_t>(std::max(0, r.max_replans)));
   c.goal(std::vector<std::string>(r.goal.begin(), r.goal.end()));
@@ -255,7 +259,25 @@ void GraphManagerNode::runOne(const msg::MissionCommand& c, const MissionRecord*
   if (Status ready = source_.waitReady(Termination::after(30.0)); !ready)
     return fail(MissionOutcome::kUnavailable, ready.error().message + " within 30 s (perception, sim running?)");
 
-  Abstraction abs(source_.world(), *robot);
+  // Policy oracle: efforts are the simulator's true durations and the world is the true one
+  // (hidden objects included); the simulator serves its truth only in an evaluation run.
+  ServiceClients* services = &clients_;
+  WorldSource* source = &source_;
+  std::optional<OracleWorldSource> oracle_source;
+  if (p.policy == Policy::kOracle) {
+    auto truth = oracle_clients_.oracle();
+    if (!truth)
+      return fail(MissionOutcome::kUnavailable,
+                  "policy oracle: " + truth.error().message +
+                      " (the simulator serves its truth only in an evaluation run: tamp run --policy oracle sets "
+                      "TAMP_ORACLE=1 for it)");
+    logger()->info("mission {}: oracle: {} hidden object(s), {} scripted fault(s), {} commands accepted", id,
+                   truth->hidden.size(), truth->faults.size(), truth->action_count);
+    oracle_source.emplace(source_, truth->hidden);
+    services = &oracle_clients_;
+    source = &*oracle_source;
+  }
+  Abstraction abs(source->world(), *robot);
   auto goal = goalOf(*sc, *robot, abs);
   if (!goal) return fail(MissionOutcome::kInputError, "bad goal: " + goal.error().toString());
   if (!c.goal().empty()) {
@@ -269,7 +291,7 @@ void GraphManagerNode::runOne(const msg::MissionCommand& c, const MissionRecord*
       goal->atoms.push_back(a);
     }
   }
-  GraphManager gm(std::move(abs), *domain, *goal, clients_, p);
+  GraphManager gm(std::move(abs), *domain, *goal, *services, p);
   // What the planner is told: the scenario's planner view (a hidden object in the gripper is not
   // in it). The robot's own report of the hand selects the conditional branch.
   // A resumed mission believes what the robot reports.
@@ -345,9 +367,9 @@ void GraphManagerNode::runOne(const msg::MissionCommand& c, const MissionRecord*
     at.in_flight_action = resumed->in_flight_action;
     at.in_flight_budget_s = resumed->in_flight_budget_s;
     publish(id, msg::MissionState::MISSION_PLANNING, "resuming after a restart of the graph manager");
-    r = gm.resumeMission(at, source_, executor, obs);
+    r = gm.resumeMission(at, *source, executor, obs);
   } else {
-    r = gm.runMission(source_, executor, obs);
+    r = gm.runMission(*source, executor, obs);
   }
   record.finished = true;
   record.outcome = std::string(toString(r.status));

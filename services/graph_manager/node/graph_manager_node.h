@@ -14,6 +14,7 @@
 #include <thread>
 
 #include "dds_clients.h"
+#include "oracle_clients.h"
 #include "tamp/dds/service_node.h"
 #include "tamp/msg_validation/validate.h"
 #include "tamp/graph_manager/journal.h"
@@ -61,6 +62,7 @@ class GraphManagerNode : public dds::ServiceNode {
   // are matched (and, under DDS Security, their crypto tokens exchanged) before the first mission
   // arrives, not at the start of each one. Used by the worker thread only.
   DdsServiceClients clients_;
+  OracleServiceClients oracle_clients_;  // policy oracle: efforts and truth from the simulator
   DdsExecutor executor_;
   DdsWorldSource source_;
   std::jthread thread_;

@@ -7,11 +7,19 @@
 
 namespace tamp::graph_manager {
 
-std::string_view toString(Policy p) { return p == Policy::kEffort ? "effort" : "infeasible"; }
+std::string_view toString(Policy p) {
+  switch (p) {
+    case Policy::kEffort: return "effort";
+    case Policy::kInfeasible: return "infeasible";
+    case Policy::kOracle: return "oracle";
+  }
+  return "?";
+}
 
 std::optional<Policy> policyFromString(std::string_view s) {
   if (s == "effort") return Policy::kEffort;
   if (s == "infeasible") return Policy::kInfeasible;
+  if (s == "oracle") return Policy::kOracle;
   return std::nullopt;
 }
 
@@ -25,13 +33,14 @@ const config::Schema<GraphManagerParams>& schema() {
     config::Schema<P> s;
     s.root()
         .convert<std::string>("policy", &P::policy,
-                              config::byName<Policy>(policyFromString, "policy", "effort, infeasible"))
+                              config::byName<Policy>(policyFromString, "policy", "effort, infeasible, oracle"))
         .field("seed", &P::seed)
         .field("max_evaluations", &P::max_evaluations, atLeast(1))
         .field("traverse_budget_s", &P::traverse_budget_s, positive())
         .field("max_replans", &P::max_replans, atLeast(0))
         .field("max_subtask_depth", &P::max_subtask_depth, atLeast(0))
         .field("max_blocking_objects", &P::max_blocking_objects, atLeast(1))
+        .field("oracle_max_objects", &P::oracle_max_objects, config::that<int>([](const int& v) { return v >= 1 && v <= 4; }, "must be in [1, 4]"))
         .field("placements_per_object", &P::placements_per_object, atLeast(1))
         .field("keep_clear_margin_m", &P::keep_clear_margin_m, config::nonNegative("m"))
         .field("lower_bound_base_speed", &P::lower_bound_base_speed, positive())

@@ -370,7 +370,7 @@ double GraphManager::evaluateBase(Edge& e, const BranchContext& ctx, int depth) 
     const EdgeId id = e.id;
     const std::string origin = e.origin;
     graph_.addVariant(id, Variant::kAround, origin);
-    if (params_.policy == Policy::kEffort && depth <= params_.max_subtask_depth) spawnSubtasks(id, ctx, depth);
+    if (params_.policy != Policy::kInfeasible && depth <= params_.max_subtask_depth) spawnSubtasks(id, ctx, depth);
     return kInfinity;
   }
   e.state = EdgeState::kFeasible;
@@ -866,8 +866,9 @@ void GraphManager::spawnSubtasks(EdgeId id, const BranchContext& ctx, int depth)
   const double radius = abstraction_.robot().baseRadius() + params_.keep_clear_margin_m;
   int objects = 0;
   std::vector<std::string> unmovable;  // why a crossed object spawned no sub-task (for the failure reason)
+  std::vector<std::pair<std::string, std::string>> first_slots;  // per movable object, for the oracle's subsets
   for (const auto& crossing : motion.crossings) {
-    if (objects >= params_.max_blocking_objects) break;
+    if (objects >= blockingObjectsConsidered()) break;
     const world::Object* o = abstraction_.world().findObject(crossing.object_id);
     if (!o) continue;
     // findPossibleActions: only pick and place move objects.
@@ -938,7 +939,9 @@ void GraphManager::spawnSubtasks(EdgeId id, const BranchContext& ctx, int depth)
       if (!isGoal(end)) (void)planFrom(end, goal_.atoms, origin);
     }
     if (slots.empty()) unmovable.push_back("no placement for '" + o->id + "' off the path");
+    else first_slots.emplace_back(o->id, slots.front());
   }
+  if (params_.policy == Policy::kOracle) spawnSubsetSubtasks(v, child, first_slots);
   // The edge may have moved: the graph grew.
   Edge& e = graph_.edge(id);
   for (const auto& why : unmovable) e.reason += "; " + why;
@@ -949,9 +952,14 @@ void GraphManager::spawnSubtasks(EdgeId id, const BranchContext& ctx, int depth)
 // ---- branch-and-bound ----------------------------------------------------------------------------------
 
 struct GraphManager::Search {
-  Search(GraphManager& g, Clock::time_point start) : gm(g), t0(start) {}
+  Search(GraphManager& g, Clock::time_point start)
+      : gm(g), t0(start), exhaustive(g.params_.policy == Policy::kOracle) {}
   GraphManager& gm;
   Clock::time_point t0;
+  /// Policy oracle: no branch is cut on its bound (every branch within the evaluation budget is
+  /// priced in full), and each complete branch pays what the scripted failures will cost it.
+  bool exhaustive{false};
+  std::vector<BranchStep> steps;  ///< parallel to `branch`: what the robot executes
   double best{kInfinity};
   double best_sd2{0.0};
   std::vector<EdgeId> best_branch;
@@ -961,6 +969,12 @@ struct GraphManager::Search {
   bool exhausted{false};
   std::vector<EdgeId> branch;
   std::vector<double> branch_sd2;
+
+  /// A manipulation with a transfer arm motion sends the robot two commands.
+  static BranchStep stepOf(const Edge& e, double effort_s) {
+    const bool transfer = e.motion && !e.motion->transfer.empty();
+    return BranchStep{e.kind, effort_s, transfer ? 2 : 1};
+  }
 
   bool outOfBudget() {
     if (evaluations >= gm.params_.max_evaluations || since(t0) > gm.params_.traverse_budget_s) {
@@ -984,7 +998,8 @@ struct GraphManager::Search {
     return e.state == EdgeState::kUnevaluated ? e.lower_bound_s : e.effort_mean_s;
   }
 
-  void complete(double cost) {
+  void complete(double branch_cost) {
+    const double cost = branch_cost + gm.oraclePenalty(steps);
     if (cost < best) {
       best = cost;
       best_branch = branch;
@@ -1019,7 +1034,7 @@ struct GraphManager::Search {
       Edge& e = gm.graph_.edge(pick);
       if (e.to == v || onBranch(e.to)) continue;
       if (!std::isfinite(pick_cost)) continue;
-      if (cost + pick_cost >= best) {
+      if (!exhaustive && cost + pick_cost >= best) {
         e.cut = true;
         cut_bound[pick] = cost + pick_cost;
         continue;
@@ -1034,17 +1049,19 @@ struct GraphManager::Search {
       // Evaluating may grow the graph (variants, sub-tasks): the edge is looked up again.
       Edge& done = gm.graph_.edge(pick);
       if (!std::isfinite(c)) continue;
-      if (cost + c >= best) {
+      if (!exhaustive && cost + c >= best) {
         done.cut = true;
         cut_bound[pick] = cost + c;
         continue;
       }
       branch.push_back(pick);
       branch_sd2.push_back(done.effort_stddev_s * done.effort_stddev_s);
+      steps.push_back(stepOf(done, c));
       const NodeId to = done.to;
       dfs(to, gm.advance(pick, -1, ctx), cost + c, depth);
       branch.pop_back();
       branch_sd2.pop_back();
+      steps.pop_back();
     }
   }
 
@@ -1061,7 +1078,7 @@ struct GraphManager::Search {
       ++evaluations;
       const double c = gm.evaluate(arm, f, ctx, depth);
       if (!std::isfinite(c)) continue;
-      if (cost + c >= best) {
+      if (!exhaustive && cost + c >= best) {
         gm.graph_.edge(arm).cut = true;
         cut_bound[arm] = cost + c;
         continue;
@@ -1069,6 +1086,7 @@ struct GraphManager::Search {
       const auto sd = gm.graph_.edge(arm).effort_by_next[f].second;
       branch.push_back(arm);
       branch_sd2.push_back(sd * sd);
+      steps.push_back(BranchStep{ActionKind::kMoveArm, c, 1});
       const BranchContext next_ctx = gm.advance(arm, f, ctx);
       if (f < 0) {
         dfs(a.to, next_ctx, cost + c, depth);
@@ -1077,16 +1095,19 @@ struct GraphManager::Search {
         const Edge& fe = gm.graph_.edge(f);
         ++evaluations;
         const double cf = gm.evaluate(f, -1, next_ctx, depth);
-        if (std::isfinite(cf) && cost + c + cf < best && !onBranch(fe.to)) {
+        if (std::isfinite(cf) && (exhaustive || cost + c + cf < best) && !onBranch(fe.to)) {
           branch.push_back(f);
           branch_sd2.push_back(fe.effort_stddev_s * fe.effort_stddev_s);
+          steps.push_back(stepOf(fe, cf));
           dfs(fe.to, gm.advance(f, -1, next_ctx), cost + c + cf, depth);
           branch.pop_back();
           branch_sd2.pop_back();
+          steps.pop_back();
         }
       }
       branch.pop_back();
       branch_sd2.pop_back();
+      steps.pop_back();
     }
   }
 };
@@ -1094,6 +1115,7 @@ struct GraphManager::Search {
 TraverseResult GraphManager::traverse(NodeId from, const BranchContext& context) {
   const auto t0 = Clock::now();
   ++traverse_count_;
+  if (params_.policy == Policy::kOracle) refreshOracle();
   TraverseResult r;
   if (graph_.out(from).empty() && !isGoal(from)) {
     auto plan = planFrom(from, goal_.atoms, "plan " + std::to_string(traverse_count_));

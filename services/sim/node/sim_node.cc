@@ -154,6 +154,7 @@ Result<std::unique_ptr<dds::ServiceNode>> SimNode::create(const dds::ServiceArgs
 SimNode::SimNode(const dds::ServiceArgs& args, SimSetup setup, SimParams params) : ServiceNode(args) {
   robot_id_ = setup.robot.name();
   joint_names_ = setup.robot.fullJointNames();
+  scripted_ = setup.faults;
   sim_ = std::make_unique<Simulator>(std::move(setup.world), std::move(setup.robot), setup.initial,
                                      std::move(params), std::move(setup.faults));
   const auto& p = participant();
@@ -193,6 +194,13 @@ SimNode::SimNode(const dds::ServiceArgs& args, SimSetup setup, SimParams params)
   fault_reader_ = std::make_unique<dds::Reader<msg::FaultInjection>>(
       p, dds::topics::kFaultInjection,
       [this](const msg::FaultInjection& m, const dds::SampleMeta&) { onFault(m); });
+  if (oracleEnabled()) {
+    logger()->warn("oracle enabled ($TAMP_ORACLE): serving the truth on {} (evaluation only)",
+                   dds::services::kOracle.name);
+    oracle_ = std::make_unique<dds::RpcServer<msg::OracleRequest, msg::OracleReply>>(
+        p, dds::services::kOracle,
+        [this](const msg::OracleRequest& req, const dds::RequestContext&) { return onOracle(req); });
+  }
   loop_->start();
 }
 
@@ -232,6 +240,7 @@ void writeFinalWorld(Simulator& sim) {
 
 SimNode::~SimNode() {
   // Stop input first, then the loop (its callbacks use the writers).
+  oracle_.reset();
   command_reader_.reset();
   fault_reader_.reset();
   if (loop_) loop_->stop();
@@ -283,6 +292,100 @@ void SimNode::onCommand(const msg::TrajectoryCommand& m) {
   } catch (const std::exception& e) {
     logger()->error("command '{}': {}", m.command_id(), e.what());
   }
+}
+
+bool oracleEnabled() {
+  const char* v = std::getenv("TAMP_ORACLE");
+  return v != nullptr && (std::string(v) == "1" || std::string(v) == "true");
+}
+
+std::vector<msg::EffortEstimate> oracleDurations(const SimParams& params, const robot::RobotModel& robot,
+                                                 const std::vector<msg::EffortQuery>& queries) {
+  const auto speeds = armSpeedLimits(robot);
+  std::vector<msg::EffortEstimate> out(queries.size());
+  for (std::size_t i = 0; i < queries.size(); ++i) {
+    const std::string field = "queries[" + std::to_string(i) + "]";
+    if (Status bad = msgv::validateQuery(queries[i], i); !bad.ok()) {
+      out[i].code(msg::STATUS_INVALID_ARGUMENT);
+      out[i].message(bad.error().message);
+      continue;
+    }
+    NominalQuery q;
+    q.kind = dds::fromMsg(queries[i].kind());
+    q.object_mass_kg = queries[i].object_mass();
+    q.approach_m = queries[i].approach_m();
+    q.retreat_m = queries[i].retreat_m();
+    if (q.kind == ActionKind::kMoveBase || q.kind == ActionKind::kMoveArm) {
+      auto path = dds::fromMsg(queries[i].path(), field + ".path");
+      if (!path) {
+        out[i].code(msg::STATUS_INVALID_ARGUMENT);
+        out[i].message(path.error().toString());
+        continue;
+      }
+      q.path = std::move(path).value();
+    }
+    auto t = nominalDuration(params.dynamics, speeds, q);
+    if (!t) {
+      out[i].code(dds::toMsg(t.error().code));
+      out[i].message(field + ": " + t.error().message);
+      continue;
+    }
+    out[i].mean_s(*t);
+    out[i].stddev_s(params.duration_noise * *t);
+    out[i].code(msg::STATUS_OK);
+  }
+  return out;
+}
+
+msg::OracleReply SimNode::onOracle(const msg::OracleRequest& req) {
+  msg::OracleReply rep;
+  try {
+    if (Status bad = msgv::validateEnvelope(req); !bad.ok()) {
+      rejects_.reject(dds::services::kOracle.name, bad.error());
+      rep.header().code(msg::STATUS_INVALID_ARGUMENT);
+      rep.header().message(bad.error().message);
+      return rep;
+    }
+    // The dynamics and the robot never change after construction: no lock needed for them.
+    rep.durations(oracleDurations(sim_->params(), sim_->robot(), req.queries()));
+    loop_->withSimulator([&](Simulator& sim) {
+      rep.action_count(sim.actionCount());
+      rep.sim_time_s(sim.time());
+      if (!req.want_truth()) return;
+      for (const auto& o : sim.world().objects()) {
+        if (!o.hidden) continue;
+        world::Object told = o;  // its kind (movable or static) on the wire: the list says it is hidden
+        told.hidden = false;
+        rep.hidden_objects().push_back(dds::toMsg(told, 0));
+      }
+    });
+    if (req.want_truth()) {
+      for (const Fault& f : scripted_) {
+        msg::OracleFault m;
+        m.fault_id(f.id);
+        switch (f.type) {
+          case FaultType::kDropHeldObject: m.type(msg::FaultType::FAULT_DROP_HELD_OBJECT); break;
+          case FaultType::kSpawnObject: m.type(msg::FaultType::FAULT_SPAWN_OBJECT); break;
+          case FaultType::kFailAction: m.type(msg::FaultType::FAULT_FAIL_NEXT_ACTION); break;
+          case FaultType::kRemoveObject: m.type(msg::FaultType::FAULT_REMOVE_OBJECT); break;
+        }
+        m.at_time(f.trigger.time_s.has_value());
+        m.time_s(f.trigger.time_s.value_or(0.0));
+        m.step(f.trigger.step.value_or(-1));
+        m.fraction(f.trigger.fraction);
+        m.any_action(!f.action.has_value());
+        m.action(dds::toMsg(f.action.value_or(ActionKind::kMoveBase)));
+        m.object_id(f.type == FaultType::kSpawnObject ? f.object.id : f.object_id);
+        rep.faults().push_back(m);
+      }
+    }
+    rep.header().code(msg::STATUS_OK);
+  } catch (const std::exception& e) {
+    rep = msg::OracleReply{};
+    rep.header().code(msg::STATUS_INTERNAL);
+    rep.header().message(std::string("oracle: ") + e.what());
+  }
+  return rep;
 }
 
 void SimNode::onFault(const msg::FaultInjection& m) {

@@ -10,10 +10,17 @@
 /// tamp/robot/record (ExecutionRecord, one per finished action, record_id = the command id; the
 /// execution monitor adds the prediction and forwards it on tamp/execution/record).
 ///
+/// Serves (only when the oracle is enabled: `ServiceArgs`-independent, $TAMP_ORACLE=1, which
+/// `tamp run --policy oracle` sets for the run): tamp/sim/oracle (OracleRequest -> OracleReply):
+/// the true nominal durations of a batch of effort queries (`sim::nominalDuration` with this
+/// simulator's dynamics), and on request the hidden objects and the scripted faults. Evaluation
+/// only: a normal deployment does not expose the truth.
+///
 /// Nothing escapes a DDS callback: malformed messages become failed results and log lines.
 
 #include <memory>
 
+#include "tamp/dds/rpc.h"
 #include "tamp/dds/service_node.h"
 #include "tamp/msg_validation/validate.h"
 #include "tamp/dds/topics.h"
@@ -34,6 +41,16 @@ Result<Fault> fromMsg(const msg::FaultInjection& m);
 msg::RobotState toMsg(const RobotStateSample& s, const std::vector<std::string>& joint_names,
                       const std::string& robot_id, std::int64_t stamp_ns, std::uint64_t seq);
 
+/// The oracle's durations: one estimate per query, mean_s the true nominal duration with
+/// `params.dynamics` (no noise, no stall), stddev_s the true execution noise around it
+/// (`duration_noise` x mean: the log-normal factor's spread, stalls not included); a malformed
+/// query gets INVALID_ARGUMENT naming the field. Exposed for tests.
+std::vector<msg::EffortEstimate> oracleDurations(const SimParams& params, const robot::RobotModel& robot,
+                                                 const std::vector<msg::EffortQuery>& queries);
+
+/// Whether this process serves the oracle ($TAMP_ORACLE is "1" or "true").
+bool oracleEnabled();
+
 class SimNode : public dds::ServiceNode {
  public:
   /// Loads the parameters (--config, else configDir()/services/sim.yaml when it exists, else the
@@ -52,6 +69,7 @@ class SimNode : public dds::ServiceNode {
   msgv::RejectLog rejects_{"sim"};  // malformed input: logged once per kind, rate-limited
   void onCommand(const msg::TrajectoryCommand& m);
   void onFault(const msg::FaultInjection& m);
+  msg::OracleReply onOracle(const msg::OracleRequest& req);
 
   std::unique_ptr<Simulator> sim_;
   std::vector<std::string> joint_names_;
@@ -63,6 +81,8 @@ class SimNode : public dds::ServiceNode {
   std::unique_ptr<SimulationLoop> loop_;
   std::unique_ptr<dds::Reader<msg::TrajectoryCommand>> command_reader_;
   std::unique_ptr<dds::Reader<msg::FaultInjection>> fault_reader_;
+  std::vector<Fault> scripted_;  ///< the scenario's faults, for the oracle
+  std::unique_ptr<dds::RpcServer<msg::OracleRequest, msg::OracleReply>> oracle_;
   std::atomic<std::uint64_t> state_seq_{0}, cloud_seq_{0};
   std::atomic<std::uint64_t> commands_{0}, rejected_{0};
 };

@@ -1,9 +1,11 @@
 // The simulator's DDS node in-process on an isolated domain: a TrajectoryCommand in, an
 // ActionResult, robot states, an execution record and a point cloud out; a malformed command
-// answered with a failed result naming the field; an injected fault applied.
+// answered with a failed result naming the field; an injected fault applied; the oracle served
+// (true nominal durations, hidden objects, scripted faults) only when enabled.
 #include "sim_node.h"
 
 #include <condition_variable>
+#include <cstdlib>
 #include <mutex>
 
 #include <gtest/gtest.h>
@@ -164,6 +166,146 @@ TEST(SimNodeTest, ConversionsRejectMalformedMessages) {
   auto fault = fromMsg(f);
   ASSERT_FALSE(fault);
   EXPECT_EQ(fault.error().where.field, "object");
+}
+
+}  // namespace
+}  // namespace tamp::sim
+
+namespace tamp::sim {
+namespace {
+
+using namespace tamp::sim::testing;
+
+/// $TAMP_ORACLE set for one scope (the node reads it when it is built).
+struct OracleEnv {
+  explicit OracleEnv(bool on) {
+    if (on) setenv("TAMP_ORACLE", "1", 1);
+    else unsetenv("TAMP_ORACLE");
+  }
+  ~OracleEnv() { unsetenv("TAMP_ORACLE"); }
+};
+
+// The oracle's durations are the simulator's true nominal ones: equal to Simulator::
+// nominalDuration of the same command (another code path: the command's planned timeline) and,
+// with noise and stalls off, to what the robot then takes. It also reveals the hidden objects
+// (with their true kind) and the scripted faults.
+TEST(SimNodeOracleTest, DurationsAreTheSimulatorsNominalOnesAndTheTruthIsRevealed) {
+  const OracleEnv env(true);
+  const int domain = dds::testing::isolatedDomain();
+  dds::ServiceArgs args;
+  args.name = "sim_oracle_test";
+  args.domain_id = domain;
+  SimParams params = exactParams();
+  params.dynamics.base.latency_s = 0.25;  // something other than the defaults' zero, if any
+  world::World w = emptyRoom();
+  ASSERT_TRUE(w.addObject(box("crate", 0.4, 0.4, 0.4, at(3.0, 2.0, 0.2), true, true)));
+  Fault fail;
+  fail.id = "pick_slips";
+  fail.type = FaultType::kFailAction;
+  fail.trigger.step = 2;
+  fail.action = ActionKind::kPick;
+  SimNode node(args, SimSetup(w, robotModel(), upright(), {fail}), params);
+
+  auto p = dds::testing::makeParticipant(domain);
+  ASSERT_TRUE(p);
+  dds::RpcClient<msg::OracleRequest, msg::OracleReply> oracle(p, dds::services::kOracle);
+  ASSERT_TRUE(oracle.waitForServer(Termination::after(20)));
+
+  const auto drive = moveBase("drive", {{0, 0, 0}, {1.5, 0, 0}, {1.5, 1.0, 1.0}});
+  const auto arm = armCommand("arm", ActionKind::kMoveArm,
+                              {std::vector<double>(robotModel().armDof(), 0.0),
+                               std::vector<double>(robotModel().armDof(), 0.4)});
+  msg::OracleRequest req;
+  msg::EffortQuery qb;
+  qb.kind(msg::ActionKind::ACTION_MOVE_BASE);
+  qb.path(dds::toMsg(drive.trajectory.path()));
+  msg::EffortQuery qa;
+  qa.kind(msg::ActionKind::ACTION_MOVE_ARM);
+  qa.path(dds::toMsg(arm.trajectory.path()));
+  qa.object_mass(3.0);
+  msg::EffortQuery qp;
+  qp.kind(msg::ActionKind::ACTION_PICK);
+  qp.approach_m(0.1);
+  qp.retreat_m(0.1);
+  qp.object_mass(2.0);
+  msg::EffortQuery qbad = qb;
+  qbad.object_mass(-1.0);
+  req.queries({qb, qa, qp, qbad});
+  req.want_truth(true);
+  auto rep = oracle.call(req, dds::CallOptions{10.0, {}});
+  ASSERT_TRUE(rep) << rep.error().toString();
+  ASSERT_EQ(rep->header().code(), msg::STATUS_OK) << rep->header().message();
+  ASSERT_EQ(rep->durations().size(), 4u);
+
+  // move_base: against the simulator's own timeline of the command from where the robot stands.
+  Result<double> planned = Error(ErrorCode::kInternal, "not run");
+  node.loop().withSimulator([&](Simulator& s) { planned = s.nominalDuration(drive); });
+  ASSERT_TRUE(planned) << planned.error().toString();
+  ASSERT_EQ(rep->durations()[0].code(), msg::STATUS_OK) << rep->durations()[0].message();
+  EXPECT_NEAR(rep->durations()[0].mean_s(), *planned, 1e-9);
+  EXPECT_EQ(rep->durations()[0].stddev_s(), 0.0);  // exactParams: no execution noise
+  // move_arm with a load and pick: the dynamics' nominal duration with the node's parameters.
+  const auto speeds = armSpeedLimits(robotModel());
+  NominalQuery na;
+  na.kind = ActionKind::kMoveArm;
+  na.path = arm.trajectory.path();
+  na.object_mass_kg = 3.0;
+  NominalQuery np;
+  np.kind = ActionKind::kPick;
+  np.approach_m = np.retreat_m = 0.1;
+  np.object_mass_kg = 2.0;
+  EXPECT_NEAR(rep->durations()[1].mean_s(), *nominalDuration(params.dynamics, speeds, na), 1e-9);
+  EXPECT_NEAR(rep->durations()[2].mean_s(), *nominalDuration(params.dynamics, speeds, np), 1e-9);
+  // A malformed query is refused alone, naming its field.
+  EXPECT_EQ(rep->durations()[3].code(), msg::STATUS_INVALID_ARGUMENT);
+  EXPECT_NE(rep->durations()[3].message().find("queries[3].object_mass"), std::string::npos)
+      << rep->durations()[3].message();
+
+  // The truth: the hidden crate as the movable object it is, the scripted failure.
+  ASSERT_EQ(rep->hidden_objects().size(), 1u);
+  EXPECT_EQ(rep->hidden_objects()[0].id(), "crate");
+  EXPECT_EQ(rep->hidden_objects()[0].kind(), msg::OBJECT_MOVABLE);
+  ASSERT_EQ(rep->faults().size(), 1u);
+  EXPECT_EQ(rep->faults()[0].fault_id(), "pick_slips");
+  EXPECT_EQ(rep->faults()[0].type(), msg::FaultType::FAULT_FAIL_NEXT_ACTION);
+  EXPECT_FALSE(rep->faults()[0].at_time());
+  EXPECT_EQ(rep->faults()[0].step(), 2);
+  EXPECT_FALSE(rep->faults()[0].any_action());
+  EXPECT_EQ(rep->faults()[0].action(), msg::ActionKind::ACTION_PICK);
+  EXPECT_EQ(rep->action_count(), 0);
+
+  // Executed (noise and stalls off), the drive takes exactly what the oracle said.
+  ASSERT_TRUE(node.loop().submit(drive));
+  double measured = -1.0;
+  while (measured < 0.0) {
+    node.loop().withSimulator([&](Simulator& s) {
+      const auto& log = s.actionLog();
+      if (!log.empty() && log.back().result) measured = log.back().result->duration_s;
+    });
+    if (measured < 0.0) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  EXPECT_NEAR(measured, rep->durations()[0].mean_s(), 1e-6);
+}
+
+// A normal deployment does not expose the truth: without $TAMP_ORACLE no oracle is served
+// (judged after the node's other request/reply service, echo, is matched).
+TEST(SimNodeOracleTest, NoOracleIsServedUnlessEnabled) {
+  const OracleEnv env(false);
+  const int domain = dds::testing::isolatedDomain();
+  dds::ServiceArgs args;
+  args.name = "sim_no_oracle_test";
+  args.domain_id = domain;
+  SimNode node(args, SimSetup(emptyRoom(), robotModel(), upright()), exactParams());
+  auto p = dds::testing::makeParticipant(domain);
+  ASSERT_TRUE(p);
+  dds::RpcClient<msg::EchoRequest, msg::EchoReply> echo(p, dds::echoService("sim_no_oracle_test"));
+  ASSERT_TRUE(echo.waitForServer(Termination::after(20)));
+  dds::RpcClient<msg::OracleRequest, msg::OracleReply> oracle(p, dds::services::kOracle);
+  EXPECT_FALSE(oracle.waitForServer(Termination::after(2)));
+  msg::OracleRequest req;
+  req.want_truth(true);
+  auto rep = oracle.call(req, dds::CallOptions{1.0, {}});
+  EXPECT_FALSE(rep);
 }
 
 }  // namespace

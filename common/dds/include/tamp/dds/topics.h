@@ -11,6 +11,7 @@
 #include "tamp/msg/heartbeatPubSubTypes.h"
 #include "tamp/msg/missionPubSubTypes.h"
 #include "tamp/msg/motionPubSubTypes.h"
+#include "tamp/msg/oraclePubSubTypes.h"
 #include "tamp/msg/planningPubSubTypes.h"
 #include "tamp/msg/robotPubSubTypes.h"
 #include "tamp/msg/worldPubSubTypes.h"
@@ -54,6 +55,8 @@ TAMP_DDS_TYPE(MissionStatus)
 TAMP_DDS_TYPE(GraphSnapshot)
 TAMP_DDS_TYPE(EchoRequest)
 TAMP_DDS_TYPE(EchoReply)
+TAMP_DDS_TYPE(OracleRequest)
+TAMP_DDS_TYPE(OracleReply)
 
 /// A request/reply service: two topics and the request's payload limit.
 template <typename Req, typename Rep>
@@ -105,6 +108,8 @@ inline constexpr ServiceSpec<msg::MotionRequest, msg::MotionReply> kMotion{"tamp
 inline constexpr ServiceSpec<msg::PlacementRequest, msg::PlacementReply> kPlacement{"tamp/motion_planner/placement"};
 inline constexpr ServiceSpec<msg::GraspRequest, msg::GraspReply> kGrasp{"tamp/motion_planner/grasp"};
 inline constexpr ServiceSpec<msg::EffortRequest, msg::EffortReply> kEffort{"tamp/effort_estimator/estimate"};
+/// The simulator's truth for the `oracle` policy (evaluation only: served when $TAMP_ORACLE=1).
+inline constexpr ServiceSpec<msg::OracleRequest, msg::OracleReply> kOracle{"tamp/sim/oracle"};
 /// Every node answers echo requests on "tamp/<node name>/echo" (see echoService()).
 }  // namespace services
 

@@ -32,6 +32,7 @@
 #include "tamp/msg/execution.h"
 #include "tamp/msg/mission.h"
 #include "tamp/msg/motion.h"
+#include "tamp/msg/oracle.h"
 #include "tamp/msg/planning.h"
 #include "tamp/msg/robot.h"
 #include "tamp/msg/world.h"
@@ -62,12 +63,15 @@ Status validate(const msg::EffortRequest& m, const Limits& limits = {});
 /// header and the number of queries, then each query (named "EffortRequest.queries[i]...").
 Status validateEnvelope(const msg::EffortRequest& m, const Limits& limits = {});
 Status validateQuery(const msg::EffortQuery& q, std::size_t index, const Limits& limits = {});
+/// OracleRequest's header and the number of queries; each query then with validateQuery.
+Status validateEnvelope(const msg::OracleRequest& m, const Limits& limits = {});
 // Replies the graph manager reads.
 Status validate(const msg::PlanReply& m, const Limits& limits = {});
 Status validate(const msg::MotionReply& m, const Limits& limits = {});
 Status validate(const msg::PlacementReply& m, const Limits& limits = {});
 Status validate(const msg::GraspReply& m, const Limits& limits = {});
 Status validate(const msg::EffortReply& m, const Limits& limits = {});
+Status validate(const msg::OracleReply& m, const Limits& limits = {});
 // Streams and commands.
 Status validate(const msg::MissionCommand& m, const Limits& limits = {});
 Status validate(const msg::ExecuteCommand& m, const Limits& limits = {});

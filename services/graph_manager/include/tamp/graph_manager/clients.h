@@ -19,6 +19,7 @@
 #include "tamp/core/error.h"
 #include "tamp/core/geometry.h"
 #include "tamp/core/trajectory.h"
+#include "tamp/graph_manager/oracle.h"
 #include "tamp/robot/robot_model.h"
 
 namespace tamp::graph_manager {
@@ -164,6 +165,11 @@ class ServiceClients {
   virtual Result<std::vector<PlacementOption>> placements(const PlacementQuery& q) = 0;
   virtual Result<std::vector<GraspOption>> grasps(const GraspQuery& q) = 0;
   virtual std::vector<EffortAnswer> effort(const std::vector<EffortQuery>& q) = 0;
+  /// Policy `oracle` only: what the simulator knows (hidden objects, scripted faults, how many
+  /// commands it accepted). An error when no oracle is served (a normal deployment).
+  virtual Result<OracleKnowledge> oracle() {
+    return Error(ErrorCode::kUnavailable, "no oracle: these clients do not reach the simulator's truth");
+  }
 };
 
 // ---- execution ----------------------------------------------------------------------------------------

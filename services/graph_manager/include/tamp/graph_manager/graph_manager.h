@@ -29,6 +29,13 @@
 ///    motion whose start no longer matches the robot, and re-running `traverse()` from the
 ///    robot's node after a failed or blocked action (bounded by `max_replans`).
 ///
+/// 4. Policies (params.h): `effort` as above; `infeasible` spawns removal sub-tasks only when the
+///    detour is proven impossible; `oracle` (oracle.h, the lower bound of the evaluation) takes
+///    its efforts and its knowledge of hidden objects and scripted faults from
+///    `ServiceClients::effort()`/`oracle()` (the simulator's truth, at the node), adds a sub-task
+///    per subset of up to `oracle_max_objects` blocking objects, cuts no branch on its bound and
+///    charges each complete branch the retries its scripted failures will cost.
+///
 /// The library knows nothing of DDS: the services are reached through `ServiceClients` and the
 /// robot through `Executor` (clients.h).
 
@@ -322,6 +329,19 @@ class GraphManager {
   bool armStowed(const std::vector<double>& arm) const;
   double lowerBound(const Edge& e) const;
   void spawnSubtasks(EdgeId e, const BranchContext& ctx, int depth);
+  // ---- policy oracle (oracle.cc) ----
+  /// Blocking objects of one edge given removal sub-tasks under the current policy.
+  int blockingObjectsConsidered() const;
+  /// Policy oracle: sub-tasks that remove every subset of 2 to `oracle_max_objects` of the
+  /// objects in `slots` (object, its first slot) together, from `v`, then achieve what the
+  /// blocked edge `v -> child` achieved, then the goal. Single objects are spawnSubtasks' own.
+  void spawnSubsetSubtasks(NodeId v, NodeId child, const std::vector<std::pair<std::string, std::string>>& slots);
+  /// Policy oracle: asks the simulator's truth again (before each Traverse: the fault schedule
+  /// is counted in the simulator's accepted commands). Keeps the last answer on failure.
+  void refreshOracle();
+  /// Policy oracle: what the scripted failures cost `steps` (0 for the other policies).
+  double oraclePenalty(const std::vector<BranchStep>& steps) const;
+  std::optional<OracleKnowledge> oracle_;
   double evaluateBase(Edge& e, const BranchContext& ctx, int depth);
   MotionAnswer planBase(const MotionQuery& q);
   MotionAnswer lazyOrFull(const MotionQuery& q);

@@ -15,8 +15,13 @@ namespace tamp::graph_manager {
 enum class Policy {
   kEffort,      ///< revise whenever a cheaper branch exists: removal and detour are both priced
   kInfeasible,  ///< consider moving an object only when full mode proves there is no way around
+  /// The lower bound (evaluation only): efforts are the simulator's true nominal durations, the
+  /// hidden objects are known at planning time, scripted action failures are priced as the
+  /// retry they cost, and remove-or-avoid is evaluated exhaustively: every subset of up to
+  /// `oracle_max_objects` blocking objects removed, the rest gone round, no branch-and-bound cut.
+  kOracle,
 };
-std::string_view toString(Policy p);  ///< "effort", "infeasible"
+std::string_view toString(Policy p);  ///< "effort", "infeasible", "oracle"
 std::optional<Policy> policyFromString(std::string_view s);
 
 struct GraphManagerParams {
@@ -27,6 +32,11 @@ struct GraphManagerParams {
   int max_replans{4};              ///< failed executions tolerated before the mission fails; >= 0
   int max_subtask_depth{1};        ///< nested sub-tasks (a removal inside a removal branch); >= 0
   int max_blocking_objects{2};     ///< blocking objects of one edge given sub-tasks; >= 1
+  /// Policy `oracle`: the largest set of an edge's blocking objects removed together in one
+  /// sub-task (every subset up to this size is planned and priced; the objects not in a subset
+  /// are gone round); also the blocking objects per edge considered. 2^n - 1 sub-tasks for n
+  /// objects, so keep it small; >= 1, <= 4.
+  int oracle_max_objects{3};
   int placements_per_object{2};    ///< findEffectStates: sampled placements kept per object; >= 1
   double keep_clear_margin_m{0.10};  ///< placements keep this much more than the robot's radius off the path
   double lower_bound_base_speed{1.5};  ///< m/s, above the robot's top speed (admissible bound); > 0

@@ -100,6 +100,8 @@ struct GraphManager::Run {
   std::string id_prefix;  ///< "r<n>-" in a resumed mission: its command ids differ from the earlier runs'
   bool first_action{true};
   std::optional<Clock::time_point> event_at;  ///< a replanning waiting for its next command
+  std::size_t event_calls{0};                 ///< the call log's mark at that event
+  LatencyBreakdown pending;                   ///< that replanning's breakdown so far
   std::set<NodeId> planned_from_scratch;      ///< nodes TP(node, goal) was asked for after a replanning
   struct PendingConditional {
     Clock::time_point at;
@@ -164,6 +166,8 @@ MissionReport GraphManager::Run::finish(MissionOutcome o, const std::string& rea
 
 bool GraphManager::Run::planBranch(std::string& why) {
   state(attempts ? "replanning" : "planning", "traverse from n" + std::to_string(current));
+  const auto t0 = Clock::now();
+  const int evaluations0 = gm.counters_.evaluations;
   TraverseResult t = gm.traverse(current, ctx);
   if (!t.found && attempts > 0 && planned_from_scratch.insert(current).second) {
     // Every re-joining branch goes through an action that can no longer be done (it failed too
@@ -181,6 +185,10 @@ bool GraphManager::Run::planBranch(std::string& why) {
   if (!t.found) {
     why = t.reason;
     return false;
+  }
+  if (event_at) {
+    pending.traverse_s += since(t0);
+    pending.evaluations += gm.counters_.evaluations - evaluations0;
   }
   branch = t.branch;
   branch_total = done_effort + t.cost_s;
@@ -259,7 +267,22 @@ void GraphManager::Run::noteCommand() {
     report.planning_time_to_first_action_s = gm.planning_s_;
     first_action = false;
   }
-  if (event_at && !report.replanning.empty()) report.replanning.back().latency_s = since(*event_at);
+  if (event_at && !report.replanning.empty()) {
+    ReplanRecord& r = report.replanning.back();
+    r.latency_s = since(*event_at);
+    r.breakdown = pending;
+    r.breakdown.repair_s = r.planning_s;
+    r.breakdown.prepare_s = std::max(0.0, r.latency_s - r.planning_s - pending.traverse_s);
+    r.breakdown.calls = gm.logged_.since(event_calls);
+    const CallSummary sum = CallSummary::of(r.breakdown.calls);
+    log::get("graph_manager")
+        ->info("replanning latency {:.3f} s: repair {:.3f} s, traverse {:.3f} s ({} evaluations), prepare {:.3f} s; "
+               "{} calls {:.3f} s (motion {} {:.3f} s, grasp {} {:.3f} s, placement {} {:.3f} s, plan {} {:.3f} s, "
+               "effort {} {:.3f} s)",
+               r.latency_s, r.breakdown.repair_s, r.breakdown.traverse_s, r.breakdown.evaluations, r.breakdown.prepare_s,
+               sum.calls(), sum.seconds(), sum.motion.calls, sum.motion.s, sum.grasp.calls, sum.grasp.s,
+               sum.placement.calls, sum.placement.s, sum.plan.calls, sum.plan.s, sum.effort.calls, sum.effort.s);
+  }
   event_at.reset();
   if (conditional_at && !report.conditionals.empty()) {
     ConditionalRecord& c = report.conditionals.back();
@@ -445,6 +468,7 @@ std::optional<MissionEvent> GraphManager::Run::watch(const Edge& done, const Edg
 
 bool GraphManager::Run::replan(const MissionEvent& ev, EdgeId failed, std::string& why) {
   const auto t0 = Clock::now();
+  const std::size_t calls0 = gm.logged_.mark();
   const double planning0 = gm.planning_s_;
   const int planner0 = gm.counters_.planner_calls, motion0 = gm.counters_.motion_calls;
   const bool failure = ev.kind != EventKind::kOverrun;
@@ -532,6 +556,8 @@ bool GraphManager::Run::replan(const MissionEvent& ev, EdgeId failed, std::strin
   log::get("graph_manager")->info("replanning after {} ({}): {} at {}", toString(ev.kind), ev.detail, rec.how, rec.at_node);
   report.replanning.push_back(rec);
   event_at = t0;
+  event_calls = calls0;
+  pending = LatencyBreakdown{};
   branch.clear();
   return true;
 }

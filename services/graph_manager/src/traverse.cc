@@ -90,7 +90,8 @@ GraphManager::GraphManager(Abstraction abstraction, std::string domain_pddl, Mis
     : abstraction_(std::move(abstraction)),
       domain_(std::move(domain_pddl)),
       goal_(std::move(goal)),
-      services_(services),
+      logged_(services),
+      services_(logged_),
       params_(params) {
   if (auto why = params_.invalidReason()) throw std::invalid_argument("GraphManagerParams: " + *why);
 }

@@ -41,6 +41,7 @@
 #include <vector>
 
 #include "tamp/graph_manager/abstraction.h"
+#include "tamp/graph_manager/call_log.h"
 #include "tamp/graph_manager/clients.h"
 #include "tamp/graph_manager/graph.h"
 #include "tamp/graph_manager/params.h"
@@ -132,6 +133,20 @@ struct MissionEvent {
   std::string detail;
 };
 
+/// Where the time from an event to the next command went (issue 12's latency), filled when the
+/// next command goes out.
+struct LatencyBreakdown {
+  double repair_s{0.0};    ///< the graph repaired: world taken in, re-join sub-tasks (= planning_s)
+  double traverse_s{0.0};  ///< Traverse from the robot's node until the first edge was decided
+  double prepare_s{0.0};   ///< the rest: the first edge planned again in the world as it is now
+  int evaluations{0};      ///< edge evaluations by that Traverse
+  /// The service calls between the event and the next command (all on its critical path).
+  std::vector<TimedCall> calls;
+  /// Calls made for the branch after the first edge was decided, while the robot executed it.
+  int background_calls{0};
+  double background_s{0.0};
+};
+
 /// One online replanning: the event, how the graph was repaired, what it cost.
 struct ReplanRecord {
   MissionEvent event;
@@ -144,6 +159,7 @@ struct ReplanRecord {
   int motion_calls{0};
   double planning_s{0.0};
   double latency_s{-1.0};             ///< from the event to the next command (-1: none followed)
+  LatencyBreakdown breakdown;         ///< where `latency_s` went (when a command followed)
 };
 
 /// What the planner is told before it observes anything (a scenario's planner view).
@@ -253,6 +269,8 @@ class GraphManager {
   const ReachabilityGraph& graph() const { return graph_; }
   const Abstraction& abstraction() const { return abstraction_; }
   const Counters& counters() const { return counters_; }
+  /// Every service call of this graph manager, timed (the replanning latency's breakdown).
+  const LoggedServiceClients& callLog() const { return logged_; }
   NodeId root() const { return root_; }
   bool isGoal(NodeId n) const;
   const std::vector<Decision>& decisions() const { return decisions_; }
@@ -346,6 +364,7 @@ class GraphManager {
   Abstraction abstraction_;
   std::string domain_;
   MissionGoal goal_;
+  LoggedServiceClients logged_;  ///< wraps the services given; declared before `services_`
   ServiceClients& services_;
   GraphManagerParams params_;
   ReachabilityGraph graph_;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <future>
 #include <set>
 #include <thread>
 
@@ -109,6 +110,15 @@ struct GraphManager::Run {
     int motion_calls{0};
   };
   std::optional<PendingConditional> conditional_at;  ///< a conditional branch waiting for its next command
+  /// After a replanning, Traverse proved the branch's first edge(s) best (traverseFirstEdge): the
+  /// rest of the branch is chosen by a Traverse from their end while the robot executes them.
+  struct Continuation {
+    std::vector<EdgeId> proven;  ///< the first edges of `branch`
+    NodeId from{-1};             ///< the end of `proven`
+    BranchContext ctx;           ///< the branch's context there
+    std::size_t replanning{0};   ///< the replanning it follows (report.replanning index)
+  };
+  std::optional<Continuation> continuation;
 
   MissionReport run();
   /// Takes up the report of the runs before a restart, and the outcome of the command that was
@@ -129,6 +139,10 @@ struct GraphManager::Run {
   Prepared prepare(EdgeId id, EdgeId next);
   Result<EdgeCommand> commandFor(EdgeId id, EdgeId next);
   ExecutionReport execute(Edge& e, EdgeCommand& cmd);
+  /// Sends `cmd` and waits for its outcome; the first of a continuation's proven edges is
+  /// executed while Traverse prices the rest of the branch (the graph may grow meanwhile:
+  /// edges are looked up again after it).
+  ExecutionReport executeAndPrice(const EdgeCommand& cmd, double budget_s);
   void succeeded(EdgeId id, EdgeId next, const EdgeCommand& cmd, const ExecutionReport& rep);
   /// After a succeeded action: what the robot sees that the graph does not expect.
   std::optional<MissionEvent> watch(const Edge& done, const EdgeCommand& cmd, const ExecutionReport& rep);
@@ -168,7 +182,9 @@ bool GraphManager::Run::planBranch(std::string& why) {
   state(attempts ? "replanning" : "planning", "traverse from n" + std::to_string(current));
   const auto t0 = Clock::now();
   const int evaluations0 = gm.counters_.evaluations;
-  TraverseResult t = gm.traverse(current, ctx);
+  // After an event the next command waits for the first edge only (first_edge.cc).
+  continuation.reset();
+  TraverseResult t = event_at && gm.params_.replan_first_edge ? gm.traverseFirstEdge(current, ctx) : gm.traverse(current, ctx);
   if (!t.found && attempts > 0 && planned_from_scratch.insert(current).second) {
     // Every re-joining branch goes through an action that can no longer be done (it failed too
     // often): the goal from here, from scratch, merged into the graph; Traverse again.
@@ -193,6 +209,14 @@ bool GraphManager::Run::planBranch(std::string& why) {
   branch = t.branch;
   branch_total = done_effort + t.cost_s;
   report.predicted_effort_s = branch_total;
+  if (t.proven_edges > 0 && t.proven_edges < branch.size()) {
+    Continuation c;
+    c.proven.assign(branch.begin(), branch.begin() + static_cast<std::ptrdiff_t>(t.proven_edges));
+    c.from = gm.graph_.edge(c.proven.back()).to;
+    c.ctx = gm.advanceAlong(c.proven, ctx);
+    c.replanning = report.replanning.empty() ? 0 : report.replanning.size() - 1;
+    continuation = std::move(c);
+  }
   if (observer.on_graph) observer.on_graph(gm.graph_, branch, current);
   return true;
 }
@@ -203,17 +227,23 @@ GraphManager::Run::Prepared GraphManager::Run::prepare(EdgeId id, EdgeId next) {
   bool ok = true;
   std::string what = gm.graph_.edge(id).action;
   if (kind == ActionKind::kPick || kind == ActionKind::kPlace) {
-    // A manipulation is never sent deferred: its grasp is planned now or it is a failure.
-    const bool priced = std::isfinite(gm.evaluate(id, -1, ctx, 0));
+    // A manipulation is never sent deferred: its grasp is planned now or it is a failure (unless
+    // it was planned from where the robot is, in the world as it is: the Traverse after an event
+    // plans the first edge so).
+    const bool priced = (gm.params_.replan_first_edge && gm.plannedIn(id, -1, ctx)) || std::isfinite(gm.evaluate(id, -1, ctx, 0));
     Edge& m = gm.graph_.edge(id);
     ok = priced && m.motion && !m.motion->deferred && !m.motion->trajectory.empty();
     if (!ok && m.reason.empty()) m.reason = "no grasp or placement in the world as it is now";
   } else if (kind == ActionKind::kMoveArm && gm.armKey(id, next) >= 0) {
     // An arm motion into a manipulation is planned again in the world as it is now: the branch
     // priced it in a hypothetical world (objects moved by earlier edges, grasps deferred).
-    Edge& arm = gm.graph_.edge(id);
-    arm.motion_by_next.erase(gm.armKey(id, next));
-    arm.effort_by_next.erase(gm.armKey(id, next));
+    // Unless it was planned from where the robot is, in the world as it is (the Traverse after an
+    // event plans the first edge so).
+    if (!gm.params_.replan_first_edge || !gm.plannedIn(id, next, ctx)) {
+      Edge& arm = gm.graph_.edge(id);
+      arm.motion_by_next.erase(gm.armKey(id, next));
+      arm.effort_by_next.erase(gm.armKey(id, next));
+    }
     ok = std::isfinite(gm.evaluate(id, next, ctx, 0));
     what = gm.graph_.edge(next).action;
   }
@@ -387,7 +417,42 @@ ExecutionReport GraphManager::Run::execute(Edge& e, EdgeCommand& cmd) {
     if (rep.outcome != ExecOutcome::kSucceeded) return rep;
   }
   const double budget = cmd.expected_s + 4 * cmd.expected_stddev_s + gm.params_.execution_margin_s;
-  return executor.execute(cmd, budget);
+  return executeAndPrice(cmd, budget);
+}
+
+ExecutionReport GraphManager::Run::executeAndPrice(const EdgeCommand& cmd, double budget_s) {
+  if (!continuation || branch.empty() || branch.front() != continuation->proven.front())
+    return executor.execute(cmd, budget_s);
+  const Continuation c = std::move(*continuation);
+  continuation.reset();
+  const std::size_t calls0 = gm.logged_.mark();
+  // The executor on its own thread (it only waits for the robot); the graph stays on this one.
+  auto running = std::async(std::launch::async, [this, &cmd, budget_s] { return executor.execute(cmd, budget_s); });
+  const TraverseResult rest = gm.traverse(c.from, c.ctx);
+  ExecutionReport rep = running.get();
+  const CallSummary calls = CallSummary::of(gm.logged_.since(calls0));
+  if (c.replanning < report.replanning.size()) {
+    report.replanning[c.replanning].breakdown.background_calls += calls.calls();
+    report.replanning[c.replanning].breakdown.background_s += calls.seconds();
+  }
+  double proven_s = 0.0;
+  for (std::size_t i = 0; i < c.proven.size(); ++i) {
+    const Edge& e = gm.graph_.edge(c.proven[i]);
+    const EdgeId key = gm.armKey(c.proven[i], i + 1 < c.proven.size() ? c.proven[i + 1] : -1);
+    const auto it = e.effort_by_next.find(key);
+    proven_s += e.kind == ActionKind::kMoveArm && it != e.effort_by_next.end() ? it->second.first : e.effort_mean_s;
+  }
+  // Without a way on from there, the next Traverse (from the robot's node then) says why.
+  branch = c.proven;
+  if (rest.found) {
+    branch.insert(branch.end(), rest.branch.begin(), rest.branch.end());
+    branch_total = done_effort + proven_s + rest.cost_s;
+    report.predicted_effort_s = branch_total;
+  }
+  log::get("graph_manager")->info("the rest of the branch from n{} priced during {}: {} edges, {:.1f} s ({} calls, {:.3f} s)",
+                                  c.from, cmd.action, rest.branch.size(), rest.cost_s, calls.calls(), calls.seconds());
+  if (observer.on_graph) observer.on_graph(gm.graph_, branch, current);
+  return rep;
 }
 
 void GraphManager::Run::succeeded(EdgeId id, EdgeId next, const EdgeCommand& cmd, const ExecutionReport& rep) {
@@ -601,8 +666,8 @@ MissionReport GraphManager::Run::run() {
     if (p == Prepared::kReplanned) continue;
     auto cmd = commandFor(id, next);
     if (!cmd) return finish(MissionOutcome::kFailed, cmd.error().message);
-    Edge& e = gm.graph_.edge(id);
-    const ExecutionReport rep = execute(e, *cmd);
+    const ExecutionReport rep = execute(gm.graph_.edge(id), *cmd);
+    Edge& e = gm.graph_.edge(id);  // after: pricing during the execution may have grown the graph
     ++step;
     ExecutedAction a = executedFrom(*cmd, rep, std::string(toString(e.variant)));
     report.actions.push_back(a);

@@ -96,6 +96,9 @@ struct TraverseResult {
   double time_s{0.0};
   int evaluations{0};
   std::string reason;          ///< when not found
+  /// traverseFirstEdge: the first this many edges of `branch` are proven best (0: the whole
+  /// branch is, or nothing is); the rest is the first complete branch found through them.
+  std::size_t proven_edges{0};
 };
 
 struct ExecutedAction {
@@ -256,6 +259,26 @@ class GraphManager {
   Status start(const world::World& live, const Observation& robot);
   /// Algorithm 3 from `from` with the robot in `context`.
   TraverseResult traverse(NodeId from, const BranchContext& context);
+  /// Algorithm 3 until the branch's first edge is decided (first_edge.cc): below the first edge
+  /// of the first complete branch nothing more is explored, every other way on from `from` is,
+  /// against that branch's cost. When the best branch goes through that edge, `proven_edges`
+  /// says so and `traverse(end of those edges)` chooses the rest as `traverse(from)` would;
+  /// otherwise this is `traverse(from)`. The first edge is an arm motion with the manipulation
+  /// it prepares, or one edge (firstEdgeOf).
+  TraverseResult traverseFirstEdge(NodeId from, const BranchContext& context);
+  /// The edges decided together at the start of `branch`: an arm motion into a manipulation
+  /// with that manipulation, else the first edge (empty for an empty branch).
+  std::vector<EdgeId> firstEdgeOf(const std::vector<EdgeId>& branch) const;
+  /// `advance` along `edges` (each arm motion with the edge after it) from `ctx`.
+  BranchContext advanceAlong(const std::vector<EdgeId>& edges, const BranchContext& ctx) const;
+  /// What a motion planned in `ctx` depends on: the base and arm, the held object, the grasp or
+  /// placement prepared, the branch's moved objects and every object of the world as last taken
+  /// in (first_edge.cc).
+  std::string contextKey(const BranchContext& ctx) const;
+  /// Whether edge `id` (an arm motion into the manipulation `next`, or a pick or place) was
+  /// planned in `ctx` (contextKey), feasible, with its grasp or placement prepared: then it need
+  /// not be planned again before it is sent. Base motions: false (commandFor checks their start).
+  bool plannedIn(EdgeId id, EdgeId next, const BranchContext& ctx) const;
   /// What the planner is told before it observes (default: what the robot reports at the start).
   void setBelief(Belief b) { belief_ = std::move(b); }
   /// The whole mission: start, traverse, execute, repair.
@@ -316,6 +339,8 @@ class GraphManager {
  private:
   struct Search;
   struct Run;
+  /// Branch-and-bound from `from`; `first_edge_only`: traverseFirstEdge's search.
+  TraverseResult search(NodeId from, const BranchContext& context, bool first_edge_only);
   /// The held object's mass in the node's state (0 when the hand is empty).
   double heldMassAt(NodeId n) const;
   /// Whether the arm is in a driving configuration (`stow` or `carry`, within

@@ -6,11 +6,14 @@ namespace tamp::graph_manager {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+double secondsSince(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
 
 std::string motionWhat(const MotionQuery& q) {
   std::string w = q.group == Group::kBase ? "base" : "arm";
-  w += q.mode == Mode::kLazy ? (q.movable_cost_weight > 0.0 ? " lazy effort-aware" : " lazy") : " full";
+  w += q.mode == Mode::kLazy ? (q.movable_cost_weight > 0.0 ? " lazy effort-aware" : " lazy")
+                             : " full";
   if (q.group == Group::kBase) {
     char buf[64];
     std::snprintf(buf, sizeof buf, " to (%.2f, %.2f)", q.goal_base.x, q.goal_base.y);
@@ -61,14 +64,16 @@ std::vector<TimedCall> LoggedServiceClients::since(std::size_t mark) const {
 TaskPlan LoggedServiceClients::plan(const TaskQuery& q) {
   const auto t0 = Clock::now();
   TaskPlan p = inner_.plan(q);
-  add({"plan", std::to_string(p.actions.size()) + " actions, " + std::string(toString(p.status)), secondsSince(t0), p.time_s});
+  add({"plan", std::to_string(p.actions.size()) + " actions, " + std::string(toString(p.status)),
+       secondsSince(t0), p.time_s});
   return p;
 }
 
 MotionAnswer LoggedServiceClients::motion(const MotionQuery& q) {
   const auto t0 = Clock::now();
   MotionAnswer a = inner_.motion(q);
-  add({"motion", motionWhat(q) + ": " + std::string(toString(a.status)), secondsSince(t0), a.time_s});
+  add({"motion", motionWhat(q) + ": " + std::string(toString(a.status)), secondsSince(t0),
+       a.time_s});
   return a;
 }
 
@@ -85,8 +90,9 @@ Result<std::vector<PlacementOption>> LoggedServiceClients::placements(const Plac
 Result<std::vector<GraspOption>> LoggedServiceClients::grasps(const GraspQuery& q) {
   const auto t0 = Clock::now();
   auto r = inner_.grasps(q);
-  add({"grasp", q.object_id + (q.base ? " from a base pose" : " sampled bases") + ": " +
-                    (r ? std::to_string(r->size()) : std::string("error")),
+  add({"grasp",
+       q.object_id + (q.base ? " from a base pose" : " sampled bases") + ": " +
+           (r ? std::to_string(r->size()) : std::string("error")),
        secondsSince(t0), 0.0});
   return r;
 }

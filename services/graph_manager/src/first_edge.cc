@@ -21,14 +21,17 @@ std::vector<EdgeId> GraphManager::firstEdgeOf(const std::vector<EdgeId>& branch)
   if (branch.empty()) return {};
   // An arm motion into a manipulation is decided with it: its target is that manipulation's
   // pre-grasp, and the manipulation is priced with the grasp the arm motion prepared.
-  if (branch.size() > 1 && graph_.edge(branch[0]).kind == ActionKind::kMoveArm && armKey(branch[0], branch[1]) >= 0)
+  if (branch.size() > 1 && graph_.edge(branch[0]).kind == ActionKind::kMoveArm &&
+      armKey(branch[0], branch[1]) >= 0)
     return {branch[0], branch[1]};
   return {branch[0]};
 }
 
-BranchContext GraphManager::advanceAlong(const std::vector<EdgeId>& edges, const BranchContext& ctx) const {
+BranchContext GraphManager::advanceAlong(const std::vector<EdgeId>& edges,
+                                         const BranchContext& ctx) const {
   BranchContext c = ctx;
-  for (std::size_t i = 0; i < edges.size(); ++i) c = advance(edges[i], i + 1 < edges.size() ? edges[i + 1] : -1, c);
+  for (std::size_t i = 0; i < edges.size(); ++i)
+    c = advance(edges[i], i + 1 < edges.size() ? edges[i + 1] : -1, c);
   return c;
 }
 
@@ -66,14 +69,16 @@ std::string GraphManager::contextKey(const BranchContext& ctx) const {
 bool GraphManager::plannedIn(EdgeId id, EdgeId next, const BranchContext& ctx) const {
   const Edge& e = graph_.edge(id);
   if (e.kind == ActionKind::kPick || e.kind == ActionKind::kPlace)
-    return e.state == EdgeState::kFeasible && e.motion && !e.motion->deferred && e.motion->prepared &&
-           !e.motion->trajectory.empty() && !e.motion->planned_in.empty() && e.motion->planned_in == contextKey(ctx);
+    return e.state == EdgeState::kFeasible && e.motion && !e.motion->deferred &&
+           e.motion->prepared && !e.motion->trajectory.empty() && !e.motion->planned_in.empty() &&
+           e.motion->planned_in == contextKey(ctx);
   if (e.kind != ActionKind::kMoveArm) return false;
   const EdgeId arm = id;
   const EdgeId key = armKey(arm, next);
   const auto m = e.motion_by_next.find(key);
   const auto effort = e.effort_by_next.find(key);
-  if (m == e.motion_by_next.end() || effort == e.effort_by_next.end() || !std::isfinite(effort->second.first))
+  if (m == e.motion_by_next.end() || effort == e.effort_by_next.end() ||
+      !std::isfinite(effort->second.first))
     return false;
   return key >= 0 && m->second.prepared && !m->second.deferred && !m->second.trajectory.empty() &&
          !m->second.planned_in.empty() && m->second.planned_in == contextKey(ctx);

@@ -59,7 +59,8 @@ class ScriptedServices : public ServiceClients {
       a.path.joint_names = std::vector<std::string>(q.goal_arm.size(), "j");
       a.path.waypoints = {q.start.arm, q.goal_arm};
       a.trajectory.joint_names = a.path.joint_names;
-      a.trajectory.points = {TrajectoryPoint{0.0, q.start.arm, {}}, TrajectoryPoint{1.0, q.goal_arm, {}}};
+      a.trajectory.points = {TrajectoryPoint{0.0, q.start.arm, {}},
+                             TrajectoryPoint{1.0, q.goal_arm, {}}};
       return a;
     }
     a.path.joint_names = {"base_x", "base_y", "base_theta"};
@@ -88,8 +89,10 @@ class ScriptedServices : public ServiceClients {
       a.ok = true;
       a.stddev_s = 0.1;
       const auto& w = q.path.waypoints;
-      for (std::size_t i = 1; i < w.size(); ++i) a.mean_s += std::hypot(w[i][0] - w[i - 1][0], w[i][1] - w[i - 1][1]);
-      if (!w.empty() && std::hypot(w[0][0] - slow_from.x(), w[0][1] - slow_from.y()) < 0.1) a.mean_s *= slow_factor;
+      for (std::size_t i = 1; i < w.size(); ++i)
+        a.mean_s += std::hypot(w[i][0] - w[i - 1][0], w[i][1] - w[i - 1][1]);
+      if (!w.empty() && std::hypot(w[0][0] - slow_from.x(), w[0][1] - slow_from.y()) < 0.1)
+        a.mean_s *= slow_factor;
       out.push_back(a);
     }
     return out;
@@ -113,12 +116,14 @@ class FirstEdgeTest : public ::testing::Test {
     auto robot = robot::RobotModel::loadDescription(sc->robot.description);
     EXPECT_TRUE(robot.ok());
     Abstraction a(sc->plannerWorld(), *robot);
-    for (const auto& [name, x, y] : {std::tuple{"a", 5.0, 2.2}, std::tuple{"b", 5.0, -1.5}, std::tuple{"c", 5.0, 6.6}})
+    for (const auto& [name, x, y] :
+         {std::tuple{"a", 5.0, 2.2}, std::tuple{"b", 5.0, -1.5}, std::tuple{"c", 5.0, 6.6}})
       EXPECT_EQ(a.locationFor(Pose2D{x, y, 0.0}, name), name);
     GraphManagerParams params;
     params.max_contingencies = 0;
     Setup s;
-    s.gm = std::make_unique<GraphManager>(std::move(a), "", MissionGoal{{"(robot-at goal)"}}, services, params);
+    s.gm = std::make_unique<GraphManager>(std::move(a), "", MissionGoal{{"(robot-at goal)"}},
+                                          services, params);
     Observation obs;
     obs.valid = true;
     obs.robot.base = sc->robot.start;
@@ -135,7 +140,8 @@ class FirstEdgeTest : public ::testing::Test {
     return s;
   }
 
-  static std::vector<std::string> actions(const GraphManager& gm, const std::vector<EdgeId>& branch) {
+  static std::vector<std::string> actions(const GraphManager& gm,
+                                          const std::vector<EdgeId>& branch) {
     std::vector<std::string> out;
     for (EdgeId e : branch) out.push_back(gm.graph().edge(e).action);
     return out;
@@ -147,7 +153,8 @@ TEST_F(FirstEdgeTest, TheFirstEdgeIsDecidedWithoutPricingBelowIt) {
   Setup full = make(full_services);
   const TraverseResult f = full.gm->traverse(full.gm->root(), full.ctx);
   ASSERT_TRUE(f.found) << f.reason;
-  EXPECT_EQ(actions(*full.gm, f.branch), (std::vector<std::string>{"(move_base start a)", "(move_base a goal)"}));
+  EXPECT_EQ(actions(*full.gm, f.branch),
+            (std::vector<std::string>{"(move_base start a)", "(move_base a goal)"}));
   // The full Traverse prices a->c too (3.6 + 2.9 s bound < 7.3 s; 3.6 + 4.4 s then cuts it).
   EXPECT_EQ(full_services.motion_calls, 4);
 
@@ -157,7 +164,8 @@ TEST_F(FirstEdgeTest, TheFirstEdgeIsDecidedWithoutPricingBelowIt) {
   ASSERT_TRUE(t.found) << t.reason;
   EXPECT_EQ(t.proven_edges, 1u);
   EXPECT_EQ(actions(*s.gm, t.branch), actions(*full.gm, f.branch));
-  EXPECT_EQ(services.motion_calls, 3) << "start-a, a-goal, start-b: nothing below start-a after its first branch";
+  EXPECT_EQ(services.motion_calls, 3)
+      << "start-a, a-goal, start-b: nothing below start-a after its first branch";
   EXPECT_LT(t.evaluations, f.evaluations);
   // Its decision is recorded at the start only (the rest is recorded by the Traverse that
   // chooses it).
@@ -165,7 +173,8 @@ TEST_F(FirstEdgeTest, TheFirstEdgeIsDecidedWithoutPricingBelowIt) {
   EXPECT_EQ(s.gm->decisions().front().node, "n" + std::to_string(s.gm->root()));
 
   // The rest, from the first edge's end, is what the full Traverse chose.
-  const std::vector<EdgeId> first(t.branch.begin(), t.branch.begin() + static_cast<std::ptrdiff_t>(t.proven_edges));
+  const std::vector<EdgeId> first(t.branch.begin(),
+                                  t.branch.begin() + static_cast<std::ptrdiff_t>(t.proven_edges));
   EXPECT_EQ(s.gm->firstEdgeOf(t.branch), first);
   const NodeId end = s.gm->graph().edge(first.back()).to;
   const TraverseResult rest = s.gm->traverse(end, s.gm->advanceAlong(first, s.ctx));
@@ -183,7 +192,8 @@ TEST_F(FirstEdgeTest, WhenAnotherWayOnBeatsTheFirstBranchTheFullTraverseDecides)
   Setup full = make(full_services);
   const TraverseResult f = full.gm->traverse(full.gm->root(), full.ctx);
   ASSERT_TRUE(f.found) << f.reason;
-  EXPECT_EQ(actions(*full.gm, f.branch), (std::vector<std::string>{"(move_base start b)", "(move_base b goal)"}));
+  EXPECT_EQ(actions(*full.gm, f.branch),
+            (std::vector<std::string>{"(move_base start b)", "(move_base b goal)"}));
 
   ScriptedServices services;
   services.slow_from = full_services.slow_from;
@@ -191,7 +201,8 @@ TEST_F(FirstEdgeTest, WhenAnotherWayOnBeatsTheFirstBranchTheFullTraverseDecides)
   Setup s = make(services);
   const TraverseResult t = s.gm->traverseFirstEdge(s.gm->root(), s.ctx);
   ASSERT_TRUE(t.found) << t.reason;
-  EXPECT_EQ(t.proven_edges, 0u) << "start-a's first branch lost: not proven, the full search decided";
+  EXPECT_EQ(t.proven_edges, 0u)
+      << "start-a's first branch lost: not proven, the full search decided";
   EXPECT_EQ(actions(*s.gm, t.branch), actions(*full.gm, f.branch));
   EXPECT_NEAR(t.cost_s, f.cost_s, 1e-9);
 }
@@ -205,7 +216,8 @@ TEST_F(FirstEdgeTest, AnArmMotionPlannedWhereTheRobotIsNeedNotBePlannedAgain) {
   const auto ready = robot->namedConfiguration("ready");
   ASSERT_TRUE(ready.has_value());
   services.pregrasp = *ready;
-  services.plans = {{"(move_arm start stow over_box_floor)", "(pick box box_floor over_box_floor)"}};
+  services.plans = {
+      {"(move_arm start stow over_box_floor)", "(pick box box_floor over_box_floor)"}};
   services.states = {{{"(arm-at stow)", "(hand-empty)", "(on box box_floor)"},
                       {"(arm-at over_box_floor)", "(hand-empty)", "(on box box_floor)"},
                       {"(arm-at over_box_floor)", "(holding box)"}}};
@@ -224,7 +236,8 @@ TEST_F(FirstEdgeTest, AnArmMotionPlannedWhereTheRobotIsNeedNotBePlannedAgain) {
   BranchContext other_grasp = over;
   other_grasp.pending_grasp->pregrasp[0] += 0.1;
   EXPECT_FALSE(s.gm->plannedIn(pick, -1, other_grasp));
-  EXPECT_EQ(s.gm->firstEdgeOf(*plan), *plan) << "an arm motion is decided with the pick it prepares";
+  EXPECT_EQ(s.gm->firstEdgeOf(*plan), *plan)
+      << "an arm motion is decided with the pick it prepares";
   // Anywhere else, or in a branch that moved an object, it was planned in another context.
   BranchContext moved = s.ctx;
   moved.state.base.x += 0.05;

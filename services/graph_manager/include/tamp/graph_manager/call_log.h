@@ -16,10 +16,10 @@ namespace tamp::graph_manager {
 
 /// One service call, timed at the client.
 struct TimedCall {
-  std::string service;  ///< "plan", "motion", "placement", "grasp", "effort"
-  std::string what;     ///< "base lazy", "arm full", "box on table", ...
-  double s{0.0};        ///< wall time of the call at the client (queueing and transport included)
-  double server_s{0.0}; ///< the service's own time when it reports one (motions, plans), else 0
+  std::string service;   ///< "plan", "motion", "placement", "grasp", "effort"
+  std::string what;      ///< "base lazy", "arm full", "box on table", ...
+  double s{0.0};         ///< wall time of the call at the client (queueing and transport included)
+  double server_s{0.0};  ///< the service's own time when it reports one (motions, plans), else 0
 };
 
 /// Calls and time per service over a stretch of calls.
@@ -29,7 +29,9 @@ struct CallSummary {
     double s{0.0};
   };
   PerService plan, motion, placement, grasp, effort;
-  int calls() const { return plan.calls + motion.calls + placement.calls + grasp.calls + effort.calls; }
+  int calls() const {
+    return plan.calls + motion.calls + placement.calls + grasp.calls + effort.calls;
+  }
   double seconds() const { return plan.s + motion.s + placement.s + grasp.s + effort.s; }
   static CallSummary of(const std::vector<TimedCall>& calls);
 };

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <future>
 #include <set>
 #include <thread>
 
@@ -100,6 +101,8 @@ struct GraphManager::Run {
   std::string id_prefix;  ///< "r<n>-" in a resumed mission: its command ids differ from the earlier runs'
   bool first_action{true};
   std::optional<Clock::time_point> event_at;  ///< a replanning waiting for its next command
+  std::size_t event_calls{0};                 ///< the call log's mark at that event
+  LatencyBreakdown pending;                   ///< that replanning's breakdown so far
   std::set<NodeId> planned_from_scratch;      ///< nodes TP(node, goal) was asked for after a replanning
   struct PendingConditional {
     Clock::time_point at;
@@ -107,6 +110,15 @@ struct GraphManager::Run {
     int motion_calls{0};
   };
   std::optional<PendingConditional> conditional_at;  ///< a conditional branch waiting for its next command
+  /// After a replanning, Traverse proved the branch's first edge(s) best (traverseFirstEdge): the
+  /// rest of the branch is chosen by a Traverse from their end while the robot executes them.
+  struct Continuation {
+    std::vector<EdgeId> proven;  ///< the first edges of `branch`
+    NodeId from{-1};             ///< the end of `proven`
+    BranchContext ctx;           ///< the branch's context there
+    std::size_t replanning{0};   ///< the replanning it follows (report.replanning index)
+  };
+  std::optional<Continuation> continuation;
 
   MissionReport run();
   /// Takes up the report of the runs before a restart, and the outcome of the command that was
@@ -127,6 +139,10 @@ struct GraphManager::Run {
   Prepared prepare(EdgeId id, EdgeId next);
   Result<EdgeCommand> commandFor(EdgeId id, EdgeId next);
   ExecutionReport execute(Edge& e, EdgeCommand& cmd);
+  /// Sends `cmd` and waits for its outcome; the first of a continuation's proven edges is
+  /// executed while Traverse prices the rest of the branch (the graph may grow meanwhile:
+  /// edges are looked up again after it).
+  ExecutionReport executeAndPrice(const EdgeCommand& cmd, double budget_s);
   void succeeded(EdgeId id, EdgeId next, const EdgeCommand& cmd, const ExecutionReport& rep);
   /// After a succeeded action: what the robot sees that the graph does not expect.
   std::optional<MissionEvent> watch(const Edge& done, const EdgeCommand& cmd, const ExecutionReport& rep);
@@ -169,7 +185,11 @@ constexpr int kMaxRefinements = 8;
 
 bool GraphManager::Run::planBranch(std::string& why) {
   state(attempts ? "replanning" : "planning", "traverse from n" + std::to_string(current));
-  TraverseResult t = gm.traverse(current, ctx);
+  const auto t0 = Clock::now();
+  const int evaluations0 = gm.counters_.evaluations;
+  // After an event the next command waits for the first edge only (first_edge.cc).
+  continuation.reset();
+  TraverseResult t = event_at && gm.params_.replan_first_edge ? gm.traverseFirstEdge(current, ctx) : gm.traverse(current, ctx);
   // The geometry refuted a region-level reach (a pick from too far on a large region): plan again
   // from the refined state, where those objects are on slots of their own. Each round adds at
   // least one slot, so this ends; the bound keeps it short.
@@ -199,9 +219,21 @@ bool GraphManager::Run::planBranch(std::string& why) {
     why = t.reason;
     return false;
   }
+  if (event_at) {
+    pending.traverse_s += since(t0);
+    pending.evaluations += gm.counters_.evaluations - evaluations0;
+  }
   branch = t.branch;
   branch_total = done_effort + t.cost_s;
   report.predicted_effort_s = branch_total;
+  if (t.proven_edges > 0 && t.proven_edges < branch.size()) {
+    Continuation c;
+    c.proven.assign(branch.begin(), branch.begin() + static_cast<std::ptrdiff_t>(t.proven_edges));
+    c.from = gm.graph_.edge(c.proven.back()).to;
+    c.ctx = gm.advanceAlong(c.proven, ctx);
+    c.replanning = report.replanning.empty() ? 0 : report.replanning.size() - 1;
+    continuation = std::move(c);
+  }
   if (observer.on_graph) observer.on_graph(gm.graph_, branch, current);
   return true;
 }
@@ -212,17 +244,23 @@ GraphManager::Run::Prepared GraphManager::Run::prepare(EdgeId id, EdgeId next) {
   bool ok = true;
   std::string what = gm.graph_.edge(id).action;
   if (kind == ActionKind::kPick || kind == ActionKind::kPlace) {
-    // A manipulation is never sent deferred: its grasp is planned now or it is a failure.
-    const bool priced = std::isfinite(gm.evaluate(id, -1, ctx, 0));
+    // A manipulation is never sent deferred: its grasp is planned now or it is a failure (unless
+    // it was planned from where the robot is, in the world as it is: the Traverse after an event
+    // plans the first edge so).
+    const bool priced = (gm.params_.replan_first_edge && gm.plannedIn(id, -1, ctx)) || std::isfinite(gm.evaluate(id, -1, ctx, 0));
     Edge& m = gm.graph_.edge(id);
     ok = priced && m.motion && !m.motion->deferred && !m.motion->trajectory.empty();
     if (!ok && m.reason.empty()) m.reason = "no grasp or placement in the world as it is now";
   } else if (kind == ActionKind::kMoveArm && gm.armKey(id, next) >= 0) {
     // An arm motion into a manipulation is planned again in the world as it is now: the branch
     // priced it in a hypothetical world (objects moved by earlier edges, grasps deferred).
-    Edge& arm = gm.graph_.edge(id);
-    arm.motion_by_next.erase(gm.armKey(id, next));
-    arm.effort_by_next.erase(gm.armKey(id, next));
+    // Unless it was planned from where the robot is, in the world as it is (the Traverse after an
+    // event plans the first edge so).
+    if (!gm.params_.replan_first_edge || !gm.plannedIn(id, next, ctx)) {
+      Edge& arm = gm.graph_.edge(id);
+      arm.motion_by_next.erase(gm.armKey(id, next));
+      arm.effort_by_next.erase(gm.armKey(id, next));
+    }
     ok = std::isfinite(gm.evaluate(id, next, ctx, 0));
     what = gm.graph_.edge(next).action;
   }
@@ -276,7 +314,22 @@ void GraphManager::Run::noteCommand() {
     report.planning_time_to_first_action_s = gm.planning_s_;
     first_action = false;
   }
-  if (event_at && !report.replanning.empty()) report.replanning.back().latency_s = since(*event_at);
+  if (event_at && !report.replanning.empty()) {
+    ReplanRecord& r = report.replanning.back();
+    r.latency_s = since(*event_at);
+    r.breakdown = pending;
+    r.breakdown.repair_s = r.planning_s;
+    r.breakdown.prepare_s = std::max(0.0, r.latency_s - r.planning_s - pending.traverse_s);
+    r.breakdown.calls = gm.logged_.since(event_calls);
+    const CallSummary sum = CallSummary::of(r.breakdown.calls);
+    log::get("graph_manager")
+        ->info("replanning latency {:.3f} s: repair {:.3f} s, traverse {:.3f} s ({} evaluations), prepare {:.3f} s; "
+               "{} calls {:.3f} s (motion {} {:.3f} s, grasp {} {:.3f} s, placement {} {:.3f} s, plan {} {:.3f} s, "
+               "effort {} {:.3f} s)",
+               r.latency_s, r.breakdown.repair_s, r.breakdown.traverse_s, r.breakdown.evaluations, r.breakdown.prepare_s,
+               sum.calls(), sum.seconds(), sum.motion.calls, sum.motion.s, sum.grasp.calls, sum.grasp.s,
+               sum.placement.calls, sum.placement.s, sum.plan.calls, sum.plan.s, sum.effort.calls, sum.effort.s);
+  }
   event_at.reset();
   if (conditional_at && !report.conditionals.empty()) {
     ConditionalRecord& c = report.conditionals.back();
@@ -381,7 +434,42 @@ ExecutionReport GraphManager::Run::execute(Edge& e, EdgeCommand& cmd) {
     if (rep.outcome != ExecOutcome::kSucceeded) return rep;
   }
   const double budget = cmd.expected_s + 4 * cmd.expected_stddev_s + gm.params_.execution_margin_s;
-  return executor.execute(cmd, budget);
+  return executeAndPrice(cmd, budget);
+}
+
+ExecutionReport GraphManager::Run::executeAndPrice(const EdgeCommand& cmd, double budget_s) {
+  if (!continuation || branch.empty() || branch.front() != continuation->proven.front())
+    return executor.execute(cmd, budget_s);
+  const Continuation c = std::move(*continuation);
+  continuation.reset();
+  const std::size_t calls0 = gm.logged_.mark();
+  // The executor on its own thread (it only waits for the robot); the graph stays on this one.
+  auto running = std::async(std::launch::async, [this, &cmd, budget_s] { return executor.execute(cmd, budget_s); });
+  const TraverseResult rest = gm.traverse(c.from, c.ctx);
+  ExecutionReport rep = running.get();
+  const CallSummary calls = CallSummary::of(gm.logged_.since(calls0));
+  if (c.replanning < report.replanning.size()) {
+    report.replanning[c.replanning].breakdown.background_calls += calls.calls();
+    report.replanning[c.replanning].breakdown.background_s += calls.seconds();
+  }
+  double proven_s = 0.0;
+  for (std::size_t i = 0; i < c.proven.size(); ++i) {
+    const Edge& e = gm.graph_.edge(c.proven[i]);
+    const EdgeId key = gm.armKey(c.proven[i], i + 1 < c.proven.size() ? c.proven[i + 1] : -1);
+    const auto it = e.effort_by_next.find(key);
+    proven_s += e.kind == ActionKind::kMoveArm && it != e.effort_by_next.end() ? it->second.first : e.effort_mean_s;
+  }
+  // Without a way on from there, the next Traverse (from the robot's node then) says why.
+  branch = c.proven;
+  if (rest.found) {
+    branch.insert(branch.end(), rest.branch.begin(), rest.branch.end());
+    branch_total = done_effort + proven_s + rest.cost_s;
+    report.predicted_effort_s = branch_total;
+  }
+  log::get("graph_manager")->info("the rest of the branch from n{} priced during {}: {} edges, {:.1f} s ({} calls, {:.3f} s)",
+                                  c.from, cmd.action, rest.branch.size(), rest.cost_s, calls.calls(), calls.seconds());
+  if (observer.on_graph) observer.on_graph(gm.graph_, branch, current);
+  return rep;
 }
 
 void GraphManager::Run::succeeded(EdgeId id, EdgeId next, const EdgeCommand& cmd, const ExecutionReport& rep) {
@@ -462,6 +550,7 @@ std::optional<MissionEvent> GraphManager::Run::watch(const Edge& done, const Edg
 
 bool GraphManager::Run::replan(const MissionEvent& ev, EdgeId failed, std::string& why) {
   const auto t0 = Clock::now();
+  const std::size_t calls0 = gm.logged_.mark();
   const double planning0 = gm.planning_s_;
   const int planner0 = gm.counters_.planner_calls, motion0 = gm.counters_.motion_calls;
   const bool failure = ev.kind != EventKind::kOverrun;
@@ -549,6 +638,8 @@ bool GraphManager::Run::replan(const MissionEvent& ev, EdgeId failed, std::strin
   log::get("graph_manager")->info("replanning after {} ({}): {} at {}", toString(ev.kind), ev.detail, rec.how, rec.at_node);
   report.replanning.push_back(rec);
   event_at = t0;
+  event_calls = calls0;
+  pending = LatencyBreakdown{};
   branch.clear();
   return true;
 }
@@ -592,8 +683,8 @@ MissionReport GraphManager::Run::run() {
     if (p == Prepared::kReplanned) continue;
     auto cmd = commandFor(id, next);
     if (!cmd) return finish(MissionOutcome::kFailed, cmd.error().message);
-    Edge& e = gm.graph_.edge(id);
-    const ExecutionReport rep = execute(e, *cmd);
+    const ExecutionReport rep = execute(gm.graph_.edge(id), *cmd);
+    Edge& e = gm.graph_.edge(id);  // after: pricing during the execution may have grown the graph
     ++step;
     ExecutedAction a = executedFrom(*cmd, rep, std::string(toString(e.variant)));
     report.actions.push_back(a);

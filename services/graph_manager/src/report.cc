@@ -83,6 +83,29 @@ std::string reportJson(const MissionReport& r, const std::string& scenario, cons
   j["actions"] = actions;
   nlohmann::json replanning = nlohmann::json::array();
   for (const auto& rp : r.replanning) {
+    nlohmann::json breakdown(nullptr);
+    if (rp.latency_s >= 0.0) {
+      const CallSummary sum = CallSummary::of(rp.breakdown.calls);
+      auto per = [](const CallSummary::PerService& p) { return nlohmann::json{{"calls", p.calls}, {"s", p.s}}; };
+      nlohmann::json calls = nlohmann::json::array();
+      for (const auto& c : rp.breakdown.calls)
+        calls.push_back({{"service", c.service}, {"what", c.what}, {"s", c.s}, {"server_s", c.server_s}});
+      breakdown = {{"repair_s", rp.breakdown.repair_s},
+                   {"traverse_s", rp.breakdown.traverse_s},
+                   {"prepare_s", rp.breakdown.prepare_s},
+                   {"evaluations", rp.breakdown.evaluations},
+                   {"per_service",
+                    {{"plan", per(sum.plan)},
+                     {"motion", per(sum.motion)},
+                     {"placement", per(sum.placement)},
+                     {"grasp", per(sum.grasp)},
+                     {"effort", per(sum.effort)}}},
+                   {"critical_calls", sum.calls()},
+                   {"critical_calls_s", sum.seconds()},
+                   {"background_calls", rp.breakdown.background_calls},
+                   {"background_s", rp.breakdown.background_s},
+                   {"calls", calls}};
+    }
     replanning.push_back({{"event", std::string(toString(rp.event.kind))},
                           {"action", rp.event.action},
                           {"object", rp.event.object_id},
@@ -93,7 +116,8 @@ std::string reportJson(const MissionReport& r, const std::string& scenario, cons
                           {"planner_calls", rp.planner_calls},
                           {"motion_calls", rp.motion_calls},
                           {"planning_s", rp.planning_s},
-                          {"latency_s", rp.latency_s >= 0.0 ? nlohmann::json(rp.latency_s) : nlohmann::json(nullptr)}});
+                          {"latency_s", rp.latency_s >= 0.0 ? nlohmann::json(rp.latency_s) : nlohmann::json(nullptr)},
+                          {"latency_breakdown", breakdown}});
   }
   j["replanning"] = replanning;
   nlohmann::json conditionals = nlohmann::json::array();

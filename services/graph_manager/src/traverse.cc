@@ -90,7 +90,8 @@ GraphManager::GraphManager(Abstraction abstraction, std::string domain_pddl, Mis
     : abstraction_(std::move(abstraction)),
       domain_(std::move(domain_pddl)),
       goal_(std::move(goal)),
-      services_(services),
+      logged_(services),
+      services_(logged_),
       params_(params) {
   if (auto why = params_.invalidReason()) throw std::invalid_argument("GraphManagerParams: " + *why);
 }
@@ -599,6 +600,7 @@ double GraphManager::evaluateArm(Edge& e, EdgeId next, const BranchContext& ctx)
   }
   m->trajectory = a.trajectory;
   m->lazy_path = a.path;
+  m->planned_in = contextKey(ctx);
   const auto [mean, sd] = pricePath(ActionKind::kMoveArm, a.path, ctx);
   e.motion_by_next[next] = *m;
   e.effort_by_next[next] = {mean, sd};
@@ -699,6 +701,7 @@ double GraphManager::evaluateManipulation(Edge& e, const BranchContext& ctx) {
   const auto [mean, sd] = price(eq);
   m.transfer_effort_s = transfer_s;
   m.transfer_stddev_s = transfer_sd;
+  m.planned_in = contextKey(ctx);
   e.motion = m;
   e.state = std::isfinite(mean + transfer_s) ? EdgeState::kFeasible : EdgeState::kInfeasible;
   e.effort_mean_s = mean + transfer_s;
@@ -969,6 +972,16 @@ struct GraphManager::Search {
   bool exhausted{false};
   std::vector<EdgeId> branch;
   std::vector<double> branch_sd2;
+  /// traverseFirstEdge: below the first edge (with the manipulation an arm motion prepares) of
+  /// the first complete branch, nothing more is explored; every other way on from the start is,
+  /// against that branch's cost (first_edge.cc).
+  bool first_edge_only{false};
+  std::vector<EdgeId> first_edge;
+
+  bool settled() const {
+    return first_edge_only && !first_edge.empty() && branch.size() >= first_edge.size() &&
+           std::equal(first_edge.begin(), first_edge.end(), branch.begin());
+  }
 
   /// A manipulation with a transfer arm motion sends the robot two commands.
   static BranchStep stepOf(const Edge& e, double effort_s) {
@@ -1000,6 +1013,7 @@ struct GraphManager::Search {
 
   void complete(double branch_cost) {
     const double cost = branch_cost + gm.oraclePenalty(steps);
+    if (first_edge_only && first_edge.empty() && !branch.empty()) first_edge = gm.firstEdgeOf(branch);
     if (cost < best) {
       best = cost;
       best_branch = branch;
@@ -1018,7 +1032,7 @@ struct GraphManager::Search {
       return;
     }
     std::set<EdgeId> tried;
-    while (!outOfBudget()) {
+    while (!settled() && !outOfBudget()) {
       // The untried out-edge with the least known or bounded effort (out(v) grows with sub-tasks).
       EdgeId pick = -1;
       double pick_cost = kInfinity;
@@ -1074,7 +1088,7 @@ struct GraphManager::Search {
       if (gm.graph_.edge(f).kind == ActionKind::kPick || gm.graph_.edge(f).kind == ActionKind::kPlace) nexts.push_back(f);
     if (nexts.empty() || (a.tokens.size() > 3 && a.tokens[3] == "stow")) nexts = {-1};
     for (EdgeId f : nexts) {
-      if (outOfBudget()) return;
+      if (settled() || outOfBudget()) return;
       ++evaluations;
       const double c = gm.evaluate(arm, f, ctx, depth);
       if (!std::isfinite(c)) continue;
@@ -1113,6 +1127,10 @@ struct GraphManager::Search {
 };
 
 TraverseResult GraphManager::traverse(NodeId from, const BranchContext& context) {
+  return search(from, context, false);
+}
+
+TraverseResult GraphManager::search(NodeId from, const BranchContext& context, bool first_edge_only) {
   const auto t0 = Clock::now();
   ++traverse_count_;
   if (params_.policy == Policy::kOracle) refreshOracle();
@@ -1127,6 +1145,7 @@ TraverseResult GraphManager::traverse(NodeId from, const BranchContext& context)
     }
   }
   Search s(*this, t0);
+  s.first_edge_only = first_edge_only;
   s.dfs(from, context, 0.0, 0);
   r.evaluations = s.evaluations;
   r.time_s = since(t0);
@@ -1142,9 +1161,19 @@ TraverseResult GraphManager::traverse(NodeId from, const BranchContext& context)
   }
   r.found = true;
   r.branch = s.best_branch;
+  // The first edge is proven best when the best branch found goes through it and every other way
+  // on was explored within the budget (first_edge.cc).
+  if (first_edge_only && !s.exhausted && !s.first_edge.empty() && r.branch.size() >= s.first_edge.size() &&
+      std::equal(s.first_edge.begin(), s.first_edge.end(), r.branch.begin()))
+    r.proven_edges = s.first_edge.size();
   r.cost_s = s.best;
   r.stddev_s = std::sqrt(s.best_sd2);
-  recordDecisions(from, s.best_through, r.branch, r.cost_s, traverse_count_, s.cut_bound);
+  // Below a proven first edge nothing was explored: only its decisions are recorded (the rest of
+  // the branch is decided, and recorded, by the Traverse that continues from there).
+  const std::vector<EdgeId> decided = first_edge_only ? std::vector<EdgeId>(r.branch.begin(),
+                                                                            r.branch.begin() + static_cast<std::ptrdiff_t>(r.proven_edges))
+                                                      : r.branch;
+  recordDecisions(from, s.best_through, decided, r.cost_s, traverse_count_, s.cut_bound);
   return r;
 }
 

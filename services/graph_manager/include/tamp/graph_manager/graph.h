@@ -65,6 +65,9 @@ struct EdgeMotion {
   Trajectory transfer;
   double transfer_effort_s{0.0};
   double transfer_stddev_s{0.0};
+  /// The context the motion was planned in (GraphManager::contextKey): a motion planned in the
+  /// robot's own context, in the world as it is, is not planned again before it is sent.
+  std::string planned_in;
 };
 
 struct Edge {

@@ -48,6 +48,7 @@
 #include <vector>
 
 #include "tamp/graph_manager/abstraction.h"
+#include "tamp/graph_manager/call_log.h"
 #include "tamp/graph_manager/clients.h"
 #include "tamp/graph_manager/graph.h"
 #include "tamp/graph_manager/params.h"
@@ -102,6 +103,9 @@ struct TraverseResult {
   double time_s{0.0};
   int evaluations{0};
   std::string reason;          ///< when not found
+  /// traverseFirstEdge: the first this many edges of `branch` are proven best (0: the whole
+  /// branch is, or nothing is); the rest is the first complete branch found through them.
+  std::size_t proven_edges{0};
 };
 
 struct ExecutedAction {
@@ -139,6 +143,20 @@ struct MissionEvent {
   std::string detail;
 };
 
+/// Where the time from an event to the next command went (issue 12's latency), filled when the
+/// next command goes out.
+struct LatencyBreakdown {
+  double repair_s{0.0};    ///< the graph repaired: world taken in, re-join sub-tasks (= planning_s)
+  double traverse_s{0.0};  ///< Traverse from the robot's node until the first edge was decided
+  double prepare_s{0.0};   ///< the rest: the first edge planned again in the world as it is now
+  int evaluations{0};      ///< edge evaluations by that Traverse
+  /// The service calls between the event and the next command (all on its critical path).
+  std::vector<TimedCall> calls;
+  /// Calls made for the branch after the first edge was decided, while the robot executed it.
+  int background_calls{0};
+  double background_s{0.0};
+};
+
 /// One online replanning: the event, how the graph was repaired, what it cost.
 struct ReplanRecord {
   MissionEvent event;
@@ -151,6 +169,7 @@ struct ReplanRecord {
   int motion_calls{0};
   double planning_s{0.0};
   double latency_s{-1.0};             ///< from the event to the next command (-1: none followed)
+  LatencyBreakdown breakdown;         ///< where `latency_s` went (when a command followed)
 };
 
 /// What the planner is told before it observes anything (a scenario's planner view).
@@ -247,6 +266,26 @@ class GraphManager {
   Status start(const world::World& live, const Observation& robot);
   /// Algorithm 3 from `from` with the robot in `context`.
   TraverseResult traverse(NodeId from, const BranchContext& context);
+  /// Algorithm 3 until the branch's first edge is decided (first_edge.cc): below the first edge
+  /// of the first complete branch nothing more is explored, every other way on from `from` is,
+  /// against that branch's cost. When the best branch goes through that edge, `proven_edges`
+  /// says so and `traverse(end of those edges)` chooses the rest as `traverse(from)` would;
+  /// otherwise this is `traverse(from)`. The first edge is an arm motion with the manipulation
+  /// it prepares, or one edge (firstEdgeOf).
+  TraverseResult traverseFirstEdge(NodeId from, const BranchContext& context);
+  /// The edges decided together at the start of `branch`: an arm motion into a manipulation
+  /// with that manipulation, else the first edge (empty for an empty branch).
+  std::vector<EdgeId> firstEdgeOf(const std::vector<EdgeId>& branch) const;
+  /// `advance` along `edges` (each arm motion with the edge after it) from `ctx`.
+  BranchContext advanceAlong(const std::vector<EdgeId>& edges, const BranchContext& ctx) const;
+  /// What a motion planned in `ctx` depends on: the base and arm, the held object, the grasp or
+  /// placement prepared, the branch's moved objects and every object of the world as last taken
+  /// in (first_edge.cc).
+  std::string contextKey(const BranchContext& ctx) const;
+  /// Whether edge `id` (an arm motion into the manipulation `next`, or a pick or place) was
+  /// planned in `ctx` (contextKey), feasible, with its grasp or placement prepared: then it need
+  /// not be planned again before it is sent. Base motions: false (commandFor checks their start).
+  bool plannedIn(EdgeId id, EdgeId next, const BranchContext& ctx) const;
   /// What the planner is told before it observes (default: what the robot reports at the start).
   void setBelief(Belief b) { belief_ = std::move(b); }
   /// The whole mission: start, traverse, execute, repair.
@@ -260,6 +299,8 @@ class GraphManager {
   const ReachabilityGraph& graph() const { return graph_; }
   const Abstraction& abstraction() const { return abstraction_; }
   const Counters& counters() const { return counters_; }
+  /// Every service call of this graph manager, timed (the replanning latency's breakdown).
+  const LoggedServiceClients& callLog() const { return logged_; }
   NodeId root() const { return root_; }
   bool isGoal(NodeId n) const;
   const std::vector<Decision>& decisions() const { return decisions_; }
@@ -322,6 +363,8 @@ class GraphManager {
  private:
   struct Search;
   struct Run;
+  /// Branch-and-bound from `from`; `first_edge_only`: traverseFirstEdge's search.
+  TraverseResult search(NodeId from, const BranchContext& context, bool first_edge_only);
   /// The held object's mass in the node's state (0 when the hand is empty).
   double heldMassAt(NodeId n) const;
   /// Whether the arm is in a driving configuration (`stow` or `carry`, within
@@ -383,6 +426,7 @@ class GraphManager {
   Abstraction abstraction_;
   std::string domain_;
   MissionGoal goal_;
+  LoggedServiceClients logged_;  ///< wraps the services given; declared before `services_`
   ServiceClients& services_;
   GraphManagerParams params_;
   ReachabilityGraph graph_;

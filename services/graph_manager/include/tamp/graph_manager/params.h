@@ -60,6 +60,12 @@ struct GraphManagerParams {
   /// Online replanning: re-join sub-tasks tried towards the next this many nodes of the branch
   /// ahead (the first reachable ones are kept, Traverse chooses among them); >= 1.
   int max_rejoin_targets{2};
+  /// Online replanning: the next command goes out once Traverse has proven the branch's first
+  /// edge best (traverseFirstEdge), the rest of the branch is priced while the robot executes
+  /// it, and an arm motion planned from where the robot is, in the world as it is, is not
+  /// planned again before it is sent. false (the default until the blocked stow arm motion in
+  /// namo_corridor_slippery is understood, docs/benchmarks.md): the whole branch first, as before.
+  bool replan_first_edge{false};
   /// Conditional planning: the nodes of the first plan given a prebuilt "the gripper is not
   /// empty" branch before execution starts (the start and the states before each pick, in plan
   /// order); each costs up to `max_rejoin_targets` planner calls at the start; >= 0 (0: none).

@@ -1,0 +1,257 @@
+// traverseFirstEdge (issue 12, replanning latency): the branch's first edge is decided with
+// fewer evaluations than the full Traverse, it is the one the full Traverse chooses, and a
+// Traverse from its end chooses the rest as the full one does. Over scripted fake services:
+// base motions are straight lines, their effort is their length at 1 m/s (the admissible bound
+// assumes 1.5 m/s), plans are given in order.
+#include <algorithm>
+#include <cmath>
+#include <deque>
+
+#include <gtest/gtest.h>
+
+#include "tamp/core/paths.h"
+#include "tamp/graph_manager/graph_manager.h"
+#include "tamp/world/scenario.h"
+
+namespace tamp::graph_manager {
+namespace {
+
+/// Plans handed out in order; straight base motions; effort = length, `slow_from` paths starting
+/// within 0.1 m of it cost `slow_factor` times more.
+class ScriptedServices : public ServiceClients {
+ public:
+  std::deque<std::vector<std::string>> plans;  ///< each a list of "(move_base from to)"
+  /// When set, the states of the next plan (else: where the robot is after each move_base).
+  std::deque<std::vector<std::vector<std::string>>> states;
+  std::vector<double> pregrasp;  ///< of the one grasp offered
+  Eigen::Vector2d slow_from{1e9, 1e9};
+  double slow_factor{1.0};
+  int motion_calls{0};
+
+  TaskPlan plan(const TaskQuery& q) override {
+    (void)q;
+    TaskPlan p;
+    if (plans.empty()) {
+      p.status = TaskStatus::kUnsolvable;
+      return p;
+    }
+    p.status = TaskStatus::kSolved;
+    p.actions = plans.front();
+    plans.pop_front();
+    if (!states.empty()) {
+      p.states = states.front();
+      states.pop_front();
+      return p;
+    }
+    // States: only where the robot is (planFrom applies the changes to the node's atoms).
+    for (std::size_t i = 0; i < p.actions.size(); ++i) {
+      const auto t = atomTokens(p.actions[i]);
+      if (i == 0) p.states.push_back({"(robot-at " + t[1] + ")"});
+      p.states.push_back({"(robot-at " + t[2] + ")"});
+    }
+    return p;
+  }
+  MotionAnswer motion(const MotionQuery& q) override {
+    ++motion_calls;
+    MotionAnswer a;
+    a.status = MotionOutcome::kSolved;
+    if (q.group == Group::kArm) {
+      a.path.joint_names = std::vector<std::string>(q.goal_arm.size(), "j");
+      a.path.waypoints = {q.start.arm, q.goal_arm};
+      a.trajectory.joint_names = a.path.joint_names;
+      a.trajectory.points = {TrajectoryPoint{0.0, q.start.arm, {}},
+                             TrajectoryPoint{1.0, q.goal_arm, {}}};
+      return a;
+    }
+    a.path.joint_names = {"base_x", "base_y", "base_theta"};
+    a.path.waypoints = {{q.start.base.x, q.start.base.y, q.start.base.theta},
+                        {q.goal_base.x, q.goal_base.y, q.goal_base.theta}};
+    a.path_length = std::hypot(q.goal_base.x - q.start.base.x, q.goal_base.y - q.start.base.y);
+    a.trajectory.joint_names = a.path.joint_names;
+    a.trajectory.points = {TrajectoryPoint{0.0, a.path.waypoints[0], {}},
+                           TrajectoryPoint{a.path_length, a.path.waypoints[1], {}}};
+    return a;
+  }
+  Result<std::vector<PlacementOption>> placements(const PlacementQuery&) override {
+    return std::vector<PlacementOption>{};
+  }
+  Result<std::vector<GraspOption>> grasps(const GraspQuery& q) override {
+    GraspOption g;
+    g.base_pose = q.base ? *q.base : Pose2D{};
+    g.pregrasp = pregrasp;
+    g.grasp = pregrasp;
+    return std::vector<GraspOption>{g};
+  }
+  std::vector<EffortAnswer> effort(const std::vector<EffortQuery>& qs) override {
+    std::vector<EffortAnswer> out;
+    for (const auto& q : qs) {
+      EffortAnswer a;
+      a.ok = true;
+      a.stddev_s = 0.1;
+      const auto& w = q.path.waypoints;
+      for (std::size_t i = 1; i < w.size(); ++i)
+        a.mean_s += std::hypot(w[i][0] - w[i - 1][0], w[i][1] - w[i - 1][1]);
+      if (!w.empty() && std::hypot(w[0][0] - slow_from.x(), w[0][1] - slow_from.y()) < 0.1)
+        a.mean_s *= slow_factor;
+      out.push_back(a);
+    }
+    return out;
+  }
+};
+
+/// Start (1.5, 1.2) and goal (8.5, 1.2) of namo_corridor, three more places: a (5, 2.2), b (5,
+/// -1.5), c (5, 6.6). Plans: start-a-goal (7.3 s), start-b-goal (8.8 s), and from a: a-c-goal
+/// (a->c 4.4 s, bounded at 2.9 s: below the first complete branch, priced by the full Traverse
+/// only).
+class FirstEdgeTest : public ::testing::Test {
+ protected:
+  struct Setup {
+    std::unique_ptr<GraphManager> gm;
+    BranchContext ctx;
+  };
+
+  Setup make(ScriptedServices& services) {
+    auto sc = world::loadScenario(configDir() / "scenarios" / "namo_corridor.yaml");
+    EXPECT_TRUE(sc.ok()) << (sc ? "" : sc.error().toString());
+    auto robot = robot::RobotModel::loadDescription(sc->robot.description);
+    EXPECT_TRUE(robot.ok());
+    Abstraction a(sc->plannerWorld(), *robot);
+    for (const auto& [name, x, y] :
+         {std::tuple{"a", 5.0, 2.2}, std::tuple{"b", 5.0, -1.5}, std::tuple{"c", 5.0, 6.6}})
+      EXPECT_EQ(a.locationFor(Pose2D{x, y, 0.0}, name), name);
+    GraphManagerParams params;
+    params.max_contingencies = 0;
+    Setup s;
+    s.gm = std::make_unique<GraphManager>(std::move(a), "", MissionGoal{{"(robot-at goal)"}},
+                                          services, params);
+    Observation obs;
+    obs.valid = true;
+    obs.robot.base = sc->robot.start;
+    obs.robot.arm = *robot->namedConfiguration("stow");
+    services.plans = {{"(move_base start a)", "(move_base a goal)"},
+                      {"(move_base start b)", "(move_base b goal)"},
+                      {"(move_base a c)", "(move_base c goal)"}};
+    EXPECT_TRUE(s.gm->start(sc->plannerWorld(), obs).ok());
+    const NodeId root = s.gm->root();
+    EXPECT_TRUE(s.gm->planFrom(root, {"(robot-at goal)"}, "plan b").ok());
+    const NodeId at_a = s.gm->graph().edge(s.gm->graph().out(root).front()).to;
+    EXPECT_TRUE(s.gm->planFrom(at_a, {"(robot-at goal)"}, "plan c").ok());
+    s.ctx = s.gm->contextOf(obs);
+    return s;
+  }
+
+  static std::vector<std::string> actions(const GraphManager& gm,
+                                          const std::vector<EdgeId>& branch) {
+    std::vector<std::string> out;
+    for (EdgeId e : branch) out.push_back(gm.graph().edge(e).action);
+    return out;
+  }
+};
+
+TEST_F(FirstEdgeTest, TheFirstEdgeIsDecidedWithoutPricingBelowIt) {
+  ScriptedServices full_services;
+  Setup full = make(full_services);
+  const TraverseResult f = full.gm->traverse(full.gm->root(), full.ctx);
+  ASSERT_TRUE(f.found) << f.reason;
+  EXPECT_EQ(actions(*full.gm, f.branch),
+            (std::vector<std::string>{"(move_base start a)", "(move_base a goal)"}));
+  // The full Traverse prices a->c too (3.6 + 2.9 s bound < 7.3 s; 3.6 + 4.4 s then cuts it).
+  EXPECT_EQ(full_services.motion_calls, 4);
+
+  ScriptedServices services;
+  Setup s = make(services);
+  const TraverseResult t = s.gm->traverseFirstEdge(s.gm->root(), s.ctx);
+  ASSERT_TRUE(t.found) << t.reason;
+  EXPECT_EQ(t.proven_edges, 1u);
+  EXPECT_EQ(actions(*s.gm, t.branch), actions(*full.gm, f.branch));
+  EXPECT_EQ(services.motion_calls, 3)
+      << "start-a, a-goal, start-b: nothing below start-a after its first branch";
+  EXPECT_LT(t.evaluations, f.evaluations);
+  // Its decision is recorded at the start only (the rest is recorded by the Traverse that
+  // chooses it).
+  ASSERT_EQ(s.gm->decisions().size(), 1u);
+  EXPECT_EQ(s.gm->decisions().front().node, "n" + std::to_string(s.gm->root()));
+
+  // The rest, from the first edge's end, is what the full Traverse chose.
+  const std::vector<EdgeId> first(t.branch.begin(),
+                                  t.branch.begin() + static_cast<std::ptrdiff_t>(t.proven_edges));
+  EXPECT_EQ(s.gm->firstEdgeOf(t.branch), first);
+  const NodeId end = s.gm->graph().edge(first.back()).to;
+  const TraverseResult rest = s.gm->traverse(end, s.gm->advanceAlong(first, s.ctx));
+  ASSERT_TRUE(rest.found) << rest.reason;
+  EXPECT_EQ(actions(*s.gm, rest.branch), (std::vector<std::string>{"(move_base a goal)"}));
+  EXPECT_NEAR(t.cost_s - s.gm->graph().edge(first.front()).effort_mean_s, rest.cost_s, 1e-9);
+  EXPECT_NEAR(f.cost_s, t.cost_s, 1e-9);
+}
+
+TEST_F(FirstEdgeTest, WhenAnotherWayOnBeatsTheFirstBranchTheFullTraverseDecides) {
+  // a->goal three times slower: start-a-goal costs 3.6 + 10.9 s, start-b-goal 8.8 s wins.
+  ScriptedServices full_services;
+  full_services.slow_from = {5.0, 2.2};
+  full_services.slow_factor = 3.0;
+  Setup full = make(full_services);
+  const TraverseResult f = full.gm->traverse(full.gm->root(), full.ctx);
+  ASSERT_TRUE(f.found) << f.reason;
+  EXPECT_EQ(actions(*full.gm, f.branch),
+            (std::vector<std::string>{"(move_base start b)", "(move_base b goal)"}));
+
+  ScriptedServices services;
+  services.slow_from = full_services.slow_from;
+  services.slow_factor = full_services.slow_factor;
+  Setup s = make(services);
+  const TraverseResult t = s.gm->traverseFirstEdge(s.gm->root(), s.ctx);
+  ASSERT_TRUE(t.found) << t.reason;
+  EXPECT_EQ(t.proven_edges, 0u)
+      << "start-a's first branch lost: not proven, the full search decided";
+  EXPECT_EQ(actions(*s.gm, t.branch), actions(*full.gm, f.branch));
+  EXPECT_NEAR(t.cost_s, f.cost_s, 1e-9);
+}
+
+TEST_F(FirstEdgeTest, AnArmMotionPlannedWhereTheRobotIsNeedNotBePlannedAgain) {
+  ScriptedServices services;
+  Setup s = make(services);
+  auto robot = robot::RobotModel::loadDescription(
+      world::loadScenario(configDir() / "scenarios" / "namo_corridor.yaml")->robot.description);
+  ASSERT_TRUE(robot.ok());
+  const auto ready = robot->namedConfiguration("ready");
+  ASSERT_TRUE(ready.has_value());
+  services.pregrasp = *ready;
+  services.plans = {
+      {"(move_arm start stow over_box_floor)", "(pick box box_floor over_box_floor)"}};
+  services.states = {{{"(arm-at stow)", "(hand-empty)", "(on box box_floor)"},
+                      {"(arm-at over_box_floor)", "(hand-empty)", "(on box box_floor)"},
+                      {"(arm-at over_box_floor)", "(holding box)"}}};
+  auto plan = s.gm->planFrom(s.gm->root(), {"(holding box)"}, "pick");
+  ASSERT_TRUE(plan.ok()) << plan.error().toString();
+  ASSERT_EQ(plan->size(), 2u);
+  const EdgeId arm = (*plan)[0], pick = (*plan)[1];
+  EXPECT_FALSE(s.gm->plannedIn(arm, pick, s.ctx)) << "not planned yet";
+  ASSERT_TRUE(std::isfinite(s.gm->evaluate(arm, pick, s.ctx, 0)));
+  EXPECT_TRUE(s.gm->plannedIn(arm, pick, s.ctx));
+  // The pick, with the grasp the arm motion prepared, where the arm motion ends.
+  const BranchContext over = s.gm->advance(arm, pick, s.ctx);
+  EXPECT_FALSE(s.gm->plannedIn(pick, -1, over));
+  ASSERT_TRUE(std::isfinite(s.gm->evaluate(pick, -1, over, 0)));
+  EXPECT_TRUE(s.gm->plannedIn(pick, -1, over));
+  BranchContext other_grasp = over;
+  other_grasp.pending_grasp->pregrasp[0] += 0.1;
+  EXPECT_FALSE(s.gm->plannedIn(pick, -1, other_grasp));
+  EXPECT_EQ(s.gm->firstEdgeOf(*plan), *plan)
+      << "an arm motion is decided with the pick it prepares";
+  // Anywhere else, or in a branch that moved an object, it was planned in another context.
+  BranchContext moved = s.ctx;
+  moved.state.base.x += 0.05;
+  EXPECT_FALSE(s.gm->plannedIn(arm, pick, moved));
+  BranchContext other_world = s.ctx;
+  other_world.object_poses["box"] = Eigen::Isometry3d(Eigen::Translation3d(4.0, 2.0, 0.15));
+  EXPECT_FALSE(s.gm->plannedIn(arm, pick, other_world));
+}
+
+TEST_F(FirstEdgeTest, AnEmptyBranchHasNoFirstEdge) {
+  ScriptedServices services;
+  Setup s = make(services);
+  EXPECT_TRUE(s.gm->firstEdgeOf({}).empty());
+}
+
+}  // namespace
+}  // namespace tamp::graph_manager

@@ -75,6 +75,31 @@ TEST(MissionTest, AParcelOnALargeFloorRegionIsPickedWhereTheArmReachesItAndDocke
   EXPECT_TRUE(picked_from_slot) << m.report["actions"].dump(1);
 }
 
+// Issue 12: a held object dropped mid-transport. The parcel slips out of the gripper during the
+// carrying move_base and falls in front of the robot; it is picked up again from where it fell
+// (a re-join after the drop event) and docked, and no command is executed twice.
+TEST(MissionTest, AParcelDroppedMidTransportIsPickedUpWhereItFellAndDocked) {
+  const Mission m = run("transport_drop.yaml", {"--policy", "effort"});
+  ASSERT_EQ(m.exit_code, 0) << m.output;
+  ASSERT_TRUE(m.truth.is_object()) << m.output;
+  const auto& box = m.truth["objects"]["box"];
+  EXPECT_GT(box["x"].get<double>(), 6.1) << box.dump();
+  EXPECT_LT(box["x"].get<double>(), 6.8) << box.dump();
+  EXPECT_GT(box["y"].get<double>(), 1.5) << box.dump();
+  EXPECT_LT(box["y"].get<double>(), 2.5) << box.dump();
+  EXPECT_EQ(m.truth["robot"]["held"], "") << m.truth.dump();
+  std::map<std::string, int> executions;
+  for (const auto& a : m.truth["action_log"]) ++executions[a.is_object() ? a["command_id"].get<std::string>() : a.get<std::string>()];
+  for (const auto& [id, n] : executions) EXPECT_EQ(n, 1) << id << " executed " << n << " times";
+  bool drop_replanned = false;
+  for (const auto& r : m.report["replanning"]) drop_replanned |= r["event"] == "object_dropped";
+  EXPECT_TRUE(drop_replanned) << m.report["replanning"].dump(1);
+  int picks = 0;
+  for (const auto& a : m.report["actions"])
+    if (a["action"].get<std::string>().rfind("(pick box", 0) == 0 && a["outcome"] == "succeeded") ++picks;
+  EXPECT_GE(picks, 2) << "picked, dropped, picked again: " << m.report["actions"].dump(1);
+}
+
 TEST(MissionTest, CorridorInfeasibilityPolicyGoesRoundAndLeavesTheBox) {
   const Mission m = run("namo_corridor.yaml", {"--policy", "infeasible"});
   ASSERT_EQ(m.exit_code, 0) << m.output;

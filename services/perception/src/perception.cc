@@ -190,10 +190,37 @@ struct Perception::Impl {
   /// is in the air where it was carried and falls onto the support below it. Often the camera
   /// cannot see there (right in front of the base), so that is where the world model keeps it
   /// until a view corrects it: seen elsewhere, reacquired; seen empty there, gone.
-  void settleReleased(FrameResult& result, std::int64_t stamp) {
+  void settleReleased(FrameResult& result, std::int64_t stamp, const RobotBody* body) {
     auto it = tracks.find(held_id);
     if (it == tracks.end() || it->second.state == TrackInfo::State::kGone) return;
-    (void)settleIfUnsupported(it->second, result, stamp, "released");
+    if (settleIfUnsupported(it->second, result, stamp, "released") && body != nullptr) keepOutOfBody(it->second, *body);
+  }
+
+  /// A fallen object cannot be inside the robot: the estimate of where it fell (from where it was
+  /// believed carried) can put it there, and the camera often cannot see right in front of the
+  /// base to correct it. It is moved straight away from the part it overlaps (horizontally, in
+  /// 1 cm steps, at most 0.5 m) until their boxes are apart.
+  void keepOutOfBody(Track& t, const RobotBody& body) {
+    constexpr double kStep = 0.01, kMaxShift = 0.5;
+    for (double moved = 0.0; moved <= kMaxShift; moved += kStep) {
+      const Aabb box = objectOf(t).aabb();
+      const BodyPart* hit = nullptr;
+      for (const auto& part : body.parts) {
+        world::Object solid;
+        solid.shape = part.shape;
+        solid.pose = part.world_T_shape;
+        if (solid.aabb().overlaps(box)) hit = &part;
+      }
+      if (hit == nullptr) {
+        if (moved > 0.0) (void)world.updateObject(objectOf(t));
+        return;
+      }
+      Eigen::Vector2d away = t.pose.translation().head<2>() - hit->world_T_shape.translation().head<2>();
+      if (away.norm() < 1e-9) away = body.world_T_tool.translation().head<2>() - hit->world_T_shape.translation().head<2>();
+      if (away.norm() < 1e-9) return;
+      t.pose.translation().head<2>() += kStep * away.normalized();
+      t.event_pose = t.pose;
+    }
   }
 
   /// An object whose bottom is above the support below it falls onto that support (a MOVED
@@ -510,7 +537,7 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
   // The held object follows the gripper; a release (the state reports the gripper empty, or
   // another object) leaves it where it was last carried, tracked as any other from then on.
   if (self_filter) {
-    if (!I.held_id.empty() && (held == nullptr || held->id != I.held_id)) I.settleReleased(result, stamp);
+    if (!I.held_id.empty() && (held == nullptr || held->id != I.held_id)) I.settleReleased(result, stamp, robot);
     I.held_id = held != nullptr ? held->id : std::string();
     I.tool_T_held = held != nullptr ? tool_T_held : Eigen::Isometry3d::Identity();
   }

@@ -513,10 +513,10 @@ TEST(ScenarioErrorsTest, ExactMessages) {
       kFile + ":9:10: field 'faults[0]': give exactly one of 'at_time' (s) or 'at_step'");
   EXPECT_EQ(errorOf(std::string(kMinimal) +
                     "faults: [{type: drop_held, at_time: 1, action: move_base}]\n"),
-            kFile + ":9:46: field 'faults[0].action': a drop waits for an action of a kind only with at_step");
+            kFile + ":9:48: field 'faults[0].action': a drop waits for an action of a kind only with at_step");
   EXPECT_EQ(errorOf(std::string(kMinimal) +
                     "faults: [{type: drop_held, at_step: 1, action: fly}]\n"),
-            kFile + ":9:46: field 'faults[0].action': unknown action 'fly' (expected move_base, move_arm, pick or place)");
+            kFile + ":9:48: field 'faults[0].action': unknown action 'fly' (expected move_base, move_arm, pick or place)");
   EXPECT_EQ(errorOf(std::string(kMinimal) + "sim: {grasp_duration: -1}\n"),
             kFile + ":9:23: field 'sim.grasp_duration': must be >= 0, got -1");
   EXPECT_EQ(errorOf(replaced(kMinimal, "world:\n", "world:\n  namo: ${NOPE}/x.json\n")),

@@ -106,18 +106,7 @@ void GraphManager::spawnSubsetSubtasks(
       goal.push_back("(on " + slots[i].first + " " + slots[i].second + ")");
       what += (what.empty() ? "" : " and ") + slots[i].first + " to " + slots[i].second;
     }
-    const std::string origin = "sub-task: move " + what;
-    auto before = planFrom(v, goal, origin);
-    if (!before) continue;
-    ++counters_.subtasks;
-    const NodeId sj = before->empty() ? v : graph_.edge(before->back()).to;
-    NodeId end = sj;
-    if (!progress.empty()) {
-      auto after = planFrom(sj, progress, origin);
-      if (!after) continue;
-      if (!after->empty()) end = graph_.edge(after->back()).to;
-    }
-    if (!isGoal(end)) (void)planFrom(end, goal_.atoms, origin);
+    addSubtask(v, goal, progress, "sub-task: move " + what);
   }
 }
 

@@ -928,18 +928,7 @@ void GraphManager::spawnSubtasks(EdgeId id, const BranchContext& ctx, int depth)
     for (const auto& a : ca)
       if (!std::binary_search(va.begin(), va.end(), a)) progress.push_back(a);
     for (const auto& s : slots) {
-      const std::string origin = "sub-task: move " + o->id + " to " + s;
-      auto before = planFrom(v, {"(on " + o->id + " " + s + ")"}, origin);
-      if (!before) continue;
-      ++counters_.subtasks;
-      const NodeId sj = before->empty() ? v : graph_.edge(before->back()).to;
-      NodeId end = sj;
-      if (!progress.empty()) {
-        auto after = planFrom(sj, progress, origin);
-        if (!after) continue;
-        if (!after->empty()) end = graph_.edge(after->back()).to;
-      }
-      if (!isGoal(end)) (void)planFrom(end, goal_.atoms, origin);
+      addSubtask(v, {"(on " + o->id + " " + s + ")"}, progress, "sub-task: move " + o->id + " to " + s);
     }
     if (slots.empty()) unmovable.push_back("no placement for '" + o->id + "' off the path");
     else first_slots.emplace_back(o->id, slots.front());
@@ -1125,6 +1114,20 @@ struct GraphManager::Search {
     }
   }
 };
+
+void GraphManager::addSubtask(NodeId v, const std::vector<std::string>& moved, const std::vector<std::string>& progress,
+                              const std::string& origin) {
+  auto before = planFrom(v, moved, origin);
+  if (!before) return;
+  ++counters_.subtasks;
+  NodeId end = before->empty() ? v : graph_.edge(before->back()).to;
+  if (!progress.empty()) {
+    auto after = planFrom(end, progress, origin);
+    if (!after) return;
+    if (!after->empty()) end = graph_.edge(after->back()).to;
+  }
+  if (!isGoal(end)) (void)planFrom(end, goal_.atoms, origin);
+}
 
 TraverseResult GraphManager::traverse(NodeId from, const BranchContext& context) {
   return search(from, context, false);

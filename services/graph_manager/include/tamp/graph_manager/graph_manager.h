@@ -372,6 +372,10 @@ class GraphManager {
   bool armStowed(const std::vector<double>& arm) const;
   double lowerBound(const Edge& e) const;
   void spawnSubtasks(EdgeId e, const BranchContext& ctx, int depth);
+  /// One sub-task from `v`: TP(v, `moved`), then TP(that, `progress`) (what the blocked action
+  /// achieved; skipped when empty), then TP(that, goal), each merged into the graph.
+  void addSubtask(NodeId v, const std::vector<std::string>& moved, const std::vector<std::string>& progress,
+                  const std::string& origin);
   // ---- policy oracle (oracle.cc) ----
   /// Blocking objects of one edge given removal sub-tasks under the current policy.
   int blockingObjectsConsidered() const;

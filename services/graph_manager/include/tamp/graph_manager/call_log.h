@@ -46,6 +46,9 @@ class LoggedServiceClients : public ServiceClients {
   Result<std::vector<PlacementOption>> placements(const PlacementQuery& q) override;
   Result<std::vector<GraspOption>> grasps(const GraspQuery& q) override;
   std::vector<EffortAnswer> effort(const std::vector<EffortQuery>& q) override;
+  /// Forwarded untimed (asked once per Traverse, not a planning call). Without it the wrapper
+  /// answered with the base class's "no oracle", and policy oracle lost its knowledge.
+  Result<OracleKnowledge> oracle() override { return inner_.oracle(); }
 
   /// The position in the log now (to read the calls made after it with `since`).
   std::size_t mark() const;

@@ -1,0 +1,128 @@
+// Sub-tasks (findPossibleActions, findEffectStates, TP(v, s), TP(s, child)): what an object that
+// blocks an edge's lazy path spawns in the reachability graph.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <set>
+
+#include "tamp/core/log.h"
+#include "tamp/graph_manager/graph_manager.h"
+#include "tamp/world/scenario.h"
+
+namespace tamp::graph_manager {
+
+void GraphManager::spawnSubtasks(EdgeId id, const BranchContext& ctx, int depth) {
+  Edge& blocked = graph_.edge(id);
+  if (blocked.subtasks_spawned || !blocked.motion) return;
+  blocked.subtasks_spawned = true;
+  const NodeId v = blocked.from;
+  const NodeId child = blocked.to;
+  const EdgeMotion motion = *blocked.motion;
+  // The robot's base poses along the blocked path: placements must keep clear of them.
+  // (every 5 cm: the placement sampler keeps clear of poses, not of segments).
+  std::vector<Pose2D> swept;
+  const auto& wps = motion.lazy_path.waypoints;
+  for (std::size_t i = 0; i < wps.size(); ++i) {
+    if (wps[i].size() < 3) continue;
+    if (i > 0 && wps[i - 1].size() >= 3) {
+      const double len = std::hypot(wps[i][0] - wps[i - 1][0], wps[i][1] - wps[i - 1][1]);
+      const int n = static_cast<int>(std::ceil(len / 0.05));
+      for (int k = 1; k < n; ++k) {
+        const double t = static_cast<double>(k) / n;
+        swept.push_back(Pose2D{wps[i - 1][0] + t * (wps[i][0] - wps[i - 1][0]),
+                               wps[i - 1][1] + t * (wps[i][1] - wps[i - 1][1]), wps[i][2]});
+      }
+    }
+    swept.push_back(Pose2D{wps[i][0], wps[i][1], wps[i][2]});
+  }
+  const double radius = abstraction_.robot().baseRadius() + params_.keep_clear_margin_m;
+  int objects = 0;
+  std::vector<std::string> unmovable;  // why a crossed object spawned no sub-task (for the failure reason)
+  std::vector<std::pair<std::string, std::string>> first_slots;  // per movable object, for the oracle's subsets
+  for (const auto& crossing : motion.crossings) {
+    if (objects >= blockingObjectsConsidered()) break;
+    const world::Object* o = abstraction_.world().findObject(crossing.object_id);
+    if (!o) continue;
+    // findPossibleActions: only pick and place move objects.
+    if (std::string why = abstraction_.whyNotGraspable(*o); !why.empty()) {
+      unmovable.push_back(why);
+      continue;
+    }
+    ++objects;
+    // A base pose beside the object from which the arm reaches it, on the side the robot comes
+    // from: back from where the lazy path first touches the object.
+    const Pose2D entry = crossing.swept_base.empty() ? ctx.state.base : crossing.swept_base.front();
+    const std::optional<GraspOption> chosen = standBeside(*o, entry, ctx.state.base);
+    if (!chosen) {
+      log::get("graph_manager")->info("no grasp of {} from any base pose: only the detour remains", o->id);
+      unmovable.push_back("no grasp of '" + o->id + "' from any base pose");
+      continue;
+    }
+    const std::string near = abstraction_.locationFor(chosen->base_pose, "near_" + o->id);
+    abstraction_.addReach(near, Abstraction::armconfOver(o->region.empty() ? std::string() : o->region));
+    log::get("graph_manager")->info("sub-task for {}: contact at ({:.2f}, {:.2f}); stand at {} ({:.2f}, {:.2f})", o->id,
+                                    entry.x, entry.y, near, chosen->base_pose.x, chosen->base_pose.y);
+    // findEffectStates: placements off the swept path, in the object's region first.
+    std::vector<std::string> regions;
+    if (!o->region.empty()) regions.push_back(o->region);
+    for (const auto& r : abstraction_.world().regions())
+      if (r.id != o->region) regions.push_back(r.id);
+    std::vector<std::string> slots;
+    for (const auto& r : regions) {
+      if (static_cast<int>(slots.size()) >= params_.placements_per_object) break;
+      PlacementQuery pq;
+      pq.object_id = o->id;
+      pq.region_id = r;
+      pq.keep_clear_path = swept;
+      pq.keep_clear_radius = radius;
+      pq.max_placements = static_cast<unsigned>(params_.placements_per_object);
+      ++counters_.placement_calls;
+      auto ps = services_.placements(pq);
+      if (!ps) continue;
+      for (const auto& p : *ps) {
+        if (static_cast<int>(slots.size()) >= params_.placements_per_object) break;
+        const std::string s = abstraction_.addSlot(o->id, r, p.object_pose);
+        log::get("graph_manager")->info("findEffectStates({}): {} at ({:.2f}, {:.2f}) on {}, base ({:.2f}, {:.2f})", o->id, s,
+                                        p.object_pose.translation().x(), p.object_pose.translation().y(), r,
+                                        p.base_pose.x, p.base_pose.y);
+        abstraction_.locationFor(p.base_pose, "place_" + o->id);
+        slots.push_back(s);
+      }
+    }
+    (void)near;
+    // What the blocked action achieved: the sub-task's second plan must achieve it too.
+    const auto& va = graph_.node(v).atoms;
+    const auto& ca = graph_.node(child).atoms;
+    std::vector<std::string> progress;
+    for (const auto& a : ca)
+      if (!std::binary_search(va.begin(), va.end(), a)) progress.push_back(a);
+    for (const auto& s : slots) {
+      addSubtask(v, {"(on " + o->id + " " + s + ")"}, progress, "sub-task: move " + o->id + " to " + s);
+    }
+    if (slots.empty()) unmovable.push_back("no placement for '" + o->id + "' off the path");
+    else first_slots.emplace_back(o->id, slots.front());
+  }
+  if (params_.policy == Policy::kOracle) spawnSubsetSubtasks(v, child, first_slots);
+  // The edge may have moved: the graph grew.
+  Edge& e = graph_.edge(id);
+  for (const auto& why : unmovable) e.reason += "; " + why;
+  (void)ctx;
+  (void)depth;
+}
+
+void GraphManager::addSubtask(NodeId v, const std::vector<std::string>& moved, const std::vector<std::string>& progress,
+                              const std::string& origin) {
+  auto before = planFrom(v, moved, origin);
+  if (!before) return;
+  ++counters_.subtasks;
+  NodeId end = before->empty() ? v : graph_.edge(before->back()).to;
+  if (!progress.empty()) {
+    auto after = planFrom(end, progress, origin);
+    if (!after) return;
+    if (!after->empty()) end = graph_.edge(after->back()).to;
+  }
+  if (!isGoal(end)) (void)planFrom(end, goal_.atoms, origin);
+}
+
+
+}  // namespace tamp::graph_manager

@@ -227,24 +227,8 @@ struct ExecutionMonitor::Impl {
         active.reset();
         continue;  // the next queued command
       }
-      records.addCommand(c);
-      RobotRequest r;
-      r.type = RobotRequest::Type::kExecute;
-      r.command = c;
-      out.robot.push_back(std::move(r));
       ++executed;
-      a.phase = Phase::kRunning;
-      a.started = now;
-      a.last_status = now;
-      const double expected =
-          c.expected_duration_s > 0.0 ? c.expected_duration_s : c.trajectory.duration();
-      a.timeout_limit =
-          expected + params.timeout.stddevs * c.expected_stddev_s + params.timeout.margin_s;
-      StatusUpdate s;
-      s.command_id = c.command_id;
-      s.state = ExecState::kRunning;
-      s.reason = a.note;
-      emit(out, s);
+      sendToRobot(out, now);
       return;
     }
   }
@@ -254,9 +238,16 @@ struct ExecutionMonitor::Impl {
   /// command ids, answers by joining the running action or by its recorded result.
   void rejoin(Outputs& out, double now) {
     Active& a = *active;
-    const ExecutionCommand& c = a.cmd;
     a.rejoined = true;
     a.note = "sent before a restart of the monitor: joined, not executed again";
+    sendToRobot(out, now);
+  }
+
+  /// The active command goes to the robot now: recorded, running, its timeout set from its
+  /// predicted duration, and reported running.
+  void sendToRobot(Outputs& out, double now) {
+    Active& a = *active;
+    const ExecutionCommand& c = a.cmd;
     records.addCommand(c);
     RobotRequest r;
     r.type = RobotRequest::Type::kExecute;

@@ -5,6 +5,7 @@
 #include <chrono>
 
 #include "tamp/core/log.h"
+#include "effort_msgs.h"
 #include "tamp/dds/convert.h"
 
 namespace tamp::graph_manager {
@@ -235,28 +236,14 @@ Result<std::vector<GraspOption>> DdsServiceClients::grasps(const GraspQuery& q) 
 
 std::vector<EffortAnswer> DdsServiceClients::effort(const std::vector<EffortQuery>& qs) {
   msg::EffortRequest req;
-  for (const auto& q : qs) {
-    msg::EffortQuery m;
-    m.kind(dds::toMsg(q.kind));
-    if (!q.path.empty()) m.path(dds::toMsg(q.path));
-    m.object_mass(q.object_mass);
-    m.approach_m(q.approach_m);
-    m.retreat_m(q.retreat_m);
-    req.queries().push_back(m);
-  }
+  for (const auto& q : qs) req.queries().push_back(toEffortMsg(q));
   std::vector<EffortAnswer> out(qs.size());
   auto rep = checked(effort_.call(req, dds::CallOptions{5.0, {}}), dds::services::kEffort.name);
   if (!rep) {
     for (auto& a : out) a.message = rep.error().message;
     return out;
   }
-  for (std::size_t i = 0; i < out.size() && i < rep->estimates().size(); ++i) {
-    const auto& e = rep->estimates()[i];
-    out[i].ok = e.code() == msg::StatusCode::STATUS_OK;
-    out[i].mean_s = e.mean_s();
-    out[i].stddev_s = e.stddev_s();
-    out[i].message = e.message();
-  }
+  fillEffortAnswers(rep->estimates(), out);
   return out;
 }
 

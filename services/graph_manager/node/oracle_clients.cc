@@ -1,5 +1,6 @@
 #include "oracle_clients.h"
 
+#include "effort_msgs.h"
 #include "tamp/dds/convert.h"
 #include "tamp/dds/world_sync.h"
 #include "tamp/msg_validation/validate.h"
@@ -40,15 +41,7 @@ OracleServiceClients::OracleServiceClients(std::shared_ptr<dds::Participant> p,
 
 std::vector<EffortAnswer> OracleServiceClients::effort(const std::vector<EffortQuery>& qs) {
   msg::OracleRequest req;
-  for (const auto& q : qs) {
-    msg::EffortQuery m;
-    m.kind(dds::toMsg(q.kind));
-    if (!q.path.empty()) m.path(dds::toMsg(q.path));
-    m.object_mass(q.object_mass);
-    m.approach_m(q.approach_m);
-    m.retreat_m(q.retreat_m);
-    req.queries().push_back(m);
-  }
+  for (const auto& q : qs) req.queries().push_back(toEffortMsg(q));
   req.want_truth(false);
   std::vector<EffortAnswer> out(qs.size());
   auto rep = oracle_.call(req, dds::CallOptions{5.0, {}});
@@ -60,13 +53,7 @@ std::vector<EffortAnswer> OracleServiceClients::effort(const std::vector<EffortQ
     for (auto& a : out) a.message = "oracle: " + rep.error().message;
     return out;
   }
-  for (std::size_t i = 0; i < out.size() && i < rep->durations().size(); ++i) {
-    const auto& e = rep->durations()[i];
-    out[i].ok = e.code() == msg::StatusCode::STATUS_OK;
-    out[i].mean_s = e.mean_s();
-    out[i].stddev_s = e.stddev_s();
-    out[i].message = e.message();
-  }
+  fillEffortAnswers(rep->durations(), out);
   return out;
 }
 

@@ -394,6 +394,59 @@ TEST(SelfFilterTest, AHeldObjectTrackedFarFromTheGripperIsRelearnedAtTheGripper)
   EXPECT_LT((p.world().object("parcel").pose.translation() - held.pose.translation()).norm(), 0.05);
 }
 
+// Dropped while carried over the base (transport_drop): straight below where it was carried is
+// inside the base, where the camera cannot see to correct the estimate. The world model keeps the
+// fallen object out of the robot's body: moved horizontally away from the part it overlaps, at
+// most 0.5 m, so that the next base motion does not start "in collision" with it.
+TEST(SelfFilterTest, AnObjectDroppedOverTheBaseIsKeptOutOfTheRobotsBody) {
+  robot::RobotState carry = robotModel().defaultState(Pose2D{0.0, 0.0, 0.0});
+  carry.arm = *robotModel().namedConfiguration("carry");
+  carry.gripper = 0.04;
+  const Eigen::Isometry3d tool = robotModel().toolPoseInWorld(carry);
+  const world::World prior = floorOnly();
+  const Eigen::Vector3d c = tool * Eigen::Vector3d(0.0, 0.0, 0.03);
+  // 35 cm deep: carried above the base, it reaches back over the base's front edge.
+  world::Object parcel = testing::box("parcel", 0.35, 0.15, 0.15, c.x(), c.y(), 0.0, c.z() - 0.075);
+  parcel.mass = 0.5;
+  parcel.graspable = true;
+  world::World truth = prior;
+  ASSERT_TRUE(truth.addObject(parcel).ok());
+  const RobotBody body = robotBodyAt(robotModel(), carry, "", 0);
+  const auto overlapsBody = [&](const world::Object& o) {
+    for (const auto& part : body.parts) {
+      world::Object solid;
+      solid.shape = part.shape;
+      solid.pose = part.world_T_shape;
+      if (solid.aabb().overlaps(o.aabb())) return part.owner;
+    }
+    return std::string();
+  };
+  // Where it would fall straight down is inside the body: the case under test.
+  world::Object below = parcel;
+  below.pose.translation().z() = parcel.shape.halfHeight();
+  ASSERT_NE(overlapsBody(below), "") << "the carry pose does not hold the parcel over the robot: at " << c.transpose();
+  sim::DepthSensorParams cp;  // the deployed simulator's camera (see_robot false)
+  cp.seed = 7;
+  cp.see_robot = false;
+  sim::DepthSensor camera(cp);
+  Perception p(prior, PerceptionParams{});
+  int64_t stamp = kSecond;
+  (void)look(p, truth, carry, 4, true, stamp, camera, "parcel");
+  ASSERT_EQ(p.heldObject(), "parcel");
+  // Dropped: the truth has it out of the camera's view; the state reports the gripper empty.
+  ASSERT_TRUE(truth.removeObject("parcel").ok());
+  const Frames run = look(p, truth, carry, 2, true, stamp, camera);
+  std::string events;
+  for (const auto& e : run.events) events += std::string(toString(e.type)) + " " + e.object_id + ": " + e.description + "\n";
+  ASSERT_NE(p.world().findObject("parcel"), nullptr) << events;
+  const world::Object& fallen = p.world().object("parcel");
+  EXPECT_EQ(overlapsBody(fallen), "") << "the fallen parcel is inside the robot at "
+                                      << fallen.pose.translation().transpose() << "\n" << events;
+  EXPECT_NEAR(fallen.pose.translation().z(), parcel.shape.halfHeight(), 0.01) << "on the floor";
+  EXPECT_LE((fallen.pose.translation().head<2>() - c.head<2>()).norm(), 0.5 + 0.3)
+      << "moved further than out of the body";
+}
+
 // Carried, then dropped (the state reports the gripper empty with the parcel in the air): the world
 // model puts it on the floor below where it was released, whether the camera sees there or not,
 // and never reports it gone.

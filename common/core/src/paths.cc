@@ -1,6 +1,11 @@
 #include "tamp/core/paths.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 
@@ -40,6 +45,42 @@ Result<std::string> readTextFile(const std::filesystem::path& file) {
   ss << in.rdbuf();
   if (in.bad()) return Error(ErrorCode::kIo, "read failed", SourceLocation{file.string()});
   return ss.str();
+}
+
+namespace {
+
+Error ioError(const std::filesystem::path& path, const std::string& what) {
+  return Error(ErrorCode::kIo, what + ": " + std::strerror(errno), SourceLocation{path.string()});
+}
+
+bool writeAll(int fd, const std::string& text) {
+  std::size_t done = 0;
+  while (done < text.size()) {
+    const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return false;
+    done += static_cast<std::size_t>(n);
+  }
+  return true;
+}
+
+}  // namespace
+
+Status writeFileAtomically(const std::filesystem::path& file, const std::string& text, const std::string& what) {
+  const std::filesystem::path tmp = file.string() + ".tmp";
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) return ioError(tmp, "cannot write " + what);
+  const bool ok = writeAll(fd, text) && ::fsync(fd) == 0;
+  ::close(fd);
+  if (!ok) return ioError(tmp, "cannot write " + what);
+  if (::rename(tmp.c_str(), file.c_str()) != 0) return ioError(file, "cannot replace " + what);
+  const std::filesystem::path dir = file.parent_path();
+  const int d = ::open(dir.empty() ? "." : dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (d < 0) return ioError(dir, "cannot open the folder of " + what);
+  const bool synced = ::fsync(d) == 0;
+  ::close(d);
+  if (!synced) return ioError(dir, "cannot sync the folder of " + what);
+  return Status::Ok();
 }
 
 }  // namespace tamp

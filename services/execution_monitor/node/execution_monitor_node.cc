@@ -6,10 +6,9 @@
 #include <optional>
 #include <stdexcept>
 
-#include <fastrtps/rtps/common/SerializedPayload.h>
-
 #include "tamp/core/log.h"
 #include "tamp/core/paths.h"
+#include "tamp/dds/cdr.h"
 #include "tamp/dds/convert.h"
 #include "tamp/world/scenario.h"
 
@@ -28,27 +27,6 @@ Error bad(const std::string& field, const std::string& message) {
 
 /// A record not acknowledged by the effort estimator is sent again after this long (s).
 constexpr double kRecordResendPeriodS = 2.0;
-
-/// A record as CDR bytes, the outbox's opaque payload.
-std::string serialize(const msg::ExecutionRecord& m) {
-  dds::TypeSupport<msg::ExecutionRecord>::type type;
-  auto* data = const_cast<msg::ExecutionRecord*>(&m);
-  eprosima::fastrtps::rtps::SerializedPayload_t payload(type.getSerializedSizeProvider(data)());
-  if (!type.serialize(data, &payload)) {
-    throw std::runtime_error("cannot serialize execution record '" + m.record_id() + "'");
-  }
-  return std::string(reinterpret_cast<const char*>(payload.data), payload.length);
-}
-
-std::optional<msg::ExecutionRecord> deserialize(const std::string& bytes) {
-  dds::TypeSupport<msg::ExecutionRecord>::type type;
-  eprosima::fastrtps::rtps::SerializedPayload_t payload(static_cast<uint32_t>(bytes.size()));
-  std::memcpy(payload.data, bytes.data(), bytes.size());
-  payload.length = static_cast<uint32_t>(bytes.size());
-  msg::ExecutionRecord m;
-  if (!type.deserialize(&payload, &m)) return std::nullopt;
-  return m;
-}
 
 }  // namespace
 
@@ -430,7 +408,7 @@ void ExecutionMonitorNode::onRecord(const msg::ExecutionRecord& m) {
     out.mission_id(a->mission_id);
     {
       std::lock_guard lock(records_mu_);
-      auto added = outbox_.add(out.record_id(), serialize(out));
+      auto added = outbox_.add(out.record_id(), dds::toCdr(out));
       if (!added) {
         // Sent once all the same; a restart of the monitor before its acknowledgement loses it.
         logger()->error("execution record '{}' not kept until acknowledged: {}", m.record_id(),
@@ -464,7 +442,7 @@ void ExecutionMonitorNode::onRecordAck(const msg::RecordAck& m) {
 void ExecutionMonitorNode::sendDueRecords() {
   std::lock_guard lock(records_mu_);
   for (const auto& e : outbox_.due(now(), kRecordResendPeriodS)) {
-    auto record = deserialize(e.payload);
+    auto record = dds::fromCdr<msg::ExecutionRecord>(e.payload);
     if (!record) {
       logger()->error("execution record '{}' in the outbox cannot be read back; dropped", e.record_id);
       (void)outbox_.acknowledge(e.record_id);

@@ -12,41 +12,14 @@
 #include <stdexcept>
 #include <utility>
 
+#include "tamp/core/hex.h"
+
 namespace tamp::execution_monitor {
 
 namespace {
 
 Error ioError(const std::filesystem::path& path, const std::string& what) {
   return Error(ErrorCode::kIo, what + ": " + std::strerror(errno), SourceLocation{path.string()});
-}
-
-std::string toHex(const std::string& bytes) {
-  static constexpr char kDigits[] = "0123456789abcdef";
-  std::string out;
-  out.reserve(2 * bytes.size());
-  for (const char c : bytes) {
-    const auto b = static_cast<unsigned char>(c);
-    out.push_back(kDigits[b >> 4]);
-    out.push_back(kDigits[b & 0xf]);
-  }
-  return out;
-}
-
-int hexDigit(char c) {
-  if (c >= '0' && c <= '9') return c - '0';
-  if (c >= 'a' && c <= 'f') return c - 'a' + 10;
-  return -1;
-}
-
-std::optional<std::string> fromHex(const std::string& hex) {
-  if (hex.size() % 2 != 0) return std::nullopt;
-  std::string out(hex.size() / 2, '\0');
-  for (std::size_t i = 0; i < out.size(); ++i) {
-    const int hi = hexDigit(hex[2 * i]), lo = hexDigit(hex[2 * i + 1]);
-    if (hi < 0 || lo < 0) return std::nullopt;
-    out[i] = static_cast<char>(hi * 16 + lo);
-  }
-  return out;
 }
 
 bool validId(const std::string& id) {

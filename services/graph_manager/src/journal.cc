@@ -1,11 +1,5 @@
 #include "tamp/graph_manager/journal.h"
 
-#include <fcntl.h>
-#include <unistd.h>
-
-#include <cerrno>
-#include <cstring>
-
 #include <nlohmann/json.hpp>
 
 #include "tamp/core/paths.h"
@@ -14,22 +8,6 @@ namespace tamp::graph_manager {
 namespace {
 
 using nlohmann::json;
-
-Error ioError(const std::filesystem::path& path, const std::string& what) {
-  return Error(ErrorCode::kIo, what + ": " + std::strerror(errno), SourceLocation{path.string()});
-}
-
-/// Writes all of `text` to `fd`; false on an error.
-bool writeAll(int fd, const std::string& text) {
-  std::size_t done = 0;
-  while (done < text.size()) {
-    const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return false;
-    done += static_cast<std::size_t>(n);
-  }
-  return true;
-}
 
 json toJson(const ExecutedAction& a) {
   return json{{"command_id", a.command_id}, {"action", a.action},       {"variant", a.variant},
@@ -119,21 +97,7 @@ Result<MissionRecord> fromJson(const json& j, const std::filesystem::path& file)
 }  // namespace
 
 Status MissionJournal::write(const MissionRecord& record) const {
-  const std::filesystem::path tmp = file_.string() + ".tmp";
-  const std::string text = toJson(record).dump(1) + "\n";
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) return ioError(tmp, "cannot write the mission journal");
-  const bool ok = writeAll(fd, text) && ::fsync(fd) == 0;
-  ::close(fd);
-  if (!ok) return ioError(tmp, "cannot write the mission journal");
-  if (::rename(tmp.c_str(), file_.c_str()) != 0) return ioError(file_, "cannot replace the mission journal");
-  const std::filesystem::path dir = file_.parent_path();
-  const int d = ::open(dir.empty() ? "." : dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (d < 0) return ioError(dir, "cannot open the mission journal's folder");
-  const bool synced = ::fsync(d) == 0;
-  ::close(d);
-  if (!synced) return ioError(dir, "cannot sync the mission journal's folder");
-  return Status::Ok();
+  return writeFileAtomically(file_, toJson(record).dump(1) + "\n", "the mission journal");
 }
 
 Result<std::optional<MissionRecord>> MissionJournal::read() const {

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdlib>
 
+#include "checkpoint.h"
 #include "cloud_convert.h"
 #include "tamp/config/yaml_reader.h"
 #include "tamp/core/log.h"
@@ -52,6 +53,11 @@ PerceptionNode::PerceptionNode(const dds::ServiceArgs& args, PerceptionNodeOptio
       world_pub_(participant(), options_.world_id),
       events_(participant(), dds::topics::kWorldEvents),
       occupancy_(participant(), dds::topics::kOccupancy) {
+  if (options_.resume_grasp) {
+    if (Status s = perception_->resumeGrasp(*options_.resume_grasp); !s.ok())
+      log::get(name())->warn("checkpoint: the grasp not taken up: {}", s.error().toString());
+  }
+  checkpointed_grasp_ = perception_->heldGrasp();
   snapshot_ = perception_->world();
   if (Status s = world_pub_.publish(snapshot_); !s.ok()) {
     throw std::runtime_error("publishing the prior world: " + s.error().toString());
@@ -79,6 +85,35 @@ PerceptionNode::~PerceptionNode() {
   if (worker_.joinable()) worker_.join();
 }
 
+namespace {
+
+/// A restarted perception (the checkpoint exists): `options.prior` restored, the grasp to take
+/// up. A checkpoint that cannot be read or applied is logged and the prior used: perception must
+/// come up, and it corrects its world model from what it sees.
+void resumeFromCheckpoint(PerceptionNodeOptions& options, const std::string& node_name) {
+  std::error_code ec;
+  if (!std::filesystem::exists(options.checkpoint_file, ec)) return;
+  const auto log = log::get(node_name);
+  auto text = readTextFile(options.checkpoint_file);
+  auto parsed = text ? parseCheckpoint(*text, options.checkpoint_file.string()) : Result<PerceptionCheckpoint>(text.error());
+  if (!parsed) {
+    log->error("checkpoint not used, starting from the scenario's prior: {}", parsed.error().toString());
+    return;
+  }
+  auto restored = restoredPrior(options.prior, *parsed);
+  if (!restored) {
+    log->error("checkpoint {} not used, starting from the scenario's prior: {}", options.checkpoint_file.string(),
+               restored.error().toString());
+    return;
+  }
+  options.prior = std::move(*restored);
+  options.resume_grasp = parsed->held;
+  log->info("resumed from checkpoint {}: {} movable object(s){}", options.checkpoint_file.string(),
+            parsed->movables.size(), parsed->held ? ", holding '" + parsed->held->object_id + "'" : std::string());
+}
+
+}  // namespace
+
 Result<std::unique_ptr<dds::ServiceNode>> PerceptionNode::create(const dds::ServiceArgs& args) {
   PerceptionNodeOptions options;
   if (!args.config_file.empty()) {
@@ -93,6 +128,10 @@ Result<std::unique_ptr<dds::ServiceNode>> PerceptionNode::create(const dds::Serv
     if (!scenario) return scenario.error();
     options.prior = scenario->plannerWorld();
     description = scenario->robot.description;
+  }
+  if (const char* run_dir = std::getenv("TAMP_RUN_DIR"); run_dir != nullptr && *run_dir != '\0') {
+    options.checkpoint_file = std::filesystem::path(run_dir) / "perception.checkpoint";
+    resumeFromCheckpoint(options, args.name);
   }
   // The robot whose body and held object the self filter removes.
   if (options.params.self_filter.enabled) {
@@ -218,6 +257,7 @@ void PerceptionNode::process(const PointCloudFrame& frame) {
       log::get(name())->error("publishing the world model failed: {}", s.error().toString());
     }
   }
+  checkpoint(r->world_changed);
   for (const WorldEvent& e : r->events) {
     log::get(name())->info("world event: {} {} ({})", toString(e.type), e.object_id, e.description);
     if (Status s = events_.write(toMsg(e, ++event_seq_)); !s.ok()) {
@@ -234,6 +274,24 @@ void PerceptionNode::process(const PointCloudFrame& frame) {
       log::get(name())->error("publishing the occupancy map failed: {}", s.error().toString());
     }
   }
+}
+
+void PerceptionNode::checkpoint(bool world_changed) {
+  if (options_.checkpoint_file.empty()) return;
+  const auto grasp = perception_->heldGrasp();
+  const bool grasp_changed = grasp.has_value() != checkpointed_grasp_.has_value() ||
+                             (grasp && (grasp->object_id != checkpointed_grasp_->object_id ||
+                                        !grasp->tool_T_object.isApprox(checkpointed_grasp_->tool_T_object)));
+  if (!world_changed && !grasp_changed) return;
+  const Status s = writeFileAtomically(options_.checkpoint_file, formatCheckpoint(perception_->world(), grasp),
+                                       "perception's checkpoint");
+  if (!s.ok()) {
+    if (!checkpoint_failed_) log::get(name())->error("{} (a restart would start from the prior)", s.error().toString());
+    checkpoint_failed_ = true;
+    return;
+  }
+  checkpoint_failed_ = false;
+  checkpointed_grasp_ = grasp;
 }
 
 }  // namespace tamp::perception

@@ -45,6 +45,11 @@ struct PerceptionNodeOptions {
   /// default robot).
   std::shared_ptr<const robot::RobotModel> robot;
   double robot_state_max_age_s{0.5};  ///< s, >= 0: largest |frame stamp - state stamp| used
+  /// Where the node keeps its checkpoint (checkpoint.h); empty: none. `create()` sets it to
+  /// `$TAMP_RUN_DIR/perception.checkpoint` and, when that file exists, starts from it: `prior`
+  /// restored and `resume_grasp` set.
+  std::filesystem::path checkpoint_file;
+  std::optional<Perception::HeldGrasp> resume_grasp;
 };
 
 /// Node options from the service's YAML (`config/services/perception.yaml`): the perception
@@ -83,6 +88,8 @@ class PerceptionNode : public dds::ServiceNode {
   std::optional<RobotBody> bodyAt(std::int64_t stamp_ns) const;
   void work(std::stop_token stop);
   void process(const PointCloudFrame& frame);
+  /// Writes the checkpoint when the world model or the grasp changed since the last one.
+  void checkpoint(bool world_changed);
 
   PerceptionNodeOptions options_;
   std::unique_ptr<Perception> perception_;  // worker thread only (world copies under mutex_)
@@ -104,6 +111,8 @@ class PerceptionNode : public dds::ServiceNode {
   std::deque<StateSample> states_seen_;  // newest last, bounded
   std::uint64_t event_seq_{0}, map_seq_{0};
   std::optional<Clock::time_point> last_map_;
+  std::optional<Perception::HeldGrasp> checkpointed_grasp_;  // worker thread only
+  bool checkpoint_failed_{false};                            // logged once
   std::jthread worker_;
   std::unique_ptr<dds::Reader<msg::RobotState>> robot_states_;
   std::unique_ptr<dds::Reader<msg::PointCloudFrame>> clouds_;  // last: callbacks need the rest

@@ -396,6 +396,23 @@ const std::vector<ObjectClass>& Perception::classes() const { return impl_->clas
 std::uint64_t Perception::frames() const { return impl_->frames; }
 const OccupancyMap* Perception::occupancy() const { return impl_->occupancy.get(); }
 const std::string& Perception::heldObject() const { return impl_->held_id; }
+
+std::optional<Perception::HeldGrasp> Perception::heldGrasp() const {
+  if (impl_->held_id.empty()) return std::nullopt;
+  return HeldGrasp{impl_->held_id, impl_->tool_T_held};
+}
+
+Status Perception::resumeGrasp(const HeldGrasp& grasp) {
+  Impl& I = *impl_;
+  auto it = I.tracks.find(grasp.object_id);
+  if (it == I.tracks.end() || it->second.state == TrackInfo::State::kGone)
+    return Error(ErrorCode::kNotFound, "resumeGrasp: '" + grasp.object_id + "' is not tracked");
+  if (!grasp.tool_T_object.matrix().allFinite())
+    return Error(ErrorCode::kInvalidArgument, "resumeGrasp: the tool_T_object of '" + grasp.object_id + "' is not finite");
+  I.held_id = grasp.object_id;
+  I.tool_T_held = grasp.tool_T_object;
+  return Status::Ok();
+}
 std::string Perception::occupancyBinary() const { return impl_->occupancy ? impl_->occupancy->toBinary() : std::string(); }
 
 namespace {

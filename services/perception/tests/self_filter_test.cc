@@ -394,6 +394,38 @@ TEST(SelfFilterTest, AHeldObjectTrackedFarFromTheGripperIsRelearnedAtTheGripper)
   EXPECT_LT((p.world().object("parcel").pose.translation() - held.pose.translation()).norm(), 0.05);
 }
 
+// Perception restarted while the robot carries an object, from its checkpoint (the node's
+// checkpoint.h): the new perception starts from the world it had and takes the grasp up, so the
+// object follows the gripper at once at the grasp it had (not re-decided from a tracked pose that
+// lags behind the lift), and nothing new appears at the gripper.
+TEST(SelfFilterTest, AGraspTakenUpAfterARestartFollowsTheGripperAtOnce) {
+  const robot::RobotState ready = armReady();
+  const Eigen::Isometry3d tool = robotModel().toolPoseInWorld(ready);
+  const auto [prior, parcel] = parcelOnStand(tool.translation());
+  world::World truth = prior;
+  sim::DepthSensor camera = robotCamera();
+  Perception before(prior, PerceptionParams{});
+  int64_t stamp = kSecond;
+  (void)look(before, truth, ready, 2, true, stamp, camera);
+  (void)look(before, truth, ready, 1, true, stamp, camera, "parcel");  // grasped where it stands
+  const auto grasp = before.heldGrasp();
+  ASSERT_TRUE(grasp.has_value());
+  EXPECT_EQ(grasp->object_id, "parcel");
+  // Restarted (the world and grasp of the checkpoint), while the arm turned on by 0.5 rad.
+  Perception after(before.world(), PerceptionParams{});
+  EXPECT_FALSE(after.resumeGrasp({"nothing", Eigen::Isometry3d::Identity()}).ok());
+  ASSERT_TRUE(after.resumeGrasp(*grasp).ok());
+  const robot::RobotState turned = armReady(0.5);
+  world::Object carried = parcel;
+  carried.pose = robotModel().toolPoseInWorld(turned) * grasp->tool_T_object;
+  ASSERT_TRUE(truth.updateObject(carried).ok());
+  const Frames run = look(after, truth, turned, 2, true, stamp, camera, "parcel");
+  EXPECT_EQ(after.heldObject(), "parcel");
+  EXPECT_LT((after.world().object("parcel").pose.translation() - carried.pose.translation()).norm(), 0.01);
+  EXPECT_EQ(count(run.events, EventType::kAdded), 0);
+  EXPECT_EQ(count(run.events, EventType::kGone), 0);
+}
+
 // Dropped while carried over the base (transport_drop): straight below where it was carried is
 // inside the base, where the camera cannot see to correct the estimate. The world model keeps the
 // fallen object out of the robot's body: moved horizontally away from the part it overlaps, at

@@ -21,5 +21,10 @@ std::filesystem::path resolveRelativeTo(const std::filesystem::path& base_file,
                                         const std::filesystem::path& relative);
 /// Reads a whole file; a failure gives a kIo/kNotFound error naming the file.
 Result<std::string> readTextFile(const std::filesystem::path& file);
+/// Replaces `file` with `text` so that a crash at any instant leaves the old content or the new
+/// one, never a torn file: written to `file.tmp`, fsynced, renamed over `file`, and the folder
+/// fsynced. kIo naming the file (`what` says which file it is: "the mission journal") on failure.
+Status writeFileAtomically(const std::filesystem::path& file, const std::string& text,
+                           const std::string& what = "the file");
 
 }  // namespace tamp

@@ -166,6 +166,20 @@ class Perception {
   /// with the self filter on), or empty.
   const std::string& heldObject() const;
 
+  /// The grasp perception holds: the object in the gripper and where it sits in the tool frame.
+  struct HeldGrasp {
+    std::string object_id;
+    Eigen::Isometry3d tool_T_object{Eigen::Isometry3d::Identity()};
+  };
+  /// The grasp held now, or nullopt with the gripper empty (to checkpoint it).
+  std::optional<HeldGrasp> heldGrasp() const;
+  /// Takes up a grasp held before a restart (from a checkpoint), as if this perception had seen
+  /// it: from the next frame whose robot state reports the object held, it follows the gripper
+  /// at `tool_T_object`, with no new grasp decided from its tracked pose (which lags behind a
+  /// grasp that lifted it). A state that reports the gripper empty releases it as usual.
+  /// kNotFound when the object is not tracked; kInvalidArgument for a non-finite transform.
+  Status resumeGrasp(const HeldGrasp& grasp);
+
   /// The current world model (prior + perceived, minus gone objects).
   const world::World& world() const;
   /// Every track (tentative, active, gone), sorted by id.

@@ -60,7 +60,11 @@ double symmetricTurn(const world::Shape& shape, const Eigen::Isometry3d& a, cons
 using Vec = Eigen::VectorXd;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kFloorTolerance = 1e-4;
-constexpr double kSupportProbe = 0.005;  // m: how far below an object its supports are looked for  // m below z = 0 that counts as touching the floor
+constexpr double kSupportProbe = 0.005;  // m: how far below an object its supports are looked for
+/// m: how far a place may press the held object into its support (the arm's compliance): a
+/// place's contact with the support is no stop up to this depth, and settle() accepts a release
+/// this far into it (its ray starts as high above the object's bottom).
+constexpr double kPlacePress = 0.02;
 
 const std::shared_ptr<spdlog::logger>& logger() {
   static const auto l = tamp::log::get("sim");
@@ -352,14 +356,17 @@ struct Simulator::Impl {
 
   /// Objects an object at `pose` rests on: those it touches (or nearly: probed 5 mm lower) whose
   /// top is not above its bottom.
-  std::vector<std::string> supportsOf(const world::Object& o, const Eigen::Isometry3d& pose) {
+  /// `press`: a support may also reach this far above the object's bottom (a place pressing
+  /// the object into it).
+  std::vector<std::string> supportsOf(const world::Object& o, const Eigen::Isometry3d& pose,
+                                      double press = kSupportProbe) {
     std::vector<std::string> out;
     const double bottom = o.shape.aabb(pose).min.z();
     Eigen::Isometry3d probe = pose;
     probe.translation().z() -= kSupportProbe;
     for (const auto& id : scene.shapeCollisions(o.shape, probe, collision::Filter::allBut({o.id}))) {
       const auto* other = world.findObject(id);
-      if (other && other->aabb().max.z() <= bottom + kSupportProbe) out.push_back(id);
+      if (other && other->aabb().max.z() <= bottom + press) out.push_back(id);
     }
     return out;
   }
@@ -722,7 +729,7 @@ struct Simulator::Impl {
       a.failure = "'" + o.id + "' released tilted by " + formatNumber(s.tilt, 4) + " rad and toppled";
     } else if (s.drop > params.place.max_drop_m) {
       a.failure = "'" + o.id + "' released " + formatNumber(s.drop, 4) + " m above its support and dropped";
-    } else if (s.drop < -0.02) {
+    } else if (s.drop < -kPlacePress) {
       a.failure = "'" + o.id + "' released " + formatNumber(-s.drop, 4) + " m below the support surface";
     } else if (s.robot_link >= 0) {
       a.failure = "'" + o.id + "' came to rest on the robot ('" + s.support + "')";
@@ -1053,7 +1060,12 @@ Result<Active> Simulator::Impl::plan(const ActionCommand& c, const std::vector<i
         for (const auto& s : supportsOf(*obj, obj->pose)) a.ignore_pairs.emplace_back(obj->id, s);
       }
     } else if (obj && c.object_pose) {
-      for (const auto& s : supportsOf(*obj, *c.object_pose)) a.ignore_pairs.emplace_back(obj->id, s);
+      // Where the object really ends at the end of the place motion (its grasp as held, not the
+      // commanded pose the robot computed from what it believed of the object).
+      const Eigen::Isometry3d at_end = world.held() && world.held()->object_id == obj->id
+                                           ? robot.toolPoseInWorld(toState(wp[g])) * world.held()->link_T_object
+                                           : *c.object_pose;
+      for (const auto& s : supportsOf(*obj, at_end, kPlacePress)) a.ignore_pairs.emplace_back(obj->id, s);
     }
   }
   // The timeline: the true timing stretched by the execution noise (none for the nominal one).

@@ -53,6 +53,13 @@ TEST(MissionTest, CorridorEffortPolicyMovesTheLightBoxAndReachesTheGoal) {
   double measured = 0.0;
   for (const auto& a : m.report["actions"]) measured += a["measured_s"].get<double>();
   EXPECT_NEAR(measured, m.report["executed_effort_s"].get<double>(), 1e-6);
+  // Where the time to the first command went: the task plan and the detour's and removal's
+  // motions were asked for before it, each call timed.
+  const auto& first = m.report["first_action_breakdown"];
+  EXPECT_GE(first["per_service"]["plan"]["calls"].get<int>(), 1) << first.dump(1);
+  EXPECT_GE(first["per_service"]["motion"]["calls"].get<int>(), 2) << first.dump(1);
+  EXPECT_EQ(first["calls"].size(), first["critical_calls"].get<std::size_t>());
+  EXPECT_LE(first["critical_calls_s"].get<double>(), m.report["planning_time_to_first_action_s"].get<double>() + 1e-6);
 }
 
 // A hall that is one large floor region: the first plan picks the parcel from wherever "reaches"

@@ -84,12 +84,13 @@ Result<EdgeCommand> GraphManager::command(EdgeId id, EdgeId next, const BranchCo
 /// One mission: the state of the loop and its steps.
 struct GraphManager::Run {
   Run(GraphManager& g, WorldSource& s, Executor& x, const MissionObserver& o)
-      : gm(g), source(s), executor(x), observer(o) {}
+      : gm(g), source(s), executor(x), observer(o), start_calls(g.logged_.mark()) {}
 
   GraphManager& gm;
   WorldSource& source;
   Executor& executor;
   const MissionObserver& observer;
+  std::size_t start_calls{0};  ///< the call log's mark at the mission's start
   MissionReport report;
   NodeId current{-1};
   BranchContext ctx;
@@ -312,6 +313,13 @@ Result<EdgeCommand> GraphManager::Run::commandFor(EdgeId id, EdgeId next) {
 void GraphManager::Run::noteCommand() {
   if (first_action) {
     report.planning_time_to_first_action_s = gm.planning_s_;
+    report.first_action_calls = gm.logged_.since(start_calls);
+    const CallSummary sum = CallSummary::of(report.first_action_calls);
+    log::get("graph_manager")
+        ->info("first command after {:.3f} s of planning: {} calls {:.3f} s (motion {} {:.3f} s, grasp {} {:.3f} s, "
+               "placement {} {:.3f} s, plan {} {:.3f} s, effort {} {:.3f} s)",
+               gm.planning_s_, sum.calls(), sum.seconds(), sum.motion.calls, sum.motion.s, sum.grasp.calls, sum.grasp.s,
+               sum.placement.calls, sum.placement.s, sum.plan.calls, sum.plan.s, sum.effort.calls, sum.effort.s);
     first_action = false;
   }
   if (event_at && !report.replanning.empty()) {

@@ -15,6 +15,24 @@ nlohmann::json pose(const Eigen::Isometry3d& p) {
   return {{"x", t.x()}, {"y", t.y()}, {"z", t.z()}, {"yaw", yaw}};
 }
 
+/// Service calls and where their time went: per service, in total ("critical": on the way to
+/// the command that followed), and each call.
+nlohmann::json callsJson(const std::vector<TimedCall>& timed) {
+  const CallSummary sum = CallSummary::of(timed);
+  auto per = [](const CallSummary::PerService& p) { return nlohmann::json{{"calls", p.calls}, {"s", p.s}}; };
+  nlohmann::json calls = nlohmann::json::array();
+  for (const auto& c : timed) calls.push_back({{"service", c.service}, {"what", c.what}, {"s", c.s}, {"server_s", c.server_s}});
+  return {{"per_service",
+           {{"plan", per(sum.plan)},
+            {"motion", per(sum.motion)},
+            {"placement", per(sum.placement)},
+            {"grasp", per(sum.grasp)},
+            {"effort", per(sum.effort)}}},
+          {"critical_calls", sum.calls()},
+          {"critical_calls_s", sum.seconds()},
+          {"calls", calls}};
+}
+
 }  // namespace
 
 std::string reportJson(const MissionReport& r, const std::string& scenario, const std::string& policy,
@@ -81,30 +99,18 @@ std::string reportJson(const MissionReport& r, const std::string& scenario, cons
                        {"base_path", path}});
   }
   j["actions"] = actions;
+  j["first_action_breakdown"] = callsJson(r.first_action_calls);
   nlohmann::json replanning = nlohmann::json::array();
   for (const auto& rp : r.replanning) {
     nlohmann::json breakdown(nullptr);
     if (rp.latency_s >= 0.0) {
-      const CallSummary sum = CallSummary::of(rp.breakdown.calls);
-      auto per = [](const CallSummary::PerService& p) { return nlohmann::json{{"calls", p.calls}, {"s", p.s}}; };
-      nlohmann::json calls = nlohmann::json::array();
-      for (const auto& c : rp.breakdown.calls)
-        calls.push_back({{"service", c.service}, {"what", c.what}, {"s", c.s}, {"server_s", c.server_s}});
-      breakdown = {{"repair_s", rp.breakdown.repair_s},
-                   {"traverse_s", rp.breakdown.traverse_s},
-                   {"prepare_s", rp.breakdown.prepare_s},
-                   {"evaluations", rp.breakdown.evaluations},
-                   {"per_service",
-                    {{"plan", per(sum.plan)},
-                     {"motion", per(sum.motion)},
-                     {"placement", per(sum.placement)},
-                     {"grasp", per(sum.grasp)},
-                     {"effort", per(sum.effort)}}},
-                   {"critical_calls", sum.calls()},
-                   {"critical_calls_s", sum.seconds()},
-                   {"background_calls", rp.breakdown.background_calls},
-                   {"background_s", rp.breakdown.background_s},
-                   {"calls", calls}};
+      breakdown = callsJson(rp.breakdown.calls);
+      breakdown["repair_s"] = rp.breakdown.repair_s;
+      breakdown["traverse_s"] = rp.breakdown.traverse_s;
+      breakdown["prepare_s"] = rp.breakdown.prepare_s;
+      breakdown["evaluations"] = rp.breakdown.evaluations;
+      breakdown["background_calls"] = rp.breakdown.background_calls;
+      breakdown["background_s"] = rp.breakdown.background_s;
     }
     replanning.push_back({{"event", std::string(toString(rp.event.kind))},
                           {"action", rp.event.action},

@@ -224,6 +224,8 @@ struct MissionReport {
   double predicted_effort_s{0.0};
   double planning_time_s{0.0};
   double planning_time_to_first_action_s{0.0};
+  /// The service calls from the mission's start to its first command (where that time went).
+  std::vector<TimedCall> first_action_calls;
   int replans{0};
   std::vector<ReplanRecord> replanning;
   std::vector<ConditionalRecord> conditionals;

@@ -286,33 +286,42 @@ std::optional<std::pair<GraspOption, Eigen::Isometry3d>> GraphManager::sampledPl
     const std::string& object, const std::string& region, const BranchContext& ctx, std::string& why, int skip) {
   // Placements the arm reaches from where the base stands, with the object held as it is and
   // collision-free place and pre-place configurations (the motion planner checks them), in the
-  // branch's world. Asked once per base pose and world.
-  const std::string k = object + "@" + region + "@" + worldKey(ctx);
-  auto it = placement_cache_.find(k);
-  if (it == placement_cache_.end()) {
+  // branch's world, per base pose and world. Asked for 4 at first, then 8, then 16, only when every placement kept so far was tried (the
+  // motion planner's sampler is seeded: a larger request repeats the smaller one's placements
+  // first). Most places take the first.
+  constexpr std::uint32_t kFirstAsk = 4, kMaxAsk = 16;
+  PlacementCacheEntry& entry = placement_cache_[object + "@" + region + "@" + worldKey(ctx)];
+  while (skip >= static_cast<int>(entry.kept.size()) && !entry.exhausted && entry.asked < kMaxAsk) {
     PlacementQuery pq;
     pq.object_id = object;
     pq.region_id = region;
-    pq.max_placements = 16;
+    pq.max_placements = entry.asked == 0 ? kFirstAsk : 2 * entry.asked;
     pq.base = ctx.state.base;
     pq.object_T_tool = ctx.held.link_T_object.inverse();
     pq.approach_m = params_.approach_m;
     pq.overrides = overridesOf(ctx, object);
     ++counters_.placement_calls;
+    entry.asked = pq.max_placements;
     auto p = services_.placements(pq);
-    if (!p) why = "placements of " + object + " on " + region + ": " + p.error().message;
-    std::vector<PlacementOption> kept = p ? *p : std::vector<PlacementOption>{};
+    entry.exhausted = !p || p->size() < pq.max_placements;
+    if (!p) {  // the placements kept from a smaller request stay
+      entry.why = "placements of " + object + " on " + region + ": " + p.error().message;
+      break;
+    }
+    std::vector<PlacementOption> kept = *p;
     // A place does not bring back occlusion: from where the arm works, the placed object must
     // stand in front of no other object (the domain's place adds no `occludes`).
     kept.erase(std::remove_if(kept.begin(), kept.end(),
                               [&](const PlacementOption& o) { return occludesFromBase(object, region, o.object_pose, ctx); }),
                kept.end());
-    if (p && !p->empty() && kept.empty())
-      why = "every placement of " + object + " on " + region + " reachable from this base pose hides another object";
-    it = placement_cache_.emplace(k, std::move(kept)).first;
+    entry.why = !p->empty() && kept.empty()
+                    ? "every placement of " + object + " on " + region + " reachable from this base pose hides another object"
+                    : std::string();
+    entry.kept = std::move(kept);
   }
-  if (skip < static_cast<int>(it->second.size())) {
-    const PlacementOption& opt = it->second[static_cast<std::size_t>(skip)];
+  const std::vector<PlacementOption>& kept = entry.kept;
+  if (skip < static_cast<int>(kept.size())) {
+    const PlacementOption& opt = kept[static_cast<std::size_t>(skip)];
     GraspOption g;
     g.pregrasp = opt.pre_arm;
     g.grasp = opt.arm;
@@ -320,8 +329,9 @@ std::optional<std::pair<GraspOption, Eigen::Isometry3d>> GraphManager::sampledPl
     g.gripper_in_object = ctx.held.link_T_object.inverse();
     return std::make_pair(g, opt.object_pose);
   }
+  if (why.empty()) why = entry.why;
   if (why.empty())
-    why = it->second.empty() ? "the arm reaches no free placement of " + object + " on " + region + " from this base pose"
+    why = kept.empty() ? "the arm reaches no free placement of " + object + " on " + region + " from this base pose"
                              : "every placement of " + object + " on " + region + " tried from this base pose failed";
   return std::nullopt;
 }

@@ -442,7 +442,15 @@ class GraphManager {
   int traverse_count_{0};
   double planning_s_{0.0};
   std::map<std::string, std::vector<GraspOption>> grasp_cache_;
-  std::map<std::string, std::vector<PlacementOption>> placement_cache_;
+  /// Placements of a held object from a base pose in a world (sampledPlace): asked for a few
+  /// at first, more only when every one kept was tried (each sample costs IK solves).
+  struct PlacementCacheEntry {
+    std::vector<PlacementOption> kept;  ///< the motion planner's answer minus those that occlude
+    std::uint32_t asked{0};             ///< max_placements of the last request
+    bool exhausted{false};              ///< the last request returned fewer than asked: no more
+    std::string why;                    ///< the last request's error, if any
+  };
+  std::map<std::string, PlacementCacheEntry> placement_cache_;
   /// Failed executions in this mission: per move edge, and per manipulation of an object ("pick
   /// box"), whichever edge carried it (a grasp that misses from one stand misses from the next).
   int failuresOf(const Edge& e) const;

@@ -79,6 +79,9 @@ std::optional<RecordAnnotation> RecordForwarder::onRecord(const std::string& rec
 
 namespace {
 
+/// Progress along the path (fraction) that counts as the robot still moving (TimeoutParams).
+constexpr double kProgressStep = 0.01;
+
 enum class Phase { kWaiting, kRunning, kStopping, kFinishing };
 enum class Verdict { kNone, kCancelRequested, kNewObstacle, kTimeout, kDropped };
 
@@ -92,6 +95,8 @@ struct Active {
   std::map<std::string, Eigen::Vector3d> validated;  // objects at validation and their positions
   std::string held_at_start;
   double progress{0.0};
+  double progress_mark{0.0};  ///< the progress when it last advanced by kProgressStep
+  double progress_at{0.0};    ///< when that was
   double last_status{0.0};
   double timeout_limit{0.0};
   std::string note;  // added to the reason of the final status (e.g. an older world version)
@@ -256,6 +261,8 @@ struct ExecutionMonitor::Impl {
     a.phase = Phase::kRunning;
     a.started = now;
     a.last_status = now;
+    a.progress_at = now;
+    a.progress_mark = a.progress;
     const double expected =
         c.expected_duration_s > 0.0 ? c.expected_duration_s : c.trajectory.duration();
     a.timeout_limit =
@@ -529,6 +536,10 @@ Outputs ExecutionMonitor::onRobotState(const RobotObservation& obs, double now) 
     case Phase::kRunning:
       if (a.rejoined) break;  // no path of its own to follow
       a.progress = a.path.project(obs.state, a.progress);
+      if (a.progress >= a.progress_mark + kProgressStep) {
+        a.progress_mark = a.progress;
+        a.progress_at = now;
+      }
       if (carries(a) && obs.held_object_id != a.held_at_start) {
         m.stop(
             out, Verdict::kDropped, a.held_at_start,
@@ -589,13 +600,17 @@ Outputs ExecutionMonitor::onTick(double now) {
       break;
     case Phase::kRunning: {
       const double elapsed = now - a.started;
-      if (elapsed > a.timeout_limit) {
+      const double still_s = now - a.progress_at;
+      const bool stalled = a.rejoined || still_s > m.params.timeout.stall_s;
+      if (elapsed > a.timeout_limit && (stalled || elapsed > m.params.timeout.max_factor * a.timeout_limit)) {
         m.stop(out, Verdict::kTimeout, "",
                "timeout: " + formatNumber(elapsed, 3) + " s elapsed, more than the expected " +
                    formatNumber(a.cmd.expected_duration_s, 3) + " s + " +
                    formatNumber(m.params.timeout.stddevs) + " x " +
                    formatNumber(a.cmd.expected_stddev_s, 3) + " s + " +
-                   formatNumber(m.params.timeout.margin_s) + " s",
+                   formatNumber(m.params.timeout.margin_s) + " s" +
+                   (stalled ? ", no progress for " + formatNumber(still_s, 3) + " s"
+                            : ", " + formatNumber(m.params.timeout.max_factor) + " times that while moving"),
                now);
       } else if (now - a.last_status >= m.params.status_period_s) {
         a.last_status = now;

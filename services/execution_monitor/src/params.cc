@@ -38,7 +38,9 @@ const config::Schema<MonitorParams>& schema() {
         .field("tolerance_m", &PathCheckParams::tolerance_m, inRange(0, 0.05, Ends::kClosed, "m"));
     s.section("timeout", &P::timeout)
         .field("stddevs", &TimeoutParams::stddevs, nonNegative())
-        .field("margin_s", &TimeoutParams::margin_s, positive());
+        .field("margin_s", &TimeoutParams::margin_s, positive())
+        .field("stall_s", &TimeoutParams::stall_s, positive())
+        .field("max_factor", &TimeoutParams::max_factor, config::atLeast(1.0));
     return s;
   }();
   return kSchema;

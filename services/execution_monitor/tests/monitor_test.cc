@@ -248,6 +248,54 @@ TEST_F(MonitorTest, DroppedObjectAndOverrunCancel) {
   EXPECT_EQ(out.failures[0].type, FailureType::kTimeout);
 }
 
+// Past its limit (expected 4 s + 3 x 0.5 s + 5 s = 10.5 s) a robot that is slower than predicted
+// but still moving along its path is let finish; it is stopped once it makes no progress for
+// stall_s (5 s), or at max_factor (3) times the limit while moving.
+TEST_F(MonitorTest, ASlowButMovingRobotIsNotStoppedAtTheLimitOnlyWhenItStallsOrCrawlsTooLong) {
+  ready();
+  monitor_.onCommand(moveBase("slow", {{1.5, 1.2, 0}, {2.5, 1.2, 0}}), now_);
+  ASSERT_EQ(monitor_.activeCommandId(), "slow");
+  // 2 cm every second: past the limit, no cancel while it moves.
+  double x = 1.5, t = now_;
+  for (int k = 0; k < 14; ++k) {
+    t += 1.0;
+    x += 0.02;
+    Outputs out = monitor_.onRobotState(observe(x, stamp_ += 10), t);
+    out = monitor_.onTick(t + 0.01);
+    ASSERT_TRUE(out.robot.empty()) << "stopped while moving at t = " << t - now_;
+  }
+  ASSERT_GT(t - now_, 10.5);
+  // It stops moving: past the limit and still for more than 5 s, it is stopped as overrun.
+  Outputs out = monitor_.onTick(t + 4.9);
+  EXPECT_TRUE(out.robot.empty());
+  out = monitor_.onTick(t + 5.2);
+  ASSERT_EQ(out.robot.size(), 1u);
+  EXPECT_EQ(out.robot[0].type, RobotRequest::Type::kCancel);
+  monitor_.onRobotResult(result("slow", RobotOutcome::kCancelled, t + 5.3 - now_), t + 5.3);
+  out = monitor_.onRobotState(observe(x, stamp_ += 10), t + 5.4);
+  const StatusUpdate* f = finalOf(out);
+  ASSERT_NE(f, nullptr);
+  EXPECT_NE(f->reason.find("no progress for"), std::string::npos) << f->reason;
+
+  // Crawling on: stopped at 3 x 10.5 s although it still moves.
+  now_ = t + 10.0;
+  monitor_.onCommand(moveBase("crawl", {{x, 1.2, 0}, {x + 1.0, 1.2, 0}}), now_);
+  ASSERT_EQ(monitor_.activeCommandId(), "crawl");
+  const double x0 = x;
+  bool stopped = false;
+  for (double dt = 1.0; dt < 40.0 && !stopped; dt += 1.0) {
+    x = x0 + 0.015 * dt;
+    (void)monitor_.onRobotState(observe(x, stamp_ += 10), now_ + dt);
+    out = monitor_.onTick(now_ + dt + 0.01);
+    if (!out.robot.empty()) {
+      stopped = true;
+      EXPECT_GT(dt, 3 * 10.5 - 1.0);
+      EXPECT_LT(dt, 3 * 10.5 + 1.5);
+    }
+  }
+  EXPECT_TRUE(stopped);
+}
+
 TEST_F(MonitorTest, RobotOutcomesMapToStatusesAndFailures) {
   ready();
   struct Case {

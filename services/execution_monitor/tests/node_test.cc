@@ -506,11 +506,11 @@ TEST_F(HoldingMonitorNodeTest, DroppingTheCarriedObjectFailsTheMove) {
   EXPECT_EQ(event->object_id(), "cup");
 }
 
-/// A monitor that allows no more than the predicted duration + 0.5 s.
+/// A monitor that allows no more than the predicted duration + 0.5 s, moving or not.
 class TightTimeoutMonitorNodeTest : public MonitorNodeTest {
  protected:
   TightTimeoutMonitorNodeTest() {
-    monitor_yaml_ = "input_wait_s: 15\ntimeout: {stddevs: 0, margin_s: 0.5}\n";
+    monitor_yaml_ = "input_wait_s: 15\ntimeout: {stddevs: 0, margin_s: 0.5, max_factor: 1}\n";
   }
 };
 

@@ -9,7 +9,7 @@
 ///   path_check: {step_m: 0.02, step_rad: 0.02}             # sampling of the swept path check
 ///   object_tolerance_m: 0.15     # pick: world-model object vs commanded object_target
 ///   moved_tolerance_m: 0.05      # while running: a known object counts as new when it moved more
-///   timeout: {stddevs: 3.0, margin_s: 5.0}  # overrun beyond expected + stddevs * stddev + margin
+///   timeout: {stddevs: 3.0, margin_s: 5.0, stall_s: 5.0, max_factor: 3.0}  # overrun: see TimeoutParams
 ///   input_wait_s: 2.0            # before a start: wait this long for a robot state / world
 ///   version result_wait_s: 10.0          # after a cancel: wait this long for the robot's result
 ///   state_wait_s: 2.0            # after a result: wait this long for a robot state written later
@@ -46,9 +46,17 @@ struct PathCheckParams {
 
 /// An action overruns when its elapsed time exceeds
 /// expected_duration_s + stddevs * expected_stddev_s + margin_s.
+/// An action is stopped as overrun once it is past expected + stddevs * stddev + margin_s AND
+/// either has made no progress along its path for `stall_s` or is past `max_factor` times that
+/// limit. A robot that is slower than predicted but moving (a loaded turn in place the default
+/// time model prices at a fifth of its duration) is let finish: cancelling it half-way and
+/// sending it again only makes it slower. The graph manager's own overrun event (its
+/// `overrun_sigma`) is unaffected.
 struct TimeoutParams {
-  double stddevs{3.0};   ///< >= 0
-  double margin_s{5.0};  ///< > 0 (s)
+  double stddevs{3.0};     ///< >= 0
+  double margin_s{5.0};    ///< > 0 (s)
+  double stall_s{5.0};     ///< > 0 (s): no progress for this long past the limit is an overrun
+  double max_factor{3.0};  ///< >= 1: past this many times the limit, overrun even while moving
 };
 
 struct MonitorParams {

@@ -986,11 +986,29 @@ SearchResult firstPlan(const Task& task, const StateBits& init, const Goal& goal
     SearchOptions first = options;
     first.ehc_fallback = false;
     first.ehc_eval_budget_per_h = options.ehc_ff_budget_per_h;
+    const bool repeat = options.ehc_ff_first_improvement && options.ehc_ff_repeat_best_sibling && options.ehc_best_sibling;
     if (options.ehc_ff_first_improvement) first.ehc_best_sibling = false;
+    if (repeat && options.ehc_ff_first_improvement_budget_per_h > 0) {
+      // A failed first-improvement run is paid on top of the repeat: a smaller budget.
+      first.ehc_eval_budget_per_h = std::min(options.ehc_ff_first_improvement_budget_per_h, options.ehc_ff_budget_per_h);
+    }
     SearchResult r1;
+    uint64_t first_evals_not_charged = 0;  // the failed first-improvement run (see below)
     try {
       Searcher s1(task, init, goal, first, heuristic, term);
       r1 = s1.run();
+      if ((r1.status == SearchStatus::kFailed || r1.status == SearchStatus::kOutOfMemory) && repeat) {
+        // The first run once more, with the best sibling (a different path, which sometimes
+        // gets through where the first better state led into a dead end), and the full budget.
+        first.ehc_best_sibling = true;
+        first.ehc_eval_budget_per_h = options.ehc_ff_budget_per_h;
+        Searcher s1b(task, init, goal, first, heuristic, term);
+        SearchResult r1b = s1b.run();
+        first_evals_not_charged = r1.stats.evaluated;
+        addRunCosts(r1b.stats, r1.stats);
+        r1b.stats.ehc_ff_repeated = true;
+        r1 = std::move(r1b);
+      }
     } catch (...) {
       heuristic.setFFStyle(false);
       throw;
@@ -1015,6 +1033,7 @@ SearchResult firstPlan(const Task& task, const StateBits& init, const Goal& goal
         r2.stats.ehc_second_won = true;
         addRunCosts(r2.stats, r1.stats);
         r2.stats.initial_h = r1.stats.initial_h;
+        r2.stats.ehc_ff_repeated = r1.stats.ehc_ff_repeated;
         return r2;
       }
       addRunCosts(r1.stats, r2.stats);
@@ -1024,10 +1043,11 @@ SearchResult firstPlan(const Task& task, const StateBits& init, const Goal& goal
     // Second run: the default search from the start, as if the first had not happened (but
     // within what is left of the hill-climbing budget).
     SearchOptions rest = options;
-    rest.ehc_fallback_budget_spent = r1.stats.evaluated;
+    rest.ehc_fallback_budget_spent = r1.stats.evaluated - first_evals_not_charged;
     Searcher s2(task, init, goal, rest, heuristic, term);
     SearchResult r2 = s2.run();
     r2.stats.ehc_ff_failed = true;
+    r2.stats.ehc_ff_repeated = r1.stats.ehc_ff_repeated;
     addRunCosts(r2.stats, r1.stats);
     return r2;
   }

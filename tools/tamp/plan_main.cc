@@ -111,7 +111,7 @@ int main(int argc, char** argv) {
   uint64_t ff_fi_budget = defaults.ehc_ff_first_improvement_budget_per_h;
   app.add_option("--ehc-ff-first-improvement-budget", ff_fi_budget,
                  "ehc: evaluations per unit of the initial h allowed to the first run with first improvement when "
-                 "the repeat with the best sibling follows (at most --ehc-ff-budget; 0 = the same)");
+                 "the repeat with the best sibling follows, which gets the rest of --ehc-ff-budget (0 = all of it)");
   app.add_option("--ehc-second-budget", second_budget,
                  "ehc: when the first run's plan has >= 2 x h(init) actions, also run the default EHC with this "
                  "many evaluations per action of that plan and keep the cheaper plan (0 = never)");

@@ -993,18 +993,24 @@ SearchResult firstPlan(const Task& task, const StateBits& init, const Goal& goal
       first.ehc_eval_budget_per_h = std::min(options.ehc_ff_first_improvement_budget_per_h, options.ehc_ff_budget_per_h);
     }
     SearchResult r1;
-    uint64_t first_evals_not_charged = 0;  // the failed first-improvement run (see below)
     try {
       Searcher s1(task, init, goal, first, heuristic, term);
       r1 = s1.run();
-      if ((r1.status == SearchStatus::kFailed || r1.status == SearchStatus::kOutOfMemory) && repeat) {
+      // What the first run's budget (ehc_ff_budget_per_h x h) leaves to the repeat.
+      const uint64_t phase_budget =
+          options.ehc_ff_budget_per_h * static_cast<uint64_t>(std::max<Cost>(r1.stats.initial_h, 2));
+      if ((r1.status == SearchStatus::kFailed || r1.status == SearchStatus::kOutOfMemory) && repeat &&
+          r1.stats.evaluated < phase_budget) {
         // The first run once more, with the best sibling (a different path, which sometimes
-        // gets through where the first better state led into a dead end), and the full budget.
+        // gets through where the first better state led into a dead end), within what the
+        // first-improvement run left of the budget: where both fail by budget, the two runs
+        // together cost what the single first run did.
         first.ehc_best_sibling = true;
         first.ehc_eval_budget_per_h = options.ehc_ff_budget_per_h;
+        const uint64_t left = phase_budget - r1.stats.evaluated;
+        first.ehc_eval_budget = options.ehc_eval_budget > 0 ? std::min(options.ehc_eval_budget, left) : left;
         Searcher s1b(task, init, goal, first, heuristic, term);
         SearchResult r1b = s1b.run();
-        first_evals_not_charged = r1.stats.evaluated;
         addRunCosts(r1b.stats, r1.stats);
         r1b.stats.ehc_ff_repeated = true;
         r1 = std::move(r1b);
@@ -1043,7 +1049,7 @@ SearchResult firstPlan(const Task& task, const StateBits& init, const Goal& goal
     // Second run: the default search from the start, as if the first had not happened (but
     // within what is left of the hill-climbing budget).
     SearchOptions rest = options;
-    rest.ehc_fallback_budget_spent = r1.stats.evaluated - first_evals_not_charged;
+    rest.ehc_fallback_budget_spent = r1.stats.evaluated;
     Searcher s2(task, init, goal, rest, heuristic, term);
     SearchResult r2 = s2.run();
     r2.stats.ehc_ff_failed = true;

@@ -80,18 +80,18 @@ struct SearchOptions {
   /// evaluations on many domains (openstacks-30: 20347 -> 5199).
   bool ehc_ff_first_improvement{true};
   /// ehc with `ehc_ff_first_improvement`: when that first run fails (or runs out of its
-  /// budget), run it once more with the best sibling (`ehc_best_sibling`) and its own budget
-  /// before the default run; the default run's budget is then reduced by this repeated run's
-  /// evaluations only, as it was by the single first run before. Keeps the instances that only
-  /// the first run with the best sibling solves (maintenance-4, docs/benchmarks.md, issue 14,
-  /// sixth round), at the cost of the failed run's evaluations where both fail.
+  /// budget), run it once more with the best sibling (`ehc_best_sibling`) before the default run.
+  /// Keeps the instances that only the first run with the best sibling solves (maintenance-4,
+  /// docs/benchmarks.md, issue 14, sixth and seventh rounds).
   bool ehc_ff_repeat_best_sibling{true};
   /// ehc with `ehc_ff_first_improvement` and `ehc_ff_repeat_best_sibling`: the first-improvement
-  /// run may use at most this many evaluations per unit of h (as `ehc_ff_budget_per_h`, and never
-  /// more than it); the repeat keeps `ehc_ff_budget_per_h`. Where both runs fail by budget
-  /// (visitall: h(init) 323-2500) the failed first-improvement run then costs a third of a first
-  /// run, not a whole one; openstacks needs 2-13 x h (docs/benchmarks.md, issue 14, seventh
-  /// round). 0 = the same budget as the repeat.
+  /// run may use at most this many evaluations per unit of h (never more than
+  /// `ehc_ff_budget_per_h`); the repeat gets what is left of `ehc_ff_budget_per_h` x h, so that
+  /// the two runs together never use more than the single first run did, and the default run's
+  /// budget is reduced by both. Where both fail by budget (visitall, h(init) 323-2500) that is
+  /// the single run's cost; openstacks needs 2-13 x h; maintenance-4's repeat about 126 x h
+  /// (docs/benchmarks.md, issue 14, seventh round). 0 = `ehc_ff_budget_per_h` (which leaves
+  /// nothing to the repeat when the first-improvement run fails by budget).
   uint64_t ehc_ff_first_improvement_budget_per_h{100};
   /// ehc: give up (kFailed, no fallback) after this many evaluations per unit of the initial
   /// state's h (at least 2 units; with the goal agenda, h of the first entry); 0 = unlimited.

@@ -63,7 +63,7 @@ int main(int argc, char** argv) {
   size_t memory_mb = 4096;
   bool stats = false, no_check = false, no_fallback = false, no_agenda = false, first_improvement = false,
        no_ff_first = false, no_landmarks = false, no_unit_first = false,
-       no_full_retry = false, no_ff_first_improvement = false;
+       no_full_retry = false, ff_first_improvement = false;
   uint64_t ff_budget = 300, second_budget = 300;
   const sp::SearchOptions defaults;
   uint64_t fallback_budget = defaults.ehc_fallback_budget_per_h, fallback_min = defaults.ehc_fallback_budget_min,
@@ -101,17 +101,13 @@ int main(int argc, char** argv) {
                  "ehc: a plateau searched again with every applicable action may use this share of the "
                  "hill-climbing budget before the complete search starts (0 = unbounded)")
       ->check(CLI::Range(0.0, 1.0));
-  app.add_flag("--no-ehc-ff-first-improvement", no_ff_first_improvement,
-               "ehc: the first run (FF-v2.3 variant) continues from the best sibling, as the default run (default: "
-               "from the first better state, as FF, and once more with the best sibling if that fails)");
+  app.add_flag("--ehc-ff-first-improvement", ff_first_improvement,
+               "ehc: the first run (FF-v2.3 variant) continues from the first better state, as FF (default: from "
+               "the best sibling, as the default run)");
   app.add_flag("--no-ehc-ff-first", no_ff_first,
                "ehc: no first hill-climbing run with FF-v2.3's variant of the relaxed plan");
   app.add_option("--ehc-ff-budget", ff_budget,
                  "ehc: evaluations allowed to that first run per unit of the initial h (0 = no first run)");
-  uint64_t ff_fi_budget = defaults.ehc_ff_first_improvement_budget_per_h;
-  app.add_option("--ehc-ff-first-improvement-budget", ff_fi_budget,
-                 "ehc: evaluations per unit of the initial h allowed to the first run with first improvement when "
-                 "the repeat with the best sibling follows, which gets the rest of --ehc-ff-budget (0 = all of it)");
   app.add_option("--ehc-second-budget", second_budget,
                  "ehc: when the first run's plan has >= 2 x h(init) actions, also run the default EHC with this "
                  "many evaluations per action of that plan and keep the cheaper plan (0 = never)");
@@ -151,10 +147,9 @@ int main(int argc, char** argv) {
   req.search.ehc_best_sibling = !first_improvement;
   req.search.ehc_full_retry = !no_full_retry;
   req.search.ehc_retry_budget_share = retry_share;
-  req.search.ehc_ff_first_improvement = !no_ff_first_improvement;
+  req.search.ehc_ff_first_improvement = ff_first_improvement;
   req.search.ehc_ff_first = !no_ff_first;
   req.search.ehc_ff_budget_per_h = ff_budget;
-  req.search.ehc_ff_first_improvement_budget_per_h = ff_fi_budget;
   req.search.ehc_second_budget_per_step = second_budget;
   req.search.ehc_fallback_budget_per_h = fallback_budget;
   req.search.ehc_fallback_budget_min = fallback_min;
@@ -190,9 +185,7 @@ int main(int argc, char** argv) {
                  static_cast<unsigned long long>(reply.stats.ehc_retries_abandoned),
                  static_cast<unsigned long long>(reply.stats.anytime_iterations),
                  static_cast<unsigned long long>(reply.stats.anytime_improvements),
-                 reply.stats.ehc_ff_failed     ? "; ehc with FF-v2.3's relaxed plan failed, restarted"
-                 : reply.stats.ehc_ff_repeated ? "; ehc with FF-v2.3's relaxed plan repeated with the best sibling"
-                                               : "",
+                 reply.stats.ehc_ff_failed ? "; ehc with FF-v2.3's relaxed plan failed, restarted" : "",
                  reply.stats.ehc_second_won   ? "; second ehc run gave the shorter plan"
                  : reply.stats.ehc_second_ran ? "; second ehc run, first plan kept"
                                               : "",

@@ -300,7 +300,6 @@ PlanReply PlanningSession::solve(const Query& q, const Termination& term) {
   reply.stats.initial_h = sr.stats.initial_h;
   reply.stats.ehc_failed = sr.stats.ehc_failed;
   reply.stats.ehc_ff_failed = sr.stats.ehc_ff_failed;
-  reply.stats.ehc_ff_repeated = sr.stats.ehc_ff_repeated;
   reply.stats.ehc_second_ran = sr.stats.ehc_second_ran;
   reply.stats.ehc_second_won = sr.stats.ehc_second_won;
   reply.stats.ehc_retries = sr.stats.ehc_retries;

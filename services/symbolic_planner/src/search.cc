@@ -986,38 +986,11 @@ SearchResult firstPlan(const Task& task, const StateBits& init, const Goal& goal
     SearchOptions first = options;
     first.ehc_fallback = false;
     first.ehc_eval_budget_per_h = options.ehc_ff_budget_per_h;
-    const bool repeat = options.ehc_ff_first_improvement && options.ehc_ff_repeat_best_sibling && options.ehc_best_sibling;
     if (options.ehc_ff_first_improvement) first.ehc_best_sibling = false;
-    if (repeat && options.ehc_ff_first_improvement_budget_per_h > 0) {
-      // A failed first-improvement run is paid on top of the repeat: a smaller budget.
-      first.ehc_eval_budget_per_h = std::min(options.ehc_ff_first_improvement_budget_per_h, options.ehc_ff_budget_per_h);
-    }
     SearchResult r1;
     try {
       Searcher s1(task, init, goal, first, heuristic, term);
       r1 = s1.run();
-      // What the first run's budget (ehc_ff_budget_per_h x h) leaves to the repeat.
-      const uint64_t phase_budget =
-          options.ehc_ff_budget_per_h * static_cast<uint64_t>(std::max<Cost>(r1.stats.initial_h, 2));
-      if ((r1.status == SearchStatus::kFailed || r1.status == SearchStatus::kOutOfMemory) && repeat &&
-          r1.stats.evaluated < phase_budget) {
-        // The first run once more, with the best sibling (a different path, which sometimes
-        // gets through where the first better state led into a dead end), within what the
-        // first-improvement run left of the budget: where both fail by budget, the two runs
-        // together cost what the single first run did.
-        first.ehc_best_sibling = true;
-        first.ehc_eval_budget_per_h = options.ehc_ff_budget_per_h;
-        const uint64_t left = phase_budget - r1.stats.evaluated;
-        first.ehc_eval_budget = options.ehc_eval_budget > 0 ? std::min(options.ehc_eval_budget, left) : left;
-        // The hill-climbing's fallback budget (at most ehc_fallback_budget_max) is shared too: on
-        // large h it, not ehc_ff_budget_per_h x h, is what bounds the first run.
-        first.ehc_fallback_budget_spent = options.ehc_fallback_budget_spent + r1.stats.evaluated;
-        Searcher s1b(task, init, goal, first, heuristic, term);
-        SearchResult r1b = s1b.run();
-        addRunCosts(r1b.stats, r1.stats);
-        r1b.stats.ehc_ff_repeated = true;
-        r1 = std::move(r1b);
-      }
     } catch (...) {
       heuristic.setFFStyle(false);
       throw;
@@ -1042,7 +1015,6 @@ SearchResult firstPlan(const Task& task, const StateBits& init, const Goal& goal
         r2.stats.ehc_second_won = true;
         addRunCosts(r2.stats, r1.stats);
         r2.stats.initial_h = r1.stats.initial_h;
-        r2.stats.ehc_ff_repeated = r1.stats.ehc_ff_repeated;
         return r2;
       }
       addRunCosts(r1.stats, r2.stats);
@@ -1056,7 +1028,6 @@ SearchResult firstPlan(const Task& task, const StateBits& init, const Goal& goal
     Searcher s2(task, init, goal, rest, heuristic, term);
     SearchResult r2 = s2.run();
     r2.stats.ehc_ff_failed = true;
-    r2.stats.ehc_ff_repeated = r1.stats.ehc_ff_repeated;
     addRunCosts(r2.stats, r1.stats);
     return r2;
   }

@@ -220,53 +220,15 @@ TEST(Search, EhcFirstRunContinuesFromTheFirstBetterState) {
   req.domain_text = test::readFile(dir / "domain.pddl");
   req.problem_text = test::readFile(dir / "instance-12.pddl");
   req.timeout_seconds = 120;
-  req.search.ehc_ff_first_improvement = true;  // the default
+  req.search.ehc_ff_first_improvement = true;
   PlanReply first = plan(req, Termination());
   ASSERT_EQ(first.status, PlanStatus::kSolved) << first.message;
   EXPECT_FALSE(first.stats.ehc_ff_failed);
-  EXPECT_FALSE(first.stats.ehc_ff_repeated);
-  req.search.ehc_ff_first_improvement = false;
+  req.search.ehc_ff_first_improvement = false;  // the default
   PlanReply best = plan(req, Termination());
   ASSERT_EQ(best.status, PlanStatus::kSolved) << best.message;
   EXPECT_FALSE(best.stats.ehc_ff_failed);
   EXPECT_LT(first.stats.evaluated, best.stats.evaluated);
-}
-
-TEST(Search, EhcFirstRunThatFailsWithFirstImprovementIsRepeatedWithTheBestSibling) {
-  // maintenance-4: the first run with first improvement fails (out of its budget); repeated with the
-  // best sibling it solves the task (as the single first run of the fifth round did), before
-  // the default run. Without the repeat, the default run fails too and the complete search has
-  // to find the plan. The plans are replayed by the checker.
-  const auto dir = test::benchmarksDir() / "pddl-more/maintenance";
-  PlanRequest req;
-  req.domain_text = test::readFile(dir / "domain.pddl");
-  req.problem_text = test::readFile(dir / "instance-4.pddl");
-  req.timeout_seconds = 120;
-  PlanReply repeated = plan(req, Termination());
-  ASSERT_EQ(repeated.status, PlanStatus::kSolved) << repeated.message;
-  EXPECT_TRUE(repeated.stats.ehc_ff_repeated);
-  EXPECT_FALSE(repeated.stats.ehc_ff_failed);
-  EXPECT_FALSE(repeated.stats.ehc_failed);
-  // The first-improvement run has at most 100 x h(init) evaluations, the repeat what is left of
-  // 300 x h: both runs together stay within the single first run's budget.
-  const auto h = static_cast<uint64_t>(repeated.stats.initial_h);
-  EXPECT_GT(h, 0u);
-  EXPECT_LE(repeated.stats.evaluated, 300 * h + 1000);
-  // A first-improvement run given the whole budget fails by budget and leaves nothing to the
-  // repeat (the default run alone, without fallback, then fails too).
-  req.search.ehc_ff_first_improvement_budget_per_h = 300;
-  req.search.ehc_fallback = false;
-  PlanReply whole = plan(req, Termination());
-  EXPECT_NE(whole.status, PlanStatus::kSolved);
-  EXPECT_FALSE(whole.stats.ehc_ff_repeated);
-  EXPECT_TRUE(whole.stats.ehc_ff_failed);
-  req.search.ehc_ff_first_improvement_budget_per_h = 100;
-  req.search.ehc_ff_repeat_best_sibling = false;
-  req.search.ehc_fallback = false;  // the default run alone: no plan
-  PlanReply single = plan(req, Termination());
-  EXPECT_NE(single.status, PlanStatus::kSolved);
-  EXPECT_FALSE(single.stats.ehc_ff_repeated);
-  EXPECT_TRUE(single.stats.ehc_ff_failed);
 }
 
 TEST(Search, AnytimePhaseNeverReturnsADearerPlanAndEndsOptimalOnASmallTask) {

@@ -82,7 +82,6 @@ struct PlanStatistics {
   int64_t initial_h{0};
   bool ehc_failed{false};
   bool ehc_ff_failed{false};  ///< the first EHC run (FF-v2.3 heuristic variant) failed; see SearchOptions
-  bool ehc_ff_repeated{false};  ///< ... with first improvement, and was repeated with the best sibling
   bool ehc_second_ran{false};  ///< the default EHC also ran after the first run's long plan; see SearchOptions
   bool ehc_second_won{false};  ///< ... and its plan was the cheaper one
   uint64_t ehc_retries{0};  ///< plateaus searched again without helpful-action pruning (every run)

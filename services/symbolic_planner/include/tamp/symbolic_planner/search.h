@@ -77,22 +77,9 @@ struct SearchOptions {
   uint64_t ehc_ff_budget_per_h{300};
   /// ehc: that first run continues from the first better state, as FF does, whatever
   /// `ehc_best_sibling` says (which then applies to the default run only): 2-6x fewer
-  /// evaluations on many domains (openstacks-30: 20347 -> 5199).
-  bool ehc_ff_first_improvement{true};
-  /// ehc with `ehc_ff_first_improvement`: when that first run fails (or runs out of its
-  /// budget), run it once more with the best sibling (`ehc_best_sibling`) before the default run.
-  /// Keeps the instances that only the first run with the best sibling solves (maintenance-4,
-  /// docs/benchmarks.md, issue 14, sixth and seventh rounds).
-  bool ehc_ff_repeat_best_sibling{true};
-  /// ehc with `ehc_ff_first_improvement` and `ehc_ff_repeat_best_sibling`: the first-improvement
-  /// run may use at most this many evaluations per unit of h (never more than
-  /// `ehc_ff_budget_per_h`); the repeat gets what is left of `ehc_ff_budget_per_h` x h and of the
-  /// fallback budget (`ehc_fallback_budget_*`), so that the two runs together never use more
-  /// than the single first run did, and the default run's budget is reduced by both. Where both fail by budget (visitall, h(init) 323-2500) that is
-  /// the single run's cost; openstacks needs 2-13 x h; maintenance-4's repeat about 126 x h
-  /// (docs/benchmarks.md, issue 14, seventh round). 0 = `ehc_ff_budget_per_h` (which leaves
-  /// nothing to the repeat when the first-improvement run fails by budget).
-  uint64_t ehc_ff_first_improvement_budget_per_h{100};
+  /// evaluations on many domains, but the first run then fails on maintenance-4, which only the
+  /// first run with the best sibling solves (docs/benchmarks.md, issue 14, fifth round): off.
+  bool ehc_ff_first_improvement{false};
   /// ehc: give up (kFailed, no fallback) after this many evaluations per unit of the initial
   /// state's h (at least 2 units; with the goal agenda, h of the first entry); 0 = unlimited.
   uint64_t ehc_eval_budget_per_h{0};
@@ -171,9 +158,6 @@ struct SearchStatistics {
   /// ehc: the first run with the FF-v2.3 heuristic variant failed (or ran out of budget) and the
   /// search started again; its evaluations are included in `evaluated`.
   bool ehc_ff_failed{false};
-  /// ehc: the first run with first improvement failed and was repeated with the best sibling
-  /// (`ehc_ff_repeat_best_sibling`); its evaluations are included in `evaluated`.
-  bool ehc_ff_repeated{false};
   /// ehc: the default EHC also ran after the FF-v2.3-variant run solved the task (see
   /// `ehc_second_budget_per_step`); `ehc_second_won`: its plan was cheaper and was returned.
   bool ehc_second_ran{false};

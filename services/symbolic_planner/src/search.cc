@@ -429,16 +429,14 @@ class Searcher {
     std::vector<OpId> all_ops;
     bool helpful_only = true;
     // Stall check: the budget this run is bounded by (in evaluations, counting the earlier run's
-    // `ehc_fallback_budget_spent`), and where this goal-agenda entry started.
-    uint64_t stall_cap = 0;
-    if (fallback_budget_ > 0) stall_cap = fallback_budget_;
-    if (eval_budget_ > 0) {
-      const uint64_t c = eval_budget_ + opt_.ehc_fallback_budget_spent;
-      if (stall_cap == 0 || c < stall_cap) stall_cap = c;
-    }
+    // `ehc_fallback_budget_spent`), projected against only after a share of the fallback budget
+    // (at least `ehc_fallback_budget_min`; a share of the first run's own 300 x h would, on small
+    // h, project from a few dozen evaluations), and where this goal-agenda entry started.
+    uint64_t stall_cap = fallback_budget_;
+    if (eval_budget_ > 0 && stall_cap > 0) stall_cap = std::min(stall_cap, eval_budget_ + opt_.ehc_fallback_budget_spent);
     const uint64_t stall_min =
         opt_.ehc_stall_share > 0 && stall_cap > 0
-            ? std::max<uint64_t>(1, static_cast<uint64_t>(opt_.ehc_stall_share * static_cast<double>(stall_cap)))
+            ? std::max<uint64_t>(1, static_cast<uint64_t>(opt_.ehc_stall_share * static_cast<double>(fallback_budget_)))
             : 0;
     const uint64_t entry_evals0 = stats_.evaluated;
     const Cost entry_h0 = hcur;
@@ -473,8 +471,10 @@ class Searcher {
           const double spent_entry = static_cast<double>(stats_.evaluated - entry_evals0);
           const double lowered = static_cast<double>(entry_h0 - hcur);
           const double used = static_cast<double>(stats_.evaluated + opt_.ehc_fallback_budget_spent);
-          if (lowered <= 0 || used + spent_entry * static_cast<double>(hcur) / lowered >
-                                  opt_.ehc_stall_slack * static_cast<double>(stall_cap)) {
+          // No progress yet is a plateau, bounded as before (full retry share, budget), not a
+          // projection.
+          if (lowered > 0 && used + spent_entry * static_cast<double>(hcur) / lowered >
+                                 opt_.ehc_stall_slack * static_cast<double>(stall_cap)) {
             ++stats_.ehc_stalled;
             return fallback();
           }

@@ -96,12 +96,14 @@ struct SearchOptions {
   uint64_t ehc_fallback_budget_max{200000};
   /// ehc: stop a hill-climbing that makes slow progress (as if it had run out of that budget),
   /// so that the complete search starts sooner. Once a hill-climbing run has spent, on the
-  /// current goal-agenda entry, at least `ehc_stall_share` of its budget (the smaller of
-  /// `ehc_eval_budget_per_h`'s and the fallback budget), it projects its evaluations at the
-  /// entry's rate so far (evaluations per unit of h lowered since the entry's start) over the
-  /// h left; when the evaluations so far (both runs) plus that projection exceed
-  /// `ehc_stall_slack` times the budget, the run stops (a failed run; no progress at all
-  /// projects to infinity). A run on track to finish within its budget is not touched; the
+  /// current goal-agenda entry, at least `ehc_stall_share` of the fallback budget
+  /// (`ehc_fallback_budget_*`), it projects its evaluations at the entry's rate so far
+  /// (evaluations per unit of h lowered since the entry's start) over the h left; when the
+  /// evaluations so far (both runs) plus that projection exceed `ehc_stall_slack` times its
+  /// budget (the smaller of the fallback budget and, for the first run, its
+  /// `ehc_ff_budget_per_h` one), the run stops (a failed run). No progress yet on the entry (a
+  /// plateau) is left to
+  /// the bounds above. A run on track to finish within its budget is not touched; the
   /// slack of 1.5 spares runs whose early rate underestimates them (pathways-24's first run
   /// finishes at 94 % of its budget; with a slack of 1 it was stopped and the default run
   /// needed 65 % more evaluations), while visitall's projections exceed the budget many times

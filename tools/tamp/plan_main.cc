@@ -70,8 +70,6 @@ int main(int argc, char** argv) {
            fallback_max = defaults.ehc_fallback_budget_max;
   double unit_first_share = defaults.unit_first_time_share;
   double retry_share = defaults.ehc_retry_budget_share;
-  double stall_share = defaults.ehc_stall_share, stall_slack = defaults.ehc_stall_slack;
-  bool no_stall = false;
   app.add_option("domain", domain, "PDDL domain file")->required();
   app.add_option("problem", problem, "PDDL problem file")->required();
   app.add_option("--search", search,
@@ -103,16 +101,6 @@ int main(int argc, char** argv) {
                  "ehc: a plateau searched again with every applicable action may use this share of the "
                  "hill-climbing budget before the complete search starts (0 = unbounded)")
       ->check(CLI::Range(0.0, 1.0));
-  app.add_flag("--no-ehc-stall", no_stall,
-               "ehc: run hill-climbing until its budget, even when its progress so far projects past it "
-               "(default: stop it then, and start the complete search)");
-  app.add_option("--ehc-stall-share", stall_share,
-                 "ehc: the share of the hill-climbing budget spent on a goal-agenda entry before its "
-                 "progress is projected (0 = never stop early)")
-      ->check(CLI::Range(0.0, 1.0));
-  app.add_option("--ehc-stall-slack", stall_slack,
-                 "ehc: stop when evaluations so far plus the projection exceed this many budgets (> 0)")
-      ->check(CLI::Range(1e-9, 1e9));
   app.add_flag("--ehc-ff-first-improvement", ff_first_improvement,
                "ehc: the first run (FF-v2.3 variant) continues from the first better state, as FF (default: from "
                "the best sibling, as the default run)");
@@ -160,8 +148,6 @@ int main(int argc, char** argv) {
   req.search.ehc_full_retry = !no_full_retry;
   req.search.ehc_retry_budget_share = retry_share;
   req.search.ehc_ff_first_improvement = ff_first_improvement;
-  req.search.ehc_stall_share = no_stall ? 0.0 : stall_share;
-  req.search.ehc_stall_slack = stall_slack;
   req.search.ehc_ff_first = !no_ff_first;
   req.search.ehc_ff_budget_per_h = ff_budget;
   req.search.ehc_second_budget_per_step = second_budget;
@@ -189,7 +175,7 @@ int main(int argc, char** argv) {
   if (stats) {
     std::fprintf(stderr,
                  "; status %s; parse %.4f s, ground %.4f s, search %.4f s; facts %zu, operators %zu; "
-                 "expanded %llu, evaluated %llu, initial h %lld; ehc plateau retries %llu (%llu abandoned); ehc stalled %llu; anytime %llu "
+                 "expanded %llu, evaluated %llu, initial h %lld; ehc plateau retries %llu (%llu abandoned); anytime %llu "
                  "iterations, %llu improvements%s%s%s%s\n",
                  sp::toString(reply.status).c_str(), reply.stats.parse_seconds, reply.stats.ground_seconds,
                  reply.stats.search_seconds, reply.stats.facts, reply.stats.operators,
@@ -197,7 +183,6 @@ int main(int argc, char** argv) {
                  static_cast<unsigned long long>(reply.stats.evaluated), static_cast<long long>(reply.stats.initial_h),
                  static_cast<unsigned long long>(reply.stats.ehc_retries),
                  static_cast<unsigned long long>(reply.stats.ehc_retries_abandoned),
-                 static_cast<unsigned long long>(reply.stats.ehc_stalled),
                  static_cast<unsigned long long>(reply.stats.anytime_iterations),
                  static_cast<unsigned long long>(reply.stats.anytime_improvements),
                  reply.stats.ehc_ff_failed ? "; ehc with FF-v2.3's relaxed plan failed, restarted" : "",

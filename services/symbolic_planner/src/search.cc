@@ -428,18 +428,6 @@ class Searcher {
     std::vector<uint32_t> queue;
     std::vector<OpId> all_ops;
     bool helpful_only = true;
-    // Stall check: the budget this run is bounded by (in evaluations, counting the earlier run's
-    // `ehc_fallback_budget_spent`), projected against only after a share of the fallback budget
-    // (at least `ehc_fallback_budget_min`; a share of the first run's own 300 x h would, on small
-    // h, project from a few dozen evaluations), and where this goal-agenda entry started.
-    uint64_t stall_cap = fallback_budget_;
-    if (eval_budget_ > 0 && stall_cap > 0) stall_cap = std::min(stall_cap, eval_budget_ + opt_.ehc_fallback_budget_spent);
-    const uint64_t stall_min =
-        opt_.ehc_stall_share > 0 && stall_cap > 0
-            ? std::max<uint64_t>(1, static_cast<uint64_t>(opt_.ehc_stall_share * static_cast<double>(fallback_budget_)))
-            : 0;
-    const uint64_t entry_evals0 = stats_.evaluated;
-    const Cost entry_h0 = hcur;
     // Evaluations a plateau searched again without pruning may use (0 = unbounded).
     const uint64_t retry_budget =
         opt_.ehc_retry_budget_share > 0 && fallback_budget_ > 0
@@ -464,20 +452,6 @@ class Searcher {
         }
         if (fallback_budget_ > 0 && stats_.evaluated + opt_.ehc_fallback_budget_spent > fallback_budget_) {
           return fallback();
-        }
-        if (stall_min > 0 && stats_.evaluated - entry_evals0 >= stall_min) {
-          // Slow progress: at this entry's rate so far, the run would not finish within its
-          // budget; stop now rather than when the budget is spent.
-          const double spent_entry = static_cast<double>(stats_.evaluated - entry_evals0);
-          const double lowered = static_cast<double>(entry_h0 - hcur);
-          const double used = static_cast<double>(stats_.evaluated + opt_.ehc_fallback_budget_spent);
-          // No progress yet is a plateau, bounded as before (full retry share, budget), not a
-          // projection.
-          if (lowered > 0 && used + spent_entry * static_cast<double>(hcur) / lowered >
-                                 opt_.ehc_stall_slack * static_cast<double>(stall_cap)) {
-            ++stats_.ehc_stalled;
-            return fallback();
-          }
         }
         const uint32_t id = queue[head];
         std::copy(reg_.get(id), reg_.get(id) + reg_.words(), buf_.begin());
@@ -938,7 +912,6 @@ void addRunCosts(SearchStatistics& into, const SearchStatistics& from) {
   into.evaluated += from.evaluated;
   into.ehc_retries += from.ehc_retries;
   into.ehc_retries_abandoned += from.ehc_retries_abandoned;
-  into.ehc_stalled += from.ehc_stalled;
   into.registered_states += from.registered_states;
   into.seconds += from.seconds;
 }
@@ -992,14 +965,6 @@ void SearchOptions::validate() const {
   if (!(ehc_retry_budget_share >= 0.0 && ehc_retry_budget_share <= 1.0)) {
     throw std::invalid_argument("SearchOptions::ehc_retry_budget_share must be in [0, 1], got " +
                                 std::to_string(ehc_retry_budget_share));
-  }
-  if (!(ehc_stall_share >= 0.0 && ehc_stall_share <= 1.0)) {
-    throw std::invalid_argument("SearchOptions::ehc_stall_share must be in [0, 1], got " +
-                                std::to_string(ehc_stall_share));
-  }
-  if (!(ehc_stall_slack > 0.0) || !std::isfinite(ehc_stall_slack)) {
-    throw std::invalid_argument("SearchOptions::ehc_stall_slack must be a finite number > 0, got " +
-                                std::to_string(ehc_stall_slack));
   }
   if (preferred_boost < 0) {
     throw std::invalid_argument("SearchOptions::preferred_boost must be >= 0, got " + std::to_string(preferred_boost));

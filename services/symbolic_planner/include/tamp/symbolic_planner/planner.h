@@ -86,7 +86,6 @@ struct PlanStatistics {
   bool ehc_second_won{false};  ///< ... and its plan was the cheaper one
   uint64_t ehc_retries{0};  ///< plateaus searched again without helpful-action pruning (every run)
   uint64_t ehc_retries_abandoned{0};  ///< ... given up at SearchOptions::ehc_retry_budget_share
-  uint64_t ehc_stalled{0};  ///< hill-climbing runs stopped for slow progress (SearchOptions::ehc_stall_share)
   uint64_t anytime_iterations{0};    ///< SearchOptions::anytime_seconds: iterations run
   uint64_t anytime_improvements{0};  ///< ... that found a cheaper plan
   bool unit_first_failed{false};  ///< the unit-cost first run failed; see SearchOptions::unit_cost_first

@@ -94,23 +94,6 @@ struct SearchOptions {
   uint64_t ehc_fallback_budget_per_h{500};
   uint64_t ehc_fallback_budget_min{50000};
   uint64_t ehc_fallback_budget_max{200000};
-  /// ehc: stop a hill-climbing that makes slow progress (as if it had run out of that budget),
-  /// so that the complete search starts sooner. Once a hill-climbing run has spent, on the
-  /// current goal-agenda entry, at least `ehc_stall_share` of the fallback budget
-  /// (`ehc_fallback_budget_*`), it projects its evaluations at the entry's rate so far
-  /// (evaluations per unit of h lowered since the entry's start) over the h left; when the
-  /// evaluations so far (both runs) plus that projection exceed `ehc_stall_slack` times its
-  /// budget (the smaller of the fallback budget and, for the first run, its
-  /// `ehc_ff_budget_per_h` one), the run stops (a failed run). No progress yet on the entry (a
-  /// plateau) is left to
-  /// the bounds above. A run on track to finish within its budget is not touched; the
-  /// slack of 1.5 spares runs whose early rate underestimates them (pathways-24's first run
-  /// finishes at 94 % of its budget; with a slack of 1 it was stopped and the default run
-  /// needed 65 % more evaluations), while visitall's projections exceed the budget many times
-  /// (docs/benchmarks.md, issue 14, eighth round). 0 = off (the hill-climbing runs until its
-  /// budget, as before); must be in [0, 1].
-  double ehc_stall_share{0.05};
-  double ehc_stall_slack{1.5};  ///< must be > 0
   /// ehc: evaluations already spent towards that budget (set by `search()` for the default
   /// hill-climbing after a failed first run with the FF-v2.3 variant, so both share one budget).
   uint64_t ehc_fallback_budget_spent{0};
@@ -181,7 +164,6 @@ struct SearchStatistics {
   bool ehc_second_won{false};
   uint64_t ehc_retries{0};  ///< plateaus searched again without helpful-action pruning
   uint64_t ehc_retries_abandoned{0};  ///< ... given up at `ehc_retry_budget_share`
-  uint64_t ehc_stalled{0};  ///< hill-climbing runs stopped for slow progress (`ehc_stall_share`)
   uint64_t landmarks{0};    ///< lazy: number of fact landmarks found (0: landmark count not used)
   uint64_t eliminated_actions{0};  ///< removed by action elimination
   uint64_t anytime_iterations{0};    ///< weighted A* iterations of the anytime phase

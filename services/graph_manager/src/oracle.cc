@@ -30,21 +30,26 @@ std::vector<std::vector<std::size_t>> removalSubsets(std::size_t n, int max_size
 }
 
 double faultRetryPenalty(const std::vector<OracleFault>& faults, int action_count,
-                         const std::vector<BranchStep>& branch) {
+                         const std::vector<BranchStep>& branch, int max_failures) {
   double penalty = 0.0;
+  std::vector<int> strikes(branch.size(), 0);
   for (const OracleFault& f : faults) {
     if (f.type != OracleFault::Type::kFailAction || !f.step || *f.step < action_count) continue;
     int command = action_count;  // the simulator's index of the branch's next command
-    for (const BranchStep& s : branch) {
+    for (std::size_t i = 0; i < branch.size(); ++i) {
+      const BranchStep& s = branch[i];
       const int last = command + s.commands - 1;  // a transfer arm motion goes first
       command += s.commands;
       if (last < *f.step) continue;
       if (f.action && *f.action != s.kind) continue;
       penalty += s.effort_s;  // two faults on one action: it is paid for each
+      ++strikes[i];
       break;
     }
   }
-  return penalty;
+  const bool given_up = max_failures > 0 && std::any_of(strikes.begin(), strikes.end(),
+                                                        [&](int n) { return n >= max_failures; });
+  return given_up ? penalty + kGivenUpPenaltyS : penalty;
 }
 
 world::World withHidden(const world::World& live, const std::vector<world::Object>& hidden) {
@@ -88,7 +93,7 @@ void GraphManager::refreshOracle() {
 
 double GraphManager::oraclePenalty(const std::vector<BranchStep>& steps) const {
   if (params_.policy != Policy::kOracle || !oracle_) return 0.0;
-  return faultRetryPenalty(oracle_->faults, oracle_->action_count, steps);
+  return faultRetryPenalty(oracle_->faults, oracle_->action_count, steps, params_.max_action_failures);
 }
 
 void GraphManager::spawnSubsetSubtasks(

@@ -67,6 +67,21 @@ TEST(OracleTest, AFailingPickIsPricedAsTheRetryItCosts) {
   EXPECT_DOUBLE_EQ(faultRetryPenalty({timed, drop}, 0, kBranch), 0.0);
 }
 
+// namo_corridor_slippery: every pick of the box fails. With max_action_failures 2 the graph
+// manager gives the pick up after two failures, so a branch through it is not executed as
+// planned: priced beyond any branch that avoids it, not as a few cheap retries.
+TEST(OracleTest, AnActionThatWillFailAsOftenAsTheGraphManagerToleratesIsGivenUp) {
+  const std::vector<OracleFault> once{failAt(0, ActionKind::kPick)};
+  const std::vector<OracleFault> twice{failAt(0, ActionKind::kPick), failAt(1, ActionKind::kPick)};
+  EXPECT_DOUBLE_EQ(faultRetryPenalty(once, 0, kBranch, 2), 5.0);
+  EXPECT_DOUBLE_EQ(faultRetryPenalty(twice, 0, kBranch, 2), 10.0 + kGivenUpPenaltyS);
+  EXPECT_DOUBLE_EQ(faultRetryPenalty(twice, 0, kBranch, 3), 10.0);
+  EXPECT_DOUBLE_EQ(faultRetryPenalty(twice, 0, kBranch), 10.0) << "no limit: retries only";
+  // Struck on two different actions once each: retried, not given up.
+  EXPECT_DOUBLE_EQ(faultRetryPenalty({failAt(0, ActionKind::kPick), failAt(0, ActionKind::kMoveArm)}, 0, kBranch, 2),
+                   8.0);
+}
+
 TEST(OracleTest, APickWithATransferArmMotionCountsTwoCommands) {
   // Drive (command 0), then a pick sent as its transfer arm motion (1) and the pick (2).
   const std::vector<BranchStep> b{{ActionKind::kMoveBase, 10.0, 1}, {ActionKind::kPick, 6.0, 2}};

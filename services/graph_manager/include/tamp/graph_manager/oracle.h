@@ -66,8 +66,12 @@ struct BranchStep {
 /// `action_count` commands: each kFailAction fault with a step trigger not yet reached strikes
 /// the first action of its kind at or after its step, which is then executed twice (the failed
 /// attempt and the retry): its effort is added once. Faults with a time trigger and other fault
-/// types cost nothing here (a drop or an appearing object is not a fixed price).
+/// types cost nothing here (a drop or an appearing object is not a fixed price). With
+/// `max_failures` > 0 (the graph manager's `max_action_failures`): an action struck by that many
+/// faults or more will be given up, so the branch will not be executed as planned; it costs
+/// `kGivenUpPenaltyS` on top, which any branch that avoids it beats.
+inline constexpr double kGivenUpPenaltyS = 1e6;
 double faultRetryPenalty(const std::vector<OracleFault>& faults, int action_count,
-                         const std::vector<BranchStep>& branch);
+                         const std::vector<BranchStep>& branch, int max_failures = 0);
 
 }  // namespace tamp::graph_manager

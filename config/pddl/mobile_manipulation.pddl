@@ -5,6 +5,9 @@
 ;   armconf   an arm configuration: the constant `stow` (arm folded, safe for base motion) or a
 ;             pre-grasp configuration over a region, reachable from some base locations
 ;   item      a movable object of the world model (by id)
+; Push: the base, arm stowed and hand empty, drives straight into an object too heavy or too wide
+; to grasp and moves it along the floor; `push-to` facts are made on the fly per blocking object
+; (a contact pose, a distance that clears the blocked path, the swept volume checked collision-free).
 ; Static facts (reaches, conf-over, graspable) come from kinematics and the world model; `occludes`
 ; comes from perception (an item in front of another, from the robot's approach direction).
 ; Action costs are placeholders (1): the graph manager prices edges with the effort estimator.
@@ -22,7 +25,9 @@
     (reaches ?l - location ?c - armconf)     ; static: from base location ?l the arm can take ?c
     (conf-over ?c - armconf ?r - region)     ; static: ?c is the pre-grasp configuration over ?r
     (graspable ?o - item)                    ; static: the gripper can hold ?o (size, mass)
-    (occludes ?x - item ?o - item))          ; ?x stands in the way of grasping ?o
+    (occludes ?x - item ?o - item)           ; ?x stands in the way of grasping ?o
+    ; static: from ?from, the base pushes ?o (on ?r) straight ahead to ?s, ending at ?to
+    (push-to ?o - item ?r - region ?from - location ?to - location ?s - region))
   (:functions (total-cost) - number)
 
   (:action move_base
@@ -47,4 +52,11 @@
     :parameters (?o - item ?r - region ?c - armconf)
     :precondition (and (arm-at ?c) (conf-over ?c ?r) (holding ?o))
     :effect (and (on ?o ?r) (hand-empty) (not (holding ?o)) (increase (total-cost) 1)))
+
+  (:action push
+    :parameters (?o - item ?r - region ?from ?to - location ?s - region)
+    :precondition (and (robot-at ?from) (arm-at stow) (hand-empty) (on ?o ?r) (push-to ?o ?r ?from ?to ?s))
+    :effect (and (not (robot-at ?from)) (robot-at ?to) (not (on ?o ?r)) (on ?o ?s)
+                 (forall (?y - item) (not (occludes ?o ?y)))
+                 (increase (total-cost) 1)))
 )

@@ -13,6 +13,7 @@
 
 #include "mission_util.h"
 #include "tamp/core/paths.h"
+#include "tamp/world/scenario.h"
 
 namespace tamp::integration {
 namespace {
@@ -122,6 +123,29 @@ TEST(MissionTest, CorridorHeavyBoxAboveThePayloadIsGoneRound) {
   expectAtTheCorridorGoal(m);
   expectTheBoxUntouched(m);
   EXPECT_EQ(m.report["grasp_calls"], 0) << "a box above the payload offers no removal to price";
+}
+
+// S-NAMO 01_basic: the only way to the goal leads through a box 1 m wide, far wider than the
+// gripper (no grasp) but within the base's push limit. The robot pushes it off the way, drives on
+// to the goal, and the simulator's world shows the box moved.
+TEST(MissionTest, ABoxTooWideToGraspIsPushedOffTheWayToTheGoal) {
+  auto sc = world::loadScenario(configDir() / "scenarios" / "namo_basic.yaml");
+  ASSERT_TRUE(sc.ok()) << sc.error().toString();
+  const world::Location* goal = sc->world.findLocation("goal_01");
+  ASSERT_NE(goal, nullptr);
+  const Eigen::Vector3d box = sc->world.object("movable_box").pose.translation();
+  const Mission m = run("namo_basic.yaml");
+  ASSERT_EQ(m.exit_code, 0) << m.output;
+  ASSERT_TRUE(m.truth.is_object()) << m.output;
+  EXPECT_EQ(m.report["status"], "succeeded") << m.report["reason"];
+  EXPECT_LT(distance(m.truth["robot"], goal->pose.x, goal->pose.y), 0.10) << m.truth.dump();
+  EXPECT_GT(distance(m.truth["objects"]["movable_box"], box.x(), box.y()), 0.5) << m.truth.dump();
+  EXPECT_EQ(m.report["objects_moved"], nlohmann::json::array({"movable_box"})) << m.report.dump(1);
+  int pushes = 0;
+  for (const auto& a : m.report["actions"])
+    if (a["action"].get<std::string>().rfind("(push movable_box ", 0) == 0 && a["outcome"] == "succeeded") ++pushes;
+  EXPECT_EQ(pushes, 1) << m.report["actions"].dump(1);
+  EXPECT_EQ(m.report["grasp_calls"].get<int>() > 0, true) << "the grasp was tried first, and refuted";
 }
 
 TEST(MissionTest, CorridorShortDetourIsTakenInsteadOfMovingTheBox) {

@@ -216,6 +216,11 @@ Result<RobotModel> RobotModel::loadDescription(const std::filesystem::path& yaml
     got << o.payload;
     r.fail("payload", "must be a finite mass >= 0 (kg), got " + got.str());
   }
+  if (r.optional("push_limit", o.push_limit) && !(std::isfinite(o.push_limit) && o.push_limit >= 0)) {
+    std::ostringstream got;
+    got << o.push_limit;
+    r.fail("push_limit", "must be a finite mass >= 0 (kg), got " + got.str());
+  }
   {
     auto g = r.child("gripper", false);
     if (r.has("gripper")) {

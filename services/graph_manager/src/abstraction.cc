@@ -149,6 +149,12 @@ void Abstraction::addReach(const std::string& location, const std::string& armco
     reaches_.insert("(reaches " + location + " " + armconf + ")");
 }
 
+void Abstraction::addPush(const std::string& object, const std::string& support, const std::string& from,
+                          const std::string& to, const std::string& slot) {
+  if (locations_.count(from) && locations_.count(to) && regions_.count(support) && slots_.count(slot))
+    pushes_.insert("(push-to " + object + " " + support + " " + from + " " + to + " " + slot + ")");
+}
+
 bool Abstraction::isRegion(const std::string& id) const { return regions_.count(id) > 0; }
 
 namespace {
@@ -218,6 +224,7 @@ std::vector<std::string> Abstraction::objects() const {
 
 std::vector<std::string> Abstraction::staticAtoms() const {
   std::set<std::string> s(reaches_.begin(), reaches_.end());
+  s.insert(pushes_.begin(), pushes_.end());
   for (const auto& [id, r] : regions_) s.insert("(conf-over " + armconfOver(id) + " " + id + ")");
   for (const auto& o : world_.objects()) {
     if (graspable(o)) s.insert("(graspable " + o.id + ")");

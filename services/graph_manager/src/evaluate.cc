@@ -74,8 +74,9 @@ MotionAnswer GraphManager::armMotion(const BranchContext& ctx, const std::vector
 
 double GraphManager::lowerBound(const Edge& e) const {
   if (e.kind != ActionKind::kMoveBase || e.tokens.size() < 3) return 0.0;
-  const auto a = abstraction_.locationPose(e.tokens[1]);
-  const auto b = abstraction_.locationPose(e.tokens[2]);
+  const bool push = isPush(e) && e.tokens.size() == 6;  // (push ?o ?r ?from ?to ?s)
+  const auto a = abstraction_.locationPose(e.tokens[push ? 3 : 1]);
+  const auto b = abstraction_.locationPose(e.tokens[push ? 4 : 2]);
   if (!a || !b) return 0.0;
   return std::hypot(a->x - b->x, a->y - b->y) / params_.lower_bound_base_speed;
 }
@@ -606,7 +607,7 @@ double GraphManager::evaluate(EdgeId id, EdgeId next, const BranchContext& ctx, 
   switch (e.kind) {
     case ActionKind::kMoveBase:
       if (e.state != EdgeState::kUnevaluated) return e.effort_mean_s;
-      return evaluateBase(e, ctx, depth);
+      return isPush(e) ? evaluatePush(e, ctx) : evaluateBase(e, ctx, depth);
     case ActionKind::kMoveArm: {
       if (auto it = e.effort_by_next.find(next); it != e.effort_by_next.end()) return it->second.first;
       return evaluateArm(e, next, ctx);
@@ -643,6 +644,15 @@ BranchContext GraphManager::advance(EdgeId id, EdgeId next, const BranchContext&
   BranchContext c = ctx;
   switch (e.kind) {
     case ActionKind::kMoveBase:
+      if (isPush(e)) {
+        // (push ?o ?r ?from ?to ?s): the base ends at ?to, the object on slot ?s.
+        if (auto to = abstraction_.locationPose(e.tokens.size() == 6 ? e.tokens[4] : "")) c.state.base = *to;
+        if (e.motion && e.motion->object_target)
+          c.object_poses[e.motion->object_id] = *e.motion->object_target;
+        else if (const Slot* s = abstraction_.slot(e.tokens.size() == 6 ? e.tokens[5] : ""))
+          c.object_poses[s->object_id] = s->pose;
+        break;
+      }
       if (auto to = abstraction_.locationPose(e.tokens.size() > 2 ? e.tokens[2] : "")) c.state.base = *to;
       break;
     case ActionKind::kMoveArm: {

@@ -485,7 +485,7 @@ void GraphManager::Run::succeeded(EdgeId id, EdgeId next, const EdgeCommand& cmd
   Edge& e = gm.graph_.edge(id);
   e.state = EdgeState::kExecuted;
   done_effort += cmd.expected_s;
-  if (e.kind == ActionKind::kPlace && cmd.object_target) {
+  if ((e.kind == ActionKind::kPlace || isPush(e)) && cmd.object_target) {
     report.objects_moved.push_back(cmd.object_id);
     if (const world::Object* o = gm.abstraction_.world().findObject(cmd.object_id))
       report.moved_from.emplace_back(o->id, o->pose);
@@ -728,7 +728,7 @@ void GraphManager::Run::resumeFrom(const ResumePoint& resume) {
     report.actions.push_back(a);
     report.executed_effort_s += a.measured_s;
     const auto tokens = atomTokens(a.action);
-    if (a.outcome == "succeeded" && tokens.size() > 1 && tokens[0] == "place") report.objects_moved.push_back(tokens[1]);
+    if (a.outcome == "succeeded" && tokens.size() > 1 && (tokens[0] == "place" || tokens[0] == "push")) report.objects_moved.push_back(tokens[1]);
   };
   for (const auto& a : resume.actions) take(a);
   if (!resume.in_flight.empty()) take(awaitInFlight(resume));

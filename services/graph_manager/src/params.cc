@@ -42,6 +42,10 @@ const config::Schema<GraphManagerParams>& schema() {
         .field("max_blocking_objects", &P::max_blocking_objects, atLeast(1))
         .field("oracle_max_objects", &P::oracle_max_objects, config::that<int>([](const int& v) { return v >= 1 && v <= 4; }, "must be in [1, 4]"))
         .field("placements_per_object", &P::placements_per_object, atLeast(1))
+        .field("push_step_m", &P::push_step_m, positive())
+        .field("push_max_m", &P::push_max_m, positive())
+        .field("push_gap_m", &P::push_gap_m, config::nonNegative("m"))
+        .field("pushes_per_object", &P::pushes_per_object, atLeast(0))
         .field("keep_clear_margin_m", &P::keep_clear_margin_m, config::nonNegative("m"))
         .field("lower_bound_base_speed", &P::lower_bound_base_speed, positive())
         .field("approach_m", &P::approach_m, positive())
@@ -68,6 +72,8 @@ const config::Schema<GraphManagerParams>& schema() {
 
 std::optional<std::string> GraphManagerParams::invalidReason() const {
   const std::vector<Error> errors = schema().errors(*this);
+  if (errors.empty() && push_max_m < push_step_m)
+    return "push_max_m must be at least push_step_m (" + std::to_string(push_step_m) + "), got " + std::to_string(push_max_m);
   if (errors.empty()) return std::nullopt;
   return joinErrors(errors);
 }
@@ -80,6 +86,7 @@ Result<GraphManagerParams> parseParams(const std::string& yaml_text, const std::
   schema().read(r, p);
   r.refuseUnknownKeys();
   if (!r.ok()) return r.status().error();
+  if (auto why = p.invalidReason()) return Error(ErrorCode::kInvalidArgument, name + ": " + *why);
   return p;
 }
 

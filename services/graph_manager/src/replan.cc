@@ -150,6 +150,7 @@ void GraphManager::reprice() {
     if (e.state == EdgeState::kExecuted || e.state == EdgeState::kExecuting) continue;
     EffortQuery q;
     q.object_mass = heldMassAt(e.from);
+    if (isPush(e) && e.motion) q.object_mass = e.motion->object_mass;
     if (e.kind == ActionKind::kMoveBase && e.state == EdgeState::kFeasible && e.motion) {
       q.kind = ActionKind::kMoveBase;
       q.path = e.motion->lazy_path;

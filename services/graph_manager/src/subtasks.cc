@@ -42,54 +42,26 @@ void GraphManager::spawnSubtasks(EdgeId id, const BranchContext& ctx, int depth)
   for (const auto& crossing : motion.crossings) {
     if (objects >= blockingObjectsConsidered()) break;
     const world::Object* o = abstraction_.world().findObject(crossing.object_id);
-    if (!o) continue;
-    // findPossibleActions: only pick and place move objects.
-    if (std::string why = abstraction_.whyNotGraspable(*o); !why.empty()) {
-      unmovable.push_back(why);
+    if (!o || o->kind != world::ObjectKind::kMovable) continue;
+    if (ctx.object_poses.count(o->id)) {
+      // This branch moved it already: moving it again would chain removals of one object along
+      // the way (a push ahead of the base, then another); the branch goes round it instead.
+      unmovable.push_back("'" + o->id + "' was moved by this branch already");
       continue;
     }
     ++objects;
-    // A base pose beside the object from which the arm reaches it, on the side the robot comes
-    // from: back from where the lazy path first touches the object.
-    const Pose2D entry = crossing.swept_base.empty() ? ctx.state.base : crossing.swept_base.front();
-    const std::optional<GraspOption> chosen = standBeside(*o, entry, ctx.state.base);
-    if (!chosen) {
-      log::get("graph_manager")->info("no grasp of {} from any base pose: only the detour remains", o->id);
-      unmovable.push_back("no grasp of '" + o->id + "' from any base pose");
-      continue;
-    }
-    const std::string near = abstraction_.locationFor(chosen->base_pose, "near_" + o->id);
-    abstraction_.addReach(near, Abstraction::armconfOver(o->region.empty() ? std::string() : o->region));
-    log::get("graph_manager")->info("sub-task for {}: contact at ({:.2f}, {:.2f}); stand at {} ({:.2f}, {:.2f})", o->id,
-                                    entry.x, entry.y, near, chosen->base_pose.x, chosen->base_pose.y);
-    // findEffectStates: placements off the swept path, in the object's region first.
-    std::vector<std::string> regions;
-    if (!o->region.empty()) regions.push_back(o->region);
-    for (const auto& r : abstraction_.world().regions())
-      if (r.id != o->region) regions.push_back(r.id);
-    std::vector<std::string> slots;
-    for (const auto& r : regions) {
-      if (static_cast<int>(slots.size()) >= params_.placements_per_object) break;
-      PlacementQuery pq;
-      pq.object_id = o->id;
-      pq.region_id = r;
-      pq.keep_clear_path = swept;
-      pq.keep_clear_radius = radius;
-      pq.max_placements = static_cast<unsigned>(params_.placements_per_object);
-      ++counters_.placement_calls;
-      auto ps = services_.placements(pq);
-      if (!ps) continue;
-      for (const auto& p : *ps) {
-        if (static_cast<int>(slots.size()) >= params_.placements_per_object) break;
-        const std::string s = abstraction_.addSlot(o->id, r, p.object_pose);
-        log::get("graph_manager")->info("findEffectStates({}): {} at ({:.2f}, {:.2f}) on {}, base ({:.2f}, {:.2f})", o->id, s,
-                                        p.object_pose.translation().x(), p.object_pose.translation().y(), r,
-                                        p.base_pose.x, p.base_pose.y);
-        abstraction_.locationFor(p.base_pose, "place_" + o->id);
-        slots.push_back(s);
+    // findPossibleActions: pick and place when the robot can grasp the object, else a push.
+    std::string why_not;
+    std::vector<std::string> slots = placeSlots(*o, crossing, ctx, swept, radius, why_not);
+    if (slots.empty()) {
+      const std::string no_push = whyNotPushable(*o);
+      std::string why_push = no_push;
+      if (no_push.empty()) slots = spawnPushes(*o, supportAt(v, o->id), ctx, swept, radius, why_push);
+      if (slots.empty()) {
+        unmovable.push_back(why_not + (why_push.empty() ? "" : "; " + why_push));
+        continue;
       }
     }
-    (void)near;
     // What the blocked action achieved: the sub-task's second plan must achieve it too.
     const auto& va = graph_.node(v).atoms;
     const auto& ca = graph_.node(child).atoms;
@@ -99,8 +71,7 @@ void GraphManager::spawnSubtasks(EdgeId id, const BranchContext& ctx, int depth)
     for (const auto& s : slots) {
       addSubtask(v, {"(on " + o->id + " " + s + ")"}, progress, "sub-task: move " + o->id + " to " + s);
     }
-    if (slots.empty()) unmovable.push_back("no placement for '" + o->id + "' off the path");
-    else first_slots.emplace_back(o->id, slots.front());
+    first_slots.emplace_back(o->id, slots.front());
   }
   if (params_.policy == Policy::kOracle) spawnSubsetSubtasks(v, child, first_slots);
   // The edge may have moved: the graph grew.
@@ -108,6 +79,63 @@ void GraphManager::spawnSubtasks(EdgeId id, const BranchContext& ctx, int depth)
   for (const auto& why : unmovable) e.reason += "; " + why;
   (void)ctx;
   (void)depth;
+}
+
+std::string GraphManager::supportAt(NodeId v, const std::string& object) const {
+  for (const auto& a : graph_.node(v).atoms) {
+    const auto t = atomTokens(a);
+    if (t.size() == 3 && t[0] == "on" && t[1] == object) return t[2];
+  }
+  const world::Object* o = abstraction_.world().findObject(object);
+  return o ? o->region : std::string();
+}
+
+std::vector<std::string> GraphManager::placeSlots(const world::Object& o, const Crossing& crossing,
+                                                  const BranchContext& ctx, const std::vector<Pose2D>& swept,
+                                                  double radius, std::string& why) {
+  if (why = abstraction_.whyNotGraspable(o); !why.empty()) return {};
+  // A base pose beside the object from which the arm reaches it, on the side the robot comes
+  // from: back from where the lazy path first touches the object.
+  const Pose2D entry = crossing.swept_base.empty() ? ctx.state.base : crossing.swept_base.front();
+  const std::optional<GraspOption> chosen = standBeside(o, entry, ctx.state.base);
+  if (!chosen) {
+    log::get("graph_manager")->info("no grasp of {} from any base pose", o.id);
+    why = "no grasp of '" + o.id + "' from any base pose";
+    return {};
+  }
+  const std::string near = abstraction_.locationFor(chosen->base_pose, "near_" + o.id);
+  abstraction_.addReach(near, Abstraction::armconfOver(o.region.empty() ? std::string() : o.region));
+  log::get("graph_manager")->info("sub-task for {}: contact at ({:.2f}, {:.2f}); stand at {} ({:.2f}, {:.2f})", o.id,
+                                  entry.x, entry.y, near, chosen->base_pose.x, chosen->base_pose.y);
+  // findEffectStates: placements off the swept path, in the object's region first.
+  std::vector<std::string> regions;
+  if (!o.region.empty()) regions.push_back(o.region);
+  for (const auto& r : abstraction_.world().regions())
+    if (r.id != o.region) regions.push_back(r.id);
+  std::vector<std::string> slots;
+  for (const auto& r : regions) {
+    if (static_cast<int>(slots.size()) >= params_.placements_per_object) break;
+    PlacementQuery pq;
+    pq.object_id = o.id;
+    pq.region_id = r;
+    pq.keep_clear_path = swept;
+    pq.keep_clear_radius = radius;
+    pq.max_placements = static_cast<unsigned>(params_.placements_per_object);
+    ++counters_.placement_calls;
+    auto ps = services_.placements(pq);
+    if (!ps) continue;
+    for (const auto& p : *ps) {
+      if (static_cast<int>(slots.size()) >= params_.placements_per_object) break;
+      const std::string s = abstraction_.addSlot(o.id, r, p.object_pose);
+      log::get("graph_manager")->info("findEffectStates({}): {} at ({:.2f}, {:.2f}) on {}, base ({:.2f}, {:.2f})", o.id, s,
+                                      p.object_pose.translation().x(), p.object_pose.translation().y(), r,
+                                      p.base_pose.x, p.base_pose.y);
+      abstraction_.locationFor(p.base_pose, "place_" + o.id);
+      slots.push_back(s);
+    }
+  }
+  if (slots.empty()) why = "no placement for '" + o.id + "' off the path";
+  return slots;
 }
 
 void GraphManager::addSubtask(NodeId v, const std::vector<std::string>& moved, const std::vector<std::string>& progress,

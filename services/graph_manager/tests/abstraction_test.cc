@@ -113,6 +113,25 @@ TEST(AbstractionTest, HeavyObjectsAreNotGraspable) {
   EXPECT_TRUE(has(b.staticAtoms(), "(graspable box)"));
 }
 
+TEST(AbstractionTest, APushIsAStaticFactBetweenKnownSymbolsOnly) {
+  auto f = load("namo_corridor");
+  Abstraction a(f.sc.plannerWorld(), f.robot);
+  Eigen::Isometry3d pose = f.sc.world.object("box").pose;
+  pose.translation() += Eigen::Vector3d(0.0, 0.5, 0.0);
+  const std::string s = a.addSlot("box", "box_floor", pose);
+  const std::string from = a.locationFor(Pose2D{4.62, 0.5, M_PI / 2}, "push_box");
+  const std::string to = a.locationFor(Pose2D{4.62, 1.0, M_PI / 2}, "pushed_box");
+  a.addPush("box", "box_floor", from, to, s);
+  EXPECT_TRUE(has(a.staticAtoms(), "(push-to box box_floor " + from + " " + to + " " + s + ")"));
+  // A symbol that does not exist makes no fact.
+  a.addPush("box", "box_floor", from, "nowhere", s);
+  a.addPush("box", "no_region", from, to, s);
+  a.addPush("box", "box_floor", from, to, "no_slot");
+  int pushes = 0;
+  for (const auto& x : a.staticAtoms()) pushes += x.rfind("(push-to ", 0) == 0;
+  EXPECT_EQ(pushes, 1);
+}
+
 TEST(AbstractionTest, AtomTokensNormalise) {
   EXPECT_EQ(atomTokens("( On  Box\tfree_patch )"), (std::vector<std::string>{"on", "box", "free_patch"}));
 }

@@ -33,5 +33,18 @@ TEST(ParamsTest, ValidateMatchesTheLoader) {
   EXPECT_NE(p.invalidReason()->find("lower_bound_base_speed"), std::string::npos);
 }
 
+TEST(ParamsTest, APushLongerThanItsStepIsRequired) {
+  GraphManagerParams p;
+  p.push_step_m = 0.5;
+  p.push_max_m = 0.25;
+  ASSERT_TRUE(p.invalidReason());
+  EXPECT_NE(p.invalidReason()->find("push_max_m"), std::string::npos);
+  auto q = parseParams("push_step_m: 0.5\npush_max_m: 0.25\n", "gm.yaml");
+  ASSERT_FALSE(q.ok());
+  EXPECT_NE(q.error().toString().find("push_max_m"), std::string::npos) << q.error().toString();
+  EXPECT_FALSE(parseParams("push_gap_m: -0.1\n", "gm.yaml").ok());
+  EXPECT_TRUE(parseParams("pushes_per_object: 0\n", "gm.yaml").ok()) << "0: never push";
+}
+
 }  // namespace
 }  // namespace tamp::graph_manager

@@ -50,6 +50,10 @@ const config::Schema<SimParams>& schema() {
                config::that<double>(
                    [](double v) { return std::isfinite(v) && v > 0 && v < std::numbers::pi / 2; },
                    "must be in (0, pi/2)"));
+    s.section("push", &P::push)
+        .field("max_contact_gap_m", &PushParams::max_contact_gap_m, positive())
+        .field("lateral_slip", &PushParams::lateral_slip, nonNegative())
+        .field("yaw_slip_rad_per_m", &PushParams::yaw_slip_rad_per_m, nonNegative());
     return s;
   }();
   return kSchema;

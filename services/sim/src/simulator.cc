@@ -169,6 +169,12 @@ struct Active {
   std::vector<ScheduledFault> faults;
   std::optional<Fault> fail_fault;  // injected "fail next action"
   double fail_at{kInf};
+  // A push: the object riding ahead of the base, how far the base drove before touching it, the
+  // direction and the base's start.
+  std::string pushed;
+  double push_gap{0.0};
+  Eigen::Vector2d push_dir{1.0, 0.0};
+  Eigen::Vector2d push_from{0.0, 0.0};
 };
 
 }  // namespace
@@ -547,6 +553,82 @@ struct Simulator::Impl {
     }
   }
 
+  /// A push starts: the base must touch `a.cmd.object_id` first, within the contact gap,
+  /// driving straight towards the trajectory's end; the object then rides ahead of the base.
+  Status startPush(Active& a) {
+    const auto& pts = a.cmd.trajectory.points;
+    Eigen::Vector2d d(pts.back().positions[0] - pts.front().positions[0],
+                      pts.back().positions[1] - pts.front().positions[1]);
+    if (d.norm() < 1e-6) {
+      return Error(ErrorCode::kInvalidArgument, "a push must drive the base", SourceLocation{"", 0, 0, "trajectory"});
+    }
+    d.normalize();
+    double gap = -1.0;
+    for (double s = 0.0; s <= params.push.max_contact_gap_m + 1e-9; s += 0.005) {
+      Vec q = idle;
+      q[0] += s * d.x();
+      q[1] += s * d.y();
+      const std::string hit = contactAt(q, nullptr);
+      if (hit.empty()) continue;
+      if (hit != a.cmd.object_id) {
+        return Error(ErrorCode::kInvalidArgument, "push of '" + a.cmd.object_id + "': the base touches '" + hit + "' first",
+                     SourceLocation{"", 0, 0, "object_id"});
+      }
+      gap = s;
+      break;
+    }
+    if (gap < 0.0) {
+      return Error(ErrorCode::kInvalidArgument,
+                   "push of '" + a.cmd.object_id + "': it is not within " + formatNumber(params.push.max_contact_gap_m) +
+                       " m ahead of the base",
+                   SourceLocation{"", 0, 0, "object_id"});
+    }
+    const auto& geo = robot.collisionGeometry();
+    const auto it = std::find(geo.links.begin(), geo.links.end(), robot.options().base_link);
+    if (it == geo.links.end()) return Error(ErrorCode::kInternal, "the robot's base link has no collision geometry");
+    const int link = static_cast<int>(it - geo.links.begin());
+    robot.linkPoses(toState(idle), link_poses);
+    stopRiding(a.cmd.object_id);
+    const Eigen::Isometry3d link_T_object = link_poses[link].inverse() * world.object(a.cmd.object_id).pose;
+    if (!scene.attach(a.cmd.object_id, geo.links[link], link_T_object)) {
+      return Error(ErrorCode::kInternal, "push of '" + a.cmd.object_id + "': cannot attach it to the base");
+    }
+    riding.push_back({a.cmd.object_id, link, link_T_object});
+    a.pushed = a.cmd.object_id;
+    a.push_gap = gap;
+    a.push_dir = d;
+    a.push_from = Eigen::Vector2d(idle[0], idle[1]);
+    return Status::Ok();
+  }
+
+  /// A push ends (however it ended): the object stays where the base left it, less the gap the
+  /// base drove before touching it, slipped sideways and turned by the push's own error.
+  void releasePushed(Active& a, const Vec& q) {
+    syncHeldPose(q);
+    stopRiding(a.pushed);
+    world::Object o = world.object(a.pushed);
+    const double driven = (Eigen::Vector2d(q[0], q[1]) - a.push_from).dot(a.push_dir);
+    const double moved = std::max(0.0, driven - a.push_gap);
+    Eigen::Isometry3d pose = o.pose;
+    pose.translation().head<2>() -= std::min(a.push_gap, std::max(0.0, driven)) * a.push_dir;
+    Eigen::Isometry3d slipped = pose;
+    if (moved > 0.0) {
+      std::normal_distribution<double> unit(0.0, 1.0);
+      const Eigen::Vector2d side(-a.push_dir.y(), a.push_dir.x());
+      slipped.translation().head<2>() += params.push.lateral_slip * moved * unit(rng) * side;
+      slipped.linear() = Eigen::AngleAxisd(params.push.yaw_slip_rad_per_m * moved * unit(rng), Eigen::Vector3d::UnitZ())
+                             .toRotationMatrix() *
+                         slipped.linear();
+    }
+    // The slip never pushes the object into something: it stays unslipped then.
+    syncScene();
+    if (!scene.shapeCollisions(o.shape, slipped, collision::Filter::allBut({o.id})).empty()) slipped = pose;
+    o.pose = slipped;
+    (void)world.updateObject(o);
+    syncScene();
+    a.pushed.clear();
+  }
+
   /// Drops the held object where it is (a fault). Returns its id ("" when the gripper is empty).
   std::string dropHeld(const Vec& q) {
     if (!world.held()) return "";
@@ -769,6 +851,10 @@ struct Simulator::Impl {
                          (a.blocking_part.empty() ? std::string() : " (of " + a.blocking_part + ")")
                    : a.reason;
     idle = stateAt(a, a.end);
+    if (!a.pushed.empty()) {
+      releasePushed(a, idle);
+      ev.world_changed = true;
+    }
     // Velocities are zero at rest: the state is exactly the stop state.
     effort_model::ExecutionRecord rec;
     rec.action.kind = a.cmd.kind;
@@ -894,6 +980,15 @@ Result<std::vector<int>> Simulator::Impl::validate(const ActionCommand& c) const
     if (c.object_pose && !c.object_pose->matrix().allFinite()) {
       return invalid("object_pose", "is not finite");
     }
+  } else if (c.kind == ActionKind::kMoveBase && !c.object_id.empty()) {
+    // A push.
+    const world::Object* o = world.findObject(c.object_id);
+    if (o == nullptr || o->kind != world::ObjectKind::kMovable) {
+      return invalid("object_id", "move_base pushes a movable object, got '" + c.object_id + "'");
+    }
+    if (world.held() && world.held()->object_id == c.object_id) {
+      return invalid("object_id", "move_base cannot push the held object '" + c.object_id + "'");
+    }
   } else if (!c.object_id.empty()) {
     return invalid("object_id", kind + " takes no object (got '" + c.object_id + "')");
   }
@@ -941,8 +1036,9 @@ Result<Active> Simulator::Impl::plan(const ActionCommand& c, const std::vector<i
   if (c.kind == ActionKind::kMoveBase) {
     // Stop-and-turn along the steps the motion planner and the execution monitor check
     // (effort_model::baseSteps: the geometry); each turn and drive timed by the robot's own
-    // S-curve.
-    a.mass = heldMass();
+    // S-curve. A push is slowed by the pushed object's mass as a load is.
+    const world::Object* pushed = c.object_id.empty() ? nullptr : world.findObject(c.object_id);
+    a.mass = pushed ? pushed->mass : heldMass();
     const double f = loadFactor(dyn, a.mass);
     pause(dyn.base.latency_s);
     std::vector<Pose2D> poses;
@@ -1158,6 +1254,9 @@ Status Simulator::submit(const ActionCommand& command) {
   auto planned = m.plan(command, *cols);
   if (!planned) return planned.error();
   Active& a = *planned;
+  if (command.kind == ActionKind::kMoveBase && !command.object_id.empty()) {
+    if (Status s = m.startPush(a); !s) return s;
+  }
   m.logged[command.command_id] = m.log.size();
   m.log.push_back(ActionLogEntry{command.command_id, command.kind, a.step, m.now, std::nullopt});
   a.step = m.actions++;

@@ -78,6 +78,9 @@ struct RobotModelOptions {
   /// kg, >= 0: the heaviest object the robot may grasp and carry (the description's required
   /// `payload`). 0 for a model loaded from a URDF alone: it grasps nothing.
   double payload{0.0};
+  /// kg, >= 0: the heaviest object the base may push along the floor (the description's optional
+  /// `push_limit`; its drive force against the object's friction). 0: it pushes nothing.
+  double push_limit{0.0};
   /// Named arm configurations (arm joints in chain order), e.g. "stow" (the PDDL constant).
   std::vector<std::pair<std::string, std::vector<double>>> named_configurations;
 };
@@ -159,6 +162,8 @@ class RobotModel {
   /// kg: the heaviest object the robot may grasp (`options().payload`). Objects above it are
   /// never graspable (world::Object::graspable; the scenario and NAMO loaders enforce it).
   double payload() const { return options().payload; }
+  /// kg: the heaviest object the base may push (`options().push_limit`; 0: none).
+  double pushLimit() const { return options().push_limit; }
   /// m: the widest object the open gripper closes around: twice the gripper joint's upper limit
   /// (two symmetric fingers, one following the other as a mimic joint, that meet at 0); 0
   /// without a gripper.

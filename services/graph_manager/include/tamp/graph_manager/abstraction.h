@@ -90,6 +90,10 @@ class Abstraction {
   std::vector<std::string> refinedSupports(const std::vector<std::string>& atoms) const;
   /// Records that from `location` the arm reaches `armconf` (proved by a grasp or IK elsewhere).
   void addReach(const std::string& location, const std::string& armconf);
+  /// Records that from `from` the base pushes `object` (on `support`) straight to `slot`, ending
+  /// at `to` (a static `push-to` fact, proven collision-free by the motion planner).
+  void addPush(const std::string& object, const std::string& support, const std::string& from,
+               const std::string& to, const std::string& slot);
   /// True when the region or slot `id` exists.
   bool isRegion(const std::string& id) const;
   /// A PDDL item that stands for an object not known yet (the conditional branch "the gripper
@@ -108,7 +112,7 @@ class Abstraction {
 
   /// PDDL objects ("name - type"), every symbol known so far.
   std::vector<std::string> objects() const;
-  /// Static facts (reaches, conf-over, graspable), sorted.
+  /// Static facts (reaches, conf-over, graspable, push-to), sorted.
   std::vector<std::string> staticAtoms() const;
   /// Dynamic facts of a live state: the robot at `base` (a location symbol, made if needed), the
   /// arm at `armconf`, holding `held` (or hand-empty), objects of `world` on regions or slots.
@@ -133,6 +137,7 @@ class Abstraction {
   std::map<std::string, world::Region> regions_;  ///< world regions and slot regions
   std::map<std::string, Slot> slots_;
   std::set<std::string> reaches_;                 ///< "(reaches l c)"
+  std::set<std::string> pushes_;                  ///< "(push-to o r from to s)"
   std::set<std::string> placeholders_;
   std::set<std::string> observed_armconfs_;
   int slot_counter_{0};

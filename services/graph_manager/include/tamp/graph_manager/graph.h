@@ -72,6 +72,7 @@ struct EdgeMotion {
 
 struct Edge {
   EdgeId id{-1};
+
   NodeId from{-1};
   NodeId to{-1};
   std::string action;              ///< "(move_base start goal)"
@@ -93,6 +94,9 @@ struct Edge {
   bool subtasks_spawned{false};
   int failures{0};  ///< failed or blocked executions of this move edge in this mission (manipulations: per object)
 };
+
+/// Whether `e` is a push: a base motion that moves an object ahead of the base.
+bool isPush(const Edge& e);
 
 class ReachabilityGraph {
  public:

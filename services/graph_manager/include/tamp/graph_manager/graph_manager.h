@@ -374,6 +374,13 @@ class GraphManager {
   bool armStowed(const std::vector<double>& arm) const;
   double lowerBound(const Edge& e) const;
   void spawnSubtasks(EdgeId e, const BranchContext& ctx, int depth);
+  /// The support (region or slot) of `object` in node `v`'s state (its world region if none).
+  std::string supportAt(NodeId v, const std::string& object) const;
+  /// findPossibleActions by pick and place: a base pose beside `o` from which the arm grasps it,
+  /// and findEffectStates, placements that clear `swept` by `radius`; their slots (empty, and
+  /// `why`, when the robot cannot grasp `o` or nothing fits).
+  std::vector<std::string> placeSlots(const world::Object& o, const Crossing& crossing, const BranchContext& ctx,
+                                      const std::vector<Pose2D>& swept, double radius, std::string& why);
   /// One sub-task from `v`: TP(v, `moved`), then TP(that, `progress`) (what the blocked action
   /// achieved; skipped when empty), then TP(that, goal), each merged into the graph.
   void addSubtask(NodeId v, const std::vector<std::string>& moved, const std::vector<std::string>& progress,
@@ -392,6 +399,23 @@ class GraphManager {
   double oraclePenalty(const std::vector<BranchStep>& steps) const;
   std::optional<OracleKnowledge> oracle_;
   double evaluateBase(Edge& e, const BranchContext& ctx, int depth);
+  // ---- pushes (push.cc) ----
+  /// Whether the domain has the `push` action and its `push-to` facts.
+  bool domainPushes() const;
+  /// Why `o` cannot be pushed ("" when it can): the domain, the robot's push limit, the floor.
+  std::string whyNotPushable(const world::Object& o) const;
+  /// The full-mode base motion of a push: from `from` to `to`, `object` (at `object_pose`)
+  /// carried ahead of the base, in the branch's world.
+  MotionQuery pushQuery(const std::string& object, const Eigen::Isometry3d& object_pose, const Pose2D& from,
+                        const Pose2D& to, const BranchContext& ctx) const;
+  /// Whether the answer is a straight drive from `from` to `to` (what a push can execute).
+  static bool straightPush(const MotionAnswer& a, const Pose2D& from, const Pose2D& to);
+  /// findPossibleActions for an object the robot cannot grasp: pushes of `o` (on `support`)
+  /// that clear `swept` by `keep_clear`, each checked collision-free; their slots (empty, and
+  /// `why`, when none).
+  std::vector<std::string> spawnPushes(const world::Object& o, const std::string& support, const BranchContext& ctx,
+                                       const std::vector<Pose2D>& swept, double keep_clear, std::string& why);
+  double evaluatePush(Edge& e, const BranchContext& ctx);
   MotionAnswer planBase(const MotionQuery& q);
   MotionAnswer lazyOrFull(const MotionQuery& q);
   double evaluateArm(Edge& e, EdgeId next, const BranchContext& ctx);

@@ -38,6 +38,14 @@ struct GraphManagerParams {
   /// objects, so keep it small; >= 1, <= 4.
   int oracle_max_objects{3};
   int placements_per_object{2};    ///< findEffectStates: sampled placements kept per object; >= 1
+  /// Pushes (an object too heavy or too wide to grasp, within the robot's push limit, when the
+  /// domain has a `push` action): straight pushes along the object's footprint axes, by the
+  /// shortest multiple of `push_step_m` up to `push_max_m` that clears the blocked path, from a
+  /// base pose `push_gap_m` short of contact; at most `pushes_per_object` kept per object.
+  double push_step_m{0.25};        ///< > 0
+  double push_max_m{3.0};          ///< >= push_step_m
+  double push_gap_m{0.03};         ///< >= 0
+  int pushes_per_object{2};        ///< >= 0 (0: never push)
   double keep_clear_margin_m{0.10};  ///< placements keep this much more than the robot's radius off the path
   double lower_bound_base_speed{1.5};  ///< m/s, above the robot's top speed (admissible bound); > 0
   double approach_m{0.10};         ///< pick/place: gripper approach and retreat along z (m); > 0

@@ -62,6 +62,16 @@ struct PlaceParams {
   double max_tilt_rad{0.1};           ///< the object's z axis vs vertical; more = topples
 };
 
+/// A push: a move_base command naming an object. The base must touch it within
+/// `max_contact_gap_m` straight ahead; the object then rides ahead of the base, and where it is
+/// released it slips: sideways by a normal error of `lateral_slip` x the distance pushed (m/m)
+/// and turns by one of `yaw_slip_rad_per_m` x that distance (the planner does not know either).
+struct PushParams {
+  double max_contact_gap_m{0.10};
+  double lateral_slip{0.02};
+  double yaw_slip_rad_per_m{0.02};
+};
+
 struct SimParams {
   std::string scenario;            ///< scenario file (node only); resolved against the YAML file
   double realtime_factor{1.0};     ///< >= 0; 0 = as fast as possible
@@ -73,6 +83,7 @@ struct SimParams {
   StartTolerance start_tolerance;
   GraspParams grasp;
   PlaceParams place;
+  PushParams push;
   DynamicsParams dynamics;         ///< the true robot's execution dynamics (dynamics.h)
   DepthSensorParams sensor;
 

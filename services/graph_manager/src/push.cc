@@ -1,0 +1,220 @@
+// Pushes: an object too heavy or too wide to grasp, within the robot's push limit, is moved off a
+// blocked path by the base driving straight into it (the domain's `push` action). Candidates
+// along the object's footprint axes, by the shortest distance that clears the path, each checked
+// collision-free by the motion planner with the object carried ahead of the base.
+#include <algorithm>
+#include <cmath>
+
+#include "tamp/core/log.h"
+#include "tamp/graph_manager/graph_manager.h"
+#include "tamp/world/polygon.h"
+
+namespace tamp::graph_manager {
+namespace {
+
+/// The object's footprint in the world plane.
+world::Polygon2 worldFootprint(const world::Object& o, const Eigen::Isometry3d& pose) {
+  world::Polygon2 out;
+  const Eigen::Matrix2d R = pose.linear().topLeftCorner<2, 2>();
+  const Eigen::Vector2d t = pose.translation().head<2>();
+  for (const auto& v : o.shape.footprint()) out.push_back(R * v + t);
+  return out;
+}
+
+double distanceToPolygon(const world::Polygon2& poly, const Eigen::Vector2d& p) {
+  if (world::containsPoint(poly, p)) return 0.0;
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < poly.size(); ++i) {
+    const Eigen::Vector2d a = poly[i], b = poly[(i + 1) % poly.size()];
+    const Eigen::Vector2d ab = b - a;
+    const double len2 = ab.squaredNorm();
+    const double t = len2 > 0.0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+    best = std::min(best, (a + t * ab - p).norm());
+  }
+  return best;
+}
+
+/// Push directions: along the footprint's longest edge and across it, both ways.
+std::vector<Eigen::Vector2d> pushDirections(const world::Polygon2& footprint) {
+  Eigen::Vector2d u(1.0, 0.0);
+  double longest = 0.0;
+  for (std::size_t i = 0; i < footprint.size(); ++i) {
+    const Eigen::Vector2d e = footprint[(i + 1) % footprint.size()] - footprint[i];
+    if (e.norm() > longest) longest = e.norm(), u = e / e.norm();
+  }
+  const Eigen::Vector2d v(-u.y(), u.x());
+  return {u, -u, v, -v};
+}
+
+/// How far the footprint reaches along `n` from `c` (the largest projection of a vertex).
+double reach(const world::Polygon2& poly, const Eigen::Vector2d& c, const Eigen::Vector2d& n) {
+  double r = -std::numeric_limits<double>::infinity();
+  for (const auto& v : poly) r = std::max(r, (v - c).dot(n));
+  return r;
+}
+
+}  // namespace
+
+bool isPush(const Edge& e) { return !e.tokens.empty() && e.tokens[0] == "push"; }
+
+bool GraphManager::domainPushes() const {
+  return domain_.find("push-to") != std::string::npos && domain_.find("(:action push") != std::string::npos;
+}
+
+std::string GraphManager::whyNotPushable(const world::Object& o) const {
+  if (!domainPushes()) return "the domain has no push action";
+  if (params_.pushes_per_object <= 0) return "pushes_per_object is 0";
+  const robot::RobotModel& robot = abstraction_.robot();
+  if (o.kind != world::ObjectKind::kMovable) return "'" + o.id + "' is static";
+  if (o.mass > robot.pushLimit())
+    return "'" + o.id + "' (" + std::to_string(o.mass) + " kg) exceeds the robot's push limit of " +
+           std::to_string(robot.pushLimit()) + " kg";
+  const world::Region* r = abstraction_.world().findRegion(o.region);
+  if (r == nullptr || r->kind != world::RegionKind::kFloor) return "'" + o.id + "' does not stand on the floor";
+  return "";
+}
+
+MotionQuery GraphManager::pushQuery(const std::string& object, const Eigen::Isometry3d& object_pose, const Pose2D& from,
+                                    const Pose2D& to, const BranchContext& ctx) const {
+  MotionQuery q;
+  q.group = Group::kBase;
+  q.mode = Mode::kFull;
+  q.start = ctx.state;
+  q.start.base = from;
+  q.goal_base = to;
+  q.held.object_id = object;
+  q.held.link = abstraction_.robot().options().base_link;
+  q.held.link_T_object = from.toIsometry(0.0).inverse() * object_pose;
+  q.overrides = overridesOf(ctx, object);
+  q.budget_s = params_.motion_budget_s;
+  return q;
+}
+
+bool GraphManager::straightPush(const MotionAnswer& a, const Pose2D& from, const Pose2D& to) {
+  if (!a.ok() || a.path.waypoints.empty()) return false;
+  const Eigen::Vector2d p0(from.x, from.y), p1(to.x, to.y);
+  const Eigen::Vector2d d = p1 - p0;
+  if (a.path_length > d.norm() + 0.05) return false;
+  const int ix = a.path.indexOf("base_x"), iy = a.path.indexOf("base_y");
+  if (ix < 0 || iy < 0) return false;
+  for (const auto& w : a.path.waypoints) {
+    const Eigen::Vector2d p(w[static_cast<std::size_t>(ix)], w[static_cast<std::size_t>(iy)]);
+    const double t = std::clamp((p - p0).dot(d) / std::max(1e-12, d.squaredNorm()), 0.0, 1.0);
+    if ((p0 + t * d - p).norm() > 0.02) return false;
+  }
+  return true;
+}
+
+std::vector<std::string> GraphManager::spawnPushes(const world::Object& o, const std::string& support,
+                                                   const BranchContext& ctx, const std::vector<Pose2D>& swept,
+                                                   double keep_clear, std::string& why) {
+  const Eigen::Isometry3d pose = ctx.object_poses.count(o.id) ? ctx.object_poses.at(o.id) : o.pose;
+  const world::Polygon2 fp = worldFootprint(o, pose);
+  const Eigen::Vector2d c = pose.translation().head<2>();
+  const robot::RobotModel& robot = abstraction_.robot();
+  double front = 0.0;  // how far the base reaches ahead of base_link
+  for (const auto& v : robot.baseFootprint()) front = std::max(front, v.x());
+  struct Candidate {
+    Eigen::Vector2d n;
+    double distance;
+  };
+  std::vector<Candidate> candidates;
+  for (const Eigen::Vector2d& n : pushDirections(fp)) {
+    for (double d = params_.push_step_m; d <= params_.push_max_m + 1e-9; d += params_.push_step_m) {
+      world::Polygon2 moved = fp;
+      for (auto& v : moved) v += d * n;
+      bool clear = true;
+      for (const auto& s : swept) clear = clear && distanceToPolygon(moved, Eigen::Vector2d(s.x, s.y)) > keep_clear;
+      if (clear) {
+        candidates.push_back({n, d});
+        break;
+      }
+    }
+  }
+  std::sort(candidates.begin(), candidates.end(),
+            [](const Candidate& a, const Candidate& b) { return a.distance < b.distance; });
+  std::vector<std::string> slots;
+  int tried = 0;
+  for (const Candidate& k : candidates) {
+    if (static_cast<int>(slots.size()) >= params_.pushes_per_object) break;
+    ++tried;
+    const double heading = std::atan2(k.n.y(), k.n.x());
+    // The base's front `push_gap_m` short of the face it pushes, centred on the object.
+    const double back = -reach(fp, c, -k.n) - front - params_.push_gap_m;
+    const Eigen::Vector2d start = c + back * k.n;
+    const Eigen::Vector2d end = start + (k.distance + params_.push_gap_m) * k.n;
+    const Pose2D from{start.x(), start.y(), heading}, to{end.x(), end.y(), heading};
+    ++counters_.motion_calls;
+    const MotionAnswer a = services_.motion(pushQuery(o.id, pose, from, to, ctx));
+    if (!straightPush(a, from, to)) {
+      log::get("graph_manager")->debug("push of {} by {:.2f} m towards ({:.2f}, {:.2f}): {}", o.id, k.distance, k.n.x(),
+                                       k.n.y(), a.ok() ? "not straight" : a.reason);
+      continue;
+    }
+    Eigen::Isometry3d target = pose;
+    target.translation().head<2>() += k.distance * k.n;
+    const std::string slot = abstraction_.addSlot(o.id, support, target);
+    const std::string l_from = abstraction_.locationFor(from, "push_" + o.id);
+    const std::string l_to = abstraction_.locationFor(to, "pushed_" + o.id);
+    abstraction_.addPush(o.id, support, l_from, l_to, slot);
+    log::get("graph_manager")->info("push of {} by {:.2f} m: from {} ({:.2f}, {:.2f}) to {}; {} at ({:.2f}, {:.2f})", o.id,
+                                    k.distance, l_from, from.x, from.y, l_to, slot, target.translation().x(),
+                                    target.translation().y());
+    slots.push_back(slot);
+  }
+  if (slots.empty())
+    why = candidates.empty() ? "no push of '" + o.id + "' within " + std::to_string(params_.push_max_m) + " m clears the path"
+                             : "no straight push of '" + o.id + "' is collision-free (" + std::to_string(tried) + " tried)";
+  return slots;
+}
+
+double GraphManager::evaluatePush(Edge& e, const BranchContext& ctx) {
+  // (push ?o ?r ?from ?to ?s)
+  const world::Object* o = e.tokens.size() == 6 ? abstraction_.world().findObject(e.tokens[1]) : nullptr;
+  const auto from = abstraction_.locationPose(e.tokens.size() == 6 ? e.tokens[3] : "");
+  const auto to = abstraction_.locationPose(e.tokens.size() == 6 ? e.tokens[4] : "");
+  const Slot* slot = abstraction_.slot(e.tokens.size() == 6 ? e.tokens[5] : "");
+  if (!o || !from || !to || !slot) {
+    e.state = EdgeState::kInfeasible;
+    e.reason = "push without its object, locations or slot";
+    return kInfinity;
+  }
+  const Eigen::Isometry3d pose = ctx.object_poses.count(o->id) ? ctx.object_poses.at(o->id) : o->pose;
+  // From where the robot stands when that is the push's start (the base stops a little off
+  // where it was sent): the push drives on to the same end.
+  Pose2D start = *from;
+  const double off = std::hypot(ctx.state.base.x - from->x, ctx.state.base.y - from->y);
+  if (off <= abstraction_.params().location_tolerance_m &&
+      std::abs(std::remainder(ctx.state.base.theta - from->theta, 2 * M_PI)) <= abstraction_.params().location_tolerance_rad)
+    start = ctx.state.base;
+  ++counters_.motion_calls;
+  const MotionAnswer a = services_.motion(pushQuery(o->id, pose, start, *to, ctx));
+  if (!straightPush(a, start, *to)) {
+    e.state = EdgeState::kInfeasible;
+    e.reason = a.ok() ? "the push is not straight in this branch's world"
+                      : std::string(toString(a.status)) + (a.reason.empty() ? "" : ": " + a.reason);
+    return kInfinity;
+  }
+  EdgeMotion m;
+  m.lazy_path = a.path;
+  m.trajectory = a.trajectory;
+  m.object_id = o->id;
+  m.region_id = slot->id;
+  m.object_mass = o->mass;
+  // Where the object ends: moved along the push as far as the slot says, from where it is.
+  Eigen::Isometry3d target = pose;
+  target.translation().head<2>() += slot->pose.translation().head<2>() - pose.translation().head<2>();
+  m.object_target = target;
+  EffortQuery q;
+  q.kind = ActionKind::kMoveBase;
+  q.path = a.path;
+  q.object_mass = o->mass;
+  const auto [mean, sd] = price(q);
+  e.motion = m;
+  e.state = EdgeState::kFeasible;
+  e.effort_mean_s = mean;
+  e.effort_stddev_s = sd;
+  return mean;
+}
+
+}  // namespace tamp::graph_manager

@@ -23,7 +23,10 @@ const std::array<ModelSpec, 4>& specTable() {
         {"max_angular_speed", "rad/s", 1.0, 0.02, 10.0, 0.5, "cruise rate of turns in place"},
         {"max_angular_accel", "rad/s^2", 1.5, 0.02, 20.0, 0.5, "angular acceleration of turns"},
         {"settle_time", "s", 0.2, 0.001, 10.0, 1.0, "stop/settle time after each drive or turn"},
-        {"overhead", "s", 0.5, 0.001, 60.0, 1.0, "fixed time per action (start-up, checks)"}}},
+        {"overhead", "s", 0.5, 0.001, 60.0, 1.0, "fixed time per action (start-up, checks)"},
+        {"payload_slowdown", "1/kg", 0.02, 1e-4, 5.0, 1.0,
+         "drive and turn speeds and accelerations divided by 1 + payload_slowdown * mass (carried "
+         "or pushed)"}}},
       {ActionKind::kMoveArm,
        {{"max_joint_speed", "rad/s", 1.0, 0.02, 10.0, 0.5, "joint cruise speed (all joints)"},
         {"max_joint_accel", "rad/s^2", 2.0, 0.02, 50.0, 0.5, "joint acceleration (all joints)"},

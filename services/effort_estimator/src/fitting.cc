@@ -417,6 +417,7 @@ Result<KindModel> fitModel(const KindModel& start, std::span<const FeatureRecord
       case 4: return fitImpl<4>(start, records, prior, options, termination);
       case 5: return fitImpl<5>(start, records, prior, options, termination);
       case 6: return fitImpl<6>(start, records, prior, options, termination);
+      case 7: return fitImpl<7>(start, records, prior, options, termination);
       default: break;
     }
   } catch (const std::exception& e) {

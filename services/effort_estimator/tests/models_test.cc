@@ -53,9 +53,10 @@ TEST(PredictDurationTest, MatchesDirectSumOfMoveTimes) {
       ASSERT_TRUE(f.ok());
       double direct = 0.0;
       if (kind == ActionKind::kMoveBase) {
+        const double slow = 1.0 + p[6] * f->object_mass_kg;
         direct = p[5] + p[4] * static_cast<double>(f->moves.size() + f->turns.size());
-        for (double d : f->moves.lengths()) direct += trapezoidTime(d, p[0], p[1]);
-        for (double d : f->turns.lengths()) direct += trapezoidTime(d, p[2], p[3]);
+        for (double d : f->moves.lengths()) direct += trapezoidTime(d, p[0] / slow, p[1] / slow);
+        for (double d : f->turns.lengths()) direct += trapezoidTime(d, p[2] / slow, p[3] / slow);
       } else {
         const double slow = 1.0 + p[4] * f->object_mass_kg;
         direct = p[3] + p[2] * static_cast<double>(f->moves.size());

@@ -120,7 +120,7 @@ ActionDescription randomAction(ActionKind kind, std::mt19937_64& rng, const Acti
 std::vector<double> trueParameters(ActionKind kind) {
   std::vector<double> factors;
   switch (kind) {
-    case ActionKind::kMoveBase: factors = {0.7, 1.4, 1.3, 0.75, 1.5, 1.6}; break;
+    case ActionKind::kMoveBase: factors = {0.7, 1.4, 1.3, 0.75, 1.5, 1.6, 1.8}; break;
     case ActionKind::kMoveArm: factors = {1.3, 0.7, 1.6, 0.6, 2.0}; break;
     case ActionKind::kPick: factors = {1.4, 0.7, 1.3, 1.8}; break;
     case ActionKind::kPlace: factors = {0.75, 1.5, 0.7, 0.5}; break;

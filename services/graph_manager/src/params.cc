@@ -45,6 +45,7 @@ const config::Schema<GraphManagerParams>& schema() {
         .field("push_step_m", &P::push_step_m, positive())
         .field("push_max_m", &P::push_max_m, positive())
         .field("push_gap_m", &P::push_gap_m, config::nonNegative("m"))
+        .field("push_backoff_m", &P::push_backoff_m, config::nonNegative("m"))
         .field("pushes_per_object", &P::pushes_per_object, atLeast(0))
         .field("keep_clear_margin_m", &P::keep_clear_margin_m, config::nonNegative("m"))
         .field("lower_bound_base_speed", &P::lower_bound_base_speed, positive())
@@ -72,6 +73,9 @@ const config::Schema<GraphManagerParams>& schema() {
 
 std::optional<std::string> GraphManagerParams::invalidReason() const {
   const std::vector<Error> errors = schema().errors(*this);
+  if (errors.empty() && push_backoff_m >= push_step_m + push_gap_m)
+    return "push_backoff_m must be below push_step_m + push_gap_m (" + std::to_string(push_step_m + push_gap_m) + "), got " +
+           std::to_string(push_backoff_m);
   if (errors.empty() && push_max_m < push_step_m)
     return "push_max_m must be at least push_step_m (" + std::to_string(push_step_m) + "), got " + std::to_string(push_max_m);
   if (errors.empty()) return std::nullopt;

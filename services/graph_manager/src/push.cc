@@ -4,6 +4,7 @@
 // collision-free by the motion planner with the object carried ahead of the base.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "tamp/core/log.h"
 #include "tamp/graph_manager/graph_manager.h"
@@ -66,9 +67,12 @@ std::string GraphManager::whyNotPushable(const world::Object& o) const {
   if (params_.pushes_per_object <= 0) return "pushes_per_object is 0";
   const robot::RobotModel& robot = abstraction_.robot();
   if (o.kind != world::ObjectKind::kMovable) return "'" + o.id + "' is static";
-  if (o.mass > robot.pushLimit())
-    return "'" + o.id + "' (" + std::to_string(o.mass) + " kg) exceeds the robot's push limit of " +
-           std::to_string(robot.pushLimit()) + " kg";
+  if (o.mass > robot.pushLimit()) {
+    char b[160];
+    std::snprintf(b, sizeof b, "'%s' (%.1f kg) exceeds the robot's push limit of %.1f kg", o.id.c_str(), o.mass,
+                  robot.pushLimit());
+    return b;
+  }
   const world::Region* r = abstraction_.world().findRegion(o.region);
   if (r == nullptr || r->kind != world::RegionKind::kFloor) return "'" + o.id + "' does not stand on the floor";
   return "";
@@ -103,6 +107,47 @@ bool GraphManager::straightPush(const MotionAnswer& a, const Pose2D& from, const
     if ((p0 + t * d - p).norm() > 0.02) return false;
   }
   return true;
+}
+
+std::optional<MotionAnswer> GraphManager::pushMotion(const std::string& object, const Eigen::Isometry3d& pose,
+                                                     const Eigen::Isometry3d& target, const Pose2D& from,
+                                                     const Pose2D& apex, const Pose2D& to, const BranchContext& ctx,
+                                                     std::string& why) {
+  ++counters_.motion_calls;
+  MotionAnswer a = services_.motion(pushQuery(object, pose, from, apex, ctx));
+  if (!straightPush(a, from, apex)) {
+    why = a.ok() ? "the push is not straight" : std::string(toString(a.status)) + (a.reason.empty() ? "" : ": " + a.reason);
+    return std::nullopt;
+  }
+  if (std::hypot(apex.x - to.x, apex.y - to.y) < 1e-6) return a;
+  // The base backs off, straight, leaving the object where it pushed it: room to turn.
+  MotionQuery back;
+  back.group = Group::kBase;
+  back.mode = Mode::kFull;
+  back.start = ctx.state;
+  back.start.base = apex;
+  back.goal_base = to;
+  back.overrides = overridesOf(ctx, object);
+  back.overrides.push_back(ObjectOverride{object, false, target});
+  // Straight away from the object it touches: the object is no obstacle to that.
+  back.ignored = {object};
+  back.budget_s = params_.motion_budget_s;
+  ++counters_.motion_calls;
+  const MotionAnswer b = services_.motion(back);
+  if (!straightPush(b, apex, to)) {
+    why = b.ok() ? "the back-off is not straight" : "back-off: " + std::string(toString(b.status)) + (b.reason.empty() ? "" : ": " + b.reason);
+    return std::nullopt;
+  }
+  // One trajectory: the push, then the back-off (its first point is the push's last).
+  for (std::size_t i = 1; i < b.path.waypoints.size(); ++i) a.path.waypoints.push_back(b.path.waypoints[i]);
+  const double t0 = a.trajectory.points.empty() ? 0.0 : a.trajectory.points.back().time_from_start;
+  for (std::size_t i = 1; i < b.trajectory.points.size(); ++i) {
+    TrajectoryPoint p = b.trajectory.points[i];
+    p.time_from_start += t0;
+    a.trajectory.points.push_back(std::move(p));
+  }
+  a.path_length += b.path_length;
+  return a;
 }
 
 std::vector<std::string> GraphManager::spawnPushes(const world::Object& o, const std::string& support,
@@ -142,17 +187,17 @@ std::vector<std::string> GraphManager::spawnPushes(const world::Object& o, const
     // The base's front `push_gap_m` short of the face it pushes, centred on the object.
     const double back = -reach(fp, c, -k.n) - front - params_.push_gap_m;
     const Eigen::Vector2d start = c + back * k.n;
-    const Eigen::Vector2d end = start + (k.distance + params_.push_gap_m) * k.n;
-    const Pose2D from{start.x(), start.y(), heading}, to{end.x(), end.y(), heading};
-    ++counters_.motion_calls;
-    const MotionAnswer a = services_.motion(pushQuery(o.id, pose, from, to, ctx));
-    if (!straightPush(a, from, to)) {
-      log::get("graph_manager")->debug("push of {} by {:.2f} m towards ({:.2f}, {:.2f}): {}", o.id, k.distance, k.n.x(),
-                                       k.n.y(), a.ok() ? "not straight" : a.reason);
-      continue;
-    }
+    const Eigen::Vector2d apex = start + (k.distance + params_.push_gap_m) * k.n;
+    const Eigen::Vector2d end = apex - params_.push_backoff_m * k.n;
+    const Pose2D from{start.x(), start.y(), heading}, top{apex.x(), apex.y(), heading}, to{end.x(), end.y(), heading};
     Eigen::Isometry3d target = pose;
     target.translation().head<2>() += k.distance * k.n;
+    std::string why_not;
+    if (!pushMotion(o.id, pose, target, from, top, to, ctx, why_not)) {
+      log::get("graph_manager")->debug("push of {} by {:.2f} m towards ({:.2f}, {:.2f}): {}", o.id, k.distance, k.n.x(),
+                                       k.n.y(), why_not);
+      continue;
+    }
     const std::string slot = abstraction_.addSlot(o.id, support, target);
     const std::string l_from = abstraction_.locationFor(from, "push_" + o.id);
     const std::string l_to = abstraction_.locationFor(to, "pushed_" + o.id);
@@ -163,7 +208,7 @@ std::vector<std::string> GraphManager::spawnPushes(const world::Object& o, const
     slots.push_back(slot);
   }
   if (slots.empty())
-    why = candidates.empty() ? "no push of '" + o.id + "' within " + std::to_string(params_.push_max_m) + " m clears the path"
+    why = candidates.empty() ? "no push of '" + o.id + "' within push_max_m clears the path"
                              : "no straight push of '" + o.id + "' is collision-free (" + std::to_string(tried) + " tried)";
   return slots;
 }
@@ -187,23 +232,27 @@ double GraphManager::evaluatePush(Edge& e, const BranchContext& ctx) {
   if (off <= abstraction_.params().location_tolerance_m &&
       std::abs(std::remainder(ctx.state.base.theta - from->theta, 2 * M_PI)) <= abstraction_.params().location_tolerance_rad)
     start = ctx.state.base;
-  ++counters_.motion_calls;
-  const MotionAnswer a = services_.motion(pushQuery(o->id, pose, start, *to, ctx));
-  if (!straightPush(a, start, *to)) {
+  // Where the object ends, and the push's direction: moved along it as far as the slot says.
+  Eigen::Isometry3d target = pose;
+  target.translation().head<2>() = slot->pose.translation().head<2>();
+  Eigen::Vector2d n = slot->pose.translation().head<2>() - pose.translation().head<2>();
+  if (n.norm() < 1e-6) n = Eigen::Vector2d(to->x - from->x, to->y - from->y);
+  n.normalize();
+  const Pose2D apex{to->x + params_.push_backoff_m * n.x(), to->y + params_.push_backoff_m * n.y(), to->theta};
+  std::string why;
+  const std::optional<MotionAnswer> pushed = pushMotion(o->id, pose, target, start, apex, *to, ctx, why);
+  if (!pushed) {
     e.state = EdgeState::kInfeasible;
-    e.reason = a.ok() ? "the push is not straight in this branch's world"
-                      : std::string(toString(a.status)) + (a.reason.empty() ? "" : ": " + a.reason);
+    e.reason = why + " in this branch's world";
     return kInfinity;
   }
+  const MotionAnswer& a = *pushed;
   EdgeMotion m;
   m.lazy_path = a.path;
   m.trajectory = a.trajectory;
   m.object_id = o->id;
   m.region_id = slot->id;
   m.object_mass = o->mass;
-  // Where the object ends: moved along the push as far as the slot says, from where it is.
-  Eigen::Isometry3d target = pose;
-  target.translation().head<2>() += slot->pose.translation().head<2>() - pose.translation().head<2>();
   m.object_target = target;
   EffortQuery q;
   q.kind = ActionKind::kMoveBase;

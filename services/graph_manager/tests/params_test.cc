@@ -44,6 +44,7 @@ TEST(ParamsTest, APushLongerThanItsStepIsRequired) {
   EXPECT_NE(q.error().toString().find("push_max_m"), std::string::npos) << q.error().toString();
   EXPECT_FALSE(parseParams("push_gap_m: -0.1\n", "gm.yaml").ok());
   EXPECT_TRUE(parseParams("pushes_per_object: 0\n", "gm.yaml").ok()) << "0: never push";
+  EXPECT_FALSE(parseParams("push_backoff_m: 0.5\n", "gm.yaml").ok()) << "backs off beyond the shortest push";
 }
 
 }  // namespace

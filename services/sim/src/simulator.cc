@@ -61,6 +61,8 @@ using Vec = Eigen::VectorXd;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kFloorTolerance = 1e-4;
 constexpr double kSupportProbe = 0.005;  // m: how far below an object its supports are looked for
+/// A pushed object slides on this far after the base stops (m): the base is not left touching it.
+constexpr double kPushSlide = 0.01;
 /// m: how far a place may press the held object into its support (the arm's compliance): a
 /// place's contact with the support is no stop up to this depth, and settle() accepts a release
 /// this far into it (its ray starts as high above the object's bottom).
@@ -171,10 +173,15 @@ struct Active {
   double fail_at{kInf};
   // A push: the object riding ahead of the base, how far the base drove before touching it, the
   // direction and the base's start.
+  // It moves only forward, as far as the base came past contact (a base backing off after the
+  // push leaves it): the base's furthest progress so far, and at the trajectory's end.
   std::string pushed;
   double push_gap{0.0};
   Eigen::Vector2d push_dir{1.0, 0.0};
   Eigen::Vector2d push_from{0.0, 0.0};
+  Eigen::Isometry3d push_start{Eigen::Isometry3d::Identity()};
+  double push_max{0.0};
+  double push_apex{0.0};
 };
 
 }  // namespace
@@ -468,6 +475,18 @@ struct Simulator::Impl {
       robot.linkPoses(st, link_poses);
       for (const auto& r : riding) (void)world.setObjectPose(r.id, link_poses[r.link] * r.link_T_object);
     }
+    if (active && !active->pushed.empty()) {
+      Active& a = *active;
+      a.push_max = std::max(a.push_max, (Eigen::Vector2d(q[0], q[1]) - a.push_from).dot(a.push_dir));
+      (void)world.setObjectPose(a.pushed, pushedPose(a, a.push_max));
+    }
+  }
+
+  /// Where the pushed object is once the base came `progress` m along the push.
+  static Eigen::Isometry3d pushedPose(const Active& a, double progress) {
+    Eigen::Isometry3d pose = a.push_start;
+    pose.translation().head<2>() += std::max(0.0, progress - a.push_gap) * a.push_dir;
+    return pose;
   }
 
   Vec current() const { return active ? stateAt(*active, now - active->start) : idle; }
@@ -557,8 +576,12 @@ struct Simulator::Impl {
   /// driving straight towards the trajectory's end; the object then rides ahead of the base.
   Status startPush(Active& a) {
     const auto& pts = a.cmd.trajectory.points;
-    Eigen::Vector2d d(pts.back().positions[0] - pts.front().positions[0],
-                      pts.back().positions[1] - pts.front().positions[1]);
+    const Eigen::Vector2d p0(pts.front().positions[0], pts.front().positions[1]);
+    Eigen::Vector2d d = Eigen::Vector2d::Zero();  // towards the point farthest from the start
+    for (const auto& p : pts) {
+      const Eigen::Vector2d v = Eigen::Vector2d(p.positions[0], p.positions[1]) - p0;
+      if (v.norm() > d.norm()) d = v;
+    }
     if (d.norm() < 1e-6) {
       return Error(ErrorCode::kInvalidArgument, "a push must drive the base", SourceLocation{"", 0, 0, "trajectory"});
     }
@@ -598,19 +621,24 @@ struct Simulator::Impl {
     a.push_gap = gap;
     a.push_dir = d;
     a.push_from = Eigen::Vector2d(idle[0], idle[1]);
+    a.push_start = world.object(a.cmd.object_id).pose;
+    a.push_max = 0.0;
+    a.push_apex = 0.0;
+    for (const auto& p : pts)
+      a.push_apex = std::max(a.push_apex, (Eigen::Vector2d(p.positions[0], p.positions[1]) - a.push_from).dot(d));
     return Status::Ok();
   }
 
   /// A push ends (however it ended): the object stays where the base left it, less the gap the
   /// base drove before touching it, slipped sideways and turned by the push's own error.
   void releasePushed(Active& a, const Vec& q) {
-    syncHeldPose(q);
     stopRiding(a.pushed);
     world::Object o = world.object(a.pushed);
     const double driven = (Eigen::Vector2d(q[0], q[1]) - a.push_from).dot(a.push_dir);
-    const double moved = std::max(0.0, driven - a.push_gap);
-    Eigen::Isometry3d pose = o.pose;
-    pose.translation().head<2>() -= std::min(a.push_gap, std::max(0.0, driven)) * a.push_dir;
+    const double furthest = std::max(driven, a.outcome == Outcome::kSucceeded ? a.push_apex : a.push_max);
+    const double moved = std::max(0.0, furthest - a.push_gap);
+    // It slides on by kPushSlide after the base stops: the base is not left touching it.
+    const Eigen::Isometry3d pose = pushedPose(a, moved > 0.0 ? furthest + kPushSlide : furthest);
     Eigen::Isometry3d slipped = pose;
     if (moved > 0.0) {
       std::normal_distribution<double> unit(0.0, 1.0);
@@ -620,12 +648,17 @@ struct Simulator::Impl {
                              .toRotationMatrix() *
                          slipped.linear();
     }
-    // The slip never pushes the object into something: it stays unslipped then.
+    // The slip never pushes the object into something, the robot included: it stays unslipped then.
     syncScene();
-    if (!scene.shapeCollisions(o.shape, slipped, collision::Filter::allBut({o.id})).empty()) slipped = pose;
     o.pose = slipped;
     (void)world.updateObject(o);
     syncScene();
+    if (!scene.shapeCollisions(o.shape, slipped, collision::Filter::allBut({o.id})).empty() ||
+        contactAt(q, nullptr) == o.id) {
+      o.pose = pose;
+      (void)world.updateObject(o);
+      syncScene();
+    }
     a.pushed.clear();
   }
 

@@ -47,8 +47,9 @@ T duration(const ActionFeatures& f, const T* p) {
   switch (f.kind) {
     case ActionKind::kMoveBase: {
       const double stops = static_cast<double>(f.moves.size() + f.turns.size());
-      return p[5] + p[4] * stops + trapezoidSum(f.moves, p[0], p[1]) +
-             trapezoidSum(f.turns, p[2], p[3]);
+      const T slow = 1.0 + p[6] * f.object_mass_kg;
+      return p[5] + p[4] * stops + trapezoidSum(f.moves, T(p[0] / slow), T(p[1] / slow)) +
+             trapezoidSum(f.turns, T(p[2] / slow), T(p[3] / slow));
     }
     case ActionKind::kMoveArm: {
       const T slow = 1.0 + p[4] * f.object_mass_kg;

@@ -8,9 +8,11 @@
 /// which is continuous and continuously differentiable in d, v and a.
 ///
 /// - **move_base** (differential drive executed stop-and-turn, see `extractFeatures`):
-///   `T = overhead + settle*(n_moves + n_turns) + sum trap(d_i; v, a) + sum trap(|phi_j|; w, alpha)`
+///   `T = overhead + settle*(n_moves + n_turns) + sum trap(d_i; v/f, a/f) + sum trap(|phi_j|; w/f, alpha/f)`,
+///   `f = 1 + payload_slowdown * m` (m: the mass carried in the gripper or pushed ahead)
 ///   parameters: max_linear_speed v (m/s), max_linear_accel a (m/s^2), max_angular_speed w
-///   (rad/s), max_angular_accel alpha (rad/s^2), settle_time (s per stop), overhead (s).
+///   (rad/s), max_angular_accel alpha (rad/s^2), settle_time (s per stop), overhead (s),
+///   payload_slowdown (1/kg).
 /// - **move_arm** (joint trapezoids synchronized to the slowest joint; with common joint limits the
 ///   slowest joint is the one with the largest displacement D_i of the segment):
 ///   `T = overhead + settle*n + sum trap(D_i; v/f, a/f)`, `f = 1 + payload_slowdown * m`
@@ -44,7 +46,7 @@
 namespace tamp::effort_model {
 
 /// Largest number of parameters of any model (move_base).
-inline constexpr int kMaxModelParameters = 6;
+inline constexpr int kMaxModelParameters = 7;
 
 /// One named, positive model parameter.
 struct ParameterSpec {

@@ -410,6 +410,12 @@ class GraphManager {
                         const Pose2D& to, const BranchContext& ctx) const;
   /// Whether the answer is a straight drive from `from` to `to` (what a push can execute).
   static bool straightPush(const MotionAnswer& a, const Pose2D& from, const Pose2D& to);
+  /// A push's base motion: straight from `from` to `apex` with the object (at `pose`) carried
+  /// ahead, then straight back to `to`, the object left at `target`; none (and `why`) when
+  /// either part is not a collision-free straight drive in the branch's world.
+  std::optional<MotionAnswer> pushMotion(const std::string& object, const Eigen::Isometry3d& pose,
+                                         const Eigen::Isometry3d& target, const Pose2D& from, const Pose2D& apex,
+                                         const Pose2D& to, const BranchContext& ctx, std::string& why);
   /// findPossibleActions for an object the robot cannot grasp: pushes of `o` (on `support`)
   /// that clear `swept` by `keep_clear`, each checked collision-free; their slots (empty, and
   /// `why`, when none).

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "tamp/core/append_file.h"
 #include "tamp/core/error.h"
 
 namespace tamp {
@@ -53,17 +54,6 @@ Error ioError(const std::filesystem::path& path, const std::string& what) {
   return Error(ErrorCode::kIo, what + ": " + std::strerror(errno), SourceLocation{path.string()});
 }
 
-bool writeAll(int fd, const std::string& text) {
-  std::size_t done = 0;
-  while (done < text.size()) {
-    const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return false;
-    done += static_cast<std::size_t>(n);
-  }
-  return true;
-}
-
 }  // namespace
 
 Status writeFileAtomically(const std::filesystem::path& file, const std::string& text, const std::string& what) {
@@ -74,13 +64,7 @@ Status writeFileAtomically(const std::filesystem::path& file, const std::string&
   ::close(fd);
   if (!ok) return ioError(tmp, "cannot write " + what);
   if (::rename(tmp.c_str(), file.c_str()) != 0) return ioError(file, "cannot replace " + what);
-  const std::filesystem::path dir = file.parent_path();
-  const int d = ::open(dir.empty() ? "." : dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (d < 0) return ioError(dir, "cannot open the folder of " + what);
-  const bool synced = ::fsync(d) == 0;
-  ::close(d);
-  if (!synced) return ioError(dir, "cannot sync the folder of " + what);
-  return Status::Ok();
+  return syncDirectory(file.parent_path(), what);
 }
 
 }  // namespace tamp

@@ -1,12 +1,5 @@
 #include "tamp/execution_monitor/sent_journal.h"
 
-#include <fcntl.h>
-#include <unistd.h>
-
-#include <cerrno>
-#include <cstring>
-#include <fstream>
-#include <sstream>
 #include <stdexcept>
 #include <utility>
 
@@ -14,9 +7,7 @@ namespace tamp::execution_monitor {
 
 namespace {
 
-Error ioError(const std::filesystem::path& path, const std::string& what) {
-  return Error(ErrorCode::kIo, what + ": " + std::strerror(errno), SourceLocation{path.string()});
-}
+constexpr const char* kWhat = "the execution monitor's journal";
 
 /// The complete lines of `text` (a last line without its newline was torn by a crash).
 std::vector<std::string> completeLines(const std::string& text) {
@@ -29,65 +20,28 @@ std::vector<std::string> completeLines(const std::string& text) {
   return out;
 }
 
-void syncDirectory(const std::filesystem::path& dir) {
-  const int d = ::open(dir.empty() ? "." : dir.c_str(), O_RDONLY | O_DIRECTORY);
-  if (d < 0) return;
-  (void)::fsync(d);
-  ::close(d);
-}
-
 }  // namespace
 
 Result<SentJournal> SentJournal::open(const std::filesystem::path& path) {
-  std::vector<std::string> previous;
-  if (std::filesystem::exists(path)) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) return ioError(path, "cannot read the execution monitor's journal");
-    std::ostringstream text;
-    text << in.rdbuf();
-    previous = completeLines(text.str());
-  }
-  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
-  if (fd < 0) return ioError(path, "cannot open the execution monitor's journal for appending");
+  auto text = readFileIfExists(path, kWhat);
+  if (!text) return text.error();
+  auto file = AppendFile::open(path, kWhat);
+  if (!file) return file.error();
   // A torn last line is cut off so that the next id starts on a line of its own.
-  std::error_code ec;
-  const auto size = std::filesystem::file_size(path, ec);
-  if (!ec && size > 0) {
-    std::ifstream in(path, std::ios::binary);
-    in.seekg(static_cast<std::streamoff>(size) - 1);
-    if (in.get() != '\n' && ::write(fd, "\n", 1) != 1) {
-      ::close(fd);
-      return ioError(path, "cannot repair the execution monitor's journal");
+  if (!text->empty() && text->back() != '\n') {
+    if (Status s = file->append("\n", false); !s) {
+      Error e = s.error();  // "cannot append to <what>: <reason>"
+      e.message.replace(0, e.message.find(':'), std::string("cannot repair ") + kWhat);
+      return e;
     }
   }
-  syncDirectory(path.parent_path());
-  return SentJournal(path, fd, std::move(previous));
+  (void)syncDirectory(path.parent_path(), kWhat);
+  return SentJournal(std::move(*file), completeLines(*text));
 }
 
-SentJournal::SentJournal(std::filesystem::path path, int fd, std::vector<std::string> previous)
-    : path_(std::move(path)), fd_(fd), previous_(std::move(previous)) {
+SentJournal::SentJournal(AppendFile file, std::vector<std::string> previous)
+    : file_(std::move(file)), previous_(std::move(previous)) {
   ids_.insert(previous_.begin(), previous_.end());
-}
-
-SentJournal::SentJournal(SentJournal&& o) noexcept
-    : path_(std::move(o.path_)),
-      fd_(std::exchange(o.fd_, -1)),
-      previous_(std::move(o.previous_)),
-      ids_(std::move(o.ids_)) {}
-
-SentJournal& SentJournal::operator=(SentJournal&& o) noexcept {
-  if (this != &o) {
-    if (fd_ >= 0) ::close(fd_);
-    path_ = std::move(o.path_);
-    fd_ = std::exchange(o.fd_, -1);
-    previous_ = std::move(o.previous_);
-    ids_ = std::move(o.ids_);
-  }
-  return *this;
-}
-
-SentJournal::~SentJournal() {
-  if (fd_ >= 0) ::close(fd_);
 }
 
 Status SentJournal::append(const std::string& command_id) {
@@ -95,15 +49,7 @@ Status SentJournal::append(const std::string& command_id) {
     throw std::invalid_argument("SentJournal::append: the id must be non-empty, on one line");
   }
   if (ids_.count(command_id)) return Status::Ok();
-  const std::string line = command_id + "\n";
-  std::size_t done = 0;
-  while (done < line.size()) {
-    const ssize_t n = ::write(fd_, line.data() + done, line.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return ioError(path_, "cannot append to the execution monitor's journal");
-    done += static_cast<std::size_t>(n);
-  }
-  if (::fdatasync(fd_) != 0) return ioError(path_, "cannot sync the execution monitor's journal");
+  if (Status s = file_.append(command_id + "\n", true); !s) return s;
   ids_.insert(command_id);
   return Status::Ok();
 }

@@ -20,8 +20,10 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "tamp/core/append_file.h"
 #include "tamp/core/error.h"
 
 namespace tamp::execution_monitor {
@@ -41,11 +43,11 @@ class RecordOutbox {
   /// were never acknowledged (due at once). kIo naming the file when it cannot be read or opened;
   /// kParseError naming the file and line for a complete line that is not an event.
   static Result<RecordOutbox> open(const std::filesystem::path& path);
-  RecordOutbox(RecordOutbox&& other) noexcept;
-  RecordOutbox& operator=(RecordOutbox&& other) noexcept;
+  RecordOutbox(RecordOutbox&& other) noexcept = default;
+  RecordOutbox& operator=(RecordOutbox&& other) noexcept = default;
   RecordOutbox(const RecordOutbox&) = delete;
   RecordOutbox& operator=(const RecordOutbox&) = delete;
-  ~RecordOutbox();
+  ~RecordOutbox() = default;
 
   /// Keeps `record_id` (non-empty, no whitespace; throws std::invalid_argument otherwise) until it
   /// is acknowledged; with a file, durably before returning. false (nothing done) for an id
@@ -65,14 +67,12 @@ class RecordOutbox {
   /// Records acknowledged since the outbox was opened (read back from the file included).
   std::size_t acknowledged() const { return acked_.size(); }
   /// Empty when in memory.
-  const std::filesystem::path& path() const { return path_; }
+  const std::filesystem::path& path() const { return file_.path(); }
 
  private:
-  RecordOutbox(std::filesystem::path path, int fd);
-  Status appendLine(const std::string& line, bool sync);
+  explicit RecordOutbox(AppendFile file) : file_(std::move(file)) {}
 
-  std::filesystem::path path_;
-  int fd_{-1};
+  AppendFile file_;  // closed when in memory
   std::map<std::string, Entry> pending_;
   std::vector<std::string> order_;  // ids in the order added (pending ones are sent in it)
   std::set<std::string> acked_;

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "tamp/core/append_file.h"
 #include "tamp/core/error.h"
 
 namespace tamp::execution_monitor {
@@ -20,23 +21,22 @@ class SentJournal {
   /// Opens (creating if missing) the journal at `path` and reads the ids already in it.
   /// kIo naming the file when it cannot be read or opened for appending.
   static Result<SentJournal> open(const std::filesystem::path& path);
-  SentJournal(SentJournal&& other) noexcept;
-  SentJournal& operator=(SentJournal&& other) noexcept;
+  SentJournal(SentJournal&& other) noexcept = default;
+  SentJournal& operator=(SentJournal&& other) noexcept = default;
   SentJournal(const SentJournal&) = delete;
   SentJournal& operator=(const SentJournal&) = delete;
-  ~SentJournal();
+  ~SentJournal() = default;
 
   /// The ids in the journal when it was opened, in order.
   const std::vector<std::string>& previous() const { return previous_; }
   /// Appends `command_id` (no newline in it) and fsyncs; a no-op for an id already in it.
   /// kIo when the write or the fsync fails (the caller must not send the command then).
   Status append(const std::string& command_id);
-  const std::filesystem::path& path() const { return path_; }
+  const std::filesystem::path& path() const { return file_.path(); }
 
  private:
-  SentJournal(std::filesystem::path path, int fd, std::vector<std::string> previous);
-  std::filesystem::path path_;
-  int fd_{-1};
+  SentJournal(AppendFile file, std::vector<std::string> previous);
+  AppendFile file_;
   std::vector<std::string> previous_;
   std::set<std::string> ids_;
 };

@@ -302,8 +302,6 @@ PlanReply PlanningSession::solve(const Query& q, const Termination& term) {
   reply.stats.ehc_ff_failed = sr.stats.ehc_ff_failed;
   reply.stats.ehc_second_ran = sr.stats.ehc_second_ran;
   reply.stats.ehc_second_won = sr.stats.ehc_second_won;
-  reply.stats.lazy_beside_started = sr.stats.lazy_beside_started;
-  reply.stats.lazy_beside_won = sr.stats.lazy_beside_won;
   reply.stats.ehc_retries = sr.stats.ehc_retries;
   reply.stats.ehc_retries_abandoned = sr.stats.ehc_retries_abandoned;
   reply.stats.anytime_iterations = sr.stats.anytime_iterations;

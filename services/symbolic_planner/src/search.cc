@@ -8,87 +8,13 @@
 #include "tamp/symbolic_planner/landmarks.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
-#include <condition_variable>
-#include <exception>
-#include <functional>
-#include <mutex>
 #include <stdexcept>
-#include <thread>
 
 namespace tamp::symbolic_planner {
 namespace {
 
 constexpr uint32_t kNone = UINT32_MAX;
-
-/// Two searches, each in a thread of its own, that take turns and never run at the same time (one
-/// core, and the same evaluations in every run): side 0 (the hill-climbing) runs `first`
-/// evaluations, then starts side 1 (`start`, which launches the lazy search's thread) and from
-/// then on each side runs `turn[side]` evaluations and hands over. A side that has finished hands
-/// over for good; with `stop_other` it also asks the other side to stop (`stopped()`), and the
-/// first side to do so is the winner.
-class TurnTaking {
- public:
-  TurnTaking(uint64_t first, uint64_t turn_ehc, uint64_t turn_lazy, std::function<void()> start)
-      : turn_len_{turn_ehc, turn_lazy}, quota_{first, turn_lazy}, start_(std::move(start)) {}
-
-  /// Side `me` evaluated a state; at the end of its turn it hands over (unless the other side has
-  /// finished) and waits for its next turn.
-  void evaluated(int me) {
-    if (++used_[me] < quota_[me]) return;
-    used_[me] = 0;
-    quota_[me] = turn_len_[me];
-    if (me == 0 && !started_) {
-      started_ = true;
-      start_();
-    }
-    std::unique_lock<std::mutex> lock(m_);
-    if (done_[1 - me] || stop_) return;
-    turn_ = 1 - me;
-    cv_.notify_all();
-    cv_.wait(lock, [&] { return turn_ == me || done_[1 - me] || stop_; });
-  }
-
-  /// Side 1's thread waits here for its first turn.
-  void waitForFirstTurn() {
-    std::unique_lock<std::mutex> lock(m_);
-    cv_.wait(lock, [&] { return turn_ == 1 || done_[0] || stop_; });
-  }
-
-  /// Side `me` has finished; `stop_other`: its answer is final, the other side should stop.
-  void finished(int me, bool stop_other) {
-    std::lock_guard<std::mutex> lock(m_);
-    done_[me] = true;
-    if (stop_other && !stop_) {
-      stop_ = true;
-      winner_ = me;
-    }
-    turn_ = 1 - me;
-    cv_.notify_all();
-  }
-
-  bool stopped() const { return stop_.load(std::memory_order_relaxed); }
-  bool started() const { return started_; }
-  /// The side that finished first with a final answer, or -1.
-  int winner() const {
-    std::lock_guard<std::mutex> lock(m_);
-    return winner_;
-  }
-
- private:
-  const uint64_t turn_len_[2];
-  uint64_t quota_[2];
-  uint64_t used_[2]{0, 0};  // each touched only by its own side, on its turn
-  std::function<void()> start_;
-  bool started_{false};     // touched by side 0 only
-  mutable std::mutex m_;
-  std::condition_variable cv_;
-  int turn_{0};
-  bool done_[2]{false, false};
-  std::atomic<bool> stop_{false};
-  int winner_{-1};
-};
 
 /// All states of one search in one pool; an open-addressing hash set of ids.
 class StateRegistry {
@@ -326,12 +252,6 @@ class Searcher {
     succ_.resize(task.numWords());
   }
 
-  /// Takes turns with another search (`turns`, as side `side`): see `TurnTaking`.
-  void takeTurns(TurnTaking* turns, int side) {
-    turns_ = turns;
-    side_ = side;
-  }
-
   SearchResult run() {
     Stopwatch sw;
     h_.setGoal(goal_);
@@ -408,7 +328,6 @@ class Searcher {
       pref_count_[id] = static_cast<uint32_t>(p.size());
       pref_pool_.insert(pref_pool_.end(), p.begin(), p.end());
     }
-    if (turns_ != nullptr) turns_->evaluated(side_);
     return h;
   }
 
@@ -429,7 +348,6 @@ class Searcher {
 
   /// Checks time and memory every 256 calls; returns a terminal status or nullopt.
   std::optional<SearchStatus> checkLimits() {
-    if (turns_ != nullptr && turns_->stopped()) return SearchStatus::kCancelled;
     if ((++checks_ & 255) != 0) return std::nullopt;
     const StopReason why = term_.reason();
     if (why == StopReason::kDeadline) return SearchStatus::kTimeout;
@@ -971,8 +889,6 @@ class Searcher {
   uint64_t eval_budget_{0};      // ehc: give up after this many evaluations (0 = unlimited)
   uint64_t fallback_budget_{0};  // ehc: fall back after this many evaluations (0 = unlimited)
   uint32_t iter_{0};
-  TurnTaking* turns_{nullptr};  // the other search taking turns with this one, if any
-  int side_{0};
 };
 
 CostType defaultCostType(const SearchOptions& o, const Task& t) {
@@ -1050,10 +966,6 @@ void SearchOptions::validate() const {
     throw std::invalid_argument("SearchOptions::ehc_retry_budget_share must be in [0, 1], got " +
                                 std::to_string(ehc_retry_budget_share));
   }
-  if (ehc_lazy_turn_ehc == 0 || ehc_lazy_turn_lazy == 0) {
-    throw std::invalid_argument("SearchOptions::ehc_lazy_turn_ehc and ehc_lazy_turn_lazy must be > 0, got " +
-                                std::to_string(ehc_lazy_turn_ehc) + " and " + std::to_string(ehc_lazy_turn_lazy));
-  }
   if (preferred_boost < 0) {
     throw std::invalid_argument("SearchOptions::preferred_boost must be >= 0, got " + std::to_string(preferred_boost));
   }
@@ -1061,10 +973,13 @@ void SearchOptions::validate() const {
 
 namespace {
 
-/// The configured search (with EHC's first run and fallback); with `turns`, every hill-climbing
-/// run before the first plan takes turns with the lazy search as side 0.
-SearchResult configuredSearch(const Task& task, const StateBits& init, const Goal& goal, const SearchOptions& options,
-                              Heuristic& heuristic, const Termination& term, TurnTaking* turns) {
+/// The first plan: the configured search (with EHC's first run and fallback).
+SearchResult firstPlan(const Task& task, const StateBits& init, const Goal& goal, const SearchOptions& options,
+                       Heuristic& heuristic, const Termination& term) {
+  if (init.size() != task.numWords()) {
+    throw std::invalid_argument("search: initial state has " + std::to_string(init.size()) + " words, task needs " +
+                                std::to_string(task.numWords()));
+  }
   if (options.algorithm == SearchAlgorithm::kEhc && options.ehc_ff_first && options.ehc_ff_budget_per_h > 0 &&
       heuristic.setFFStyle(true)) {
     // First run: EHC with FF-v2.3's relaxed plan, no fallback, bounded evaluations.
@@ -1075,7 +990,6 @@ SearchResult configuredSearch(const Task& task, const StateBits& init, const Goa
     SearchResult r1;
     try {
       Searcher s1(task, init, goal, first, heuristic, term);
-      s1.takeTurns(turns, 0);
       r1 = s1.run();
     } catch (...) {
       heuristic.setFFStyle(false);
@@ -1112,109 +1026,13 @@ SearchResult configuredSearch(const Task& task, const StateBits& init, const Goa
     SearchOptions rest = options;
     rest.ehc_fallback_budget_spent = r1.stats.evaluated;
     Searcher s2(task, init, goal, rest, heuristic, term);
-    s2.takeTurns(turns, 0);
     SearchResult r2 = s2.run();
     r2.stats.ehc_ff_failed = true;
     addRunCosts(r2.stats, r1.stats);
     return r2;
   }
   Searcher s(task, init, goal, options, heuristic, term);
-  s.takeTurns(turns, 0);
   return s.run();
-}
-
-/// True when a search's answer is final (nothing the other search of a pair could improve on).
-bool isFinal(SearchStatus st) {
-  return st == SearchStatus::kSolved || st == SearchStatus::kUnsolvable || st == SearchStatus::kTimeout ||
-         st == SearchStatus::kCancelled;
-}
-
-/// `winner`'s result with `other`'s effort and the hill-climbing's own flags (`ehc`).
-SearchResult merged(SearchResult winner, const SearchStatistics& other, const SearchStatistics& ehc) {
-  addRunCosts(winner.stats, other);
-  winner.stats.initial_h = ehc.initial_h;
-  winner.stats.ehc_failed = ehc.ehc_failed;
-  winner.stats.ehc_ff_failed = ehc.ehc_ff_failed;
-  winner.stats.ehc_second_ran = ehc.ehc_second_ran;
-  winner.stats.ehc_second_won = ehc.ehc_second_won;
-  return winner;
-}
-
-/// The lazy search (with landmarks, as configured) of `options`, from the start.
-SearchResult lazySearch(const Task& task, const StateBits& init, const Goal& goal, const SearchOptions& options,
-                        Heuristic& heuristic, const Termination& term, TurnTaking* turns) {
-  SearchOptions lazy = options;
-  lazy.algorithm = SearchAlgorithm::kLazy;
-  Searcher s(task, init, goal, lazy, heuristic, term);
-  s.takeTurns(turns, 1);
-  return s.run();
-}
-
-/// SearchOptions::ehc_lazy_beside: the hill-climbing (without fallback) in this thread, the lazy
-/// search in a second one started after `ehc_lazy_after` evaluations with a heuristic of its own
-/// (`kind`, `cost_type`), taking turns; the first final answer wins. When the hill-climbing
-/// gives up, the lazy search goes on alone (or starts now, with `heuristic`, if it had not).
-SearchResult ehcWithLazyBeside(const Task& task, const StateBits& init, const Goal& goal, const SearchOptions& options,
-                               Heuristic& heuristic, HeuristicKind kind, CostType cost_type, const Termination& term) {
-  SearchResult lazy;
-  std::exception_ptr lazy_error;
-  std::thread lazy_thread;
-  TurnTaking turns(options.ehc_lazy_after, options.ehc_lazy_turn_ehc, options.ehc_lazy_turn_lazy, [&] {
-    lazy_thread = std::thread([&] {
-      turns.waitForFirstTurn();
-      bool final_answer = false;
-      try {
-        if (!turns.stopped()) {
-          std::unique_ptr<Heuristic> own = makeHeuristic(kind, task, cost_type);
-          lazy = lazySearch(task, init, goal, options, *own, term, &turns);
-          final_answer = lazy.status == SearchStatus::kSolved || lazy.status == SearchStatus::kUnsolvable;
-        }
-      } catch (...) {
-        lazy_error = std::current_exception();
-      }
-      turns.finished(1, final_answer);
-    });
-  });
-  SearchOptions ehc_only = options;
-  ehc_only.ehc_fallback = false;
-  SearchResult ehc;
-  try {
-    ehc = configuredSearch(task, init, goal, ehc_only, heuristic, term, &turns);
-  } catch (...) {
-    turns.finished(0, true);
-    if (lazy_thread.joinable()) lazy_thread.join();
-    throw;
-  }
-  turns.finished(0, isFinal(ehc.status));
-  if (lazy_thread.joinable()) lazy_thread.join();
-  if (lazy_error) std::rethrow_exception(lazy_error);
-  if (turns.started()) {
-    ehc.stats.lazy_beside_started = true;
-    lazy.stats.lazy_beside_started = true;
-  }
-  if (turns.winner() == 1 || (turns.started() && !isFinal(ehc.status))) {
-    lazy.stats.lazy_beside_won = turns.winner() == 1;
-    return merged(std::move(lazy), ehc.stats, ehc.stats);
-  }
-  if (turns.started() || isFinal(ehc.status)) return merged(std::move(ehc), lazy.stats, ehc.stats);
-  // The hill-climbing gave up before the lazy search started: the lazy search alone, as the
-  // fallback without this option.
-  return merged(lazySearch(task, init, goal, options, heuristic, term, nullptr), ehc.stats, ehc.stats);
-}
-
-/// The first plan: the configured search, with the lazy search beside the hill-climbing when
-/// `ehc_lazy_beside` applies (its heuristic: `kind` with `cost_type`).
-SearchResult firstPlan(const Task& task, const StateBits& init, const Goal& goal, const SearchOptions& options,
-                       Heuristic& heuristic, CostType cost_type, const Termination& term) {
-  if (init.size() != task.numWords()) {
-    throw std::invalid_argument("search: initial state has " + std::to_string(init.size()) + " words, task needs " +
-                                std::to_string(task.numWords()));
-  }
-  if (options.algorithm == SearchAlgorithm::kEhc && options.ehc_fallback &&
-      options.fallback == SearchAlgorithm::kLazy && options.ehc_lazy_beside) {
-    return ehcWithLazyBeside(task, init, goal, options, heuristic, defaultHeuristic(options), cost_type, term);
-  }
-  return configuredSearch(task, init, goal, options, heuristic, term, nullptr);
 }
 
 /// True when the operators do not all cost the same (plan cost is not plan length).
@@ -1237,12 +1055,12 @@ SearchResult unitCostFirstPlan(const Task& task, const StateBits& init, const Go
     const double left = term.deadline().secondsLeft();
     const Termination share =
         std::isfinite(left) ? term.tightened(Deadline::in(options.unit_first_time_share * left)) : term;
-    unit = firstPlan(task, init, goal, options, *unit_h, CostType::kUnit, share);
+    unit = firstPlan(task, init, goal, options, *unit_h, share);
   }  // the unit-cost heuristic and the run's states are freed before the second run
   const bool retry = unit.status == SearchStatus::kOutOfMemory || unit.status == SearchStatus::kFailed ||
                      (unit.status == SearchStatus::kTimeout && !term());
   if (!retry) return unit;
-  SearchResult r = firstPlan(task, init, goal, options, heuristic, defaultCostType(options, task), term);
+  SearchResult r = firstPlan(task, init, goal, options, heuristic, term);
   r.stats.unit_first_failed = true;
   addRunCosts(r.stats, unit.stats);
   return r;
@@ -1264,7 +1082,7 @@ SearchResult search(const Task& task, const StateBits& init, const Goal& goal, c
   // iterations with cost + 1.
   SearchResult best = anytime && options.unit_cost_first && !options.cost_type
                           ? unitCostFirstPlan(task, init, goal, options, heuristic, term)
-                          : firstPlan(task, init, goal, options, heuristic, defaultCostType(options, task), term);
+                          : firstPlan(task, init, goal, options, heuristic, term);
   if (best.status != SearchStatus::kSolved || !anytime) return best;
   // Anytime phase (LAMA 2011): the lazy greedy search, then lazy weighted A* with w = 5, 3, 2, 1,
   // 1, ..., each bounded by the

@@ -1,9 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <filesystem>
 #include <thread>
-#include <tuple>
 
 #include "tamp/symbolic_planner/landmarks.h"
 #include "tamp/symbolic_planner/search.h"
@@ -101,7 +99,6 @@ TEST(Search, SecondEhcRunKeepsTheCheaperPlan) {
   PlanRequest req;
   req.domain_text = test::readFile(dir / "domain.pddl");
   req.problem_text = test::readFile(dir / "instance-20.pddl");
-  req.search.ehc_lazy_beside = false;  // the hill-climbing alone
   req.search.ehc_second_budget_per_step = 0;
   PlanReply one = plan(req, Termination());
   ASSERT_EQ(one.status, PlanStatus::kSolved) << one.message;
@@ -201,7 +198,6 @@ TEST(Search, EhcPlateauSearchedAgainWithoutPruningIsBoundedByItsShareOfTheBudget
   PlanRequest req;
   req.domain_text = test::readFile(dir / "domain.pddl");
   req.problem_text = test::readFile(dir / "instance-40.pddl");
-  req.search.ehc_lazy_beside = false;  // the hill-climbing alone
   req.timeout_seconds = 120;
   PlanReply bounded = plan(req, Termination());
   ASSERT_EQ(bounded.status, PlanStatus::kSolved) << bounded.message;
@@ -223,7 +219,6 @@ TEST(Search, EhcFirstRunContinuesFromTheFirstBetterState) {
   PlanRequest req;
   req.domain_text = test::readFile(dir / "domain.pddl");
   req.problem_text = test::readFile(dir / "instance-12.pddl");
-  req.search.ehc_lazy_beside = false;  // the hill-climbing alone
   req.timeout_seconds = 120;
   req.search.ehc_ff_first_improvement = true;
   PlanReply first = plan(req, Termination());
@@ -337,104 +332,6 @@ TEST(Search, UnitCostFirstRunFallsBackToCostPlusOneWhenOutOfTimeShareOrMemory) {
   EXPECT_TRUE(r.stats.unit_first_failed);
 }
 
-/// A request for `set/domain/instance-N` (per-instance domain folders too) with a 120 s limit.
-PlanRequest benchmarkRequest(const std::string& set, const std::string& domain, int n) {
-  const auto dir = test::benchmarksDir() / set / domain;
-  const std::string inst = "instance-" + std::to_string(n);
-  const bool own_folder = std::filesystem::is_directory(dir / inst);
-  PlanRequest req;
-  req.domain_text = test::readFile(own_folder ? dir / inst / "domain.pddl" : dir / "domain.pddl");
-  req.problem_text = test::readFile((own_folder ? dir / inst : dir) / (inst + ".pddl"));
-  req.timeout_seconds = 120;
-  return req;
-}
-
-TEST(Search, LazySearchBesideTheHillClimbingGivesThePlanWhenItNeedsFewerEvaluations) {
-  // openstacks-18: the hill-climbing alone needs about 3400 evaluations, the lazy search about
-  // 200. Beside it from the 1000th evaluation on, taking turns of 100, the lazy search gives the
-  // plan well before the hill-climbing would; alone (the option off) it never starts.
-  PlanRequest req = benchmarkRequest("pddl-more", "openstacks", 18);
-  req.search.ehc_lazy_after = 1000;
-  req.search.ehc_lazy_turn_ehc = 100;
-  req.search.ehc_lazy_turn_lazy = 100;
-  PlanReply beside = plan(req, Termination());
-  ASSERT_EQ(beside.status, PlanStatus::kSolved) << beside.message;  // replayed by the checker
-  EXPECT_TRUE(beside.stats.lazy_beside_started);
-  EXPECT_TRUE(beside.stats.lazy_beside_won);
-  req.search.ehc_lazy_beside = false;
-  PlanReply alone = plan(req, Termination());
-  ASSERT_EQ(alone.status, PlanStatus::kSolved) << alone.message;
-  EXPECT_FALSE(alone.stats.lazy_beside_started);
-  EXPECT_FALSE(alone.stats.ehc_failed);  // the hill-climbing itself solves it, later
-  EXPECT_LT(beside.stats.evaluated, alone.stats.evaluated);
-  EXPECT_GT(beside.stats.evaluated, 1000U);
-  // Turns are counted in evaluations, not time: the same search every run.
-  req.search.ehc_lazy_beside = true;
-  PlanReply again = plan(req, Termination());
-  ASSERT_EQ(again.status, PlanStatus::kSolved) << again.message;
-  EXPECT_EQ(again.plan, beside.plan);
-  EXPECT_EQ(again.stats.evaluated, beside.stats.evaluated);
-}
-
-TEST(Search, LazySearchBesideTheHillClimbingNotStartedLeavesTheHillClimbingThenTheLazySearch) {
-  // openstacks-6 is solved by the hill-climbing within its first 1000 evaluations: the lazy search
-  // never starts, and plan and evaluations are those of the option off.
-  PlanRequest small = benchmarkRequest("pddl-more", "openstacks", 6);
-  PlanReply beside = plan(small, Termination());
-  small.search.ehc_lazy_beside = false;
-  PlanReply off = plan(small, Termination());
-  ASSERT_EQ(beside.status, PlanStatus::kSolved) << beside.message;
-  ASSERT_EQ(off.status, PlanStatus::kSolved) << off.message;
-  EXPECT_FALSE(beside.stats.lazy_beside_started);
-  EXPECT_EQ(beside.plan, off.plan);
-  EXPECT_EQ(beside.stats.evaluated, off.stats.evaluated);
-  // psr-small-40: the hill-climbing gives up before a lazy search that would start at 10^9
-  // evaluations does; the lazy search then runs once, from the start: exactly the hill-climbing
-  // without fallback followed by the lazy search alone. (With the option off the fallback runs
-  // inside a goal-agenda entry that is not the last, and the hill-climbing goes on with the next
-  // entries afterwards, so it costs more: docs/benchmarks.md, ninth round.)
-  PlanRequest req = benchmarkRequest("pddl-more", "psr-small", 40);
-  req.search.ehc_lazy_after = 1000000000;
-  PlanReply late = plan(req, Termination());
-  ASSERT_EQ(late.status, PlanStatus::kSolved) << late.message;
-  EXPECT_FALSE(late.stats.lazy_beside_started);
-  EXPECT_TRUE(late.stats.ehc_failed);
-  req.search.ehc_lazy_beside = false;
-  req.search.ehc_fallback = false;
-  PlanReply hill = plan(req, Termination());
-  EXPECT_EQ(hill.status, PlanStatus::kFailed) << hill.message;
-  req.search.algorithm = SearchAlgorithm::kLazy;
-  PlanReply lazy = plan(req, Termination());
-  ASSERT_EQ(lazy.status, PlanStatus::kSolved) << lazy.message;
-  EXPECT_EQ(late.plan, lazy.plan);
-  EXPECT_EQ(late.stats.evaluated, hill.stats.evaluated + lazy.stats.evaluated);
-}
-
-TEST(Search, LazySearchBesideTheHillClimbingProvesUnsolvabilityAndStopsOnTheDeadline) {
-  // Each action deletes what the other adds: the lazy search, started at the first evaluation
-  // and taking turns of one, exhausts the space.
-  const std::string dom = R"((define (domain swap) (:predicates (p) (q))
-    (:action a :parameters () :effect (and (p) (not (q))))
-    (:action b :parameters () :effect (and (q) (not (p))))))";
-  PlanRequest req;
-  req.domain_text = dom;
-  req.problem_text = "(define (problem x) (:domain swap) (:init) (:goal (and (p) (q))))";
-  req.search.ehc_lazy_after = 1;
-  req.search.ehc_lazy_turn_ehc = 1;
-  req.search.ehc_lazy_turn_lazy = 1;
-  PlanReply r = plan(req, Termination());
-  EXPECT_EQ(r.status, PlanStatus::kUnsolvable) << r.message;
-  // blocks-80, solved by neither search in 0.3 s: both stop on the deadline, none waits forever.
-  PlanRequest hard = benchmarkRequest("pddl", "blocks", 80);
-  hard.search.ehc_lazy_after = 1;
-  hard.timeout_seconds = 0.3;
-  const Stopwatch sw;
-  PlanReply t = plan(hard, Termination());
-  EXPECT_EQ(t.status, PlanStatus::kTimeout) << t.message;
-  EXPECT_TRUE(t.stats.lazy_beside_started);
-  EXPECT_LT(sw.seconds(), 10.0);
-}
-
 TEST(Search, OptionsAreValidated) {
   SearchOptions o;
   o.weight = 0.5;
@@ -455,13 +352,6 @@ TEST(Search, OptionsAreValidated) {
     EXPECT_THROW(o.validate(), std::invalid_argument) << bad;
   }
   o.ehc_retry_budget_share = 0;  // unbounded
-  EXPECT_NO_THROW(o.validate());
-  o.ehc_lazy_turn_ehc = 0;
-  EXPECT_THROW(o.validate(), std::invalid_argument);
-  o.ehc_lazy_turn_ehc = 1;
-  o.ehc_lazy_turn_lazy = 0;
-  EXPECT_THROW(o.validate(), std::invalid_argument);
-  o.ehc_lazy_turn_lazy = 1;
   EXPECT_NO_THROW(o.validate());
   EXPECT_EQ(parseSearchAlgorithm("astar"), SearchAlgorithm::kAstar);
   EXPECT_EQ(parseSearchAlgorithm("lazy"), SearchAlgorithm::kLazy);

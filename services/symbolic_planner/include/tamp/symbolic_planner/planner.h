@@ -84,8 +84,6 @@ struct PlanStatistics {
   bool ehc_ff_failed{false};  ///< the first EHC run (FF-v2.3 heuristic variant) failed; see SearchOptions
   bool ehc_second_ran{false};  ///< the default EHC also ran after the first run's long plan; see SearchOptions
   bool ehc_second_won{false};  ///< ... and its plan was the cheaper one
-  bool lazy_beside_started{false};  ///< the lazy search ran beside the hill-climbing; see SearchOptions::ehc_lazy_beside
-  bool lazy_beside_won{false};      ///< ... and gave the answer
   uint64_t ehc_retries{0};  ///< plateaus searched again without helpful-action pruning (every run)
   uint64_t ehc_retries_abandoned{0};  ///< ... given up at SearchOptions::ehc_retry_budget_share
   uint64_t anytime_iterations{0};    ///< SearchOptions::anytime_seconds: iterations run

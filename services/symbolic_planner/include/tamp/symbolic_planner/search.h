@@ -108,20 +108,6 @@ struct SearchOptions {
   uint64_t ehc_second_budget_per_step{300};
   uint64_t ehc_second_budget_factor{16};
   double ehc_second_trigger_ratio{2.0};
-  /// ehc with the lazy fallback (`ehc_fallback`, `fallback` = kLazy): run that lazy search
-  /// beside the hill-climbing instead of only after it fails. Once the hill-climbing (all its
-  /// runs) has used `ehc_lazy_after` evaluations, the lazy search starts and the two take turns,
-  /// `ehc_lazy_turn_ehc` evaluations of the hill-climbing, then `ehc_lazy_turn_lazy` of the lazy
-  /// search (each in a thread of its own, never both at once: one core, deterministic); the
-  /// first plan found is returned and the other search stopped. When the hill-climbing fails or
-  /// runs out of its budget, the lazy search goes on alone, as the fallback did; when the lazy
-  /// search proves the task unsolvable, that is the answer. Each search has its own heuristic
-  /// (the lazy one built when it starts) and memory budget. false: the lazy search only after
-  /// the hill-climbing fails.
-  bool ehc_lazy_beside{true};
-  uint64_t ehc_lazy_after{1000};
-  uint64_t ehc_lazy_turn_ehc{100};   ///< must be > 0
-  uint64_t ehc_lazy_turn_lazy{100};  ///< must be > 0
   bool preferred_operators{true};  ///< gbfs/lazy: use the helpful-action open list(s)
   /// lazy: alternate h_FF with LAMA's landmark-count heuristic (landmarks.h), four queues.
   bool landmarks{true};
@@ -176,10 +162,6 @@ struct SearchStatistics {
   /// `ehc_second_budget_per_step`); `ehc_second_won`: its plan was cheaper and was returned.
   bool ehc_second_ran{false};
   bool ehc_second_won{false};
-  /// ehc with `ehc_lazy_beside`: the lazy search started beside the hill-climbing;
-  /// `lazy_beside_won`: the plan (or the proof of unsolvability) came from it.
-  bool lazy_beside_started{false};
-  bool lazy_beside_won{false};
   uint64_t ehc_retries{0};  ///< plateaus searched again without helpful-action pruning
   uint64_t ehc_retries_abandoned{0};  ///< ... given up at `ehc_retry_budget_share`
   uint64_t landmarks{0};    ///< lazy: number of fact landmarks found (0: landmark count not used)

@@ -73,6 +73,8 @@ TEST(SimParamsTest, ErrorsNameFileLineAndField) {
       {"dynamics:\n  base: {corner_threshold_rad: 0.05}\n", "field 'dynamics.base.corner_threshold_rad': unknown key"},
       {"sensor:\n  width: 0\n", "sim.yaml:2:"},
       {"duration_noise: abc\n", "field 'duration_noise'"},
+      {"push:\n  lateral_slip: -0.1\n", "field 'push.lateral_slip'"},
+      {"push:\n  max_contact_gap_m: 0\n", "field 'push.max_contact_gap_m'"},
   };
   for (const auto& c : cases) {
     auto p = parseSimParams(c.yaml, "sim.yaml");

@@ -325,7 +325,7 @@ TEST(RobotDescriptionTest, BrokenDescriptionsNameTheField) {
             file +
                 ":3:1: field 'tool': unknown key 'tool' (expected one of: "
                 "base_link, camera_frame, gripper, "
-                "gripper_joint, named_configurations, payload, tool_link, urdf)");
+                "gripper_joint, named_configurations, payload, push_limit, tool_link, urdf)");
   auto r4 = write("urdf: missing.urdf\npayload: 5\n");
   ASSERT_FALSE(r4.ok());
   EXPECT_EQ(r4.error().code, ErrorCode::kNotFound);
@@ -348,6 +348,14 @@ TEST(RobotDescriptionTest, BrokenDescriptionsNameTheField) {
   auto p5 = write("urdf: mobile_manipulator.urdf\npayload: 0\n");
   ASSERT_TRUE(p5.ok()) << p5.error().toString();
   EXPECT_DOUBLE_EQ(p5->payload(), 0.0);
+  EXPECT_DOUBLE_EQ(p5->pushLimit(), 0.0) << "without push_limit the base pushes nothing";
+  // The push limit: optional, a finite mass >= 0.
+  auto q1 = write("urdf: mobile_manipulator.urdf\npayload: 5\npush_limit: -1\n");
+  ASSERT_FALSE(q1.ok());
+  EXPECT_EQ(q1.error().toString(), file + ":3:13: field 'push_limit': must be a finite mass >= 0 (kg), got -1");
+  auto q2 = write("urdf: mobile_manipulator.urdf\npayload: 5\npush_limit: 40\n");
+  ASSERT_TRUE(q2.ok()) << q2.error().toString();
+  EXPECT_DOUBLE_EQ(q2->pushLimit(), 40.0);
 }
 
 TEST(RobotDescriptionTest, PayloadAndGripperWidth) {
@@ -356,6 +364,7 @@ TEST(RobotDescriptionTest, PayloadAndGripperWidth) {
   EXPECT_DOUBLE_EQ(r->payload(), 25.0);
   EXPECT_DOUBLE_EQ(r->options().payload, 25.0);
   EXPECT_DOUBLE_EQ(r->maxGraspWidth(), 0.08);  // 2 x the finger joint's 0.04 m
+  EXPECT_DOUBLE_EQ(r->pushLimit(), 60.0);
 }
 
 // ---- broken URDFs ------------------------------------------------------------------------------

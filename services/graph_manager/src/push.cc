@@ -54,6 +54,18 @@ double reach(const world::Polygon2& poly, const Eigen::Vector2d& c, const Eigen:
   return r;
 }
 
+/// A full-mode base motion from `from` to `to`, the rest of the robot as in `ctx`.
+MotionQuery fullBaseQuery(const Pose2D& from, const Pose2D& to, const BranchContext& ctx, double budget_s) {
+  MotionQuery q;
+  q.group = Group::kBase;
+  q.mode = Mode::kFull;
+  q.start = ctx.state;
+  q.start.base = from;
+  q.goal_base = to;
+  q.budget_s = budget_s;
+  return q;
+}
+
 }  // namespace
 
 bool isPush(const Edge& e) { return !e.tokens.empty() && e.tokens[0] == "push"; }
@@ -80,17 +92,11 @@ std::string GraphManager::whyNotPushable(const world::Object& o) const {
 
 MotionQuery GraphManager::pushQuery(const std::string& object, const Eigen::Isometry3d& object_pose, const Pose2D& from,
                                     const Pose2D& to, const BranchContext& ctx) const {
-  MotionQuery q;
-  q.group = Group::kBase;
-  q.mode = Mode::kFull;
-  q.start = ctx.state;
-  q.start.base = from;
-  q.goal_base = to;
+  MotionQuery q = fullBaseQuery(from, to, ctx, params_.motion_budget_s);
   q.held.object_id = object;
   q.held.link = abstraction_.robot().options().base_link;
   q.held.link_T_object = from.toIsometry(0.0).inverse() * object_pose;
   q.overrides = overridesOf(ctx, object);
-  q.budget_s = params_.motion_budget_s;
   return q;
 }
 
@@ -121,17 +127,11 @@ std::optional<MotionAnswer> GraphManager::pushMotion(const std::string& object, 
   }
   if (std::hypot(apex.x - to.x, apex.y - to.y) < 1e-6) return a;
   // The base backs off, straight, leaving the object where it pushed it: room to turn.
-  MotionQuery back;
-  back.group = Group::kBase;
-  back.mode = Mode::kFull;
-  back.start = ctx.state;
-  back.start.base = apex;
-  back.goal_base = to;
+  MotionQuery back = fullBaseQuery(apex, to, ctx, params_.motion_budget_s);
   back.overrides = overridesOf(ctx, object);
   back.overrides.push_back(ObjectOverride{object, false, target});
   // Straight away from the object it touches: the object is no obstacle to that.
   back.ignored = {object};
-  back.budget_s = params_.motion_budget_s;
   ++counters_.motion_calls;
   const MotionAnswer b = services_.motion(back);
   if (!straightPush(b, apex, to)) {

@@ -22,6 +22,14 @@ world::World crateAhead(double gap, double mass = 30.0) {
   return w;
 }
 
+/// Exact, and the push without slip.
+SimParams noSlip() {
+  SimParams p = exactParams();
+  p.push.lateral_slip = 0.0;
+  p.push.yaw_slip_rad_per_m = 0.0;
+  return p;
+}
+
 ActionCommand push(const std::string& id, double distance) {
   ActionCommand c = moveBase(id, {{0.0, 0.0, 0.0}, {distance, 0.0, 0.0}});
   c.object_id = "crate";
@@ -29,9 +37,7 @@ ActionCommand push(const std::string& id, double distance) {
 }
 
 TEST(PushTest, ThePushedObjectEndsAheadOfTheBaseByTheDistanceDrivenPastContact) {
-  SimParams p = exactParams();
-  p.push.lateral_slip = 0.0;
-  p.push.yaw_slip_rad_per_m = 0.0;
+  const SimParams p = noSlip();
   Simulator sim(crateAhead(0.03), robotModel(), upright(), p);
   ASSERT_TRUE(sim.submit(push("push", 1.03)));
   const StepEvents e = runToEnd(sim);
@@ -65,9 +71,7 @@ TEST(PushTest, ThePushSlipsSidewaysByTheSimulatorsOwnError) {
 }
 
 TEST(PushTest, ABaseBackingOffAfterThePushLeavesTheObjectWhereItWasPushed) {
-  SimParams p = exactParams();
-  p.push.lateral_slip = 0.0;
-  p.push.yaw_slip_rad_per_m = 0.0;
+  const SimParams p = noSlip();
   Simulator sim(crateAhead(0.03), robotModel(), upright(), p);
   ActionCommand c = moveBase("push", {{0.0, 0.0, 0.0}, {1.03, 0.0, 0.0}, {0.88, 0.0, 0.0}});
   c.object_id = "crate";
@@ -102,9 +106,7 @@ TEST(PushTest, AStaticObjectOrAnUnknownOneCannotBePushed) {
 TEST(PushTest, APushIntoAWallStopsBeforeTheObjectTouchesIt) {
   world::World w = crateAhead(0.03);
   ASSERT_TRUE(w.addObject(box("wall", 0.2, 3.0, 1.0, at(1.6, 0.0, 0.5))));  // its face at x = 1.5
-  SimParams p = exactParams();
-  p.push.lateral_slip = 0.0;
-  p.push.yaw_slip_rad_per_m = 0.0;
+  const SimParams p = noSlip();
   Simulator sim(std::move(w), robotModel(), upright(), p);
   ASSERT_TRUE(sim.submit(push("push", 1.03)));
   const StepEvents e = runToEnd(sim);

@@ -27,13 +27,12 @@ Result<SentJournal> SentJournal::open(const std::filesystem::path& path) {
   if (!text) return text.error();
   auto file = AppendFile::open(path, kWhat);
   if (!file) return file.error();
-  // A torn last line is cut off so that the next id starts on a line of its own.
+  // A torn last line is cut off: completing it with a newline would turn the fragment into an
+  // id on the next open ("m3-e1" torn from "m3-e12"), and a command with that id would then pass
+  // for one sent before, not validated again.
   if (!text->empty() && text->back() != '\n') {
-    if (Status s = file->append("\n", false); !s) {
-      Error e = s.error();  // "cannot append to <what>: <reason>"
-      e.message.replace(0, e.message.find(':'), std::string("cannot repair ") + kWhat);
-      return e;
-    }
+    const std::size_t nl = text->rfind('\n');
+    if (Status s = file->truncate(nl == std::string::npos ? 0 : nl + 1); !s) return s.error();
   }
   (void)syncDirectory(path.parent_path(), kWhat);
   return SentJournal(std::move(*file), completeLines(*text));

@@ -1,5 +1,5 @@
 // The execution monitor's journal of commands sent to the robot: ids survive a reopen (a restart),
-// a torn last line is dropped and repaired, a repeated id is written once, and a journal that
+// a torn last line is cut off, a repeated id is written once, and a journal that
 // cannot be opened is an error naming the file.
 #include "tamp/execution_monitor/sent_journal.h"
 
@@ -52,14 +52,21 @@ TEST_F(SentJournalTest, IdsSurviveAReopenAndARepeatIsWrittenOnce) {
 }
 
 TEST_F(SentJournalTest, ATornLastLineIsDroppedAndTheNextIdStartsOnItsOwnLine) {
-  std::ofstream(file()) << "a\nhal";
+  std::ofstream(file()) << "a\nm3-e1";  // "m3-e12" torn by a crash
   auto j = SentJournal::open(file());
   ASSERT_TRUE(j);
   EXPECT_EQ(j->previous(), (std::vector<std::string>{"a"}));
   ASSERT_TRUE(j->append("b"));
   auto again = SentJournal::open(file());
   ASSERT_TRUE(again);
-  EXPECT_EQ(again->previous(), (std::vector<std::string>{"a", "hal", "b"}));
+  // The fragment never becomes an id: a later command "m3-e1" is not taken for one sent before.
+  EXPECT_EQ(again->previous(), (std::vector<std::string>{"a", "b"}));
+  EXPECT_EQ(text(), "a\nb\n");
+  std::ofstream(file(), std::ios::trunc) << "torn";  // a first line torn
+  auto first = SentJournal::open(file());
+  ASSERT_TRUE(first);
+  EXPECT_TRUE(first->previous().empty());
+  EXPECT_EQ(text(), "");
 }
 
 TEST_F(SentJournalTest, AnUnwritableJournalIsAnErrorNamingTheFile) {

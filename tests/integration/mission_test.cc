@@ -185,7 +185,7 @@ TEST(MissionTest, SecuredCorridorMissionSucceeds) {
   Mission m = run("namo_corridor.yaml", {"--policy", "effort", "--security", pki.string()});
   if (m.exit_code != 0) {
     // Known weakness, docs/benchmarks.md: secured, 2 corridor runs of 6 failed on this loaded VM
-    // (a service pair not matched within the graph manager's 10 s, a lost reply). One more try,
+    // (a service pair not matched within the graph manager's wait, 10 s then, now 30 s; a lost reply). One more try,
     // the first failure shown; two failures in a row fail the test.
     std::cerr << "secured mission failed once (exit " << m.exit_code << "), trying again:\n" << m.output << "\n";
     RecordProperty("secured_first_attempt_failed", "true");

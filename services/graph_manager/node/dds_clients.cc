@@ -265,11 +265,17 @@ void DdsExecutor::onStatus(const msg::ExecuteStatus& s) {
   }
 }
 
+namespace {
+constexpr double kMonitorMatchWaitS = 30.0;
+}  // namespace
+
 ExecutionReport DdsExecutor::execute(const EdgeCommand& c, double budget_s) {
   ExecutionReport r;
-  if (!writer_.waitForReaders(Termination::after(10.0))) {
+  // Up to 30 s for the monitor to be matched: with DDS Security on a loaded 2-core machine the
+  // authentication handshake of a pair took more than 10 s (MissionTest.Secured..., 2 CI runs).
+  if (!writer_.waitForReaders(Termination::after(kMonitorMatchWaitS))) {
     r.outcome = ExecOutcome::kUnavailable;
-    r.reason = "no execution monitor on this domain";
+    r.reason = "no execution monitor on this domain (none matched within " + std::to_string(static_cast<int>(kMonitorMatchWaitS)) + " s)";
     return r;
   }
   const std::string wire = wireId(c.command_id);

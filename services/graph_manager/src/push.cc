@@ -4,6 +4,7 @@
 // collision-free by the motion planner with the object carried ahead of the base.
 #include <algorithm>
 #include <cmath>
+#include <cctype>
 #include <cstdio>
 
 #include "tamp/core/log.h"
@@ -70,9 +71,20 @@ MotionQuery fullBaseQuery(const Pose2D& from, const Pose2D& to, const BranchCont
 
 bool isPush(const Edge& e) { return !e.tokens.empty() && e.tokens[0] == "push"; }
 
-bool GraphManager::domainPushes() const {
-  return domain_.find("push-to") != std::string::npos && domain_.find("(:action push") != std::string::npos;
+bool pushesIn(const std::string& domain_pddl) {
+  // PDDL is case-insensitive and free in its whitespace: compare on lower-case tokens.
+  std::string flat;
+  bool space = true;
+  for (char c : domain_pddl) {
+    const bool ws = std::isspace(static_cast<unsigned char>(c)) != 0;
+    if (ws && !space) flat += ' ';
+    if (!ws) flat += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    space = ws;
+  }
+  return flat.find("(push-to ") != std::string::npos && flat.find("(:action push ") != std::string::npos;
 }
+
+bool GraphManager::domainPushes() const { return domain_pushes_; }
 
 std::string GraphManager::whyNotPushable(const world::Object& o) const {
   if (!domainPushes()) return "the domain has no push action";

@@ -73,6 +73,7 @@ GraphManager::GraphManager(Abstraction abstraction, std::string domain_pddl, Mis
       services_(logged_),
       params_(params) {
   if (auto why = params_.invalidReason()) throw std::invalid_argument("GraphManagerParams: " + *why);
+  domain_pushes_ = pushesIn(domain_);
 }
 
 bool GraphManager::isGoal(NodeId n) const {

@@ -1,4 +1,5 @@
 #include "tamp/graph_manager/abstraction.h"
+#include "tamp/graph_manager/graph.h"
 
 #include <algorithm>
 
@@ -130,6 +131,15 @@ TEST(AbstractionTest, APushIsAStaticFactBetweenKnownSymbolsOnly) {
   int pushes = 0;
   for (const auto& x : a.staticAtoms()) pushes += x.rfind("(push-to ", 0) == 0;
   EXPECT_EQ(pushes, 1);
+}
+
+TEST(AbstractionTest, ADomainPushesOnlyWithThePushActionAndItsFact) {
+  auto text = readTextFile(configDir() / "pddl" / "mobile_manipulation.pddl");
+  ASSERT_TRUE(text.ok());
+  EXPECT_TRUE(pushesIn(*text));
+  EXPECT_TRUE(pushesIn("(:ACTION  Push\n :parameters ()) (PUSH-TO\t?o)"));
+  EXPECT_FALSE(pushesIn("(:action pushy) (push-to ?o)"));
+  EXPECT_FALSE(pushesIn("(:action push :parameters ())"));
 }
 
 TEST(AbstractionTest, AtomTokensNormalise) {

@@ -97,6 +97,8 @@ struct Edge {
 
 /// Whether `e` is a push: a base motion that moves an object ahead of the base.
 bool isPush(const Edge& e);
+/// Whether a domain text declares the `push` action and the `push-to` predicate (any case and spacing).
+bool pushesIn(const std::string& domain_pddl);
 
 class ReachabilityGraph {
  public:

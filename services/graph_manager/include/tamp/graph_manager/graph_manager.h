@@ -461,6 +461,7 @@ class GraphManager {
 
   Abstraction abstraction_;
   std::string domain_;
+  bool domain_pushes_{false};  ///< the domain has `push` and `push-to` (pushesIn, at construction)
   MissionGoal goal_;
   LoggedServiceClients logged_;  ///< wraps the services given; declared before `services_`
   ServiceClients& services_;

@@ -267,14 +267,10 @@ class RecordDeliveryTest : public ::testing::Test {
     forwarded_reader_ = std::make_unique<dds::Reader<msg::ExecutionRecord>>(
         participant_, dds::topics::kExecutionRecords,
         [this](const msg::ExecutionRecord& m, const dds::SampleMeta&) { forwarded_.add(m.record_id()); });
-    ack_reader_ = std::make_unique<dds::Reader<msg::RecordAck>>(
-        participant_, dds::topics::kRecordAcks,
-        [this](const msg::RecordAck& m, const dds::SampleMeta&) { acked_.add(m.record_id()); });
     ASSERT_TRUE(robot_->waitForReaders(Termination::after(30.0))) << "the monitor does not read robot records";
   }
 
   void TearDown() override {
-    ack_reader_.reset();
     forwarded_reader_.reset();
     robot_.reset();
     sup_.stopAll(5.0);
@@ -347,7 +343,8 @@ class RecordDeliveryTest : public ::testing::Test {
   /// True once the monitor's outbox (its file in the run folder) holds an acknowledgement for
   /// every id of `want`, false after `seconds`. The monitor's view, not the test's: an
   /// acknowledgement that a restarted estimator writes before this test's participant has
-  /// discovered it never reaches the test (VOLATILE topic), while the monitor, which stops
+  /// discovered it never reaches the test (VOLATILE topic; the first ones too, when the estimator's ack
+  /// writer matches the monitor before this test: CI failed so once), while the monitor, which stops
   /// resending only on an acknowledgement, is what delivery depends on.
   bool monitorAcknowledged(const std::set<std::string>& want, double seconds) {
     const Deadline d = Deadline::in(seconds);
@@ -381,16 +378,15 @@ class RecordDeliveryTest : public ::testing::Test {
   process::Supervisor sup_;
   std::shared_ptr<dds::Participant> participant_;
   std::unique_ptr<dds::Writer<msg::ExecutionRecord>> robot_;
-  IdSet forwarded_, acked_;
+  IdSet forwarded_;
   std::unique_ptr<dds::Reader<msg::ExecutionRecord>> forwarded_reader_;
-  std::unique_ptr<dds::Reader<msg::RecordAck>> ack_reader_;
 };
 
 // More records while the estimator is dead than the record topics keep for a late reader (KEEP_LAST
 // 100): the monitor keeps them until acknowledged, so every one is stored once after the restart.
 TEST_F(RecordDeliveryTest, RecordsForwardedWhileTheEstimatorIsDownAllArriveOnceAfterItRestarts) {
   std::set<std::string> all = publish("before-", 3);
-  ASSERT_TRUE(acked_.waitForAll(all, 30.0)) << "the estimator did not acknowledge the first records";
+  ASSERT_TRUE(monitorAcknowledged(all, 30.0)) << "the estimator did not acknowledge the first records";
   killService("effort_estimator");
   const std::set<std::string> down = publish("down-", 130);
   all.insert(down.begin(), down.end());
@@ -406,7 +402,7 @@ TEST_F(RecordDeliveryTest, RecordsForwardedWhileTheEstimatorIsDownAllArriveOnceA
 // them from its outbox in the run folder; each is stored once, none of the earlier ones again.
 TEST_F(RecordDeliveryTest, AMonitorRestartedWithUnacknowledgedRecordsDeliversThemOnce) {
   std::set<std::string> all = publish("before-", 3);
-  ASSERT_TRUE(acked_.waitForAll(all, 30.0)) << "the estimator did not acknowledge the first records";
+  ASSERT_TRUE(monitorAcknowledged(all, 30.0)) << "the estimator did not acknowledge the first records";
   killService("effort_estimator");
   const std::set<std::string> waiting = publish("waiting-", 5);
   all.insert(waiting.begin(), waiting.end());

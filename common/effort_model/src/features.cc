@@ -118,9 +118,23 @@ std::vector<BaseStep> baseSteps(const std::vector<Pose2D>& poses) {
   if (poses.empty()) return steps;
   double heading = poses.front().theta;
   BaseStep run{BaseStep::Kind::kDrive, 0.0, 0.0, {}};  // the straight run being accumulated
+  // A turn right after a turn the same way is the same turn in place, only sampled at more
+  // waypoints (a time-parameterized trajectory has one every sample period): one rest-to-rest
+  // turn, not one stop per sample. A turn back the other way is a new step.
+  double last_turn = 0.0;  // signed angle of steps.back() when it is a turn
   auto turnTo = [&](double target) {
-    const double turn = std::abs(angleDiff(target, heading));
-    if (turn > Tol::kMinTurnRad) steps.push_back(BaseStep{BaseStep::Kind::kTurn, target, turn, {}});
+    const double signed_turn = angleDiff(target, heading);
+    const double turn = std::abs(signed_turn);
+    if (turn > Tol::kMinTurnRad) {
+      if (!steps.empty() && steps.back().kind == BaseStep::Kind::kTurn && last_turn * signed_turn > 0.0) {
+        steps.back().target_heading = target;
+        steps.back().amount += turn;
+        last_turn += signed_turn;
+      } else {
+        steps.push_back(BaseStep{BaseStep::Kind::kTurn, target, turn, {}});
+        last_turn = signed_turn;
+      }
+    }
     heading = target;
   };
   auto flushRun = [&]() {

@@ -75,6 +75,25 @@ TEST(BaseFeaturesTest, TurnsTakeTheShortWayAcrossPi) {
   EXPECT_THAT(f->turns.lengths(), ElementsAre(DoubleNear(2 * kPi - 6.2, 1e-9)));
 }
 
+// A time-parameterized trajectory samples one turn in place at every sample period: still one
+// turn (the simulator times each step rest-to-rest, so 40 samples were 40 stops).
+TEST(BaseFeaturesTest, ATurnInPlaceSampledAtManyWaypointsIsOneTurn) {
+  std::vector<std::vector<double>> wp;
+  for (int i = 0; i <= 40; ++i) wp.push_back({0, 0, -kPi / 2 - 1.2 * i / 40.0});
+  // The drive along -x needs a heading of pi: 0.37 rad more the same way, still the same turn.
+  wp.push_back({-1, 0, kPi});
+  auto f = extractFeatures(basePath(wp));
+  ASSERT_TRUE(f.ok());
+  EXPECT_THAT(f->turns.lengths(), ElementsAre(DoubleNear(kPi / 2, 1e-9)));
+  EXPECT_THAT(f->moves.lengths(), ElementsAre(DoubleNear(1.0, 1e-12)));
+}
+
+TEST(BaseFeaturesTest, ATurnBackTheOtherWayIsASecondTurn) {
+  auto f = extractFeatures(basePath({{0, 0, 0}, {0, 0, 0.25}, {0, 0, 0.5}, {0, 0, 0.2}}));
+  ASSERT_TRUE(f.ok());
+  EXPECT_THAT(f->turns.lengths(), ElementsAre(DoubleNear(0.3, 1e-12), DoubleNear(0.5, 1e-12)));
+}
+
 TEST(BaseFeaturesTest, ColumnOrderDoesNotMatter) {
   ActionDescription a;
   a.kind = ActionKind::kMoveBase;

@@ -126,7 +126,8 @@ struct BaseStep {
 /// The stop-and-turn steps of a base path (`poses`: its waypoints' base poses): for each straight
 /// run of the polyline (merged per FeatureTolerances::kCollinearRad), a turn in place to the
 /// run's heading (driven forwards or backwards, whichever turns less), then the drive; a waypoint without translation but with a new heading is a turn
-/// in place to it; at the end a turn to the last heading. Turns up to kMinTurnRad and
+/// in place to it (consecutive turns the same way are one turn: a trajectory samples one turn at
+/// many waypoints); at the end a turn to the last heading. Turns up to kMinTurnRad and
 /// translations below kMinTranslationM are not steps. The segmentation the move_base features and
 /// the simulator's base timeline share.
 std::vector<BaseStep> baseSteps(const std::vector<Pose2D>& poses);

@@ -244,13 +244,24 @@ std::vector<ObjectOverride> GraphManager::overridesOf(const BranchContext& ctx, 
 std::string GraphManager::worldKey(const BranchContext& ctx) {
   char buf[96];
   std::snprintf(buf, sizeof buf, "%.3f,%.3f,%.3f", ctx.state.base.x, ctx.state.base.y, ctx.state.base.theta);
-  std::string k = buf;
+  return buf + objectsKey(ctx);
+}
+
+std::string GraphManager::objectsKey(const BranchContext& ctx) {
+  char buf[96];
+  std::string k;
   for (const auto& [id, pose] : ctx.object_poses) {
     std::snprintf(buf, sizeof buf, "|%.3f,%.3f,%.3f", pose.translation().x(), pose.translation().y(),
                   pose.translation().z());
     k += id + buf;
   }
-  return k;
+  return k + "|held " + ctx.held.object_id;
+}
+
+void GraphManager::clearWorldCaches() {
+  grasp_cache_.clear();
+  placement_cache_.clear();
+  push_cache_.clear();
 }
 
 std::optional<std::pair<GraspOption, Eigen::Isometry3d>> GraphManager::preparePlace(

@@ -273,8 +273,7 @@ GraphManager::Run::Prepared GraphManager::Run::prepare(EdgeId id, EdgeId next) {
   a.reason = "cannot prepare " + what + ": " + e.reason;
   report.actions.push_back(a);
   if (observer.on_action) observer.on_action(a, done_effort, branch_total);
-  gm.grasp_cache_.clear();
-  gm.placement_cache_.clear();
+  gm.clearWorldCaches();
   if (e.kind == ActionKind::kMoveArm) {
     e.motion_by_next.erase(gm.armKey(id, next));
     e.effort_by_next.erase(gm.armKey(id, next));
@@ -595,8 +594,7 @@ bool GraphManager::Run::replan(const MissionEvent& ev, EdgeId failed, std::strin
       (void)live.setObjectPose(o.id, *expected);
   }
   gm.abstraction_.setWorld(live);
-  gm.grasp_cache_.clear();
-  gm.placement_cache_.clear();
+  gm.clearWorldCaches();
   const HeldGrasp held_before = ctx.held;
   if (now.valid) ctx = gm.contextOf(now);
   // Still holding what the branch picked: the grasp is the one it executed. The world model

@@ -131,6 +131,25 @@ std::optional<MotionAnswer> GraphManager::pushMotion(const std::string& object, 
                                                      const Eigen::Isometry3d& target, const Pose2D& from,
                                                      const Pose2D& apex, const Pose2D& to, const BranchContext& ctx,
                                                      std::string& why) {
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "%.3f,%.3f,%.3f>%.3f,%.3f>%.3f,%.3f|%.3f,%.3f>%.3f,%.3f@", from.x, from.y, from.theta,
+                apex.x, apex.y, to.x, to.y, pose.translation().x(), pose.translation().y(), target.translation().x(),
+                target.translation().y());
+  const std::string key = object + ":" + buf + objectsKey(ctx);
+  auto it = push_cache_.find(key);
+  if (it == push_cache_.end()) {
+    PushCacheEntry entry;
+    entry.answer = planPushMotion(object, pose, target, from, apex, to, ctx, entry.why);
+    it = push_cache_.emplace(key, std::move(entry)).first;
+  }
+  why = it->second.why;
+  return it->second.answer;
+}
+
+std::optional<MotionAnswer> GraphManager::planPushMotion(const std::string& object, const Eigen::Isometry3d& pose,
+                                                         const Eigen::Isometry3d& target, const Pose2D& from,
+                                                         const Pose2D& apex, const Pose2D& to,
+                                                         const BranchContext& ctx, std::string& why) {
   ++counters_.motion_calls;
   MotionAnswer a = services_.motion(pushQuery(object, pose, from, apex, ctx));
   if (!straightPush(a, from, apex)) {

@@ -413,9 +413,14 @@ class GraphManager {
   /// A push's base motion: straight from `from` to `apex` with the object (at `pose`) carried
   /// ahead, then straight back to `to`, the object left at `target`; none (and `why`) when
   /// either part is not a collision-free straight drive in the branch's world.
+  /// Memoised per world (push_cache_): spawnPushes checks a push that evaluatePush prices later.
   std::optional<MotionAnswer> pushMotion(const std::string& object, const Eigen::Isometry3d& pose,
                                          const Eigen::Isometry3d& target, const Pose2D& from, const Pose2D& apex,
                                          const Pose2D& to, const BranchContext& ctx, std::string& why);
+  /// pushMotion's two motion calls, uncached.
+  std::optional<MotionAnswer> planPushMotion(const std::string& object, const Eigen::Isometry3d& pose,
+                                             const Eigen::Isometry3d& target, const Pose2D& from, const Pose2D& apex,
+                                             const Pose2D& to, const BranchContext& ctx, std::string& why);
   /// findPossibleActions for an object the robot cannot grasp: pushes of `o` (on `support`)
   /// that clear `swept` by `keep_clear`, each checked collision-free; their slots (empty, and
   /// `why`, when none).
@@ -454,6 +459,11 @@ class GraphManager {
   static std::vector<ObjectOverride> overridesOf(const BranchContext& ctx, const std::string& except = {});
   /// A cache key for queries in the branch's world from its base pose.
   static std::string worldKey(const BranchContext& ctx);
+  /// The branch's object poses and held object, without the base pose (for queries whose start
+  /// is given, not the branch's base).
+  static std::string objectsKey(const BranchContext& ctx);
+  /// Forgets what was computed in the world before it changed (grasps, placements, pushes).
+  void clearWorldCaches();
   MotionQuery baseQuery(const Edge& e, const BranchContext& ctx) const;
   std::vector<std::string> withStatics(const std::vector<std::string>& dynamic) const;
   void recordDecisions(NodeId from, const std::map<EdgeId, double>& best_through, const std::vector<EdgeId>& branch,
@@ -482,6 +492,12 @@ class GraphManager {
     std::string why;                    ///< the last request's error, if any
   };
   std::map<std::string, PlacementCacheEntry> placement_cache_;
+  /// pushMotion's answers (or why not) per push and branch world.
+  struct PushCacheEntry {
+    std::optional<MotionAnswer> answer;
+    std::string why;
+  };
+  std::map<std::string, PushCacheEntry> push_cache_;
   /// Failed executions in this mission: per move edge, and per manipulation of an object ("pick
   /// box"), whichever edge carried it (a grasp that misses from one stand misses from the next).
   int failuresOf(const Edge& e) const;

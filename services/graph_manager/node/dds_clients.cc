@@ -3,6 +3,7 @@
 #include "tamp/msg_validation/validate.h"
 
 #include <chrono>
+#include <future>
 
 #include "tamp/core/log.h"
 #include "effort_msgs.h"
@@ -170,6 +171,17 @@ MotionAnswer DdsServiceClients::motion(const MotionQuery& q) {
     a.blocking.push_back(std::move(c));
   }
   return a;
+}
+
+std::vector<MotionAnswer> DdsServiceClients::motions(const std::vector<MotionQuery>& qs) {
+  std::vector<std::future<MotionAnswer>> rest;
+  for (std::size_t i = 1; i < qs.size(); ++i)
+    rest.push_back(std::async(std::launch::async, [this, &q = qs[i]] { return motion(q); }));
+  std::vector<MotionAnswer> out;
+  out.reserve(qs.size());
+  if (!qs.empty()) out.push_back(motion(qs.front()));
+  for (auto& f : rest) out.push_back(f.get());
+  return out;
 }
 
 Result<std::vector<PlacementOption>> DdsServiceClients::placements(const PlacementQuery& q) {

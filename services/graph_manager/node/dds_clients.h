@@ -26,6 +26,9 @@ class DdsServiceClients : public ServiceClients {
   void setRobot(robot::RobotModel robot) { robot_ = std::move(robot); }
   TaskPlan plan(const TaskQuery& q) override;
   MotionAnswer motion(const MotionQuery& q) override;
+  /// Every query sent before any answer is awaited (one thread each; the RPC client is
+  /// thread-safe): the motion node's planner pool works on them side by side.
+  std::vector<MotionAnswer> motions(const std::vector<MotionQuery>& qs) override;
   Result<std::vector<PlacementOption>> placements(const PlacementQuery& q) override;
   Result<std::vector<GraspOption>> grasps(const GraspQuery& q) override;
   std::vector<EffortAnswer> effort(const std::vector<EffortQuery>& q) override;

@@ -18,6 +18,7 @@ class OracleServiceClients : public ServiceClients {
   OracleServiceClients(std::shared_ptr<dds::Participant> p, ServiceClients& base);
   TaskPlan plan(const TaskQuery& q) override { return base_.plan(q); }
   MotionAnswer motion(const MotionQuery& q) override { return base_.motion(q); }
+  std::vector<MotionAnswer> motions(const std::vector<MotionQuery>& qs) override { return base_.motions(qs); }
   Result<std::vector<PlacementOption>> placements(const PlacementQuery& q) override {
     return base_.placements(q);
   }

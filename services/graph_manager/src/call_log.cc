@@ -69,6 +69,26 @@ TaskPlan LoggedServiceClients::plan(const TaskQuery& q) {
   return p;
 }
 
+std::vector<MotionAnswer> ServiceClients::motions(const std::vector<MotionQuery>& qs) {
+  std::vector<MotionAnswer> out;
+  out.reserve(qs.size());
+  for (const MotionQuery& q : qs) out.push_back(motion(q));
+  return out;
+}
+
+std::vector<MotionAnswer> LoggedServiceClients::motions(const std::vector<MotionQuery>& qs) {
+  const auto t0 = Clock::now();
+  std::vector<MotionAnswer> out = inner_.motions(qs);
+  // Concurrent calls overlap: each is logged with its own round trip where the inner clients
+  // timed it, and the batch's wall time is the first one's (so a sum over the log stays close to
+  // the time waited).
+  const double wall = secondsSince(t0);
+  for (std::size_t i = 0; i < out.size() && i < qs.size(); ++i)
+    add({"motion", motionWhat(qs[i]) + ": " + std::string(toString(out[i].status)) + (i ? " (concurrent)" : ""),
+         i == 0 ? wall : 0.0, out[i].time_s});
+  return out;
+}
+
 MotionAnswer LoggedServiceClients::motion(const MotionQuery& q) {
   const auto t0 = Clock::now();
   MotionAnswer a = inner_.motion(q);

@@ -95,17 +95,25 @@ MotionQuery GraphManager::baseQuery(const Edge& e, const BranchContext& ctx) con
 }
 
 MotionAnswer GraphManager::lazyOrFull(const MotionQuery& q) {
+  // The static-only path ignores movables, so it may cross one where a path of about the same
+  // length touches nothing (an object beside the way, one this branch put aside): the
+  // effort-aware lazy path replaces it when it is clear and hardly longer.
+  MotionQuery aware = q;
+  aware.movable_cost_weight = 1.0;
+  auto better = [&](MotionAnswer& a, MotionAnswer&& b) {
+    if (b.ok() && b.blocking.empty() && b.path_length <= params_.clear_path_stretch * a.path_length) a = std::move(b);
+  };
+  if (q.mode == Mode::kLazy && params_.concurrent_motions) {
+    counters_.motion_calls += 2;
+    std::vector<MotionAnswer> ab = services_.motions({q, aware});
+    if (ab[0].ok() && !ab[0].blocking.empty()) better(ab[0], std::move(ab[1]));
+    return std::move(ab[0]);
+  }
   ++counters_.motion_calls;
   MotionAnswer a = services_.motion(q);
   if (a.ok() && q.mode == Mode::kLazy && !a.blocking.empty()) {
-    // The static-only path ignores movables, so it may cross one where a path of about the same
-    // length touches nothing (an object beside the way, one this branch put aside): ask for the
-    // effort-aware lazy path and take it when it is clear and hardly longer.
-    MotionQuery aware = q;
-    aware.movable_cost_weight = 1.0;
     ++counters_.motion_calls;
-    MotionAnswer b = services_.motion(aware);
-    if (b.ok() && b.blocking.empty() && b.path_length <= params_.clear_path_stretch * a.path_length) a = std::move(b);
+    better(a, services_.motion(aware));
   }
   return a;
 }

@@ -150,21 +150,34 @@ std::optional<MotionAnswer> GraphManager::planPushMotion(const std::string& obje
                                                          const Eigen::Isometry3d& target, const Pose2D& from,
                                                          const Pose2D& apex, const Pose2D& to,
                                                          const BranchContext& ctx, std::string& why) {
-  ++counters_.motion_calls;
-  MotionAnswer a = services_.motion(pushQuery(object, pose, from, apex, ctx));
-  if (!straightPush(a, from, apex)) {
-    why = a.ok() ? "the push is not straight" : std::string(toString(a.status)) + (a.reason.empty() ? "" : ": " + a.reason);
-    return std::nullopt;
-  }
-  if (std::hypot(apex.x - to.x, apex.y - to.y) < 1e-6) return a;
+  const MotionQuery push = pushQuery(object, pose, from, apex, ctx);
+  const bool backs_off = std::hypot(apex.x - to.x, apex.y - to.y) >= 1e-6;
   // The base backs off, straight, leaving the object where it pushed it: room to turn.
   MotionQuery back = fullBaseQuery(apex, to, ctx, params_.motion_budget_s);
   back.overrides = overridesOf(ctx, object);
   back.overrides.push_back(ObjectOverride{object, false, target});
   // Straight away from the object it touches: the object is no obstacle to that.
   back.ignored = {object};
-  ++counters_.motion_calls;
-  const MotionAnswer b = services_.motion(back);
+  std::vector<MotionAnswer> answers;
+  answers.reserve(2);  // `a` below stays valid when the back-off is asked after it
+  if (backs_off && params_.concurrent_motions) {
+    counters_.motion_calls += 2;
+    answers = services_.motions({push, back});
+  } else {
+    ++counters_.motion_calls;
+    answers.push_back(services_.motion(push));
+  }
+  MotionAnswer& a = answers.front();
+  if (!straightPush(a, from, apex)) {
+    why = a.ok() ? "the push is not straight" : std::string(toString(a.status)) + (a.reason.empty() ? "" : ": " + a.reason);
+    return std::nullopt;
+  }
+  if (!backs_off) return std::move(a);
+  if (answers.size() < 2) {
+    ++counters_.motion_calls;
+    answers.push_back(services_.motion(back));
+  }
+  const MotionAnswer& b = answers.back();
   if (!straightPush(b, apex, to)) {
     why = b.ok() ? "the back-off is not straight" : "back-off: " + std::string(toString(b.status)) + (b.reason.empty() ? "" : ": " + b.reason);
     return std::nullopt;

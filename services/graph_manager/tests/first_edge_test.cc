@@ -27,6 +27,13 @@ class ScriptedServices : public ServiceClients {
   Eigen::Vector2d slow_from{1e9, 1e9};
   double slow_factor{1.0};
   int motion_calls{0};
+  int batches{0};                   ///< motions() calls (concurrent queries)
+  bool block_static_lazy{false};    ///< static-only lazy paths cross "box"; effort-aware ones do not
+
+  std::vector<MotionAnswer> motions(const std::vector<MotionQuery>& qs) override {
+    ++batches;
+    return ServiceClients::motions(qs);
+  }
 
   TaskPlan plan(const TaskQuery& q) override {
     (void)q;
@@ -70,6 +77,13 @@ class ScriptedServices : public ServiceClients {
     a.trajectory.joint_names = a.path.joint_names;
     a.trajectory.points = {TrajectoryPoint{0.0, a.path.waypoints[0], {}},
                            TrajectoryPoint{a.path_length, a.path.waypoints[1], {}}};
+    if (block_static_lazy && q.mode == Mode::kLazy && q.movable_cost_weight == 0.0) {
+      Crossing c;
+      c.object_id = "box";
+      c.enter_fraction = 0.4;
+      c.exit_fraction = 0.6;
+      a.blocking.push_back(c);
+    }
     return a;
   }
   Result<std::vector<PlacementOption>> placements(const PlacementQuery&) override {
@@ -110,7 +124,7 @@ class FirstEdgeTest : public ::testing::Test {
     BranchContext ctx;
   };
 
-  Setup make(ScriptedServices& services) {
+  Setup make(ScriptedServices& services, bool concurrent = false) {
     auto sc = world::loadScenario(configDir() / "scenarios" / "namo_corridor.yaml");
     EXPECT_TRUE(sc.ok()) << (sc ? "" : sc.error().toString());
     auto robot = robot::RobotModel::loadDescription(sc->robot.description);
@@ -121,6 +135,8 @@ class FirstEdgeTest : public ::testing::Test {
       EXPECT_EQ(a.locationFor(Pose2D{x, y, 0.0}, name), name);
     GraphManagerParams params;
     params.max_contingencies = 0;
+    // Off unless asked: the tests count one motion call per edge priced.
+    params.concurrent_motions = concurrent;
     Setup s;
     s.gm = std::make_unique<GraphManager>(std::move(a), "", MissionGoal{{"(robot-at goal)"}},
                                           services, params);
@@ -147,6 +163,29 @@ class FirstEdgeTest : public ::testing::Test {
     return out;
   }
 };
+
+// Motions asked together (a lazy path with its effort-aware alternative) decide exactly as the
+// same motions asked one after the other, whether the static-only path crosses an object (the
+// clear alternative is taken) or not (it is asked for nothing).
+TEST_F(FirstEdgeTest, ConcurrentMotionsDecideAsOnesAskedOneAfterTheOther) {
+  for (bool blocked : {false, true}) {
+    ScriptedServices one_by_one, together;
+    one_by_one.block_static_lazy = together.block_static_lazy = blocked;
+    Setup a = make(one_by_one, false);
+    Setup b = make(together, true);
+    const TraverseResult ra = a.gm->traverse(a.gm->root(), a.ctx);
+    const TraverseResult rb = b.gm->traverse(b.gm->root(), b.ctx);
+    ASSERT_TRUE(ra.found) << ra.reason;
+    ASSERT_TRUE(rb.found) << rb.reason;
+    EXPECT_EQ(actions(*b.gm, rb.branch), actions(*a.gm, ra.branch)) << "blocked " << blocked;
+    EXPECT_DOUBLE_EQ(rb.cost_s, ra.cost_s) << "blocked " << blocked;
+    EXPECT_EQ(one_by_one.batches, 0);
+    EXPECT_GT(together.batches, 0);
+    // One after the other, the alternative is asked only for a crossing path.
+    EXPECT_EQ(one_by_one.motion_calls, blocked ? 8 : 4);
+    EXPECT_EQ(together.motion_calls, 8);
+  }
+}
 
 TEST_F(FirstEdgeTest, TheFirstEdgeIsDecidedWithoutPricingBelowIt) {
   ScriptedServices full_services;

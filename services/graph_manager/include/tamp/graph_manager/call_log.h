@@ -18,7 +18,8 @@ namespace tamp::graph_manager {
 struct TimedCall {
   std::string service;   ///< "plan", "motion", "placement", "grasp", "effort"
   std::string what;      ///< "base lazy", "arm full", "box on table", ...
-  double s{0.0};         ///< wall time of the call at the client (queueing and transport included)
+  double s{0.0};         ///< wall time of the call at the client (queueing and transport included);
+                         ///< in a batch of concurrent motions the first has the batch's, the others 0
   double server_s{0.0};  ///< the service's own time when it reports one (motions, plans), else 0
 };
 
@@ -43,6 +44,7 @@ class LoggedServiceClients : public ServiceClients {
   explicit LoggedServiceClients(ServiceClients& inner) : inner_(inner) {}
   TaskPlan plan(const TaskQuery& q) override;
   MotionAnswer motion(const MotionQuery& q) override;
+  std::vector<MotionAnswer> motions(const std::vector<MotionQuery>& qs) override;
   Result<std::vector<PlacementOption>> placements(const PlacementQuery& q) override;
   Result<std::vector<GraspOption>> grasps(const GraspQuery& q) override;
   std::vector<EffortAnswer> effort(const std::vector<EffortQuery>& q) override;

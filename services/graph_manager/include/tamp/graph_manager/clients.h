@@ -162,6 +162,10 @@ class ServiceClients {
   virtual ~ServiceClients() = default;
   virtual TaskPlan plan(const TaskQuery& q) = 0;
   virtual MotionAnswer motion(const MotionQuery& q) = 0;
+  /// Independent motion queries at once, answered in their order. This one asks them one after
+  /// the other; clients of a planner that serves requests concurrently (the motion node's pool)
+  /// send them all before waiting, so the batch takes about as long as its slowest query.
+  virtual std::vector<MotionAnswer> motions(const std::vector<MotionQuery>& qs);
   virtual Result<std::vector<PlacementOption>> placements(const PlacementQuery& q) = 0;
   virtual Result<std::vector<GraspOption>> grasps(const GraspQuery& q) = 0;
   virtual std::vector<EffortAnswer> effort(const std::vector<EffortQuery>& q) = 0;

@@ -62,6 +62,10 @@ struct GraphManagerParams {
   /// A lazy path crossing movables is replaced by a clear effort-aware one at most this much
   /// longer (the objects are then beside the way, not in it); >= 1.
   double clear_path_stretch{1.25};
+  /// Motion queries known together go out together (ServiceClients::motions: the motion node's
+  /// planner pool answers them side by side): a lazy base path with its effort-aware alternative
+  /// (asked speculatively, used only when the first crosses a movable), a push with its back-off.
+  bool concurrent_motions{true};
   /// A base path longer than this many times the straight line from a start facing away is
   /// planned again after a turn in place towards the goal; >= 1.
   double turn_first_ratio{1.5};

@@ -73,11 +73,15 @@ class TurnDriveTurnSpace : public ob::SE2StateSpace {
     return out;
   }
 
-  unsigned int validSegmentCount(const ob::State* s1, const ob::State* s2) const override {
+  /// The turns at the turn radius plus the drive (what interpolate() parametrises).
+  double sweptLength(const ob::State* s1, const ob::State* s2) const {
     const Pieces p = pieces(s1, s2);
-    const double total = (std::abs(p.turn1) + std::abs(p.turn2)) * turn_radius_ + p.drive;
+    return (std::abs(p.turn1) + std::abs(p.turn2)) * turn_radius_ + p.drive;
+  }
+
+  unsigned int validSegmentCount(const ob::State* s1, const ob::State* s2) const override {
     return longestValidSegmentCountFactor_ *
-           static_cast<unsigned int>(std::max(1.0, std::ceil(total / longestValidSegment_)));
+           static_cast<unsigned int>(std::max(1.0, std::ceil(sweptLength(s1, s2) / longestValidSegment_)));
   }
 
  private:
@@ -152,6 +156,11 @@ class ArmProjection : public ob::ProjectionEvaluator {
 std::vector<double> turnCorners(const ob::StateSpace& space, const ob::State* a, const ob::State* b) {
   if (const auto* tdt = dynamic_cast<const TurnDriveTurnSpace*>(&space)) return tdt->cornerFractions(a, b);
   return {};
+}
+
+double sweptLength(const ob::StateSpace& space, const ob::State* a, const ob::State* b) {
+  if (const auto* tdt = dynamic_cast<const TurnDriveTurnSpace*>(&space)) return tdt->sweptLength(a, b);
+  return space.distance(a, b);
 }
 
 bool isStopAndTurn(const ob::StateSpace& space) { return dynamic_cast<const TurnDriveTurnSpace*>(&space) != nullptr; }

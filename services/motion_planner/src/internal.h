@@ -164,6 +164,10 @@ class Oracle {
 /// Fractions of the motion a -> b at the corners of a stop-and-turn base's motion (where a turn
 /// ends and the drive begins, where the drive ends); empty for other spaces.
 std::vector<double> turnCorners(const ob::StateSpace& space, const ob::State* a, const ob::State* b);
+/// How far the robot's farthest point travels from a to b: for a stop-and-turn base the turns
+/// (at its circumradius) plus the drive, which the SE(2) distance under-counts when a segment
+/// turns away and back (its end yaws agree); otherwise the space's distance.
+double sweptLength(const ob::StateSpace& space, const ob::State* a, const ob::State* b);
 /// Whether `space` is the stop-and-turn SE(2) (sampling.base_turn_in_place).
 bool isStopAndTurn(const ob::StateSpace& space);
 

@@ -260,7 +260,11 @@ std::vector<BlockingObject> blockingReport(Oracle& oracle, const og::PathGeometr
     const ob::State* a = path.getState(k);
     const ob::State* b = ns > 1 ? path.getState(k + 1) : a;
     const double len = ns > 1 ? space->distance(a, b) : 0.0;
-    const int n = std::max(1, static_cast<int>(std::ceil(len / resolution)));
+    // Sampled along what the robot sweeps: a base segment that turns away and back has a small
+    // SE(2) distance and a long sweep (a turn in place a few cm from an object touched it
+    // between samples, and the execution monitor refused the path).
+    const double swept = ns > 1 ? std::max(len, sweptLength(*space, a, b)) : 0.0;
+    const int n = std::max(1, static_cast<int>(std::ceil(swept / resolution)));
     oracle.candidates(a, b, cand);
     for (int i = (k == 0 ? 0 : 1); i <= n; ++i) {
       space->interpolate(a, b, static_cast<double>(i) / n, cur.get());

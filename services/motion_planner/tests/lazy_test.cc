@@ -230,5 +230,57 @@ TEST_F(LazyTest, SamplesAroundACrossedObjectFindTheGapBesideIt) {
   EXPECT_LE(with.cost_s, without.cost_s + 1e-9);
 }
 
+// (Last in the file: SamplesAroundACrossedObjectFindTheGapBesideIt compares two random lazy
+// paths and failed when this test ran before it; seedRandomness does not reset every random state.)
+// A 0.6 x 0.5 m stop-and-turn base drives north to a pose facing east, 4 cm short of a crate
+// beside the goal: it turns in place there, and its corner (0.39 m out) sweeps 5 cm into the
+// crate. The report must hold what the robot sweeps (an independent rectangle test, 2 mrad and
+// 1 mm apart), or the execution monitor refuses a path the graph manager believed clear. The
+// segment's end yaws agree, so its SE(2) distance is the drive alone: the report now samples by
+// the swept length (turns at the circumradius), about 1.5 times denser here. (This graze is deep
+// enough that the sparser samples caught it too; the refusals seen in the NAMO worlds at push
+// start poses are not reproduced by this test.)
+TEST_F(LazyTest, AStopAndTurnBaseReportsWhatItsTurnInPlaceSweeps) {
+  world::World w("room");
+  ASSERT_TRUE(w.addObject(testing::box("crate", 0.3 + 0.04 + 0.2, 3.0, 0.4, 0.4, true, 0.5)).ok());
+  MotionPlannerParams p = testing::untimedParams();
+  p.sampling.base_turn_in_place = true;
+  MotionPlanner mp(collision::RobotGeometry::box(0.6, 0.5, 0.35), p);
+  mp.setWorld(w);
+  const MotionResult r = mp.plan(baseRequest({0.0, 0.0, 0.0}, {0.0, 3.0, 0.0}), Termination::after(5.0));
+  ASSERT_EQ(r.status, MotionStatus::kSolved) << r.reason;
+  const double hx = 0.3, hy = 0.25;
+  auto touchesCrate = [&](double x, double y, double th) {
+    const double c = std::cos(th), s = std::sin(th);
+    const double dx = 0.54 - x, dy = 3.0 - y;
+    const double tx = 0.2 * std::abs(c) + 0.2 * std::abs(s);
+    return std::abs(dx) < hx * std::abs(c) + hy * std::abs(s) + 0.2 && std::abs(dy) < hx * std::abs(s) + hy * std::abs(c) + 0.2 &&
+           std::abs(dx * c + dy * s) < hx + tx && std::abs(-dx * s + dy * c) < hy + tx;
+  };
+  auto wrap = [](double a) { return std::remainder(a, 2.0 * M_PI); };
+  bool touched = false;
+  const auto& wp = r.path.waypoints;
+  double heading = wp.front()[2];
+  auto turn = [&](double x, double y, double to) {
+    const double d = wrap(to - heading);
+    const int n = std::max(1, static_cast<int>(std::ceil(std::abs(d) / 0.002)));
+    for (int k = 0; k <= n; ++k) touched = touched || touchesCrate(x, y, heading + d * k / n);
+    heading = to;
+  };
+  for (std::size_t i = 0; i + 1 < wp.size(); ++i) {
+    const double dx = wp[i + 1][0] - wp[i][0], dy = wp[i + 1][1] - wp[i][1], len = std::hypot(dx, dy);
+    if (len >= 1e-6) {
+      double h = std::atan2(dy, dx);
+      if (std::abs(wrap(h + M_PI - wp[i][2])) < std::abs(wrap(h - wp[i][2]))) h = wrap(h + M_PI);
+      turn(wp[i][0], wp[i][1], h);
+      const int n = std::max(1, static_cast<int>(std::ceil(len / 0.001)));
+      for (int k = 0; k <= n; ++k) touched = touched || touchesCrate(wp[i][0] + dx * k / n, wp[i][1] + dy * k / n, h);
+    }
+    turn(wp[i + 1][0], wp[i + 1][1], wp[i + 1][2]);
+  }
+  EXPECT_TRUE(touched) << "the scene should make the final turn sweep the crate";
+  EXPECT_EQ(blockingIds(r.blocking), touched ? std::vector<std::string>{"crate"} : std::vector<std::string>{});
+}
+
 }  // namespace
 }  // namespace tamp::motion_planner

@@ -127,6 +127,15 @@ bool GraphManager::straightPush(const MotionAnswer& a, const Pose2D& from, const
   return true;
 }
 
+double GraphManager::pushBackoff() const {
+  double front = 0.0, circumradius = 0.0;
+  for (const auto& v : abstraction_.robot().baseFootprint()) {
+    front = std::max(front, v.x());
+    circumradius = std::max(circumradius, v.norm());
+  }
+  return params_.push_backoff_m + std::max(0.0, circumradius - front);
+}
+
 std::optional<MotionAnswer> GraphManager::pushMotion(const std::string& object, const Eigen::Isometry3d& pose,
                                                      const Eigen::Isometry3d& target, const Pose2D& from,
                                                      const Pose2D& apex, const Pose2D& to, const BranchContext& ctx,
@@ -232,7 +241,7 @@ std::vector<std::string> GraphManager::spawnPushes(const world::Object& o, const
     const double back = -reach(fp, c, -k.n) - front - params_.push_gap_m;
     const Eigen::Vector2d start = c + back * k.n;
     const Eigen::Vector2d apex = start + (k.distance + params_.push_gap_m) * k.n;
-    const Eigen::Vector2d end = apex - params_.push_backoff_m * k.n;
+    const Eigen::Vector2d end = apex - pushBackoff() * k.n;
     const Pose2D from{start.x(), start.y(), heading}, top{apex.x(), apex.y(), heading}, to{end.x(), end.y(), heading};
     Eigen::Isometry3d target = pose;
     target.translation().head<2>() += k.distance * k.n;
@@ -282,7 +291,7 @@ double GraphManager::evaluatePush(Edge& e, const BranchContext& ctx) {
   Eigen::Vector2d n = slot->pose.translation().head<2>() - pose.translation().head<2>();
   if (n.norm() < 1e-6) n = Eigen::Vector2d(to->x - from->x, to->y - from->y);
   n.normalize();
-  const Pose2D apex{to->x + params_.push_backoff_m * n.x(), to->y + params_.push_backoff_m * n.y(), to->theta};
+  const Pose2D apex{to->x + pushBackoff() * n.x(), to->y + pushBackoff() * n.y(), to->theta};
   std::string why;
   const std::optional<MotionAnswer> pushed = pushMotion(o->id, pose, target, start, apex, *to, ctx, why);
   if (!pushed) {

@@ -413,6 +413,11 @@ class GraphManager {
   /// A push's base motion: straight from `from` to `apex` with the object (at `pose`) carried
   /// ahead, then straight back to `to`, the object left at `target`; none (and `why`) when
   /// either part is not a collision-free straight drive in the branch's world.
+  /// How far the base backs off after a push: `push_backoff_m` beyond the distance a turn in
+  /// place sweeps past its front (its circumradius minus its front's reach), so that the base can
+  /// turn away from the object it pushed with that much to spare (perception's estimate of a pushed
+  /// object lags; with a fixed 0.15 m the next turn swept into it, and the monitor stopped it).
+  double pushBackoff() const;
   /// Memoised per world (push_cache_): spawnPushes checks a push that evaluatePush prices later.
   std::optional<MotionAnswer> pushMotion(const std::string& object, const Eigen::Isometry3d& pose,
                                          const Eigen::Isometry3d& target, const Pose2D& from, const Pose2D& apex,

@@ -45,8 +45,9 @@ struct GraphManagerParams {
   double push_step_m{0.25};        ///< > 0
   double push_max_m{3.0};          ///< >= push_step_m
   double push_gap_m{0.03};         ///< >= 0
-  /// After a push the base backs off this far, straight, leaving the object: room to turn; >= 0
-  /// and below push_step_m + push_gap_m.
+  /// After a push the base backs off straight, leaving the object: as far as a turn in place
+  /// sweeps past its front (from the robot's footprint) plus this margin; >= 0 and below
+  /// push_step_m + push_gap_m.
   double push_backoff_m{0.15};
   int pushes_per_object{2};        ///< >= 0 (0: never push)
   double keep_clear_margin_m{0.10};  ///< placements keep this much more than the robot's radius off the path

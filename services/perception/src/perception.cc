@@ -76,6 +76,29 @@ double footprintMinor(const world::Shape& s) {
   return std::min(b.max.x() - b.min.x(), b.max.y() - b.min.y());
 }
 
+/// The footprint of `shape` at `world_T_shape` in the world's xy-plane (upright shapes).
+world::Polygon2 worldFootprint(const world::Shape& shape, const Eigen::Isometry3d& world_T_shape) {
+  world::Polygon2 out = shape.footprint(16);
+  for (auto& v : out) v = (world_T_shape * Eigen::Vector3d(v.x(), v.y(), 0.0)).head<2>();
+  return out;
+}
+
+/// Whether two convex polygons overlap by more than `depth` (separating axes).
+bool convexOverlap(const world::Polygon2& a, const world::Polygon2& b, double depth) {
+  for (const world::Polygon2* poly : {&a, &b}) {
+    for (std::size_t i = 0; i < poly->size(); ++i) {
+      const Eigen::Vector2d e = (*poly)[(i + 1) % poly->size()] - (*poly)[i];
+      const Eigen::Vector2d n(-e.y(), e.x());
+      if (n.norm() < 1e-12) continue;
+      double a0 = kInf, a1 = -kInf, b0 = kInf, b1 = -kInf;
+      for (const auto& v : a) a0 = std::min(a0, n.normalized().dot(v)), a1 = std::max(a1, n.normalized().dot(v));
+      for (const auto& v : b) b0 = std::min(b0, n.normalized().dot(v)), b1 = std::max(b1, n.normalized().dot(v));
+      if (a1 - b0 <= depth || b1 - a0 <= depth) return false;
+    }
+  }
+  return true;
+}
+
 struct Track {
   std::string id;
   std::string label;
@@ -98,6 +121,7 @@ struct Track {
   const ObjectClass* cls{nullptr};
   // This frame's measurement (tentatives: for the confirmation).
   bool matched{false};
+  bool pushed{false};  ///< moved out of the base this frame (keepOutOfBase)
 };
 
 /// Fraction of `points` inside the track's shape at its pose, grown by `margin`.
@@ -221,6 +245,42 @@ struct Perception::Impl {
       t.pose.translation().head<2>() += kStep * away.normalized();
       t.event_pose = t.pose;
     }
+  }
+
+  /// An object cannot be inside the robot's base: the base drives into what it pushes, whose
+  /// near face is filtered as the robot's own and whose smoothed (or kept, for a partial view)
+  /// estimate lags behind. A track whose footprint the base's overlaps by more than `depth` is
+  /// moved out along the base's heading when it is ahead of the base (pushed), else straight away
+  /// from the base's centre, in 1 cm steps, at most 0.6 m. True when it moved.
+  bool keepOutOfBase(Track& t, const RobotBody& body, double depth) {
+    constexpr double kStep = 0.01, kMaxShift = 0.6;
+    const double z0 = t.pose.translation().z() - t.shape.halfHeight(), z1 = t.pose.translation().z() + t.shape.halfHeight();
+    std::vector<std::pair<world::Polygon2, Eigen::Isometry3d>> base;
+    for (const auto& part : body.parts) {
+      if (part.owner != body.base_link) continue;
+      const Aabb b = part.shape.aabb(part.world_T_shape);
+      if (b.max.z() <= z0 || b.min.z() >= z1) continue;  // not at the object's height
+      base.emplace_back(worldFootprint(part.shape, part.world_T_shape), part.world_T_shape);
+    }
+    if (base.empty() || !world::isConvex(t.shape.footprint(16))) return false;
+    Eigen::Vector2d dir = Eigen::Vector2d::Zero();
+    double moved = 0.0;
+    for (; moved <= kMaxShift; moved += kStep) {
+      // Deeper than `depth` to start (an estimate beside the base may graze it), then out of it.
+      const world::Polygon2 fp = worldFootprint(t.shape, t.pose);
+      const std::pair<world::Polygon2, Eigen::Isometry3d>* hit = nullptr;
+      for (const auto& b : base)
+        if (convexOverlap(fp, b.first, moved > 0.0 ? 0.0 : depth)) hit = &b;
+      if (hit == nullptr) break;
+      if (dir.isZero()) {
+        const Eigen::Vector2d centre = hit->second.translation().head<2>();
+        const Eigen::Vector2d away = t.pose.translation().head<2>() - centre;
+        const Eigen::Vector2d heading = hit->second.linear().col(0).head<2>().normalized();
+        dir = away.dot(heading) > 0.0 ? heading : (away.norm() > 1e-9 ? away.normalized() : heading);
+      }
+      t.pose.translation().head<2>() += kStep * dir;
+    }
+    return moved > 0.0;
   }
 
   /// An object whose bottom is above the support below it falls onto that support (a MOVED
@@ -636,6 +696,7 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
   std::vector<Track*> candidates;
   for (auto& [id, t] : I.tracks) {
     t.matched = false;
+    t.pushed = false;
     if (t.state != TrackInfo::State::kGone && id != I.held_id) candidates.push_back(&t);
   }
   const auto& dets = result.detections;
@@ -705,6 +766,17 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
       t.pose = uprightPose(pos.x(), pos.y(), meas.translation().z(), sym > 0 ? wrapAngle(yaw_t + a * dy) : 0.0);
     }
     result.stats.matched += t.state == TrackInfo::State::kActive ? 1 : 0;
+  }
+
+  // Movable objects cannot be inside the base (keepOutOfBase): what it pushes stays ahead of it.
+  // The world model follows below, with the other tracks' updates.
+  if (self_filter) {
+    for (auto& [id, t] : I.tracks) {
+      if (t.state != TrackInfo::State::kActive || t.kind != world::ObjectKind::kMovable || id == I.held_id ||
+          id == robot->held_object_id)
+        continue;
+      t.pushed = I.keepOutOfBase(t, *robot, P.self_filter.padding);
+    }
   }
 
   // Unmatched detections become tentative objects (class from the priors, else by size),
@@ -854,7 +926,7 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
   }
 
   for (auto& [id, t] : I.tracks) {
-    if (t.state != TrackInfo::State::kActive || !t.matched) continue;
+    if (t.state != TrackInfo::State::kActive || !(t.matched || t.pushed)) continue;
     const world::Object* o = I.world.findObject(id);
     if (o == nullptr) continue;
     const double dpos = (o->pose.translation() - t.pose.translation()).norm();

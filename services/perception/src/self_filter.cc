@@ -31,6 +31,7 @@ RobotBody robotBodyAt(const robot::RobotModel& robot, const robot::RobotState& s
     body.parts.push_back(BodyPart{g.links[link], p.shape, poses[link] * p.link_T_shape});
   }
   body.world_T_tool = robot.toolPoseInWorld(state);
+  body.base_link = robot.options().base_link;
   body.held_object_id = std::move(held_object_id);
   body.stamp_ns = stamp_ns;
   return body;

@@ -42,6 +42,7 @@ struct RobotBody {
   std::string held_object_id;   ///< the object in the gripper (robot state), empty: none
   Eigen::Isometry3d world_T_tool{Eigen::Isometry3d::Identity()};  ///< the tool link (held object)
   std::int64_t stamp_ns{0};  ///< of the robot state it was computed from
+  std::string base_link;     ///< owner of the parts that drive on the floor (objects cannot be inside them)
 };
 
 /// The body of `robot` in `state` (link poses by `RobotModel::linkPoses`, shapes from

@@ -384,6 +384,7 @@ class Searcher {
       Goal partial;
       partial.conjuncts.push_back(GoalConjunct{so_far, {}});
       const bool last = k + 1 == agenda.size();
+      in_agenda_entry_before_last_ = !last;
       SearchResult r = ehcTo(last ? goal_ : partial, cur, plan, k == 0);
       if (r.status != SearchStatus::kSolved || last) return r;
       // Continue from the state the entry was reached in.
@@ -513,6 +514,8 @@ class Searcher {
   SearchResult fallback() {
     stats_.ehc_failed = true;
     if (!opt_.ehc_fallback) return finish(SearchStatus::kFailed);
+    ++stats_.ehc_fallbacks;
+    if (in_agenda_entry_before_last_) ++stats_.ehc_fallbacks_in_agenda;
     h_.setGoal(goal_);
     return opt_.fallback == SearchAlgorithm::kGbfs ? gbfs() : lazy();
   }
@@ -889,6 +892,7 @@ class Searcher {
   uint64_t eval_budget_{0};      // ehc: give up after this many evaluations (0 = unlimited)
   uint64_t fallback_budget_{0};  // ehc: fall back after this many evaluations (0 = unlimited)
   uint32_t iter_{0};
+  bool in_agenda_entry_before_last_{false};  // ehc: hill-climbing to a goal-agenda entry, not the last
 };
 
 CostType defaultCostType(const SearchOptions& o, const Task& t) {
@@ -912,6 +916,8 @@ void addRunCosts(SearchStatistics& into, const SearchStatistics& from) {
   into.evaluated += from.evaluated;
   into.ehc_retries += from.ehc_retries;
   into.ehc_retries_abandoned += from.ehc_retries_abandoned;
+  into.ehc_fallbacks += from.ehc_fallbacks;
+  into.ehc_fallbacks_in_agenda += from.ehc_fallbacks_in_agenda;
   into.registered_states += from.registered_states;
   into.seconds += from.seconds;
 }

@@ -386,7 +386,11 @@ class Searcher {
       const bool last = k + 1 == agenda.size();
       in_agenda_entry_before_last_ = !last;
       SearchResult r = ehcTo(last ? goal_ : partial, cur, plan, k == 0);
-      if (r.status != SearchStatus::kSolved || last) return r;
+      // After a fallback, the complete search has searched for the whole goal from the initial
+      // state (FF): its answer (plan, proof, or limit) is final, whichever entry the hill-climbing
+      // failed in. Going on to the next entry from the hill-climbing's own plan would discard
+      // the complete search's plan and repeat it at the next failure.
+      if (r.status != SearchStatus::kSolved || last || stats_.ehc_fallbacks > 0) return r;
       // Continue from the state the entry was reached in.
       StateBits st = init_;
       StateBits nxt(st.size());
@@ -400,7 +404,8 @@ class Searcher {
   }
 
   /// Hill-climbs from `cur` to `goal`, appending to `plan`. On success returns kSolved with the
-  /// whole plan so far; on failure falls back to GBFS from the start (full goal).
+  /// whole plan so far; on failure returns `fallback()`'s result: the complete search from the
+  /// initial state to the full goal `goal_`, not to `goal` (a plan for the whole task).
   SearchResult ehcTo(const Goal& goal, uint32_t cur, std::vector<OpId>& plan, bool first) {
     h_.setGoal(goal);
     std::fill(h_cache_.begin(), h_cache_.end(), kUnknown);

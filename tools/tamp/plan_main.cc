@@ -175,7 +175,8 @@ int main(int argc, char** argv) {
   if (stats) {
     std::fprintf(stderr,
                  "; status %s; parse %.4f s, ground %.4f s, search %.4f s; facts %zu, operators %zu; "
-                 "expanded %llu, evaluated %llu, initial h %lld; ehc plateau retries %llu (%llu abandoned); anytime %llu "
+                 "expanded %llu, evaluated %llu, initial h %lld; ehc plateau retries %llu (%llu abandoned); ehc fallbacks "
+                 "%llu (%llu in a goal-agenda entry before the last); anytime %llu "
                  "iterations, %llu improvements%s%s%s%s\n",
                  sp::toString(reply.status).c_str(), reply.stats.parse_seconds, reply.stats.ground_seconds,
                  reply.stats.search_seconds, reply.stats.facts, reply.stats.operators,
@@ -183,6 +184,8 @@ int main(int argc, char** argv) {
                  static_cast<unsigned long long>(reply.stats.evaluated), static_cast<long long>(reply.stats.initial_h),
                  static_cast<unsigned long long>(reply.stats.ehc_retries),
                  static_cast<unsigned long long>(reply.stats.ehc_retries_abandoned),
+                 static_cast<unsigned long long>(reply.stats.ehc_fallbacks),
+                 static_cast<unsigned long long>(reply.stats.ehc_fallbacks_in_agenda),
                  static_cast<unsigned long long>(reply.stats.anytime_iterations),
                  static_cast<unsigned long long>(reply.stats.anytime_improvements),
                  reply.stats.ehc_ff_failed ? "; ehc with FF-v2.3's relaxed plan failed, restarted" : "",

@@ -61,6 +61,7 @@ struct Row {
   long peak_kb{0};
   int exit_code{0};
   std::string note;
+  std::string stats;  // the planner's `--stats` line (commas as semicolons), when it printed one
 };
 
 struct RunResult {
@@ -70,6 +71,7 @@ struct RunResult {
   double cpu_s{0};
   long peak_kb{0};
   std::string out;
+  std::string err;
 };
 
 RunResult runChild(const std::vector<std::string>& argv, double timeout_s) {
@@ -81,12 +83,19 @@ RunResult runChild(const std::vector<std::string>& argv, double timeout_s) {
     return r;
   }
   unlink(tmpl);
+  char etmpl[] = "/tmp/tamp_ipc_bench_XXXXXX";
+  const int efd = mkstemp(etmpl);
+  if (efd < 0) {
+    close(fd);
+    r.out = "mkstemp failed";
+    return r;
+  }
+  unlink(etmpl);
   const auto t0 = std::chrono::steady_clock::now();
   const pid_t pid = fork();
   if (pid == 0) {
     dup2(fd, STDOUT_FILENO);
-    const int devnull = open("/dev/null", O_WRONLY);
-    if (devnull >= 0) dup2(devnull, STDERR_FILENO);
+    dup2(efd, STDERR_FILENO);
     std::vector<char*> args;
     for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
     args.push_back(nullptr);
@@ -127,6 +136,9 @@ RunResult runChild(const std::vector<std::string>& argv, double timeout_s) {
   ssize_t n;
   while ((n = read(fd, buf, sizeof buf)) > 0) r.out.append(buf, static_cast<size_t>(n));
   close(fd);
+  lseek(efd, 0, SEEK_SET);
+  while ((n = read(efd, buf, sizeof buf)) > 0) r.err.append(buf, static_cast<size_t>(n));
+  close(efd);
   return r;
 }
 
@@ -353,6 +365,14 @@ int main(int argc, char** argv) {
     row.cpu_s = rr.cpu_s;
     row.peak_kb = rr.peak_kb;
     row.exit_code = rr.exit_code;
+    // The planner's statistics line (`tamp plan --stats`), kept in the CSV as one field.
+    for (size_t pos = 0; pos < rr.err.size();) {
+      size_t end = rr.err.find('\n', pos);
+      if (end == std::string::npos) end = rr.err.size();
+      if (rr.err.compare(pos, 9, "; status ") == 0) row.stats = rr.err.substr(pos + 2, end - pos - 2);
+      pos = end + 1;
+    }
+    std::replace(row.stats.begin(), row.stats.end(), ',', ';');
     if (rr.exit_code == 0 && !rr.killed && dom) {
       auto plan = sp::parsePlan(rr.out, p.string() + ".plan");
       auto ptext = tamp::readTextFile(p);
@@ -379,14 +399,14 @@ int main(int argc, char** argv) {
   }
   if (!out_csv.empty()) {
     std::ofstream out(out_csv);
-    out << "domain,problem,planner,solved,wall_s,cpu_s,plan_length,plan_cost,peak_kb,exit_code,note\n";
+    out << "domain,problem,planner,solved,wall_s,cpu_s,plan_length,plan_cost,peak_kb,exit_code,note,stats\n";
     for (const auto& r : rows) {
-      char b[512];
-      std::snprintf(b, sizeof b, "%s,%s,%s,%d,%.4f,%.4f,%s,%s,%ld,%d,%s\n", r.domain.c_str(), r.problem.c_str(),
+      char b[1024];
+      std::snprintf(b, sizeof b, "%s,%s,%s,%d,%.4f,%.4f,%s,%s,%ld,%d,%s,%s\n", r.domain.c_str(), r.problem.c_str(),
                     r.planner.c_str(), r.solved ? 1 : 0, r.wall_s, r.cpu_s,
                     r.solved ? std::to_string(r.plan_length).c_str() : "",
                     r.solved ? std::to_string(static_cast<long>(r.plan_cost)).c_str() : "", r.peak_kb, r.exit_code,
-                    r.note.c_str());
+                    r.note.c_str(), r.stats.c_str());
       out << b;
     }
   }

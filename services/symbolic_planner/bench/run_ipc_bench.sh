@@ -6,6 +6,10 @@
 # (--lock), so that builds can run between instances but never during one. The planner gets the
 # limit minus 1 s as its own --timeout, so that its anytime phase (cost domains) ends with a plan
 # before the driver would kill it.
+# The planner runs with --stats; its statistics line (evaluations, fallbacks, ...) is the CSV's
+# last column. With TAMP_BENCH_TAG=t, the files are <name>_t.csv / <name>_t_summary.md and the
+# planner column says t, so that configurations can be run side by side without overwriting the
+# landed results.
 #   services/symbolic_planner/bench/run_ipc_bench.sh [BUILD_DIR] [SET...]
 #   (default build/planner, Release; default sets: pddl pddl-adl pddl-more)
 set -euo pipefail
@@ -26,9 +30,14 @@ for set in "${sets[@]}"; do
     pddl-more) name=symbolic_planner_ipc_more; limit=30 ;;
     *) name=symbolic_planner_ipc_${set//-/_}; limit=30 ;;
   esac
+  label=tamp-plan
+  if [ -n "${TAMP_BENCH_TAG:-}" ]; then
+    name=${name}_${TAMP_BENCH_TAG}
+    label=$TAMP_BENCH_TAG
+  fi
   echo "== $set ($limit s), $(date -u +%FT%TZ), load $(cut -d' ' -f1-3 /proc/loadavg)" >&2
-  "$bench" --planner "$planner" --set "$data/$set" --out "$out/$name.csv" \
-    --timeout "$limit" --lock /tmp/tamp-build.lock -- --timeout "$((limit - 1))" > "$out/${name}_summary.md"
+  "$bench" --planner "$planner" --set "$data/$set" --out "$out/$name.csv" --label "$label" \
+    --timeout "$limit" --lock /tmp/tamp-build.lock -- --timeout "$((limit - 1))" --stats > "$out/${name}_summary.md"
   echo "== $set done, $(date -u +%FT%TZ), load $(cut -d' ' -f1-3 /proc/loadavg)" >&2
 done
 

@@ -384,8 +384,13 @@ class Searcher {
       Goal partial;
       partial.conjuncts.push_back(GoalConjunct{so_far, {}});
       const bool last = k + 1 == agenda.size();
+      in_agenda_entry_before_last_ = !last;
       SearchResult r = ehcTo(last ? goal_ : partial, cur, plan, k == 0);
-      if (r.status != SearchStatus::kSolved || last) return r;
+      // After a fallback, the complete search has searched for the whole goal from the initial
+      // state (FF): its answer (plan, proof, or limit) is final, whichever entry the hill-climbing
+      // failed in. Going on to the next entry from the hill-climbing's own plan would discard
+      // the complete search's plan and repeat it at the next failure.
+      if (r.status != SearchStatus::kSolved || last || stats_.ehc_fallbacks > 0) return r;
       // Continue from the state the entry was reached in.
       StateBits st = init_;
       StateBits nxt(st.size());
@@ -399,7 +404,8 @@ class Searcher {
   }
 
   /// Hill-climbs from `cur` to `goal`, appending to `plan`. On success returns kSolved with the
-  /// whole plan so far; on failure falls back to GBFS from the start (full goal).
+  /// whole plan so far; on failure returns `fallback()`'s result: the complete search from the
+  /// initial state to the full goal `goal_`, not to `goal` (a plan for the whole task).
   SearchResult ehcTo(const Goal& goal, uint32_t cur, std::vector<OpId>& plan, bool first) {
     h_.setGoal(goal);
     std::fill(h_cache_.begin(), h_cache_.end(), kUnknown);
@@ -513,6 +519,8 @@ class Searcher {
   SearchResult fallback() {
     stats_.ehc_failed = true;
     if (!opt_.ehc_fallback) return finish(SearchStatus::kFailed);
+    ++stats_.ehc_fallbacks;
+    if (in_agenda_entry_before_last_) ++stats_.ehc_fallbacks_in_agenda;
     h_.setGoal(goal_);
     return opt_.fallback == SearchAlgorithm::kGbfs ? gbfs() : lazy();
   }
@@ -889,6 +897,7 @@ class Searcher {
   uint64_t eval_budget_{0};      // ehc: give up after this many evaluations (0 = unlimited)
   uint64_t fallback_budget_{0};  // ehc: fall back after this many evaluations (0 = unlimited)
   uint32_t iter_{0};
+  bool in_agenda_entry_before_last_{false};  // ehc: hill-climbing to a goal-agenda entry, not the last
 };
 
 CostType defaultCostType(const SearchOptions& o, const Task& t) {
@@ -912,6 +921,8 @@ void addRunCosts(SearchStatistics& into, const SearchStatistics& from) {
   into.evaluated += from.evaluated;
   into.ehc_retries += from.ehc_retries;
   into.ehc_retries_abandoned += from.ehc_retries_abandoned;
+  into.ehc_fallbacks += from.ehc_fallbacks;
+  into.ehc_fallbacks_in_agenda += from.ehc_fallbacks_in_agenda;
   into.registered_states += from.registered_states;
   into.seconds += from.seconds;
 }

@@ -164,6 +164,10 @@ struct SearchStatistics {
   bool ehc_second_won{false};
   uint64_t ehc_retries{0};  ///< plateaus searched again without helpful-action pruning
   uint64_t ehc_retries_abandoned{0};  ///< ... given up at `ehc_retry_budget_share`
+  /// ehc: complete searches the hill-climbing fell back to (`ehc_fallback`), and how many of
+  /// them started inside a goal-agenda entry that is not the last.
+  uint64_t ehc_fallbacks{0};
+  uint64_t ehc_fallbacks_in_agenda{0};
   uint64_t landmarks{0};    ///< lazy: number of fact landmarks found (0: landmark count not used)
   uint64_t eliminated_actions{0};  ///< removed by action elimination
   uint64_t anytime_iterations{0};    ///< weighted A* iterations of the anytime phase

@@ -10,6 +10,15 @@
 namespace tamp::symbolic_planner {
 namespace {
 
+/// A request for `instance` of a benchmark folder (its domain.pddl) under tests/data/benchmarks.
+PlanRequest benchmarkRequest(const std::string& folder, const std::string& instance) {
+  const auto dir = test::benchmarksDir() / folder;
+  PlanRequest req;
+  req.domain_text = test::readFile(dir / "domain.pddl");
+  req.problem_text = test::readFile(dir / instance);
+  return req;
+}
+
 class EverySearch : public ::testing::TestWithParam<SearchAlgorithm> {};
 
 TEST_P(EverySearch, SolvesTheAdlTaskWithACheckedPlan) {
@@ -67,10 +76,7 @@ TEST(Search, AstarIsCostOptimalAndWastarWithinItsBound) {
 }
 
 TEST(Search, RespectsDeadlineStopTokenAndMemoryBudget) {
-  const auto dir = test::benchmarksDir() / "pddl/blocks";
-  PlanRequest req;
-  req.domain_text = test::readFile(dir / "domain.pddl");
-  req.problem_text = test::readFile(dir / "instance-80.pddl");  // far beyond a few milliseconds
+  PlanRequest req = benchmarkRequest("pddl/blocks", "instance-80.pddl");  // far beyond a few milliseconds
   req.search.algorithm = SearchAlgorithm::kGbfs;
   req.timeout_seconds = 0.05;
   PlanReply r = plan(req, Termination());
@@ -95,10 +101,7 @@ TEST(Search, RespectsDeadlineStopTokenAndMemoryBudget) {
 TEST(Search, SecondEhcRunKeepsTheCheaperPlan) {
   // blocks-20: the FF-v2.3-order run gives a 50-step plan for an initial h of 5; the default EHC,
   // run second within its budget, a shorter one. Either way the plan is checked.
-  const auto dir = test::benchmarksDir() / "pddl/blocks";
-  PlanRequest req;
-  req.domain_text = test::readFile(dir / "domain.pddl");
-  req.problem_text = test::readFile(dir / "instance-20.pddl");
+  PlanRequest req = benchmarkRequest("pddl/blocks", "instance-20.pddl");
   req.search.ehc_second_budget_per_step = 0;
   PlanReply one = plan(req, Termination());
   ASSERT_EQ(one.status, PlanStatus::kSolved) << one.message;
@@ -194,10 +197,7 @@ TEST(Search, EhcPlateauSearchedAgainWithoutPruningIsBoundedByItsShareOfTheBudget
   // plateaus are large (tens of thousands of evaluations). Bounded, the hill-climbing gives up
   // on the first such plateau and the plan comes from the complete search; unbounded, it
   // wanders until the whole fallback budget is spent. Both plans are replayed by the checker.
-  const auto dir = test::benchmarksDir() / "pddl-more/psr-small/instance-40";
-  PlanRequest req;
-  req.domain_text = test::readFile(dir / "domain.pddl");
-  req.problem_text = test::readFile(dir / "instance-40.pddl");
+  PlanRequest req = benchmarkRequest("pddl-more/psr-small/instance-40", "instance-40.pddl");
   req.timeout_seconds = 120;
   PlanReply bounded = plan(req, Termination());
   ASSERT_EQ(bounded.status, PlanStatus::kSolved) << bounded.message;
@@ -219,10 +219,7 @@ TEST(Search, EhcFallbackInsideAGoalAgendaEntryIsFinal) {
   // with the fallback off) plus the lazy search alone, and returns the lazy search's plan. (It
   // used to go on to the next entry from the hill-climbing's own plan, discarding that plan,
   // and fall back a second time there: 11949 evaluations instead of 6076 + 351.)
-  const auto dir = test::benchmarksDir() / "pddl-more/psr-small/instance-40";
-  PlanRequest req;
-  req.domain_text = test::readFile(dir / "domain.pddl");
-  req.problem_text = test::readFile(dir / "instance-40.pddl");
+  PlanRequest req = benchmarkRequest("pddl-more/psr-small/instance-40", "instance-40.pddl");
   req.timeout_seconds = 120;
   PlanReply with = plan(req, Termination());
   ASSERT_EQ(with.status, PlanStatus::kSolved) << with.message;  // replayed by the checker
@@ -243,10 +240,7 @@ TEST(Search, EhcFallbackInsideAGoalAgendaEntryIsFinal) {
 TEST(Search, EhcFirstRunContinuesFromTheFirstBetterState) {
   // openstacks-12: the first run (FF-v2.3 variant) solves it; continuing from the first better
   // state instead of evaluating every sibling needs fewer evaluations. Both plans are checked.
-  const auto dir = test::benchmarksDir() / "pddl-more/openstacks";
-  PlanRequest req;
-  req.domain_text = test::readFile(dir / "domain.pddl");
-  req.problem_text = test::readFile(dir / "instance-12.pddl");
+  PlanRequest req = benchmarkRequest("pddl-more/openstacks", "instance-12.pddl");
   req.timeout_seconds = 120;
   req.search.ehc_ff_first_improvement = true;
   PlanReply first = plan(req, Termination());

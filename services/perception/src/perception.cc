@@ -88,11 +88,11 @@ bool convexOverlap(const world::Polygon2& a, const world::Polygon2& b, double de
   for (const world::Polygon2* poly : {&a, &b}) {
     for (std::size_t i = 0; i < poly->size(); ++i) {
       const Eigen::Vector2d e = (*poly)[(i + 1) % poly->size()] - (*poly)[i];
-      const Eigen::Vector2d n(-e.y(), e.x());
-      if (n.norm() < 1e-12) continue;
+      if (e.norm() < 1e-12) continue;
+      const Eigen::Vector2d n = Eigen::Vector2d(-e.y(), e.x()).normalized();
       double a0 = kInf, a1 = -kInf, b0 = kInf, b1 = -kInf;
-      for (const auto& v : a) a0 = std::min(a0, n.normalized().dot(v)), a1 = std::max(a1, n.normalized().dot(v));
-      for (const auto& v : b) b0 = std::min(b0, n.normalized().dot(v)), b1 = std::max(b1, n.normalized().dot(v));
+      for (const auto& v : a) a0 = std::min(a0, n.dot(v)), a1 = std::max(a1, n.dot(v));
+      for (const auto& v : b) b0 = std::min(b0, n.dot(v)), b1 = std::max(b1, n.dot(v));
       if (a1 - b0 <= depth || b1 - a0 <= depth) return false;
     }
   }

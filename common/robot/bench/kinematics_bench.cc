@@ -46,6 +46,30 @@ void BM_InverseKinematics(benchmark::State& state) {
 }
 BENCHMARK(BM_InverseKinematics)->Unit(benchmark::kMicrosecond);
 
+// The graph manager's reach facts (world::reachesRegion, 24 attempts) ask IK for a point over every
+// region from every location: mostly far out of reach. Arg 0: a target 2 m ahead (outside the reach
+// sphere: rejected before any attempt); arg 1: a target inside the sphere that no configuration
+// reaches with that orientation (every attempt runs).
+void BM_InverseKinematicsUnreachable(benchmark::State& state) {
+  Eigen::Isometry3d target = Eigen::Isometry3d::Identity();
+  target.linear() = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  const RobotModel::ReachSphere reach = model().armReach();
+  target.translation() = state.range(0) == 0 ? Eigen::Vector3d(2.0, 0.0, 0.85)
+                                             : reach.centre + Eigen::Vector3d(0.0, 0.0, -0.95 * reach.radius);
+  IkOptions opt;
+  opt.max_attempts = 24;
+  const auto seed = model().defaultState().arm;
+  std::size_t solved = 0, attempts = 0;
+  for (auto _ : state) {
+    const IkResult r = model().inverseKinematics(target, seed, opt);
+    solved += r.ok();
+    attempts += static_cast<std::size_t>(r.attempts);
+  }
+  state.counters["solved"] = static_cast<double>(solved) / static_cast<double>(state.iterations());
+  state.counters["attempts"] = static_cast<double>(attempts) / static_cast<double>(state.iterations());
+}
+BENCHMARK(BM_InverseKinematicsUnreachable)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+
 void BM_FullStateCollisionCheck(benchmark::State& state) {
   world::World w;
   world::Object table;

@@ -4,7 +4,9 @@
 #include <cctype>
 #include <cmath>
 #include <map>
+#include <limits>
 #include <numeric>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -138,6 +140,13 @@ struct RobotModel::Impl {
   int gripper_joint{-1};
   int tool_link{-1};
   KDL::Chain chain;
+  /// No tool position is farther than `reach_bound` from `reach_origin` (base_link): the first arm
+  /// joint's axis point, fixed in base_link. A revolute joint keeps the distance from its axis
+  /// point to the next one, so the sum of those distances (at zero), the last one's to the tool
+  /// and the prismatic joints' travel bound the reach (the triangle inequality).
+  Eigen::Vector3d reach_origin{Eigen::Vector3d::Zero()};
+  double reach_bound{std::numeric_limits<double>::infinity()};
+  void boundReach();
   collision::RobotGeometry geometry;
   world::Polygon2 footprint;
   double base_radius{0.0};
@@ -176,6 +185,37 @@ struct RobotModel::Impl {
     }
   }
 };
+
+/// reach_origin and reach_bound from the chain at zero (see Impl).
+void RobotModel::Impl::boundReach() {
+  Impl& m = *this;
+  KDL::Frame f = KDL::Frame::Identity();
+  std::optional<Eigen::Vector3d> first, last;
+  double bound = 0.0;
+  for (unsigned i = 0; i < m.chain.getNrOfSegments(); ++i) {
+    const KDL::Segment& seg = m.chain.getSegment(i);
+    const KDL::Joint& j = seg.getJoint();
+    if (j.getType() != KDL::Joint::None) {
+      const KDL::Vector p = f * j.JointOrigin();
+      const Eigen::Vector3d o(p.x(), p.y(), p.z());
+      if (!first) first = o;
+      if (last) bound += (o - *last).norm();
+      last = o;
+    }
+    f = f * seg.pose(0.0);
+  }
+  if (!first) return;
+  bound += (Eigen::Vector3d(f.p.x(), f.p.y(), f.p.z()) - *last).norm();
+  for (std::size_t k = 0; k < m.arm_joint_index.size(); ++k) {
+    const Joint& j = m.joints[static_cast<std::size_t>(m.arm_joint_index[k])];
+    if (j.type != JointType::kPrismatic) continue;
+    const JointLimits& l = m.arm_limits[k];
+    if (!std::isfinite(l.lower) || !std::isfinite(l.upper)) return;  // unbounded travel: no bound
+    bound += std::max(std::abs(l.lower), std::abs(l.upper));
+  }
+  m.reach_origin = *first;
+  m.reach_bound = bound;
+}
 
 RobotModel::RobotModel() : impl_(std::make_unique<Impl>()) {}
 RobotModel::RobotModel(const RobotModel& other) : impl_(std::make_unique<Impl>(*other.impl_)) {}
@@ -519,6 +559,7 @@ Result<RobotModel> RobotModel::fromUrdfString(const std::string& xml, const std:
                    "' has no movable joint",
                lineOfLink(options.tool_link), "tool_link");
   }
+  m.boundReach();
   if (!options.gripper_joint.empty()) {
     auto it = std::find_if(m.joints.begin(), m.joints.end(),
                            [&](const Joint& j) { return j.name == options.gripper_joint; });
@@ -813,6 +854,8 @@ void RobotModel::linkPoses(const RobotState& s, std::vector<Eigen::Isometry3d>& 
   impl_->poses(s, out);
 }
 
+RobotModel::ReachSphere RobotModel::armReach() const { return {impl_->reach_origin, impl_->reach_bound}; }
+
 IkResult RobotModel::inverseKinematics(const Eigen::Isometry3d& target,
                                        std::span<const double> seed, const IkOptions& options,
                                        const Termination& termination) const {
@@ -828,6 +871,10 @@ IkResult RobotModel::inverseKinematics(const Eigen::Isometry3d& target,
       r.status = IkStatus::kInvalidInput;
       return r;
     }
+  }
+  if ((target.translation() - impl_->reach_origin).norm() > impl_->reach_bound + options.position_tolerance) {
+    r.status = IkStatus::kNoSolution;  // farther than any configuration reaches: no attempt can succeed
+    return r;
   }
   Eigen::Matrix<double, 6, 1> L;
   L << 1, 1, 1, 0.3, 0.3, 0.3;

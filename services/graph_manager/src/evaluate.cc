@@ -68,8 +68,7 @@ MotionAnswer GraphManager::armMotion(const BranchContext& ctx, const std::vector
   q.held = ctx.held;
   q.overrides = overridesOf(ctx);
   q.budget_s = params_.motion_budget_s;
-  ++counters_.motion_calls;
-  return services_.motion(q);
+  return askMotion(q);
 }
 
 double GraphManager::lowerBound(const Edge& e) const {
@@ -104,16 +103,13 @@ MotionAnswer GraphManager::lazyOrFull(const MotionQuery& q) {
     if (b.ok() && b.blocking.empty() && b.path_length <= params_.clear_path_stretch * a.path_length) a = std::move(b);
   };
   if (q.mode == Mode::kLazy && params_.concurrent_motions) {
-    counters_.motion_calls += 2;
-    std::vector<MotionAnswer> ab = services_.motions({q, aware});
+    std::vector<MotionAnswer> ab = askMotions({q, aware});
     if (ab[0].ok() && !ab[0].blocking.empty()) better(ab[0], std::move(ab[1]));
     return std::move(ab[0]);
   }
-  ++counters_.motion_calls;
-  MotionAnswer a = services_.motion(q);
+  MotionAnswer a = askMotion(q);
   if (a.ok() && q.mode == Mode::kLazy && !a.blocking.empty()) {
-    ++counters_.motion_calls;
-    better(a, services_.motion(aware));
+    better(a, askMotion(aware));
   }
   return a;
 }
@@ -132,8 +128,7 @@ MotionAnswer GraphManager::planBase(const MotionQuery& q) {
   MotionQuery turn = q;
   turn.mode = Mode::kFull;
   turn.goal_base = Pose2D{q.start.base.x, q.start.base.y, heading};
-  ++counters_.motion_calls;
-  if (!services_.motion(turn).ok()) return a;
+  if (!askMotion(turn).ok()) return a;
   MotionQuery from_turned = q;
   from_turned.start.base.theta = heading;
   MotionAnswer b = lazyOrFull(from_turned);
@@ -267,6 +262,7 @@ std::string GraphManager::objectsKey(const BranchContext& ctx) {
 }
 
 void GraphManager::clearWorldCaches() {
+  memo_.clear();
   grasp_cache_.clear();
   placement_cache_.clear();
   push_cache_.clear();
@@ -388,8 +384,7 @@ std::optional<EdgeMotion> GraphManager::armTarget(const Edge& arm_edge, EdgeId n
       gq.base = ctx.state.base;
       gq.max_grasps = 8;
       gq.overrides = overridesOf(ctx, object);
-      ++counters_.grasp_calls;
-      auto g = services_.grasps(gq);
+      auto g = askGrasps(gq);
       it = grasp_cache_.emplace(key, g ? *g : std::vector<GraspOption>{}).first;
       if (!g) why = "grasps of " + object + ": " + g.error().message;
     }
@@ -485,8 +480,7 @@ double GraphManager::evaluateManipulation(Edge& e, const BranchContext& ctx) {
     gq.object_id = object;
     gq.base = ctx.state.base;
     gq.overrides = overridesOf(ctx, object);
-    ++counters_.grasp_calls;
-    auto grasps = services_.grasps(gq);
+    auto grasps = askGrasps(gq);
     if (grasps && !grasps->empty()) g = grasps->front();
   }
   std::optional<Eigen::Isometry3d> place_pose = ctx.pending_place;

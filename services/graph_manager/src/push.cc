@@ -170,11 +170,9 @@ std::optional<MotionAnswer> GraphManager::planPushMotion(const std::string& obje
   std::vector<MotionAnswer> answers;
   answers.reserve(2);  // `a` below stays valid when the back-off is asked after it
   if (backs_off && params_.concurrent_motions) {
-    counters_.motion_calls += 2;
-    answers = services_.motions({push, back});
+    answers = askMotions({push, back});
   } else {
-    ++counters_.motion_calls;
-    answers.push_back(services_.motion(push));
+    answers.push_back(askMotion(push));
   }
   MotionAnswer& a = answers.front();
   if (!straightPush(a, from, apex)) {
@@ -183,8 +181,7 @@ std::optional<MotionAnswer> GraphManager::planPushMotion(const std::string& obje
   }
   if (!backs_off) return std::move(a);
   if (answers.size() < 2) {
-    ++counters_.motion_calls;
-    answers.push_back(services_.motion(back));
+    answers.push_back(askMotion(back));
   }
   const MotionAnswer& b = answers.back();
   if (!straightPush(b, apex, to)) {

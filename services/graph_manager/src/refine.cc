@@ -20,7 +20,7 @@ bool GraphManager::refineSupport(const std::string& object, const std::string& r
   if (!abstraction_.isReached(Abstraction::armconfOver(s))) {
     // No known base pose reaches it (an object dropped where no location was foreseen): a stand
     // beside it, as for a blocking object.
-    if (auto g = standBeside(*o, ctx.state.base, ctx.state.base)) {
+    if (auto g = standBeside(*o, ctx.state.base, ctx)) {
       const std::string near = abstraction_.locationFor(g->base_pose, "near_" + object);
       abstraction_.addReach(near, Abstraction::armconfOver(s));
       log::get("graph_manager")->info("{} is reached from {} ({:.2f}, {:.2f})", s, near, g->base_pose.x, g->base_pose.y);
@@ -29,10 +29,10 @@ bool GraphManager::refineSupport(const std::string& object, const std::string& r
   return true;
 }
 
-std::optional<GraspOption> GraphManager::standBeside(const world::Object& o, const Pose2D& entry, const Pose2D& fallback) {
+std::optional<GraspOption> GraphManager::standBeside(const world::Object& o, const Pose2D& entry, const BranchContext& ctx) {
   const Eigen::Vector2d oc = o.pose.translation().head<2>();
   Eigen::Vector2d away = Eigen::Vector2d(entry.x, entry.y) - oc;
-  if (away.norm() < 1e-6) away = Eigen::Vector2d(fallback.x, fallback.y) - oc;
+  if (away.norm() < 1e-6) away = Eigen::Vector2d(ctx.state.base.x, ctx.state.base.y) - oc;
   if (away.norm() < 1e-6) away = Eigen::Vector2d(-1.0, 0.0);
   away.normalize();
   for (double d : {0.60, 0.70, 0.50, 0.80}) {
@@ -40,8 +40,8 @@ std::optional<GraspOption> GraphManager::standBeside(const world::Object& o, con
     GraspQuery gq;
     gq.object_id = o.id;
     gq.base = Pose2D{b.x(), b.y(), std::atan2(-away.y(), -away.x())};
-    ++counters_.grasp_calls;
-    auto g = services_.grasps(gq);
+    gq.overrides = overridesOf(ctx, o.id);
+    auto g = askGrasps(gq);
     if (g && !g->empty()) {
       GraspOption chosen = g->front();
       chosen.base_pose = *gq.base;
@@ -51,8 +51,8 @@ std::optional<GraspOption> GraphManager::standBeside(const world::Object& o, con
   GraspQuery gq;
   gq.object_id = o.id;
   gq.max_grasps = 8;
-  ++counters_.grasp_calls;
-  auto g = services_.grasps(gq);
+  gq.overrides = overridesOf(ctx, o.id);
+  auto g = askGrasps(gq);
   std::optional<GraspOption> chosen;
   if (g) {
     for (const auto& x : *g) {

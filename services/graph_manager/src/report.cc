@@ -60,6 +60,7 @@ std::string reportJson(const MissionReport& r, const std::string& scenario, cons
   j["effort_calls"] = r.counters.effort_calls;
   j["edge_evaluations"] = r.counters.evaluations;
   j["subtasks"] = r.counters.subtasks;
+  j["memo_hits"] = r.counters.memo_hits;
   j["objects_moved"] = r.objects_moved;
   nlohmann::json moved = nlohmann::json::array();
   for (std::size_t i = 0; i < r.moved_to.size(); ++i) {

@@ -200,7 +200,16 @@ class RobotModel {
   /// World poses of every link, in `linkNames()` order (Eigen tree walk). `out` is resized.
   /// Throws std::invalid_argument when `s.arm` has the wrong size.
   void linkPoses(const RobotState& s, std::vector<Eigen::Isometry3d>& out) const;
-  /// Arm joints reaching base_link_T_tool `target` (see the file comment). Never throws.
+  /// A sphere in base_link that holds the tool's position in every configuration: centred on the
+  /// first arm joint's axis, its radius the sum of the distances between consecutive joint axes
+  /// and to the tool, plus the prismatic joints' travel (infinite when a travel is unbounded).
+  struct ReachSphere {
+    Eigen::Vector3d centre;
+    double radius;
+  };
+  ReachSphere armReach() const;
+  /// Arm joints reaching base_link_T_tool `target` (see the file comment). Never throws. A target
+  /// outside armReach() is kNoSolution at once, with no attempt.
   IkResult inverseKinematics(const Eigen::Isometry3d& target, std::span<const double> seed,
                              const IkOptions& options = {},
                              const Termination& termination = {}) const;

@@ -52,6 +52,7 @@
 #include "tamp/graph_manager/clients.h"
 #include "tamp/graph_manager/graph.h"
 #include "tamp/graph_manager/params.h"
+#include "tamp/graph_manager/query_memo.h"
 
 namespace tamp::graph_manager {
 
@@ -93,6 +94,7 @@ struct Counters {
   int effort_calls{0};
   int evaluations{0};
   int subtasks{0};
+  int memo_hits{0};  ///< motion and grasp questions answered from the memo (query_memo.h), not asked
 };
 
 struct TraverseResult {
@@ -358,9 +360,10 @@ class GraphManager {
   /// Whether a refinement happened since the last call (and clears it).
   bool takeRefinement();
   /// A base pose beside `o` from which the arm grasps it, facing it from the side of `entry`
-  /// (`fallback` when `entry` is on the object): 0.5-0.8 m back first, else the grasp service's
-  /// own samples nearest to `entry`. None when no base pose reaches it.
-  std::optional<GraspOption> standBeside(const world::Object& o, const Pose2D& entry, const Pose2D& fallback);
+  /// (the branch's base when `entry` is on the object): 0.5-0.8 m back first, else the grasp
+  /// service's own samples nearest to `entry`, in the branch's world (the objects it moved where
+  /// it put them). None when no base pose reaches it.
+  std::optional<GraspOption> standBeside(const world::Object& o, const Pose2D& entry, const BranchContext& ctx);
 
  private:
   struct Search;
@@ -467,8 +470,14 @@ class GraphManager {
   /// The branch's object poses and held object, without the base pose (for queries whose start
   /// is given, not the branch's base).
   static std::string objectsKey(const BranchContext& ctx);
-  /// Forgets what was computed in the world before it changed (grasps, placements, pushes).
+  /// Forgets what was computed in the world before it changed (grasps, placements, pushes, the
+  /// memo of motion and grasp answers).
   void clearWorldCaches();
+  /// The motion and grasp services, through `memo_` (ask.cc): counted in `counters_` when asked.
+  MotionAnswer askMotion(const MotionQuery& q);
+  /// Independent motion queries at once (ServiceClients::motions), those not in the memo.
+  std::vector<MotionAnswer> askMotions(const std::vector<MotionQuery>& qs);
+  Result<std::vector<GraspOption>> askGrasps(const GraspQuery& q);
   MotionQuery baseQuery(const Edge& e, const BranchContext& ctx) const;
   std::vector<std::string> withStatics(const std::vector<std::string>& dynamic) const;
   void recordDecisions(NodeId from, const std::map<EdgeId, double>& best_through, const std::vector<EdgeId>& branch,
@@ -487,6 +496,7 @@ class GraphManager {
   std::vector<Decision> decisions_;
   int traverse_count_{0};
   double planning_s_{0.0};
+  QueryMemo memo_;
   std::map<std::string, std::vector<GraspOption>> grasp_cache_;
   /// Placements of a held object from a base pose in a world (sampledPlace): asked for a few
   /// at first, more only when every one kept was tried (each sample costs IK solves).

@@ -1,0 +1,54 @@
+// The graph manager's questions to the motion planner's services, through the memo of answers
+// given in the world as it stands (query_memo.h). Counters count the questions the services
+// answered; `memo_hits` those answered from memory.
+#include "tamp/graph_manager/graph_manager.h"
+
+namespace tamp::graph_manager {
+
+MotionAnswer GraphManager::askMotion(const MotionQuery& q) {
+  if (const MotionAnswer* kept = memo_.motion(q)) {
+    ++counters_.memo_hits;
+    return *kept;
+  }
+  ++counters_.motion_calls;
+  MotionAnswer a = services_.motion(q);
+  memo_.keep(q, a);
+  return a;
+}
+
+std::vector<MotionAnswer> GraphManager::askMotions(const std::vector<MotionQuery>& qs) {
+  std::vector<MotionAnswer> out(qs.size());
+  std::vector<MotionQuery> ask;
+  std::vector<std::size_t> where;
+  for (std::size_t i = 0; i < qs.size(); ++i) {
+    if (const MotionAnswer* kept = memo_.motion(qs[i])) {
+      ++counters_.memo_hits;
+      out[i] = *kept;
+    } else {
+      ask.push_back(qs[i]);
+      where.push_back(i);
+    }
+  }
+  if (ask.empty()) return out;
+  counters_.motion_calls += static_cast<int>(ask.size());
+  std::vector<MotionAnswer> answers = ask.size() == 1 ? std::vector<MotionAnswer>{services_.motion(ask[0])}
+                                                      : services_.motions(ask);
+  for (std::size_t j = 0; j < answers.size() && j < where.size(); ++j) {
+    memo_.keep(ask[j], answers[j]);
+    out[where[j]] = std::move(answers[j]);
+  }
+  return out;
+}
+
+Result<std::vector<GraspOption>> GraphManager::askGrasps(const GraspQuery& q) {
+  if (const std::vector<GraspOption>* kept = memo_.grasps(q)) {
+    ++counters_.memo_hits;
+    return *kept;
+  }
+  ++counters_.grasp_calls;
+  auto g = services_.grasps(q);
+  if (g) memo_.keep(q, *g);
+  return g;
+}
+
+}  // namespace tamp::graph_manager

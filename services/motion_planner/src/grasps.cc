@@ -109,6 +109,7 @@ Result<std::vector<Grasp>> MotionPlanner::generateGrasps(const GraspRequest& req
   }
 
   const double max_open = m->gripperLimits().upper;
+  const robot::RobotModel::ReachSphere reach = m->armReach();
   const auto cands = graspCandidates(obj->shape, P, max_open);
   std::vector<Pose2D> bases;
   const Eigen::Vector3d c = obj->pose.translation();
@@ -141,9 +142,9 @@ Result<std::vector<Grasp>> MotionPlanner::generateGrasps(const GraspRequest& req
     const Eigen::Isometry3d retreat = Eigen::Translation3d(0, 0, P.retreat_distance) * grasp;
     for (const Pose2D& b : bases) {
       if (termination()) break;
-      // Cheap reject: the tool target must be within the arm's reach of the shoulder.
+      // Cheap reject: the tool target must be within the arm's reach (the robot's reach sphere).
       const Eigen::Vector3d rel = b.toIsometry().inverse() * grasp.translation();
-      if (rel.norm() > 1.6) continue;
+      if ((rel - reach.centre).norm() > reach.radius) continue;
       auto q_pre = solveIk(impl, b, pre, seed, all, opening, ++salt, 32, termination);
       if (!q_pre) continue;
       auto q_grasp = solveIk(impl, b, grasp, *q_pre, but_object, opening, ++salt, 32, termination);

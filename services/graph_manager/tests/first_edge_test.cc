@@ -294,3 +294,32 @@ TEST_F(FirstEdgeTest, AnEmptyBranchHasNoFirstEdge) {
 
 }  // namespace
 }  // namespace tamp::graph_manager
+
+namespace tamp::graph_manager {
+namespace {
+
+// A second plan through other symbolic states (here one more fact) asks the motion planner the
+// same questions as the first, from the same poses in the same world: the memo answers them
+// (issue 12, replanning latency), and the decision and its cost are unchanged.
+TEST_F(FirstEdgeTest, TheSameMotionQuestionInTheSameWorldIsAskedOnce) {
+  ScriptedServices base_services;
+  Setup base = make(base_services);
+  const TraverseResult before = base.gm->traverse(base.gm->root(), base.ctx);
+  ASSERT_TRUE(before.found) << before.reason;
+  const int calls_without_twin = base_services.motion_calls;
+
+  ScriptedServices services;
+  Setup s = make(services);
+  services.plans = {{"(move_base start a)", "(move_base a goal)"}};
+  services.states = {{{"(robot-at start)"}, {"(robot-at a)", "(visited a)"}, {"(robot-at goal)", "(visited a)"}}};
+  ASSERT_TRUE(s.gm->planFrom(s.gm->root(), {"(robot-at goal)"}, "plan d").ok());
+  const TraverseResult t = s.gm->traverse(s.gm->root(), s.ctx);
+  ASSERT_TRUE(t.found) << t.reason;
+  EXPECT_DOUBLE_EQ(t.cost_s, before.cost_s);
+  EXPECT_EQ(services.motion_calls, calls_without_twin) << "the twin plan's two motions come from the memo";
+  EXPECT_EQ(s.gm->counters().memo_hits, 2);
+  EXPECT_EQ(s.gm->counters().motion_calls, services.motion_calls);
+}
+
+}  // namespace
+}  // namespace tamp::graph_manager

@@ -108,6 +108,7 @@ std::string formatCheckpoint(const SimSnapshot& s) {
   out.precision(17);
   out << kHeader << "\n";
   out << "time " << s.time_s << "\n";
+  out << "epoch " << s.epoch_s << "\n";
   out << "robot " << s.robot.base.x << " " << s.robot.base.y << " " << s.robot.base.theta << " " << s.robot.gripper;
   for (double q : s.robot.arm) out << " " << q;
   out << "\n";
@@ -137,7 +138,7 @@ Result<SimSnapshot> parseCheckpoint(const std::string& text, const std::string& 
   if (!std::getline(lines, line) || line != kHeader) {
     return parseError(file, 1, "header", "not a simulator checkpoint (expected '" + std::string(kHeader) + "')");
   }
-  bool have_time = false, have_robot = false;
+  bool have_time = false, have_epoch = false, have_robot = false;
   int n = 1;
   for (n = 2; std::getline(lines, line); ++n) {
     if (line.empty()) continue;
@@ -147,6 +148,9 @@ Result<SimSnapshot> parseCheckpoint(const std::string& text, const std::string& 
     if (kind == "time") {
       if (!readNumbers(fields, &s.time_s, 1) || s.time_s < 0) return parseError(file, n, "time", "expected a finite time >= 0");
       have_time = true;
+    } else if (kind == "epoch") {
+      if (!readNumbers(fields, &s.epoch_s, 1) || s.epoch_s <= 0) return parseError(file, n, "epoch", "expected a wall-clock time > 0");
+      have_epoch = true;
     } else if (kind == "robot") {
       double base[4];
       if (!readNumbers(fields, base, 4)) return parseError(file, n, "robot", "expected base x, y, theta and the gripper");
@@ -192,6 +196,7 @@ Result<SimSnapshot> parseCheckpoint(const std::string& text, const std::string& 
     }
   }
   if (!have_time) return parseError(file, n, "time", "missing");
+  if (!have_epoch) return parseError(file, n, "epoch", "missing");
   if (!have_robot) return parseError(file, n, "robot", "missing");
   return s;
 }

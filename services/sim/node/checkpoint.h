@@ -13,6 +13,7 @@
 /// File (`$TAMP_RUN_DIR/sim.checkpoint`), one record per line, numbers in full precision:
 ///   tamp-sim-checkpoint 1
 ///   time <simulated s>
+///   epoch <wall-clock s since the Unix epoch at simulated time 0: stamps go on from there>
 ///   robot <base x> <base y> <base theta> <gripper> <arm joint values, in the robot's order>
 ///   held <object id> <link> <link_T_object: 12 numbers, the 3x4 matrix row by row>  (at most once)
 ///   object <visible|hidden> <msg::WorldObject as CDR, in hex; its kind static or movable> (every object)

@@ -1468,6 +1468,7 @@ StepEvents Simulator::step(double dt) {
 }
 
 double Simulator::time() const { return impl_->now; }
+double Simulator::epoch() const { return impl_->epoch_s; }
 bool Simulator::busy() const { return impl_->active.has_value(); }
 double Simulator::remainingActionTime() const {
   const Impl& m = *impl_;
@@ -1481,6 +1482,7 @@ SimSnapshot Simulator::snapshot() const {
   const Impl& m = *impl_;
   SimSnapshot s;
   s.time_s = m.now;
+  s.epoch_s = m.epoch_s;
   s.robot = m.toState(m.current());
   s.held = m.world.held();
   for (const auto& o : m.world.objects()) s.objects.push_back(o);
@@ -1528,6 +1530,9 @@ Status Simulator::resume(const SimSnapshot& snapshot) {
   if (!std::isfinite(snapshot.time_s) || snapshot.time_s < 0.0) {
     return invalid("time_s", "must be finite and >= 0, got " + formatNumber(snapshot.time_s, 4));
   }
+  if (!std::isfinite(snapshot.epoch_s) || snapshot.epoch_s <= 0.0) {
+    return invalid("epoch_s", "must be a positive wall-clock time, got " + formatNumber(snapshot.epoch_s, 4));
+  }
   if (snapshot.robot.arm.size() != static_cast<std::size_t>(m.dof)) {
     return invalid("robot.arm", std::to_string(snapshot.robot.arm.size()) + " values, the robot has " +
                                     std::to_string(m.dof) + " arm joints");
@@ -1571,7 +1576,7 @@ Status Simulator::resume(const SimSnapshot& snapshot) {
   }
   m.fired = std::move(fired);
   m.pending_fails = std::move(pending);
-  m.epoch_s -= snapshot.time_s - m.now;  // record stamps stay wall-clock times
+  m.epoch_s = snapshot.epoch_s;  // stamps go on, never back
   m.now = snapshot.time_s;
   m.log = snapshot.log;
   m.logged.clear();

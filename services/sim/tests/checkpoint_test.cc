@@ -14,6 +14,7 @@ using namespace tamp::sim::testing;
 SimSnapshot sampleSnapshot() {
   SimSnapshot s;
   s.time_s = 12.345678901234;
+  s.epoch_s = 1796333902.4864765;
   s.robot = upright(Pose2D{1.25, -0.5, 0.3});
   s.robot.arm[1] = 0.123456789012345;
   s.held = world::HeldObject{"carried", robotModel().options().tool_link,
@@ -39,6 +40,7 @@ TEST(SimCheckpointTest, ReadsBackExactly) {
   auto back = parseCheckpoint(formatCheckpoint(s), "sim.checkpoint");
   ASSERT_TRUE(back) << back.error().toString();
   EXPECT_EQ(back->time_s, s.time_s);
+  EXPECT_EQ(back->epoch_s, s.epoch_s);
   EXPECT_EQ(back->robot.base.x, s.robot.base.x);
   EXPECT_EQ(back->robot.base.y, s.robot.base.y);
   EXPECT_EQ(back->robot.base.theta, s.robot.base.theta);
@@ -84,16 +86,18 @@ TEST(SimCheckpointTest, ABrokenCheckpointIsRefusedNamingTheFileLineAndField) {
   };
   const std::vector<Case> cases{
       {"tamp-perception-checkpoint 1\n", 1, "header"},
-      {edited("robot ", "robot 1.0 2.0 0.1 0.0 0.5 nan 0.2"), 3, "robot.arm[1]"},
-      {edited("robot ", "robot 1.0 2.0"), 3, "robot"},
+      {edited("robot ", "robot 1.0 2.0 0.1 0.0 0.5 nan 0.2"), 4, "robot.arm[1]"},
+      {edited("robot ", "robot 1.0 2.0"), 4, "robot"},
       {edited("time ", "time -3"), 2, "time"},
-      {edited("held ", "held carried tool 1 0 0"), 4, "held"},
-      {edited("object ", "object visible 0a0b"), 5, "object"},
-      {edited("object ", "object wobbly 00"), 5, "object.hidden"},
-      {edited("action ", "action 0 0.5 move_base 6d31 exploded 1 1 - -"), 11, "action.outcome"},
-      {edited("action ", "action 0 0.5 fly 6d31 running"), 11, "action.kind"},
-      {good + "teleport 1 2 3\n", 13, "record"},
-      {"tamp-sim-checkpoint 1\ntime 1.0\n", 3, "robot"},
+      {edited("epoch ", "epoch 0"), 3, "epoch"},
+      {edited("held ", "held carried tool 1 0 0"), 5, "held"},
+      {edited("object ", "object visible 0a0b"), 6, "object"},
+      {edited("object ", "object wobbly 00"), 6, "object.hidden"},
+      {edited("action ", "action 0 0.5 move_base 6d31 exploded 1 1 - -"), 12, "action.outcome"},
+      {edited("action ", "action 0 0.5 fly 6d31 running"), 12, "action.kind"},
+      {good + "teleport 1 2 3\n", 14, "record"},
+      {"tamp-sim-checkpoint 1\ntime 1.0\nepoch 5.0\n", 4, "robot"},
+      {"tamp-sim-checkpoint 1\ntime 1.0\n", 3, "epoch"},
   };
   for (const Case& c : cases) {
     auto r = parseCheckpoint(c.text, "/run/sim.checkpoint");

@@ -530,6 +530,7 @@ TEST(SimulatorResumeTest, ARestartedSimulatorResumesTheWorldAndNeverExecutesTheI
   Simulator after(roomWithHeldBox(), robotModel(), upright(), exactParams());
   ASSERT_TRUE(after.resume(snap));
   EXPECT_DOUBLE_EQ(after.time(), snap.time_s);
+  EXPECT_DOUBLE_EQ(after.epoch(), before.epoch());  // stamps go on, not back
   EXPECT_DOUBLE_EQ(after.robotState().state.base.x, mid);
   EXPECT_EQ(after.robotState().held_object_id, "carried");
   EXPECT_TRUE(after.world().object("hidden_wall").hidden);
@@ -580,6 +581,9 @@ TEST(SimulatorResumeTest, ASnapshotThatDoesNotFitIsRefusedNamingTheField) {
   SimSnapshot s = good;
   s.robot.arm.pop_back();
   refused(s, "robot.arm");
+  s = good;
+  s.epoch_s = 0.0;
+  refused(s, "epoch_s");
   s = good;
   s.held->link = "base_link";
   refused(s, "held");

@@ -139,6 +139,10 @@ struct StepEvents {
 /// injected faults not fired yet.
 struct SimSnapshot {
   double time_s{0.0};                     ///< simulated time of the snapshot
+  /// Wall-clock time (s since the Unix epoch) of simulated time 0: stamps are epoch_s + time, so
+  /// a resumed simulator's stamps go on from where they were instead of jumping back (readers
+  /// such as perception drop a frame older than the previous one).
+  double epoch_s{0.0};
   robot::RobotState robot;                ///< base, arm and gripper joints
   std::optional<world::HeldObject> held;  ///< the object in the gripper (held by the tool link)
   std::vector<world::Object> objects;     ///< every object of the ground truth, hidden ones included
@@ -188,8 +192,11 @@ class Simulator {
 
   /// Advances simulated time by `dt` >= 0 seconds (throws std::invalid_argument otherwise).
   StepEvents step(double dt);
-  /// Simulated seconds since construction.
+  /// Simulated seconds since construction (since the start of the run after `resume()`).
   double time() const;
+  /// Wall-clock seconds since the Unix epoch at simulated time 0 (construction, or the resumed
+  /// snapshot's): a stamp of simulated time t is epoch() + t (records; SimulationLoop::stampNs).
+  double epoch() const;
   bool busy() const;
   /// Time left of the action in progress (0 when idle), simulated seconds.
   double remainingActionTime() const;
@@ -203,7 +210,7 @@ class Simulator {
   SimSnapshot snapshot() const;
   /// Takes up `snapshot` (a simulator killed and restarted): the world's objects, the held object
   /// and the robot's state are the snapshot's (regions and locations stay this simulator's),
-  /// simulated time goes on from the snapshot's, the scripted faults that fired stay fired, and
+  /// simulated time and the stamps' epoch go on from the snapshot's, the scripted faults that fired stay fired, and
   /// the action log is the snapshot's. The command that was running is not resumed (the robot
   /// stopped where it stood): it ends kFailed with `kRestartedMidAction` in its reason, reported by
   /// the next `step()` and again to a sender that repeats its id; no record is made for it.

@@ -13,12 +13,14 @@ namespace {
 
 constexpr const char* kHeader = "tamp-sim-checkpoint 1";
 
-Error parseError(const std::string& file, int line, const std::string& field, const std::string& what) {
+Error parseError(const std::string& file, int line, const std::string& field,
+                 const std::string& what) {
   return Error(ErrorCode::kParseError, what, SourceLocation{file, line, 0, field});
 }
 
 std::optional<Outcome> outcomeFromString(const std::string& s) {
-  for (Outcome o : {Outcome::kSucceeded, Outcome::kBlocked, Outcome::kFailed, Outcome::kCancelled}) {
+  for (Outcome o :
+       {Outcome::kSucceeded, Outcome::kBlocked, Outcome::kFailed, Outcome::kCancelled}) {
     if (toString(o) == s) return o;
   }
   return std::nullopt;
@@ -40,7 +42,8 @@ std::optional<std::string> decode(const std::string& token) {
 }
 
 void formatAction(std::ostream& out, const ActionLogEntry& e) {
-  out << "action " << e.step << " " << e.start_s << " " << toString(e.kind) << " " << encode(e.command_id);
+  out << "action " << e.step << " " << e.start_s << " " << toString(e.kind) << " "
+      << encode(e.command_id);
   if (!e.result) {
     out << " running\n";
     return;
@@ -54,32 +57,40 @@ void formatAction(std::ostream& out, const ActionLogEntry& e) {
 Result<ActionLogEntry> parseAction(std::istringstream& fields, const std::string& file, int n) {
   ActionLogEntry e;
   std::string kind, id, state;
-  if (!(fields >> e.step) || e.step < 0) return parseError(file, n, "action.step", "expected a step index >= 0");
-  if (!readNumbers(fields, &e.start_s, 1)) return parseError(file, n, "action.start_s", "expected a finite number");
+  if (!(fields >> e.step) || e.step < 0)
+    return parseError(file, n, "action.step", "expected a step index >= 0");
+  if (!readNumbers(fields, &e.start_s, 1))
+    return parseError(file, n, "action.start_s", "expected a finite number");
   fields >> kind;
   const auto k = actionKindFromString(kind);
   if (!k) return parseError(file, n, "action.kind", "unknown action kind '" + kind + "'");
   e.kind = *k;
   fields >> id;
   const auto cid = decode(id);
-  if (!cid || cid->empty()) return parseError(file, n, "action.command_id", "expected a command id in hex");
+  if (!cid || cid->empty())
+    return parseError(file, n, "action.command_id", "expected a command id in hex");
   e.command_id = *cid;
   fields >> state;
   if (state == "running") return e;
   const auto outcome = outcomeFromString(state);
-  if (!outcome) return parseError(file, n, "action.outcome", "expected running or an outcome, got '" + state + "'");
+  if (!outcome)
+    return parseError(file, n, "action.outcome",
+                      "expected running or an outcome, got '" + state + "'");
   ActionResult r;
   r.command_id = e.command_id;
   r.outcome = *outcome;
   double nums[2];
-  if (!readNumbers(fields, nums, 2)) return parseError(file, n, "action.duration_s", "expected duration and progress");
+  if (!readNumbers(fields, nums, 2))
+    return parseError(file, n, "action.duration_s", "expected duration and progress");
   r.duration_s = nums[0];
   r.progress = nums[1];
   std::string blocking, reason;
   fields >> blocking >> reason;
   const auto b = decode(blocking);
   const auto why = decode(reason);
-  if (!b || !why) return parseError(file, n, "action.reason", "expected the blocking object and the reason in hex");
+  if (!b || !why)
+    return parseError(file, n, "action.reason",
+                      "expected the blocking object and the reason in hex");
   r.blocking_object_id = *b;
   r.reason = *why;
   e.result = r;
@@ -90,7 +101,8 @@ Result<world::Object> parseObject(std::istringstream& fields, const std::string&
   std::string visibility, hex;
   fields >> visibility >> hex;
   if (visibility != "visible" && visibility != "hidden") {
-    return parseError(file, n, "object.hidden", "expected visible or hidden, got '" + visibility + "'");
+    return parseError(file, n, "object.hidden",
+                      "expected visible or hidden, got '" + visibility + "'");
   }
   const auto bytes = fromHex(hex);
   const auto m = bytes ? dds::fromCdr<msg::WorldObject>(*bytes) : std::nullopt;
@@ -109,7 +121,8 @@ std::string formatCheckpoint(const SimSnapshot& s) {
   out << kHeader << "\n";
   out << "time " << s.time_s << "\n";
   out << "epoch " << s.epoch_s << "\n";
-  out << "robot " << s.robot.base.x << " " << s.robot.base.y << " " << s.robot.base.theta << " " << s.robot.gripper;
+  out << "robot " << s.robot.base.x << " " << s.robot.base.y << " " << s.robot.base.theta << " "
+      << s.robot.gripper;
   for (double q : s.robot.arm) out << " " << q;
   out << "\n";
   if (s.held) {
@@ -123,7 +136,8 @@ std::string formatCheckpoint(const SimSnapshot& s) {
     // The message folds "hidden" into the object's kind (static or movable): the record keeps both.
     world::Object told = o;
     told.hidden = false;
-    out << "object " << (o.hidden ? "hidden" : "visible") << " " << toHex(dds::toCdr(dds::toMsg(told, 0))) << "\n";
+    out << "object " << (o.hidden ? "hidden" : "visible") << " "
+        << toHex(dds::toCdr(dds::toMsg(told, 0))) << "\n";
   }
   for (const auto& id : s.fired_faults) out << "fired " << id << "\n";
   for (const auto& id : s.pending_faults) out << "pending " << id << "\n";
@@ -136,7 +150,8 @@ Result<SimSnapshot> parseCheckpoint(const std::string& text, const std::string& 
   std::istringstream lines(text);
   std::string line;
   if (!std::getline(lines, line) || line != kHeader) {
-    return parseError(file, 1, "header", "not a simulator checkpoint (expected '" + std::string(kHeader) + "')");
+    return parseError(file, 1, "header",
+                      "not a simulator checkpoint (expected '" + std::string(kHeader) + "')");
   }
   bool have_time = false, have_epoch = false, have_robot = false;
   int n = 1;
@@ -146,14 +161,17 @@ Result<SimSnapshot> parseCheckpoint(const std::string& text, const std::string& 
     std::string kind;
     fields >> kind;
     if (kind == "time") {
-      if (!readNumbers(fields, &s.time_s, 1) || s.time_s < 0) return parseError(file, n, "time", "expected a finite time >= 0");
+      if (!readNumbers(fields, &s.time_s, 1) || s.time_s < 0)
+        return parseError(file, n, "time", "expected a finite time >= 0");
       have_time = true;
     } else if (kind == "epoch") {
-      if (!readNumbers(fields, &s.epoch_s, 1) || s.epoch_s <= 0) return parseError(file, n, "epoch", "expected a wall-clock time > 0");
+      if (!readNumbers(fields, &s.epoch_s, 1) || s.epoch_s <= 0)
+        return parseError(file, n, "epoch", "expected a wall-clock time > 0");
       have_epoch = true;
     } else if (kind == "robot") {
       double base[4];
-      if (!readNumbers(fields, base, 4)) return parseError(file, n, "robot", "expected base x, y, theta and the gripper");
+      if (!readNumbers(fields, base, 4))
+        return parseError(file, n, "robot", "expected base x, y, theta and the gripper");
       s.robot.base = Pose2D{base[0], base[1], base[2]};
       s.robot.gripper = base[3];
       std::string token;
@@ -161,7 +179,8 @@ Result<SimSnapshot> parseCheckpoint(const std::string& text, const std::string& 
         char* end = nullptr;
         const double q = std::strtod(token.c_str(), &end);
         if (end == token.c_str() || *end != '\0' || !std::isfinite(q)) {
-          return parseError(file, n, "robot.arm[" + std::to_string(s.robot.arm.size()) + "]", "not a finite number: '" + token + "'");
+          return parseError(file, n, "robot.arm[" + std::to_string(s.robot.arm.size()) + "]",
+                            "not a finite number: '" + token + "'");
         }
         s.robot.arm.push_back(q);
       }

@@ -167,7 +167,8 @@ Result<std::unique_ptr<dds::ServiceNode>> SimNode::create(const dds::ServiceArgs
 
 SimNode::SimNode(const dds::ServiceArgs& args, SimSetup setup, SimParams params,
                  std::filesystem::path checkpoint_file, std::optional<SimSnapshot> resume_from)
-    : ServiceNode(args), checkpoint_file_(std::move(checkpoint_file)), checkpoint_period_s_(params.checkpoint_period_s) {
+    : ServiceNode(args), checkpoint_file_(std::move(checkpoint_file)), checkpoint_period_s_(params.checkpoint_period_s),
+      checkpoint_idle_period_s_(params.checkpoint_idle_period_s) {
   robot_id_ = setup.robot.name();
   joint_names_ = setup.robot.fullJointNames();
   scripted_ = setup.faults;
@@ -196,7 +197,7 @@ SimNode::SimNode(const dds::ServiceArgs& args, SimSetup setup, SimParams params,
     if (Status st = state_writer_->write(toMsg(s, joint_names_, robot_id_, stamp, ++state_seq_)); !st) {
       logger()->warn("robot state not published: {}", st.error().toString());
     }
-    checkpointWhileMoving(s);
+    checkpointPeriodically(s);
   };
   cb.on_cloud = [this](const PointCloudFrame& f) {
     if (Status st = cloud_writer_->write(dds::toMsg(f, ++cloud_seq_)); !st) {
@@ -263,13 +264,15 @@ void SimNode::checkpoint(const char* why) {
   }
 }
 
-void SimNode::checkpointWhileMoving(const RobotStateSample& s) {
-  if (checkpoint_file_.empty() || !s.moving) return;
+void SimNode::checkpointPeriodically(const RobotStateSample& s) {
+  if (checkpoint_file_.empty()) return;
+  // An action also runs while the robot stands still in it (the gripper closing, a settle pause).
+  const bool busy = s.moving || loop_->busy();
   {
     std::lock_guard lock(checkpoint_mutex_);
-    if (s.time_s - last_checkpoint_s_ < checkpoint_period_s_) return;
+    if (s.time_s - last_checkpoint_s_ < (busy ? checkpoint_period_s_ : checkpoint_idle_period_s_)) return;
   }
-  checkpoint("moving");
+  checkpoint(busy ? "action" : "idle");
 }
 
 namespace {

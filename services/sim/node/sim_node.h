@@ -98,10 +98,11 @@ class SimNode : public dds::ServiceNode {
 
   /// Writes the checkpoint now (any thread; serialised). `why` is for the log.
   void checkpoint(const char* why);
-  /// A periodic checkpoint while the robot moves (loop thread, from the state callback).
-  void checkpointWhileMoving(const RobotStateSample& s);
+  /// A periodic checkpoint (loop thread, from the state callback): every `checkpoint_period_s`
+  /// while an action runs, every `checkpoint_idle_period_s` otherwise.
+  void checkpointPeriodically(const RobotStateSample& s);
   std::filesystem::path checkpoint_file_;  ///< empty: no checkpoint
-  double checkpoint_period_s_{0.2};
+  double checkpoint_period_s_{0.2}, checkpoint_idle_period_s_{1.0};
   std::mutex checkpoint_mutex_;            ///< guards the write and the fields below
   double last_checkpoint_s_{-1.0};         ///< simulated time of the last one
   bool checkpoint_failed_{false};

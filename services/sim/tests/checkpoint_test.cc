@@ -29,7 +29,8 @@ SimSnapshot sampleSnapshot() {
   s.objects = {carried, crate, wall};
   s.fired_faults = {"fault_0", "fault_2"};
   s.pending_faults = {"fault_2"};
-  ActionResult done{"m1-e1", Outcome::kBlocked, 4.5, 0.625, "crate", "stopped before contact with 'crate'"};
+  ActionResult done{"m1-e1", Outcome::kBlocked, 4.5,
+                    0.625,   "crate",           "stopped before contact with 'crate'"};
   s.log.push_back(ActionLogEntry{"m1-e1", ActionKind::kMoveBase, 0, 0.5, done});
   s.log.push_back(ActionLogEntry{"id with spaces", ActionKind::kPick, 1, 7.25, std::nullopt});
   return s;

@@ -3,27 +3,31 @@
 # `tamp run` (every service its own process, restarted by tamp run's supervisor when it dies), and a
 # SIGKILL to that service at a seeded random point of the mission: the k-th command the robot
 # starts (k drawn from the seed among the first --max-step commands), a seeded delay after it
-# started, so mid-action kills are the rule. The simulator is not in the matrix by default: it
-# stands in for the physical world, which does not restart (a restarted simulator starts its world
-# from the scenario again).
+# started, so mid-action kills are the rule. The simulator is in it as the robot driver: its
+# process dies, the physical world does not; a restarted simulator resumes from its checkpoint in
+# the run folder (sim.checkpoint: the robot, the objects, the action log) and ends the command it
+# was running as failed ("robot driver restarted mid-action") instead of executing it again.
 #
 #   tests/fault/kill_matrix.sh BUILD_DIR [--scenario FILE] [--services "a b ..."] [--seeds "1 2 ..."]
 #        [--max-step K] [--out DIR] [--speed F]
 #
 # Each run is judged from its run folder: exit code and reason (report.json), the robot's final
 # pose and the objects (sim_final_world.json), every command id at most once in the simulator's
-# action log, the execution records in the effort estimator's store (one per succeeded action:
-# none lost, none twice), the service's restart in events.jsonl. One line per run goes to
-# OUT/matrix.tsv:
+# action log, every action the report lists as succeeded in that log (a simulator that forgot
+# what the robot did, e.g. one restarted from the scenario, loses them), the execution records in
+# the effort estimator's store (one per succeeded action: none lost, none twice), the service's
+# restart in events.jsonl. One line per run goes to OUT/matrix.tsv:
 #   service seed kill_at_command delay_s killed(yes/no) exit status resumptions repeated_ids
-#   succeeded_actions stored_records restarts reason
-# Exit 0 when every run ended succeeded or failed with a reason, no command id was executed twice
-# and no record was lost; 1 otherwise (or when nothing ran); 30 on bad arguments.
+#   succeeded_actions stored_records restarts unlogged reason
+# (unlogged: the report's succeeded command ids missing from the simulator's action log.)
+# Exit 0 when every run ended succeeded or failed with a reason, no command id was executed twice,
+# none of the report's succeeded actions is missing from the action log and no record was lost;
+# 1 otherwise (or when nothing ran); 30 on bad arguments.
 set -uo pipefail
 BUILD=${1:?usage: kill_matrix.sh BUILD_DIR [options]}; shift
 ROOT=$(cd "$(dirname "$0")/../.." && pwd)
 SCENARIO=$ROOT/config/scenarios/namo_corridor.yaml
-SERVICES="graph_manager execution_monitor motion_planner symbolic_planner effort_estimator perception"
+SERVICES="graph_manager execution_monitor motion_planner symbolic_planner effort_estimator perception sim"
 SEEDS="1 2"
 MAX_STEP=4
 OUT=${TMPDIR:-/tmp}/tamp-kill-matrix
@@ -48,7 +52,7 @@ mkdir -p "$OUT/deploy/store"
 # start from the default time models in every run).
 sed -E "s/realtime_factor: [0-9.]+/realtime_factor: $SPEED/" "$ROOT/config/services/sim.yaml" > "$OUT/deploy/sim.yaml"
 TSV=$OUT/matrix.tsv
-printf 'service\tseed\tkill_at_command\tdelay_s\tkilled\texit\tstatus\tresumptions\trepeated_ids\tsucceeded_actions\tstored_records\trestarts\treason\n' > "$TSV"
+printf 'service\tseed\tkill_at_command\tdelay_s\tkilled\texit\tstatus\tresumptions\trepeated_ids\tsucceeded_actions\tstored_records\trestarts\tunlogged\treason\n' > "$TSV"
 bad=0
 runs=0
 for svc in $SERVICES; do
@@ -96,12 +100,12 @@ EOF
     # What physically happened (the simulator's action log) against the estimator's store: every
     # command id once in the log, and a record in the store for every succeeded action (records
     # are de-duplicated by id: a resent one is not stored twice).
-    read -r repeated succeeded records < <(python3 - "$dir/sim_final_world.json" "$store/effort_store.sqlite" << 'EOF'
+    read -r repeated succeeded records unlogged < <(python3 - "$dir/sim_final_world.json" "$store/effort_store.sqlite" "$dir/report.json" << 'EOF'
 import collections, json, sqlite3, sys
 try:
     w = json.load(open(sys.argv[1]))
 except Exception:
-    print("no-world 0 0"); sys.exit()
+    print("no-world 0 0 -"); sys.exit()
 log = w.get("action_log", [])
 ids = [a["command_id"] if isinstance(a, dict) else a for a in log]
 rep = [i for i, n in collections.Counter(ids).items() if n > 1]
@@ -110,7 +114,15 @@ try:
     n = sqlite3.connect(sys.argv[2]).execute("select count(distinct record_id) from records").fetchone()[0]
 except Exception:
     n = -1
-print(",".join(rep) if rep else "none", ok, n)
+# The robot's log names a command "<mission id>/<command id>", the report "<command id>".
+logged = {i.split("/")[-1] for i in ids}
+try:
+    acts = json.load(open(sys.argv[3])).get("actions", [])
+except Exception:
+    acts = []
+lost = [a["command_id"] for a in acts if a.get("outcome") == "succeeded" and a.get("command_id")
+        and a["command_id"] not in logged]
+print(",".join(rep) if rep else "none", ok, n, ",".join(lost) if lost else "none")
 EOF
 )
     restarts=$(python3 - "$dir/events.jsonl" "$svc" << 'EOF'
@@ -129,11 +141,11 @@ except OSError:
 print(n)
 EOF
 )
-    printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$svc" "$seed" "$k" "$delay" "$killed" "$rc" "$status" \
-      "$resumptions" "$repeated" "$succeeded" "$records" "${restarts:-0}" "$reason" >> "$TSV"
+    printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$svc" "$seed" "$k" "$delay" "$killed" "$rc" "$status" \
+      "$resumptions" "$repeated" "$succeeded" "$records" "${restarts:-0}" "$unlogged" "$reason" >> "$TSV"
     echo "$svc seed $seed: kill at command $k +${delay}s killed=$killed exit $rc $status repeated=$repeated" \
-      "records=$records/$succeeded restarts=${restarts:-0}"
-    if [ "$repeated" != "none" ] || { [ "$status" != "succeeded" ] && [ "$status" != "failed" ]; } || \
+      "records=$records/$succeeded restarts=${restarts:-0} unlogged=$unlogged"
+    if [ "$repeated" != "none" ] || [ "$unlogged" != "none" ] || { [ "$status" != "succeeded" ] && [ "$status" != "failed" ]; } || \
        { [ "$status" = "failed" ] && [ "$reason" = "-" ]; } || [ "$records" -lt "$succeeded" ]; then
       bad=$((bad + 1))
     fi

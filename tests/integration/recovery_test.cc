@@ -145,6 +145,110 @@ TEST(RecoveryTest, AGraphManagerKilledMidActionTakesTheMissionUpWithoutRepeating
   if (!HasFailure()) fs::remove_all(out);
 }
 
+// The robot driver (the simulator) killed (SIGKILL) while the robot moves during the second command
+// of namo_corridor. The physical world does not restart with the driver: the restarted simulator
+// resumes from its checkpoint in the run folder (the robot, the box, the action log), ends the
+// command it was running as failed ("robot driver restarted mid-action") instead of executing it
+// again, and the graph manager replans from where the robot stands. Judged by the simulator's final
+// world (the robot at the goal) and its action log (every command id at most once, the killed
+// command once, failed), and the restart in events.jsonl.
+TEST(RecoveryTest, ASimulatorKilledMidActionResumesTheWorldAndTheMissionReachesTheGoal) {
+  const fs::path out = tempFile("tamp_sim_recovery");
+  fs::remove_all(out);
+  fs::create_directories(out / "deploy" / "store");
+  const fs::path deployment = fastDeployment(out / "deploy", 2.0);
+  const int domain = isolatedDomain();
+  const std::string run_id = "simrecovery-" + std::to_string(::getpid());
+
+  auto participant = dds::Participant::create({domain, dds::kProfileDefault, "sim-recovery-test", {}}, run_id);
+  ASSERT_TRUE(participant.ok()) << participant.error().toString();
+  std::mutex m;
+  std::vector<std::string> running;  // command ids the monitor reported running, in order
+  bool moving_in_second = false;     // a robot state with the robot moving, after the second began
+  dds::Reader<msg::ExecuteStatus> statuses(*participant, dds::topics::kExecuteStatus,
+                                           [&](const msg::ExecuteStatus& s, const dds::SampleMeta&) {
+                                             if (s.state() != msg::ExecState::EXEC_RUNNING) return;
+                                             std::lock_guard g(m);
+                                             if (std::find(running.begin(), running.end(), s.command_id()) == running.end())
+                                               running.push_back(s.command_id());
+                                           });
+  dds::Reader<msg::RobotState> states(*participant, dds::topics::kRobotState,
+                                      [&](const msg::RobotState& s, const dds::SampleMeta&) {
+                                        std::lock_guard g(m);
+                                        if (running.size() >= 2 && s.moving()) moving_in_second = true;
+                                      });
+  dds::HeartbeatMonitor beats(*participant);
+
+  process::Supervisor sup;
+  process::ProcessSpec run;
+  run.name = "tamp-run";
+  run.executable = binDir() / "tamp-run";
+  run.args = {(configDir() / "scenarios" / "namo_corridor.yaml").string(), "--out", out.string(), "--domain",
+              std::to_string(domain), "--deployment", deployment.string(), "--run-id", run_id, "--policy", "effort"};
+  run.log_file = out / "tamp-run.out";
+  run.restart = false;
+  sup.add(run);
+  ASSERT_TRUE(sup.startAll().ok());
+
+  std::string victim;
+  ASSERT_TRUE(waitUntil(
+      [&] {
+        std::lock_guard g(m);
+        if (!moving_in_second) return false;
+        victim = running[1];
+        return true;
+      },
+      300.0, sup))
+      << readFile(run.log_file);
+  pid_t sim = 0;
+  for (const auto& s : beats.services())
+    if (s.name == "sim" && s.alive) sim = static_cast<pid_t>(s.pid);
+  ASSERT_GT(sim, 0) << "no live simulator heard";
+  ASSERT_EQ(::kill(sim, SIGKILL), 0);
+
+  ASSERT_TRUE(waitUntil(
+      [&] {
+        auto st = sup.status("tamp-run");
+        return st && st->phase != process::ProcessPhase::kRunning;
+      },
+      600.0, sup))
+      << readFile(run.log_file);
+  const auto st = sup.status("tamp-run");
+  const fs::path run_dir = out / run_id;
+  const std::string output = readFile(run.log_file);
+  const std::string sim_log = readFile(run_dir / "sim.log");
+  EXPECT_EQ(st->last_exit_code, 0) << output << readFile(run_dir / "graph_manager.log");
+
+  const std::string events = readFile(run_dir / "events.jsonl");
+  EXPECT_NE(events.find("\"restarted\""), std::string::npos) << events;
+  EXPECT_NE(sim_log.find("resumed from checkpoint"), std::string::npos) << sim_log;
+
+  // The mission ended at the goal of the world the robot really is in.
+  const auto truth = nlohmann::json::parse(readFile(run_dir / "sim_final_world.json"), nullptr, false);
+  ASSERT_TRUE(truth.is_object()) << output;
+  EXPECT_LT(distance(truth["robot"], 8.5, 1.2), 0.10) << truth.dump();
+  // Nothing physically done twice; the command the driver died in is there once, failed.
+  std::map<std::string, int> executions;
+  std::map<std::string, std::string> outcomes;
+  for (const auto& a : truth["action_log"]) {
+    ++executions[a["command_id"].get<std::string>()];
+    outcomes[a["command_id"].get<std::string>()] = a["outcome"].get<std::string>();
+  }
+  for (const auto& [id, n] : executions) EXPECT_EQ(n, 1) << id << " executed " << n << " times";
+  const std::string local_id = victim.substr(victim.find('/') + 1);
+  std::string logged_victim;
+  for (const auto& [id, n] : executions)
+    if (id == victim || id == local_id || id.ends_with("/" + local_id)) logged_victim = id;
+  ASSERT_FALSE(logged_victim.empty()) << victim << " not in " << truth["action_log"].dump(1);
+  EXPECT_EQ(outcomes[logged_victim], "failed") << truth["action_log"].dump(1);
+
+  const auto report = nlohmann::json::parse(readFile(run_dir / "report.json"), nullptr, false);
+  ASSERT_TRUE(report.is_object()) << output;
+  EXPECT_EQ(report["status"], "succeeded") << report.dump(1);
+  sup.stopAll(5.0);
+  if (!HasFailure()) fs::remove_all(out);
+}
+
 // A deployment started again long after its graph manager stopped must not set the robot moving
 // on the old mission: a journal older than resume_max_age_s is closed as aborted, not resumed.
 TEST(RecoveryTest, AnOldUnfinishedMissionIsClosedNotResumed) {

@@ -1,5 +1,6 @@
 #include "sim_node.h"
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -12,6 +13,7 @@
 #include "tamp/core/paths.h"
 #include "tamp/dds/convert.h"
 #include "tamp/dds/world_sync.h"
+#include "checkpoint.h"
 
 namespace tamp::sim {
 namespace {
@@ -143,20 +145,47 @@ Result<std::unique_ptr<dds::ServiceNode>> SimNode::create(const dds::ServiceArgs
   if (!args.scenario_file.empty()) params->scenario = std::filesystem::absolute(args.scenario_file).string();
   auto setup = loadSetup(*params);
   if (!setup) return setup.error();
+  // A restart within the run: the physical world stood where the checkpoint has it.
+  std::filesystem::path checkpoint_file;
+  std::optional<SimSnapshot> resume_from;
+  if (const char* run_dir = std::getenv("TAMP_RUN_DIR"); run_dir != nullptr && *run_dir != '\0') {
+    checkpoint_file = std::filesystem::path(run_dir) / kCheckpointFileName;
+    std::error_code ec;
+    if (std::filesystem::exists(checkpoint_file, ec)) {
+      auto snapshot = readCheckpoint(checkpoint_file);
+      if (!snapshot) return snapshot.error();
+      resume_from = std::move(snapshot).value();
+    }
+  }
   try {
-    return std::unique_ptr<dds::ServiceNode>(
-        std::make_unique<SimNode>(args, std::move(setup).value(), std::move(params).value()));
+    return std::unique_ptr<dds::ServiceNode>(std::make_unique<SimNode>(
+        args, std::move(setup).value(), std::move(params).value(), std::move(checkpoint_file), std::move(resume_from)));
   } catch (const std::invalid_argument& e) {
     return Error(ErrorCode::kInvalidArgument, e.what());
   }
 }
 
-SimNode::SimNode(const dds::ServiceArgs& args, SimSetup setup, SimParams params) : ServiceNode(args) {
+SimNode::SimNode(const dds::ServiceArgs& args, SimSetup setup, SimParams params,
+                 std::filesystem::path checkpoint_file, std::optional<SimSnapshot> resume_from)
+    : ServiceNode(args), checkpoint_file_(std::move(checkpoint_file)), checkpoint_period_s_(params.checkpoint_period_s),
+      checkpoint_idle_period_s_(params.checkpoint_idle_period_s) {
   robot_id_ = setup.robot.name();
   joint_names_ = setup.robot.fullJointNames();
   scripted_ = setup.faults;
   sim_ = std::make_unique<Simulator>(std::move(setup.world), std::move(setup.robot), setup.initial,
                                      std::move(params), std::move(setup.faults));
+  if (resume_from) {
+    if (Status s = sim_->resume(*resume_from); !s) {
+      throw std::invalid_argument("checkpoint " + checkpoint_file_.string() + " does not fit the scenario: " +
+                                  s.error().toString());
+    }
+    const RobotStateSample st = sim_->robotState();
+    logger()->warn("resumed from checkpoint {}: simulated time {:.2f} s, robot at ({:.3f}, {:.3f}, {:.3f}){}, "
+                   "{} command(s) in the action log",
+                   checkpoint_file_.string(), sim_->time(), st.state.base.x, st.state.base.y, st.state.base.theta,
+                   st.held_object_id.empty() ? std::string() : ", holding '" + st.held_object_id + "'",
+                   sim_->actionLog().size());
+  }
   const auto& p = participant();
   state_writer_ = std::make_unique<dds::Writer<msg::RobotState>>(p, dds::topics::kRobotState);
   cloud_writer_ = std::make_unique<dds::Writer<msg::PointCloudFrame>>(p, dds::topics::kPointCloud);
@@ -168,6 +197,7 @@ SimNode::SimNode(const dds::ServiceArgs& args, SimSetup setup, SimParams params)
     if (Status st = state_writer_->write(toMsg(s, joint_names_, robot_id_, stamp, ++state_seq_)); !st) {
       logger()->warn("robot state not published: {}", st.error().toString());
     }
+    checkpointPeriodically(s);
   };
   cb.on_cloud = [this](const PointCloudFrame& f) {
     if (Status st = cloud_writer_->write(dds::toMsg(f, ++cloud_seq_)); !st) {
@@ -175,6 +205,8 @@ SimNode::SimNode(const dds::ServiceArgs& args, SimSetup setup, SimParams params)
     }
   };
   cb.on_result = [this](const ActionResult& r) {
+    // On disk before it goes out: a restart after the result was seen finds the action ended.
+    checkpoint("action end");
     if (Status st = result_writer_->write(toMsg(r)); !st) {
       logger()->error("result of '{}' not published: {}", r.command_id, st.error().toString());
     }
@@ -184,8 +216,9 @@ SimNode::SimNode(const dds::ServiceArgs& args, SimSetup setup, SimParams params)
       logger()->warn("execution record of '{}' not published: {}", r.record_id, st.error().toString());
     }
   };
-  cb.on_fault = [](const FaultEvent& e) {
+  cb.on_fault = [this](const FaultEvent& e) {
     logger()->info("fault '{}' ({}): {}", e.fault_id, toString(e.type), e.description);
+    checkpoint("fault");
   };
   loop_ = std::make_unique<SimulationLoop>(*sim_, std::move(cb));
   command_reader_ = std::make_unique<dds::Reader<msg::TrajectoryCommand>>(
@@ -201,7 +234,45 @@ SimNode::SimNode(const dds::ServiceArgs& args, SimSetup setup, SimParams params)
         p, dds::services::kOracle,
         [this](const msg::OracleRequest& req, const dds::RequestContext&) { return onOracle(req); });
   }
+  checkpoint("start");
   loop_->start();
+}
+
+void SimNode::checkpoint(const char* why) {
+  if (checkpoint_file_.empty() || !loop_) return;
+  std::lock_guard lock(checkpoint_mutex_);
+  const auto t0 = std::chrono::steady_clock::now();
+  SimSnapshot snapshot;
+  loop_->withSimulator([&](Simulator& sim) { snapshot = sim.snapshot(); });
+  const std::string text = formatCheckpoint(snapshot);
+  const Status s = writeFileAtomically(checkpoint_file_, text, "the simulator's checkpoint");
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  if (!s) {
+    if (!checkpoint_failed_) logger()->error("{} ({}): a restart would not find this state", s.error().toString(), why);
+    checkpoint_failed_ = true;
+    return;
+  }
+  checkpoint_failed_ = false;
+  last_checkpoint_s_ = snapshot.time_s;
+  ++checkpoint_writes_;
+  checkpoint_total_ms_ += ms;
+  checkpoint_max_ms_ = std::max(checkpoint_max_ms_, ms);
+  checkpoint_bytes_ = text.size();
+  if (checkpoint_writes_ % 200 == 0) {
+    logger()->info("checkpoint: {} writes, mean {:.2f} ms, max {:.2f} ms, {} bytes", checkpoint_writes_,
+                   checkpoint_total_ms_ / static_cast<double>(checkpoint_writes_), checkpoint_max_ms_, checkpoint_bytes_);
+  }
+}
+
+void SimNode::checkpointPeriodically(const RobotStateSample& s) {
+  if (checkpoint_file_.empty()) return;
+  // An action also runs while the robot stands still in it (the gripper closing, a settle pause).
+  const bool busy = s.moving || loop_->busy();
+  {
+    std::lock_guard lock(checkpoint_mutex_);
+    if (s.time_s - last_checkpoint_s_ < (busy ? checkpoint_period_s_ : checkpoint_idle_period_s_)) return;
+  }
+  checkpoint(busy ? "action" : "idle");
 }
 
 namespace {
@@ -244,6 +315,15 @@ SimNode::~SimNode() {
   command_reader_.reset();
   fault_reader_.reset();
   if (loop_) loop_->stop();
+  if (sim_ && loop_) {
+    checkpoint("stop");
+    std::lock_guard lock(checkpoint_mutex_);
+    if (checkpoint_writes_ > 0) {
+      logger()->info("checkpoint: {} writes, mean {:.2f} ms, max {:.2f} ms, {} bytes", checkpoint_writes_,
+                     checkpoint_total_ms_ / static_cast<double>(checkpoint_writes_), checkpoint_max_ms_,
+                     checkpoint_bytes_);
+    }
+  }
   if (sim_) {
     try {
       writeFinalWorld(*sim_);
@@ -288,7 +368,9 @@ void SimNode::onCommand(const msg::TrajectoryCommand& m) {
     if (Status s = loop_->submit(*cmd); !s) {  // the loop reports the rejection as a result
       ++rejected_;
       logger()->warn("command '{}' rejected: {}", m.command_id(), s.error().message);
+      return;
     }
+    checkpoint("action start");  // the id is on disk as started: a restart never executes it again
   } catch (const std::exception& e) {
     logger()->error("command '{}': {}", m.command_id(), e.what());
   }

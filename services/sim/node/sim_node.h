@@ -18,7 +18,10 @@
 ///
 /// Nothing escapes a DDS callback: malformed messages become failed results and log lines.
 
+#include <filesystem>
 #include <memory>
+#include <mutex>
+#include <optional>
 
 #include "tamp/dds/rpc.h"
 #include "tamp/dds/service_node.h"
@@ -54,12 +57,19 @@ bool oracleEnabled();
 class SimNode : public dds::ServiceNode {
  public:
   /// Loads the parameters (--config, else configDir()/services/sim.yaml when it exists, else the
-  /// defaults) and the scenario they name, then builds the node. Errors: bad parameters or
-  /// scenario (exit 30 through serviceMain).
+  /// defaults) and the scenario they name, then builds the node. With $TAMP_RUN_DIR, a checkpoint
+  /// found there (a restart within the run) is resumed from instead of the scenario's start state.
+  /// Errors: bad parameters or scenario, a checkpoint that cannot be read or does not fit the
+  /// scenario (naming the file, line and field; the simulator does not start: the world it would
+  /// start from is unknown) (exit 30 through serviceMain).
   static Result<std::unique_ptr<dds::ServiceNode>> create(const dds::ServiceArgs& args);
-  /// Builds the node around an explicit setup (tests, embedding). Throws std::runtime_error when
-  /// DDS fails and std::invalid_argument when the setup is invalid.
-  SimNode(const dds::ServiceArgs& args, SimSetup setup, SimParams params);
+  /// Builds the node around an explicit setup (tests, embedding). With `checkpoint_file` (create()
+  /// passes $TAMP_RUN_DIR/sim.checkpoint) the node resumes from `resume_from` when given
+  /// (`Simulator::resume`: a restarted robot driver) and checkpoints its physical state there
+  /// (checkpoint.h). Throws std::runtime_error when DDS fails and std::invalid_argument when the
+  /// setup is invalid or `resume_from` does not fit it.
+  SimNode(const dds::ServiceArgs& args, SimSetup setup, SimParams params,
+          std::filesystem::path checkpoint_file = {}, std::optional<SimSnapshot> resume_from = std::nullopt);
   ~SimNode() override;
 
   /// The running loop (e.g. for in-process tests to read the ground truth).
@@ -85,6 +95,20 @@ class SimNode : public dds::ServiceNode {
   std::unique_ptr<dds::RpcServer<msg::OracleRequest, msg::OracleReply>> oracle_;
   std::atomic<std::uint64_t> state_seq_{0}, cloud_seq_{0};
   std::atomic<std::uint64_t> commands_{0}, rejected_{0};
+
+  /// Writes the checkpoint now (any thread; serialised). `why` is for the log.
+  void checkpoint(const char* why);
+  /// A periodic checkpoint (loop thread, from the state callback): every `checkpoint_period_s`
+  /// while an action runs, every `checkpoint_idle_period_s` otherwise.
+  void checkpointPeriodically(const RobotStateSample& s);
+  std::filesystem::path checkpoint_file_;  ///< empty: no checkpoint
+  double checkpoint_period_s_{0.2}, checkpoint_idle_period_s_{1.0};
+  std::mutex checkpoint_mutex_;            ///< guards the write and the fields below
+  double last_checkpoint_s_{-1.0};         ///< simulated time of the last one
+  bool checkpoint_failed_{false};
+  std::uint64_t checkpoint_writes_{0};
+  double checkpoint_total_ms_{0.0}, checkpoint_max_ms_{0.0};
+  std::size_t checkpoint_bytes_{0};
 };
 
 }  // namespace tamp::sim

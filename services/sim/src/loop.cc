@@ -1,6 +1,7 @@
 #include "tamp/sim/loop.h"
 
 #include <chrono>
+#include <cmath>
 #include <vector>
 
 #include "tamp/core/log.h"
@@ -24,10 +25,7 @@ void safeCall(const Fn& fn, const char* what, Args&&... args) {
 
 SimulationLoop::SimulationLoop(Simulator& sim, LoopCallbacks callbacks)
     : sim_(sim), cb_(std::move(callbacks)) {
-  epoch_ns_ = std::chrono::duration_cast<std::chrono::nanoseconds>(
-                  std::chrono::system_clock::now().time_since_epoch())
-                  .count() -
-              static_cast<std::int64_t>(sim.time() * 1e9);
+  epoch_ns_ = std::llround(sim.epoch() * 1e9);
   next_cloud_ = sim.time();
 }
 

@@ -26,6 +26,8 @@ const config::Schema<SimParams>& schema() {
         .field("realtime_factor", &P::realtime_factor, nonNegative("(0 = as fast as possible)"))
         .field("state_period_s", &P::state_period_s, inRange(0, 10, Ends::kOpenClosed, "s"))
         .field("cloud_period_s", &P::cloud_period_s, nonNegative("s"))
+        .field("checkpoint_period_s", &P::checkpoint_period_s, inRange(0, 10, Ends::kOpenClosed, "s"))
+        .field("checkpoint_idle_period_s", &P::checkpoint_idle_period_s, inRange(0, 60, Ends::kOpenClosed, "s"))
         .field("duration_noise", &P::duration_noise,
                inRange(0, 1, Ends::kClosed, "(stddev of log duration)"))
         .convert<int>("seed", &P::seed,

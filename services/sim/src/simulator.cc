@@ -462,6 +462,16 @@ struct Simulator::Impl {
     scene.syncWorld(world);
   }
 
+  /// The collision scene built anew over `world` (the held object attached, posed at `idle`).
+  Status rebuildScene() {
+    scene = collision::Scene(world);
+    scene.setRobot(robot.collisionGeometry());
+    if (Status s = scene.attachHeld(); !s) return s;
+    syncHeldPose(idle);
+    syncScene();
+    return Status::Ok();
+  }
+
   /// Keeps the world poses of the held object and of objects resting on the robot where the
   /// robot's links are.
   void syncHeldPose(const Vec& q) {
@@ -1257,11 +1267,7 @@ Simulator::Simulator(world::World truth, robot::RobotModel robot, robot::RobotSt
   m.scripted = std::move(faults);
   m.fired.assign(m.scripted.size(), false);
   m.rng.seed(m.params.seed);
-  m.scene = collision::Scene(m.world);
-  m.scene.setRobot(m.robot.collisionGeometry());
-  if (Status s = m.scene.attachHeld(); !s) throw std::invalid_argument("Simulator: " + s.error().message);
-  m.syncHeldPose(m.idle);
-  m.syncScene();
+  if (Status s = m.rebuildScene(); !s) throw std::invalid_argument("Simulator: " + s.error().message);
   m.epoch_s = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
 
@@ -1462,6 +1468,7 @@ StepEvents Simulator::step(double dt) {
 }
 
 double Simulator::time() const { return impl_->now; }
+double Simulator::epoch() const { return impl_->epoch_s; }
 bool Simulator::busy() const { return impl_->active.has_value(); }
 double Simulator::remainingActionTime() const {
   const Impl& m = *impl_;
@@ -1470,6 +1477,126 @@ double Simulator::remainingActionTime() const {
 int Simulator::actionCount() const { return impl_->actions; }
 
 const std::vector<ActionLogEntry>& Simulator::actionLog() const { return impl_->log; }
+
+SimSnapshot Simulator::snapshot() const {
+  const Impl& m = *impl_;
+  SimSnapshot s;
+  s.time_s = m.now;
+  s.epoch_s = m.epoch_s;
+  s.robot = m.toState(m.current());
+  s.held = m.world.held();
+  for (const auto& o : m.world.objects()) s.objects.push_back(o);
+  for (std::size_t i = 0; i < m.scripted.size(); ++i) {
+    if (m.fired[i]) s.fired_faults.push_back(m.scripted[i].id);
+  }
+  for (const Fault& f : m.pending_fails) s.pending_faults.push_back(f.id);
+  s.log = m.log;
+  return s;
+}
+
+namespace {
+
+/// The index of the scripted fault `id`, or nullopt.
+std::optional<std::size_t> faultIndex(const std::vector<Fault>& scripted, const std::string& id) {
+  for (std::size_t i = 0; i < scripted.size(); ++i) {
+    if (scripted[i].id == id) return i;
+  }
+  return std::nullopt;
+}
+
+/// Ok when the log can be this simulator's: ids non-empty and unique, only the last entry
+/// without a result, results carrying their entry's id.
+Status checkLog(const std::vector<ActionLogEntry>& log) {
+  std::set<std::string> ids;
+  for (std::size_t i = 0; i < log.size(); ++i) {
+    const std::string field = "log[" + std::to_string(i) + "]";
+    const ActionLogEntry& e = log[i];
+    if (e.command_id.empty()) return invalid(field + ".command_id", "empty");
+    if (!ids.insert(e.command_id).second) return invalid(field + ".command_id", "'" + e.command_id + "' twice");
+    if (!std::isfinite(e.start_s)) return invalid(field + ".start_s", "not finite");
+    if (!e.result && i + 1 != log.size()) return invalid(field + ".result", "running, but not the last action");
+    if (e.result && e.result->command_id != e.command_id) {
+      return invalid(field + ".result.command_id", "'" + e.result->command_id + "' is not the entry's id");
+    }
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status Simulator::resume(const SimSnapshot& snapshot) {
+  Impl& m = *impl_;
+  if (!m.log.empty() || m.active) throw std::logic_error("Simulator::resume: commands were accepted already");
+  if (!std::isfinite(snapshot.time_s) || snapshot.time_s < 0.0) {
+    return invalid("time_s", "must be finite and >= 0, got " + formatNumber(snapshot.time_s, 4));
+  }
+  if (!std::isfinite(snapshot.epoch_s) || snapshot.epoch_s <= 0.0) {
+    return invalid("epoch_s", "must be a positive wall-clock time, got " + formatNumber(snapshot.epoch_s, 4));
+  }
+  if (snapshot.robot.arm.size() != static_cast<std::size_t>(m.dof)) {
+    return invalid("robot.arm", std::to_string(snapshot.robot.arm.size()) + " values, the robot has " +
+                                    std::to_string(m.dof) + " arm joints");
+  }
+  const Vec q = m.toVec(snapshot.robot);
+  if (!q.allFinite()) return invalid("robot", "not finite");
+  world::World w = m.world;
+  for (const auto& o : m.world.objects()) (void)w.removeObject(o.id);
+  for (const auto& o : snapshot.objects) {
+    if (Status s = w.addObject(o); !s) return invalid("objects[" + o.id + "]", s.error().message);
+  }
+  if (snapshot.held) {
+    if (snapshot.held->link != m.robot.options().tool_link) {
+      return invalid("held", "held by link '" + snapshot.held->link + "', not by the tool link '" +
+                                 m.robot.options().tool_link + "'");
+    }
+    if (Status s = w.setHeld(snapshot.held); !s) return invalid("held", s.error().message);
+  }
+  std::vector<bool> fired(m.scripted.size(), false);
+  for (std::size_t i = 0; i < snapshot.fired_faults.size(); ++i) {
+    const auto idx = faultIndex(m.scripted, snapshot.fired_faults[i]);
+    if (!idx) return invalid("fired_faults[" + std::to_string(i) + "]", "no scripted fault '" + snapshot.fired_faults[i] + "'");
+    fired[*idx] = true;
+  }
+  std::vector<Fault> pending;
+  for (std::size_t i = 0; i < snapshot.pending_faults.size(); ++i) {
+    const auto idx = faultIndex(m.scripted, snapshot.pending_faults[i]);
+    if (!idx) return invalid("pending_faults[" + std::to_string(i) + "]", "no scripted fault '" + snapshot.pending_faults[i] + "'");
+    pending.push_back(m.scripted[*idx]);
+  }
+  if (Status s = checkLog(snapshot.log); !s) return s;
+
+  const world::World before = m.world;
+  m.world = std::move(w);
+  m.idle = q;
+  m.riding.clear();
+  if (Status s = m.rebuildScene(); !s) {
+    m.world = before;
+    (void)m.rebuildScene();
+    return invalid("held", s.error().message);
+  }
+  m.fired = std::move(fired);
+  m.pending_fails = std::move(pending);
+  m.epoch_s = snapshot.epoch_s;  // stamps go on, never back
+  m.now = snapshot.time_s;
+  m.log = snapshot.log;
+  m.logged.clear();
+  for (std::size_t i = 0; i < m.log.size(); ++i) m.logged[m.log[i].command_id] = i;
+  m.actions = static_cast<int>(m.log.size());
+  for (ActionLogEntry& e : m.log) {
+    if (e.result) continue;
+    // The robot stopped where it stood: the command is over, as a failure the planner replans from.
+    ActionResult r;
+    r.command_id = e.command_id;
+    r.outcome = Outcome::kFailed;
+    r.duration_s = std::max(0.0, snapshot.time_s - e.start_s);
+    r.reason = std::string(kRestartedMidAction) + ": the robot stopped where it stood; '" + e.command_id +
+               "' is not executed again";
+    e.result = r;
+    m.replayed.push_back(r);
+    logger()->warn("'{}' was running when the driver stopped: {}", e.command_id, r.reason);
+  }
+  return Status::Ok();
+}
 
 RobotStateSample Simulator::robotState() const {
   const Impl& m = *impl_;

@@ -24,6 +24,8 @@ TEST(SimParamsTest, ParsesEveryBlock) {
 realtime_factor: 0
 state_period_s: 0.1
 cloud_period_s: 1.0
+checkpoint_period_s: 0.5
+checkpoint_idle_period_s: 2.0
 duration_noise: 0.02
 seed: 5
 max_step_m: 0.005
@@ -39,6 +41,8 @@ sensor: {width: 64, height: 48, horizontal_fov_rad: 1.2, see_robot: true}
   auto p = parseSimParams(yaml, "sim.yaml");
   ASSERT_TRUE(p) << p.error().toString();
   EXPECT_EQ(p->realtime_factor, 0.0);
+  EXPECT_EQ(p->checkpoint_period_s, 0.5);
+  EXPECT_EQ(p->checkpoint_idle_period_s, 2.0);
   EXPECT_EQ(p->seed, 5u);
   EXPECT_EQ(p->max_step_m, 0.005);
   EXPECT_EQ(p->start_tolerance.angle_rad, 0.2);
@@ -75,6 +79,8 @@ TEST(SimParamsTest, ErrorsNameFileLineAndField) {
       {"duration_noise: abc\n", "field 'duration_noise'"},
       {"push:\n  lateral_slip: -0.1\n", "field 'push.lateral_slip'"},
       {"push:\n  max_contact_gap_m: 0\n", "field 'push.max_contact_gap_m'"},
+      {"checkpoint_period_s: 0\n", "field 'checkpoint_period_s'"},
+      {"checkpoint_idle_period_s: -1\n", "field 'checkpoint_idle_period_s'"},
   };
   for (const auto& c : cases) {
     auto p = parseSimParams(c.yaml, "sim.yaml");

@@ -494,3 +494,114 @@ TEST(SimulatorTest, ARejectedCommandIsNotLoggedAsExecuted) {
 
 }  // namespace
 }  // namespace tamp::sim
+
+namespace tamp::sim {
+namespace {
+
+using namespace tamp::sim::testing;
+
+/// The empty room with a hidden static wall and a movable box held in the gripper.
+world::World roomWithHeldBox() {
+  world::World w = emptyRoom();
+  EXPECT_TRUE(w.addObject(box("hidden_wall", 0.2, 3.0, 1.0, at(6.0, 0.0, 0.5), false, true)));
+  world::Object held = box("carried", 0.05, 0.05, 0.1, at(0.5, 0.0, 1.0), true);
+  held.graspable = true;
+  EXPECT_TRUE(w.addObject(held));
+  EXPECT_TRUE(w.setHeld(world::HeldObject{"carried", robotModel().options().tool_link,
+                                          Eigen::Isometry3d(Eigen::Translation3d(0.0, 0.0, 0.05))}));
+  return w;
+}
+
+TEST(SimulatorResumeTest, ARestartedSimulatorResumesTheWorldAndNeverExecutesTheInFlightIdAgain) {
+  // The driver's process: a 2 m drive, "killed" half-way (its snapshot is all that is left).
+  Simulator before(roomWithHeldBox(), robotModel(), upright(), exactParams());
+  const ActionCommand drive = moveBase("drive", {{0, 0, 0}, {2, 0, 0}});
+  ASSERT_TRUE(before.submit(drive));
+  for (int i = 0; i < 40; ++i) (void)before.step(0.05);
+  ASSERT_TRUE(before.busy());
+  const SimSnapshot snap = before.snapshot();
+  const double mid = snap.robot.base.x;
+  ASSERT_GT(mid, 0.2);
+  ASSERT_LT(mid, 1.8);
+  ASSERT_EQ(snap.log.size(), 1u);
+  EXPECT_FALSE(snap.log[0].result.has_value());
+
+  // The restarted driver: built from the scenario, then resumed.
+  Simulator after(roomWithHeldBox(), robotModel(), upright(), exactParams());
+  ASSERT_TRUE(after.resume(snap));
+  EXPECT_DOUBLE_EQ(after.time(), snap.time_s);
+  EXPECT_DOUBLE_EQ(after.epoch(), before.epoch());  // stamps go on, not back
+  EXPECT_DOUBLE_EQ(after.robotState().state.base.x, mid);
+  EXPECT_EQ(after.robotState().held_object_id, "carried");
+  EXPECT_TRUE(after.world().object("hidden_wall").hidden);
+  // The held object is at the gripper where the robot stands, not where the scenario had it.
+  EXPECT_NEAR(after.world().object("carried").pose.translation().x(),
+              before.world().object("carried").pose.translation().x(), 1e-9);
+  EXPECT_FALSE(after.busy());
+  // The interrupted command ends, failed with the reason, at the first step; no record.
+  const StepEvents first = after.step(0.05);
+  ASSERT_EQ(first.results.size(), 1u);
+  EXPECT_EQ(first.results[0].command_id, "drive");
+  EXPECT_EQ(first.results[0].outcome, Outcome::kFailed);
+  EXPECT_NE(first.results[0].reason.find(kRestartedMidAction), std::string::npos) << first.results[0].reason;
+  EXPECT_TRUE(first.records.empty());
+  // The sender repeats the id (a restarted monitor): the same failure, the robot does not move.
+  ASSERT_TRUE(after.submit(drive));
+  EXPECT_FALSE(after.busy());
+  const StepEvents again = after.step(0.5);
+  ASSERT_EQ(again.results.size(), 1u);
+  EXPECT_EQ(again.results[0].outcome, Outcome::kFailed);
+  EXPECT_DOUBLE_EQ(after.robotState().state.base.x, mid);
+  EXPECT_EQ(after.actionCount(), 1);
+  ASSERT_EQ(after.actionLog().size(), 1u);
+  ASSERT_TRUE(after.actionLog()[0].result.has_value());
+  EXPECT_EQ(after.actionLog()[0].result->outcome, Outcome::kFailed);
+  // A new command from where the robot really is runs.
+  ASSERT_TRUE(after.submit(moveBase("rest", {{mid, 0, 0}, {2, 0, 0}})));
+  const StepEvents rest = runToEnd(after);
+  ASSERT_EQ(rest.results.size(), 1u);
+  EXPECT_EQ(rest.results[0].outcome, Outcome::kSucceeded) << rest.results[0].reason;
+  EXPECT_NEAR(after.robotState().state.base.x, 2.0, 1e-6);
+  EXPECT_EQ(after.actionLog()[1].step, 1);
+}
+
+TEST(SimulatorResumeTest, ASnapshotThatDoesNotFitIsRefusedNamingTheField) {
+  Simulator source(roomWithHeldBox(), robotModel(), upright(), exactParams());
+  const SimSnapshot good = source.snapshot();
+  const auto refused = [&](SimSnapshot s, const std::string& field) {
+    Simulator sim(roomWithHeldBox(), robotModel(), upright(), exactParams());
+    const Status st = sim.resume(s);
+    EXPECT_FALSE(st.ok()) << field;
+    if (!st.ok()) {
+      EXPECT_EQ(st.error().code, ErrorCode::kInvalidArgument);
+      EXPECT_NE(st.error().message.find(field), std::string::npos) << st.error().message;
+    }
+    EXPECT_DOUBLE_EQ(sim.robotState().state.base.x, 0.0);  // nothing changed
+  };
+  SimSnapshot s = good;
+  s.robot.arm.pop_back();
+  refused(s, "robot.arm");
+  s = good;
+  s.epoch_s = 0.0;
+  refused(s, "epoch_s");
+  s = good;
+  s.held->link = "base_link";
+  refused(s, "held");
+  s = good;
+  s.objects.push_back(s.objects.front());
+  refused(s, "objects[" + s.objects.front().id + "]");
+  s = good;
+  s.fired_faults.push_back("fault_9");
+  refused(s, "fired_faults[0]");
+  s = good;
+  s.log.push_back(ActionLogEntry{"a", ActionKind::kMoveBase, 0, 0.0, ActionResult{"a", Outcome::kSucceeded, 1.0, 1.0, "", ""}});
+  s.log.push_back(ActionLogEntry{"a", ActionKind::kMoveBase, 1, 0.0, std::nullopt});
+  refused(s, "log[1].command_id");
+  // Resuming after commands were accepted is misuse.
+  Simulator busy(roomWithHeldBox(), robotModel(), upright(), exactParams());
+  ASSERT_TRUE(busy.submit(moveBase("drive", {{0, 0, 0}, {1, 0, 0}})));
+  EXPECT_THROW((void)busy.resume(good), std::logic_error);
+}
+
+}  // namespace
+}  // namespace tamp::sim

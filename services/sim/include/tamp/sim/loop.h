@@ -56,8 +56,8 @@ class SimulationLoop {
   Status inject(Fault fault);
   void requestCloud();
 
-  /// Stamp (ns since the Unix epoch) of simulated time `t`: the wall-clock time at construction
-  /// plus `t`.
+  /// Stamp (ns since the Unix epoch) of simulated time `t`: `Simulator::epoch()` (the wall-clock
+  /// time at simulated time 0) plus `t`.
   std::int64_t stampNs(double t) const;
   double simTime() const;
   bool busy() const;

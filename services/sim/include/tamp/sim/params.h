@@ -9,6 +9,8 @@
 ///   realtime_factor: 1.0         # simulated seconds per wall-clock second; 0 = as fast as possible
 ///   state_period_s: 0.05         # simulated time between robot-state samples
 ///   cloud_period_s: 0.5          # simulated time between point clouds; 0 = only after actions
+///   checkpoint_period_s: 0.2     # simulated time between checkpoints while an action runs (node)
+///   checkpoint_idle_period_s: 1.0  # the same while idle (the clock goes on)
 ///   duration_noise: 0.03         # stddev of log(duration) of an action (log-normal, median 1)
 ///   seed: 1                      # execution-noise seed (the sensor has its own)
 ///   max_step_m: 0.01             # swept check: largest displacement of any robot point between checks
@@ -77,6 +79,14 @@ struct SimParams {
   double realtime_factor{1.0};     ///< >= 0; 0 = as fast as possible
   double state_period_s{0.05};     ///< > 0
   double cloud_period_s{0.5};      ///< >= 0; 0 = clouds only after actions (and on demand)
+  /// In (0, 10]: simulated time between checkpoints of the physical state while an action runs
+  /// (node only, with $TAMP_RUN_DIR; every action's start and end and every fault write one too).
+  /// A restarted simulator resumes the robot where the last checkpoint had it.
+  double checkpoint_period_s{0.2};
+  /// In (0, 60]: the same while no action runs (the state does not change then, but the clock
+  /// does: a resumed simulator's stamps go on from the last checkpoint's time, and a reader drops
+  /// frames stamped before the killed process's last ones).
+  double checkpoint_idle_period_s{1.0};
   double duration_noise{0.03};     ///< in [0, 1]: stddev of log(duration); 0 = exact model time
   std::uint64_t seed{1};
   double max_step_m{0.01};         ///< in (0, 0.5]

@@ -128,6 +128,33 @@ struct StepEvents {
   bool world_changed{false};  ///< objects moved, appeared or disappeared (not just the robot)
 };
 
+/// What a robot driver that is restarted needs to resume the physical world where it stood
+/// (issue 13: the robot and the world do not restart with the driver's process): the robot's
+/// state, what the gripper holds, every object (hidden ones included, wherever faults, pushes and
+/// places left them) and the simulator's memory of command ids (the action log), so that an id
+/// accepted before the restart is still never executed again. Written by `snapshot()`, taken up by
+/// `resume()`; the node keeps it in the run folder (node/checkpoint.h).
+/// Not in it: objects that fell onto the robot and ride on it (they stay where they were), the
+/// random streams (execution noise after a restart is drawn afresh from `SimParams::seed`), and
+/// injected faults not fired yet.
+struct SimSnapshot {
+  double time_s{0.0};                     ///< simulated time of the snapshot
+  /// Wall-clock time (s since the Unix epoch) of simulated time 0: stamps are epoch_s + time, so
+  /// a resumed simulator's stamps go on from where they were instead of jumping back (readers
+  /// such as perception drop a frame older than the previous one).
+  double epoch_s{0.0};
+  robot::RobotState robot;                ///< base, arm and gripper joints
+  std::optional<world::HeldObject> held;  ///< the object in the gripper (held by the tool link)
+  std::vector<world::Object> objects;     ///< every object of the ground truth, hidden ones included
+  std::vector<std::string> fired_faults;    ///< ids of the scripted faults that have fired
+  std::vector<std::string> pending_faults;  ///< ids of fail-action faults waiting for their kind
+  /// Every accepted command in order; the one running at the snapshot has no result.
+  std::vector<ActionLogEntry> log;
+};
+
+/// The reason given for a command that was running when the robot driver was restarted.
+inline constexpr const char* kRestartedMidAction = "robot driver restarted mid-action";
+
 /// The URDF velocity limit of each arm joint, by name (the `joint_speed` of dynamics.h).
 std::unordered_map<std::string, double> armSpeedLimits(const robot::RobotModel& robot);
 
@@ -165,8 +192,11 @@ class Simulator {
 
   /// Advances simulated time by `dt` >= 0 seconds (throws std::invalid_argument otherwise).
   StepEvents step(double dt);
-  /// Simulated seconds since construction.
+  /// Simulated seconds since construction (since the start of the run after `resume()`).
   double time() const;
+  /// Wall-clock seconds since the Unix epoch at simulated time 0 (construction, or the resumed
+  /// snapshot's): a stamp of simulated time t is epoch() + t (records; SimulationLoop::stampNs).
+  double epoch() const;
   bool busy() const;
   /// Time left of the action in progress (0 when idle), simulated seconds.
   double remainingActionTime() const;
@@ -174,6 +204,20 @@ class Simulator {
   int actionCount() const;
   /// Every accepted action in order, with its result once it ended.
   const std::vector<ActionLogEntry>& actionLog() const;
+
+  /// The physical state and the action log now (see SimSnapshot). The robot state is the one an
+  /// action in progress has reached; that action is in the log without a result.
+  SimSnapshot snapshot() const;
+  /// Takes up `snapshot` (a simulator killed and restarted): the world's objects, the held object
+  /// and the robot's state are the snapshot's (regions and locations stay this simulator's),
+  /// simulated time and the stamps' epoch go on from the snapshot's, the scripted faults that fired stay fired, and
+  /// the action log is the snapshot's. The command that was running is not resumed (the robot
+  /// stopped where it stood): it ends kFailed with `kRestartedMidAction` in its reason, reported by
+  /// the next `step()` and again to a sender that repeats its id; no record is made for it.
+  /// kInvalidArgument naming the field (`robot.arm`, `held`, `objects[id]`, `fired_faults[i]`,
+  /// `log[i].command_id`) when the snapshot does not fit this simulator; then nothing changed.
+  /// @throws std::logic_error when this simulator has accepted a command already.
+  Status resume(const SimSnapshot& snapshot);
 
   RobotStateSample robotState() const;
   /// The ground truth (hidden objects included; the held object at its current pose).

@@ -63,7 +63,7 @@ int main(int argc, char** argv) {
   size_t memory_mb = 4096;
   bool stats = false, no_check = false, no_fallback = false, no_agenda = false, first_improvement = false,
        no_ff_first = false, no_landmarks = false, no_unit_first = false,
-       no_full_retry = false, ff_first_improvement = false, fallback_from_reached = false;
+       no_full_retry = false, ff_first_improvement = false;
   uint64_t ff_budget = 300, second_budget = 300;
   const sp::SearchOptions defaults;
   uint64_t fallback_budget = defaults.ehc_fallback_budget_per_h, fallback_min = defaults.ehc_fallback_budget_min,
@@ -94,10 +94,6 @@ int main(int argc, char** argv) {
   app.add_flag("--no-goal-agenda", no_agenda, "ehc: pursue all goals at once (no FF goal agenda)");
   app.add_flag("--ehc-first-improvement", first_improvement,
                "ehc: continue from the first better state (FF) instead of the best sibling");
-  app.add_flag("--ehc-fallback-from-reached", fallback_from_reached,
-               "ehc: the lazy fallback starts from the state the hill-climbing reached (its plan follows the "
-               "hill-climbing's; from the initial state only if that state is a dead end), instead of from the "
-               "initial state (FF)");
   app.add_flag("--no-ehc-full-retry", no_full_retry,
                "ehc: fall back as soon as a plateau is exhausted with helpful actions (FF), instead of searching "
                "it again with every applicable action");
@@ -150,7 +146,6 @@ int main(int argc, char** argv) {
   req.search.goal_agenda = !no_agenda;
   req.search.ehc_best_sibling = !first_improvement;
   req.search.ehc_full_retry = !no_full_retry;
-  req.search.ehc_fallback_from_reached = fallback_from_reached;
   req.search.ehc_retry_budget_share = retry_share;
   req.search.ehc_ff_first_improvement = ff_first_improvement;
   req.search.ehc_ff_first = !no_ff_first;
@@ -181,7 +176,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr,
                  "; status %s; parse %.4f s, ground %.4f s, search %.4f s; facts %zu, operators %zu; "
                  "expanded %llu, evaluated %llu, initial h %lld; ehc plateau retries %llu (%llu abandoned); ehc fallbacks "
-                 "%llu (%llu in a goal-agenda entry before the last, %llu from the state reached, %llu restarted); anytime %llu "
+                 "%llu (%llu in a goal-agenda entry before the last); anytime %llu "
                  "iterations, %llu improvements%s%s%s%s\n",
                  sp::toString(reply.status).c_str(), reply.stats.parse_seconds, reply.stats.ground_seconds,
                  reply.stats.search_seconds, reply.stats.facts, reply.stats.operators,
@@ -191,8 +186,6 @@ int main(int argc, char** argv) {
                  static_cast<unsigned long long>(reply.stats.ehc_retries_abandoned),
                  static_cast<unsigned long long>(reply.stats.ehc_fallbacks),
                  static_cast<unsigned long long>(reply.stats.ehc_fallbacks_in_agenda),
-                 static_cast<unsigned long long>(reply.stats.ehc_fallbacks_from_reached),
-                 static_cast<unsigned long long>(reply.stats.ehc_fallbacks_restarted),
                  static_cast<unsigned long long>(reply.stats.anytime_iterations),
                  static_cast<unsigned long long>(reply.stats.anytime_improvements),
                  reply.stats.ehc_ff_failed ? "; ehc with FF-v2.3's relaxed plan failed, restarted" : "",

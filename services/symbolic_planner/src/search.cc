@@ -429,7 +429,7 @@ class Searcher {
     }
     if (hcur == Heuristic::kDeadEnd) {
       if (first && &goal == &goal_) return finish(SearchStatus::kUnsolvable);
-      return fallback(plan);
+      return fallback();
     }
     std::vector<uint32_t> queue;
     std::vector<OpId> all_ops;
@@ -454,10 +454,10 @@ class Searcher {
           // The plateau searched again without helpful-action pruning is too large: treat it as
           // a failed hill-climbing.
           ++stats_.ehc_retries_abandoned;
-          return fallback(plan);
+          return fallback();
         }
         if (fallback_budget_ > 0 && stats_.evaluated + opt_.ehc_fallback_budget_spent > fallback_budget_) {
-          return fallback(plan);
+          return fallback();
         }
         const uint32_t id = queue[head];
         std::copy(reg_.get(id), reg_.get(id) + reg_.words(), buf_.begin());
@@ -504,7 +504,7 @@ class Searcher {
           ++stats_.ehc_retries;
           continue;
         }
-        return fallback(plan);
+        return fallback();
       }
       helpful_only = true;
       std::vector<OpId> seg = path(found, cur);
@@ -516,32 +516,12 @@ class Searcher {
     }
   }
 
-  /// `plan`: the hill-climbing's plan so far (from the initial state).
-  SearchResult fallback(const std::vector<OpId>& plan) {
+  SearchResult fallback() {
     stats_.ehc_failed = true;
     if (!opt_.ehc_fallback) return finish(SearchStatus::kFailed);
     ++stats_.ehc_fallbacks;
     if (in_agenda_entry_before_last_) ++stats_.ehc_fallbacks_in_agenda;
     h_.setGoal(goal_);
-    if (opt_.ehc_fallback_from_reached && !plan.empty() && opt_.fallback == SearchAlgorithm::kLazy) {
-      // The lazy search continues from the state the hill-climbing reached, with the full goal;
-      // its plan follows the hill-climbing's. Only when that state is proven a dead end does it
-      // start again from the initial state.
-      StateBits reached = init_;
-      StateBits nxt(reached.size());
-      for (OpId o : plan) {
-        task_.apply(reached.data(), o, nxt.data());
-        reached.swap(nxt);
-      }
-      ++stats_.ehc_fallbacks_from_reached;
-      SearchResult r = lazy(std::numeric_limits<Cost>::max(), &reached);
-      if (r.status == SearchStatus::kSolved) {
-        r.plan.insert(r.plan.begin(), plan.begin(), plan.end());
-        return r;
-      }
-      if (r.status != SearchStatus::kUnsolvable) return r;
-      ++stats_.ehc_fallbacks_restarted;
-    }
     return opt_.fallback == SearchAlgorithm::kGbfs ? gbfs() : lazy();
   }
 
@@ -598,12 +578,10 @@ class Searcher {
 
   /// Paths costing `bound` or more are pruned (the anytime phase's first iteration); g is the
   /// cost of the path found first (no re-opening).
-  /// `from`: the state to start from (nullptr: the initial state).
-  SearchResult lazy(Cost bound = std::numeric_limits<Cost>::max(), const StateBits* from = nullptr) {
-    const StateBits& start = from != nullptr ? *from : init_;
+  SearchResult lazy(Cost bound = std::numeric_limits<Cost>::max()) {
     resetRegistry();
     bool is_new = false;
-    const uint32_t root = registerState(start.data(), &is_new);
+    const uint32_t root = registerState(init_.data(), &is_new);
     g_[root] = 0;
     if (task_.goalReached(reg_.get(root), goal_)) return finish(SearchStatus::kSolved);
     const Cost h0 = evaluate(root);
@@ -613,7 +591,7 @@ class Searcher {
     // LAMA's second heuristic: landmark count, with its own accepted-landmark set per state.
     std::unique_ptr<LandmarkCounter> lm;
     if (opt_.landmarks) {
-      lm = std::make_unique<LandmarkCounter>(task_, start, goal_);
+      lm = std::make_unique<LandmarkCounter>(task_, init_, goal_);
       if (!lm->enabled()) lm.reset();
     }
     const size_t lw = lm ? lm->words() : 0;
@@ -945,8 +923,6 @@ void addRunCosts(SearchStatistics& into, const SearchStatistics& from) {
   into.ehc_retries_abandoned += from.ehc_retries_abandoned;
   into.ehc_fallbacks += from.ehc_fallbacks;
   into.ehc_fallbacks_in_agenda += from.ehc_fallbacks_in_agenda;
-  into.ehc_fallbacks_from_reached += from.ehc_fallbacks_from_reached;
-  into.ehc_fallbacks_restarted += from.ehc_fallbacks_restarted;
   into.registered_states += from.registered_states;
   into.seconds += from.seconds;
 }

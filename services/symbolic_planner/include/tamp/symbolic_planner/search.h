@@ -57,12 +57,6 @@ struct SearchOptions {
   std::optional<CostType> cost_type;
   double weight{5.0};           ///< wastar only; must be >= 1
   bool ehc_fallback{true};      ///< ehc: complete best-first search when hill-climbing fails
-  /// ehc with the lazy fallback: when the hill-climbing fails after taking steps (in any
-  /// goal-agenda entry, or without an agenda), the lazy search starts from the state it reached,
-  /// with the full goal, and its plan follows the hill-climbing's; only when that state is proven
-  /// a dead end does it start again from the initial state. Off: FF's behaviour, the complete
-  /// search from the initial state (docs/benchmarks.md, issue 14, tenth and eleventh rounds).
-  bool ehc_fallback_from_reached{false};
   /// ehc: the complete search to fall back to: kLazy (LAMA's lazy GBFS) or kGbfs (eager).
   SearchAlgorithm fallback{SearchAlgorithm::kLazy};
   bool goal_agenda{true};       ///< ehc: FF's goal agenda (achieve ordered goal subsets in turn)
@@ -174,11 +168,6 @@ struct SearchStatistics {
   /// them started inside a goal-agenda entry that is not the last.
   uint64_t ehc_fallbacks{0};
   uint64_t ehc_fallbacks_in_agenda{0};
-  /// `ehc_fallback_from_reached`: fallbacks whose lazy search started from the state the
-  /// hill-climbing reached, and how many of those proved it a dead end and started again from
-  /// the initial state.
-  uint64_t ehc_fallbacks_from_reached{0};
-  uint64_t ehc_fallbacks_restarted{0};
   uint64_t landmarks{0};    ///< lazy: number of fact landmarks found (0: landmark count not used)
   uint64_t eliminated_actions{0};  ///< removed by action elimination
   uint64_t anytime_iterations{0};    ///< weighted A* iterations of the anytime phase

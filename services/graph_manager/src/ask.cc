@@ -6,13 +6,13 @@
 namespace tamp::graph_manager {
 
 MotionAnswer GraphManager::askMotion(const MotionQuery& q) {
-  if (const MotionAnswer* kept = memo_.motion(q)) {
+  if (const MotionAnswer* kept = params_.memoise_answers ? memo_.motion(q) : nullptr) {
     ++counters_.memo_hits;
     return *kept;
   }
   ++counters_.motion_calls;
   MotionAnswer a = services_.motion(q);
-  memo_.keep(q, a);
+  if (params_.memoise_answers) memo_.keep(q, a);
   return a;
 }
 
@@ -21,7 +21,7 @@ std::vector<MotionAnswer> GraphManager::askMotions(const std::vector<MotionQuery
   std::vector<MotionQuery> ask;
   std::vector<std::size_t> where;
   for (std::size_t i = 0; i < qs.size(); ++i) {
-    if (const MotionAnswer* kept = memo_.motion(qs[i])) {
+    if (const MotionAnswer* kept = params_.memoise_answers ? memo_.motion(qs[i]) : nullptr) {
       ++counters_.memo_hits;
       out[i] = *kept;
     } else {
@@ -34,20 +34,20 @@ std::vector<MotionAnswer> GraphManager::askMotions(const std::vector<MotionQuery
   std::vector<MotionAnswer> answers = ask.size() == 1 ? std::vector<MotionAnswer>{services_.motion(ask[0])}
                                                       : services_.motions(ask);
   for (std::size_t j = 0; j < answers.size() && j < where.size(); ++j) {
-    memo_.keep(ask[j], answers[j]);
+    if (params_.memoise_answers) memo_.keep(ask[j], answers[j]);
     out[where[j]] = std::move(answers[j]);
   }
   return out;
 }
 
 Result<std::vector<GraspOption>> GraphManager::askGrasps(const GraspQuery& q) {
-  if (const std::vector<GraspOption>* kept = memo_.grasps(q)) {
+  if (const std::vector<GraspOption>* kept = params_.memoise_answers ? memo_.grasps(q) : nullptr) {
     ++counters_.memo_hits;
     return *kept;
   }
   ++counters_.grasp_calls;
   auto g = services_.grasps(q);
-  if (g) memo_.keep(q, *g);
+  if (g && params_.memoise_answers) memo_.keep(q, *g);
   return g;
 }
 

@@ -62,6 +62,7 @@ const config::Schema<GraphManagerParams>& schema() {
         .field("max_rejoin_targets", &P::max_rejoin_targets, atLeast(1))
         .field("replan_first_edge", &P::replan_first_edge)
         .field("concurrent_motions", &P::concurrent_motions)
+        .field("memoise_answers", &P::memoise_answers)
         .field("max_contingencies", &P::max_contingencies, atLeast(0))
         .field("held_object_wait_s", &P::held_object_wait_s, positive())
         .field("max_action_failures", &P::max_action_failures, atLeast(1))

@@ -124,7 +124,7 @@ class FirstEdgeTest : public ::testing::Test {
     BranchContext ctx;
   };
 
-  Setup make(ScriptedServices& services, bool concurrent = false) {
+  Setup make(ScriptedServices& services, bool concurrent = false, bool memoise = false) {
     auto sc = world::loadScenario(configDir() / "scenarios" / "namo_corridor.yaml");
     EXPECT_TRUE(sc.ok()) << (sc ? "" : sc.error().toString());
     auto robot = robot::RobotModel::loadDescription(sc->robot.description);
@@ -137,6 +137,7 @@ class FirstEdgeTest : public ::testing::Test {
     params.max_contingencies = 0;
     // Off unless asked: the tests count one motion call per edge priced.
     params.concurrent_motions = concurrent;
+    params.memoise_answers = memoise;
     Setup s;
     s.gm = std::make_unique<GraphManager>(std::move(a), "", MissionGoal{{"(robot-at goal)"}},
                                           services, params);
@@ -303,13 +304,22 @@ namespace {
 // (issue 12, replanning latency), and the decision and its cost are unchanged.
 TEST_F(FirstEdgeTest, TheSameMotionQuestionInTheSameWorldIsAskedOnce) {
   ScriptedServices base_services;
-  Setup base = make(base_services);
+  Setup base = make(base_services, false, true);
   const TraverseResult before = base.gm->traverse(base.gm->root(), base.ctx);
   ASSERT_TRUE(before.found) << before.reason;
   const int calls_without_twin = base_services.motion_calls;
 
+  ScriptedServices off_services;
+  Setup off = make(off_services);
+  off_services.plans = {{"(move_base start a)", "(move_base a goal)"}};
+  off_services.states = {{{"(robot-at start)"}, {"(robot-at a)", "(visited a)"}, {"(robot-at goal)", "(visited a)"}}};
+  ASSERT_TRUE(off.gm->planFrom(off.gm->root(), {"(robot-at goal)"}, "plan d").ok());
+  ASSERT_TRUE(off.gm->traverse(off.gm->root(), off.ctx).found);
+  EXPECT_EQ(off_services.motion_calls, calls_without_twin + 2) << "memoise_answers off (the default): asked again";
+  EXPECT_EQ(off.gm->counters().memo_hits, 0);
+
   ScriptedServices services;
-  Setup s = make(services);
+  Setup s = make(services, false, true);
   services.plans = {{"(move_base start a)", "(move_base a goal)"}};
   services.states = {{{"(robot-at start)"}, {"(robot-at a)", "(visited a)"}, {"(robot-at goal)", "(visited a)"}}};
   ASSERT_TRUE(s.gm->planFrom(s.gm->root(), {"(robot-at goal)"}, "plan d").ok());

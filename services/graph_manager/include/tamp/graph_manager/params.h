@@ -67,6 +67,10 @@ struct GraphManagerParams {
   /// planner pool answers them side by side): a lazy base path with its effort-aware alternative
   /// (asked speculatively, used only when the first crosses a movable), a push with its back-off.
   bool concurrent_motions{true};
+  /// Answer a motion or grasp question asked again in the same world from memory (QueryMemo).
+  /// Off by default: with it on, occluded_can failed 4 of 8 runs on a base path into the counter
+  /// (0 of 2 off), not diagnosed (docs/benchmarks.md, sixth session).
+  bool memoise_answers{false};
   /// A base path longer than this many times the straight line from a start facing away is
   /// planned again after a turn in place towards the goal; >= 1.
   double turn_first_ratio{1.5};

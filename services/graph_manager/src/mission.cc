@@ -149,6 +149,8 @@ struct GraphManager::Run {
   std::optional<MissionEvent> watch(const Edge& done, const EdgeCommand& cmd, const ExecutionReport& rep);
   /// Online replanning after `ev`; false when the mission must give up (`why` says why).
   bool replan(const MissionEvent& ev, EdgeId failed, std::string& why);
+  /// Waits (drop_settle_timeout_s at most) until the world model has `object` resting on a support.
+  void awaitSettled(const std::string& object);
   void noteCommand();
   /// Conditional planning: before the first action and before each pick, the hand as the robot
   /// reports it against the node's belief. A gripper that holds an object where the node has
@@ -555,6 +557,33 @@ std::optional<MissionEvent> GraphManager::Run::watch(const Edge& done, const Edg
   return std::nullopt;
 }
 
+void GraphManager::Run::awaitSettled(const std::string& object) {
+  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                           std::chrono::duration<double>(gm.params_.drop_settle_timeout_s));
+  const auto t0 = Clock::now();
+  while (true) {
+    const world::World w = source.world();
+    if (const world::Object* o = w.findObject(object)) {
+      const double half = o->shape.halfHeight();
+      const Eigen::Vector3d bottom = o->pose.translation() - Eigen::Vector3d(0, 0, half);
+      const world::Region* below = w.regionBelow(bottom, 0.05);
+      const double support = below ? below->height : 0.0;
+      if (std::abs(bottom.z() - support) <= 0.05) {
+        log::get("graph_manager")->info("'{}' rests at ({:.2f}, {:.2f}, {:.2f}) {:.3f} s after the drop", object,
+                                        o->pose.translation().x(), o->pose.translation().y(), o->pose.translation().z(),
+                                        since(t0));
+        return;
+      }
+    }
+    if (Clock::now() >= deadline) {
+      log::get("graph_manager")->warn("'{}' not seen resting on a support {:.1f} s after the drop: planning from the world model as it is",
+                                      object, gm.params_.drop_settle_timeout_s);
+      return;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+}
+
 bool GraphManager::Run::replan(const MissionEvent& ev, EdgeId failed, std::string& why) {
   const auto t0 = Clock::now();
   const std::size_t calls0 = gm.logged_.mark();
@@ -577,6 +606,7 @@ bool GraphManager::Run::replan(const MissionEvent& ev, EdgeId failed, std::strin
   } else {
     ahead = branch;
   }
+  if (ev.kind == EventKind::kObjectDropped) awaitSettled(!ev.object_id.empty() ? ev.object_id : ctx.held.object_id);
   // What the robot and the world are now: perception's objects, but where the graph knows an
   // object to be (its prior, or where the mission put it) within the tolerance, that pose: a
   // partial view strays further than a place does, and a stray estimate would unbind the slot.

@@ -103,6 +103,11 @@ struct GraphManagerParams {
   /// box, the estimate strays about 0.09 m (namo_corridor, measured), and a false event replaces
   /// a good prior with that estimate.
   double moved_object_tolerance_m{0.15};
+  /// After a drop, the world is taken in once the world model has the dropped object resting on a
+  /// support (its bottom within 5 cm of the support below), or after this long (s); >= 0. The
+  /// robot reports the empty hand before perception has seen where the object fell: a re-pick
+  /// planned on the estimate of a falling object sends the gripper into it.
+  double drop_settle_timeout_s{2.0};
   /// A restarted graph manager takes up an unfinished mission of its journal only when the
   /// journal was written at most this long ago (s, > 0): a deployment started again hours later
   /// must not set the robot moving on an old mission. An older one is closed as aborted.

@@ -38,6 +38,37 @@ bool waitUntil(const std::function<bool()>& pred, double seconds, process::Super
   return pred();
 }
 
+/// `tamp run` of namo_corridor (effort), every service a process, on `domain` with `deployment`,
+/// its output in OUT/tamp-run.out; not restarted when it ends.
+process::ProcessSpec corridorRun(const fs::path& out, int domain, const fs::path& deployment, const std::string& run_id) {
+  process::ProcessSpec run;
+  run.name = "tamp-run";
+  run.executable = binDir() / "tamp-run";
+  run.args = {(configDir() / "scenarios" / "namo_corridor.yaml").string(), "--out", out.string(), "--domain",
+              std::to_string(domain), "--deployment", deployment.string(), "--run-id", run_id, "--policy", "effort"};
+  run.log_file = out / "tamp-run.out";
+  run.restart = false;
+  return run;
+}
+
+/// The pid of the live `service` its heartbeats name (0: none heard).
+pid_t livePid(dds::HeartbeatMonitor& beats, const std::string& service) {
+  pid_t pid = 0;
+  for (const auto& s : beats.services())
+    if (s.name == service && s.alive) pid = static_cast<pid_t>(s.pid);
+  return pid;
+}
+
+/// Polls the supervisor until the process `name` is no longer running (600 s at most).
+bool waitForEnd(process::Supervisor& sup, const std::string& name) {
+  return waitUntil(
+      [&] {
+        auto st = sup.status(name);
+        return st && st->phase != process::ProcessPhase::kRunning;
+      },
+      600.0, sup);
+}
+
 TEST(RecoveryTest, AGraphManagerKilledMidActionTakesTheMissionUpWithoutRepeatingIt) {
   const fs::path out = tempFile("tamp_recovery");
   fs::remove_all(out);
@@ -61,13 +92,7 @@ TEST(RecoveryTest, AGraphManagerKilledMidActionTakesTheMissionUpWithoutRepeating
   dds::HeartbeatMonitor beats(*participant);
 
   process::Supervisor sup;
-  process::ProcessSpec run;
-  run.name = "tamp-run";
-  run.executable = binDir() / "tamp-run";
-  run.args = {(configDir() / "scenarios" / "namo_corridor.yaml").string(), "--out", out.string(), "--domain",
-              std::to_string(domain), "--deployment", deployment.string(), "--run-id", run_id, "--policy", "effort"};
-  run.log_file = out / "tamp-run.out";
-  run.restart = false;
+  const process::ProcessSpec run = corridorRun(out, domain, deployment, run_id);
   sup.add(run);
   ASSERT_TRUE(sup.startAll().ok());
 
@@ -82,19 +107,11 @@ TEST(RecoveryTest, AGraphManagerKilledMidActionTakesTheMissionUpWithoutRepeating
       },
       300.0, sup))
       << readFile(run.log_file);
-  pid_t gm = 0;
-  for (const auto& s : beats.services())
-    if (s.name == "graph_manager" && s.alive) gm = static_cast<pid_t>(s.pid);
+  const pid_t gm = livePid(beats, "graph_manager");
   ASSERT_GT(gm, 0) << "no live graph manager heard";
   ASSERT_EQ(::kill(gm, SIGKILL), 0);
 
-  ASSERT_TRUE(waitUntil(
-      [&] {
-        auto st = sup.status("tamp-run");
-        return st && st->phase != process::ProcessPhase::kRunning;
-      },
-      600.0, sup))
-      << readFile(run.log_file);
+  ASSERT_TRUE(waitForEnd(sup, "tamp-run")) << readFile(run.log_file);
   const auto st = sup.status("tamp-run");
   const fs::path run_dir = out / run_id;
   const std::string output = readFile(run.log_file);
@@ -180,13 +197,7 @@ TEST(RecoveryTest, ASimulatorKilledMidActionResumesTheWorldAndTheMissionReachesT
   dds::HeartbeatMonitor beats(*participant);
 
   process::Supervisor sup;
-  process::ProcessSpec run;
-  run.name = "tamp-run";
-  run.executable = binDir() / "tamp-run";
-  run.args = {(configDir() / "scenarios" / "namo_corridor.yaml").string(), "--out", out.string(), "--domain",
-              std::to_string(domain), "--deployment", deployment.string(), "--run-id", run_id, "--policy", "effort"};
-  run.log_file = out / "tamp-run.out";
-  run.restart = false;
+  const process::ProcessSpec run = corridorRun(out, domain, deployment, run_id);
   sup.add(run);
   ASSERT_TRUE(sup.startAll().ok());
 
@@ -200,19 +211,11 @@ TEST(RecoveryTest, ASimulatorKilledMidActionResumesTheWorldAndTheMissionReachesT
       },
       300.0, sup))
       << readFile(run.log_file);
-  pid_t sim = 0;
-  for (const auto& s : beats.services())
-    if (s.name == "sim" && s.alive) sim = static_cast<pid_t>(s.pid);
+  const pid_t sim = livePid(beats, "sim");
   ASSERT_GT(sim, 0) << "no live simulator heard";
   ASSERT_EQ(::kill(sim, SIGKILL), 0);
 
-  ASSERT_TRUE(waitUntil(
-      [&] {
-        auto st = sup.status("tamp-run");
-        return st && st->phase != process::ProcessPhase::kRunning;
-      },
-      600.0, sup))
-      << readFile(run.log_file);
+  ASSERT_TRUE(waitForEnd(sup, "tamp-run")) << readFile(run.log_file);
   const auto st = sup.status("tamp-run");
   const fs::path run_dir = out / run_id;
   const std::string output = readFile(run.log_file);

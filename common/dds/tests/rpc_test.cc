@@ -138,5 +138,28 @@ TEST(RpcTest, SlowHandlerTimesOutAndCancelStopsIt) {
   ASSERT_TRUE(rep3.ok()) << rep3.error().toString();
 }
 
+// An anytime handler works until its budget runs out and answers with what it has. Its reply must
+// reach the client: the server's budget ends before the client's deadline (the reply margin), not
+// at the same instant measured from a later start.
+TEST(RpcTest, AHandlerThatUsesItsWholeBudgetIsAnsweredInTime) {
+  auto p = makeParticipant();
+  ASSERT_TRUE(p);
+  Server server(p, "tamp/test/anytime", [](const msg::EchoRequest& req, const RequestContext& ctx) {
+    while (!ctx.termination()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    msg::EchoReply rep;
+    rep.payload(req.payload());
+    return rep;
+  });
+  Client client(p, "tamp/test/anytime", RpcClientOptions{10.0, 1, 0});
+  ASSERT_TRUE(client.waitForServer(Termination::after(5.0)));
+  for (int i = 0; i < 3; ++i) {
+    const Stopwatch sw;
+    auto rep = client.call(echo({7}), CallOptions{0.4, {}});
+    ASSERT_TRUE(rep.ok()) << rep.error().toString();
+    EXPECT_EQ(rep->payload(), (std::vector<uint8_t>{7}));
+    EXPECT_GT(sw.seconds(), 0.2);  // it did work to (near) the end of its budget
+  }
+}
+
 }  // namespace
 }  // namespace tamp::dds

@@ -36,6 +36,10 @@ struct RpcClientOptions {
   double attempt_timeout_s{1.0};  ///< re-send when no reply came within this time
   int max_attempts{10};           ///< sends per call, the first included
   uint32_t max_request_bytes{0};  ///< 0: the ServiceSpec's limit
+  /// The server's budget is the call's remaining time less this margin (at most a fifth of that
+  /// time), so that a handler that works to the end of its budget (an anytime planner) still has
+  /// its reply reach the client before the client gives up.
+  double reply_margin_s{0.05};
 };
 
 struct CallOptions {
@@ -101,7 +105,7 @@ class RpcClient {
     request.header().client_id(client_id_);
     request.header().cancel(false);
     request.header().attempt(1);
-    request.header().budget_s(opts.timeout_s);
+    request.header().budget_s(serverBudget(opts.timeout_s));
     const uint32_t size = writer_.serializedSize(request);
     if (size > max_bytes_) {
       return Error(ErrorCode::kInvalidArgument, "request of " + std::to_string(size) + " bytes exceeds the limit of " +
@@ -131,7 +135,7 @@ class RpcClient {
       if (attempts < options_.max_attempts) {
         ++attempts;
         request.header().attempt(attempts);
-        request.header().budget_s(std::max(0.0, deadline.secondsLeft()));
+        request.header().budget_s(serverBudget(deadline.secondsLeft()));
         if (Status s = writer_.write(request); !s.ok()) return s.error();
       }
       const Deadline attempt_end = deadline.min(Deadline::in(options_.attempt_timeout_s));
@@ -163,6 +167,13 @@ class RpcClient {
   }
 
  private:
+  /// What the server may spend of `left` seconds: the reply margin kept back, never 0 (which the
+  /// header reads as "no budget").
+  double serverBudget(double left) const {
+    const double margin = std::min(std::max(0.0, options_.reply_margin_s), 0.2 * left);
+    return std::max(left - margin, 1e-6);
+  }
+
   struct Pending {
     std::mutex m;
     std::condition_variable cv;

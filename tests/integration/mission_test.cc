@@ -156,8 +156,8 @@ TEST(MissionTest, CorridorShortDetourIsTakenInsteadOfMovingTheBox) {
 }
 
 // Every pick of the corridor box misses (scripted). The pick is tried max_action_failures (2)
-// times, then given up: no re-joining branch is left, the graph manager plans from scratch and the
-// robot goes round. The box stays where it was; the mission succeeds.
+// times, then given up: every re-joining branch goes through that pick, so the graph manager plans
+// from scratch and the robot goes round. The box stays where it was; the mission succeeds.
 TEST(MissionTest, APickThatKeepsFailingIsGivenUpForTheWayRound) {
   const Mission m = run("namo_corridor_slippery.yaml", {"--policy", "effort"});
   ASSERT_EQ(m.exit_code, 0) << m.output;
@@ -168,8 +168,13 @@ TEST(MissionTest, APickThatKeepsFailingIsGivenUpForTheWayRound) {
   for (const auto& a : m.report["actions"])
     if (a["action"].get<std::string>().rfind("(pick box", 0) == 0 && a["outcome"] == "failed") ++failed_picks;
   EXPECT_EQ(failed_picks, 2) << m.report["actions"].dump(1);
-  ASSERT_FALSE(m.report["replanning"].empty());
-  EXPECT_EQ(m.report["replanning"].back()["how"], "from scratch") << m.report["replanning"].dump(1);
+  // The replanning after the second failed pick is the one that gives the pick up. Later events of
+  // the way round (an overrun, a blocked base motion) may follow it, so it is found by its action.
+  std::vector<nlohmann::json> after_pick;
+  for (const auto& rp : m.report["replanning"])
+    if (rp["event"] == "action_failed" && rp["action"].get<std::string>().rfind("(pick box", 0) == 0) after_pick.push_back(rp);
+  ASSERT_EQ(after_pick.size(), 2u) << m.report["replanning"].dump(1);
+  EXPECT_EQ(after_pick.back()["how"], "from scratch") << m.report["replanning"].dump(1);
 }
 
 // The DDS Security profile (deploy/security/): every service with its own certificate and

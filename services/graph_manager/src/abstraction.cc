@@ -80,6 +80,21 @@ std::string Abstraction::locationFor(const Pose2D& pose, const std::string& hint
   return id;
 }
 
+std::string Abstraction::slotAt(const std::string& object_id, const Eigen::Vector2d& xy,
+                                const std::string& parent_region) const {
+  std::string best;
+  double best_d = params_.slot_tolerance_m;
+  for (const auto& [id, s] : slots_) {
+    if (s.object_id != object_id || (!parent_region.empty() && s.parent_region != parent_region)) continue;
+    const double d = (s.pose.translation().head<2>() - xy).norm();
+    if (d <= best_d) {
+      best_d = d;
+      best = id;
+    }
+  }
+  return best;
+}
+
 world::Region Abstraction::slotRegion(const Slot& s) const {
   world::Region r;
   r.id = s.id;
@@ -127,11 +142,8 @@ std::vector<std::string> Abstraction::refinedSupports(const std::vector<std::str
     std::string replaced;
     if (t.size() == 3 && t[0] == "on" && slots_.count(t[2]) == 0) {
       if (const world::Object* o = world_.findObject(t[1])) {
-        for (const auto& [id, s] : slots_) {
-          if (s.object_id == t[1] && s.parent_region == t[2] &&
-              (s.pose.translation().head<2>() - o->pose.translation().head<2>()).norm() <= params_.slot_tolerance_m)
-            replaced = "(on " + t[1] + " " + id + ")";
-        }
+        if (const std::string id = slotAt(t[1], o->pose.translation().head<2>(), t[2]); !id.empty())
+          replaced = "(on " + t[1] + " " + id + ")";
       }
     }
     out.push_back(replaced.empty() ? a : replaced);
@@ -245,12 +257,7 @@ std::vector<std::string> Abstraction::dynamicAtoms(const world::World& w, const 
   std::map<std::string, std::string> support;
   for (const auto& o : w.objects()) {
     if (o.kind != world::ObjectKind::kMovable || o.id == held) continue;
-    std::string where;
-    for (const auto& [id, s] : slots_) {
-      if (s.object_id == o.id &&
-          (s.pose.translation().head<2>() - o.pose.translation().head<2>()).norm() <= params_.slot_tolerance_m)
-        where = id;
-    }
+    std::string where = slotAt(o.id, o.pose.translation().head<2>());
     if (where.empty() && !o.region.empty() && regions_.count(o.region)) where = o.region;
     if (where.empty()) {
       if (const world::Region* r = w.regionBelow(o.pose.translation() - Eigen::Vector3d(0, 0, o.shape.halfHeight())))

@@ -83,6 +83,10 @@ class Abstraction {
                       const Eigen::Isometry3d& pose);
   const Slot* slot(const std::string& id) const;
   std::size_t slotCount() const { return slots_.size(); }
+  /// The slot of `object_id` nearest to `xy` within slot_tolerance_m (of `parent_region` only,
+  /// when given); "" when none. Two slots of one object may lie closer than twice the tolerance:
+  /// the nearest one is where the object stands.
+  std::string slotAt(const std::string& object_id, const Eigen::Vector2d& xy, const std::string& parent_region = {}) const;
   /// Whether some location reaches `armconf`.
   bool isReached(const std::string& armconf) const;
   /// `atoms` with every `(on o r)` whose object stands on a slot of r (within slot_tolerance_m,

@@ -29,41 +29,6 @@ bool GraphManager::refineSupport(const std::string& object, const std::string& r
   return true;
 }
 
-std::optional<GraspOption> GraphManager::standBeside(const world::Object& o, const Pose2D& entry, const BranchContext& ctx) {
-  const Eigen::Vector2d oc = o.pose.translation().head<2>();
-  Eigen::Vector2d away = Eigen::Vector2d(entry.x, entry.y) - oc;
-  if (away.norm() < 1e-6) away = Eigen::Vector2d(ctx.state.base.x, ctx.state.base.y) - oc;
-  if (away.norm() < 1e-6) away = Eigen::Vector2d(-1.0, 0.0);
-  away.normalize();
-  for (double d : {0.60, 0.70, 0.50, 0.80}) {
-    const Eigen::Vector2d b = oc + d * away;
-    GraspQuery gq;
-    gq.object_id = o.id;
-    gq.base = Pose2D{b.x(), b.y(), std::atan2(-away.y(), -away.x())};
-    gq.overrides = overridesOf(ctx, o.id);
-    auto g = askGrasps(gq);
-    if (g && !g->empty()) {
-      GraspOption chosen = g->front();
-      chosen.base_pose = *gq.base;
-      return chosen;
-    }
-  }
-  GraspQuery gq;
-  gq.object_id = o.id;
-  gq.max_grasps = 8;
-  gq.overrides = overridesOf(ctx, o.id);
-  auto g = askGrasps(gq);
-  std::optional<GraspOption> chosen;
-  if (g) {
-    for (const auto& x : *g) {
-      if (!chosen || std::hypot(x.base_pose.x - entry.x, x.base_pose.y - entry.y) <
-                         std::hypot(chosen->base_pose.x - entry.x, chosen->base_pose.y - entry.y))
-        chosen = x;
-    }
-  }
-  return chosen;
-}
-
 bool GraphManager::takeRefinement() {
   const bool r = refined_;
   refined_ = false;

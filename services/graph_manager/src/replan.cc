@@ -7,6 +7,7 @@
 
 #include "tamp/core/log.h"
 #include "tamp/graph_manager/graph_manager.h"
+#include "object_geometry.h"
 #include "state_atoms.h"
 #include "tamp/world/polygon.h"
 
@@ -32,14 +33,6 @@ double distanceToBasePath(const Eigen::Vector2d& p, const JointPath& path) {
   double d = (at(0) - p).norm();
   for (std::size_t i = 1; i < path.waypoints.size(); ++i) d = std::min(d, pointSegment(p, at(i - 1), at(i)));
   return d;
-}
-
-/// The object's footprint radius about its centre (m).
-double footprintRadius(const world::Object& o) {
-  const world::Polygon2 f = o.shape.footprint(12);
-  double r = 0.0;
-  for (const auto& v : f) r = std::max(r, v.norm());
-  return r;
 }
 
 }  // namespace
@@ -115,7 +108,7 @@ int GraphManager::invalidateNear(const std::vector<world::Object>& objects) {
   auto near = [&](const JointPath& path) {
     for (const auto& o : objects) {
       const Eigen::Vector2d c = o.pose.translation().head<2>();
-      if (distanceToBasePath(c, path) <= robot + footprintRadius(o) + params_.keep_clear_margin_m) return true;
+      if (distanceToBasePath(c, path) <= robot + detail::footprintRadius(o) + params_.keep_clear_margin_m) return true;
     }
     return false;
   };

@@ -97,7 +97,7 @@ std::vector<std::string> GraphManager::placeSlots(const world::Object& o, const 
   // A base pose beside the object from which the arm reaches it, on the side the robot comes
   // from: back from where the lazy path first touches the object.
   const Pose2D entry = crossing.swept_base.empty() ? ctx.state.base : crossing.swept_base.front();
-  const std::optional<GraspOption> chosen = standBeside(o, entry, ctx);
+  const std::optional<GraspOption> chosen = standBeside(o, entry, ctx, swept);
   if (!chosen) {
     log::get("graph_manager")->info("no grasp of {} from any base pose", o.id);
     why = "no grasp of '" + o.id + "' from any base pose";

@@ -359,11 +359,23 @@ class GraphManager {
   NodeId refinedNode(NodeId n);
   /// Whether a refinement happened since the last call (and clears it).
   bool takeRefinement();
-  /// A base pose beside `o` from which the arm grasps it, facing it from the side of `entry`
-  /// (the branch's base when `entry` is on the object): 0.5-0.8 m back first, else the grasp
-  /// service's own samples nearest to `entry`, in the branch's world (the objects it moved where
-  /// it put them). None when no base pose reaches it.
-  std::optional<GraspOption> standBeside(const world::Object& o, const Pose2D& entry, const BranchContext& ctx);
+  /// A base pose beside `o` from which the arm grasps it, in the branch's world (the objects it
+  /// moved where it put them); none when no base pose reaches it. Tried in order
+  /// (standCandidates): poses of `approach` (the base poses of the branch's way in, `entry` the
+  /// first that touches `o`) back from `entry`; poses facing `o` from the side of `entry` (the
+  /// branch's base when `entry` is on the object); then the grasp service's own samples, the one
+  /// nearest to `entry`.
+  std::optional<GraspOption> standBeside(const world::Object& o, const Pose2D& entry, const BranchContext& ctx,
+                                         const std::vector<Pose2D>& approach = {});
+  /// The base poses standBeside asks the grasp service about, nearest to `o` first; at most
+  /// kStandSteps of each kind, kStandStep_m apart. A pose keeps the base clear of `o` by
+  /// `keep_clear_margin_m` (its radius on the way in, whatever its heading; its front when facing
+  /// `o`) and `o` within the arm's reach sphere: they follow the robot's description, not a
+  /// robot's numbers.
+  std::vector<Pose2D> standCandidates(const world::Object& o, const Pose2D& entry, const std::vector<Pose2D>& approach,
+                                      const BranchContext& ctx) const;
+  static constexpr std::size_t kStandSteps = 3;
+  static constexpr double kStandStep_m = 0.10;
 
  private:
   struct Search;

@@ -142,6 +142,7 @@ std::string formatCheckpoint(const SimSnapshot& s) {
   for (const auto& id : s.fired_faults) out << "fired " << id << "\n";
   for (const auto& id : s.pending_faults) out << "pending " << id << "\n";
   for (const auto& e : s.log) formatAction(out, e);
+  for (const auto& [commanded, truth] : s.names) out << "name " << commanded << " " << truth << "\n";
   return out.str();
 }
 
@@ -206,6 +207,11 @@ Result<SimSnapshot> parseCheckpoint(const std::string& text, const std::string& 
       std::string id;
       if (!(fields >> id)) return parseError(file, n, kind, "expected a fault id");
       (kind == "fired" ? s.fired_faults : s.pending_faults).push_back(id);
+    } else if (kind == "name") {
+      std::string commanded, truth;
+      if (!(fields >> commanded >> truth) || !world::isValidId(commanded) || !world::isValidId(truth))
+        return parseError(file, n, "name", "expected a commanded object id and the truth's id");
+      if (!s.names.emplace(commanded, truth).second) return parseError(file, n, "name", "'" + commanded + "' bound twice");
     } else if (kind == "action") {
       auto e = parseAction(fields, file, n);
       if (!e) return e.error();

@@ -231,6 +231,45 @@ struct Simulator::Impl {
   std::vector<ActionLogEntry> log;            // every accepted action, in order (the truth)
   std::map<std::string, std::size_t> logged;  // command id -> index in `log`
   std::vector<ActionResult> replayed;         // results of repeated ids, out at the next step()
+  // The commanding side's own names of objects it perceived (perception's ids), bound to objects
+  // of the truth when a command first names one: the physical world has no ids. Commanded id ->
+  // truth id.
+  std::map<std::string, std::string> names;
+
+  std::string truthId(const std::string& id) const {
+    const auto it = names.find(id);
+    return it == names.end() ? id : it->second;
+  }
+  /// The name the commanding side uses for the truth's object `id`.
+  std::string commandedId(const std::string& id) const {
+    for (const auto& [commanded, truth] : names)
+      if (truth == id) return commanded;
+    return id;
+  }
+  /// `c` with its object named as the truth names it. An id the truth does not know, in a command
+  /// with the object's pose (pick, place), is bound to the movable object that pose lies in (the
+  /// nearest centre within the object's bounding radius), once; otherwise the id stays, and the
+  /// command fails as naming no object.
+  ActionCommand inTruthNames(ActionCommand c) {
+    if (c.object_id.empty() || world.findObject(c.object_id) != nullptr) return c;
+    if (names.count(c.object_id)) {
+      c.object_id = names.at(c.object_id);
+      return c;
+    }
+    if (!c.object_pose || !c.object_pose->matrix().allFinite()) return c;
+    const world::Object* best = nullptr;
+    double best_d = 0.0;
+    for (const auto& o : world.objects()) {
+      if (o.kind != world::ObjectKind::kMovable || commandedId(o.id) != o.id) continue;
+      const double d = (o.pose.translation() - c.object_pose->translation()).norm();
+      if (d <= boundingRadius(o.shape) && (best == nullptr || d < best_d)) best = &o, best_d = d;
+    }
+    if (best == nullptr) return c;
+    logger()->info("'{}' of the commands is '{}' ({:.3f} m from the commanded pose)", c.object_id, best->id, best_d);
+    names[c.object_id] = best->id;
+    c.object_id = best->id;
+    return c;
+  }
 
   Impl(world::World w, robot::RobotModel r, SimParams p)
       : world(std::move(w)), robot(std::move(r)), params(std::move(p)), sensor(params.sensor) {}
@@ -888,9 +927,9 @@ struct Simulator::Impl {
     r.outcome = a.outcome;
     r.duration_s = a.end;
     r.progress = a.total > 0.0 ? std::clamp(a.end / a.total, 0.0, 1.0) : 1.0;
-    r.blocking_object_id = a.blocking;
+    r.blocking_object_id = commandedId(a.blocking);
     r.reason = a.outcome == Outcome::kBlocked && a.reason.empty()
-                   ? "stopped before contact with '" + a.blocking + "'" +
+                   ? "stopped before contact with '" + r.blocking_object_id + "'" +
                          (a.blocking_part.empty() ? std::string() : " (of " + a.blocking_part + ")")
                    : a.reason;
     idle = stateAt(a, a.end);
@@ -1288,12 +1327,13 @@ Status Simulator::submit(const ActionCommand& command) {
     return Error(ErrorCode::kUnavailable,
                  "busy: action '" + m.active->cmd.command_id + "' is still running", SourceLocation{"", 0, 0, "command_id"});
   }
-  auto cols = m.validate(command);
+  const ActionCommand cmd = m.inTruthNames(command);
+  auto cols = m.validate(cmd);
   if (!cols) return cols.error();
-  auto planned = m.plan(command, *cols);
+  auto planned = m.plan(cmd, *cols);
   if (!planned) return planned.error();
   Active& a = *planned;
-  if (command.kind == ActionKind::kMoveBase && !command.object_id.empty()) {
+  if (cmd.kind == ActionKind::kMoveBase && !cmd.object_id.empty()) {
     if (Status s = m.startPush(a); !s) return s;
   }
   m.logged[command.command_id] = m.log.size();
@@ -1491,6 +1531,7 @@ SimSnapshot Simulator::snapshot() const {
   }
   for (const Fault& f : m.pending_fails) s.pending_faults.push_back(f.id);
   s.log = m.log;
+  s.names = m.names;
   return s;
 }
 
@@ -1564,6 +1605,9 @@ Status Simulator::resume(const SimSnapshot& snapshot) {
     pending.push_back(m.scripted[*idx]);
   }
   if (Status s = checkLog(snapshot.log); !s) return s;
+  for (const auto& [commanded, truth] : snapshot.names) {
+    if (w.findObject(truth) == nullptr) return invalid("names[" + commanded + "]", "no object '" + truth + "'");
+  }
 
   const world::World before = m.world;
   m.world = std::move(w);
@@ -1579,6 +1623,7 @@ Status Simulator::resume(const SimSnapshot& snapshot) {
   m.epoch_s = snapshot.epoch_s;  // stamps go on, never back
   m.now = snapshot.time_s;
   m.log = snapshot.log;
+  m.names = snapshot.names;
   m.logged.clear();
   for (std::size_t i = 0; i < m.log.size(); ++i) m.logged[m.log[i].command_id] = i;
   m.actions = static_cast<int>(m.log.size());
@@ -1617,7 +1662,7 @@ RobotStateSample Simulator::robotState() const {
       s.moving = dq.cwiseAbs().maxCoeff() > 1e-9;
     }
   }
-  if (m.world.held()) s.held_object_id = m.world.held()->object_id;
+  if (m.world.held()) s.held_object_id = m.commandedId(m.world.held()->object_id);
   return s;
 }
 

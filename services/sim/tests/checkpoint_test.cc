@@ -33,6 +33,7 @@ SimSnapshot sampleSnapshot() {
                     0.625,   "crate",           "stopped before contact with 'crate'"};
   s.log.push_back(ActionLogEntry{"m1-e1", ActionKind::kMoveBase, 0, 0.5, done});
   s.log.push_back(ActionLogEntry{"id with spaces", ActionKind::kPick, 1, 7.25, std::nullopt});
+  s.names = {{"seen_box_1", "carried"}};
   return s;
 }
 
@@ -69,6 +70,7 @@ TEST(SimCheckpointTest, ReadsBackExactly) {
   EXPECT_EQ(back->log[1].command_id, "id with spaces");
   EXPECT_EQ(back->log[1].kind, ActionKind::kPick);
   EXPECT_FALSE(back->log[1].result.has_value());
+  EXPECT_EQ(back->names, s.names);
 }
 
 TEST(SimCheckpointTest, ABrokenCheckpointIsRefusedNamingTheFileLineAndField) {
@@ -96,7 +98,9 @@ TEST(SimCheckpointTest, ABrokenCheckpointIsRefusedNamingTheFileLineAndField) {
       {edited("object ", "object wobbly 00"), 6, "object.hidden"},
       {edited("action ", "action 0 0.5 move_base 6d31 exploded 1 1 - -"), 12, "action.outcome"},
       {edited("action ", "action 0 0.5 fly 6d31 running"), 12, "action.kind"},
-      {good + "teleport 1 2 3\n", 14, "record"},
+      {good + "teleport 1 2 3\n", 15, "record"},
+      {edited("name ", "name seen_box_1"), 14, "name"},
+      {good + "name seen_box_1 crate\n", 15, "name"},
       {"tamp-sim-checkpoint 1\ntime 1.0\nepoch 5.0\n", 4, "robot"},
       {"tamp-sim-checkpoint 1\ntime 1.0\n", 3, "epoch"},
   };

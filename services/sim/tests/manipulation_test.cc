@@ -138,6 +138,51 @@ TEST(ManipulationTest, PickAttachesTheObjectAndPlacePutsItOnARegion) {
   EXPECT_TRUE(sim.world().object("can").pose.isApprox(placed.pose, 0));
 }
 
+// The physical world has no ids: perception names an object it found itself ("seen_can_1"), and
+// the robot picks what is where the command says. The name stays bound to that object: the place
+// names it, the robot reports holding it by that name, and a snapshot keeps the binding.
+TEST(ManipulationTest, AnObjectNamedByPerceptionIsPickedAndPlacedWhereTheCommandSaysItIs) {
+  const SimParams params = exactParams();
+  Simulator sim(kitchen(), robotModel(), upright(), params);
+  const Eigen::Vector3d can = sim.world().object("can").pose.translation();
+  const PickSetup ps = pickSetup(can);
+  moveArmTo(sim, ps.pregrasp, "to_pregrasp");
+  // Nothing at the commanded pose: the name binds to nothing, the pick (closing the gripper
+  // where the arm stands) fails naming it.
+  ActionCommand astray = armCommand("astray", ActionKind::kPick, {ps.pregrasp, ps.pregrasp});
+  astray.object_id = "seen_can_1";
+  astray.object_pose = at(0.58, 0.3, kTableTop + 0.06);
+  ASSERT_TRUE(sim.submit(astray));
+  StepEvents e = runToEnd(sim);
+  ASSERT_EQ(e.results.at(0).outcome, Outcome::kFailed);
+  EXPECT_NE(e.results[0].reason.find("no object 'seen_can_1'"), std::string::npos) << e.results[0].reason;
+  EXPECT_TRUE(sim.snapshot().names.empty());
+  // Where the can is, 1 cm off: that is the can.
+  ActionCommand pick = armCommand("pick", ActionKind::kPick, {ps.pregrasp, ps.grasp, ps.pregrasp});
+  pick.object_id = "seen_can_1";
+  pick.object_pose = at(can.x() + 0.01, can.y(), can.z());
+  ASSERT_TRUE(sim.submit(pick));
+  e = runToEnd(sim);
+  ASSERT_EQ(e.results.at(0).outcome, Outcome::kSucceeded) << e.results[0].reason;
+  ASSERT_TRUE(sim.world().held());
+  EXPECT_EQ(sim.world().held()->object_id, "can");
+  EXPECT_EQ(sim.robotState().held_object_id, "seen_can_1");
+  EXPECT_EQ(sim.snapshot().names, (std::map<std::string, std::string>{{"seen_can_1", "can"}}));
+  ASSERT_TRUE(sim.submit(moveBase("turn", {{0, 0, 0}, {0, 0, M_PI / 2}})));
+  ASSERT_EQ(runToEnd(sim).results.at(0).outcome, Outcome::kSucceeded);
+  Eigen::Isometry3d target = sim.world().object("can").pose;
+  target.translation().z() = kTableTop + 0.06;
+  ActionCommand place = armCommand("place", ActionKind::kPlace, {ps.pregrasp, ps.grasp, ps.pregrasp});
+  place.object_id = "seen_can_1";
+  place.object_pose = target;
+  ASSERT_TRUE(sim.submit(place));
+  e = runToEnd(sim);
+  ASSERT_EQ(e.results.at(0).outcome, Outcome::kSucceeded) << e.results[0].reason;
+  EXPECT_FALSE(sim.world().held());
+  EXPECT_EQ(sim.world().object("can").region, "side_top");
+  EXPECT_EQ(sim.robotState().held_object_id, "");
+}
+
 /// Picks the can of `kitchen()` and turns the base so that it is over the side table.
 void pickAndTurn(Simulator& sim, const PickSetup& ps) {
   moveArmTo(sim, ps.pregrasp, "to_pregrasp");

@@ -55,6 +55,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <map>
 #include <optional>
 #include <string>
 #include <unordered_map>
@@ -150,6 +151,9 @@ struct SimSnapshot {
   std::vector<std::string> pending_faults;  ///< ids of fail-action faults waiting for their kind
   /// Every accepted command in order; the one running at the snapshot has no result.
   std::vector<ActionLogEntry> log;
+  /// The commanding side's names of objects it perceived itself, bound to the truth's ids
+  /// (commanded id -> truth id; see `submit`).
+  std::map<std::string, std::string> names;
 };
 
 /// The reason given for a command that was running when the robot driver was restarted.
@@ -178,6 +182,10 @@ class Simulator {
   /// duplicate joint, NaN, non-monotonic times, a start away from the current state, a missing
   /// object pose, joint limits; kUnavailable while another action runs) leave the robot idle and
   /// produce no record. An accepted command's outcome comes from later `step()` calls.
+  /// Object ids: the physical world has none. A pick or place naming an object the truth does not
+  /// know (perception's own id for an object it found) acts on the truth's movable object that the
+  /// command's object pose lies in, and that name stays bound to it: later commands, the held
+  /// object of `robotState()` and a blocked action's `blocking_object_id` use it.
   Status submit(const ActionCommand& command);
   /// The true nominal duration of `command` started now (no noise, no stall; deterministic and
   /// without touching the random streams): the oracle's answer. The same validation as submit().

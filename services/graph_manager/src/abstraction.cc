@@ -253,7 +253,8 @@ std::vector<std::string> Abstraction::dynamicAtoms(const world::World& w, const 
     atoms.insert("(hand-empty)");
   else
     atoms.insert("(holding " + held + ")");
-  // on: a slot the object occupies, else its region, else the region below it.
+  // on: a slot the object occupies, else its region, else the region below it, else a slot made
+  // where it stands.
   std::map<std::string, std::string> support;
   for (const auto& o : w.objects()) {
     if (o.kind != world::ObjectKind::kMovable || o.id == held) continue;
@@ -263,10 +264,11 @@ std::vector<std::string> Abstraction::dynamicAtoms(const world::World& w, const 
       if (const world::Region* r = w.regionBelow(o.pose.translation() - Eigen::Vector3d(0, 0, o.shape.halfHeight())))
         where = r->id;
     }
-    if (!where.empty()) {
-      atoms.insert("(on " + o.id + " " + where + ")");
-      support[o.id] = slots_.count(where) ? slots_.at(where).parent_region : where;
-    }
+    // On no known region (an object perceived where the scenario named no region): a slot of its
+    // own where it stands, so that it can be picked like any other.
+    if (where.empty()) where = addSlot(o.id, "", o.pose);
+    atoms.insert("(on " + o.id + " " + where + ")");
+    support[o.id] = slots_.count(where) ? slots_.at(where).parent_region : where;
   }
   // occludes: x in the corridor from the approach location of o's support to o (as seen by the
   // nearest location that reaches that support).

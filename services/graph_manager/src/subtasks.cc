@@ -52,7 +52,7 @@ void GraphManager::spawnSubtasks(EdgeId id, const BranchContext& ctx, int depth)
     ++objects;
     // findPossibleActions: pick and place when the robot can grasp the object, else a push.
     std::string why_not;
-    std::vector<std::string> slots = placeSlots(*o, crossing, ctx, swept, radius, why_not);
+    std::vector<std::string> slots = placeSlots(*o, supportAt(v, o->id), crossing, ctx, swept, radius, why_not);
     if (slots.empty()) {
       const std::string no_push = whyNotPushable(*o);
       std::string why_push = no_push;
@@ -90,7 +90,7 @@ std::string GraphManager::supportAt(NodeId v, const std::string& object) const {
   return o ? o->region : std::string();
 }
 
-std::vector<std::string> GraphManager::placeSlots(const world::Object& o, const Crossing& crossing,
+std::vector<std::string> GraphManager::placeSlots(const world::Object& o, const std::string& support, const Crossing& crossing,
                                                   const BranchContext& ctx, const std::vector<Pose2D>& swept,
                                                   double radius, std::string& why) {
   if (why = abstraction_.whyNotGraspable(o); !why.empty()) return {};
@@ -104,7 +104,8 @@ std::vector<std::string> GraphManager::placeSlots(const world::Object& o, const 
     return {};
   }
   const std::string near = abstraction_.locationFor(chosen->base_pose, "near_" + o.id);
-  abstraction_.addReach(near, Abstraction::armconfOver(o.region.empty() ? std::string() : o.region));
+  // The grasp proves the reach of what the object stands on in this branch (a slot once moved).
+  if (!support.empty()) abstraction_.addReach(near, Abstraction::armconfOver(support));
   log::get("graph_manager")->info("sub-task for {}: contact at ({:.2f}, {:.2f}); stand at {} ({:.2f}, {:.2f})", o.id,
                                   entry.x, entry.y, near, chosen->base_pose.x, chosen->base_pose.y);
   // findEffectStates: placements off the swept path, in the object's region first.

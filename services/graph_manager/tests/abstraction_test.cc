@@ -130,6 +130,33 @@ TEST(AbstractionTest, AnObjectBetweenTwoOfItsSlotsIsOnTheNearerOne) {
   }
 }
 
+// An object perceived where the scenario names no region (a box put down in the corridor) stands
+// on a slot of its own: it can be picked, from where the arm reaches that slot.
+TEST(AbstractionTest, AnObjectOnNoKnownRegionGetsASlotWhereItStands) {
+  auto f = load("namo_corridor");
+  Abstraction a(f.sc.plannerWorld(), f.robot);
+  world::World w = f.sc.plannerWorld();
+  world::Object box2 = w.object("box");
+  box2.id = "box_2";
+  box2.region.clear();
+  box2.pose.translation().head<2>() = Eigen::Vector2d(6.1, 1.2);
+  ASSERT_EQ(w.regionBelow(box2.pose.translation() - Eigen::Vector3d(0, 0, box2.shape.halfHeight())), nullptr);
+  ASSERT_TRUE(w.addObject(box2).ok());
+  const auto atoms = a.dynamicAtoms(w, f.sc.robot.start, "stow", "");
+  const std::string s = a.slotAt("box_2", Eigen::Vector2d(6.1, 1.2));
+  ASSERT_FALSE(s.empty());
+  EXPECT_TRUE(has(atoms, "(on box_2 " + s + ")"));
+  // Seen again a few millimetres off: the same slot, not a new one.
+  const std::size_t slots = a.slotCount();
+  ASSERT_TRUE(w.setObjectPose("box_2", Eigen::Isometry3d(Eigen::Translation3d(6.104, 1.198, box2.pose.translation().z()))).ok());
+  EXPECT_TRUE(has(a.dynamicAtoms(w, f.sc.robot.start, "stow", ""), "(on box_2 " + s + ")"));
+  EXPECT_EQ(a.slotCount(), slots);
+  // A base pose beside it reaches the slot; the start, 4.6 m away, does not.
+  const std::string near = a.locationFor(Pose2D{5.6, 1.2, 0.0}, "near_box_2");
+  EXPECT_TRUE(has(a.staticAtoms(), "(reaches " + near + " over_" + s + ")"));
+  EXPECT_FALSE(has(a.staticAtoms(), "(reaches start over_" + s + ")"));
+}
+
 TEST(AbstractionTest, HeavyObjectsAreNotGraspable) {
   auto f = load("namo_corridor");
   AbstractionParams p;

@@ -119,7 +119,8 @@ class Abstraction {
   /// Static facts (reaches, conf-over, graspable, push-to), sorted.
   std::vector<std::string> staticAtoms() const;
   /// Dynamic facts of a live state: the robot at `base` (a location symbol, made if needed), the
-  /// arm at `armconf`, holding `held` (or hand-empty), objects of `world` on regions or slots.
+  /// arm at `armconf`, holding `held` (or hand-empty), objects of `world` on regions or slots
+  /// (an object on no known region gets a slot where it stands).
   std::vector<std::string> dynamicAtoms(const world::World& world, const Pose2D& base,
                                         const std::string& armconf, const std::string& held);
   /// The geometry of a symbolic state (dynamic atoms).

@@ -393,8 +393,10 @@ class GraphManager {
   std::string supportAt(NodeId v, const std::string& object) const;
   /// findPossibleActions by pick and place: a base pose beside `o` from which the arm grasps it,
   /// and findEffectStates, placements that clear `swept` by `radius`; their slots (empty, and
-  /// `why`, when the robot cannot grasp `o` or nothing fits).
-  std::vector<std::string> placeSlots(const world::Object& o, const Crossing& crossing, const BranchContext& ctx,
+  /// `why`, when the robot cannot grasp `o` or nothing fits). `support`: what `o` stands on in the
+  /// branch's state (the region or slot the base pose is then known to reach).
+  std::vector<std::string> placeSlots(const world::Object& o, const std::string& support, const Crossing& crossing,
+                                      const BranchContext& ctx,
                                       const std::vector<Pose2D>& swept, double radius, std::string& why);
   /// One sub-task from `v`: TP(v, `moved`), then TP(that, `progress`) (what the blocked action
   /// achieved; skipped when empty), then TP(that, goal), each merged into the graph.

@@ -264,9 +264,13 @@ std::vector<std::string> Abstraction::dynamicAtoms(const world::World& w, const 
       if (const world::Region* r = w.regionBelow(o.pose.translation() - Eigen::Vector3d(0, 0, o.shape.halfHeight())))
         where = r->id;
     }
-    // On no known region (an object perceived where the scenario named no region): a slot of its
-    // own where it stands, so that it can be picked like any other.
-    if (where.empty()) where = addSlot(o.id, "", o.pose);
+    // On the floor but on no known region (an object perceived where the scenario named no
+    // region): a slot of its own where it stands, so that it can be picked like any other. An
+    // object off the floor on no region (in a hand the planner thinks empty, on an unknown
+    // support) stays without an `on` fact.
+    const double bottom = o.pose.translation().z() - o.shape.halfHeight();
+    if (where.empty() && std::abs(bottom) <= kOnTheFloor_m) where = addSlot(o.id, "", o.pose);
+    if (where.empty()) continue;
     atoms.insert("(on " + o.id + " " + where + ")");
     support[o.id] = slots_.count(where) ? slots_.at(where).parent_region : where;
   }

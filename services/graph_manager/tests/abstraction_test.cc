@@ -155,6 +155,14 @@ TEST(AbstractionTest, AnObjectOnNoKnownRegionGetsASlotWhereItStands) {
   const std::string near = a.locationFor(Pose2D{5.6, 1.2, 0.0}, "near_box_2");
   EXPECT_TRUE(has(a.staticAtoms(), "(reaches " + near + " over_" + s + ")"));
   EXPECT_FALSE(has(a.staticAtoms(), "(reaches start over_" + s + ")"));
+  // Off the floor (in a hand the planner believes empty): no support, no slot.
+  world::Object cup = box2;
+  cup.id = "cup";
+  cup.pose.translation() = Eigen::Vector3d(7.0, 1.2, 0.9);
+  ASSERT_TRUE(w.addObject(cup).ok());
+  const std::size_t before = a.slotCount();
+  for (const auto& atom : a.dynamicAtoms(w, f.sc.robot.start, "stow", "")) EXPECT_EQ(atom.find("cup"), std::string::npos) << atom;
+  EXPECT_EQ(a.slotCount(), before);
 }
 
 TEST(AbstractionTest, HeavyObjectsAreNotGraspable) {

@@ -120,7 +120,9 @@ class Abstraction {
   std::vector<std::string> staticAtoms() const;
   /// Dynamic facts of a live state: the robot at `base` (a location symbol, made if needed), the
   /// arm at `armconf`, holding `held` (or hand-empty), objects of `world` on regions or slots
-  /// (an object on no known region gets a slot where it stands).
+  /// (an object on the floor, within kOnTheFloor_m, but on no known region gets a slot where it
+  /// stands).
+  static constexpr double kOnTheFloor_m = 0.05;
   std::vector<std::string> dynamicAtoms(const world::World& world, const Pose2D& base,
                                         const std::string& armconf, const std::string& held);
   /// The geometry of a symbolic state (dynamic atoms).

@@ -164,6 +164,7 @@ struct Grounder::Impl {
 
   // Atoms and reachability.
   SeqTable atoms;
+  DenseAtomIndex dense_atoms;  // atom ids of predicates with few tuples, looked up without hashing
   std::vector<char> reached;  // in R(U) (fluent) or in U (static)
   std::vector<AtomId> queue;
   size_t queue_head{0};
@@ -404,6 +405,10 @@ struct Grounder::Impl {
     triggers.assign(pred_names.size(), {});
     by_pred.assign(pred_names.size(), {});
     by_arg = ArgIndex(pred_arity);
+    // 2^16 tuples (256 KiB) per predicate, 2^18 in all: small tasks, where a lookup's hashing is
+    // a visible share of the grounding time, get every predicate.
+    dense_atoms = DenseAtomIndex(pred_arity, static_cast<uint32_t>(obj_names.size()), size_t{1} << 16,
+                                 size_t{1} << 18);
 
     for (const auto& a : domain.actions) {
       Schema s;
@@ -490,8 +495,12 @@ struct Grounder::Impl {
   }
 
   AtomId internKey(const uint32_t* key, uint32_t n) {
+    if (const int64_t d = dense_atoms.find(key, n); d >= 0) return static_cast<AtomId>(d);
     auto [id, inserted] = atoms.insert(key, n);
-    if (inserted) reached.push_back(0);
+    if (inserted) {
+      reached.push_back(0);
+      dense_atoms.set(key, n, id);
+    }
     return id;
   }
 
@@ -789,7 +798,9 @@ struct Grounder::Impl {
       const LTerm t = args[i];
       key[i + 1] = isVar(t) ? static_cast<uint32_t>(bind[static_cast<size_t>(t)]) : objOf(t);
     }
-    return atoms.find(key, static_cast<uint32_t>(args.size() + 1));
+    const uint32_t n = static_cast<uint32_t>(args.size() + 1);
+    if (const int64_t d = dense_atoms.find(key, n); d != DenseAtomIndex::kNotDense) return d;
+    return atoms.find(key, n);
   }
 
   /// Instantiates and simplifies a lifted NNF formula under `bind`.
@@ -1160,18 +1171,21 @@ struct Grounder::Impl {
     out.resize(1);
     Conj& conj = out[0];
     conj.clear();
+    // (In)equalities and static literals first: they are what usually fails (the relaxed
+    // exploration over-approximates them); the result does not depend on the order.
     for (const LFormula& f : v.parts) {
       if (f.kind == LKind::kEq) {
         bool known = false;
         if (!eqHolds(f, bind, &known)) return false;
-        continue;
-      }
-      const int64_t id = findAtom(f.pred, f.args, bind);
-      if (pred_static[f.pred]) {
+      } else if (pred_static[f.pred]) {
+        const int64_t id = findAtom(f.pred, f.args, bind);
         const bool t = id >= 0 && ctx.has_static_true(static_cast<AtomId>(id));
         if (t == f.neg) return false;
-        continue;
       }
+    }
+    for (const LFormula& f : v.parts) {
+      if (f.kind == LKind::kEq || pred_static[f.pred]) continue;
+      const int64_t id = findAtom(f.pred, f.args, bind);
       if (id < 0 || !reached[static_cast<size_t>(id)]) {
         if (!f.neg) return false;
         continue;

@@ -77,5 +77,53 @@ TEST(ArgIndex, ListsInInsertionOrderAndEmptyBeyondTheObjectsSeen) {
   EXPECT_TRUE(idx.get(3, 0, UINT32_MAX).empty());  // never seen: empty, not out of bounds
 }
 
+TEST(DenseAtomIndex, FindsWhatWasSetAndSaysWhichPredicatesItDoesNotHold) {
+  // Predicates: arity 0, 1, 2, 3 over 10 objects (1, 10, 100, 1000 tuples). Caps: 100 per
+  // predicate, 105 in all: p0 (1) and p1 (10) fit, p2 (100) does not fit beside them (111 > 105),
+  // p3 is over the per-predicate cap.
+  DenseAtomIndex idx({0, 1, 2, 3}, 10, 100, 105);
+  EXPECT_TRUE(idx.isDense(0));
+  EXPECT_TRUE(idx.isDense(1));
+  EXPECT_FALSE(idx.isDense(2));
+  EXPECT_FALSE(idx.isDense(3));
+  EXPECT_FALSE(idx.isDense(4));  // no such predicate
+  EXPECT_EQ(idx.numSlots(), 11U);
+  const uint32_t k0[] = {0};
+  const uint32_t k1a[] = {1, 0}, k1b[] = {1, 9};
+  const uint32_t k2[] = {2, 3, 4}, k3[] = {3, 1, 2, 3};
+  EXPECT_EQ(idx.find(k0, 1), -1);
+  EXPECT_EQ(idx.find(k1b, 2), -1);
+  idx.set(k0, 1, 7);
+  idx.set(k1b, 2, 12345);
+  idx.set(k2, 3, 5);  // not dense: ignored
+  EXPECT_EQ(idx.find(k0, 1), 7);
+  EXPECT_EQ(idx.find(k1a, 2), -1);
+  EXPECT_EQ(idx.find(k1b, 2), 12345);
+  EXPECT_EQ(idx.find(k2, 3), DenseAtomIndex::kNotDense);
+  EXPECT_EQ(idx.find(k3, 4), DenseAtomIndex::kNotDense);
+
+  // Every tuple of a dense binary predicate maps to its own slot.
+  DenseAtomIndex all({2}, 37, 1 << 20, 1 << 20);
+  ASSERT_TRUE(all.isDense(0));
+  uint32_t id = 0;
+  for (uint32_t a = 0; a < 37; ++a) {
+    for (uint32_t b = 0; b < 37; ++b) {
+      const uint32_t k[] = {0, a, b};
+      all.set(k, 3, id++);
+    }
+  }
+  id = 0;
+  for (uint32_t a = 0; a < 37; ++a) {
+    for (uint32_t b = 0; b < 37; ++b) {
+      const uint32_t k[] = {0, a, b};
+      ASSERT_EQ(all.find(k, 3), id++) << a << " " << b;
+    }
+  }
+  // No objects: only arity 0 has a tuple.
+  DenseAtomIndex none({0, 2}, 0, 100, 100);
+  EXPECT_TRUE(none.isDense(0));
+  EXPECT_EQ(none.numSlots(), 1U);
+}
+
 }  // namespace
 }  // namespace tamp::symbolic_planner

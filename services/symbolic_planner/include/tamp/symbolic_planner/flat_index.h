@@ -127,4 +127,62 @@ class ArgIndex {
   std::vector<uint32_t> empty_;
 };
 
+/// Ground atom ids by their arguments, without hashing: for each predicate whose argument tuples
+/// are few enough (num_objects ^ arity <= the caps), a flat array indexed by the tuple
+/// (mixed radix over the object ids) holding the atom id or -1. Predicates over the caps are
+/// "not dense": find() answers kNotDense and the caller looks the atom up in its hash table.
+class DenseAtomIndex {
+ public:
+  static constexpr int64_t kNotDense = -2;
+
+  DenseAtomIndex() = default;
+  /// `arity[p]`: arity of predicate p; objects are 0 .. num_objects - 1. A predicate is dense when
+  /// its tuples number at most `max_per_predicate` and all dense predicates together at most
+  /// `max_total` (predicates in id order, first come first served).
+  DenseAtomIndex(const std::vector<uint32_t>& arity, uint32_t num_objects, size_t max_per_predicate,
+                 size_t max_total)
+      : num_objects_(num_objects) {
+    offset_.assign(arity.size(), kNone);
+    size_t total = 0;
+    for (size_t p = 0; p < arity.size(); ++p) {
+      size_t n = 1;
+      bool small = true;
+      for (uint32_t i = 0; i < arity[p] && small; ++i) {
+        small = num_objects == 0 || n <= max_per_predicate / num_objects;
+        n *= num_objects;
+      }
+      if (!small || n > max_per_predicate || total + n > max_total) continue;
+      offset_[p] = total;
+      total += n;
+    }
+    slots_.assign(total, -1);
+  }
+
+  bool isDense(uint32_t pred) const { return pred < offset_.size() && offset_[pred] != kNone; }
+  /// `key` = [pred, args...] with `n` - 1 = arity of pred and every arg < num_objects: the atom's
+  /// id, -1 when it has none, kNotDense when pred is not dense.
+  int64_t find(const uint32_t* key, uint32_t n) const {
+    const size_t off = key[0] < offset_.size() ? offset_[key[0]] : kNone;
+    if (off == kNone) return kNotDense;
+    return slots_[off + tuple(key, n)];
+  }
+  /// Records `id` for `key` (ignored when pred is not dense). Same preconditions as find().
+  void set(const uint32_t* key, uint32_t n, uint32_t id) {
+    const size_t off = key[0] < offset_.size() ? offset_[key[0]] : kNone;
+    if (off != kNone) slots_[off + tuple(key, n)] = static_cast<int32_t>(id);
+  }
+  size_t numSlots() const { return slots_.size(); }
+
+ private:
+  static constexpr size_t kNone = SIZE_MAX;
+  size_t tuple(const uint32_t* key, uint32_t n) const {
+    size_t t = 0;
+    for (uint32_t i = 1; i < n; ++i) t = t * num_objects_ + key[i];
+    return t;
+  }
+  uint32_t num_objects_{0};
+  std::vector<size_t> offset_;
+  std::vector<int32_t> slots_;
+};
+
 }  // namespace tamp::symbolic_planner

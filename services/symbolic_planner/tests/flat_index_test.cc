@@ -36,8 +36,8 @@ TEST(U64IdMap, AgreesWithUnorderedMapTryEmplace) {
 TEST(U64IdMap, KeysThatShareTheirLowOrHighBitsAndTheExtremes) {
   U64IdMap m;
   std::vector<uint64_t> keys = {0, UINT64_MAX, UINT64_MAX - 1, uint64_t{1} << 63};
-  for (uint64_t i = 1; i < 512; ++i) keys.push_back(i << 40);     // equal low bits
-  for (uint64_t i = 1; i < 512; ++i) keys.push_back(i);           // equal high bits
+  for (uint64_t i = 1; i < 512; ++i) keys.push_back(i << 40);      // equal low bits
+  for (uint64_t i = 1; i < 512; ++i) keys.push_back(i);            // equal high bits
   for (uint64_t i = 1; i < 512; ++i) keys.push_back(i * 0x10000);  // strided
   std::map<uint64_t, uint32_t> ref;
   for (uint32_t i = 0; i < keys.size(); ++i) {
@@ -61,7 +61,8 @@ TEST(ArgIndex, ListsInInsertionOrderAndEmptyBeyondTheObjectsSeen) {
   for (uint32_t atom = 0; atom < 5000; ++atom) {
     uint32_t pred = 1 + rng() % 3;
     const uint32_t pos = rng() % arity[pred];
-    const uint32_t obj = (atom % 7 == 0) ? 1000 + rng() % 100 : rng() % 20;  // sparse and dense objects
+    const uint32_t obj =
+        (atom % 7 == 0) ? 1000 + rng() % 100 : rng() % 20;  // sparse and dense objects
     idx.add(pred, pos, obj, atom);
     ref[{pred, pos, obj}].push_back(atom);
   }

@@ -2,6 +2,8 @@
 // -> ground operators with DNF-split preconditions and compiled negation (complement facts).
 #include "tamp/symbolic_planner/grounding.h"
 
+#include "tamp/symbolic_planner/flat_index.h"
+
 #include <algorithm>
 #include <cmath>
 #include <functional>
@@ -99,6 +101,7 @@ struct Variant {
   std::vector<LAtom> pos;       // top-level positive atoms (static and fluent)
   std::vector<LFormula> eqs;    // top-level (in)equalities, checked early
   std::vector<LFormula> parts;  // the whole conjunction (instantiated at build time)
+  bool flat{false};             // every part is a literal or an (in)equality: no nesting
 };
 
 struct LEffect {
@@ -161,11 +164,12 @@ struct Grounder::Impl {
 
   // Atoms and reachability.
   SeqTable atoms;
+  DenseAtomIndex dense_atoms;  // atom ids of predicates with few tuples, looked up without hashing
   std::vector<char> reached;  // in R(U) (fluent) or in U (static)
   std::vector<AtomId> queue;
   size_t queue_head{0};
   std::vector<std::vector<AtomId>> by_pred;  // processed atoms
-  std::unordered_map<uint64_t, std::vector<AtomId>> by_arg;
+  ArgIndex by_arg;  // (pred, position, object) -> processed atoms, in processing order
   std::vector<std::vector<std::pair<uint32_t, uint32_t>>> triggers;  // pred -> (schema, variant)
   bool initialized{false};
   SeqTable bindings;
@@ -400,6 +404,11 @@ struct Grounder::Impl {
     }
     triggers.assign(pred_names.size(), {});
     by_pred.assign(pred_names.size(), {});
+    by_arg = ArgIndex(pred_arity);
+    // 2^16 tuples (256 KiB) per predicate, 2^18 in all: small tasks, where a lookup's hashing is
+    // a visible share of the grounding time, get every predicate.
+    dense_atoms = DenseAtomIndex(pred_arity, static_cast<uint32_t>(obj_names.size()), size_t{1} << 16,
+                                 size_t{1} << 18);
 
     for (const auto& a : domain.actions) {
       Schema s;
@@ -418,6 +427,8 @@ struct Grounder::Impl {
           if (part.kind == LKind::kAtom && !part.neg) v.pos.push_back(LAtom{part.pred, part.args});
           if (part.kind == LKind::kEq) v.eqs.push_back(part);
         }
+        v.flat = std::all_of(tc.parts.begin(), tc.parts.end(),
+                             [](const LFormula& p) { return p.kind == LKind::kAtom || p.kind == LKind::kEq; });
         v.parts = std::move(tc.parts);
         s.variants.push_back(std::move(v));
       }
@@ -484,8 +495,12 @@ struct Grounder::Impl {
   }
 
   AtomId internKey(const uint32_t* key, uint32_t n) {
+    if (const int64_t d = dense_atoms.find(key, n); d >= 0) return static_cast<AtomId>(d);
     auto [id, inserted] = atoms.insert(key, n);
-    if (inserted) reached.push_back(0);
+    if (inserted) {
+      reached.push_back(0);
+      dense_atoms.set(key, n, id);
+    }
     return id;
   }
 
@@ -498,10 +513,6 @@ struct Grounder::Impl {
 
   // ---------------------------------------------------------------------------------------------
   // Relaxed reachability
-
-  static uint64_t argKey(uint32_t pred, uint32_t pos, uint32_t obj) {
-    return (uint64_t{pred} << 40) | (uint64_t{pos} << 32) | obj;
-  }
 
   void markReached(AtomId a) {
     if (reached[a]) return;
@@ -563,28 +574,33 @@ struct Grounder::Impl {
       const LTerm t = la.args[i];
       int64_t obj = isVar(t) ? bind[static_cast<size_t>(t)] : objOf(t);
       if (obj < 0) continue;
-      auto it = by_arg.find(argKey(la.pred, static_cast<uint32_t>(i), static_cast<uint32_t>(obj)));
-      if (it == by_arg.end()) return Status::Ok();
-      if (it->second.size() < cands->size()) cands = &it->second;
+      const std::vector<AtomId>& with = by_arg.get(la.pred, static_cast<uint32_t>(i), static_cast<uint32_t>(obj));
+      if (with.empty()) return Status::Ok();
+      if (with.size() < cands->size()) cands = &with;
     }
     used[best] = 1;
-    std::vector<uint32_t> trail;
+    // The variables this level binds go on the shared trail above `mark` (no vector per call).
+    const size_t mark = trail_.size();
+    auto undo = [&]() {
+      for (size_t t = mark; t < trail_.size(); ++t) bind[trail_[t]] = -1;
+      trail_.resize(mark);
+    };
     const size_t n = cands->size();  // the index may grow during the loop; new atoms are queued
     for (size_t c = 0; c < n; ++c) {
-      trail.clear();
       const AtomId a = (*cands)[c];
-      if (matchAtom(la, a, bind, trail)) {
+      if (matchAtom(la, a, bind, trail_)) {
         if (Status s = join(si, vi, bind, used, remaining - 1, term); !s.ok()) {
-          for (uint32_t t : trail) bind[t] = -1;
+          undo();
           used[best] = 0;
           return s;
         }
       }
-      for (uint32_t t : trail) bind[t] = -1;
+      undo();
     }
     used[best] = 0;
     return Status::Ok();
   }
+  std::vector<uint32_t> trail_;  // variables bound by the joins in progress (a stack)
 
   Status enumerateFree(uint32_t si, uint32_t vi, std::vector<int64_t>& bind, size_t k, const Termination& term) {
     const Schema& s = schemas[si];
@@ -616,7 +632,8 @@ struct Grounder::Impl {
   Status addBinding(uint32_t si, uint32_t vi, std::vector<int64_t>& bind) {
     const Schema& s = schemas[si];
     const Variant& v = s.variants[vi];
-    std::vector<uint32_t> key{si, vi};
+    std::vector<uint32_t>& key = key_buf_;
+    key.assign({si, vi});
     for (uint32_t var : v.vars) key.push_back(static_cast<uint32_t>(bind[var]));
     auto [id, inserted] = bindings.insert(key.data(), static_cast<uint32_t>(key.size()));
     (void)id;
@@ -629,7 +646,8 @@ struct Grounder::Impl {
       if (e.del) continue;
       Status st = forEachForall(e.forall, 0, bind, [&]() -> Status {
         if (evalStatic(e.cond, bind) == 0) return Status::Ok();
-        std::vector<uint32_t> k2{e.atom.pred};
+        std::vector<uint32_t>& k2 = key_buf_;
+        k2.assign(1, e.atom.pred);
         for (LTerm t : e.atom.args) k2.push_back(isVar(t) ? static_cast<uint32_t>(bind[static_cast<size_t>(t)]) : objOf(t));
         const AtomId a = internKey(k2.data(), static_cast<uint32_t>(k2.size()));
         markReached(a);
@@ -642,6 +660,8 @@ struct Grounder::Impl {
     }
     return Status::Ok();
   }
+
+  std::vector<uint32_t> key_buf_;  // scratch key of addBinding (bindings, then effect atoms)
 
   template <typename Fn>
   Status forEachForall(const std::vector<uint32_t>& vars, size_t k, std::vector<int64_t>& bind, const Fn& fn) {
@@ -673,13 +693,10 @@ struct Grounder::Impl {
       }
       case LKind::kAtom: {
         if (!pred_static[f.pred]) return 2;
-        std::vector<uint32_t> k{f.pred};
         for (LTerm t : f.args) {
-          const int64_t o = isVar(t) ? bind[static_cast<size_t>(t)] : objOf(t);
-          if (o < 0) return 2;
-          k.push_back(static_cast<uint32_t>(o));
+          if (isVar(t) && bind[static_cast<size_t>(t)] < 0) return 2;
         }
-        const int64_t id = atoms.find(k.data(), static_cast<uint32_t>(k.size()));
+        const int64_t id = findAtom(f.pred, f.args, bind);
         const bool holds = id >= 0 && reached[static_cast<size_t>(id)];
         return holds != f.neg ? 1 : 0;
       }
@@ -730,7 +747,7 @@ struct Grounder::Impl {
       // Index first, so joins can use `a` in other positions too.
       if (pending_index_ != a) {
         by_pred[pred].push_back(a);
-        for (uint32_t i = 1; i < atoms.length(a); ++i) by_arg[argKey(pred, i - 1, k[i])].push_back(a);
+        for (uint32_t i = 1; i < atoms.length(a); ++i) by_arg.add(pred, i - 1, k[i], a);
         pending_index_ = a;
       }
       for (auto [si, vi] : triggers[pred]) {
@@ -739,9 +756,11 @@ struct Grounder::Impl {
         for (size_t pi = 0; pi < v.pos.size(); ++pi) {
           if (v.pos[pi].pred != pred) continue;
           bind.assign(schemas[si].var_type.size(), -1);
-          std::vector<char> used(v.pos.size(), 0);
-          std::vector<uint32_t> trail;
-          if (!matchAtom(v.pos[pi], a, bind, trail)) continue;
+          std::vector<char>& used = used_buf_;
+          used.assign(v.pos.size(), 0);
+          trail_.clear();
+          if (!matchAtom(v.pos[pi], a, bind, trail_)) continue;
+          trail_.clear();  // the trigger's own bindings stay for this join
           used[pi] = 1;
           // Resuming after an interruption re-runs this atom's joins; bindings are deduplicated.
           if (Status s = join(si, vi, bind, used, v.pos.size() - 1, term); !s.ok()) return s;
@@ -756,6 +775,7 @@ struct Grounder::Impl {
     return Status::Ok();
   }
   AtomId pending_index_{UINT32_MAX};
+  std::vector<char> used_buf_;  // scratch of explore(): which positive atoms a join has matched
 
   // ---------------------------------------------------------------------------------------------
   // Task construction
@@ -778,7 +798,9 @@ struct Grounder::Impl {
       const LTerm t = args[i];
       key[i + 1] = isVar(t) ? static_cast<uint32_t>(bind[static_cast<size_t>(t)]) : objOf(t);
     }
-    return atoms.find(key, static_cast<uint32_t>(args.size() + 1));
+    const uint32_t n = static_cast<uint32_t>(args.size() + 1);
+    if (const int64_t d = dense_atoms.find(key, n); d != DenseAtomIndex::kNotDense) return d;
+    return atoms.find(key, n);
   }
 
   /// Instantiates and simplifies a lifted NNF formula under `bind`.
@@ -988,22 +1010,27 @@ struct Grounder::Impl {
       const Variant& v = s.variants[key[1]];
       bind.assign(s.var_type.size(), -1);
       for (size_t i = 0; i < v.vars.size(); ++i) bind[v.vars[i]] = key[2 + i];
-      // Precondition.
-      GFormula pre;
-      pre.kind = GFormula::kAnd;
-      bool pre_false = false;
-      for (const auto& part : v.parts) {
-        if (!absorb(pre, instantiate(part, bind, ctx, s.var_type), true)) {
-          pre_false = pre.kind == GFormula::kFalse;
-          break;
+      // Precondition. Flat (a conjunction of literals and (in)equalities, as in STRIPS): its
+      // one DNF term directly, as instantiate() + dnf() would give it, without the formula tree.
+      if (v.flat) {
+        if (!flatPrecondition(v, bind, ctx, pre_dnf)) continue;
+      } else {
+        GFormula pre;
+        pre.kind = GFormula::kAnd;
+        bool pre_false = false;
+        for (const auto& part : v.parts) {
+          if (!absorb(pre, instantiate(part, bind, ctx, s.var_type), true)) {
+            pre_false = pre.kind == GFormula::kFalse;
+            break;
+          }
         }
-      }
-      if (pre_false) continue;
-      pre = finish(std::move(pre), true);
-      if (pre.kind == GFormula::kFalse) continue;
-      if (!dnf(pre, pre_dnf)) {
-        return Error(ErrorCode::kUnsupported, "precondition of action '" + s.name + "' grounds to more than " +
-                                                  std::to_string(limits.max_dnf_terms) + " disjuncts");
+        if (pre_false) continue;
+        pre = finish(std::move(pre), true);
+        if (pre.kind == GFormula::kFalse) continue;
+        if (!dnf(pre, pre_dnf)) {
+          return Error(ErrorCode::kUnsupported, "precondition of action '" + s.name + "' grounds to more than " +
+                                                    std::to_string(limits.max_dnf_terms) + " disjuncts");
+        }
       }
       if (pre_dnf.empty()) continue;
       // Cost.
@@ -1134,6 +1161,54 @@ struct Grounder::Impl {
     stats.operators = task->ops.size();
     stats.build_seconds = sw.seconds();
     return std::shared_ptr<const Task>(std::move(task));
+  }
+
+  /// The DNF of a flat precondition (see Variant::flat) under `bind`: false when it is false (out
+  /// is then unspecified), else `out` holds its one conjunct, sorted by (atom, negated) and without
+  /// duplicates, exactly what dnf(instantiate(...)) gives (an empty `out` when p and not p meet).
+  bool flatPrecondition(const Variant& v, const std::vector<int64_t>& bind, const BuildCtx& ctx,
+                        std::vector<Conj>& out) const {
+    out.resize(1);
+    Conj& conj = out[0];
+    conj.clear();
+    // (In)equalities and static literals first: they are what usually fails (the relaxed
+    // exploration over-approximates them); the result does not depend on the order.
+    for (const LFormula& f : v.parts) {
+      if (f.kind == LKind::kEq) {
+        bool known = false;
+        if (!eqHolds(f, bind, &known)) return false;
+      } else if (pred_static[f.pred]) {
+        const int64_t id = findAtom(f.pred, f.args, bind);
+        const bool t = id >= 0 && ctx.has_static_true(static_cast<AtomId>(id));
+        if (t == f.neg) return false;
+      }
+    }
+    for (const LFormula& f : v.parts) {
+      if (f.kind == LKind::kEq || pred_static[f.pred]) continue;
+      const int64_t id = findAtom(f.pred, f.args, bind);
+      if (id < 0 || !reached[static_cast<size_t>(id)]) {
+        if (!f.neg) return false;
+        continue;
+      }
+      conj.push_back(AtomLiteral{static_cast<AtomId>(id), f.neg});
+    }
+    if (conj.size() > 1) {
+      std::sort(conj.begin(), conj.end(), [](const AtomLiteral& x, const AtomLiteral& y) {
+        return x.atom != y.atom ? x.atom < y.atom : x.negated < y.negated;
+      });
+      conj.erase(std::unique(conj.begin(), conj.end(),
+                             [](const AtomLiteral& x, const AtomLiteral& y) {
+                               return x.atom == y.atom && x.negated == y.negated;
+                             }),
+                 conj.end());
+      for (size_t i = 1; i < conj.size(); ++i) {
+        if (conj[i].atom == conj[i - 1].atom) {
+          out.clear();
+          return true;
+        }
+      }
+    }
+    return true;
   }
 
   /// Merges conditional effects with identical conditions and moves empty-condition ones.

@@ -1,8 +1,9 @@
 #include "tamp/symbolic_planner/heuristic.h"
 
+#include "tamp/symbolic_planner/flat_index.h"
+
 #include <algorithm>
 #include <stdexcept>
-#include <unordered_map>
 
 namespace tamp::symbolic_planner {
 namespace {
@@ -173,7 +174,9 @@ struct RelaxedOps {
       return true;
     };
     auto eligible = [](const Operator& x) { return x.cond_effects.empty() && !x.add.empty() && !x.pre.empty(); };
-    std::unordered_map<uint64_t, uint32_t> key_id;
+    size_t num_keys = 0;  // one per (eligible operator, precondition): the map never grows
+    for (const Operator& x : task.ops) num_keys += eligible(x) ? x.pre.size() : 0;
+    U64IdMap key_id(num_keys);
     std::vector<uint32_t> key_count;
     std::vector<std::pair<OpId, uint32_t>> key_rep;  // key -> its first (operator, skip)
     std::vector<uint32_t> first_key(task.ops.size() + 1, 0), keys;  // per operator, its keys' ids
@@ -182,8 +185,7 @@ struct RelaxedOps {
       const Operator& x = task.ops[o];
       if (!eligible(x)) continue;
       for (size_t i = 0; i < x.pre.size(); ++i) {
-        auto [it, inserted] = key_id.try_emplace(hash(x, i), static_cast<uint32_t>(key_count.size()));
-        uint32_t id = it->second;
+        auto [id, inserted] = key_id.tryEmplace(hash(x, i), static_cast<uint32_t>(key_count.size()));
         if (inserted) {
           key_count.push_back(0);
           key_rep.push_back({o, static_cast<uint32_t>(i)});

@@ -69,6 +69,22 @@ TEST_F(Cli, EverySearchAlgorithm) {
   EXPECT_EQ(r.code, 30) << r.out;
 }
 
+TEST_F(Cli, HeapReserveKeepsThePlanAndRefusesBadValues) {
+  CliRun def = runCli(dom_ + " " + prob_);
+  ASSERT_EQ(def.code, 0) << def.out;
+  for (const char* mib : {"0", "1", "64", "4096"}) {
+    CliRun r = runCli(dom_ + " " + prob_ + " --heap-reserve " + mib);
+    EXPECT_EQ(r.code, 0) << mib << ": " << r.out;
+    EXPECT_EQ(r.out, def.out) << mib;  // the reserve changes where memory comes from, not the plan
+  }
+  for (const char* bad : {"-1", "4097", "100000000000", "lots", "1.5"}) {
+    CliRun r = runCli(dom_ + " " + prob_ + " --heap-reserve " + bad);
+    EXPECT_EQ(r.code, 30) << bad << ": " << r.out;
+    EXPECT_NE(r.out.find("--heap-reserve"), std::string::npos) << bad << ": " << r.out;
+    EXPECT_EQ(r.out.find("(move_base"), std::string::npos) << bad << ": planned anyway: " << r.out;
+  }
+}
+
 TEST_F(Cli, ExitCodes) {
   // 30: input error, with file:line:column.
   const std::string broken = tmpFile("broken.pddl", "(define (problem x)\n  (:domain mobile-manipulation)\n  (:init (robot-at nowhere))\n  (:goal (hand-empty)))\n");

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <map>
 
 #include "tamp/symbolic_planner/grounding.h"
 #include "test_util.h"
@@ -188,6 +189,48 @@ TEST(Grounding, DisjunctivePreconditionsSplitIntoOperators) {
   int n = 0;
   for (const auto& o : g.task->ops) n += o.name == "(x)";
   EXPECT_EQ(n, 3);
+}
+
+TEST(Grounding, FlatAndNestedPreconditionsGroundAlike) {
+  // `flat` has a flat precondition (literals, negation, inequality: the fast path); `nested` has
+  // the same one plus a quantified conjunct that grounds to true (the general path). Their
+  // operators must have the same preconditions; `clash` needs p and not p and grounds to nothing.
+  const std::string dom = R"(
+(define (domain flat) (:requirements :adl)
+  (:types obj)
+  (:predicates (p ?x - obj) (q ?x - obj) (r ?x ?y - obj) (s ?x - obj) (done ?x ?y - obj))
+  (:action flat :parameters (?a ?b - obj)
+    :precondition (and (p ?a) (not (q ?b)) (r ?a ?b) (not (= ?a ?b)) (p ?a))
+    :effect (and (done ?a ?b) (q ?a)))
+  (:action nested :parameters (?a ?b - obj)
+    :precondition (and (p ?a) (not (q ?b)) (r ?a ?b) (not (= ?a ?b)) (forall (?z - obj) (s ?z)))
+    :effect (and (done ?a ?b) (q ?a)))
+  (:action clash :parameters (?a - obj)
+    :precondition (and (p ?a) (not (p ?a)))
+    :effect (and (q ?a) (not (p ?a)))))
+)";
+  const std::string prob = R"(
+(define (problem f) (:domain flat) (:objects o1 o2 o3 - obj)
+  (:init (p o1) (p o2) (r o1 o2) (r o2 o1) (r o1 o1) (r o2 o3) (s o1) (s o2) (s o3))
+  (:goal (and (done o1 o2) (not (q o3)))))
+)";
+  auto g = ground(dom, prob, false);
+  const Task& t = *g.task;
+  std::map<std::string, std::vector<FactId>> flat, nested;
+  for (const auto& o : t.ops) {
+    EXPECT_NE(o.name.rfind("(clash", 0), 0U) << o.name;
+    const std::string args = o.name.substr(o.name.find(' '));
+    if (o.name.rfind("(flat", 0) == 0) flat[args] = o.pre;
+    if (o.name.rfind("(nested", 0) == 0) nested[args] = o.pre;
+  }
+  EXPECT_EQ(flat, nested);
+  // (r o1 o1) is excluded by the inequality; (r o2 o3) with p o2: yes.
+  EXPECT_EQ(flat.count(" o1 o1)"), 0U);
+  ASSERT_EQ(flat.count(" o2 o3)"), 1U);
+  ASSERT_EQ(flat.count(" o1 o2)"), 1U);
+  // (p ?a) twice is one precondition (p is fluent: clash deletes it): p, not q (a complement
+  // fact), and no static r.
+  EXPECT_EQ(flat[" o1 o2)"].size(), 2U);
 }
 
 TEST(Grounding, StopsOnAnExpiredDeadline) {

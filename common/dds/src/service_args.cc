@@ -1,4 +1,5 @@
 // The only translation unit of tamp_dds that includes CLI11 (it is slow to compile).
+#include <cstdlib>
 #include <iostream>
 
 #include <CLI/CLI.hpp>
@@ -11,6 +12,7 @@ Result<ServiceArgs> parseServiceArgs(int argc, char** argv, const std::string& d
                                      const std::string& description) {
   ServiceArgs a;
   a.name = default_name;
+  if (const char* env = std::getenv("TAMP_LOG_LEVEL"); env != nullptr && *env != '\0') a.log_level = env;
   CLI::App app{description, default_name};
   app.add_option("--name", a.name, "service name (heartbeat and echo topic)");
   app.add_option("--domain", a.domain_id, "DDS domain id (default: $TAMP_DOMAIN_ID or 0)")->check(CLI::Range(0, 232));
@@ -19,7 +21,7 @@ Result<ServiceArgs> parseServiceArgs(int argc, char** argv, const std::string& d
   app.add_option("--scenario", a.scenario_file,
                  "scenario YAML of the run (services that need the world, robot or priors read it)")
       ->check(CLI::ExistingFile);
-  app.add_option("--log-level", a.log_level, "trace, debug, info, warn, error, off");
+  app.add_option("--log-level", a.log_level, "trace, debug, info, warn, error, off (default: $TAMP_LOG_LEVEL or info)");
   app.add_option("--heartbeat-period", a.heartbeat_period_s, "seconds between heartbeats")
       ->check(CLI::Range(0.01, 60.0));
   app.add_option("--run-id", a.run_id, "run this service belongs to (DDS partition; default: $TAMP_RUN_ID or none)");

@@ -317,6 +317,7 @@ Status validate(const msg::MotionRequest& m, const Limits& limits) {
   if (m.held_grasp_given() && m.held_object_id().empty()) c.fail("held_grasp_given", "true without held_object_id");
   c.id("held_link", m.held_link(), false);  // empty: the robot's tool link
   c.pose3("held_link_T_object", m.held_link_T_object(), m.held_grasp_given());
+  c.inRange("held_padding_m", m.held_padding_m(), 0.0, 0.25);
   c.ids("ignored_objects", m.ignored_objects(), limits.max_items);
   if (c.size("object_overrides", m.object_overrides(), limits.max_items)) {
     for (std::size_t i = 0; i < m.object_overrides().size() && c.ok(); ++i) {

@@ -58,6 +58,11 @@ TEST(MsgValidation, MotionRequest) {
   m.start_joint_positions().pop_back();
   EXPECT_EQ(why(m), "MotionRequest.start_joint_positions: 3 values for 4 start_joint_names");
   m = validMotion();
+  m.held_padding_m(0.5);
+  EXPECT_EQ(why(m).rfind("MotionRequest.held_padding_m: must be in [", 0), 0u) << why(m);
+  m.held_padding_m(kNaN);
+  EXPECT_EQ(why(m), "MotionRequest.held_padding_m: NaN");
+  m = validMotion();
   m.header().request_id("");
   EXPECT_EQ(why(m), "MotionRequest.header.request_id: empty (an id is required)");
   m = validMotion();

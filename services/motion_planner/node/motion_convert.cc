@@ -109,6 +109,7 @@ Result<MotionRequest> fromMsg(const msg::MotionRequest& m, const MotionPlanner& 
     if (!t) return t.error();
     r.held_grasp = HeldGrasp{m.held_link(), *t};
   }
+  r.held_padding_m = m.held_padding_m();
   r.ignored_objects.assign(m.ignored_objects().begin(), m.ignored_objects().end());
   auto overrides = overridesFromMsg(m.object_overrides());
   if (!overrides) return overrides.error();

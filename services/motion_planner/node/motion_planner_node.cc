@@ -323,9 +323,13 @@ msg::MotionReply MotionPlannerNode::handleMotion(const msg::MotionRequest& req, 
   }
   if (request->group == PlanningGroup::kBase) slot.last_base_start = request->start;
   const MotionResult r = slot.planner.plan(*request, *term);
-  nodeLog()->debug("motion {} on planner {}: {} {} {} in {:.1f} ms, {} blocking{}", ctx.request_id, lease->index(),
-                   toString(request->group), toString(request->mode), toString(r.status), r.planning_time_s * 1e3,
-                   r.blocking.size(), request->object_overrides.empty() ? "" : ", overrides");
+  const PlanningStats& st = r.stats;
+  nodeLog()->debug(
+      "motion {} on planner {}: {} {} {} in {:.1f} ms (goal {:.1f}, sampling {:.1f}, proof {:.1f}, optimize {:.1f}, "
+      "shortcut {:.1f}, analysis {:.1f}; {} checks), {} blocking{}",
+      ctx.request_id, lease->index(), toString(request->group), toString(request->mode), toString(r.status),
+      r.planning_time_s * 1e3, st.goal_ms, st.sampling_ms, st.proof_ms, st.optimize_ms, st.shortcut_ms,
+      st.analysis_ms, st.validity_checks, r.blocking.size(), request->object_overrides.empty() ? "" : ", overrides");
   for (const auto& id : r.start_contacts) {
     nodeLog()->info("motion {}: the start touches '{}'; the path leaves it first", ctx.request_id, id);
   }

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <limits>
 #include <mutex>
 
 #include <ompl/base/ProblemDefinition.h>
@@ -359,6 +360,9 @@ std::vector<std::string> MotionPlanner::groupJointNames(PlanningGroup group) con
 
 namespace {
 
+/// The largest margin a request may grow its held object by (m).
+constexpr double kMaxHeldPadding_m = 0.25;
+
 /// Validates the request against the robot and the world; the first problem, naming the field.
 std::optional<std::string> validateRequest(const MotionRequest& r, const MotionPlanner::Impl& impl,
                                            const std::vector<std::string>& group_names) {
@@ -428,6 +432,13 @@ std::optional<std::string> validateRequest(const MotionRequest& r, const MotionP
       return "ignored_objects[" + std::to_string(i) + "]: no object '" + r.ignored_objects[i] + "' in the world";
     }
   }
+  if (!std::isfinite(r.held_padding_m) || r.held_padding_m < 0 || r.held_padding_m > kMaxHeldPadding_m) {
+    return "held_padding_m: must be finite and in [0, " + formatNumber(kMaxHeldPadding_m) + "], got " +
+           formatNumber(r.held_padding_m);
+  }
+  if (r.held_padding_m > 0 && r.held_object.empty() && !impl.world.held()) {
+    return std::string("held_padding_m: given without a held object");
+  }
   if (!std::isfinite(r.object_cost_scale) || r.object_cost_scale < 0) {
     return "object_cost_scale: must be finite and >= 0, got " + formatNumber(r.object_cost_scale);
   }
@@ -480,6 +491,40 @@ Result<world::World> overriddenWorld(const world::World& base, const std::vector
 
 namespace {
 
+/// `shape` grown sideways by `d` (m): its footprint, not its height, so that a held object still
+/// rests on its support when it is put down. A prism grows about its vertices' centroid, by a
+/// factor that moves its nearest edge out by `d` (every other edge by at least as much).
+world::Shape grownShape(const world::Shape& shape, double d) {
+  world::Shape g = shape;
+  switch (shape.kind) {
+    case world::ShapeKind::kBox:
+      g.size.x() += 2 * d;
+      g.size.y() += 2 * d;
+      break;
+    case world::ShapeKind::kCylinder: g.radius += d; break;
+    case world::ShapeKind::kSphere: g.radius += d; break;  // no footprint apart from its height
+    case world::ShapeKind::kPrism: {
+      const auto& v = shape.polygon;
+      Eigen::Vector2d c = Eigen::Vector2d::Zero();
+      for (const auto& p : v) c += p;
+      c /= static_cast<double>(v.size());
+      double nearest = std::numeric_limits<double>::infinity();
+      for (std::size_t i = 0; i < v.size(); ++i) {
+        const Eigen::Vector2d a = v[i], b = v[(i + 1) % v.size()];
+        const Eigen::Vector2d ab = b - a;
+        const double t = std::clamp((c - a).dot(ab) / std::max(1e-12, ab.squaredNorm()), 0.0, 1.0);
+        nearest = std::min(nearest, (a + t * ab - c).norm());
+      }
+      const double k = 1.0 + d / std::max(1e-6, nearest);
+      std::vector<Eigen::Vector2d> out;
+      for (const auto& p : v) out.push_back(c + k * (p - c));
+      g = world::Shape::prism(world::Polygon2(out.begin(), out.end()), shape.height);
+      break;
+    }
+  }
+  return g;
+}
+
 /// Puts the planner's scene and world back when a request planned in a hypothetical world ends.
 class WorldRestore {
  public:
@@ -501,6 +546,12 @@ class WorldRestore {
   WorldRestore(const WorldRestore&) = delete;
   WorldRestore& operator=(const WorldRestore&) = delete;
   ~WorldRestore() { restore(); }
+  bool active() const { return impl_ != nullptr; }
+  /// Another hypothetical world; the saved one stays what is restored.
+  void replaceWorld(MotionPlanner::Impl& impl, world::World hypothetical) {
+    impl.world = std::move(hypothetical);
+    impl.scene.syncWorld(impl.world);
+  }
 
  private:
   void restore() {
@@ -626,6 +677,21 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
     if (!hypothetical) return finish(MotionStatus::kInvalidRequest, hypothetical.error().message);
     restore = WorldRestore(impl, std::move(*hypothetical));
   }
+  // The held object with its margin (the world restored afterwards, as for overrides).
+  if (req.held_padding_m > 0) {
+    world::World padded = impl.world;
+    const std::string id = !req.held_object.empty() ? req.held_object : impl.world.held()->object_id;
+    world::Object o = padded.object(id);
+    o.shape = grownShape(o.shape, req.held_padding_m);
+    if (Status s = padded.updateObject(o); !s) {
+      return finish(MotionStatus::kInvalidRequest, "held_padding_m: " + s.error().message);
+    }
+    if (restore.active()) {
+      restore.replaceWorld(impl, std::move(padded));
+    } else {
+      restore = WorldRestore(impl, std::move(padded));
+    }
+  }
 
   // Base bounds: the world, the start and a base goal.
   std::vector<Eigen::Vector2d> extra{{req.start.base.x, req.start.base.y}};
@@ -735,6 +801,7 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
   }
 
   // ---- goal ----
+  Stopwatch goal_clock;
   auto pdef = std::make_shared<ob::ProblemDefinition>(si);
   pdef->addStartState(escaped ? escaped.get() : start.get());
   std::optional<Eigen::Vector2d> base_goal;  // for the proof
@@ -852,6 +919,8 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
     pdef->setGoal(goals);
   }
 
+  res.stats.goal_ms = goal_clock.millis();
+
   // ---- lazy: the cached roadmap of the static free space ----
   const double spu = gs.secondsPerUnit(P.cost);
   const double res_check = P.sampling.validity_resolution;
@@ -922,7 +991,18 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
            : collision::Filter{collision::kAllGroups, {}, ignored};
   std::size_t proof_level = 0;
   double slice = lazy ? 0.25 : 0.05;
-  bool solved = from_roadmap.has_value();
+  // Full mode: the direct motion to a goal state, when it is free, needs no sampling.
+  std::optional<og::PathGeometric> direct;
+  if (!lazy && P.sampling.direct_first && !termination()) {
+    const ob::State* from = escaped ? escaped.get() : start.get();
+    for (const ob::State* g : goal_states) {
+      if (!si->checkMotion(from, g)) continue;
+      direct.emplace(si, from, g);
+      res.stats.direct = true;
+      break;
+    }
+  }
+  bool solved = from_roadmap.has_value() || direct.has_value();
   res.stats.lazy_planner_used = !solved;
   bool first = true;
   while (!solved) {
@@ -960,7 +1040,9 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
                       (proof_cells.empty() ? std::string(" (no infeasibility proof for this group)")
                                            : std::string(" (infeasibility not proven)")));
   }
-  og::PathGeometric raw = from_roadmap ? *from_roadmap : *pdef->getSolutionPath()->as<og::PathGeometric>();
+  og::PathGeometric raw = from_roadmap ? *from_roadmap
+                          : direct     ? *direct
+                                       : *pdef->getSolutionPath()->as<og::PathGeometric>();
   res.stats.raw_path_length = detail::reportedLength(gs, raw);
 
   og::PathGeometric final_path(si);
@@ -1004,7 +1086,7 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
     final_path = raw;
     og::PathSimplifier simplifier(si);
     const Termination simp = termination.tightened(Deadline::in(0.05));
-    for (int round = 0; round < 4 && !simp(); ++round) {
+    for (int round = 0; round < 4 && !direct && !simp(); ++round) {
       bool better = simplifier.shortcutPath(final_path, 0, 0, 0.33, 0.005);
       better |= simplifier.reduceVertices(final_path);
       if (!better) break;

@@ -95,6 +95,23 @@ TEST_F(ArmTest, ArmConfigurationGoalIsReachedOnACollisionFreePath) {
   EXPECT_NO_THROW(r.trajectory.validate());
 }
 
+TEST_F(ArmTest, ANearbyFreeConfigurationIsReachedByTheDirectMotion) {
+  MotionPlanner mp = planner();
+  MotionRequest req;
+  req.group = PlanningGroup::kArm;
+  req.mode = MotionMode::kFull;
+  req.start = model_->defaultState(Pose2D{0, 0, 0});
+  std::vector<double> goal = req.start.arm;
+  goal[0] += 0.3;  // the first joint turned a little: free all the way (checked below)
+  req.goal = MotionGoal::configurationGoal(goal);
+  const MotionResult r = mp.plan(req, Termination::after(10.0));
+  ASSERT_EQ(r.status, MotionStatus::kSolved) << r.reason;
+  EXPECT_TRUE(r.stats.direct);
+  EXPECT_EQ(r.path.waypoints.size(), 2u);
+  expectCollisionFree(r.path, req.start);
+  for (std::size_t j = 0; j < goal.size(); ++j) EXPECT_NEAR(r.path.waypoints.back()[j], goal[j], 1e-9);
+}
+
 TEST_F(ArmTest, EndEffectorGoalThroughIkIsReachedWithinTolerance) {
   MotionPlanner mp = planner();
   // A reachable pose in front of the robot, the tool pointing down.

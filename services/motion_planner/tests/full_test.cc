@@ -41,6 +41,32 @@ TEST_F(FullTest, PathThroughTheOpenDoorIsCollisionFreeWhenRecheckedDensely) {
   }
 }
 
+// A free direct motion is taken without sampling; one through a wall is not, and the sampled
+// path still goes through the door. Off, the planner samples even the free one.
+TEST_F(FullTest, AFreeDirectMotionIsTakenBeforeSampling) {
+  const world::World w = testing::corridorWorld(false);
+  MotionPlanner mp = planner(w);
+  const MotionResult near = mp.plan(request({2, 3, 0.0}, {3.5, 2.5, 0.5}), Termination::after(5.0));
+  ASSERT_EQ(near.status, MotionStatus::kSolved) << near.reason;
+  EXPECT_TRUE(near.stats.direct);
+  EXPECT_GE(discClearance(w, near.path, kRadius, 0.002), 0.0);
+  EXPECT_NEAR(near.path.waypoints.back()[0], 3.5, 1e-9);
+  EXPECT_NEAR(near.path.waypoints.back()[1], 2.5, 1e-9);
+
+  // The straight line crosses the wall above the door.
+  const MotionResult door = mp.plan(request({2, 3.5, 0.0}, {8, 3.0, 0.0}), Termination::after(5.0));
+  ASSERT_EQ(door.status, MotionStatus::kSolved) << door.reason;
+  EXPECT_FALSE(door.stats.direct);
+  EXPECT_GE(discClearance(w, door.path, kRadius, 0.002), 0.0);
+
+  MotionPlannerParams off;
+  off.sampling.direct_first = false;
+  MotionPlanner sampling = planner(w, off);
+  const MotionResult sampled = sampling.plan(request({2, 3, 0.0}, {3.5, 2.5, 0.5}), Termination::after(5.0));
+  ASSERT_EQ(sampled.status, MotionStatus::kSolved) << sampled.reason;
+  EXPECT_FALSE(sampled.stats.direct);
+}
+
 TEST_F(FullTest, BlockedDoorIsAProvenNoPath) {
   const world::World w = testing::corridorWorld(true);
   MotionPlanner mp = planner(w);

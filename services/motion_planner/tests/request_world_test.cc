@@ -184,6 +184,51 @@ TEST_F(RequestWorldTest, HeldObjectIsAttachedAtTheGivenGrasp) {
   EXPECT_NE(mp.plan(bad).reason.find("held_grasp"), std::string::npos);
 }
 
+TEST_F(RequestWorldTest, HeldPaddingGrowsTheHeldObjectForThatRequestOnly) {
+  world::World w = testing::corridorWorld(false);
+  ASSERT_TRUE(w.addObject(testing::box("parcel", 9.5, 0.5, 0.3, 0.3, true, 0.3, 2.0)).ok());
+  MotionPlannerParams p = testing::untimedParams();
+  p.sampling.base_turn_in_place = false;
+  MotionPlanner mp = testing::discPlanner(w, p);
+  // The parcel held 0.5 m to the robot's right: at y = 0.7 its south face is 5 cm off the wall.
+  const Eigen::Vector2d offset(0.0, -0.5);
+  MotionRequest req = baseRequest({2, 0.7, 0}, {8, 2, 0});
+  req.held_object = "parcel";
+  req.held_grasp = HeldGrasp{"", at(offset.x(), offset.y(), 0.0)};
+  req.mode = MotionMode::kFull;
+  const MotionResult plain = mp.plan(req, Termination::after(10.0));
+  ASSERT_EQ(plain.status, MotionStatus::kSolved) << plain.reason;
+
+  // Grown by 8 cm it touches the wall already at the start.
+  MotionRequest padded = req;
+  padded.held_padding_m = 0.08;
+  const MotionResult hit = mp.plan(padded, Termination::after(5.0));
+  EXPECT_EQ(hit.status, MotionStatus::kStartInCollision) << hit.reason;
+  EXPECT_EQ(hit.colliding_object, "wall_south");
+
+  // Grown by 4 cm: solved, and the parcel's inscribed disc keeps the margin off every wall
+  // (an independent check on the path), where the plain request need not.
+  padded.held_padding_m = 0.04;
+  const MotionResult wide = mp.plan(padded, Termination::after(10.0));
+  ASSERT_EQ(wide.status, MotionStatus::kSolved) << wide.reason;
+  EXPECT_GT(discClearance(w, heldCentres(wide.path, offset), 0.15 + 0.04, 0.005, {"parcel"}, false), -1e-3);
+
+  // The margin was for that request only: the plain request is solved again from the same start.
+  EXPECT_EQ(mp.plan(req, Termination::after(10.0)).status, MotionStatus::kSolved);
+
+  // Misuse names the field.
+  for (double bad : {-0.01, 0.3, std::numeric_limits<double>::quiet_NaN()}) {
+    MotionRequest r = padded;
+    r.held_padding_m = bad;
+    const MotionResult out = mp.plan(r);
+    EXPECT_EQ(out.status, MotionStatus::kInvalidRequest) << bad;
+    EXPECT_NE(out.reason.find("held_padding_m"), std::string::npos) << out.reason;
+  }
+  MotionRequest none = baseRequest({2, 2, 0}, {8, 2, 0});
+  none.held_padding_m = 0.05;
+  EXPECT_NE(mp.plan(none).reason.find("held_padding_m: given without a held object"), std::string::npos);
+}
+
 TEST(ObjectEffortTest, FittedModelsPriceObjects) {
   const CostParams cost;
   const world::Object crate = testing::box("crate", 0, 0, 0.4, 0.4, true, 0.5, 8.0);

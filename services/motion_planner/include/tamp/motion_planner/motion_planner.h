@@ -148,6 +148,12 @@ struct MotionRequest {
   /// With `held_object`: the grasp to attach it with, overriding the world's held record and
   /// the object's pose (which then does not matter: the object moves with `link`).
   std::optional<HeldGrasp> held_grasp;
+  /// With `held_object`: its footprint grown by this much (m) on every side for this request
+  /// (not its height: it still rests on its support when put down; a sphere grows whole).
+  /// Where the object sits in the hand is known only as well as the grasp went (perception's
+  /// estimate of it, where the base and arm really stopped): a caller that saw the held object
+  /// touch what the plan cleared asks for margin here. Finite, in [0, 0.25]; 0 = as modelled.
+  double held_padding_m{0.0};
   std::vector<std::string> ignored_objects;  ///< treated as absent (e.g. the object to pick)
   /// The request is planned in the planner's world with these objects moved or removed (e.g.
   /// after a sampled placement of a blocking object); the world is restored afterwards. Each id
@@ -182,6 +188,7 @@ struct PlanningStats {
   double shortcut_ms{0.0};
   double analysis_ms{0.0};      ///< blocking report
   double proof_ms{0.0};         ///< full mode: infeasibility grid
+  double goal_ms{0.0};          ///< goal states: IK for an end-effector goal, validity of the goal
   std::uint64_t validity_checks{0};
   std::size_t roadmap_nodes{0};
   std::size_t roadmap_edges{0};
@@ -196,6 +203,7 @@ struct PlanningStats {
   bool optimize_completed{false};  ///< the roadmap search finished before its budget
   bool roadmap_reused{false};   ///< lazy: the cached roadmap of this static world was reused
   bool lazy_planner_used{false};  ///< lazy: lazy KPIECE ran (roadmap_first off, or the roadmap could not connect)
+  bool direct{false};           ///< full mode: the direct motion to a goal state was free (no sampling)
 };
 
 struct MotionResult {

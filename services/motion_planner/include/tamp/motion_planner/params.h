@@ -57,6 +57,10 @@ struct SamplingParams {
   /// the same). 0: such a start is kStartInCollision. >= 0.
   double start_escape_distance{0.15};
   int start_escape_attempts{400};  ///< >= 1
+  /// Full mode: the direct motion from the start to a goal state (a straight line in joint
+  /// space; for a stop-and-turn base, turn, drive, turn) is checked first and taken when it is
+  /// free, before any sampling. Arm motions between nearby configurations usually are.
+  bool direct_first{true};
 };
 
 /// Lazy mode: making the lazy path worth executing (see motion_planner.h). The roadmap of the

@@ -127,6 +127,7 @@ MotionAnswer DdsServiceClients::motion(const MotionQuery& q) {
     req.held_grasp_given(true);
     req.held_link(q.held.link);
     req.held_link_T_object(dds::toMsg(q.held.link_T_object));
+    req.held_padding_m(q.held_padding_m);
   }
   req.ignored_objects(q.ignored);
   for (const auto& o : q.overrides) req.object_overrides().push_back(toMsg(o));

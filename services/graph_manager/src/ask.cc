@@ -5,7 +5,14 @@
 
 namespace tamp::graph_manager {
 
-MotionAnswer GraphManager::askMotion(const MotionQuery& q) {
+MotionQuery GraphManager::withHeldMargin(MotionQuery q) const {
+  const bool in_hand = !q.held.object_id.empty() && q.held.link != abstraction_.robot().options().base_link;
+  q.held_padding_m = in_hand ? held_padding_m_ : 0.0;
+  return q;
+}
+
+MotionAnswer GraphManager::askMotion(const MotionQuery& query) {
+  const MotionQuery q = withHeldMargin(query);
   if (const MotionAnswer* kept = params_.memoise_answers ? memo_.motion(q) : nullptr) {
     ++counters_.memo_hits;
     return *kept;
@@ -16,7 +23,9 @@ MotionAnswer GraphManager::askMotion(const MotionQuery& q) {
   return a;
 }
 
-std::vector<MotionAnswer> GraphManager::askMotions(const std::vector<MotionQuery>& qs) {
+std::vector<MotionAnswer> GraphManager::askMotions(const std::vector<MotionQuery>& queries) {
+  std::vector<MotionQuery> qs;
+  for (const auto& q : queries) qs.push_back(withHeldMargin(q));
   std::vector<MotionAnswer> out(qs.size());
   std::vector<MotionQuery> ask;
   std::vector<std::size_t> where;

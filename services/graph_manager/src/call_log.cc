@@ -20,6 +20,11 @@ std::string motionWhat(const MotionQuery& q) {
     w += buf;
   }
   if (!q.held.object_id.empty()) w += " holding " + q.held.object_id;
+  if (q.held_padding_m > 0) {
+    char buf[48];
+    std::snprintf(buf, sizeof buf, " (+%.2f m)", q.held_padding_m);
+    w += buf;
+  }
   return w;
 }
 

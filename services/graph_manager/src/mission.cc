@@ -630,6 +630,18 @@ bool GraphManager::Run::replan(const MissionEvent& ev, EdgeId failed, std::strin
   // Still holding what the branch picked: the grasp is the one it executed. The world model
   // cannot tell (perception filters the held object, whose modelled pose is where it was seen).
   if (!ctx.held.object_id.empty() && ctx.held.object_id == held_before.object_id) ctx.held = held_before;
+  // Stopped before an object the plan knew where it is (a wall, or a movable where the graph
+  // expects it) while holding one: the plan cleared it with the held object where the graph
+  // believes it sits in the hand, and the robot did not. Held objects are planned with a
+  // margin from now on.
+  if (ev.kind == EventKind::kActionBlocked && !held_before.object_id.empty()) {
+    const world::Object* blocker = live.findObject(ev.object_id);
+    auto named = [&](const world::Object& o) { return o.id == ev.object_id; };
+    const bool known = blocker && std::find(fresh.begin(), fresh.end(), ev.object_id) == fresh.end() &&
+                       std::none_of(changed.begin(), changed.end(), named);
+    if (known) gm.widenHeldMargin(held_before.object_id, ev.object_id);
+  }
+  rec.held_padding_m = gm.held_padding_m_;
   gm.invalidateNear(changed);
   if (failed >= 0) {
     // Planned again in the world as it is now, unless it failed too often (then infeasible).

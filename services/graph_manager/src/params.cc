@@ -48,6 +48,9 @@ const config::Schema<GraphManagerParams>& schema() {
         .field("push_backoff_m", &P::push_backoff_m, config::nonNegative("m"))
         .field("pushes_per_object", &P::pushes_per_object, atLeast(0))
         .field("keep_clear_margin_m", &P::keep_clear_margin_m, config::nonNegative("m"))
+        .field("held_padding_step_m", &P::held_padding_step_m, config::nonNegative("m"))
+        .field("held_padding_max_m", &P::held_padding_max_m,
+               config::inRange(0.0, 0.25, config::Ends::kClosed, "m"))
         .field("lower_bound_base_speed", &P::lower_bound_base_speed, positive())
         .field("approach_m", &P::approach_m, positive())
         .field("plan_budget_s", &P::plan_budget_s, positive())

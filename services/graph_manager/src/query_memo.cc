@@ -47,6 +47,10 @@ std::string QueryMemo::key(const MotionQuery& q) {
   for (double v : q.goal_arm) put(k, v);
   k += "|held " + q.held.object_id + " " + q.held.link + " ";
   if (!q.held.object_id.empty()) put(k, q.held.link_T_object);
+  if (q.held_padding_m > 0) {
+    k += "|pad";
+    put(k, q.held_padding_m);
+  }
   for (const auto& id : q.ignored) k += "|ignore " + id;
   put(k, q.overrides);
   k += "|w";

@@ -127,13 +127,47 @@ int GraphManager::invalidateNear(const std::vector<world::Object>& objects) {
   return n;
 }
 
-double GraphManager::heldMassAt(NodeId n) const {
+bool GraphManager::widenHeldMargin(const std::string& held, const std::string& blocker) {
+  const double was = held_padding_m_;
+  held_padding_m_ = std::min(params_.held_padding_max_m, held_padding_m_ + params_.held_padding_step_m);
+  if (held_padding_m_ <= was) {
+    log::get("graph_manager")->warn("stopped before '{}' holding '{}': the held object's margin is already {:.2f} m",
+                                    blocker, held, was);
+    return false;
+  }
+  int n = 0;
+  for (const Edge& ce : graph_.edges()) {
+    Edge& e = graph_.edge(ce.id);
+    if (e.state == EdgeState::kExecuted || e.state == EdgeState::kExecuting) continue;
+    if (e.kind != ActionKind::kMoveBase && e.kind != ActionKind::kMoveArm) continue;
+    if (heldAt(e.from).empty() || isPush(e)) continue;
+    e.motion.reset();
+    e.motion_by_next.clear();
+    e.effort_by_next.clear();
+    e.state = EdgeState::kUnevaluated;
+    e.effort_mean_s = kInfinity;
+    e.reason.clear();
+    ++n;
+  }
+  log::get("graph_manager")->info("stopped before '{}' holding '{}': held objects planned {:.2f} m larger from now on "
+                                  "({} motions to plan again)",
+                                  blocker, held, held_padding_m_, n);
+  return true;
+}
+
+std::string GraphManager::heldAt(NodeId n) const {
   for (const auto& a : graph_.node(n).atoms) {
     const auto t = atomTokens(a);
-    if (t.size() == 2 && t[0] == "holding")
-      if (const world::Object* o = abstraction_.world().findObject(t[1])) return o->mass;
+    if (t.size() == 2 && t[0] == "holding") return t[1];
   }
-  return 0.0;
+  return {};
+}
+
+double GraphManager::heldMassAt(NodeId n) const {
+  const std::string held = heldAt(n);
+  if (held.empty()) return 0.0;
+  const world::Object* o = abstraction_.world().findObject(held);
+  return o ? o->mass : 0.0;
 }
 
 void GraphManager::reprice() {

@@ -120,6 +120,7 @@ std::string reportJson(const MissionReport& r, const std::string& scenario, cons
                           {"at_node", rp.at_node},
                           {"how", rp.how},
                           {"rejoined", rp.rejoined},
+                          {"held_padding_m", rp.held_padding_m},
                           {"planner_calls", rp.planner_calls},
                           {"motion_calls", rp.motion_calls},
                           {"planning_s", rp.planning_s},

@@ -58,8 +58,10 @@ class ScriptedServices : public ServiceClients {
     }
     return p;
   }
+  std::vector<double> held_paddings;  ///< of every motion query holding an object
   MotionAnswer motion(const MotionQuery& q) override {
     ++motion_calls;
+    if (!q.held.object_id.empty()) held_paddings.push_back(q.held_padding_m);
     MotionAnswer a;
     a.status = MotionOutcome::kSolved;
     if (q.group == Group::kArm) {
@@ -124,7 +126,8 @@ class FirstEdgeTest : public ::testing::Test {
     BranchContext ctx;
   };
 
-  Setup make(ScriptedServices& services, bool concurrent = false, bool memoise = false) {
+  Setup make(ScriptedServices& services, bool concurrent = false, bool memoise = false,
+             const std::string& holding = "") {
     auto sc = world::loadScenario(configDir() / "scenarios" / "namo_corridor.yaml");
     EXPECT_TRUE(sc.ok()) << (sc ? "" : sc.error().toString());
     auto robot = robot::RobotModel::loadDescription(sc->robot.description);
@@ -145,6 +148,7 @@ class FirstEdgeTest : public ::testing::Test {
     obs.valid = true;
     obs.robot.base = sc->robot.start;
     obs.robot.arm = *robot->namedConfiguration("stow");
+    obs.held_object_id = holding;
     services.plans = {{"(move_base start a)", "(move_base a goal)"},
                       {"(move_base start b)", "(move_base b goal)"},
                       {"(move_base a c)", "(move_base c goal)"}};
@@ -329,6 +333,39 @@ TEST_F(FirstEdgeTest, TheSameMotionQuestionInTheSameWorldIsAskedOnce) {
   EXPECT_EQ(services.motion_calls, calls_without_twin) << "the twin plan's two motions come from the memo";
   EXPECT_EQ(s.gm->counters().memo_hits, 2);
   EXPECT_EQ(s.gm->counters().motion_calls, services.motion_calls);
+}
+
+// Stopped before a wall while holding an object: the graph manager plans held objects with a
+// margin from then on (a step per such stop, up to a maximum), and plans again the motions it
+// had planned with the object in the hand.
+TEST_F(FirstEdgeTest, AStopBeforeAWallWhileHoldingGrowsTheHeldObjectInLaterMotions) {
+  ScriptedServices services;
+  Setup s = make(services, false, false, "box");
+  ASSERT_EQ(s.ctx.held.object_id, "box");
+  const TraverseResult before = s.gm->traverse(s.gm->root(), s.ctx);
+  ASSERT_TRUE(before.found) << before.reason;
+  ASSERT_FALSE(services.held_paddings.empty());
+  for (double p : services.held_paddings) EXPECT_EQ(p, 0.0);
+  const int calls_before = services.motion_calls;
+
+  const GraphManagerParams defaults;
+  ASSERT_TRUE(s.gm->widenHeldMargin("box", "block_mid"));
+  for (EdgeId e : before.branch) EXPECT_FALSE(s.gm->graph().edge(e).motion.has_value());
+  services.held_paddings.clear();
+  const TraverseResult after = s.gm->traverse(s.gm->root(), s.ctx);
+  ASSERT_TRUE(after.found) << after.reason;
+  EXPECT_GT(services.motion_calls, calls_before) << "the motions holding the box are planned again";
+  ASSERT_FALSE(services.held_paddings.empty());
+  for (double p : services.held_paddings) EXPECT_DOUBLE_EQ(p, defaults.held_padding_step_m);
+
+  // Up to the maximum, then no more.
+  int steps = 1;
+  while (s.gm->widenHeldMargin("box", "block_mid")) ++steps;
+  EXPECT_EQ(steps, static_cast<int>(std::round(defaults.held_padding_max_m / defaults.held_padding_step_m)));
+  services.held_paddings.clear();
+  ASSERT_TRUE(s.gm->traverse(s.gm->root(), s.ctx).found);
+  ASSERT_FALSE(services.held_paddings.empty());
+  for (double p : services.held_paddings) EXPECT_NEAR(p, defaults.held_padding_max_m, 1e-12);
 }
 
 }  // namespace

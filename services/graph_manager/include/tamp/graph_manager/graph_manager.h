@@ -167,6 +167,7 @@ struct ReplanRecord {
   /// "from scratch" (TP(current, goal): no node ahead could be re-joined).
   std::string how;
   std::vector<std::string> rejoined;  ///< the nodes ahead that a sub-task reached
+  double held_padding_m{0.0};         ///< the held object's planning margin from this event on
   int planner_calls{0};
   int motion_calls{0};
   double planning_s{0.0};
@@ -342,6 +343,12 @@ class GraphManager {
   /// Forgets the motions of unexecuted edges that pass near `objects` (their footprints grown
   /// by the robot's radius): they are planned again in the world as it is now. Returns how many.
   int invalidateNear(const std::vector<world::Object>& objects);
+  /// Raises the held object's planning margin by a step (up to its maximum) after the robot was
+  /// stopped before `blocker` (known where it is) while holding `held`, and forgets the motions planned
+  /// with an object in the hand. False when the margin was already at its maximum.
+  bool widenHeldMargin(const std::string& held, const std::string& blocker);
+  /// The object held in node `n`'s state, or "".
+  std::string heldAt(NodeId n) const;
   /// Prices every evaluated, unexecuted motion again (the effort models may have been refitted).
   void reprice();
   /// The key of an arm edge's motion: the manipulation `next` it prepares, or -1 (stow, none).
@@ -489,6 +496,8 @@ class GraphManager {
   void clearWorldCaches();
   /// The motion and grasp services, through `memo_` (ask.cc): counted in `counters_` when asked.
   MotionAnswer askMotion(const MotionQuery& q);
+  /// `q` with the mission's margin around a held object (not one pushed by the base).
+  MotionQuery withHeldMargin(MotionQuery q) const;
   /// Independent motion queries at once (ServiceClients::motions), those not in the memo.
   std::vector<MotionAnswer> askMotions(const std::vector<MotionQuery>& qs);
   Result<std::vector<GraspOption>> askGrasps(const GraspQuery& q);
@@ -510,6 +519,9 @@ class GraphManager {
   std::vector<Decision> decisions_;
   int traverse_count_{0};
   double planning_s_{0.0};
+  /// The margin a held object is planned with (params_.held_padding_step_m per static contact
+  /// the robot was stopped before while holding; see Run::replan).
+  double held_padding_m_{0.0};
   QueryMemo memo_;
   std::map<std::string, std::vector<GraspOption>> grasp_cache_;
   /// Placements of a held object from a base pose in a world (sampledPlace): asked for a few

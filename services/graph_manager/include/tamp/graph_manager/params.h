@@ -51,6 +51,12 @@ struct GraphManagerParams {
   double push_backoff_m{0.15};
   int pushes_per_object{2};        ///< >= 0 (0: never push)
   double keep_clear_margin_m{0.10};  ///< placements keep this much more than the robot's radius off the path
+  /// A held object is planned grown by a margin that starts at 0 and rises by this step each
+  /// time the robot is stopped before touching an object whose place it knew while holding (where it sits
+  /// in the hand is known only as well as the grasp went), up to held_padding_max_m. >= 0
+  /// (0: never grown); the maximum is at most 0.25 m.
+  double held_padding_step_m{0.03};
+  double held_padding_max_m{0.09};
   double lower_bound_base_speed{1.5};  ///< m/s, above the robot's top speed (admissible bound); > 0
   double approach_m{0.10};         ///< pick/place: gripper approach and retreat along z (m); > 0
   double plan_budget_s{5.0};       ///< per task-planner call; > 0

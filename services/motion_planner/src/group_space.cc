@@ -424,20 +424,26 @@ Oracle::Oracle(collision::Scene& scene, const GroupSpace& gs, std::vector<std::s
   reach_radius_ = reach_radius;
 }
 
-bool Oracle::selfFree() { return scene_.selfCollisions().empty(); }
+std::vector<std::pair<std::string, std::string>> Oracle::selfContacts(const ob::State* s) {
+  if (!self_scene_) return scene_.selfCollisions();
+  gs_.placeRobot(s, *self_scene_);
+  return self_scene_->selfCollisions();
+}
+
+bool Oracle::selfFree(const ob::State* s) { return selfContacts(s).empty(); }
 
 bool Oracle::staticFree(const ob::State* s) {
   ++checks_;
   gs_.placeRobot(s, scene_);
   if (scene_.robotInCollision(static_filter_)) return false;
-  return !self_check_ || selfFree();
+  return !self_check_ || selfFree(s);
 }
 
 bool Oracle::allFree(const ob::State* s) {
   ++checks_;
   gs_.placeRobot(s, scene_);
   if (scene_.robotInCollision(all_filter_)) return false;
-  return !self_check_ || selfFree();
+  return !self_check_ || selfFree(s);
 }
 
 bool Oracle::mayTouch(const ob::State* s, int index) const {
@@ -480,7 +486,7 @@ std::string Oracle::collidingObject(const ob::State* s, bool include_movables) {
   const auto ids = scene_.robotCollisions(include_movables ? all_filter_ : static_filter_);
   if (!ids.empty()) return ids.front();
   if (self_check_ || !scene_.attachedObjects().empty()) {
-    const auto self = scene_.selfCollisions();
+    const auto self = selfContacts(s);
     if (!self.empty()) return "self:" + self.front().first + "/" + self.front().second;
   }
   return {};

@@ -147,10 +147,15 @@ class Oracle {
   std::uint64_t checks() const { return checks_; }
   const GroupSpace& group() const { return gs_; }
   collision::Scene& scene() { return scene_; }
+  /// Contacts of the robot with itself are checked in `self` (placed at each state) instead of
+  /// the scene: there the held object is as modelled, in the scene it has a margin. Null: the scene.
+  void setSelfScene(collision::Scene* self) { self_scene_ = self; }
 
  private:
-  bool selfFree();
+  bool selfFree(const ob::State* s);
+  std::vector<std::pair<std::string, std::string>> selfContacts(const ob::State* s);
   collision::Scene& scene_;
+  collision::Scene* self_scene_{nullptr};
   const GroupSpace& gs_;
   collision::Filter static_filter_, all_filter_, movable_filter_;
   std::vector<MovableInfo> movables_;

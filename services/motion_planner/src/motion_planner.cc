@@ -678,10 +678,12 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
     restore = WorldRestore(impl, std::move(*hypothetical));
   }
   // The held object with its margin (the world restored afterwards, as for overrides).
+  std::optional<world::Shape> held_shape;  // its modelled shape, when grown
   if (req.held_padding_m > 0) {
     world::World padded = impl.world;
     const std::string id = !req.held_object.empty() ? req.held_object : impl.world.held()->object_id;
     world::Object o = padded.object(id);
+    held_shape = o.shape;
     o.shape = grownShape(o.shape, req.held_padding_m);
     if (Status s = padded.updateObject(o); !s) {
       return finish(MotionStatus::kInvalidRequest, "held_padding_m: " + s.error().message);
@@ -758,9 +760,31 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
     gs.setValues(v, start.get());
   }
   auto collides = [&](const ob::State* s) { return lazy ? !oracle.staticFree(s) : !oracle.allFree(s); };
-  auto selfHit = [&]() -> std::string {
+  // The request's scene with the held object as modelled (no margin), built when first needed:
+  // its contacts with the robot itself, and a start that touches something only with the margin.
+  std::unique_ptr<collision::Scene> plain;
+  auto plainScene = [&]() -> collision::Scene& {
+    if (!plain) {
+      world::World w = impl.world;
+      world::Object o = w.object(held);
+      o.shape = *held_shape;
+      (void)w.updateObject(o);
+      plain = std::make_unique<collision::Scene>(w);
+      plain->setRobot(impl.robot.geometry());
+      (void)plain->attach(held, held_link, link_T_held);
+    }
+    return *plain;
+  };
+  if (held_shape) oracle.setSelfScene(&plainScene());
+  // Contacts of the robot with itself at `s` (placed in the scene by the caller).
+  auto selfHit = [&](const ob::State* s) -> std::string {
     if (impl.scene.attachedObjects().empty() && !gs.movesArm()) return {};
-    const auto self = impl.scene.selfCollisions();
+    collision::Scene* sc = &impl.scene;
+    if (held_shape) {
+      sc = &plainScene();
+      gs.placeRobot(s, *sc);
+    }
+    const auto self = sc->selfCollisions();
     return self.empty() ? std::string() : "self:" + self.front().first + "/" + self.front().second;
   };
   // A full-mode start that touches movables only leaves them by a short straight motion first.
@@ -781,6 +805,7 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
         }
       }
       detail::Oracle escape_oracle(impl.scene, gs, ignore, std::move(others), reach);
+      if (held_shape) escape_oracle.setSelfScene(&plainScene());
       escaped.reset(space->allocState());
       if (detail::escapeStart(si, makeSi(escape_oracle, true), start.get(), P.sampling.start_escape_distance,
                               P.sampling.start_escape_attempts, escaped.get())) {
@@ -789,6 +814,19 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
         escaped.reset();
       }
     }
+    // Touching only with the held object's margin: leave by a short straight motion checked
+    // without it (the robot was stopped before the contact it is now given room for).
+    if (!escaped && held_shape && P.sampling.start_escape_distance > 0.0) {
+      detail::Oracle plain_oracle(plainScene(), gs, ignored, oracle.movables(), reach);
+      if (lazy ? plain_oracle.staticFree(start.get()) : plain_oracle.allFree(start.get())) {
+        escaped.reset(space->allocState());
+        if (!detail::escapeStart(si, makeSi(plain_oracle, !lazy), start.get(), P.sampling.start_escape_distance,
+                                 P.sampling.start_escape_attempts, escaped.get())) {
+          escaped.reset();
+        }
+      }
+      gs.placeRobot(start.get(), impl.scene);
+    }
     if (!escaped) {
       return finish(MotionStatus::kStartInCollision, "the start state touches '" + who + "'" +
                                                          (touching.empty() ? "" : " (no way out of the contact found)"),
@@ -796,7 +834,7 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
     }
   }
   gs.placeRobot(start.get(), impl.scene);
-  if (std::string s = selfHit(); !s.empty()) {
+  if (std::string s = selfHit(start.get()); !s.empty()) {
     return finish(MotionStatus::kStartInCollision, "the start state is in self-collision (" + s + ")", s);
   }
 
@@ -820,7 +858,7 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
       return false;
     }
     gs.placeRobot(s, impl.scene);
-    who = gs.movesArm() ? selfHit() : std::string();
+    who = gs.movesArm() ? selfHit(s) : std::string();
     return who.empty();
   };
   if (G.kind == MotionGoal::Kind::kConfiguration || G.kind == MotionGoal::Kind::kBasePose) {
@@ -1076,6 +1114,7 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
     detail::effortShortcut(oracle, ep, P.lazy.shortcut_attempts, res_check, spu, rng, termination);
     res.cost_s = ep.cost(oracle, spu).cost;
     final_path = ep.path;
+    if (escaped) final_path.prepend(start.get());
     if (req.group == PlanningGroup::kBase && P.sampling.base_turn_in_place) detail::alignBaseHeadings(si, final_path);
     res.stats.shortcut_ms = phase.millis();
     phase.reset();

@@ -112,6 +112,29 @@ TEST_F(ArmTest, ANearbyFreeConfigurationIsReachedByTheDirectMotion) {
   for (std::size_t j = 0; j < goal.size(); ++j) EXPECT_NEAR(r.path.waypoints.back()[j], goal[j], 1e-9);
 }
 
+// The margin of a held object keeps it off the world, not off the robot that holds it: a small
+// block in the hand, grown by 12 cm into the wrist and fingers, still moves (its contacts with
+// the robot are checked as modelled). Grown into the table, the start is left first.
+TEST_F(ArmTest, AHeldObjectsMarginIsNotAContactWithTheRobotHoldingIt) {
+  world::Object block = testing::box("block", -2.5, -2.5, 0.04, 0.04, true, 0.04, 0.2);
+  ASSERT_TRUE(world_.addObject(block).ok());
+  MotionPlanner mp = planner();
+  MotionRequest req;
+  req.group = PlanningGroup::kArm;
+  req.mode = MotionMode::kFull;
+  req.start = model_->defaultState(Pose2D{0, 0, 0});
+  std::vector<double> goal = req.start.arm;
+  goal[0] += 0.3;
+  req.goal = MotionGoal::configurationGoal(goal);
+  req.held_object = "block";
+  req.held_grasp = HeldGrasp{"", Eigen::Isometry3d::Identity()};  // at the tool's origin
+  const MotionResult plain = mp.plan(req, Termination::after(10.0));
+  ASSERT_EQ(plain.status, MotionStatus::kSolved) << plain.reason;
+  req.held_padding_m = 0.12;
+  const MotionResult padded = mp.plan(req, Termination::after(10.0));
+  ASSERT_EQ(padded.status, MotionStatus::kSolved) << padded.reason;
+}
+
 TEST_F(ArmTest, EndEffectorGoalThroughIkIsReachedWithinTolerance) {
   MotionPlanner mp = planner();
   // A reachable pose in front of the robot, the tool pointing down.

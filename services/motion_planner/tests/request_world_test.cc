@@ -199,10 +199,23 @@ TEST_F(RequestWorldTest, HeldPaddingGrowsTheHeldObjectForThatRequestOnly) {
   const MotionResult plain = mp.plan(req, Termination::after(10.0));
   ASSERT_EQ(plain.status, MotionStatus::kSolved) << plain.reason;
 
-  // Grown by 8 cm it touches the wall already at the start.
+  // Grown by 8 cm it touches the wall already at the start: the path leaves the wall first by a
+  // short straight motion (checked without the margin), then keeps the margin. Without an escape
+  // distance, the start is in collision.
   MotionRequest padded = req;
   padded.held_padding_m = 0.08;
-  const MotionResult hit = mp.plan(padded, Termination::after(5.0));
+  const MotionResult out = mp.plan(padded, Termination::after(10.0));
+  ASSERT_EQ(out.status, MotionStatus::kSolved) << out.reason;
+  ASSERT_GE(out.path.waypoints.size(), 3u);
+  EXPECT_NEAR(out.path.waypoints[0][1], 0.7, 1e-9);
+  EXPECT_GT(out.path.waypoints[1][1], 0.7 + 0.02) << "away from the wall first";
+  JointPath after_escape = out.path;
+  after_escape.waypoints.erase(after_escape.waypoints.begin());
+  EXPECT_GT(discClearance(w, heldCentres(after_escape, offset), 0.15 + 0.08, 0.005, {"parcel"}, false), -1e-3);
+  MotionPlannerParams stuck_params = p;
+  stuck_params.sampling.start_escape_distance = 0.0;
+  MotionPlanner stuck = testing::discPlanner(w, stuck_params);
+  const MotionResult hit = stuck.plan(padded, Termination::after(5.0));
   EXPECT_EQ(hit.status, MotionStatus::kStartInCollision) << hit.reason;
   EXPECT_EQ(hit.colliding_object, "wall_south");
 
@@ -220,9 +233,9 @@ TEST_F(RequestWorldTest, HeldPaddingGrowsTheHeldObjectForThatRequestOnly) {
   for (double bad : {-0.01, 0.3, std::numeric_limits<double>::quiet_NaN()}) {
     MotionRequest r = padded;
     r.held_padding_m = bad;
-    const MotionResult out = mp.plan(r);
-    EXPECT_EQ(out.status, MotionStatus::kInvalidRequest) << bad;
-    EXPECT_NE(out.reason.find("held_padding_m"), std::string::npos) << out.reason;
+    const MotionResult refused = mp.plan(r);
+    EXPECT_EQ(refused.status, MotionStatus::kInvalidRequest) << bad;
+    EXPECT_NE(refused.reason.find("held_padding_m"), std::string::npos) << refused.reason;
   }
   MotionRequest none = baseRequest({2, 2, 0}, {8, 2, 0});
   none.held_padding_m = 0.05;

@@ -111,6 +111,12 @@ MotionPlannerNode::MotionPlannerNode(const dds::ServiceArgs& args, NodeConfig co
     std::lock_guard g(pool_mutex_);
     for (auto& sl : slots_) sl->dirty = true;
   });
+  if (slots_.front()->planner.robotModel()) {
+    robot_reader_ = std::make_unique<dds::Reader<msg::RobotState>>(
+        participant(), dds::topics::kRobotState, [this](const msg::RobotState& m, const dds::SampleMeta& meta) {
+          if (meta.alive && msgv::accept(m, dds::topics::kRobotState.name, rejects_)) onRobotState(m);
+        });
+  }
   effort_reader_ = std::make_unique<dds::Reader<msg::EffortModelSnapshot>>(
       participant(), dds::topics::kEffortModel, [this](const msg::EffortModelSnapshot& m, const dds::SampleMeta& meta) {
         if (!meta.alive || !msgv::accept(m, dds::topics::kEffortModel.name, rejects_)) return;
@@ -238,6 +244,23 @@ uint64_t MotionPlannerNode::syncPlanner(Slot& slot) {
   return version;
 }
 
+void MotionPlannerNode::onRobotState(const msg::RobotState& m) {
+  const robot::RobotModel* model = slots_.front()->planner.robotModel();
+  auto base = dds::fromMsg(m.base(), "base");
+  if (!model || !base) return;
+  auto st = model->fromJointValues(std::vector<std::string>(m.joint_names().begin(), m.joint_names().end()),
+                                   std::vector<double>(m.joint_positions().begin(), m.joint_positions().end()),
+                                   model->defaultState(*base));
+  if (!st) return;
+  st->base = *base;
+  std::lock_guard g(pool_mutex_);
+  const bool first = !robot_now_;
+  robot_now_ = *st;
+  // Prepared before the robot was heard of: for the default state, which may not be its own.
+  if (first)
+    for (auto& sl : slots_) sl->dirty = true;
+}
+
 std::vector<std::optional<PrepareStats>> MotionPlannerNode::prepareIfWorldChanged() {
   std::vector<std::optional<PrepareStats>> out(slots_.size());
   if (!config_.prepare) return out;
@@ -259,6 +282,8 @@ std::vector<std::optional<PrepareStats>> MotionPlannerNode::prepareIfWorldChange
     robot::RobotState state;
     if (slot.last_base_start) {
       state = *slot.last_base_start;
+    } else if (std::lock_guard g(pool_mutex_); robot_now_) {
+      state = *robot_now_;
     } else if (const auto* model = slot.planner.robotModel()) {
       state = model->defaultState();
     }

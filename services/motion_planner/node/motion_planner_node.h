@@ -139,6 +139,11 @@ class MotionPlannerNode : public dds::ServiceNode {
   std::uint64_t effort_model_version_{0};         // the snapshot's version
   std::unique_ptr<dds::WorldMirror> mirror_;
   std::unique_ptr<dds::Reader<msg::EffortModelSnapshot>> effort_reader_;
+  /// The robot's reported state: a preparation before any request is for the robot as it stands
+  /// (arm, gripper), which keys the roadmap the first request will look for.
+  void onRobotState(const msg::RobotState& m);
+  std::optional<robot::RobotState> robot_now_;  // guarded by pool_mutex_
+  std::unique_ptr<dds::Reader<msg::RobotState>> robot_reader_;
   std::unique_ptr<dds::RpcServer<msg::MotionRequest, msg::MotionReply>> motion_;
   std::unique_ptr<dds::RpcServer<msg::PlacementRequest, msg::PlacementReply>> placement_;
   std::unique_ptr<dds::RpcServer<msg::GraspRequest, msg::GraspReply>> grasp_;

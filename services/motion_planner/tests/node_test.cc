@@ -415,6 +415,48 @@ TEST_F(NodeTest, ConcurrentRequestsRunOnSeparatePlanners) {
   EXPECT_EQ(paths[0], paths[1]);  // the same planner, the same (warm) answer
 }
 
+// Before its first request a planner prepares for the robot as it reports itself (arm and
+// gripper key the roadmap): a robot standing with its gripper open, not the default state's
+// closed gripper, gets a roadmap of its own before any request asks for it.
+TEST_F(NodeTest, ThePreparationFollowsTheReportedRobotState) {
+  node_.reset();
+  dds::ServiceArgs args;
+  args.name = "motion_planner_robot_state_test";
+  args.domain_id = domain_;
+  NodeConfig cfg;  // the mobile manipulator
+  cfg.planners = 2;  // planner 0 serves the request below; planner 1 has served none
+  auto node = MotionPlannerNode::create(args, cfg);
+  ASSERT_TRUE(node.ok()) << node.error().toString();
+  node_ = std::move(*node);
+  ASSERT_TRUE(motion_->call(lazyRequest(), dds::CallOptions{30.0, {}}).ok());  // world mirrored
+  bool idle = false;  // prepared for the default state until there is nothing left to do
+  for (int i = 0; i < 100 && !idle; ++i) {
+    const auto preps = node_->prepareIfWorldChanged();
+    idle = std::none_of(preps.begin(), preps.end(), [](const auto& p) { return p.has_value(); });
+  }
+  ASSERT_TRUE(idle);
+
+  auto model = robot::RobotModel::loadDefault();
+  ASSERT_TRUE(model.ok());
+  robot::RobotState st = model->defaultState(Pose2D{2, 2, 0});
+  st.gripper = model->options().gripper_open;
+  msg::RobotState m;
+  m.robot_id(model->name());
+  m.base(dds::toMsg(st.base));
+  m.joint_names(model->fullJointNames());
+  m.joint_positions(model->toJointValues(st));
+  dds::Writer<msg::RobotState> states(client_, dds::topics::kRobotState);
+  ASSERT_TRUE(states.waitForReaders(Termination::after(10.0)));
+  std::optional<PrepareStats> prep;
+  for (int i = 0; i < 500 && !prep; ++i) {
+    ASSERT_TRUE(states.write(m).ok());  // best effort: written until the node has it
+    prep = node_->prepareIfWorldChanged()[1];
+    if (!prep) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ASSERT_TRUE(prep.has_value()) << "no preparation after the robot reported its state";
+  EXPECT_TRUE(prep->built) << "the open gripper keys a roadmap the default state did not build";
+}
+
 TEST(NodeConfigTest, ShippedConfigLoadsAndBadNodeKeysAreNamed) {
   auto c = loadNodeConfig(configDir() / "services" / "motion_planner.yaml");
   ASSERT_TRUE(c.ok()) << c.error().toString();

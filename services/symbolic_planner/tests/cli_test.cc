@@ -1,11 +1,15 @@
 // Process-level tests of `tamp plan` / `tamp-plan`: output format and exit codes.
+#include <elf.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
 #include <array>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <vector>
 
 #include "test_util.h"
 
@@ -83,6 +87,56 @@ TEST_F(Cli, HeapReserveKeepsThePlanAndRefusesBadValues) {
     EXPECT_NE(r.out.find("--heap-reserve"), std::string::npos) << bad << ": " << r.out;
     EXPECT_EQ(r.out.find("(move_base"), std::string::npos) << bad << ": planned anyway: " << r.out;
   }
+}
+
+/// Whether the ELF executable at `path` asks for a dynamic loader (a PT_INTERP program header) and
+/// how many shared libraries it names (DT_NEEDED entries); false, -1 when it is not a 64-bit ELF.
+struct ElfLinkage {
+  bool interp{false};
+  int needed{-1};
+};
+ElfLinkage elfLinkage(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  const std::vector<char> b((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ElfLinkage r;
+  Elf64_Ehdr eh;
+  if (b.size() < sizeof(eh)) return r;
+  std::memcpy(&eh, b.data(), sizeof(eh));
+  if (std::memcmp(eh.e_ident, ELFMAG, SELFMAG) != 0 || eh.e_ident[EI_CLASS] != ELFCLASS64) return r;
+  r.needed = 0;
+  for (size_t i = 0; i < eh.e_phnum; ++i) {
+    Elf64_Phdr ph;
+    const size_t at = eh.e_phoff + i * eh.e_phentsize;
+    if (at + sizeof(ph) > b.size()) break;
+    std::memcpy(&ph, b.data() + at, sizeof(ph));
+    if (ph.p_type == PT_INTERP) r.interp = true;
+    if (ph.p_type != PT_DYNAMIC) continue;
+    for (size_t d = ph.p_offset; d + sizeof(Elf64_Dyn) <= b.size() && d < ph.p_offset + ph.p_filesz;
+         d += sizeof(Elf64_Dyn)) {
+      Elf64_Dyn dyn;
+      std::memcpy(&dyn, b.data() + d, sizeof(dyn));
+      if (dyn.d_tag == DT_NULL) break;
+      if (dyn.d_tag == DT_NEEDED) ++r.needed;
+    }
+  }
+  return r;
+}
+
+// Issue 14, thirteenth round: tamp-plan is linked statically (static-pie), which takes 1.5-3 ms
+// off a run on a small task; only a build that says it could not (TAMP_PLAN_STATIC_EXPECTED=0:
+// sanitizers, no libc.a, TAMP_PLAN_STATIC=OFF) expects a dynamic one.
+TEST_F(Cli, LinkedStaticallyWhereTheBuildCan) {
+  const ElfLinkage l = elfLinkage(std::string(TAMP_BIN_DIR) + "/tamp-plan");
+  ASSERT_GE(l.needed, 0) << "tamp-plan is not a 64-bit ELF executable";
+#if !defined(TAMP_PLAN_STATIC_EXPECTED) || TAMP_PLAN_STATIC_EXPECTED
+  EXPECT_FALSE(l.interp) << "tamp-plan asks for a dynamic loader";
+  EXPECT_EQ(l.needed, 0) << "tamp-plan names shared libraries";
+#else
+  EXPECT_TRUE(l.interp);
+#endif
+  // Static or not, it plans.
+  CliRun r = runCli(dom_ + " " + prob_);
+  EXPECT_EQ(r.code, 0) << r.out;
 }
 
 TEST_F(Cli, ExitCodes) {

@@ -1001,7 +1001,7 @@ struct Grounder::Impl {
     std::vector<int64_t> bind;
     std::vector<Conj> pre_dnf, cond_dnf;
     std::unordered_set<std::string> seen_ops;
-    size_t op_name_size = 0;  // the longest name so far: one allocation per name
+    size_t op_name_size = 0;               // the longest name so far: one allocation per name
     std::vector<FactId> add_buf, del_buf;  // an operator's unconditional effects, reused
     for (uint32_t b = 0; b < bindings.size(); ++b) {
       if ((b & 255) == 0 && term()) {
@@ -1108,7 +1108,9 @@ struct Grounder::Impl {
       // Add wins over delete (both sorted: drop from del what add has).
       if (!add_buf.empty() && !del_buf.empty()) {
         del_buf.erase(std::remove_if(del_buf.begin(), del_buf.end(),
-                                     [&](FactId f) { return std::binary_search(add_buf.begin(), add_buf.end(), f); }),
+                                     [&](FactId f) {
+                                       return std::binary_search(add_buf.begin(), add_buf.end(), f);
+                                     }),
                       del_buf.end());
       }
       proto.add.assign(add_buf.begin(), add_buf.end());

@@ -176,9 +176,12 @@ TEST_F(Cli, HeapReserveStartsAtAHugePage) {
 #endif
   std::ifstream thp("/sys/kernel/mm/transparent_hugepage/enabled");
   std::string mode((std::istreambuf_iterator<char>(thp)), std::istreambuf_iterator<char>());
-  if (mode.find("[never]") != std::string::npos || mode.empty()) GTEST_SKIP() << "no transparent huge pages";
+  if (mode.find("[never]") != std::string::npos || mode.empty()) {
+    GTEST_SKIP() << "no transparent huge pages";
+  }
   const auto dir = test::benchmarksDir() / "pddl-more/trucks";
-  const std::vector<std::string> args{(dir / "domain.pddl").string(), (dir / "instance-6.pddl").string()};
+  const std::vector<std::string> args{(dir / "domain.pddl").string(),
+                                      (dir / "instance-6.pddl").string()};
   long most = 0;
   for (int run = 0; run < 5; ++run) {
     const auto [code, faults] = runCounted(args);

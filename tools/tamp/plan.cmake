@@ -4,7 +4,7 @@
 tamp_add_executable(tamp-plan SOURCES plan_main.cc DEPS tamp::symbolic_planner tamp::cli11)
 target_include_directories(tamp-plan PRIVATE ${CMAKE_CURRENT_SOURCE_DIR})
 # Linked statically, as a position-independent executable (issue 14, thirteenth round): a run on a
-# small task (10-15 ms) is 1.5-3 ms faster without the dynamic loader and the shared libc and libm
+# small task (10-15 ms) is 0.7-2.3 ms faster without the dynamic loader and the shared libc and libm
 # (docs/benchmarks.md). The planner links no third-party library (tamp::core_base), so only the C
 # and C++ runtimes' archives are needed; where they are missing (no libc.a), or under the
 # sanitizers (their runtimes are shared objects), the executable stays dynamic.

@@ -126,7 +126,7 @@ ElfLinkage elfLinkage(const std::string& path) {
   return r;
 }
 
-// Issue 14, thirteenth round: tamp-plan is linked statically (static-pie), which takes 1.5-3 ms
+// Issue 14, thirteenth round: tamp-plan is linked statically (static-pie), which takes 1-2 ms
 // off a run on a small task; only a build that says it could not (TAMP_PLAN_STATIC_EXPECTED=0:
 // sanitizers, no libc.a, TAMP_PLAN_STATIC=OFF) expects a dynamic one.
 TEST_F(Cli, LinkedStaticallyWhereTheBuildCan) {

@@ -1001,6 +1001,8 @@ struct Grounder::Impl {
     std::vector<int64_t> bind;
     std::vector<Conj> pre_dnf, cond_dnf;
     std::unordered_set<std::string> seen_ops;
+    size_t op_name_size = 0;               // the longest name so far: one allocation per name
+    std::vector<FactId> add_buf, del_buf;  // an operator's unconditional effects, reused
     for (uint32_t b = 0; b < bindings.size(); ++b) {
       if ((b & 255) == 0 && term()) {
         return Error(term.reason() == StopReason::kDeadline ? ErrorCode::kTimeout : ErrorCode::kCancelled, "task construction interrupted");
@@ -1062,9 +1064,17 @@ struct Grounder::Impl {
       // Effects.
       Operator proto;
       proto.cost = cost;
-      proto.name = "(" + s.name;
-      for (uint32_t i = 0; i < s.num_params; ++i) proto.name += " " + obj_names[static_cast<size_t>(bind[i])];
-      proto.name += ")";
+      proto.name.reserve(op_name_size);
+      proto.name = '(';
+      proto.name += s.name;
+      for (uint32_t i = 0; i < s.num_params; ++i) {
+        proto.name += ' ';
+        proto.name += obj_names[static_cast<size_t>(bind[i])];
+      }
+      proto.name += ')';
+      op_name_size = std::max(op_name_size, proto.name.size());
+      add_buf.clear();
+      del_buf.clear();
       for (const auto& e : s.effects) {
         Status st = Status::Ok();
         quantify(e.forall, 0, bind, s.var_type, [&]() {
@@ -1075,7 +1085,7 @@ struct Grounder::Impl {
           GFormula c = instantiate(e.cond, bind, ctx, s.var_type);
           if (c.kind == GFormula::kFalse) return;
           if (c.kind == GFormula::kTrue) {
-            (e.del ? proto.del : proto.add).push_back(f);
+            (e.del ? del_buf : add_buf).push_back(f);
             return;
           }
           if (!dnf(c, cond_dnf)) {
@@ -1093,15 +1103,24 @@ struct Grounder::Impl {
         });
         if (!st.ok()) return st.error();
       }
-      sortUnique(proto.add);
-      sortUnique(proto.del);
-      // Add wins over delete.
-      std::vector<FactId> del;
-      std::set_difference(proto.del.begin(), proto.del.end(), proto.add.begin(), proto.add.end(), std::back_inserter(del));
-      proto.del = std::move(del);
+      sortUnique(add_buf);
+      sortUnique(del_buf);
+      // Add wins over delete (both sorted: drop from del what add has).
+      if (!add_buf.empty() && !del_buf.empty()) {
+        del_buf.erase(std::remove_if(del_buf.begin(), del_buf.end(),
+                                     [&](FactId f) {
+                                       return std::binary_search(add_buf.begin(), add_buf.end(), f);
+                                     }),
+                      del_buf.end());
+      }
+      proto.add.assign(add_buf.begin(), add_buf.end());
+      proto.del.assign(del_buf.begin(), del_buf.end());
       mergeConditionalEffects(proto);
-      for (const auto& conj : pre_dnf) {
-        Operator op = proto;
+      for (size_t k = 0; k < pre_dnf.size(); ++k) {
+        const Conj& conj = pre_dnf[k];
+        // The last (usually the only) term takes the prototype, the others a copy.
+        Operator op = k + 1 == pre_dnf.size() ? std::move(proto) : proto;
+        op.pre.reserve(conj.size());
         for (const auto& l : conj) op.pre.push_back(litFact(tb, l));
         sortUnique(op.pre);
         // Variants of one action (top-level disjunctions, existentials) can ground to the same
@@ -1133,13 +1152,13 @@ struct Grounder::Impl {
     };
     for (auto& op : task->ops) {
       addComplements(op.add, op.del);
-      std::vector<FactId> all_add = op.add, all_del = op.del;
-      for (auto& ce : op.cond_effects) {
-        addComplements(ce.add, ce.del);
-        all_add.insert(all_add.end(), ce.add.begin(), ce.add.end());
-        all_del.insert(all_del.end(), ce.del.begin(), ce.del.end());
-      }
       if (!op.cond_effects.empty()) {
+        std::vector<FactId> all_add = op.add, all_del = op.del;
+        for (auto& ce : op.cond_effects) {
+          addComplements(ce.add, ce.del);
+          all_add.insert(all_add.end(), ce.add.begin(), ce.add.end());
+          all_del.insert(all_del.end(), ce.del.begin(), ce.del.end());
+        }
         sortUnique(all_add);
         sortUnique(all_del);
         std::vector<FactId> both;

@@ -7,8 +7,27 @@ namespace tamp::symbolic_planner {
 
 void Task::finalize() {
   const size_t n = numFacts();
+  constexpr OpId kNoOp = UINT32_MAX;
+  // Every list is sized first and filled after (one allocation each; same contents and order as
+  // appending): achievers (an operator once per fact), operators by key precondition.
+  std::vector<uint32_t> pre_count(n, 0), ach_count(n, 0);
+  std::vector<OpId> last(n, kNoOp);
+  auto countAch = [&](OpId o, FactId f) {
+    if (last[f] != o) {
+      last[f] = o;
+      ++ach_count[f];
+    }
+  };
+  for (OpId o = 0; o < ops.size(); ++o) {
+    const auto& op = ops[o];
+    for (FactId f : op.add) countAch(o, f);
+    for (const auto& ce : op.cond_effects) {
+      for (FactId f : ce.add) countAch(o, f);
+    }
+    for (FactId f : op.pre) ++pre_count[f];
+  }
   achievers.assign(n, {});
-  std::vector<uint32_t> pre_count(n, 0);
+  for (size_t f = 0; f < n; ++f) achievers[f].reserve(ach_count[f]);
   for (OpId o = 0; o < ops.size(); ++o) {
     auto& op = ops[o];
     auto addAch = [&](FactId f) {
@@ -18,25 +37,37 @@ void Task::finalize() {
     for (const auto& ce : op.cond_effects) {
       for (FactId f : ce.add) addAch(f);
     }
-    for (FactId f : op.pre) ++pre_count[f];
   }
   buildEffectIndex();
   // Key precondition: the one whose fact has the fewest... we use a proxy for "rarely true":
   // facts that are preconditions of few operators are specific (e.g. an object's position);
   // facts shared by many operators (hand-empty) are often true.
-  ops_by_key_.assign(n, {});
-  ops_without_pre_.clear();
+  std::vector<FactId> keys(ops.size(), 0);
+  std::vector<uint32_t> key_count(n, 0);
+  size_t without_pre = 0;
   for (OpId o = 0; o < ops.size(); ++o) {
     const auto& pre = ops[o].pre;
     if (pre.empty()) {
-      ops_without_pre_.push_back(o);
+      ++without_pre;
       continue;
     }
     FactId key = pre[0];
     for (FactId f : pre) {
       if (pre_count[f] < pre_count[key]) key = f;
     }
-    ops_by_key_[key].push_back(o);
+    keys[o] = key;
+    ++key_count[key];
+  }
+  ops_by_key_.assign(n, {});
+  for (size_t f = 0; f < n; ++f) ops_by_key_[f].reserve(key_count[f]);
+  ops_without_pre_.clear();
+  ops_without_pre_.reserve(without_pre);
+  for (OpId o = 0; o < ops.size(); ++o) {
+    if (ops[o].pre.empty()) {
+      ops_without_pre_.push_back(o);
+    } else {
+      ops_by_key_[keys[o]].push_back(o);
+    }
   }
 }
 
@@ -44,6 +75,10 @@ void Task::buildEffectIndex() {
   const size_t n = numFacts();
   EffectIndex& e = effects;
   e = EffectIndex{};
+  size_t num_effects = ops.size();
+  for (const auto& op : ops) num_effects += op.cond_effects.size();
+  e.op.reserve(num_effects);
+  e.ce.reserve(num_effects);
   for (OpId o = 0; o < ops.size(); ++o) {
     e.op.push_back(o);
     e.ce.push_back(-1);

@@ -112,10 +112,16 @@ MotionPlannerNode::MotionPlannerNode(const dds::ServiceArgs& args, NodeConfig co
     for (auto& sl : slots_) sl->dirty = true;
   });
   if (slots_.front()->planner.robotModel()) {
-    robot_reader_ = std::make_unique<dds::Reader<msg::RobotState>>(
-        participant(), dds::topics::kRobotState, [this](const msg::RobotState& m, const dds::SampleMeta& meta) {
-          if (meta.alive && msgv::accept(m, dds::topics::kRobotState.name, rejects_)) onRobotState(m);
-        });
+    // Only for the preparation: a node that may not read the robot's state (permissions that
+    // predate it) prepares for the default state, as it did before, and serves all the same.
+    try {
+      robot_reader_ = std::make_unique<dds::Reader<msg::RobotState>>(
+          participant(), dds::topics::kRobotState, [this](const msg::RobotState& m, const dds::SampleMeta& meta) {
+            if (meta.alive && msgv::accept(m, dds::topics::kRobotState.name, rejects_)) onRobotState(m);
+          });
+    } catch (const std::exception& e) {
+      nodeLog()->warn("no robot state ({}): roadmaps are prepared for the default state", e.what());
+    }
   }
   effort_reader_ = std::make_unique<dds::Reader<msg::EffortModelSnapshot>>(
       participant(), dds::topics::kEffortModel, [this](const msg::EffortModelSnapshot& m, const dds::SampleMeta& meta) {

@@ -96,7 +96,10 @@ TEST_F(ArmTest, ArmConfigurationGoalIsReachedOnACollisionFreePath) {
 }
 
 TEST_F(ArmTest, ANearbyFreeConfigurationIsReachedByTheDirectMotion) {
-  MotionPlanner mp = planner();
+  MotionPlannerParams p;
+  p.sampling.direct_first = true;
+  MotionPlanner mp(*model_, p);
+  mp.setWorld(world_);
   MotionRequest req;
   req.group = PlanningGroup::kArm;
   req.mode = MotionMode::kFull;

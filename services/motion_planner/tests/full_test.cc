@@ -45,7 +45,9 @@ TEST_F(FullTest, PathThroughTheOpenDoorIsCollisionFreeWhenRecheckedDensely) {
 // path still goes through the door. Off, the planner samples even the free one.
 TEST_F(FullTest, AFreeDirectMotionIsTakenBeforeSampling) {
   const world::World w = testing::corridorWorld(false);
-  MotionPlanner mp = planner(w);
+  MotionPlannerParams direct;
+  direct.sampling.direct_first = true;
+  MotionPlanner mp = planner(w, direct);
   const MotionResult near = mp.plan(request({2, 3, 0.0}, {3.5, 2.5, 0.5}), Termination::after(5.0));
   ASSERT_EQ(near.status, MotionStatus::kSolved) << near.reason;
   EXPECT_TRUE(near.stats.direct);

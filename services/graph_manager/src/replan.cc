@@ -35,6 +35,17 @@ double distanceToBasePath(const Eigen::Vector2d& p, const JointPath& path) {
   return d;
 }
 
+/// Forgets the motion (and the arm motions per next edge) an edge was priced with: planned again
+/// when a branch reaches it.
+void forgetMotion(Edge& e) {
+  e.motion.reset();
+  e.motion_by_next.clear();
+  e.effort_by_next.clear();
+  e.state = EdgeState::kUnevaluated;
+  e.effort_mean_s = kInfinity;
+  e.reason.clear();
+}
+
 }  // namespace
 
 std::string_view toString(EventKind k) {
@@ -117,11 +128,8 @@ int GraphManager::invalidateNear(const std::vector<world::Object>& objects) {
     if (e.kind != ActionKind::kMoveBase || !e.motion) continue;
     if (e.state == EdgeState::kExecuted || e.state == EdgeState::kExecuting) continue;
     if (!near(e.motion->lazy_path) && !near(e.motion->trajectory.path())) continue;
-    e.motion.reset();
-    e.state = EdgeState::kUnevaluated;
-    e.effort_mean_s = kInfinity;
+    forgetMotion(e);  // a base edge: no arm motions per next edge
     e.subtasks_spawned = false;
-    e.reason.clear();
     ++n;
   }
   return n;
@@ -141,12 +149,7 @@ bool GraphManager::widenHeldMargin(const std::string& held, const std::string& b
     if (e.state == EdgeState::kExecuted || e.state == EdgeState::kExecuting) continue;
     if (e.kind != ActionKind::kMoveBase && e.kind != ActionKind::kMoveArm) continue;
     if (heldAt(e.from).empty() || isPush(e)) continue;
-    e.motion.reset();
-    e.motion_by_next.clear();
-    e.effort_by_next.clear();
-    e.state = EdgeState::kUnevaluated;
-    e.effort_mean_s = kInfinity;
-    e.reason.clear();
+    forgetMotion(e);
     ++n;
   }
   log::get("graph_manager")->info("stopped before '{}' holding '{}': held objects planned {:.2f} m larger from now on "

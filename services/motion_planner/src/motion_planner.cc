@@ -547,10 +547,10 @@ class WorldRestore {
   WorldRestore& operator=(const WorldRestore&) = delete;
   ~WorldRestore() { restore(); }
   bool active() const { return impl_ != nullptr; }
-  /// Another hypothetical world; the saved one stays what is restored.
-  void replaceWorld(MotionPlanner::Impl& impl, world::World hypothetical) {
-    impl.world = std::move(hypothetical);
-    impl.scene.syncWorld(impl.world);
+  /// Another hypothetical world (active only); the saved one stays what is restored.
+  void replaceWorld(world::World hypothetical) {
+    impl_->world = std::move(hypothetical);
+    impl_->scene.syncWorld(impl_->world);
   }
 
  private:
@@ -689,7 +689,7 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
       return finish(MotionStatus::kInvalidRequest, "held_padding_m: " + s.error().message);
     }
     if (restore.active()) {
-      restore.replaceWorld(impl, std::move(padded));
+      restore.replaceWorld(std::move(padded));
     } else {
       restore = WorldRestore(impl, std::move(padded));
     }

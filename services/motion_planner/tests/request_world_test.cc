@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include "tamp/motion_planner/motion_planner.h"
 #include "test_worlds.h"
@@ -138,14 +139,23 @@ JointPath heldCentres(const JointPath& path, const Eigen::Vector2d& offset) {
   return out;
 }
 
-TEST_F(RequestWorldTest, HeldObjectIsAttachedAtTheGivenGrasp) {
+/// The corridor with a 0.3 m parcel far away in a corner: only a grasp decides where it is.
+world::World parcelWorld() {
   world::World w = testing::corridorWorld(false);
-  // A 0.3 m parcel, in the world far away in a corner: only the grasp decides where it is.
-  ASSERT_TRUE(w.addObject(testing::box("parcel", 9.5, 0.5, 0.3, 0.3, true, 0.3, 2.0)).ok());
-  // A holonomic base (it slides sideways through the door; a stop-and-turn base cannot).
+  if (!w.addObject(testing::box("parcel", 9.5, 0.5, 0.3, 0.3, true, 0.3, 2.0)).ok()) throw std::logic_error("parcel");
+  return w;
+}
+
+/// A holonomic base (it slides sideways through the door; a stop-and-turn base cannot).
+MotionPlannerParams holonomicParams() {
   MotionPlannerParams p = testing::untimedParams();
   p.sampling.base_turn_in_place = false;
-  MotionPlanner mp = testing::discPlanner(w, p);
+  return p;
+}
+
+TEST_F(RequestWorldTest, HeldObjectIsAttachedAtTheGivenGrasp) {
+  world::World w = parcelWorld();
+  MotionPlanner mp = testing::discPlanner(w, holonomicParams());
   MotionRequest req = baseRequest({2, 2, 0}, {8, 2, 0});
   req.held_object = "parcel";
   // Beside the robot: robot and parcel are 1.05 m wide across its heading, wider than the 1 m
@@ -185,10 +195,8 @@ TEST_F(RequestWorldTest, HeldObjectIsAttachedAtTheGivenGrasp) {
 }
 
 TEST_F(RequestWorldTest, HeldPaddingGrowsTheHeldObjectForThatRequestOnly) {
-  world::World w = testing::corridorWorld(false);
-  ASSERT_TRUE(w.addObject(testing::box("parcel", 9.5, 0.5, 0.3, 0.3, true, 0.3, 2.0)).ok());
-  MotionPlannerParams p = testing::untimedParams();
-  p.sampling.base_turn_in_place = false;
+  const world::World w = parcelWorld();
+  const MotionPlannerParams p = holonomicParams();
   MotionPlanner mp = testing::discPlanner(w, p);
   // The parcel held 0.5 m to the robot's right: at y = 0.7 its south face is 5 cm off the wall.
   const Eigen::Vector2d offset(0.0, -0.5);

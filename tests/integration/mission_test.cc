@@ -148,6 +148,32 @@ TEST(MissionTest, ABoxTooWideToGraspIsPushedOffTheWayToTheGoal) {
   EXPECT_EQ(m.report["grasp_calls"].get<int>() > 0, true) << "the grasp was tried first, and refuted";
 }
 
+// A crate too heavy to lift stands in the only doorway between two rooms; the door frame leaves
+// no room to push it sideways. The robot pushes it ahead into the next room, far enough to drive
+// round it, and goes on to the goal.
+TEST(MissionTest, ACrateInTheOnlyDoorwayIsPushedIntoTheNextRoomAndDrivenRound) {
+  auto sc = world::loadScenario(configDir() / "scenarios" / "namo_doorway.yaml");
+  ASSERT_TRUE(sc.ok()) << sc.error().toString();
+  const world::Location* goal = sc->world.findLocation("goal");
+  ASSERT_NE(goal, nullptr);
+  const world::Object& crate = sc->world.object("crate");
+  const double door_x = crate.pose.translation().x();  // the crate stands centred in the doorway
+  const Mission m = run("namo_doorway.yaml");
+  ASSERT_EQ(m.exit_code, 0) << m.output;
+  ASSERT_TRUE(m.truth.is_object()) << m.output;
+  EXPECT_EQ(m.report["status"], "succeeded") << m.report["reason"];
+  EXPECT_LT(distance(m.truth["robot"], goal->pose.x, goal->pose.y), 0.10) << m.truth.dump();
+  // Out of the doorway, on the far side: its near face past the frame (0.1 m each side of the
+  // doorway's centre line) by more than the robot could squeeze through otherwise.
+  const double half = crate.shape.size.x() / 2;
+  EXPECT_GT(m.truth["objects"]["crate"]["x"].get<double>() - half, door_x + 0.1) << m.truth.dump();
+  EXPECT_EQ(m.report["objects_moved"], nlohmann::json::array({"crate"})) << m.report.dump(1);
+  int pushes = 0;
+  for (const auto& a : m.report["actions"])
+    if (a["action"].get<std::string>().rfind("(push crate ", 0) == 0 && a["outcome"] == "succeeded") ++pushes;
+  EXPECT_GE(pushes, 1) << m.report["actions"].dump(1);
+}
+
 TEST(MissionTest, CorridorShortDetourIsTakenInsteadOfMovingTheBox) {
   const Mission m = run("namo_corridor_short.yaml");
   ASSERT_EQ(m.exit_code, 0) << m.output;

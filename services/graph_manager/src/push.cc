@@ -1,11 +1,14 @@
 // Pushes: an object too heavy or too wide to grasp, within the robot's push limit, is moved off a
 // blocked path by the base driving straight into it (the domain's `push` action). Candidates
 // along the object's footprint axes, by the shortest distance that clears the path, each checked
-// collision-free by the motion planner with the object carried ahead of the base.
+// collision-free by the motion planner with the object carried ahead of the base. When none is
+// free, a push forwards along the path by the shortest distance that opens a way round the object.
 #include <algorithm>
 #include <cmath>
 #include <cctype>
 #include <cstdio>
+#include <limits>
+#include <optional>
 
 #include "tamp/core/log.h"
 #include "tamp/graph_manager/graph_manager.h"
@@ -53,6 +56,28 @@ double reach(const world::Polygon2& poly, const Eigen::Vector2d& c, const Eigen:
   double r = -std::numeric_limits<double>::infinity();
   for (const auto& v : poly) r = std::max(r, (v - c).dot(n));
   return r;
+}
+
+/// Whether every pose keeps farther than `keep_clear` from the polygon.
+bool clearOf(const world::Polygon2& poly, const std::vector<Pose2D>& poses, double keep_clear) {
+  return std::all_of(poses.begin(), poses.end(),
+                     [&](const Pose2D& s) { return distanceToPolygon(poly, Eigen::Vector2d(s.x, s.y)) > keep_clear; });
+}
+
+/// The way's direction where it passes closest to `c` (over about 0.5 m of it); zero when
+/// the way has fewer than two poses.
+Eigen::Vector2d wayDirectionAt(const std::vector<Pose2D>& swept, const Eigen::Vector2d& c) {
+  if (swept.size() < 2) return Eigen::Vector2d::Zero();
+  std::size_t best = 0;
+  double best_d = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < swept.size(); ++i) {
+    const double d = (Eigen::Vector2d(swept[i].x, swept[i].y) - c).norm();
+    if (d < best_d) best_d = d, best = i;
+  }
+  constexpr std::size_t kSpan = 5;  // swept poses are 5 cm apart
+  const std::size_t a = best >= kSpan ? best - kSpan : 0, b = std::min(swept.size() - 1, best + kSpan);
+  const Eigen::Vector2d d(swept[b].x - swept[a].x, swept[b].y - swept[a].y);
+  return d.norm() > 1e-9 ? Eigen::Vector2d(d / d.norm()) : Eigen::Vector2d::Zero();
 }
 
 /// A full-mode base motion from `from` to `to`, the rest of the robot as in `ctx`.
@@ -200,31 +225,119 @@ std::optional<MotionAnswer> GraphManager::planPushMotion(const std::string& obje
   return a;
 }
 
-std::vector<std::string> GraphManager::spawnPushes(const world::Object& o, const std::string& support,
-                                                   const BranchContext& ctx, const std::vector<Pose2D>& swept,
-                                                   double keep_clear, std::string& why) {
-  const Eigen::Isometry3d pose = ctx.object_poses.count(o.id) ? ctx.object_poses.at(o.id) : o.pose;
+GraphManager::PushGeometry GraphManager::pushGeometry(const world::Object& o, const Eigen::Isometry3d& pose,
+                                                     const Eigen::Vector2d& n, double distance) const {
   const world::Polygon2 fp = worldFootprint(o, pose);
   const Eigen::Vector2d c = pose.translation().head<2>();
-  const robot::RobotModel& robot = abstraction_.robot();
   double front = 0.0;  // how far the base reaches ahead of base_link
-  for (const auto& v : robot.baseFootprint()) front = std::max(front, v.x());
+  for (const auto& v : abstraction_.robot().baseFootprint()) front = std::max(front, v.x());
+  const double heading = std::atan2(n.y(), n.x());
+  // The base's front `push_gap_m` short of the face it pushes, centred on the object.
+  const double back = -reach(fp, c, -n) - front - params_.push_gap_m;
+  const Eigen::Vector2d start = c + back * n;
+  const Eigen::Vector2d apex = start + (distance + params_.push_gap_m) * n;
+  const Eigen::Vector2d end = apex - pushBackoff() * n;
+  PushGeometry g;
+  g.from = Pose2D{start.x(), start.y(), heading};
+  g.apex = Pose2D{apex.x(), apex.y(), heading};
+  g.to = Pose2D{end.x(), end.y(), heading};
+  g.target = pose;
+  g.target.translation().head<2>() += distance * n;
+  return g;
+}
+
+std::optional<std::string> GraphManager::addPushIfFree(const world::Object& o, const std::string& support,
+                                                       const Eigen::Isometry3d& pose, const Eigen::Vector2d& n,
+                                                       double distance, const BranchContext& ctx) {
+  const PushGeometry g = pushGeometry(o, pose, n, distance);
+  std::string why_not;
+  if (!pushMotion(o.id, pose, g.target, g.from, g.apex, g.to, ctx, why_not)) {
+    log::get("graph_manager")->debug("push of {} by {:.2f} m towards ({:.2f}, {:.2f}): {}", o.id, distance, n.x(), n.y(),
+                                     why_not);
+    return std::nullopt;
+  }
+  const std::string slot = abstraction_.addSlot(o.id, support, g.target);
+  const std::string l_from = abstraction_.locationFor(g.from, "push_" + o.id);
+  const std::string l_to = abstraction_.locationFor(g.to, "pushed_" + o.id);
+  abstraction_.addPush(o.id, support, l_from, l_to, slot);
+  log::get("graph_manager")->info("push of {} by {:.2f} m: from {} ({:.2f}, {:.2f}) to {}; {} at ({:.2f}, {:.2f})", o.id,
+                                  distance, l_from, g.from.x, g.from.y, l_to, slot, g.target.translation().x(),
+                                  g.target.translation().y());
+  return slot;
+}
+
+std::optional<double> GraphManager::openingPushDistance(const world::Object& o, const Eigen::Isometry3d& pose,
+                                                        const Eigen::Vector2d& n, const Pose2D& way_end,
+                                                        const std::vector<std::string>& crossed,
+                                                        const BranchContext& ctx) {
+  // One lazy question per distance, asked together: from where the base ends after the push to
+  // where the blocked way ends, with the object at its new place. A path that prices crossings
+  // dearly goes round the object when a way round is open; the shortest push after which it crosses neither
+  // the object nor any movable that the blocked way did not cross already wins (a way "round" it
+  // through another object is no opening).
+  std::vector<double> distances;
+  std::vector<MotionQuery> queries;
+  for (double d = params_.push_step_m; d <= params_.push_max_m + 1e-9; d += params_.push_step_m) {
+    const PushGeometry g = pushGeometry(o, pose, n, d);
+    MotionQuery q;
+    q.group = Group::kBase;
+    q.mode = Mode::kLazy;
+    q.start = ctx.state;
+    q.start.base = g.to;
+    q.goal_base = way_end;
+    q.overrides = overridesOf(ctx, o.id);
+    q.overrides.push_back(ObjectOverride{o.id, false, g.target});
+    // Crossings priced far above any detour within the map: the lazy path crosses an object
+    // only where there is no way round it.
+    q.movable_cost_weight = 100.0;
+    q.budget_s = params_.motion_budget_s;
+    distances.push_back(d);
+    queries.push_back(std::move(q));
+  }
+  const std::vector<MotionAnswer> answers = askMotions(queries);
+  auto opens = [&](std::size_t i) {
+    const MotionAnswer& a = answers[i];
+    std::string crossing;
+    for (const auto& c : a.blocking) crossing += " " + c.object_id;
+    log::get("graph_manager")
+        ->debug("opening push of {} by {:.2f} m towards ({:.2f}, {:.2f}): {}, crosses:{}", o.id, distances[i], n.x(), n.y(),
+                a.ok() ? "solved" : std::string(toString(a.status)) + " " + a.reason, crossing);
+    return a.ok() && std::all_of(a.blocking.begin(), a.blocking.end(), [&](const Crossing& c) {
+             return c.object_id != o.id && std::find(crossed.begin(), crossed.end(), c.object_id) != crossed.end();
+           });
+  };
+  for (std::size_t i = 0; i < answers.size(); ++i) {
+    if (!opens(i)) continue;
+    // One step further when that is open too: the shortest opening leaves the robot a way that
+    // hugs the object, lost to the centimetres by which a push misses its slot.
+    if (i + 1 < answers.size() && opens(i + 1)) return distances[i + 1];
+    return distances[i];
+  }
+  return std::nullopt;
+}
+
+std::vector<std::string> GraphManager::spawnPushes(const world::Object& o, const std::string& support,
+                                                   const BranchContext& ctx, const std::vector<Pose2D>& swept,
+                                                   const std::vector<std::string>& crossed, double keep_clear,
+                                                   std::string& why) {
+  const Eigen::Isometry3d pose = ctx.object_poses.count(o.id) ? ctx.object_poses.at(o.id) : o.pose;
+  const world::Polygon2 fp = worldFootprint(o, pose);
   struct Candidate {
     Eigen::Vector2d n;
     double distance;
   };
+  // Per direction, the shortest push that takes the object off the blocked way; the directions
+  // along the way have none (the object stays on it however far it goes).
   std::vector<Candidate> candidates;
+  std::vector<Eigen::Vector2d> along;
   for (const Eigen::Vector2d& n : pushDirections(fp)) {
-    for (double d = params_.push_step_m; d <= params_.push_max_m + 1e-9; d += params_.push_step_m) {
+    bool found = false;
+    for (double d = params_.push_step_m; d <= params_.push_max_m + 1e-9 && !found; d += params_.push_step_m) {
       world::Polygon2 moved = fp;
       for (auto& v : moved) v += d * n;
-      bool clear = true;
-      for (const auto& s : swept) clear = clear && distanceToPolygon(moved, Eigen::Vector2d(s.x, s.y)) > keep_clear;
-      if (clear) {
-        candidates.push_back({n, d});
-        break;
-      }
+      if (clearOf(moved, swept, keep_clear)) candidates.push_back({n, d}), found = true;
     }
+    if (!found) along.push_back(n);
   }
   std::sort(candidates.begin(), candidates.end(),
             [](const Candidate& a, const Candidate& b) { return a.distance < b.distance; });
@@ -233,33 +346,23 @@ std::vector<std::string> GraphManager::spawnPushes(const world::Object& o, const
   for (const Candidate& k : candidates) {
     if (static_cast<int>(slots.size()) >= params_.pushes_per_object) break;
     ++tried;
-    const double heading = std::atan2(k.n.y(), k.n.x());
-    // The base's front `push_gap_m` short of the face it pushes, centred on the object.
-    const double back = -reach(fp, c, -k.n) - front - params_.push_gap_m;
-    const Eigen::Vector2d start = c + back * k.n;
-    const Eigen::Vector2d apex = start + (k.distance + params_.push_gap_m) * k.n;
-    const Eigen::Vector2d end = apex - pushBackoff() * k.n;
-    const Pose2D from{start.x(), start.y(), heading}, top{apex.x(), apex.y(), heading}, to{end.x(), end.y(), heading};
-    Eigen::Isometry3d target = pose;
-    target.translation().head<2>() += k.distance * k.n;
-    std::string why_not;
-    if (!pushMotion(o.id, pose, target, from, top, to, ctx, why_not)) {
-      log::get("graph_manager")->debug("push of {} by {:.2f} m towards ({:.2f}, {:.2f}): {}", o.id, k.distance, k.n.x(),
-                                       k.n.y(), why_not);
-      continue;
-    }
-    const std::string slot = abstraction_.addSlot(o.id, support, target);
-    const std::string l_from = abstraction_.locationFor(from, "push_" + o.id);
-    const std::string l_to = abstraction_.locationFor(to, "pushed_" + o.id);
-    abstraction_.addPush(o.id, support, l_from, l_to, slot);
-    log::get("graph_manager")->info("push of {} by {:.2f} m: from {} ({:.2f}, {:.2f}) to {}; {} at ({:.2f}, {:.2f})", o.id,
-                                    k.distance, l_from, from.x, from.y, l_to, slot, target.translation().x(),
-                                    target.translation().y());
-    slots.push_back(slot);
+    if (auto slot = addPushIfFree(o, support, pose, k.n, k.distance, ctx)) slots.push_back(*slot);
+  }
+  // None of those is free (a chair in a doorway, its sides against the frame or other chairs): a
+  // push along the way, out of the doorway into open space, opens a way round it instead. Only
+  // forwards: the base pushes from the side it comes from.
+  const Eigen::Vector2d forwards = wayDirectionAt(swept, pose.translation().head<2>());
+  for (const Eigen::Vector2d& n : along) {
+    if (static_cast<int>(slots.size()) >= params_.pushes_per_object || swept.empty()) break;
+    if (n.dot(forwards) <= 0.0) continue;
+    const std::optional<double> d = openingPushDistance(o, pose, n, swept.back(), crossed, ctx);
+    if (!d) continue;
+    ++tried;
+    if (auto slot = addPushIfFree(o, support, pose, n, *d, ctx)) slots.push_back(*slot);
   }
   if (slots.empty())
-    why = candidates.empty() ? "no push of '" + o.id + "' within push_max_m clears the path"
-                             : "no straight push of '" + o.id + "' is collision-free (" + std::to_string(tried) + " tried)";
+    why = tried == 0 ? "no push of '" + o.id + "' within push_max_m clears or opens the way"
+                     : "no straight push of '" + o.id + "' is collision-free (" + std::to_string(tried) + " tried)";
   return slots;
 }
 

@@ -36,6 +36,8 @@ void GraphManager::spawnSubtasks(EdgeId id, const BranchContext& ctx, int depth)
     swept.push_back(Pose2D{wps[i][0], wps[i][1], wps[i][2]});
   }
   const double radius = abstraction_.robot().baseRadius() + params_.keep_clear_margin_m;
+  std::vector<std::string> crossed;
+  for (const auto& c : motion.crossings) crossed.push_back(c.object_id);
   int objects = 0;
   std::vector<std::string> unmovable;  // why a crossed object spawned no sub-task (for the failure reason)
   std::vector<std::pair<std::string, std::string>> first_slots;  // per movable object, for the oracle's subsets
@@ -56,7 +58,7 @@ void GraphManager::spawnSubtasks(EdgeId id, const BranchContext& ctx, int depth)
     if (slots.empty()) {
       const std::string no_push = whyNotPushable(*o);
       std::string why_push = no_push;
-      if (no_push.empty()) slots = spawnPushes(*o, supportAt(v, o->id), ctx, swept, radius, why_push);
+      if (no_push.empty()) slots = spawnPushes(*o, supportAt(v, o->id), ctx, swept, crossed, radius, why_push);
       if (slots.empty()) {
         unmovable.push_back(why_not + (why_push.empty() ? "" : "; " + why_push));
         continue;

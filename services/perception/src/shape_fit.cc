@@ -382,6 +382,8 @@ Detection describeCluster(std::vector<Eigen::Vector3d> points, double support_z,
 ShapeFit fitShape(const Detection& det, const world::Shape& shape, const Eigen::Vector3d& sensor,
                   const TrackingParams& params, double yaw_hint) {
   ShapeFit fit;
+  const bool hinted = std::isfinite(yaw_hint);  // a track's yaw; NaN: a first sighting
+  const double hint = hinted ? yaw_hint : 0.0;
   const Aabb local = shape.localAabb();
   const double shape_height = local.max.z() - local.min.z();
   fit.height_error = det.height - shape_height;
@@ -421,7 +423,17 @@ ShapeFit fitShape(const Detection& det, const world::Shape& shape, const Eigen::
     };
     const Eigen::Vector2d La = dims, Lb(dims.y(), dims.x());
     const double xa = excessOf(La), xb = excessOf(Lb);
-    const bool swapped = xb < xa - 1e-9 || (std::abs(xb - xa) <= 1e-9 && deficitOf(Lb) < deficitOf(La) - 1e-9);
+    // Which of the box's sides lies along the detection's first axis. A view that shows too
+    // little of the box to tell (a face seen from afar fits either side within the size
+    // tolerance) keeps the side the track had: a guess would turn a nearly square box a quarter
+    // turn and shift its centre by half the sides' difference, towards the robot.
+    bool swapped = xb < xa - 1e-9 || (std::abs(xb - xa) <= 1e-9 && deficitOf(Lb) < deficitOf(La) - 1e-9);
+    if (std::abs(xb - xa) <= 1e-9 && std::abs(deficitOf(Lb) - deficitOf(La)) <= params.size_tolerance &&
+        hinted) {
+      const double off_a = std::abs(std::remainder(det.rect.yaw - yaw_hint, kPi));
+      const double off_b = std::abs(std::remainder(det.rect.yaw + kPi / 2 - yaw_hint, kPi));
+      swapped = off_b < off_a;
+    }
     const Eigen::Vector2d L = swapped ? Lb : La;
     fit.excess = swapped ? xb : xa;
     fit.deficit = deficitOf(L);
@@ -444,8 +456,8 @@ ShapeFit fitShape(const Detection& det, const world::Shape& shape, const Eigen::
     double yaw = det.rect.yaw + (swapped ? kPi / 2 : 0.0);
     // The symmetric equivalent closest to the hint.
     const double sym = yawSymmetry(world::Shape::box(dims.x(), dims.y(), 1.0));
-    yaw = yaw_hint + wrapAngle(yaw - yaw_hint);
-    yaw -= sym * std::round((yaw - yaw_hint) / sym);
+    yaw = hint + wrapAngle(yaw - hint);
+    yaw -= sym * std::round((yaw - hint) / sym);
     yaw = wrapAngle(yaw);
     // Residual: boundary points against the fitted rectangle.
     const Eigen::Vector2d b0 = axis(yaw), b1 = axis(yaw + kPi / 2);

@@ -450,11 +450,34 @@ class GraphManager {
   std::optional<MotionAnswer> planPushMotion(const std::string& object, const Eigen::Isometry3d& pose,
                                              const Eigen::Isometry3d& target, const Pose2D& from, const Pose2D& apex,
                                              const Pose2D& to, const BranchContext& ctx, std::string& why);
+  /// Where a push of an object (at `pose`) along `n` by a distance starts, peaks and ends, and
+  /// where it leaves the object.
+  struct PushGeometry {
+    Pose2D from, apex, to;
+    Eigen::Isometry3d target{Eigen::Isometry3d::Identity()};
+  };
+  PushGeometry pushGeometry(const world::Object& o, const Eigen::Isometry3d& pose, const Eigen::Vector2d& n,
+                            double distance) const;
+  /// The push's slot and locations, added to the abstraction when its motion is free in the
+  /// branch's world; none otherwise.
+  std::optional<std::string> addPushIfFree(const world::Object& o, const std::string& support,
+                                           const Eigen::Isometry3d& pose, const Eigen::Vector2d& n, double distance,
+                                           const BranchContext& ctx);
+  /// The shortest push of `o` along `n` (up to push_max_m) after which a lazy path pricing
+  /// crossings dearly, from the pushed base to `way_end`, goes round `o` and crosses no movable
+  /// outside `crossed` (the blocked way's): a push that does not take the object off the way but
+  /// opens a way round it; one push step further when that opens too (room to spare). None when
+  /// no distance opens a way.
+  std::optional<double> openingPushDistance(const world::Object& o, const Eigen::Isometry3d& pose,
+                                            const Eigen::Vector2d& n, const Pose2D& way_end,
+                                            const std::vector<std::string>& crossed, const BranchContext& ctx);
   /// findPossibleActions for an object the robot cannot grasp: pushes of `o` (on `support`)
-  /// that clear `swept` by `keep_clear`, each checked collision-free; their slots (empty, and
-  /// `why`, when none).
+  /// that clear `swept` by `keep_clear`, each checked collision-free; when none of those is
+  /// free, pushes along the way that open a way round `o` (openingPushDistance). Their slots
+  /// (empty, and `why`, when none).
   std::vector<std::string> spawnPushes(const world::Object& o, const std::string& support, const BranchContext& ctx,
-                                       const std::vector<Pose2D>& swept, double keep_clear, std::string& why);
+                                       const std::vector<Pose2D>& swept, const std::vector<std::string>& crossed,
+                                       double keep_clear, std::string& why);
   double evaluatePush(Edge& e, const BranchContext& ctx);
   MotionAnswer planBase(const MotionQuery& q);
   MotionAnswer lazyOrFull(const MotionQuery& q);

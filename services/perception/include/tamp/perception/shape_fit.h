@@ -14,6 +14,7 @@
 /// coincides with the observed near face. Heights come from the support surface (the floor or
 /// table below), not from the lowest point seen, so occluded bottoms do not bias them.
 
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -87,10 +88,13 @@ struct ShapeFit {
 };
 
 /// Fits `shape` (box, cylinder; a sphere as a cylinder of its radius; a prism by its bounding
-/// box) to a detection seen from `sensor` (world frame). `yaw_hint` resolves a box's yaw among
-/// its symmetric equivalents (the result is the equivalent closest to it).
+/// box) to a detection seen from `sensor` (world frame). `yaw_hint` (a track's yaw) resolves a
+/// box's yaw among its symmetric equivalents (the result is the equivalent closest to it), and
+/// which side of the box a face belongs to when the view cannot tell (both fit within
+/// `size_tolerance`). NaN (the default, a first sighting): yaw 0 for the equivalents, the
+/// detection's extents for the side.
 ShapeFit fitShape(const Detection& detection, const world::Shape& shape, const Eigen::Vector3d& sensor,
-                  const TrackingParams& params, double yaw_hint = 0.0);
+                  const TrackingParams& params, double yaw_hint = std::numeric_limits<double>::quiet_NaN());
 
 /// Yaw of an upright pose (rotation about world z), in [-pi, pi).
 double yawOf(const Eigen::Isometry3d& pose);

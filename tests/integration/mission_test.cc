@@ -174,6 +174,27 @@ TEST(MissionTest, ACrateInTheOnlyDoorwayIsPushedIntoTheNextRoomAndDrivenRound) {
   EXPECT_GE(pushes, 1) << m.report["actions"].dump(1);
 }
 
+// namosim's 03_big_crossing: a chair too heavy to lift in the mouth of the start corridor, another
+// beside it, a third in the mouth of the goal corridor. The first is pushed ahead into the room,
+// the third aside; a motion the monitor refuses because a pushed chair's estimate lags behind its
+// slot is planned again where perception sees the chair (before, the same motion was planned again
+// and refused until the mission gave up).
+TEST(MissionTest, ChairsInTheMouthsOfTwoCorridorsArePushedOutOfTheWay) {
+  auto sc = world::loadScenario(configDir() / "scenarios" / "namo_big_crossing.yaml");
+  ASSERT_TRUE(sc.ok()) << sc.error().toString();
+  const world::Location* goal = sc->world.findLocation("goal_01");
+  ASSERT_NE(goal, nullptr);
+  const Mission m = run("namo_big_crossing.yaml");
+  ASSERT_EQ(m.exit_code, 0) << m.output;
+  ASSERT_TRUE(m.truth.is_object()) << m.output;
+  EXPECT_EQ(m.report["status"], "succeeded") << m.report["reason"];
+  EXPECT_LT(distance(m.truth["robot"], goal->pose.x, goal->pose.y), 0.10) << m.truth.dump();
+  const Eigen::Vector3d chair1 = sc->world.object("room_1_chair1").pose.translation();
+  EXPECT_GT(distance(m.truth["objects"]["room_1_chair1"], chair1.x(), chair1.y()), 0.5) << m.truth.dump();
+  for (const auto& a : m.report["actions"])
+    if (a["action"].get<std::string>().rfind("(pick ", 0) == 0) ADD_FAILURE() << "a chair above the payload was picked";
+}
+
 TEST(MissionTest, CorridorShortDetourIsTakenInsteadOfMovingTheBox) {
   const Mission m = run("namo_corridor_short.yaml");
   ASSERT_EQ(m.exit_code, 0) << m.output;

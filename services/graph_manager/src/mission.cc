@@ -610,16 +610,23 @@ bool GraphManager::Run::replan(const MissionEvent& ev, EdgeId failed, std::strin
   // What the robot and the world are now: perception's objects, but where the graph knows an
   // object to be (its prior, or where the mission put it) within the tolerance, that pose: a
   // partial view strays further than a place does, and a stray estimate would unbind the slot.
+  // The exception: the object that a refused or stopped motion named. The monitor judges a
+  // motion by the world model, so planning again where the graph believes that object is would
+  // be refused again (a pushed chair whose estimate lags 11 cm behind its slot); it is taken
+  // where perception sees it.
   const Observation now = source.robot();
   world::World live = source.world();
   std::vector<std::string> fresh;
-  std::vector<world::Object> changed;
+  std::vector<world::Object> changed, refused;
+  const bool names_object = ev.kind == EventKind::kActionFailed || ev.kind == EventKind::kActionBlocked;
   for (const auto& o : live.objects()) {
     if (o.kind != world::ObjectKind::kMovable) continue;
     const auto expected = expectedPose(o.id);
     if (!expected) fresh.push_back(o.id);
     if (!expected || (expected->translation() - o.pose.translation()).norm() > gm.params_.moved_object_tolerance_m)
       changed.push_back(o);
+    else if (names_object && o.id == ev.object_id)
+      refused.push_back(o);
     else
       (void)live.setObjectPose(o.id, *expected);
   }
@@ -642,6 +649,7 @@ bool GraphManager::Run::replan(const MissionEvent& ev, EdgeId failed, std::strin
     if (known) gm.widenHeldMargin(held_before.object_id, ev.object_id);
   }
   rec.held_padding_m = gm.held_padding_m_;
+  changed.insert(changed.end(), refused.begin(), refused.end());
   gm.invalidateNear(changed);
   if (failed >= 0) {
     // Planned again in the world as it is now, unless it failed too often (then infeasible).

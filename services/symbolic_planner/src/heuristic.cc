@@ -57,10 +57,12 @@ struct RelaxedOps {
   bool merged(uint32_t r) const { return member_begin[r] != member_begin[r + 1]; }
   size_t numNodes() const { return node_count.size(); }
 
-  /// Builds the counting structure above: each rop that is not merged and has at least three
+  /// Builds the counting structure above: each rop that is not merged and has at least four
   /// preconditions joins the largest group of such rops that share all its preconditions but
-  /// one (over its choices of that one; first on ties); a group is a node when it pays,
-  /// (members - 1) x (common facts - 1) >= 2 edges saved per reach of its facts.
+  /// one (over its choices of that one; first on ties); a group of two or more is a node. With
+  /// three preconditions (nodes of two facts) it did not pay: on grid, mprime and mystery nearly
+  /// every rop formed such nodes, 27-31 % fewer edges, and neither the search of grid-5 got
+  /// faster nor did building them (0.5-0.8 ms on mprime-21 and mystery-30) pay off.
   void factor() {
     const uint32_t n = static_cast<uint32_t>(size());
     const size_t nf = pre_of_begin.size() - 1;
@@ -70,7 +72,7 @@ struct RelaxedOps {
       x = (x ^ (x >> 27)) * 0x94D049BB133111EBULL;
       return x ^ (x >> 31);
     };
-    auto eligible = [&](uint32_t r) { return !merged(r) && count[r] >= 3; };
+    auto eligible = [&](uint32_t r) { return !merged(r) && count[r] >= 4; };
     // Do rops a and b have the same preconditions once a's skip-th and b's skip-th are left out?
     // (Preconditions are sorted.)
     auto same = [&](uint32_t a, uint32_t sa, uint32_t b, uint32_t sb) {
@@ -128,11 +130,10 @@ struct RelaxedOps {
     for (uint32_t r = 0; r < n; ++r) {
       if (chosen[r] == kNone) continue;
       const uint32_t kid = keys[chosen[r]];
-      const uint32_t m = members_of_key[kid], c = count[r] - 1;
-      if (m < 2 || (m - 1) * (c - 1) < 2) continue;
+      if (members_of_key[kid] < 2) continue;
       if (node_of_key[kid] == kNone) {
         node_of_key[kid] = static_cast<uint32_t>(node_count.size());
-        node_count.push_back(c);
+        node_count.push_back(count[r] - 1);
         node_rep.push_back(r);
         node_skip.push_back(chosen[r] - first_key[r]);
       }

@@ -61,7 +61,7 @@ struct RelaxedOps {
   /// preconditions joins the largest group of such rops that share all its preconditions but
   /// one (over its choices of that one; first on ties); a group of two or more is a node. With
   /// three preconditions (nodes of two facts) it did not pay: on grid, mprime and mystery nearly
-  /// every rop formed such nodes, 27-31 % fewer edges, and neither the search of grid-5 got
+  /// every rop formed such nodes, 21-31 % fewer edges, and neither the search of grid-5 got
   /// faster nor did building them (0.5-0.8 ms on mprime-21 and mystery-30) pay off.
   void factor() {
     const uint32_t n = static_cast<uint32_t>(size());

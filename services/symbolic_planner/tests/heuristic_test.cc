@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <random>
+#include <set>
+#include <string>
 
 #include "tamp/symbolic_planner/heuristic.h"
 #include "tamp/symbolic_planner/search.h"
@@ -133,6 +135,129 @@ TEST(Heuristic, OperatorsThatDifferInOnePreconditionGiveTheRelaxedPlanAndHelpful
     setBit(ac.data(), 2);  // at a and at c: go-a or go-c, then open; both helpful
     EXPECT_EQ(h->evaluate(ac.data()), 2);
     EXPECT_EQ(sorted(h->preferred()), (std::vector<OpId>{0, 2}));
+  }
+}
+
+TEST(Heuristic, SharedPreconditionsCountedOnceGiveTheSameLayers) {
+  // ship-0 and ship-1 share m1, m2, m3 and differ in s0 / s1 (and in one add each, so they are
+  // not merged): the layered graph counts m1..m3 once for both, through a conjunction node that
+  // completes when m3 is reached at layer 1, which must activate ship-0 at layer 1, as m3 does
+  // pick. The goal has two conjuncts, {gB, gB2} (make3, pick, q: 3) and {gA} (make3, ship-0: 2),
+  // both complete at layer 2; FF takes the first one completed, in the order the rops fire:
+  // ship-0 (operator 1) before pick (operator 3), so {gA} and h = 2. A node completed a layer
+  // late (gA at layer 3) or the rops of m3 fired in another order gives {gB, gB2} and 3.
+  Task t;
+  t.fact_names = {"(m1)", "(m2)", "(m3)", "(s0)", "(s1)", "(w)", "(gA)", "(z0)", "(z1)", "(gB)", "(gB2)"};
+  t.complement.assign(t.fact_names.size(), -1);
+  auto op = [&](const char* name, std::vector<FactId> pre, std::vector<FactId> add) {
+    Operator o;
+    o.name = name;
+    o.pre = std::move(pre);
+    o.add = std::move(add);
+    t.ops.push_back(o);
+  };
+  op("(make3)", {5}, {2});               // 0
+  op("(ship-0)", {0, 1, 2, 3}, {6, 7});  // 1
+  op("(ship-1)", {0, 1, 2, 4}, {6, 8});  // 2
+  op("(pick)", {2}, {9});                // 3
+  op("(q)", {5}, {10});                  // 4
+  t.finalize();
+  Goal goal;
+  goal.conjuncts.push_back(GoalConjunct{{9, 10}, {}});
+  goal.conjuncts.push_back(GoalConjunct{{6}, {}});
+  StateBits s(t.numWords(), 0);
+  for (FactId f : {0U, 1U, 3U, 5U}) setBit(s.data(), f);
+  for (bool factor : {true, false}) {
+    auto h = detail::makeLayeredFF(t, CostType::kUnit, factor);
+    h->setGoal(goal);
+    for (bool ff_style : {false, true}) {
+      ASSERT_TRUE(h->setFFStyle(ff_style));
+      EXPECT_EQ(h->evaluate(s.data()), 2) << factor << " " << ff_style;
+      EXPECT_EQ(h->preferred(), std::vector<OpId>{0}) << factor << " " << ff_style;
+    }
+  }
+  // The default h_FF of this unit-cost task is the layered one.
+  auto h = makeHeuristic(HeuristicKind::kFF, t, CostType::kUnit);
+  h->setGoal(goal);
+  EXPECT_EQ(h->evaluate(s.data()), 2);
+}
+
+/// The initial state of a solved session's task by fact names: the problem's init atoms, and a
+/// complement fact "(not a)" where a is not among them.
+StateBits initialStateByName(const PlanningSession& s) {
+  const Task& t = *s.task();
+  std::set<std::string> init;
+  for (const auto& a : s.problem().init) init.insert(pddl::toString(a));
+  StateBits st(t.numWords(), 0);
+  for (FactId f = 0; f < t.numFacts(); ++f) {
+    const std::string& n = t.fact_names[f];
+    const bool neg = n.rfind("(not ", 0) == 0;
+    const bool in = init.count(neg ? n.substr(5, n.size() - 6) : n) > 0;
+    if (in != neg) setBit(st.data(), f);
+  }
+  return st;
+}
+
+TEST(Heuristic, SharedPreconditionNodesChangeNoValueNorHelpfulActionOnRandomWalks) {
+  // h_FF's layered graph with and without the conjunction nodes, on openstacks (whose
+  // ship-order(o, s, s') share all preconditions but the stack count: the nodes are used) and
+  // gripper: the same value and the same helpful actions in the same order in every state of
+  // random walks (fixed seed), with either order of the helpful actions.
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"pddl-more/openstacks/domain.pddl", "pddl-more/openstacks/instance-6.pddl"},
+      {"pddl/gripper/domain.pddl", "pddl/gripper/instance-4.pddl"},
+  };
+  for (const auto& [dom, prob] : cases) {
+    SCOPED_TRACE(prob);
+    auto s = PlanningSession::fromText(test::readFile(test::benchmarksDir() / dom),
+                                       test::readFile(test::benchmarksDir() / prob));
+    ASSERT_TRUE(s.ok());
+    Query q;
+    q.init = *(*s)->problemInit();
+    q.goal_formula = (*s)->problem().goal;
+    ASSERT_EQ((*s)->solve(q, Termination()).status, PlanStatus::kSolved);
+    const Task& t = *(*s)->task();
+    const StateBits init = initialStateByName(**s);
+    Goal goal;
+    GoalConjunct gc;
+    for (const auto& c : (*s)->problem().goal.children) {
+      for (FactId f = 0; f < t.numFacts(); ++f) {
+        if (t.fact_names[f] == pddl::toString(c.atom)) gc.pos.push_back(f);
+      }
+    }
+    ASSERT_EQ(gc.pos.size(), (*s)->problem().goal.children.size());
+    std::sort(gc.pos.begin(), gc.pos.end());
+    goal.conjuncts.push_back(gc);
+    auto with = detail::makeLayeredFF(t, CostType::kUnit, true);
+    auto without = detail::makeLayeredFF(t, CostType::kUnit, false);
+    with->setGoal(goal);
+    without->setGoal(goal);
+    std::mt19937 rng(7);
+    std::vector<OpId> ops;
+    StateBits next(init.size());
+    size_t states = 0, positive = 0;
+    for (int walk = 0; walk < 20; ++walk) {
+      StateBits cur = init;
+      for (int step = 0; step < 80; ++step) {
+        for (bool ff_style : {false, true}) {
+          with->setFFStyle(ff_style);
+          without->setFFStyle(ff_style);
+          const Cost a = with->evaluate(cur.data());
+          const Cost b = without->evaluate(cur.data());
+          ASSERT_EQ(a, b) << "walk " << walk << " step " << step;
+          ASSERT_EQ(with->preferred(), without->preferred()) << "walk " << walk << " step " << step;
+          positive += a > 0 && a != Heuristic::kDeadEnd ? 1 : 0;
+        }
+        ++states;
+        ops.clear();
+        t.applicableOps(cur.data(), ops);
+        if (ops.empty()) break;
+        t.apply(cur.data(), ops[rng() % ops.size()], next.data());
+        cur.swap(next);
+      }
+    }
+    EXPECT_GT(states, 500U);
+    EXPECT_GT(positive, states);  // most states are neither goal states nor dead ends
   }
 }
 

@@ -64,6 +64,15 @@ class Heuristic {
 /// (unknown kind).
 std::unique_ptr<Heuristic> makeHeuristic(HeuristicKind kind, const Task& task, CostType cost_type);
 
+namespace detail {
+/// h_FF's layered graph (what `makeHeuristic(kFF, ...)` gives when every operator costs the same
+/// under `cost_type`) with `factor` choosing whether rops that share all preconditions but one
+/// count the shared part through one node (the default) or each their own. Both give the same
+/// values and helpful actions in the same order; for the test that says so.
+/// @throws std::invalid_argument when the operators differ in cost under `cost_type`.
+std::unique_ptr<Heuristic> makeLayeredFF(const Task& task, CostType cost_type, bool factor);
+}  // namespace detail
+
 /// Operator cost under `type`.
 inline Cost adjustedCost(const Operator& op, CostType type, bool unit_task) {
   if (type == CostType::kUnit || unit_task) return 1;

@@ -236,7 +236,13 @@ std::vector<std::string> Abstraction::objects() const {
 
 std::vector<std::string> Abstraction::staticAtoms() const {
   std::set<std::string> s(reaches_.begin(), reaches_.end());
-  s.insert(pushes_.begin(), pushes_.end());
+  // Pushes of objects the world still has: perception may lose one (a pushed crate seen through
+  // where its estimate lagged), and a fact about an object the problem does not declare makes
+  // the whole problem invalid for the task planner.
+  for (const auto& push : pushes_) {
+    const std::size_t a = std::string("(push-to ").size(), b = push.find(' ', a);
+    if (world_.findObject(push.substr(a, b - a)) != nullptr) s.insert(push);
+  }
   for (const auto& [id, r] : regions_) s.insert("(conf-over " + armconfOver(id) + " " + id + ")");
   for (const auto& o : world_.objects()) {
     if (graspable(o)) s.insert("(graspable " + o.id + ")");

@@ -164,7 +164,7 @@ void Abstraction::addReach(const std::string& location, const std::string& armco
 void Abstraction::addPush(const std::string& object, const std::string& support, const std::string& from,
                           const std::string& to, const std::string& slot) {
   if (locations_.count(from) && locations_.count(to) && regions_.count(support) && slots_.count(slot))
-    pushes_.insert("(push-to " + object + " " + support + " " + from + " " + to + " " + slot + ")");
+    pushes_.emplace("(push-to " + object + " " + support + " " + from + " " + to + " " + slot + ")", object);
 }
 
 bool Abstraction::isRegion(const std::string& id) const { return regions_.count(id) > 0; }
@@ -239,10 +239,8 @@ std::vector<std::string> Abstraction::staticAtoms() const {
   // Pushes of objects the world still has: perception may lose one (a pushed crate seen through
   // where its estimate lagged), and a fact about an object the problem does not declare makes
   // the whole problem invalid for the task planner.
-  for (const auto& push : pushes_) {
-    const std::size_t a = std::string("(push-to ").size(), b = push.find(' ', a);
-    if (world_.findObject(push.substr(a, b - a)) != nullptr) s.insert(push);
-  }
+  for (const auto& [fact, object] : pushes_)
+    if (world_.findObject(object) != nullptr) s.insert(fact);
   for (const auto& [id, r] : regions_) s.insert("(conf-over " + armconfOver(id) + " " + id + ")");
   for (const auto& o : world_.objects()) {
     if (graspable(o)) s.insert("(graspable " + o.id + ")");

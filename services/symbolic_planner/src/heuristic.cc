@@ -14,6 +14,30 @@ constexpr uint32_t kNone = UINT32_MAX;
 /// The delete relaxation of a task in flat (CSR) arrays. A relaxed operator ("rop", FF's
 /// "effect") is an operator's unconditional part or one of its conditional effects, with the
 /// effect condition added to the precondition. Built once per heuristic object.
+/// Grouping by shared keys (h_FF's precondition groups, the operator merging): item r has the
+/// keys keys[first_key[r] .. first_key[r + 1]), key k is shared by key_count[k] items. Per item,
+/// `chosen` is the index into `keys` of its key shared by the most items (more than one; the first
+/// on ties), kNone when none is shared; `members_of_key` counts the items that chose each key.
+void chooseLargestKeys(const std::vector<uint32_t>& first_key, const std::vector<uint32_t>& keys,
+                       const std::vector<uint32_t>& key_count, std::vector<uint32_t>& chosen,
+                       std::vector<uint32_t>& members_of_key) {
+  const size_t n = first_key.size() - 1;
+  chosen.assign(n, kNone);
+  members_of_key.assign(key_count.size(), 0);
+  for (size_t r = 0; r < n; ++r) {
+    uint32_t best = kNone, best_n = 1;
+    for (uint32_t i = first_key[r]; i < first_key[r + 1]; ++i) {
+      if (key_count[keys[i]] > best_n) {
+        best_n = key_count[keys[i]];
+        best = i;
+      }
+    }
+    if (best == kNone) continue;
+    chosen[r] = best;
+    ++members_of_key[keys[best]];
+  }
+}
+
 struct RelaxedOps {
   std::vector<OpId> op;              ///< rop -> operator
   std::vector<int32_t> ce;           ///< rop -> conditional effect index, -1 = unconditional part
@@ -110,19 +134,8 @@ struct RelaxedOps {
       }
     }
     first_key[n] = static_cast<uint32_t>(keys.size());
-    std::vector<uint32_t> chosen(n, kNone), members_of_key(key_count.size(), 0);
-    for (uint32_t r = 0; r < n; ++r) {
-      uint32_t best = kNone, best_n = 1;
-      for (uint32_t i = first_key[r]; i < first_key[r + 1]; ++i) {
-        if (key_count[keys[i]] > best_n) {
-          best_n = key_count[keys[i]];
-          best = i;
-        }
-      }
-      if (best == kNone) continue;
-      chosen[r] = best;
-      ++members_of_key[keys[best]];
-    }
+    std::vector<uint32_t> chosen, members_of_key;
+    chooseLargestKeys(first_key, keys, key_count, chosen, members_of_key);
     // Nodes, and per rop its node (kNone: counts every precondition itself) and own fact.
     std::vector<uint32_t> node_of_key(key_count.size(), kNone), node(n, kNone), own(n, 0);
     std::vector<uint32_t> node_rep;  // node -> (rop whose preconditions, bar one, are its facts)
@@ -344,20 +357,8 @@ struct RelaxedOps {
       }
     }
     first_key[task.ops.size()] = static_cast<uint32_t>(keys.size());
-    std::vector<uint32_t> chosen(task.ops.size(), kNone), group_of_key(key_count.size(), kNone);
-    std::vector<uint32_t> members_of_key(key_count.size(), 0);
-    for (OpId o = 0; o < task.ops.size(); ++o) {
-      uint32_t best = kNone, best_n = 1;
-      for (uint32_t i = first_key[o]; i < first_key[o + 1]; ++i) {
-        if (key_count[keys[i]] > best_n) {
-          best_n = key_count[keys[i]];
-          best = i;
-        }
-      }
-      if (best == kNone) continue;
-      chosen[o] = best;
-      ++members_of_key[keys[best]];
-    }
+    std::vector<uint32_t> chosen, members_of_key, group_of_key(key_count.size(), kNone);
+    chooseLargestKeys(first_key, keys, key_count, chosen, members_of_key);
     for (OpId o = 0; o < task.ops.size(); ++o) {
       if (chosen[o] == kNone) continue;
       const uint32_t kid = keys[chosen[o]];

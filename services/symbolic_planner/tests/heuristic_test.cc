@@ -13,6 +13,19 @@
 namespace tamp::symbolic_planner {
 namespace {
 
+/// The problem's goal atoms as one conjunct of a solved session's task facts, in the goal's order
+/// (an atom without a fact is left out: callers compare the size with the goal's).
+GoalConjunct goalFactsByName(const PlanningSession& s) {
+  const Task& t = *s.task();
+  GoalConjunct gc;
+  for (const auto& c : s.problem().goal.children) {
+    for (FactId f = 0; f < t.numFacts(); ++f) {
+      if (t.fact_names[f] == pddl::toString(c.atom)) gc.pos.push_back(f);
+    }
+  }
+  return gc;
+}
+
 class HeuristicContract : public ::testing::TestWithParam<std::tuple<HeuristicKind, CostType>> {};
 
 TEST_P(HeuristicContract, ZeroAtGoalNonNegativeAndDeadEndsOnRandomWalks) {
@@ -40,12 +53,7 @@ TEST_P(HeuristicContract, ZeroAtGoalNonNegativeAndDeadEndsOnRandomWalks) {
   }
   // Goal conjunct = facts of the goal atoms.
   Goal goal;
-  GoalConjunct gc;
-  for (const auto& c : (*s)->problem().goal.children) {
-    for (FactId f = 0; f < t.numFacts(); ++f) {
-      if (t.fact_names[f] == pddl::toString(c.atom)) gc.pos.push_back(f);
-    }
-  }
+  const GoalConjunct gc = goalFactsByName(**s);
   ASSERT_EQ(gc.pos.size(), (*s)->problem().goal.children.size());
   goal.conjuncts.push_back(gc);
   h->setGoal(goal);
@@ -219,12 +227,7 @@ TEST(Heuristic, SharedPreconditionNodesChangeNoValueNorHelpfulActionOnRandomWalk
     const Task& t = *(*s)->task();
     const StateBits init = initialStateByName(**s);
     Goal goal;
-    GoalConjunct gc;
-    for (const auto& c : (*s)->problem().goal.children) {
-      for (FactId f = 0; f < t.numFacts(); ++f) {
-        if (t.fact_names[f] == pddl::toString(c.atom)) gc.pos.push_back(f);
-      }
-    }
+    GoalConjunct gc = goalFactsByName(**s);
     ASSERT_EQ(gc.pos.size(), (*s)->problem().goal.children.size());
     std::sort(gc.pos.begin(), gc.pos.end());
     goal.conjuncts.push_back(gc);

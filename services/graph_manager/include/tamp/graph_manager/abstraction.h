@@ -144,7 +144,7 @@ class Abstraction {
   std::map<std::string, world::Region> regions_;  ///< world regions and slot regions
   std::map<std::string, Slot> slots_;
   std::set<std::string> reaches_;                 ///< "(reaches l c)"
-  std::set<std::string> pushes_;                  ///< "(push-to o r from to s)"
+  std::map<std::string, std::string> pushes_;     ///< "(push-to o r from to s)" -> o
   std::set<std::string> placeholders_;
   std::set<std::string> observed_armconfs_;
   int slot_counter_{0};

@@ -1,5 +1,7 @@
 #include "perception_node.h"
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 
@@ -27,6 +29,7 @@ Result<PerceptionNodeOptions> parseNodeOptions(const std::string& yaml_text, con
     n.optional("occupancy_period_s", o.occupancy_period_s);
     n.optional("frame_budget_s", o.frame_budget_s);
     n.optional("robot_state_max_age_s", o.robot_state_max_age_s);
+    n.optional("robot_state_wait_s", o.robot_state_wait_s);
     n.check(!o.world_id.empty(), "world_id", "must not be empty");
     n.check(std::isfinite(o.occupancy_period_s) && o.occupancy_period_s >= 0, "occupancy_period_s",
             "must be >= 0, got " + std::to_string(o.occupancy_period_s));
@@ -34,6 +37,8 @@ Result<PerceptionNodeOptions> parseNodeOptions(const std::string& yaml_text, con
             "must be positive, got " + std::to_string(o.frame_budget_s));
     n.check(std::isfinite(o.robot_state_max_age_s) && o.robot_state_max_age_s >= 0,
             "robot_state_max_age_s", "must be >= 0, got " + std::to_string(o.robot_state_max_age_s));
+    n.check(std::isfinite(o.robot_state_wait_s) && o.robot_state_wait_s >= 0 && o.robot_state_wait_s <= 5.0,
+            "robot_state_wait_s", "must be in [0, 5], got " + std::to_string(o.robot_state_wait_s));
     n.refuseUnknownKeys();
     if (!r.ok()) return r.status().error();
   }
@@ -198,24 +203,32 @@ void PerceptionNode::onState(const msg::RobotState& m) {
   if (!s) return fail(s.error().toString());
   if (s->arm.size() != options_.robot->armDof()) return fail("arm: wrong number of joints");
   ++states_;
-  std::lock_guard lock(state_mutex_);
-  states_seen_.push_back(StateSample{m.header().stamp_ns(), std::move(s).value(), m.held_object_id()});
-  while (states_seen_.size() > 64) states_seen_.pop_front();
-}
-
-std::optional<RobotBody> PerceptionNode::bodyAt(std::int64_t stamp_ns) const {
-  if (!options_.robot) return std::nullopt;
-  std::optional<StateSample> best;
   {
     std::lock_guard lock(state_mutex_);
-    for (const StateSample& s : states_seen_) {
-      if (!best || std::llabs(s.stamp_ns - stamp_ns) <= std::llabs(best->stamp_ns - stamp_ns)) best = s;
-    }
+    // Kept in stamp order (one writer delivers in order; a restarted one may not).
+    StampedRobotState sample{m.header().stamp_ns(), std::move(s).value(), m.held_object_id()};
+    const auto at = std::upper_bound(states_seen_.begin(), states_seen_.end(), sample.stamp_ns,
+                                     [](std::int64_t t, const StampedRobotState& x) { return t < x.stamp_ns; });
+    states_seen_.insert(at, std::move(sample));
+    while (states_seen_.size() > 64) states_seen_.pop_front();
   }
-  if (!best || static_cast<double>(std::llabs(best->stamp_ns - stamp_ns)) > options_.robot_state_max_age_s * 1e9) {
-    return std::nullopt;
+  state_cv_.notify_all();
+}
+
+std::optional<RobotBody> PerceptionNode::bodyAt(std::int64_t stamp_ns, std::stop_token stop) const {
+  if (!options_.robot) return std::nullopt;
+  std::optional<StampedRobotState> at;
+  {
+    std::unique_lock lock(state_mutex_);
+    // The state of the frame's instant may still be on its way (another topic, another thread):
+    // wait for one at or after the stamp, so that the body is interpolated, not extrapolated.
+    const auto wait = std::chrono::duration<double>(options_.robot_state_wait_s);
+    state_cv_.wait_for(lock, stop, wait,
+                       [&] { return !states_seen_.empty() && states_seen_.back().stamp_ns >= stamp_ns; });
+    at = robotStateAt(states_seen_, stamp_ns, options_.robot_state_max_age_s);
   }
-  return robotBodyAt(*options_.robot, best->state, best->held_object_id, best->stamp_ns);
+  if (!at) return std::nullopt;
+  return robotBodyAt(*options_.robot, at->state, at->held_object_id, at->stamp_ns);
 }
 
 void PerceptionNode::work(std::stop_token stop) {
@@ -229,7 +242,7 @@ void PerceptionNode::work(std::stop_token stop) {
       pending_.reset();
     }
     try {
-      process(*frame);
+      process(*frame, stop);
     } catch (const std::exception& e) {
       ++rejected_;
       log::get(name())->error("processing a frame failed: {}", e.what());
@@ -237,8 +250,8 @@ void PerceptionNode::work(std::stop_token stop) {
   }
 }
 
-void PerceptionNode::process(const PointCloudFrame& frame) {
-  const std::optional<RobotBody> body = bodyAt(frame.stamp_ns);
+void PerceptionNode::process(const PointCloudFrame& frame, std::stop_token stop) {
+  const std::optional<RobotBody> body = bodyAt(frame.stamp_ns, stop);
   if (options_.robot && !body) ++without_state_;
   auto r = perception_->processFrame(frame, Termination::after(options_.frame_budget_s),
                                      body ? &*body : nullptr);

@@ -9,10 +9,12 @@
 /// - the OctoMap of unexplained space (`topics::kOccupancy`, the OctoMap binary stream) at most
 ///   every `occupancy_period_s`.
 /// With a robot model it also subscribes the robot state (`topics::kRobotState`: base pose,
-/// joint positions, held object id) and gives each frame the robot's body at the state nearest
-/// the frame's stamp (within `robot_state_max_age_s`), so the robot's links and held object are
-/// not reported as obstacles (`self_filter.h`). A frame with no state that close is processed
-/// unfiltered and counted (`framesWithoutState`).
+/// joint positions, held object id) and gives each frame the robot's body at the frame's stamp,
+/// interpolated between the states around it (`robotStateAt`), so the robot's links and held
+/// object are not reported as obstacles (`self_filter.h`). A frame whose state has not arrived
+/// yet waits for it up to `robot_state_wait_s`; then the nearest state within
+/// `robot_state_max_age_s` is used. A frame with no state that close is processed unfiltered and
+/// counted (`framesWithoutState`).
 /// A malformed frame is rejected with a warning naming the field and counted; nothing escapes
 /// the DDS callback or the worker thread.
 
@@ -45,6 +47,9 @@ struct PerceptionNodeOptions {
   /// default robot).
   std::shared_ptr<const robot::RobotModel> robot;
   double robot_state_max_age_s{0.5};  ///< s, >= 0: largest |frame stamp - state stamp| used
+  /// s, in [0, 5]: how long a frame waits for a robot state at or after its stamp (states and
+  /// frames travel on different topics; under load the frame may arrive first).
+  double robot_state_wait_s{0.25};
   /// Where the node keeps its checkpoint (checkpoint.h); empty: none. `create()` sets it to
   /// `$TAMP_RUN_DIR/perception.checkpoint` and, when that file exists, starts from it: `prior`
   /// restored and `resume_grasp` set.
@@ -84,10 +89,11 @@ class PerceptionNode : public dds::ServiceNode {
   msgv::RejectLog rejects_{"perception"};  // malformed input: logged once per kind, rate-limited
   void onCloud(const msg::PointCloudFrame& m);
   void onState(const msg::RobotState& m);
-  /// The robot's body at the state nearest `stamp_ns` within the age limit, or nullopt.
-  std::optional<RobotBody> bodyAt(std::int64_t stamp_ns) const;
+  /// The robot's body at `stamp_ns` (waiting up to `robot_state_wait_s` for a state at or after
+  /// it), or nullopt when no state is within the age limit.
+  std::optional<RobotBody> bodyAt(std::int64_t stamp_ns, std::stop_token stop) const;
   void work(std::stop_token stop);
-  void process(const PointCloudFrame& frame);
+  void process(const PointCloudFrame& frame, std::stop_token stop);
   /// Writes the checkpoint when the world model or the grasp changed since the last one.
   void checkpoint(bool world_changed);
 
@@ -102,13 +108,9 @@ class PerceptionNode : public dds::ServiceNode {
   world::World snapshot_;
   std::atomic<std::uint64_t> processed_{0}, rejected_{0}, skipped_{0}, without_state_{0};
   std::atomic<std::uint64_t> states_{0}, bad_states_{0};
-  struct StateSample {
-    std::int64_t stamp_ns{0};
-    robot::RobotState state;
-    std::string held_object_id;
-  };
   mutable std::mutex state_mutex_;
-  std::deque<StateSample> states_seen_;  // newest last, bounded
+  mutable std::condition_variable_any state_cv_;  // a state arrived
+  std::deque<StampedRobotState> states_seen_;     // stamp order, newest last, bounded
   std::uint64_t event_seq_{0}, map_seq_{0};
   std::optional<Clock::time_point> last_map_;
   std::optional<Perception::HeldGrasp> checkpointed_grasp_;  // worker thread only

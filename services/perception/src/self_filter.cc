@@ -1,6 +1,8 @@
 #include "tamp/perception/self_filter.h"
 
+#include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <stdexcept>
 
@@ -18,6 +20,36 @@ struct SensorSolid {
 };
 
 }  // namespace
+
+std::optional<StampedRobotState> robotStateAt(const std::deque<StampedRobotState>& samples, std::int64_t stamp_ns,
+                                              double max_age_s) {
+  if (samples.empty()) return std::nullopt;
+  // The first sample at or after the stamp.
+  const auto after = std::lower_bound(samples.begin(), samples.end(), stamp_ns,
+                                      [](const StampedRobotState& s, std::int64_t t) { return s.stamp_ns < t; });
+  if (after != samples.end() && after->stamp_ns == stamp_ns) return *after;
+  if (after == samples.begin() || after == samples.end()) {
+    const StampedRobotState& nearest = after == samples.end() ? samples.back() : samples.front();
+    const double age = std::abs(static_cast<double>(nearest.stamp_ns - stamp_ns)) * 1e-9;
+    if (age > max_age_s) return std::nullopt;
+    return nearest;
+  }
+  const StampedRobotState& a = *std::prev(after);
+  const StampedRobotState& b = *after;
+  const double f = static_cast<double>(stamp_ns - a.stamp_ns) / static_cast<double>(b.stamp_ns - a.stamp_ns);
+  StampedRobotState out = f < 0.5 ? a : b;
+  out.stamp_ns = stamp_ns;
+  out.state.base.x = a.state.base.x + f * (b.state.base.x - a.state.base.x);
+  out.state.base.y = a.state.base.y + f * (b.state.base.y - a.state.base.y);
+  out.state.base.theta =
+      std::remainder(a.state.base.theta + f * std::remainder(b.state.base.theta - a.state.base.theta, 2 * M_PI), 2 * M_PI);
+  if (a.state.arm.size() == b.state.arm.size()) {
+    for (std::size_t i = 0; i < a.state.arm.size(); ++i)
+      out.state.arm[i] = a.state.arm[i] + f * (b.state.arm[i] - a.state.arm[i]);
+    out.state.gripper = a.state.gripper + f * (b.state.gripper - a.state.gripper);
+  }
+  return out;
+}
 
 RobotBody robotBodyAt(const robot::RobotModel& robot, const robot::RobotState& state,
                       std::string held_object_id, std::int64_t stamp_ns) {

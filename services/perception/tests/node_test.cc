@@ -215,6 +215,9 @@ TEST(PerceptionNodeTest, NodeOptionsFromYaml) {
   auto age = parseNodeOptions("node: {robot_state_max_age_s: -1}\nself_filter: {padding: 0.05}\n", "n.yaml");
   ASSERT_FALSE(age.ok());
   EXPECT_NE(age.error().toString().find("node.robot_state_max_age_s"), std::string::npos) << age.error().toString();
+  auto wait = parseNodeOptions("node: {robot_state_wait_s: 9}\n", "n.yaml");
+  ASSERT_FALSE(wait.ok());
+  EXPECT_NE(wait.error().toString().find("node.robot_state_wait_s"), std::string::npos) << wait.error().toString();
   auto pad = parseNodeOptions("self_filter: {padding: 0.05, enabled: false}\n", "n.yaml");
   ASSERT_TRUE(pad.ok()) << pad.error().toString();
   EXPECT_DOUBLE_EQ(pad->params.self_filter.padding, 0.05);

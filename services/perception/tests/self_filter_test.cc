@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <deque>
 #include <limits>
 #include <stdexcept>
 #include <utility>
@@ -132,6 +133,41 @@ TEST(SelfFilterTest, BodyPartsFollowForwardKinematics) {
   robot::RobotState bad = s;
   bad.arm.pop_back();
   EXPECT_THROW((void)robotBodyAt(robotModel(), bad), std::invalid_argument);
+}
+
+TEST(SelfFilterTest, TheStateOfAFramesInstantIsInterpolatedBetweenTheReportsAroundIt) {
+  // A base driving at 1 m/s and turning across the yaw wrap, reported every 50 ms.
+  std::deque<StampedRobotState> reports;
+  for (int k = 0; k < 3; ++k) {
+    StampedRobotState r;
+    r.stamp_ns = 50'000'000LL * k;
+    r.state = armReady(0.2 * k);
+    r.state.base.x = 0.05 * k;
+    r.state.base.theta = std::remainder(3.1 + 0.1 * k, 2 * M_PI);
+    r.held_object_id = k == 2 ? "can" : "";
+    reports.push_back(r);
+  }
+  // 40 ms: 80 % of the way from the first report to the second (the nearest report is 1 cm off).
+  const auto mid = robotStateAt(reports, 40'000'000LL, 0.5);
+  ASSERT_TRUE(mid.has_value());
+  EXPECT_EQ(mid->stamp_ns, 40'000'000LL);
+  EXPECT_NEAR(mid->state.base.x, 0.04, 1e-9);
+  EXPECT_NEAR(std::remainder(mid->state.base.theta - 3.18, 2 * M_PI), 0.0, 1e-9);
+  EXPECT_NEAR(mid->state.arm[0], 0.16, 1e-9);
+  // Across the wrap (3.2 is -3.083): the short way round, not back through zero.
+  const auto wrap = robotStateAt(reports, 70'000'000LL, 0.5);
+  ASSERT_TRUE(wrap.has_value());
+  EXPECT_NEAR(std::remainder(wrap->state.base.theta - 3.24, 2 * M_PI), 0.0, 1e-9);
+  EXPECT_EQ(wrap->held_object_id, "");      // nearer the second report (k = 1): empty hand
+  EXPECT_EQ(robotStateAt(reports, 90'000'000LL, 0.5)->held_object_id, "can");  // nearer the third
+  // A report at the very stamp is itself.
+  EXPECT_EQ(robotStateAt(reports, 50'000'000LL, 0.0)->state.base.x, reports[1].state.base.x);
+  // Past the last report: the last one, within the age limit only.
+  ASSERT_TRUE(robotStateAt(reports, 140'000'000LL, 0.05).has_value());
+  EXPECT_EQ(robotStateAt(reports, 140'000'000LL, 0.05)->state.base.x, reports[2].state.base.x);
+  EXPECT_FALSE(robotStateAt(reports, 160'000'000LL, 0.05).has_value());
+  EXPECT_FALSE(robotStateAt(reports, -60'000'000LL, 0.05).has_value());
+  EXPECT_FALSE(robotStateAt({}, 0, 1.0).has_value());
 }
 
 TEST(SelfFilterTest, RemovesExactlyThePointsOnTheBodyAndTheHeldObject) {

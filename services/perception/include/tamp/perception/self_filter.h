@@ -17,6 +17,8 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <deque>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -44,6 +46,24 @@ struct RobotBody {
   std::int64_t stamp_ns{0};  ///< of the robot state it was computed from
   std::string base_link;     ///< owner of the parts that drive on the floor (objects cannot be inside them)
 };
+
+/// What the robot reported at one instant: its state and the object in its gripper.
+struct StampedRobotState {
+  std::int64_t stamp_ns{0};
+  robot::RobotState state;
+  std::string held_object_id;
+};
+
+/// The robot's state at `stamp_ns` from `samples` (oldest first). Between two samples it is
+/// interpolated: base position and joints linearly, the base yaw the short way round, the held
+/// object that of the nearer sample. A frame's returns are filtered with the body where it was
+/// at the frame's instant, not at the nearest report (which, a state period away on a moving
+/// base, leaves a strip of the robot in the frame: a "new box" beside it). Outside the samples'
+/// span, the nearest sample when it is within `max_age_s` of `stamp_ns`; nullopt otherwise
+/// (or when `samples` is empty). Arm vectors of different sizes are not interpolated (the
+/// nearer sample is used).
+std::optional<StampedRobotState> robotStateAt(const std::deque<StampedRobotState>& samples, std::int64_t stamp_ns,
+                                              double max_age_s);
 
 /// The body of `robot` in `state` (link poses by `RobotModel::linkPoses`, shapes from
 /// `collisionGeometry()`; the tool link is `options().tool_link`).

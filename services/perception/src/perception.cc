@@ -781,7 +781,9 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
 
   // Unmatched detections become tentative objects (class from the priors, else by size),
   // unless they are mostly inside a tracked object (a fragment of it, e.g. a side face split
-  // off by range noise).
+  // off by range noise, or the part of it the image cuts off, too short to match it). Inside
+  // within the size tolerance plus the range noise where the point was seen: from afar a face
+  // spreads over a band a dozen centimetres deep, and the track may be a few centimetres off.
   for (std::size_t i = 0; i < dets.size(); ++i) {
     if (det_used[i]) continue;
     const Detection& d = dets[i];
@@ -789,7 +791,10 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
     for (const auto& [id, t] : I.tracks) {
       if (t.state == TrackInfo::State::kGone) continue;
       std::size_t inside = 0;
-      for (const auto& p : d.points) inside += pointInShape(t.shape, t.pose, p, T.size_tolerance) ? 1 : 0;
+      for (const auto& p : d.points) {
+        const double margin = T.size_tolerance + P.planes.noise_sigmas * P.sensor.stddev((p - sensor).norm());
+        inside += pointInShape(t.shape, t.pose, p, margin) ? 1 : 0;
+      }
       if (2 * inside >= d.points.size()) {
         fragment = true;
         break;

@@ -117,7 +117,7 @@ int main(int argc, char** argv) {
   size_t memory_mb = 4096;
   bool stats = false, no_check = false, no_fallback = false, no_agenda = false, first_improvement = false,
        no_ff_first = false, no_landmarks = false, no_unit_first = false,
-       no_full_retry = false, ff_first_improvement = false;
+       no_full_retry = false, ff_first_improvement = false, no_lazy_beside = false;
   uint64_t ff_budget = 300, second_budget = 300;
   const sp::SearchOptions defaults;
   uint64_t fallback_budget = defaults.ehc_fallback_budget_per_h, fallback_min = defaults.ehc_fallback_budget_min,
@@ -125,6 +125,8 @@ int main(int argc, char** argv) {
   double unit_first_share = defaults.unit_first_time_share;
   int64_t heap_reserve_mib = 64;
   double retry_share = defaults.ehc_retry_budget_share;
+  uint64_t lazy_after = defaults.ehc_lazy_after, lazy_turn_ehc = defaults.ehc_lazy_turn_ehc,
+           lazy_turn_lazy = defaults.ehc_lazy_turn_lazy;
   app.add_option("domain", domain, "PDDL domain file")->required();
   app.add_option("problem", problem, "PDDL problem file")->required();
   app.add_option("--search", search,
@@ -185,6 +187,15 @@ int main(int argc, char** argv) {
                  "the share of the time left that the unit-cost first run may use, in (0, 1]")
       ->check(CLI::Range(1e-9, 1.0));
   app.add_flag("--no-landmarks", no_landmarks, "lazy: h_FF only (no landmark-count heuristic)");
+  app.add_flag("--no-ehc-lazy-beside", no_lazy_beside,
+               "ehc: the lazy search only after the hill-climbing fails (FF's order), not beside it");
+  app.add_option("--ehc-lazy-after", lazy_after,
+                 "ehc: the lazy search starts beside the hill-climbing after this many evaluations (> 0)")
+      ->check(CLI::Range(uint64_t{1}, UINT64_MAX));
+  app.add_option("--ehc-lazy-turn-ehc", lazy_turn_ehc, "ehc: evaluations of the hill-climbing per turn (> 0)")
+      ->check(CLI::Range(uint64_t{1}, UINT64_MAX));
+  app.add_option("--ehc-lazy-turn-lazy", lazy_turn_lazy, "ehc: evaluations of the lazy search per turn (> 0)")
+      ->check(CLI::Range(uint64_t{1}, UINT64_MAX));
   app.add_option("--ehc-fallback-min", fallback_min, "ehc: the MIN of --ehc-fallback-budget");
   app.add_option("--ehc-fallback-max", fallback_max, "ehc: at most this many evaluations before falling back (0 = no cap)");
   try {
@@ -216,6 +227,10 @@ int main(int argc, char** argv) {
   req.search.ehc_fallback_budget_min = fallback_min;
   req.search.ehc_fallback_budget_max = fallback_max;
   req.search.landmarks = !no_landmarks;
+  req.search.ehc_lazy_beside = !no_lazy_beside;
+  req.search.ehc_lazy_after = lazy_after;
+  req.search.ehc_lazy_turn_ehc = lazy_turn_ehc;
+  req.search.ehc_lazy_turn_lazy = lazy_turn_lazy;
   req.search.anytime_seconds = anytime;
   req.search.unit_cost_first = !no_unit_first;
   req.search.unit_first_time_share = unit_first_share;
@@ -238,7 +253,7 @@ int main(int argc, char** argv) {
                  "; status %s; parse %.4f s, ground %.4f s, search %.4f s; facts %zu, operators %zu; "
                  "expanded %llu, evaluated %llu, initial h %lld; ehc plateau retries %llu (%llu abandoned); ehc fallbacks "
                  "%llu (%llu in a goal-agenda entry before the last); anytime %llu "
-                 "iterations, %llu improvements%s%s%s%s\n",
+                 "iterations, %llu improvements%s%s%s%s%s\n",
                  sp::toString(reply.status).c_str(), reply.stats.parse_seconds, reply.stats.ground_seconds,
                  reply.stats.search_seconds, reply.stats.facts, reply.stats.operators,
                  static_cast<unsigned long long>(reply.stats.expanded),
@@ -254,6 +269,9 @@ int main(int argc, char** argv) {
                  : reply.stats.ehc_second_ran ? "; second ehc run, first plan kept"
                                               : "",
                  reply.stats.ehc_failed ? "; ehc failed, fell back to best-first search" : "",
+                 reply.stats.lazy_beside_won       ? "; lazy search beside ehc gave the answer"
+                 : reply.stats.lazy_beside_started ? "; lazy search beside ehc started"
+                                                   : "",
                  reply.stats.unit_first_failed ? "; unit-cost first run failed, first plan with cost + 1" : "");
   }
   if (reply.status != sp::PlanStatus::kSolved) {

@@ -306,6 +306,8 @@ PlanReply PlanningSession::solve(const Query& q, const Termination& term) {
   reply.stats.ehc_retries_abandoned = sr.stats.ehc_retries_abandoned;
   reply.stats.ehc_fallbacks = sr.stats.ehc_fallbacks;
   reply.stats.ehc_fallbacks_in_agenda = sr.stats.ehc_fallbacks_in_agenda;
+  reply.stats.lazy_beside_started = sr.stats.lazy_beside_started;
+  reply.stats.lazy_beside_won = sr.stats.lazy_beside_won;
   reply.stats.anytime_iterations = sr.stats.anytime_iterations;
   reply.stats.anytime_improvements = sr.stats.anytime_improvements;
   reply.stats.unit_first_failed = sr.stats.unit_first_failed;

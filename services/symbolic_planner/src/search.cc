@@ -9,12 +9,66 @@
 
 #include <algorithm>
 #include <cmath>
+#include <coroutine>
+#include <exception>
+#include <functional>
+#include <optional>
 #include <stdexcept>
+#include <utility>
 
 namespace tamp::symbolic_planner {
 namespace {
 
 constexpr uint32_t kNone = UINT32_MAX;
+
+/// A search that runs in steps: created suspended; each `resume()` runs it to its next
+/// suspension (the end of a turn) or to its end, after which `result()` holds its answer. An
+/// exception thrown inside comes out of the `resume()` that ran into it.
+class SearchCoroutine {
+ public:
+  struct promise_type {
+    SearchResult result;
+    std::exception_ptr error;
+    SearchCoroutine get_return_object() {
+      return SearchCoroutine(std::coroutine_handle<promise_type>::from_promise(*this));
+    }
+    std::suspend_always initial_suspend() noexcept { return {}; }
+    std::suspend_always final_suspend() noexcept { return {}; }
+    void return_value(SearchResult r) { result = std::move(r); }
+    void unhandled_exception() { error = std::current_exception(); }
+  };
+  explicit SearchCoroutine(std::coroutine_handle<promise_type> h) : h_(h) {}
+  SearchCoroutine(SearchCoroutine&& o) noexcept : h_(std::exchange(o.h_, {})) {}
+  SearchCoroutine& operator=(SearchCoroutine&&) = delete;
+  SearchCoroutine(const SearchCoroutine&) = delete;
+  ~SearchCoroutine() {
+    if (h_) h_.destroy();
+  }
+  bool done() const { return h_.done(); }
+  void resume() {
+    h_.resume();
+    if (h_.done() && h_.promise().error) std::rethrow_exception(std::exchange(h_.promise().error, nullptr));
+  }
+  /// Runs the rest of the search in one go.
+  void runToEnd() {
+    while (!done()) resume();
+  }
+  SearchResult& result() { return h_.promise().result; }
+  const SearchResult& result() const { return h_.promise().result; }
+
+ private:
+  std::coroutine_handle<promise_type> h_;
+};
+
+/// What a hill-climbing run calls when another search takes turns with it
+/// (`SearchOptions::ehc_lazy_beside`): `evaluated()` after each of its evaluations (and the other
+/// search may run a turn inside it), `stopped()` once the other has given a final answer.
+class TurnTaker {
+ public:
+  virtual ~TurnTaker() = default;
+  virtual void evaluated() = 0;
+  virtual bool stopped() const = 0;
+};
 
 /// All states of one search in one pool; an open-addressing hash set of ids.
 class StateRegistry {
@@ -252,6 +306,21 @@ class Searcher {
     succ_.resize(task.numWords());
   }
 
+  /// The counters so far.
+  const SearchStatistics& statistics() const { return stats_; }
+
+  /// Hill-climbing runs: take turns with another search (see `TurnTaker`).
+  void takeTurns(TurnTaker* turns) { turns_ = turns; }
+
+  /// The lazy search (`kLazy`) from the start, suspended after every `turn` evaluations (> 0).
+  SearchCoroutine lazyInTurns(uint64_t turn) {
+    Stopwatch sw;
+    h_.setGoal(goal_);
+    SearchCoroutine steps = lazySteps(std::numeric_limits<Cost>::max(), turn);
+    for (steps.resume(); !steps.done(); steps.resume()) co_await std::suspend_always{};
+    co_return finished(std::move(steps.result()), sw, true);
+  }
+
   SearchResult run() {
     Stopwatch sw;
     h_.setGoal(goal_);
@@ -328,6 +397,7 @@ class Searcher {
       pref_count_[id] = static_cast<uint32_t>(p.size());
       pref_pool_.insert(pref_pool_.end(), p.begin(), p.end());
     }
+    if (turns_ != nullptr) turns_->evaluated();
     return h;
   }
 
@@ -348,6 +418,7 @@ class Searcher {
 
   /// Checks time and memory every 256 calls; returns a terminal status or nullopt.
   std::optional<SearchStatus> checkLimits() {
+    if (turns_ != nullptr && turns_->stopped()) return SearchStatus::kCancelled;
     if ((++checks_ & 255) != 0) return std::nullopt;
     const StopReason why = term_.reason();
     if (why == StopReason::kDeadline) return SearchStatus::kTimeout;
@@ -579,14 +650,21 @@ class Searcher {
   /// Paths costing `bound` or more are pruned (the anytime phase's first iteration); g is the
   /// cost of the path found first (no re-opening).
   SearchResult lazy(Cost bound = std::numeric_limits<Cost>::max()) {
+    SearchCoroutine steps = lazySteps(bound, 0);
+    steps.runToEnd();
+    return std::move(steps.result());
+  }
+
+  /// The lazy search as a coroutine: suspended after every `turn` evaluations (0: never).
+  SearchCoroutine lazySteps(Cost bound, uint64_t turn) {
     resetRegistry();
     bool is_new = false;
     const uint32_t root = registerState(init_.data(), &is_new);
     g_[root] = 0;
-    if (task_.goalReached(reg_.get(root), goal_)) return finish(SearchStatus::kSolved);
+    if (task_.goalReached(reg_.get(root), goal_)) co_return finish(SearchStatus::kSolved);
     const Cost h0 = evaluate(root);
     if (stats_.initial_h == 0) stats_.initial_h = h0;
-    if (h0 == Heuristic::kDeadEnd) return finish(SearchStatus::kUnsolvable);
+    if (h0 == Heuristic::kDeadEnd) co_return finish(SearchStatus::kUnsolvable);
     const bool use_pref = opt_.preferred_operators && h_.computesPreferred();
     // LAMA's second heuristic: landmark count, with its own accepted-landmark set per state.
     std::unique_ptr<LandmarkCounter> lm;
@@ -638,15 +716,20 @@ class Searcher {
     };
     expand(root);
     Cost best_ff = h0, best_lm = lm ? hlm[root] : 0;
+    uint64_t turn_end = stats_.evaluated + turn;
     for (;;) {
-      if (auto st = checkLimits()) return finish(*st);
+      if (turn > 0 && stats_.evaluated >= turn_end) {
+        co_await std::suspend_always{};
+        turn_end = stats_.evaluated + turn;
+      }
+      if (auto st = checkLimits()) co_return finish(*st);
       open_bytes_ = lists[0].bytes() + lists[1].bytes() + lists[2].bytes() + lists[3].bytes() + accepted.capacity() * 8 +
                     hlm.capacity() * 8;
       int pick = -1;
       for (int i = 0; i < 4; ++i) {
         if (active[i] && !lists[i].empty() && (pick < 0 || prio[i] < prio[pick])) pick = i;
       }
-      if (pick < 0) return finish(SearchStatus::kUnsolvable);
+      if (pick < 0) co_return finish(SearchStatus::kUnsolvable);
       ++prio[pick];
       const LazyEntry e = lists[pick].pop();
       std::copy(reg_.get(e.parent), reg_.get(e.parent) + reg_.words(), buf_.begin());
@@ -656,7 +739,7 @@ class Searcher {
       parent_[sid] = e.parent;
       op_[sid] = e.op;
       g_[sid] = g_[e.parent] + opCost(e.op);
-      if (task_.goalReached(succ_.data(), goal_)) return finish(SearchStatus::kSolved, path(sid, kNone));
+      if (task_.goalReached(succ_.data(), goal_)) co_return finish(SearchStatus::kSolved, path(sid, kNone));
       if (lm) {
         lm->progress(accepted.data() + static_cast<size_t>(e.parent) * lw, succ_.data(), acc_tmp.data());
         accepted.insert(accepted.end(), acc_tmp.begin(), acc_tmp.end());
@@ -897,6 +980,7 @@ class Searcher {
   uint64_t eval_budget_{0};      // ehc: give up after this many evaluations (0 = unlimited)
   uint64_t fallback_budget_{0};  // ehc: fall back after this many evaluations (0 = unlimited)
   uint32_t iter_{0};
+  TurnTaker* turns_{nullptr};  // another search taking turns with this hill-climbing, if any
   bool in_agenda_entry_before_last_{false};  // ehc: hill-climbing to a goal-agenda entry, not the last
 };
 
@@ -977,6 +1061,11 @@ void SearchOptions::validate() const {
     throw std::invalid_argument("SearchOptions::ehc_retry_budget_share must be in [0, 1], got " +
                                 std::to_string(ehc_retry_budget_share));
   }
+  if (ehc_lazy_turn_ehc == 0 || ehc_lazy_turn_lazy == 0) {
+    throw std::invalid_argument("SearchOptions::ehc_lazy_turn_ehc and ehc_lazy_turn_lazy must be > 0, got " +
+                                std::to_string(ehc_lazy_turn_ehc) + " and " + std::to_string(ehc_lazy_turn_lazy));
+  }
+  if (ehc_lazy_after == 0) throw std::invalid_argument("SearchOptions::ehc_lazy_after must be > 0, got 0");
   if (preferred_boost < 0) {
     throw std::invalid_argument("SearchOptions::preferred_boost must be >= 0, got " + std::to_string(preferred_boost));
   }
@@ -984,13 +1073,11 @@ void SearchOptions::validate() const {
 
 namespace {
 
-/// The first plan: the configured search (with EHC's first run and fallback).
-SearchResult firstPlan(const Task& task, const StateBits& init, const Goal& goal, const SearchOptions& options,
-                       Heuristic& heuristic, const Termination& term) {
-  if (init.size() != task.numWords()) {
-    throw std::invalid_argument("search: initial state has " + std::to_string(init.size()) + " words, task needs " +
-                                std::to_string(task.numWords()));
-  }
+/// The configured search (with EHC's first run and fallback); with `turns`, every hill-climbing
+/// run before the first plan takes turns with the lazy search (not the second run, which starts
+/// once the hill-climbing has a plan).
+SearchResult configuredSearch(const Task& task, const StateBits& init, const Goal& goal, const SearchOptions& options,
+                              Heuristic& heuristic, const Termination& term, TurnTaker* turns) {
   if (options.algorithm == SearchAlgorithm::kEhc && options.ehc_ff_first && options.ehc_ff_budget_per_h > 0 &&
       heuristic.setFFStyle(true)) {
     // First run: EHC with FF-v2.3's relaxed plan, no fallback, bounded evaluations.
@@ -1001,6 +1088,7 @@ SearchResult firstPlan(const Task& task, const StateBits& init, const Goal& goal
     SearchResult r1;
     try {
       Searcher s1(task, init, goal, first, heuristic, term);
+      s1.takeTurns(turns);
       r1 = s1.run();
     } catch (...) {
       heuristic.setFFStyle(false);
@@ -1037,13 +1125,127 @@ SearchResult firstPlan(const Task& task, const StateBits& init, const Goal& goal
     SearchOptions rest = options;
     rest.ehc_fallback_budget_spent = r1.stats.evaluated;
     Searcher s2(task, init, goal, rest, heuristic, term);
+    s2.takeTurns(turns);
     SearchResult r2 = s2.run();
     r2.stats.ehc_ff_failed = true;
     addRunCosts(r2.stats, r1.stats);
     return r2;
   }
   Searcher s(task, init, goal, options, heuristic, term);
+  s.takeTurns(turns);
   return s.run();
+}
+
+/// SearchOptions::ehc_lazy_beside: the lazy search, started once the hill-climbing has used
+/// `ehc_lazy_after` evaluations, then run for `ehc_lazy_turn_lazy` evaluations after every
+/// `ehc_lazy_turn_ehc` of the hill-climbing's, inside the hill-climbing's own call (one thread:
+/// a turn costs a function call). It has a searcher (states) and a heuristic of its own.
+class LazyBeside : public TurnTaker {
+ public:
+  LazyBeside(const Task& task, const StateBits& init, const Goal& goal, const SearchOptions& options,
+             const Termination& term)
+      : task_(task), init_(init), goal_(goal), options_(options), term_(term), left_(options.ehc_lazy_after) {
+    options_.algorithm = SearchAlgorithm::kLazy;
+  }
+
+  void evaluated() override {
+    if (finished_ || --left_ > 0) return;
+    left_ = options_.ehc_lazy_turn_ehc;
+    start();
+    steps_->resume();
+    finished_ = steps_->done();
+  }
+  /// The lazy search has given a final answer (a plan or a proof): the hill-climbing stops.
+  bool stopped() const override {
+    if (!finished_) return false;
+    const SearchStatus st = steps_->result().status;
+    return st == SearchStatus::kSolved || st == SearchStatus::kUnsolvable;
+  }
+  bool started() const { return steps_.has_value(); }
+  /// The lazy search's counters so far (it must have started).
+  const SearchStatistics& statistics() const { return searcher_->statistics(); }
+  bool finished() const { return finished_; }
+  /// Runs the lazy search to its end (starting it if it has not started).
+  SearchResult& runToEnd() {
+    start();
+    steps_->runToEnd();
+    finished_ = true;
+    return steps_->result();
+  }
+
+ private:
+  void start() {
+    if (steps_) return;
+    heuristic_ = makeHeuristic(defaultHeuristic(options_), task_, defaultCostType(options_, task_));
+    searcher_ = std::make_unique<Searcher>(task_, init_, goal_, options_, *heuristic_, term_);
+    steps_.emplace(searcher_->lazyInTurns(options_.ehc_lazy_turn_lazy));
+  }
+
+  const Task& task_;
+  const StateBits& init_;
+  const Goal& goal_;
+  SearchOptions options_;
+  const Termination& term_;
+  uint64_t left_;  // hill-climbing evaluations before the lazy search's next turn
+  std::unique_ptr<Heuristic> heuristic_;
+  std::unique_ptr<Searcher> searcher_;
+  std::optional<SearchCoroutine> steps_;
+  bool finished_{false};
+};
+
+/// `winner`'s result with `other`'s effort counted and the hill-climbing's own flags (`ehc`).
+SearchResult withBothRuns(SearchResult winner, const SearchStatistics& other, const SearchStatistics& ehc) {
+  addRunCosts(winner.stats, other);
+  winner.stats.initial_h = ehc.initial_h;
+  winner.stats.ehc_ff_failed = ehc.ehc_ff_failed;
+  winner.stats.ehc_retries = ehc.ehc_retries;
+  winner.stats.ehc_retries_abandoned = ehc.ehc_retries_abandoned;
+  return winner;
+}
+
+/// The hill-climbing (without its fallback) with the lazy search beside it (`LazyBeside`). The
+/// first final answer wins: a plan or a proof of either, or the deadline. When the hill-climbing
+/// gives up (or runs out of memory), the lazy search goes on alone from where it is, or starts
+/// now; its answer is then the answer, as the fallback's is without this option.
+SearchResult ehcWithLazyBeside(const Task& task, const StateBits& init, const Goal& goal, const SearchOptions& options,
+                               Heuristic& heuristic, const Termination& term) {
+  LazyBeside lazy(task, init, goal, options, term);
+  SearchOptions ehc_only = options;
+  ehc_only.ehc_fallback = false;
+  SearchResult ehc = configuredSearch(task, init, goal, ehc_only, heuristic, term, &lazy);
+  ehc.stats.lazy_beside_started = lazy.started();
+  if (lazy.stopped()) {  // the lazy search's plan or proof came first
+    SearchResult r = withBothRuns(std::move(lazy.runToEnd()), ehc.stats, ehc.stats);
+    r.stats.lazy_beside_started = r.stats.lazy_beside_won = true;
+    return r;
+  }
+  const bool ehc_gave_up = ehc.status == SearchStatus::kFailed || ehc.status == SearchStatus::kOutOfMemory;
+  if (!ehc_gave_up) {  // the hill-climbing's plan, proof or limit
+    if (lazy.started()) addRunCosts(ehc.stats, lazy.statistics());
+    return ehc;
+  }
+  // The fallback: the lazy search from where it is (or from the start), or its end if it ended
+  // (out of memory) before.
+  SearchResult r = withBothRuns(std::move(lazy.runToEnd()), ehc.stats, ehc.stats);
+  r.stats.ehc_failed = true;
+  r.stats.ehc_fallbacks = 1;
+  r.stats.lazy_beside_started = ehc.stats.lazy_beside_started;
+  return r;
+}
+
+/// The first plan: the configured search, with the lazy search beside the hill-climbing when
+/// `ehc_lazy_beside` applies.
+SearchResult firstPlan(const Task& task, const StateBits& init, const Goal& goal, const SearchOptions& options,
+                       Heuristic& heuristic, const Termination& term) {
+  if (init.size() != task.numWords()) {
+    throw std::invalid_argument("search: initial state has " + std::to_string(init.size()) + " words, task needs " +
+                                std::to_string(task.numWords()));
+  }
+  if (options.algorithm == SearchAlgorithm::kEhc && options.ehc_fallback &&
+      options.fallback == SearchAlgorithm::kLazy && options.ehc_lazy_beside) {
+    return ehcWithLazyBeside(task, init, goal, options, heuristic, term);
+  }
+  return configuredSearch(task, init, goal, options, heuristic, term, nullptr);
 }
 
 /// True when the operators do not all cost the same (plan cost is not plan length).
@@ -1062,11 +1264,13 @@ SearchResult unitCostFirstPlan(const Task& task, const StateBits& init, const Go
                                Heuristic& heuristic, const Termination& term) {
   SearchResult unit;
   {
+    SearchOptions unit_options = options;
+    unit_options.cost_type = CostType::kUnit;  // also for the heuristic of a lazy search beside
     std::unique_ptr<Heuristic> unit_h = makeHeuristic(defaultHeuristic(options), task, CostType::kUnit);
     const double left = term.deadline().secondsLeft();
     const Termination share =
         std::isfinite(left) ? term.tightened(Deadline::in(options.unit_first_time_share * left)) : term;
-    unit = firstPlan(task, init, goal, options, *unit_h, share);
+    unit = firstPlan(task, init, goal, unit_options, *unit_h, share);
   }  // the unit-cost heuristic and the run's states are freed before the second run
   const bool retry = unit.status == SearchStatus::kOutOfMemory || unit.status == SearchStatus::kFailed ||
                      (unit.status == SearchStatus::kTimeout && !term());

@@ -199,6 +199,7 @@ TEST(Search, EhcPlateauSearchedAgainWithoutPruningIsBoundedByItsShareOfTheBudget
   // wanders until the whole fallback budget is spent. Both plans are replayed by the checker.
   PlanRequest req = benchmarkRequest("pddl-more/psr-small/instance-40", "instance-40.pddl");
   req.timeout_seconds = 120;
+  req.search.ehc_lazy_beside = false;  // the hill-climbing's own mechanism, alone
   PlanReply bounded = plan(req, Termination());
   ASSERT_EQ(bounded.status, PlanStatus::kSolved) << bounded.message;
   EXPECT_GE(bounded.stats.ehc_retries_abandoned, 1U);
@@ -221,6 +222,7 @@ TEST(Search, EhcFallbackInsideAGoalAgendaEntryIsFinal) {
   // and fall back a second time there: 11949 evaluations instead of 6076 + 351.)
   PlanRequest req = benchmarkRequest("pddl-more/psr-small/instance-40", "instance-40.pddl");
   req.timeout_seconds = 120;
+  req.search.ehc_lazy_beside = false;  // the fallback after the hill-climbing, alone
   PlanReply with = plan(req, Termination());
   ASSERT_EQ(with.status, PlanStatus::kSolved) << with.message;  // replayed by the checker
   EXPECT_EQ(with.stats.ehc_fallbacks, 1U);
@@ -235,6 +237,93 @@ TEST(Search, EhcFallbackInsideAGoalAgendaEntryIsFinal) {
   ASSERT_EQ(lazy.status, PlanStatus::kSolved) << lazy.message;
   EXPECT_EQ(with.stats.evaluated, climbing.stats.evaluated + lazy.stats.evaluated);
   EXPECT_EQ(with.plan, lazy.plan);
+}
+
+TEST(Search, LazySearchBesideTheHillClimbingGivesThePlanWithFewerEvaluationsTheSameEveryRun) {
+  // psr-small-40: both hill-climbing runs fail (the second inside a goal-agenda entry), and the
+  // lazy search alone needs a few hundred evaluations. Beside the hill-climbing (from 4000
+  // evaluations on, turns of 100), it gives the plan before the hill-climbing gives up: fewer
+  // evaluations than the hill-climbing followed by the lazy search (6427), and the same plan and
+  // evaluations in a second run (the turns are counted in evaluations, not time). Checked plans.
+  PlanRequest req = benchmarkRequest("pddl-more/psr-small/instance-40", "instance-40.pddl");
+  req.timeout_seconds = 120;
+  ASSERT_TRUE(req.search.ehc_lazy_beside);  // the default
+  PlanReply beside = plan(req, Termination());
+  ASSERT_EQ(beside.status, PlanStatus::kSolved) << beside.message;
+  EXPECT_TRUE(beside.stats.lazy_beside_started);
+  EXPECT_TRUE(beside.stats.lazy_beside_won);
+  PlanReply again = plan(req, Termination());
+  ASSERT_EQ(again.status, PlanStatus::kSolved) << again.message;
+  EXPECT_EQ(again.stats.evaluated, beside.stats.evaluated);
+  EXPECT_EQ(again.plan, beside.plan);
+  req.search.ehc_lazy_beside = false;
+  PlanReply after = plan(req, Termination());
+  ASSERT_EQ(after.status, PlanStatus::kSolved) << after.message;
+  EXPECT_FALSE(after.stats.lazy_beside_started);
+  EXPECT_TRUE(after.stats.ehc_failed);
+  EXPECT_LT(beside.stats.evaluated, after.stats.evaluated);
+  EXPECT_GT(beside.stats.evaluated, req.search.ehc_lazy_after);  // the hill-climbing's share included
+}
+
+TEST(Search, LazySearchBesideNotStartedChangesNothing) {
+  // A hill-climbing that needs fewer evaluations than `ehc_lazy_after` (openstacks-6: 275) never
+  // meets the lazy search; one that gives up before (psr-small-40 with the lazy search starting
+  // only after 10^9 evaluations) is followed by the lazy search from the start, exactly as with
+  // the option off: the same plan and evaluations either way.
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"pddl-more/openstacks", "instance-6.pddl"},
+      {"pddl-more/psr-small/instance-40", "instance-40.pddl"},
+  };
+  for (const auto& [folder, instance] : cases) {
+    SCOPED_TRACE(folder);
+    PlanRequest req = benchmarkRequest(folder, instance);
+    req.timeout_seconds = 120;
+    req.search.ehc_lazy_after = 1'000'000'000;
+    PlanReply on = plan(req, Termination());
+    req.search.ehc_lazy_beside = false;
+    PlanReply off = plan(req, Termination());
+    ASSERT_EQ(on.status, PlanStatus::kSolved) << on.message;
+    ASSERT_EQ(off.status, PlanStatus::kSolved) << off.message;
+    EXPECT_FALSE(on.stats.lazy_beside_started);
+    EXPECT_EQ(on.stats.evaluated, off.stats.evaluated);
+    EXPECT_EQ(on.stats.ehc_failed, off.stats.ehc_failed);
+    EXPECT_EQ(on.plan, off.plan);
+  }
+}
+
+TEST(Search, LazySearchBesideProvesUnsolvabilityAndGoesOnAloneWhenTheHillClimbingGivesUp) {
+  // Turns of one evaluation from the first one on. (1) The swap task (relaxed solvable, really
+  // unsolvable): the answer is the proof. (2) logistics-12 with a hill-climbing that gives up
+  // after a few evaluations (its fallback budget: 1 + h(init)): the lazy search, already started, goes on
+  // alone and gives a checked plan; the hill-climbing counts as failed.
+  const std::string dom = R"((define (domain swap) (:predicates (p) (q))
+    (:action a :parameters () :effect (and (p) (not (q))))
+    (:action b :parameters () :effect (and (q) (not (p))))))";
+  PlanRequest req;
+  req.domain_text = dom;
+  req.problem_text = "(define (problem x) (:domain swap) (:init) (:goal (and (p) (q))))";
+  req.search.ehc_lazy_after = 1;
+  req.search.ehc_lazy_turn_ehc = 1;
+  req.search.ehc_lazy_turn_lazy = 1;
+  req.timeout_seconds = 60;
+  PlanReply swap = plan(req, Termination());
+  EXPECT_EQ(swap.status, PlanStatus::kUnsolvable) << swap.message;
+  EXPECT_TRUE(swap.stats.lazy_beside_started);
+
+  PlanRequest lg = benchmarkRequest("pddl/logistics", "instance-12.pddl");
+  lg.search.ehc_lazy_after = 1;
+  lg.search.ehc_lazy_turn_ehc = 1;
+  lg.search.ehc_lazy_turn_lazy = 1;
+  lg.search.ehc_ff_first = false;
+  lg.search.ehc_fallback_budget_min = 1;  // gives up after 1 + h(init) evaluations
+  lg.search.ehc_fallback_budget_per_h = 1;
+  lg.timeout_seconds = 120;
+  PlanReply r = plan(lg, Termination());
+  ASSERT_EQ(r.status, PlanStatus::kSolved) << r.message;  // replayed by the checker
+  EXPECT_TRUE(r.stats.lazy_beside_started);
+  EXPECT_FALSE(r.stats.lazy_beside_won);
+  EXPECT_TRUE(r.stats.ehc_failed);
+  EXPECT_EQ(r.stats.ehc_fallbacks, 1U);
 }
 
 TEST(Search, EhcFirstRunContinuesFromTheFirstBetterState) {
@@ -375,6 +464,11 @@ TEST(Search, OptionsAreValidated) {
   }
   o.ehc_retry_budget_share = 0;  // unbounded
   EXPECT_NO_THROW(o.validate());
+  for (int field = 0; field < 3; ++field) {
+    SearchOptions b = o;
+    (field == 0 ? b.ehc_lazy_after : field == 1 ? b.ehc_lazy_turn_ehc : b.ehc_lazy_turn_lazy) = 0;
+    EXPECT_THROW(b.validate(), std::invalid_argument) << field;
+  }
   EXPECT_EQ(parseSearchAlgorithm("astar"), SearchAlgorithm::kAstar);
   EXPECT_EQ(parseSearchAlgorithm("lazy"), SearchAlgorithm::kLazy);
   EXPECT_FALSE(parseSearchAlgorithm("dfs").has_value());

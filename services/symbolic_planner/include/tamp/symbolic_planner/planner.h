@@ -88,6 +88,8 @@ struct PlanStatistics {
   uint64_t ehc_retries_abandoned{0};  ///< ... given up at SearchOptions::ehc_retry_budget_share
   uint64_t ehc_fallbacks{0};  ///< complete searches the hill-climbing fell back to
   uint64_t ehc_fallbacks_in_agenda{0};  ///< ... started inside a goal-agenda entry that is not the last
+  bool lazy_beside_started{false};  ///< the lazy search ran beside the hill-climbing; see SearchOptions
+  bool lazy_beside_won{false};      ///< ... and gave the answer while the hill-climbing ran
   uint64_t anytime_iterations{0};    ///< SearchOptions::anytime_seconds: iterations run
   uint64_t anytime_improvements{0};  ///< ... that found a cheaper plan
   bool unit_first_failed{false};  ///< the unit-cost first run failed; see SearchOptions::unit_cost_first

@@ -8,7 +8,10 @@
 ///   (`ehc_fallback_budget_*`, so that a hill-climbing lost on plateaus leaves the time to the
 ///   complete search), it falls back to a complete best-first search from the start
 ///   (`ehc_fallback`, `fallback`: LAMA's lazy search by default, FF's own order: hill-climbing
-///   first, then best-first). With `ehc_ff_first` (the default) and a heuristic that has
+///   first, then best-first). With `ehc_lazy_beside` (the default) that lazy search starts beside
+///   a hill-climbing that has used `ehc_lazy_after` evaluations and the two take turns in one
+///   thread; the first plan or proof wins, and a failed hill-climbing leaves the lazy search to go
+///   on from where it is. With `ehc_ff_first` (the default) and a heuristic that has
 ///   FF-v2.3's variant (`Heuristic::setFFStyle`), a first hill-climbing run uses that variant
 ///   within a budget of evaluations (it tends to give shorter plans); when it fails or runs
 ///   out of budget, the search starts again from the initial state with the default heuristic,
@@ -108,6 +111,19 @@ struct SearchOptions {
   uint64_t ehc_second_budget_per_step{300};
   uint64_t ehc_second_budget_factor{16};
   double ehc_second_trigger_ratio{2.0};
+  /// ehc with the lazy fallback: once the hill-climbing (all its runs before the first plan) has
+  /// used `ehc_lazy_after` evaluations, the fallback's lazy search starts beside it, and the two
+  /// take turns of `ehc_lazy_turn_ehc` / `ehc_lazy_turn_lazy` evaluations in the same thread (the
+  /// lazy search is a coroutine the hill-climbing resumes), so the same evaluations and plans in
+  /// every run. The first plan or proof of either is the answer; when the hill-climbing gives up,
+  /// the lazy search goes on alone from where it is. The lazy search has its own states and
+  /// heuristic, so the memory budget holds for each of the two. A hill-climbing that needs fewer
+  /// evaluations (a TAMP query: about 30) never meets the lazy search. false: the lazy search
+  /// only after the hill-climbing has failed (FF's order).
+  bool ehc_lazy_beside{true};
+  uint64_t ehc_lazy_after{4000};
+  uint64_t ehc_lazy_turn_ehc{100};
+  uint64_t ehc_lazy_turn_lazy{100};
   bool preferred_operators{true};  ///< gbfs/lazy: use the helpful-action open list(s)
   /// lazy: alternate h_FF with LAMA's landmark-count heuristic (landmarks.h), four queues.
   bool landmarks{true};
@@ -168,6 +184,10 @@ struct SearchStatistics {
   /// them started inside a goal-agenda entry that is not the last.
   uint64_t ehc_fallbacks{0};
   uint64_t ehc_fallbacks_in_agenda{0};
+  /// `ehc_lazy_beside`: the lazy search started beside the hill-climbing; `lazy_beside_won`: it
+  /// gave the answer while the hill-climbing was still running.
+  bool lazy_beside_started{false};
+  bool lazy_beside_won{false};
   uint64_t landmarks{0};    ///< lazy: number of fact landmarks found (0: landmark count not used)
   uint64_t eliminated_actions{0};  ///< removed by action elimination
   uint64_t anytime_iterations{0};    ///< weighted A* iterations of the anytime phase

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <condition_variable>
 #include <deque>
 #include <mutex>
@@ -45,6 +46,7 @@ struct EffortEstimator::State {
   std::array<std::deque<FeatureRecord>, kKinds> records;
   std::array<std::size_t, kKinds> pending{};
   std::array<Clock::time_point, kKinds> oldest_pending{};
+  std::array<bool, kKinds> urgent{};  // a surprising record: refit now
   std::unordered_set<std::string> ids;
   EstimatorCounters counters;
 
@@ -143,6 +145,11 @@ Estimate EffortEstimator::estimate(const ActionFeatures& features) const {
   return predict(snap->models[indexOf(features.kind)], features);
 }
 
+bool surprising(const Estimate& e, double measured_s, double sigma) {
+  if (!(sigma > 0) || !(e.mean_s > 0) || !std::isfinite(measured_s)) return false;
+  return std::abs(measured_s - e.mean_s) > sigma * std::max(e.stddev_s, 0.05 * e.mean_s);
+}
+
 Status EffortEstimator::addRecord(const ExecutionRecord& record) {
   auto log = tamp::log::get("effort_estimator");
   auto fr = toFeatureRecord(record, params_.max_record_duration_s, params_.features);
@@ -167,9 +174,20 @@ Status EffortEstimator::addRecord(const ExecutionRecord& record) {
       ++state_->counters.store_write_failures;
     }
   }
+  // Against the model the robot was just priced with: far off, the kind is refitted at once.
+  const Estimate before = predict(snapshot_.load()->models[k], fr->features);
+  const bool surprise = surprising(before, fr->duration_s, params_.surprise_sigma);
+  if (surprise) {
+    log->info("record '{}' ({}): {:.2f} s against {:.2f} +- {:.2f} s estimated: refitting now", fr->record_id,
+              toString(fr->features.kind), fr->duration_s, before.mean_s, before.stddev_s);
+  }
   {
     std::lock_guard lk(state_->mu);
     auto& recs = state_->records[k];
+    if (surprise) {
+      state_->urgent[k] = true;
+      ++state_->counters.surprises;
+    }
     recs.push_back(std::move(*fr));
     if (recs.size() > static_cast<std::size_t>(params_.max_records_per_kind)) recs.pop_front();
     if (state_->pending[k]++ == 0) state_->oldest_pending[k] = Clock::now();
@@ -191,7 +209,8 @@ void EffortEstimator::workerLoop(std::stop_token stop) {
     for (std::size_t k = 0; k < kKinds; ++k) {
       if (state_->pending[k] == 0) continue;
       const auto when = state_->oldest_pending[k] + period;
-      if (state_->pending[k] >= batch || now >= when) {
+      if (state_->pending[k] >= batch || now >= when || state_->urgent[k]) {
+        state_->urgent[k] = false;
         due.push_back(k);
       } else if (!next_wake || when < *next_wake) {
         next_wake = when;

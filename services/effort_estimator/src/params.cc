@@ -29,6 +29,7 @@ const config::Schema<EstimatorParams>& schema() {
         .field("store_directory", &P::store_directory)
         .field("refit_batch_size", &P::refit_batch_size, atLeast(1))
         .field("refit_period_s", &P::refit_period_s, positive())
+        .field("surprise_sigma", &P::surprise_sigma, nonNegative())
         .field("refit_time_budget_s", &P::refit_time_budget_s, positive())
         .field("max_records_per_kind", &P::max_records_per_kind, atLeast(1))
         .field("max_record_duration_s", &P::max_record_duration_s, positive());

@@ -26,6 +26,7 @@ EstimatorParams paramsFor(const std::filesystem::path& dir, int batch = 10, doub
   p.store_directory = dir.string();
   p.refit_batch_size = batch;
   p.refit_period_s = period_s;
+  p.surprise_sigma = 0.0;  // batches and periods only (SurprisingRecordIsRefittedAtOnce turns it on)
   return p;
 }
 
@@ -141,6 +142,39 @@ TEST(EstimatorTest, OnlineWorkerRefitsInBatchesAndBumpsTheVersion) {
   EXPECT_EQ(callbacks.load(), 2);
   EXPECT_EQ(last_published.load(), 2u);
   EXPECT_EQ(est.counters().refits, 2u);
+}
+
+TEST(EstimatorTest, ARecordFarOffItsEstimateIsSurprising) {
+  Estimate e;
+  e.mean_s = 8.0;
+  e.stddev_s = 0.5;
+  EXPECT_TRUE(surprising(e, 20.4, 3.0));   // a push of a 58 kg chair, priced as a light one
+  EXPECT_TRUE(surprising(e, 6.0, 3.0));    // as far below
+  EXPECT_FALSE(surprising(e, 9.4, 3.0));   // within 3 stddevs
+  EXPECT_FALSE(surprising(e, 20.4, 0.0));  // off
+  e.stddev_s = 0.01;                       // a tiny stddev: at least 5 % of the mean counts
+  EXPECT_FALSE(surprising(e, 9.1, 3.0));
+  EXPECT_TRUE(surprising(e, 9.3, 3.0));
+}
+
+TEST(EstimatorTest, ASurprisingRecordIsRefittedAtOnce) {
+  // Neither a batch (1000) nor the period (1000 s) would refit: the record's surprise does.
+  EstimatorParams p = paramsFor("", /*batch=*/1000, /*period_s=*/1000.0);
+  p.surprise_sigma = 3.0;
+  EffortEstimator est(p, true);
+  std::mt19937_64 rng(11);
+  ExecutionRecord r = synthetic::records(ActionKind::kMoveBase, 1, rng)[0];
+  const auto features = extractFeatures(r.action, p.features);
+  ASSERT_TRUE(features.ok()) << features.error().toString();
+  const Estimate before = est.estimate(*features);
+  r.duration_s = 3.0 * before.mean_s;  // the robot took three times the estimate
+  ASSERT_TRUE(surprising(before, r.duration_s, 3.0));
+  ASSERT_TRUE(est.addRecord(r).ok());
+  ASSERT_TRUE(est.waitForVersion(ActionKind::kMoveBase, 1, Deadline::in(kWaitS)));
+  EXPECT_EQ(est.counters().surprises, 1u);
+  EXPECT_EQ(est.pendingCount(ActionKind::kMoveBase), 0u);
+  // The refitted model moved towards what the robot did.
+  EXPECT_GT(est.estimate(*features).mean_s, 1.3 * before.mean_s);
 }
 
 TEST(EstimatorTest, OnlineWorkerRefitsAfterThePeriodWithFewRecords) {

@@ -18,6 +18,7 @@ TEST(ParamsTest, ShippedConfigLoadsAndMatchesTheBuiltInDefaults) {
   const EstimatorParams d;
   EXPECT_EQ(p->store_directory, d.store_directory);
   EXPECT_EQ(p->refit_batch_size, d.refit_batch_size);
+  EXPECT_DOUBLE_EQ(p->surprise_sigma, d.surprise_sigma);
   EXPECT_EQ(p->fit.loss, d.fit.loss);
   EXPECT_DOUBLE_EQ(p->fit.prior_noise, d.fit.prior_noise);
   for (ActionKind k : kAllActionKinds) EXPECT_EQ(p->prior(k).values, modelSpec(k).defaults()) << toString(k);
@@ -51,7 +52,8 @@ TEST(ParamsTest, ReportsEveryErrorWithFileLineAndField) {
       "  move_base:\n"
       "    max_linear_speed: 50\n"
       "    top_speed: 1\n"
-      "  fly: {}\n",
+      "  fly: {}\n"
+      "surprise_sigma: -1\n",
       "svc.yaml");
   ASSERT_FALSE(p.ok());
   const std::string msg = p.error().message;
@@ -62,6 +64,7 @@ TEST(ParamsTest, ReportsEveryErrorWithFileLineAndField) {
   EXPECT_THAT(msg, HasSubstr("svc.yaml:7:23: field 'defaults.move_base.max_linear_speed': must be within [0.01, 5] m/s, got 50"));
   EXPECT_THAT(msg, HasSubstr("field 'defaults.move_base.top_speed': unknown key"));
   EXPECT_THAT(msg, HasSubstr("field 'defaults.fly': unknown action kind 'fly'"));
+  EXPECT_THAT(msg, HasSubstr("svc.yaml:10:17: field 'surprise_sigma'"));
 }
 
 TEST(ParamsTest, MissingFileNamesIt) {

@@ -260,6 +260,13 @@ std::vector<EffortAnswer> DdsServiceClients::effort(const std::vector<EffortQuer
   return out;
 }
 
+std::optional<std::uint64_t> DdsServiceClients::effortModelVersion() {
+  // An empty batch: the reply carries the version of the snapshot it would have used.
+  auto rep = checked(effort_.call(msg::EffortRequest{}, dds::CallOptions{2.0, {}}), dds::services::kEffort.name);
+  if (!rep) return std::nullopt;
+  return rep->model_version();
+}
+
 // ---- execution ---------------------------------------------------------------------------------------
 
 DdsExecutor::DdsExecutor(std::shared_ptr<dds::Participant> p, std::string mission_id)

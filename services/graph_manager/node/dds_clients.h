@@ -32,6 +32,7 @@ class DdsServiceClients : public ServiceClients {
   Result<std::vector<PlacementOption>> placements(const PlacementQuery& q) override;
   Result<std::vector<GraspOption>> grasps(const GraspQuery& q) override;
   std::vector<EffortAnswer> effort(const std::vector<EffortQuery>& q) override;
+  std::optional<std::uint64_t> effortModelVersion() override;
 
  private:
   robot::RobotModel robot_;

@@ -98,6 +98,8 @@ struct GraphManager::Run {
   double branch_total{0.0};
   double done_effort{0.0};
   int attempts{0};  ///< replanning attempts after failures (bounded by max_replans)
+  /// The effort estimator's model version when the action in flight was sent (nullopt: unknown).
+  std::optional<std::uint64_t> models_before;
   int step{0};
   std::string id_prefix;  ///< "r<n>-" in a resumed mission: its command ids differ from the earlier runs'
   bool first_action{true};
@@ -151,6 +153,9 @@ struct GraphManager::Run {
   bool replan(const MissionEvent& ev, EdgeId failed, std::string& why);
   /// Waits (drop_settle_timeout_s at most) until the world model has `object` resting on a support.
   void awaitSettled(const std::string& object);
+  /// After an overrun: until the effort estimator has refitted since the action was sent, at most
+  /// params.refit_wait_s.
+  void awaitRefit();
   void noteCommand();
   /// Conditional planning: before the first action and before each pick, the hand as the robot
   /// reports it against the node's belief. A gripper that holds an object where the node has
@@ -557,6 +562,28 @@ std::optional<MissionEvent> GraphManager::Run::watch(const Edge& done, const Edg
   return std::nullopt;
 }
 
+void GraphManager::Run::awaitRefit() {
+  // The overrunning action's record reaches the estimator beside its result, and a record that
+  // far off its estimate is refitted at once: prices asked before that refit are the old ones.
+  if (!models_before || !(gm.params_.refit_wait_s > 0)) return;
+  const auto t0 = Clock::now();
+  const auto deadline = t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(gm.params_.refit_wait_s));
+  while (true) {
+    const std::optional<std::uint64_t> now = gm.services_.effortModelVersion();
+    if (now && *now > *models_before) {
+      log::get("graph_manager")->info("effort models refitted ({} -> {}) {:.3f} s after the overrun", *models_before, *now,
+                                      since(t0));
+      return;
+    }
+    if (!now || Clock::now() >= deadline) {
+      log::get("graph_manager")->info("no refit of the effort models {:.3f} s after the overrun: pricing with the models as they are",
+                                      since(t0));
+      return;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+}
+
 void GraphManager::Run::awaitSettled(const std::string& object) {
   const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                            std::chrono::duration<double>(gm.params_.drop_settle_timeout_s));
@@ -662,6 +689,7 @@ bool GraphManager::Run::replan(const MissionEvent& ev, EdgeId failed, std::strin
     f.subtasks_spawned = false;
   }
   if (ev.kind == EventKind::kOverrun) {
+    awaitRefit();
     gm.reprice();
     rec.how = "re-traverse";
   } else {
@@ -739,6 +767,7 @@ MissionReport GraphManager::Run::run() {
     if (p == Prepared::kReplanned) continue;
     auto cmd = commandFor(id, next);
     if (!cmd) return finish(MissionOutcome::kFailed, cmd.error().message);
+    models_before = gm.services_.effortModelVersion();
     const ExecutionReport rep = execute(gm.graph_.edge(id), *cmd);
     Edge& e = gm.graph_.edge(id);  // after: pricing during the execution may have grown the graph
     ++step;

@@ -62,6 +62,7 @@ const config::Schema<GraphManagerParams>& schema() {
         .field("clear_path_stretch", &P::clear_path_stretch, config::atLeast(1.0))
         .field("turn_first_ratio", &P::turn_first_ratio, config::atLeast(1.0))
         .field("overrun_sigma", &P::overrun_sigma, positive())
+        .field("refit_wait_s", &P::refit_wait_s, config::nonNegative("s"))
         .field("max_rejoin_targets", &P::max_rejoin_targets, atLeast(1))
         .field("replan_first_edge", &P::replan_first_edge)
         .field("concurrent_motions", &P::concurrent_motions)

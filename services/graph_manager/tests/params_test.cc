@@ -23,6 +23,10 @@ TEST(ParamsTest, ErrorsNameLineAndField) {
   EXPECT_NE(q.error().toString().find("unknown policy 'greedy'"), std::string::npos) << q.error().toString();
   auto u = parseParams("polcy: effort\n", "gm.yaml");
   EXPECT_FALSE(u.ok());
+  auto w = parseParams("refit_wait_s: -1\n", "gm.yaml");
+  ASSERT_FALSE(w.ok());
+  EXPECT_NE(w.error().toString().find("refit_wait_s"), std::string::npos) << w.error().toString();
+  EXPECT_TRUE(parseParams("refit_wait_s: 0\n", "gm.yaml").ok()) << "0: no wait";
 }
 
 TEST(ParamsTest, ValidateMatchesTheLoader) {

@@ -88,6 +88,10 @@ struct RefitReport {
   std::size_t record_count{0};
 };
 
+/// Whether `measured_s` is more than `sigma` of `e`'s stddevs (at least 5 % of its mean) from its
+/// mean: the robot showed the model wrong (EstimatorParams::surprise_sigma). False for sigma <= 0.
+bool surprising(const Estimate& e, double measured_s, double sigma);
+
 /// Counters for the node's heartbeat.
 struct EstimatorCounters {
   std::uint64_t estimates{0};
@@ -95,6 +99,7 @@ struct EstimatorCounters {
   std::uint64_t records_rejected{0};
   std::uint64_t records_duplicate{0};
   std::uint64_t refits{0};
+  std::uint64_t surprises{0};  ///< records refitted at once (EstimatorParams::surprise_sigma)
   std::uint64_t refit_failures{0};
   std::uint64_t store_write_failures{0};
 };
@@ -123,7 +128,8 @@ class EffortEstimator {
   /// that price the same edge again after a refit.
   Estimate estimate(const ActionFeatures& features) const;
 
-  /// Validates, stores and queues an execution record for the next refit of its kind.
+  /// Validates, stores and queues an execution record for the next refit of its kind; a
+  /// surprising one (`surprising` against the current model) has its kind refitted at once.
   /// @return ok (also for a duplicate `record_id`, which is ignored), or kInvalidArgument with
   ///   the reason and `where.field` naming the bad field. Never blocks on a fit.
   Status addRecord(const ExecutionRecord& record);

@@ -6,6 +6,7 @@
 ///   store_directory: effort_estimator  # relative to the data dir (see resolveStoreDirectory); "" = none
 ///   refit_batch_size: 10       # new records of one kind that trigger a refit of that kind
 ///   refit_period_s: 30         # a pending record waits at most this long for its refit
+///   surprise_sigma: 3          # a record this many stddevs off the model's estimate is refitted at once (0: never)
 ///   refit_time_budget_s: 5     # deadline of one kind's refit
 ///   max_records_per_kind: 5000 # the most recent records a refit uses
 ///   max_record_duration_s: 3600
@@ -35,6 +36,11 @@ struct EstimatorParams {
   std::string store_directory{"effort_estimator"};
   int refit_batch_size{10};               ///< >= 1
   double refit_period_s{30.0};            ///< > 0
+  /// A record whose duration is more than this many of the estimate's stddevs (at least 5 % of
+  /// its mean, the graph manager's overrun rule) from the current model's estimate is refitted
+  /// at once, without waiting for a batch or the period: the robot just showed the model wrong,
+  /// and the next decisions should not wait for it. 0: never (batches and periods only). >= 0.
+  double surprise_sigma{3.0};
   double refit_time_budget_s{5.0};        ///< > 0
   int max_records_per_kind{5000};         ///< >= 1
   double max_record_duration_s{kDefaultMaxRecordDurationS};  ///< > 0; longer records are rejected

@@ -170,6 +170,10 @@ class ServiceClients {
   virtual Result<std::vector<PlacementOption>> placements(const PlacementQuery& q) = 0;
   virtual Result<std::vector<GraspOption>> grasps(const GraspQuery& q) = 0;
   virtual std::vector<EffortAnswer> effort(const std::vector<EffortQuery>& q) = 0;
+  /// The effort estimator's model version (+1 per refit of any kind), or nullopt when these
+  /// clients cannot tell (or the estimator does not answer). The graph manager compares it
+  /// across an action to see the refit that the action's record caused.
+  virtual std::optional<std::uint64_t> effortModelVersion() { return std::nullopt; }
   /// Policy `oracle` only: what the simulator knows (hidden objects, scripted faults, how many
   /// commands it accepted). An error when no oracle is served (a normal deployment).
   virtual Result<OracleKnowledge> oracle() {

@@ -83,6 +83,11 @@ struct GraphManagerParams {
   /// Online replanning: an action that takes longer than its prediction plus this many standard
   /// deviations is an event (the plan ahead is priced again from the refitted models); > 0.
   double overrun_sigma{3.0};
+  /// After an overrun, how long the graph manager waits for the effort estimator to refit from
+  /// that action's record (the estimator refits a surprising record at once) before it prices the
+  /// plan ahead again; without the wait the prices are asked before the refit. s, >= 0 (0: no
+  /// wait).
+  double refit_wait_s{1.0};
   /// Online replanning: re-join sub-tasks tried towards the next this many nodes of the branch
   /// ahead (the first reachable ones are kept, Traverse chooses among them); >= 1.
   int max_rejoin_targets{2};

@@ -788,13 +788,15 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
     if (det_used[i]) continue;
     const Detection& d = dets[i];
     bool fragment = false;
+    std::vector<double> margins;  // per point, the same for every track
+    margins.reserve(d.points.size());
+    for (const auto& p : d.points)
+      margins.push_back(T.size_tolerance + P.planes.noise_sigmas * P.sensor.stddev((p - sensor).norm()));
     for (const auto& [id, t] : I.tracks) {
       if (t.state == TrackInfo::State::kGone) continue;
       std::size_t inside = 0;
-      for (const auto& p : d.points) {
-        const double margin = T.size_tolerance + P.planes.noise_sigmas * P.sensor.stddev((p - sensor).norm());
-        inside += pointInShape(t.shape, t.pose, p, margin) ? 1 : 0;
-      }
+      for (std::size_t k = 0; k < d.points.size(); ++k)
+        inside += pointInShape(t.shape, t.pose, d.points[k], margins[k]) ? 1 : 0;
       if (2 * inside >= d.points.size()) {
         fragment = true;
         break;

@@ -23,8 +23,18 @@ tamp_wrap_dependency(yaml LIBS yaml-cpp)
 
 # Geometry, planning, estimation, perception. Found always: the algorithm libraries need them
 # whether or not DDS is built.
+find_package(orocos_kdl REQUIRED)
+tamp_wrap_dependency(kdl INCLUDES ${orocos_kdl_INCLUDE_DIRS} LIBS ${orocos_kdl_LIBRARIES})
 find_package(ompl 1.5 REQUIRED)          # lower-case config file; no imported target in 1.5
 tamp_wrap_dependency(ompl INCLUDES ${OMPL_INCLUDE_DIRS} LIBS ${OMPL_LIBRARIES})
+# KDL loaded before OMPL by every binary that links OMPL: both export the weak
+# Eigen::JacobiSVD<MatrixXd>::allocate, the dynamic linker binds KDL's calls to the first library
+# loaded, and with OMPL's copy KDL's LMA IK aborts on an Eigen assertion (docs/architecture.md,
+# section 8). Link options come before every library on the command line, so this -l is the first
+# NEEDED entry; CMake's ordering of the libraries themselves puts OMPL first in some binaries.
+find_library(TAMP_KDL_LIBRARY NAMES orocos-kdl REQUIRED)
+target_link_options(tamp_dep_ompl INTERFACE "LINKER:--push-state,--no-as-needed" "${TAMP_KDL_LIBRARY}"
+                    "LINKER:--pop-state")
 find_package(fcl 0.7 REQUIRED)           # target `fcl`, brings ccd and octomap
 tamp_wrap_dependency(fcl LIBS fcl)
 find_package(octomap 1.9 REQUIRED)
@@ -37,8 +47,6 @@ tamp_wrap_dependency(pcl INCLUDES ${PCL_INCLUDE_DIRS}
   LIBS pcl_common pcl_filters pcl_segmentation pcl_sample_consensus pcl_kdtree pcl_search)
 find_package(urdfdom REQUIRED)           # no version file on Debian
 tamp_wrap_dependency(urdfdom LIBS urdfdom::urdfdom_model)
-find_package(orocos_kdl REQUIRED)
-tamp_wrap_dependency(kdl INCLUDES ${orocos_kdl_INCLUDE_DIRS} LIBS ${orocos_kdl_LIBRARIES})
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(CAIRO REQUIRED IMPORTED_TARGET cairo)
 tamp_wrap_dependency(cairo LIBS PkgConfig::CAIRO)

@@ -204,11 +204,118 @@ bool CornerMotionValidator::checkMotion(const ob::State* s1, const ob::State* s2
   return ok;
 }
 
+unsigned SweptArmMotionValidator::segments(const ob::State* s1, const ob::State* s2) const {
+  const std::vector<double> a = gs_.values(s1), b = gs_.values(s2);
+  double bound = 0.0;
+  for (std::size_t i = 0; i < a.size() && i < b.size() && i < radii_.size(); ++i) bound += std::abs(b[i] - a[i]) * radii_[i];
+  const double swept = std::ceil(bound / step_);
+  const unsigned n = si_->getStateSpace()->validSegmentCount(s1, s2);
+  return std::max(n, swept >= 1e7 ? 10000000u : static_cast<unsigned>(swept));
+}
+
+bool SweptArmMotionValidator::checkMotion(const ob::State* s1, const ob::State* s2) const {
+  std::pair<ob::State*, double> unused{nullptr, 0.0};
+  return checkMotion(s1, s2, unused);
+}
+
+bool SweptArmMotionValidator::checkMotion(const ob::State* s1, const ob::State* s2,
+                                          std::pair<ob::State*, double>& last_valid) const {
+  const auto& space = si_->getStateSpace();
+  if (!si_->isValid(s2)) {
+    if (last_valid.first != nullptr) space->copyState(last_valid.first, s1);
+    last_valid.second = 0.0;
+    ++invalid_;
+    return false;
+  }
+  const unsigned n = segments(s1, s2);
+  ob::State* tmp = space->allocState();
+  bool ok = true;
+  unsigned j = 1;
+  for (; j < n; ++j) {
+    space->interpolate(s1, s2, static_cast<double>(j) / n, tmp);
+    if (!si_->isValid(tmp)) {
+      ok = false;
+      break;
+    }
+  }
+  if (!ok) {
+    const double previous = static_cast<double>(j - 1) / n;
+    if (last_valid.first != nullptr) space->interpolate(s1, s2, previous, last_valid.first);
+    last_valid.second = previous;
+    ++invalid_;
+  } else {
+    ++valid_;
+  }
+  space->freeState(tmp);
+  return ok;
+}
+
 // ---- RobotBinding -----------------------------------------------------------------------------
 
 RobotBinding::RobotBinding(robot::RobotModel model)
     : model_(std::move(model)), geometry_(model_->collisionGeometry()), hold_link_(model_->options().tool_link) {
   computeFootprint();
+  computeArmSweep();
+}
+
+void RobotBinding::computeArmSweep() {
+  if (!model_ || model_->armJointNames().empty()) return;
+  const robot::Joint* first = model_->findJoint(model_->armJointNames().front());
+  if (!first) return;
+  // Chain length from the first joint to each link it moves, along the kinematic tree.
+  arm_reach_ = {{first->child_link, 0.0}};
+  for (bool grew = true; grew;) {
+    grew = false;
+    for (const auto& j : model_->joints()) {
+      auto parent = std::find_if(arm_reach_.begin(), arm_reach_.end(), [&](const auto& e) { return e.first == j.parent_link; });
+      if (parent == arm_reach_.end()) continue;
+      if (std::any_of(arm_reach_.begin(), arm_reach_.end(), [&](const auto& e) { return e.first == j.child_link; }))
+        continue;
+      arm_reach_.emplace_back(j.child_link, parent->second + j.parent_T_joint.translation().norm());
+      grew = true;
+    }
+  }
+  for (const auto& part : geometry_.parts) {
+    const double chain = armReachTo(geometry_.links[static_cast<std::size_t>(part.link)]);
+    if (chain < 0.0) continue;  // not moved by the arm
+    const Aabb box = part.shape.aabb(Eigen::Isometry3d::Identity());
+    const double extent = part.link_T_shape.translation().norm() + 0.5 * (box.max - box.min).norm();
+    arm_sweep_radius_ = std::max(arm_sweep_radius_, chain + extent);
+  }
+  // Per joint: the chain from that joint's child link out to the farthest part it moves.
+  for (const auto& name : model_->armJointNames()) {
+    const robot::Joint* joint = model_->findJoint(name);
+    const double base = joint ? armReachTo(joint->child_link) : -1.0;
+    double r = 0.0;
+    if (base >= 0.0) {
+      // Links below this joint: reached from its child link along the tree.
+      std::vector<std::string> below{joint->child_link};
+      for (bool grew = true; grew;) {
+        grew = false;
+        for (const auto& j : model_->joints()) {
+          if (std::find(below.begin(), below.end(), j.parent_link) != below.end() &&
+              std::find(below.begin(), below.end(), j.child_link) == below.end()) {
+            below.push_back(j.child_link);
+            grew = true;
+          }
+        }
+      }
+      for (const auto& part : geometry_.parts) {
+        const std::string& link = geometry_.links[static_cast<std::size_t>(part.link)];
+        if (std::find(below.begin(), below.end(), link) == below.end()) continue;
+        const Aabb box = part.shape.aabb(Eigen::Isometry3d::Identity());
+        r = std::max(r, armReachTo(link) - base + part.link_T_shape.translation().norm() +
+                            0.5 * (box.max - box.min).norm());
+      }
+    }
+    arm_joint_radii_.push_back(base >= 0.0 ? r : arm_sweep_radius_);
+  }
+}
+
+double RobotBinding::armReachTo(const std::string& link) const {
+  for (const auto& [name, d] : arm_reach_)
+    if (name == link) return d;
+  return -1.0;
 }
 
 RobotBinding::RobotBinding(collision::RobotGeometry planar) : geometry_(std::move(planar)) {
@@ -320,6 +427,10 @@ GroupSpace::GroupSpace(const RobotBinding& robot, PlanningGroup group, const rob
     robot::RobotState at_origin = start_;
     at_origin.base = Pose2D{};
     robot_.linkPoses(at_origin, base_T_link_);
+  } else {
+    const auto& geo = robot.geometry();
+    for (std::size_t i = 0; i < geo.parts.size(); ++i)
+      if (robot.armReachTo(geo.links[static_cast<std::size_t>(geo.parts[i].link)]) >= 0.0) arm_parts_.push_back(i);
   }
 }
 
@@ -393,6 +504,15 @@ robot::RobotState GroupSpace::robotState(const ob::State* s) const {
   return r;
 }
 
+bool GroupSpace::armAboveFloor() const {
+  const auto& geo = robot_.geometry();
+  for (std::size_t i : arm_parts_) {
+    const auto& part = geo.parts[i];
+    if (part.shape.aabb(poses_[static_cast<std::size_t>(part.link)] * part.link_T_shape).min.z() < 0.0) return false;
+  }
+  return true;
+}
+
 void GroupSpace::placeRobot(const ob::State* s, collision::Scene& scene) const {
   if (group_ == PlanningGroup::kBase) {
     const Eigen::Isometry3d world_T_base = basePose(s).toIsometry();
@@ -435,6 +555,7 @@ bool Oracle::selfFree(const ob::State* s) { return selfContacts(s).empty(); }
 bool Oracle::staticFree(const ob::State* s) {
   ++checks_;
   gs_.placeRobot(s, scene_);
+  if (self_check_ && !gs_.armAboveFloor()) return false;
   if (scene_.robotInCollision(static_filter_)) return false;
   return !self_check_ || selfFree(s);
 }
@@ -442,6 +563,7 @@ bool Oracle::staticFree(const ob::State* s) {
 bool Oracle::allFree(const ob::State* s) {
   ++checks_;
   gs_.placeRobot(s, scene_);
+  if (self_check_ && !gs_.armAboveFloor()) return false;
   if (scene_.robotInCollision(all_filter_)) return false;
   return !self_check_ || selfFree(s);
 }
@@ -485,6 +607,7 @@ std::string Oracle::collidingObject(const ob::State* s, bool include_movables) {
   gs_.placeRobot(s, scene_);
   const auto ids = scene_.robotCollisions(include_movables ? all_filter_ : static_filter_);
   if (!ids.empty()) return ids.front();
+  if (self_check_ && !gs_.armAboveFloor()) return RobotBinding::kFloor;
   if (self_check_ || !scene_.attachedObjects().empty()) {
     const auto self = selfContacts(s);
     if (!self.empty()) return "self:" + self.front().first + "/" + self.front().second;

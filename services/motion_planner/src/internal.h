@@ -5,6 +5,7 @@
 // infeasibility proof). OMPL appears here and in the .cc files, never in the public headers.
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <random>
@@ -12,6 +13,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include <ompl/base/Planner.h>
 #include <ompl/base/SpaceInformation.h>
 #include <ompl/base/StateSpace.h>
 #include <ompl/geometric/PathGeometric.h>
@@ -50,9 +52,22 @@ class RobotBinding {
   double inscribedZMax() const { return inscribed_zmax_; }
   /// Largest xy distance from the base origin to the base's footprint, m.
   double footprintRadius() const { return footprint_radius_; }
+  /// Arm robots: a bound on how far any point of the arm's links (from the first arm joint on:
+  /// links, gripper, fingers) moves per radian of joint motion, summed over the joints (m/rad):
+  /// the chain's joint offsets out to the farthest link plus that link's parts. 0 without an arm.
+  double armSweepRadius() const { return arm_sweep_radius_; }
+  /// Per arm joint (chain order): the same bound for the links that joint moves (m/rad); the
+  /// displacement of any point for a joint motion dq is at most sum_j |dq_j| armJointRadii()[j].
+  const std::vector<double>& armJointRadii() const { return arm_joint_radii_; }
+  /// Floor contact of an arm part (the planner's name for it in reasons and contacts).
+  static constexpr const char* kFloor = "floor";
+  /// Arm robots: the chain length from the first arm joint to `link`'s origin (m); -1 for a link
+  /// that the arm does not move.
+  double armReachTo(const std::string& link) const;
 
  private:
   void computeFootprint();
+  void computeArmSweep();
   std::optional<robot::RobotModel> model_;
   collision::RobotGeometry geometry_;
   std::string hold_link_;
@@ -60,6 +75,9 @@ class RobotBinding {
   double inscribed_zmin_{0.0};
   double inscribed_zmax_{0.0};
   double footprint_radius_{0.0};
+  double arm_sweep_radius_{0.0};
+  std::vector<double> arm_joint_radii_;
+  std::vector<std::pair<std::string, double>> arm_reach_;  // link -> chain length from the first arm joint
 };
 
 // ---- planning group -------------------------------------------------------------------------
@@ -90,6 +108,9 @@ class GroupSpace {
   Pose2D basePose(const ob::State* s) const;
   /// Sets the robot's link poses in `scene` for state `s`.
   void placeRobot(const ob::State* s, collision::Scene& scene) const;
+  /// After placeRobot(): whether every part that the arm moves is above the floor (z = 0; the
+  /// robot stands on it and no scene object models it). True for the base group.
+  bool armAboveFloor() const;
   bool inBounds(const ob::State* s) const { return space_->satisfiesBounds(s); }
   const Aabb& baseBounds() const { return base_bounds_; }
 
@@ -101,6 +122,7 @@ class GroupSpace {
   ob::StateSpacePtr space_;
   std::vector<std::string> names_;
   std::vector<Eigen::Isometry3d> base_T_link_;  // base group: rigid robot relative to the base
+  std::vector<std::size_t> arm_parts_;          // arm groups: geometry parts that the arm moves
   mutable std::vector<Eigen::Isometry3d> poses_;
   mutable robot::RobotState scratch_;
 };
@@ -186,6 +208,29 @@ class CornerMotionValidator : public ob::MotionValidator {
   bool checkMotion(const ob::State* s1, const ob::State* s2, std::pair<ob::State*, double>& last_valid) const override;
 };
 
+/// Arm group: OMPL's discrete motion check, with at least as many states as keep every point of
+/// the robot (and the held object) within `step_m` of the last checked state: the joint motion's
+/// motion weighted per joint by how far its links reach (RobotBinding::armJointRadii, grown by a
+/// held object) bounds any point's displacement. The robot sweeps every commanded motion at such a resolution and stops
+/// before the first contact, so a coarser check (0.02 in joint space moves a fingertip 3-5 cm)
+/// let planned paths clip a box's corner between two checked states (tests/contract).
+class SweptArmMotionValidator : public ob::MotionValidator {
+ public:
+  /// `radii_m`: per arm joint, how far a point moves per radian of that joint (armJointRadii,
+  /// each grown by the held object's extent).
+  SweptArmMotionValidator(const ob::SpaceInformationPtr& si, const GroupSpace& gs, std::vector<double> radii_m,
+                          double step_m)
+      : ob::MotionValidator(si), gs_(gs), radii_(std::move(radii_m)), step_(step_m) {}
+  bool checkMotion(const ob::State* s1, const ob::State* s2) const override;
+  bool checkMotion(const ob::State* s1, const ob::State* s2, std::pair<ob::State*, double>& last_valid) const override;
+
+ private:
+  unsigned segments(const ob::State* s1, const ob::State* s2) const;
+  const GroupSpace& gs_;
+  std::vector<double> radii_;
+  double step_;
+};
+
 /// OMPL validity checker over the oracle (static only, or everything).
 class OracleValidityChecker : public ob::StateValidityChecker {
  public:
@@ -245,6 +290,15 @@ struct EvaluatedPath {
   explicit EvaluatedPath(const ob::SpaceInformationPtr& si) : path(si) {}
   PathCost cost(const Oracle& oracle, double seconds_per_unit) const;
 };
+
+/// Re-checks every segment of `path` with `fine_si` (its motion validator, e.g. the swept arm
+/// check) and plans each segment that fails again in `fine_si` (a planner from `make`, in slices
+/// of growing length until `termination`, between the segment's two states; then shortened
+/// there), splicing the result in. The first and last states are kept. Returns the number of
+/// segments re-planned, or -1 when one could not be (`path` is then unchanged).
+int repairSegments(const ob::SpaceInformationPtr& fine_si, og::PathGeometric& path,
+                   const std::function<ob::PlannerPtr(const ob::SpaceInformationPtr&)>& make,
+                   const Termination& termination);
 
 /// Evaluates every segment of a statically valid path, after cutting segments longer than
 /// `max_segment` (space metric; 0: no cutting).

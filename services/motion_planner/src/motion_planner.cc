@@ -741,6 +741,15 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
   detail::Oracle oracle(impl.scene, gs, ignored, std::move(movables), reach);
   const bool lazy = req.mode == MotionMode::kLazy;
 
+  // How far a point of the arm (or the object it holds) moves per radian of each joint.
+  std::vector<double> sweep_radii = impl.robot.armJointRadii();
+  if (!held.empty() && impl.robot.armReachTo(held_link) >= 0.0) {
+    // The held object rides on `held_link`, below every arm joint: its reach from each joint is
+    // at most that joint's radius plus the object's extent beyond the link.
+    const Aabb box = impl.world.object(held).shape.aabb(Eigen::Isometry3d::Identity());
+    const double extent = link_T_held.translation().norm() + 0.5 * (box.max - box.min).norm() + req.held_padding_m;
+    for (double& r : sweep_radii) r += extent;
+  }
   auto makeSi = [&](detail::Oracle& checker, bool full) {
     auto si = std::make_shared<ob::SpaceInformation>(space);
     si->setStateValidityChecker(std::make_shared<detail::OracleValidityChecker>(si, checker, full));
@@ -1131,6 +1140,26 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
       if (!better) break;
     }
     simplifier.collapseCloseVertices(final_path);
+    // The path as the robot sweeps it: segments that touch something between two states checked
+    // at validity_resolution are planned again at the swept resolution.
+    if (req.group == PlanningGroup::kArm && P.sampling.arm_swept_step > 0.0 && !sweep_radii.empty()) {
+      auto fine_si = std::make_shared<ob::SpaceInformation>(space);
+      fine_si->setStateValidityChecker(si->getStateValidityChecker());
+      fine_si->setStateValidityCheckingResolution(si->getStateValidityCheckingResolution());
+      fine_si->setMotionValidator(
+          std::make_shared<detail::SweptArmMotionValidator>(fine_si, gs, sweep_radii, P.sampling.arm_swept_step));
+      fine_si->setup();
+      const PlannerKind arm_kind = P.sampling.arm_planner;
+      res.stats.swept_repairs = detail::repairSegments(
+          fine_si, final_path, [&](const ob::SpaceInformationPtr& s) { return makePlanner(arm_kind, s, P.sampling.range); },
+          termination);
+      if (res.stats.swept_repairs < 0) {
+        return finish(MotionStatus::kTimeout,
+                      "a segment of the path touches an object between two checked states and could not be planned "
+                      "again at the swept resolution (arm_swept_step " + formatNumber(P.sampling.arm_swept_step) +
+                          " m) in time");
+      }
+    }
     if (escaped) final_path.prepend(start.get());
     if (req.group == PlanningGroup::kBase && P.sampling.base_turn_in_place) detail::alignBaseHeadings(si, final_path);
     res.stats.shortcut_ms = phase.millis();

@@ -43,6 +43,7 @@ const config::Schema<MotionPlannerParams>& schema() {
         .field("start_escape_distance", &S::start_escape_distance, nonNegative())
         .field("start_escape_attempts", &S::start_escape_attempts, atLeast(1))
         .field("direct_first", &S::direct_first)
+        .field("arm_swept_step", &S::arm_swept_step, nonNegative())
         .convert<std::string>("lazy_planner", &S::lazy_planner, planner)
         .convert<std::string>("full_planner", &S::full_planner, planner)
         .convert<std::string>("arm_planner", &S::arm_planner, planner);

@@ -5,6 +5,7 @@
 #include <map>
 
 #include <ompl/base/spaces/SE2StateSpace.h>
+#include <ompl/geometric/PathSimplifier.h>
 
 #include "internal.h"
 
@@ -321,6 +322,41 @@ std::vector<BlockingObject> blockingReport(Oracle& oracle, const og::PathGeometr
     return std::tie(x.enter_fraction, x.object_id) < std::tie(y.enter_fraction, y.object_id);
   });
   return out;
+}
+
+int repairSegments(const ob::SpaceInformationPtr& fine_si, og::PathGeometric& path,
+                   const std::function<ob::PlannerPtr(const ob::SpaceInformationPtr&)>& make,
+                   const Termination& termination) {
+  if (path.getStateCount() < 2) return 0;
+  og::PathGeometric out(fine_si);
+  out.append(path.getState(0));
+  int repaired = 0;
+  for (std::size_t i = 0; i + 1 < path.getStateCount(); ++i) {
+    const ob::State* a = path.getState(i);
+    const ob::State* b = path.getState(i + 1);
+    if (fine_si->checkMotion(a, b)) {
+      out.append(b);
+      continue;
+    }
+    auto pdef = std::make_shared<ob::ProblemDefinition>(fine_si);
+    pdef->setStartAndGoalStates(a, b, 1e-9);
+    const ob::PlannerPtr planner = make(fine_si);
+    planner->setProblemDefinition(pdef);
+    planner->setup();
+    for (double slice = 0.05; !pdef->hasExactSolution() && !termination(); slice *= 2) {
+      const Termination t = termination.tightened(Deadline::in(slice));
+      planner->solve(ob::PlannerTerminationCondition([&t] { return t(); }));
+    }
+    if (!pdef->hasExactSolution()) return -1;
+    og::PathGeometric sub = *pdef->getSolutionPath()->as<og::PathGeometric>();
+    og::PathSimplifier simplifier(fine_si);
+    simplifier.shortcutPath(sub, 0, 0, 0.33, 0.005);
+    simplifier.reduceVertices(sub);
+    for (std::size_t k = 1; k < sub.getStateCount(); ++k) out.append(sub.getState(k));
+    ++repaired;
+  }
+  if (repaired > 0) path = out;
+  return repaired;
 }
 
 double reportedLength(const GroupSpace& gs, const og::PathGeometric& path) {

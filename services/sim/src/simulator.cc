@@ -775,6 +775,14 @@ struct Simulator::Impl {
           active->end = std::max(0.0, rel);
           active->blocking.clear();
           e.description = "action '" + active->cmd.command_id + "' failed";
+          // A pick that fails after its gripper closed: the object slips out of the fingers and
+          // falls onto what is below it (it is not carried away on the retreat).
+          if (active->cmd.kind == ActionKind::kPick && world.held() &&
+              world.held()->object_id == active->cmd.object_id) {
+            e.object_id = dropHeld(current());
+            e.description += "; '" + e.object_id + "' slipped out of the gripper";
+            ev.world_changed = true;
+          }
         } else {
           pending_fails.push_back(f);
           e.description = "the next " + (f.action ? std::string(toString(*f.action)) + " " : std::string()) +

@@ -372,6 +372,40 @@ TEST(ManipulationTest, ScriptedDropDuringACarryPutsTheObjectOnTheFloor) {
   EXPECT_EQ(e.results[0].blocking_object_id, "can");
 }
 
+// A pick that fails on its retreat, after the fingers closed ("the box slips out of the
+// fingers"): the object is not carried away; it falls back onto what is below it, and the robot
+// reports an empty gripper. A pick that fails on its approach leaves the object untouched.
+TEST(ManipulationTest, APickThatFailsAfterTheGripperClosedLetsTheObjectFall) {
+  for (double fraction : {0.2, 0.85}) {
+    Fault slip;
+    slip.id = "slip";
+    slip.type = FaultType::kFailAction;
+    slip.action = ActionKind::kPick;
+    slip.trigger.step = 1;  // 0: move_arm, 1: the pick
+    slip.trigger.fraction = fraction;
+    Simulator sim(kitchen(), robotModel(), upright(), exactParams(), {slip});
+    const Eigen::Vector3d before = sim.world().object("can").pose.translation();
+    const PickSetup ps = pickSetup(before);
+    moveArmTo(sim, ps.pregrasp, "to_pregrasp");
+    ActionCommand pick = armCommand("pick", ActionKind::kPick, {ps.pregrasp, ps.grasp, ps.pregrasp});
+    pick.object_id = "can";
+    ASSERT_TRUE(sim.submit(pick));
+    const StepEvents e = runToEnd(sim);
+    ASSERT_EQ(e.results.size(), 1u);
+    EXPECT_EQ(e.results[0].outcome, Outcome::kFailed) << "fraction " << fraction;
+    EXPECT_FALSE(sim.world().held()) << "fraction " << fraction;
+    EXPECT_EQ(sim.robotState().held_object_id, "") << "fraction " << fraction;
+    const world::Object& can = sim.world().object("can");
+    EXPECT_EQ(can.region, "table_top") << "fraction " << fraction;
+    EXPECT_NEAR(can.pose.translation().z(), before.z(), 1e-6) << "fraction " << fraction;
+    EXPECT_LT((can.pose.translation() - before).head<2>().norm(), 0.02) << "fraction " << fraction;
+    if (fraction > 0.5) {
+      ASSERT_EQ(e.faults.size(), 1u);
+      EXPECT_EQ(e.faults[0].object_id, "can");
+    }
+  }
+}
+
 // "It slips while carried": a drop filtered by action kind waits for the first action of that kind
 // that starts with something in the gripper (a move_base with an empty gripper does not count).
 TEST(ManipulationTest, ADropFilteredByActionWaitsForTheFirstCarryingActionOfThatKind) {

@@ -190,6 +190,9 @@ struct PlanningStats {
   double proof_ms{0.0};         ///< full mode: infeasibility grid
   double goal_ms{0.0};          ///< goal states: IK for an end-effector goal, validity of the goal
   std::uint64_t validity_checks{0};
+  /// Full-mode arm paths: segments planned again because they touched something between two
+  /// checked states at the swept resolution (SamplingParams::arm_swept_step).
+  int swept_repairs{0};
   std::size_t roadmap_nodes{0};
   std::size_t roadmap_edges{0};
   std::size_t roadmap_pruned{0};  ///< request nodes removed from the roadmap before this search

@@ -63,6 +63,14 @@ struct SamplingParams {
   /// default: a direct arm motion right after a place swept the fingers past the object just put
   /// down with no clearance, and the robot was stopped before it (holding_unknown, 3 of 12 runs).
   bool direct_first{false};
+  /// Full-mode arm paths are checked again as the robot sweeps them: no point of the robot or
+  /// the held object moves more than this (m) between two checked states (the simulator stops
+  /// before a contact at 1 cm); a segment that touches something is planned again at that
+  /// resolution. `validity_resolution` alone moves a fingertip 3-5 cm between checks, and about
+  /// 1 in 80 planned paths clipped an object's corner that the robot then stopped before
+  /// (tests/contract, tamp_motion_planner_arm_bench). Searching at this resolution throughout
+  /// costs 3-4x the planning time; checking the final path costs a few ms. 0: off. >= 0.
+  double arm_swept_step{0.0025};
 };
 
 /// Lazy mode: making the lazy path worth executing (see motion_planner.h). The roadmap of the

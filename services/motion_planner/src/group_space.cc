@@ -250,6 +250,15 @@ bool SweptArmMotionValidator::checkMotion(const ob::State* s1, const ob::State* 
   return ok;
 }
 
+bool ClearanceValidityChecker::isValid(const ob::State* s) const {
+  if (!si_->satisfiesBounds(s) || !oracle_.allFree(s)) return false;
+  if (relaxed_) return true;
+  const Pose2D p = gs_.basePose(s);
+  for (const auto& e : ends_)
+    if ((Eigen::Vector2d(p.x, p.y) - e).norm() <= near_) return true;
+  return padded_.allFree(s);
+}
+
 // ---- RobotBinding -----------------------------------------------------------------------------
 
 RobotBinding::RobotBinding(robot::RobotModel model)

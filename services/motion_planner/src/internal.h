@@ -231,6 +231,30 @@ class SweptArmMotionValidator : public ob::MotionValidator {
   double step_;
 };
 
+/// Full-mode base requests: everything free, as OracleValidityChecker, and a clearance kept where
+/// the robot has room for it: away from the request's start and goal (within `near_ends_m` of
+/// either only the plain check applies: a robot parked beside a table must still leave it), a
+/// state must also be free for the robot grown sideways by the clearance (`padded`, an oracle over
+/// a scene with the grown robot). relax() drops that once no path kept the clearance in time.
+class ClearanceValidityChecker : public ob::StateValidityChecker {
+ public:
+  ClearanceValidityChecker(const ob::SpaceInformationPtr& si, Oracle& oracle, Oracle& padded, const GroupSpace& gs,
+                           std::vector<Eigen::Vector2d> ends, double near_ends_m)
+      : ob::StateValidityChecker(si), oracle_(oracle), padded_(padded), gs_(gs), ends_(std::move(ends)),
+        near_(near_ends_m) {}
+  bool isValid(const ob::State* s) const override;
+  void relax() { relaxed_ = true; }
+  bool relaxed() const { return relaxed_; }
+
+ private:
+  Oracle& oracle_;
+  Oracle& padded_;
+  const GroupSpace& gs_;
+  std::vector<Eigen::Vector2d> ends_;
+  double near_;
+  bool relaxed_{false};
+};
+
 /// OMPL validity checker over the oracle (static only, or everything).
 class OracleValidityChecker : public ob::StateValidityChecker {
  public:

@@ -491,6 +491,14 @@ Result<world::World> overriddenWorld(const world::World& base, const std::vector
 
 namespace {
 
+world::Shape grownShape(const world::Shape& shape, double d);
+
+/// The robot's parts grown sideways by `d` (m).
+collision::RobotGeometry grownGeometry(collision::RobotGeometry geometry, double d) {
+  for (auto& part : geometry.parts) part.shape = grownShape(part.shape, d);
+  return geometry;
+}
+
 /// `shape` grown sideways by `d` (m): its footprint, not its height, so that a held object still
 /// rests on its support when it is put down. A prism grows about its vertices' centroid, by a
 /// factor that moves its nearest edge out by `d` (every other edge by at least as much).
@@ -760,6 +768,25 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
     return si;
   };
   const ob::SpaceInformationPtr si = makeSi(oracle, !lazy);
+  // Full-mode base paths: a clearance round objects where there is room for it (not for a push,
+  // whose object rides on the base and drives into contact).
+  std::unique_ptr<collision::Scene> padded_scene;
+  std::unique_ptr<detail::Oracle> padded_oracle;
+  std::shared_ptr<detail::ClearanceValidityChecker> clearance;
+  const bool pushes = !held.empty() && held_link == impl.robot.geometry().links.front();
+  if (!lazy && req.group == PlanningGroup::kBase && P.sampling.base_clearance > 0.0 && !pushes) {
+    padded_scene = std::make_unique<collision::Scene>(impl.world);
+    padded_scene->setRobot(grownGeometry(impl.robot.geometry(), P.sampling.base_clearance));
+    if (!held.empty()) (void)padded_scene->attach(held, held_link, link_T_held);
+    padded_oracle = std::make_unique<detail::Oracle>(*padded_scene, gs, ignored, oracle.movables(), reach);
+    std::vector<Eigen::Vector2d> ends{{req.start.base.x, req.start.base.y}};
+    if (req.goal.kind == MotionGoal::Kind::kBasePose) ends.emplace_back(req.goal.base.x, req.goal.base.y);
+    if (req.goal.kind == MotionGoal::Kind::kConfiguration && req.goal.configuration.size() >= 2)
+      ends.emplace_back(req.goal.configuration[0], req.goal.configuration[1]);
+    clearance = std::make_shared<detail::ClearanceValidityChecker>(si, oracle, *padded_oracle, gs, std::move(ends),
+                                                                   P.sampling.base_clearance_near_ends);
+    si->setStateValidityChecker(clearance);
+  }
   auto freeState = [&](ob::State* s) { space->freeState(s); };
   std::unique_ptr<ob::State, decltype(freeState)> start(space->allocState(), freeState);
   {
@@ -1072,7 +1099,14 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
     }
     first = false;
     if (termination()) break;
-    const Termination slice_term = termination.tightened(Deadline::in(slice));
+    // No path kept the clearance in time: on without it (every state and motion of the tree so
+    // far passed the stronger check, so the tree stays valid).
+    if (clearance && !clearance->relaxed() && phase.seconds() - res.stats.proof_ms / 1000.0 >= P.sampling.base_clearance_time_s) {
+      clearance->relax();
+      res.stats.clearance_relaxed = true;
+    }
+    const Termination slice_term = termination.tightened(Deadline::in(
+        clearance && !clearance->relaxed() ? std::min(slice, P.sampling.base_clearance_time_s) : slice));
     planner->solve(ptcOf(slice_term));
     solved = pdef->hasExactSolution();
     slice *= 2;

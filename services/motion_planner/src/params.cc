@@ -44,6 +44,9 @@ const config::Schema<MotionPlannerParams>& schema() {
         .field("start_escape_attempts", &S::start_escape_attempts, atLeast(1))
         .field("direct_first", &S::direct_first)
         .field("arm_swept_step", &S::arm_swept_step, nonNegative())
+        .field("base_clearance", &S::base_clearance, nonNegative())
+        .field("base_clearance_near_ends", &S::base_clearance_near_ends, nonNegative())
+        .field("base_clearance_time_s", &S::base_clearance_time_s, positive())
         .convert<std::string>("lazy_planner", &S::lazy_planner, planner)
         .convert<std::string>("full_planner", &S::full_planner, planner)
         .convert<std::string>("arm_planner", &S::arm_planner, planner);

@@ -41,6 +41,50 @@ TEST_F(FullTest, PathThroughTheOpenDoorIsCollisionFreeWhenRecheckedDensely) {
   }
 }
 
+// Where there is room, a full-mode base path keeps SamplingParams::base_clearance from every
+// object. The straight way here passes 3 cm from a box: taken without the clearance (the control,
+// direct motion first), bowed out to keep 5 cm with it.
+TEST_F(FullTest, ABasePathKeepsItsClearanceWhereThereIsRoom) {
+  const world::World w = testing::openRoomWorld();  // a 0.6 m box at (5, 3): y in [2.7, 3.3]
+  const double y = 3.3 + kRadius + 0.03;
+  auto least = [&](double clearance, bool& direct) {
+    MotionPlannerParams p;
+    p.sampling.direct_first = true;
+    p.sampling.base_clearance = clearance;
+    MotionPlanner mp = planner(w, p);
+    double d = INFINITY;
+    direct = true;
+    for (int run = 0; run < 5; ++run) {
+      const MotionResult r = mp.plan(request({2, y, 0.0}, {8, y, 0.0}), Termination::after(5.0));
+      EXPECT_EQ(r.status, MotionStatus::kSolved) << r.reason;
+      EXPECT_FALSE(r.stats.clearance_relaxed) << "run " << run;
+      direct = direct && r.stats.direct;
+      d = std::min(d, discClearance(w, r.path, kRadius, 0.002));
+    }
+    return d;
+  };
+  bool direct = false;
+  EXPECT_NEAR(least(0.0, direct), 0.03, 1e-3);
+  EXPECT_TRUE(direct);
+  // Checked states keep 5 cm; between two of them (2 cm apart) the disc may come ~1 cm closer.
+  EXPECT_GE(least(0.05, direct), 0.035);
+  EXPECT_FALSE(direct);
+}
+
+// A door only 4 cm wider than the robot: no path keeps the clearance, so the search goes on
+// without it and still finds the way through, collision-free.
+TEST_F(FullTest, ADoorTooNarrowForTheClearanceIsStillPassed) {
+  world::World w = testing::corridorWorld(false);
+  // Narrow the door (y in [1.5, 2.5]) to [1.68, 2.32]: 0.64 m for a 0.6 m disc.
+  ASSERT_TRUE(w.addObject(testing::box("jamb_low", 5, 1.59, 0.2, 0.18, false)).ok());
+  ASSERT_TRUE(w.addObject(testing::box("jamb_high", 5, 2.41, 0.2, 0.18, false)).ok());
+  MotionPlanner mp = planner(w);
+  const MotionResult r = mp.plan(request({2, 3, 0.5}, {8, 1, -1.0}), Termination::after(10.0));
+  ASSERT_EQ(r.status, MotionStatus::kSolved) << r.reason;
+  EXPECT_TRUE(r.stats.clearance_relaxed);
+  EXPECT_GE(discClearance(w, r.path, kRadius, 0.002), 0.0);
+}
+
 // A free direct motion is taken without sampling; one through a wall is not, and the sampled
 // path still goes through the door. Off, the planner samples even the free one.
 TEST_F(FullTest, AFreeDirectMotionIsTakenBeforeSampling) {

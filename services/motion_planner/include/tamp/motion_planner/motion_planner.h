@@ -193,6 +193,9 @@ struct PlanningStats {
   /// Full-mode arm paths: segments planned again because they touched something between two
   /// checked states at the swept resolution (SamplingParams::arm_swept_step).
   int swept_repairs{0};
+  /// Full-mode base paths: no path kept SamplingParams::base_clearance in time, so the path
+  /// found may pass closer to objects.
+  bool clearance_relaxed{false};
   std::size_t roadmap_nodes{0};
   std::size_t roadmap_edges{0};
   std::size_t roadmap_pruned{0};  ///< request nodes removed from the roadmap before this search

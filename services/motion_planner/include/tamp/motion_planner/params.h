@@ -71,6 +71,15 @@ struct SamplingParams {
   /// (tests/contract, tamp_motion_planner_arm_bench). Searching at this resolution throughout
   /// costs 3-4x the planning time; checking the final path costs a few ms. 0: off. >= 0.
   double arm_swept_step{0.0025};
+  /// Full-mode base paths keep this much room (m) round every object where there is room for it:
+  /// the robot is checked grown sideways by it, except within `base_clearance_near_ends` of the
+  /// start and the goal. A base path that hugs an object is lost to the centimetres by which the
+  /// object's estimate is off, and the robot is stopped before it (namo_doorway: the way round a
+  /// pushed crate). When no such path is found within `base_clearance_time_s` of sampling, the
+  /// search goes on without it (its tree stays valid). 0: off. >= 0.
+  double base_clearance{0.05};
+  double base_clearance_near_ends{0.3};  ///< m, >= 0
+  double base_clearance_time_s{0.25};    ///< s, > 0
 };
 
 /// Lazy mode: making the lazy path worth executing (see motion_planner.h). The roadmap of the

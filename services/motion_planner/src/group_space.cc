@@ -251,12 +251,13 @@ bool SweptArmMotionValidator::checkMotion(const ob::State* s1, const ob::State* 
 }
 
 bool ClearanceValidityChecker::isValid(const ob::State* s) const {
-  if (!si_->satisfiesBounds(s) || !oracle_.allFree(s)) return false;
-  if (relaxed_) return true;
+  if (!si_->satisfiesBounds(s)) return false;
+  bool near = relaxed_;
   const Pose2D p = gs_.basePose(s);
-  for (const auto& e : ends_)
-    if ((Eigen::Vector2d(p.x, p.y) - e).norm() <= near_) return true;
-  return padded_.allFree(s);
+  for (std::size_t i = 0; i < ends_.size() && !near; ++i) near = (Eigen::Vector2d(p.x, p.y) - ends_[i]).norm() <= near_;
+  if (near) return oracle_.allFree(s);
+  if (!padded_.allFree(s)) return false;
+  return implied_ || oracle_.allFree(s);
 }
 
 // ---- RobotBinding -----------------------------------------------------------------------------

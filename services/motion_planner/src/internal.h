@@ -238,10 +238,12 @@ class SweptArmMotionValidator : public ob::MotionValidator {
 /// a scene with the grown robot). relax() drops that once no path kept the clearance in time.
 class ClearanceValidityChecker : public ob::StateValidityChecker {
  public:
+  /// `padded_contains_plain`: the grown robot contains the robot and `padded`'s scene has every
+  /// object of `oracle`'s, so a state free for the former is free for the latter (one check).
   ClearanceValidityChecker(const ob::SpaceInformationPtr& si, Oracle& oracle, Oracle& padded, const GroupSpace& gs,
-                           std::vector<Eigen::Vector2d> ends, double near_ends_m)
+                           std::vector<Eigen::Vector2d> ends, double near_ends_m, bool padded_contains_plain)
       : ob::StateValidityChecker(si), oracle_(oracle), padded_(padded), gs_(gs), ends_(std::move(ends)),
-        near_(near_ends_m) {}
+        near_(near_ends_m), implied_(padded_contains_plain) {}
   bool isValid(const ob::State* s) const override;
   void relax() { relaxed_ = true; }
   bool relaxed() const { return relaxed_; }
@@ -252,6 +254,7 @@ class ClearanceValidityChecker : public ob::StateValidityChecker {
   const GroupSpace& gs_;
   std::vector<Eigen::Vector2d> ends_;
   double near_;
+  bool implied_;
   bool relaxed_{false};
 };
 

@@ -783,8 +783,14 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
     if (req.goal.kind == MotionGoal::Kind::kBasePose) ends.emplace_back(req.goal.base.x, req.goal.base.y);
     if (req.goal.kind == MotionGoal::Kind::kConfiguration && req.goal.configuration.size() >= 2)
       ends.emplace_back(req.goal.configuration[0], req.goal.configuration[1]);
+    // Grown boxes, cylinders and spheres contain the originals (a grown prism need not); the
+    // grown scene has no unknown space.
+    const auto& parts = impl.robot.geometry().parts;
+    const bool contains = !impl.scene.hasUnknownSpace() && std::all_of(parts.begin(), parts.end(), [](const auto& part) {
+      return part.shape.kind != world::ShapeKind::kPrism;
+    });
     clearance = std::make_shared<detail::ClearanceValidityChecker>(si, oracle, *padded_oracle, gs, std::move(ends),
-                                                                   P.sampling.base_clearance_near_ends);
+                                                                   P.sampling.base_clearance_near_ends, contains);
     si->setStateValidityChecker(clearance);
   }
   auto freeState = [&](ob::State* s) { space->freeState(s); };

@@ -165,19 +165,12 @@ double sweptLength(const ob::StateSpace& space, const ob::State* a, const ob::St
 
 bool isStopAndTurn(const ob::StateSpace& space) { return dynamic_cast<const TurnDriveTurnSpace*>(&space) != nullptr; }
 
-bool CornerMotionValidator::checkMotion(const ob::State* s1, const ob::State* s2) const {
-  std::pair<ob::State*, double> unused{nullptr, 0.0};
-  return checkMotion(s1, s2, unused);
-}
-
-bool CornerMotionValidator::checkMotion(const ob::State* s1, const ob::State* s2,
-                                        std::pair<ob::State*, double>& last_valid) const {
-  const auto& space = si_->getStateSpace();
-  std::vector<double> at = turnCorners(*space, s1, s2);
-  const unsigned n = space->validSegmentCount(s1, s2);
-  for (unsigned j = 1; j < n; ++j) at.push_back(static_cast<double>(j) / n);
-  std::sort(at.begin(), at.end());
-  at.push_back(1.0);
+namespace {
+/// Checks the states of the motion s1 -> s2 at the sorted fractions `at` (the last one 1: s2
+/// itself), in order; on the first invalid one, `last_valid` gets the fraction before it.
+bool checkAt(const ob::SpaceInformation& si, const ob::State* s1, const ob::State* s2, const std::vector<double>& at,
+             std::pair<ob::State*, double>& last_valid) {
+  const auto& space = si.getStateSpace();
   ob::State* tmp = space->allocState();
   double previous = 0.0;
   bool ok = true;
@@ -187,7 +180,7 @@ bool CornerMotionValidator::checkMotion(const ob::State* s1, const ob::State* s2
       space->interpolate(s1, s2, f, tmp);
       s = tmp;
     }
-    if (!si_->isValid(s)) {
+    if (!si.isValid(s)) {
       ok = false;
       break;
     }
@@ -196,11 +189,36 @@ bool CornerMotionValidator::checkMotion(const ob::State* s1, const ob::State* s2
   if (!ok) {
     if (last_valid.first != nullptr) space->interpolate(s1, s2, previous, last_valid.first);
     last_valid.second = previous;
-    ++invalid_;
-  } else {
-    ++valid_;
   }
   space->freeState(tmp);
+  return ok;
+}
+
+/// j / n for j = 1 .. n - 1, then 1.
+std::vector<double> uniformFractions(unsigned n) {
+  std::vector<double> at;
+  for (unsigned j = 1; j < n; ++j) at.push_back(static_cast<double>(j) / n);
+  at.push_back(1.0);
+  return at;
+}
+}  // namespace
+
+bool CornerMotionValidator::checkMotion(const ob::State* s1, const ob::State* s2) const {
+  std::pair<ob::State*, double> unused{nullptr, 0.0};
+  return checkMotion(s1, s2, unused);
+}
+
+bool CornerMotionValidator::checkMotion(const ob::State* s1, const ob::State* s2,
+                                        std::pair<ob::State*, double>& last_valid) const {
+  const auto& space = si_->getStateSpace();
+  std::vector<double> at = uniformFractions(space->validSegmentCount(s1, s2));
+  at.pop_back();
+  const std::vector<double> corners = turnCorners(*space, s1, s2);
+  at.insert(at.end(), corners.begin(), corners.end());
+  std::sort(at.begin(), at.end());
+  at.push_back(1.0);
+  const bool ok = checkAt(*si_, s1, s2, at, last_valid);
+  ++(ok ? valid_ : invalid_);
   return ok;
 }
 
@@ -220,33 +238,8 @@ bool SweptArmMotionValidator::checkMotion(const ob::State* s1, const ob::State* 
 
 bool SweptArmMotionValidator::checkMotion(const ob::State* s1, const ob::State* s2,
                                           std::pair<ob::State*, double>& last_valid) const {
-  const auto& space = si_->getStateSpace();
-  if (!si_->isValid(s2)) {
-    if (last_valid.first != nullptr) space->copyState(last_valid.first, s1);
-    last_valid.second = 0.0;
-    ++invalid_;
-    return false;
-  }
-  const unsigned n = segments(s1, s2);
-  ob::State* tmp = space->allocState();
-  bool ok = true;
-  unsigned j = 1;
-  for (; j < n; ++j) {
-    space->interpolate(s1, s2, static_cast<double>(j) / n, tmp);
-    if (!si_->isValid(tmp)) {
-      ok = false;
-      break;
-    }
-  }
-  if (!ok) {
-    const double previous = static_cast<double>(j - 1) / n;
-    if (last_valid.first != nullptr) space->interpolate(s1, s2, previous, last_valid.first);
-    last_valid.second = previous;
-    ++invalid_;
-  } else {
-    ++valid_;
-  }
-  space->freeState(tmp);
+  const bool ok = checkAt(*si_, s1, s2, uniformFractions(segments(s1, s2)), last_valid);
+  ++(ok ? valid_ : invalid_);
   return ok;
 }
 
@@ -268,57 +261,39 @@ RobotBinding::RobotBinding(robot::RobotModel model)
   computeArmSweep();
 }
 
+namespace {
+/// The links below `root` (itself included) with the chain length of joint offsets from `root`'s
+/// origin to each, along the kinematic tree.
+std::vector<std::pair<std::string, double>> chainsBelow(const robot::RobotModel& model, const std::string& root) {
+  std::vector<std::pair<std::string, double>> out{{root, 0.0}};
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    for (const auto& j : model.joints()) {
+      if (j.parent_link != out[i].first) continue;
+      if (std::any_of(out.begin(), out.end(), [&](const auto& e) { return e.first == j.child_link; })) continue;
+      out.emplace_back(j.child_link, out[i].second + j.parent_T_joint.translation().norm());
+    }
+  }
+  return out;
+}
+}  // namespace
+
 void RobotBinding::computeArmSweep() {
   if (!model_ || model_->armJointNames().empty()) return;
   const robot::Joint* first = model_->findJoint(model_->armJointNames().front());
   if (!first) return;
-  // Chain length from the first joint to each link it moves, along the kinematic tree.
-  arm_reach_ = {{first->child_link, 0.0}};
-  for (bool grew = true; grew;) {
-    grew = false;
-    for (const auto& j : model_->joints()) {
-      auto parent = std::find_if(arm_reach_.begin(), arm_reach_.end(), [&](const auto& e) { return e.first == j.parent_link; });
-      if (parent == arm_reach_.end()) continue;
-      if (std::any_of(arm_reach_.begin(), arm_reach_.end(), [&](const auto& e) { return e.first == j.child_link; }))
-        continue;
-      arm_reach_.emplace_back(j.child_link, parent->second + j.parent_T_joint.translation().norm());
-      grew = true;
-    }
-  }
-  for (const auto& part : geometry_.parts) {
-    const double chain = armReachTo(geometry_.links[static_cast<std::size_t>(part.link)]);
-    if (chain < 0.0) continue;  // not moved by the arm
-    const Aabb box = part.shape.aabb(Eigen::Isometry3d::Identity());
-    const double extent = part.link_T_shape.translation().norm() + 0.5 * (box.max - box.min).norm();
-    arm_sweep_radius_ = std::max(arm_sweep_radius_, chain + extent);
-  }
+  arm_reach_ = chainsBelow(*model_, first->child_link);
   // Per joint: the chain from that joint's child link out to the farthest part it moves.
   for (const auto& name : model_->armJointNames()) {
     const robot::Joint* joint = model_->findJoint(name);
-    const double base = joint ? armReachTo(joint->child_link) : -1.0;
     double r = 0.0;
-    if (base >= 0.0) {
-      // Links below this joint: reached from its child link along the tree.
-      std::vector<std::string> below{joint->child_link};
-      for (bool grew = true; grew;) {
-        grew = false;
-        for (const auto& j : model_->joints()) {
-          if (std::find(below.begin(), below.end(), j.parent_link) != below.end() &&
-              std::find(below.begin(), below.end(), j.child_link) == below.end()) {
-            below.push_back(j.child_link);
-            grew = true;
-          }
-        }
-      }
+    for (const auto& [link, chain] : chainsBelow(*model_, joint ? joint->child_link : first->child_link)) {
       for (const auto& part : geometry_.parts) {
-        const std::string& link = geometry_.links[static_cast<std::size_t>(part.link)];
-        if (std::find(below.begin(), below.end(), link) == below.end()) continue;
+        if (geometry_.links[static_cast<std::size_t>(part.link)] != link) continue;
         const Aabb box = part.shape.aabb(Eigen::Isometry3d::Identity());
-        r = std::max(r, armReachTo(link) - base + part.link_T_shape.translation().norm() +
-                            0.5 * (box.max - box.min).norm());
+        r = std::max(r, chain + part.link_T_shape.translation().norm() + 0.5 * (box.max - box.min).norm());
       }
     }
-    arm_joint_radii_.push_back(base >= 0.0 ? r : arm_sweep_radius_);
+    arm_joint_radii_.push_back(r);
   }
 }
 

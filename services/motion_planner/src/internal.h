@@ -52,12 +52,10 @@ class RobotBinding {
   double inscribedZMax() const { return inscribed_zmax_; }
   /// Largest xy distance from the base origin to the base's footprint, m.
   double footprintRadius() const { return footprint_radius_; }
-  /// Arm robots: a bound on how far any point of the arm's links (from the first arm joint on:
-  /// links, gripper, fingers) moves per radian of joint motion, summed over the joints (m/rad):
-  /// the chain's joint offsets out to the farthest link plus that link's parts. 0 without an arm.
-  double armSweepRadius() const { return arm_sweep_radius_; }
-  /// Per arm joint (chain order): the same bound for the links that joint moves (m/rad); the
-  /// displacement of any point for a joint motion dq is at most sum_j |dq_j| armJointRadii()[j].
+  /// Per arm joint (chain order): how far any point of the links that joint moves (links,
+  /// gripper, fingers) moves per radian of it (m/rad): the chain's joint offsets out to the
+  /// farthest link plus that link's parts. The displacement of any point for a joint motion dq is
+  /// at most sum_j |dq_j| armJointRadii()[j]. Empty without an arm.
   const std::vector<double>& armJointRadii() const { return arm_joint_radii_; }
   /// Floor contact of an arm part (the planner's name for it in reasons and contacts).
   static constexpr const char* kFloor = "floor";
@@ -75,7 +73,6 @@ class RobotBinding {
   double inscribed_zmin_{0.0};
   double inscribed_zmax_{0.0};
   double footprint_radius_{0.0};
-  double arm_sweep_radius_{0.0};
   std::vector<double> arm_joint_radii_;
   std::vector<std::pair<std::string, double>> arm_reach_;  // link -> chain length from the first arm joint
 };

@@ -154,7 +154,8 @@ TEST(MissionTest, ABoxTooWideToGraspIsPushedOffTheWayToTheGoal) {
 // Back in CI since 2026-12-05 (session 11): it was disabled at 12 of 14 runs, the misses the
 // product's (the base path round the pushed crate kept no clearance, and the simulator stopped the
 // robot beside it). With base paths keeping 5 cm where there is room: 17 of 17 runs, 16 of them
-// beside a busy loop.
+// beside a busy loop. Not all cleanly: in 7 of 18 runs the monitor stopped or refused a drive
+// when perception's side-on estimate of the crate drifted onto the path, and the mission recovered.
 TEST(MissionTest, ACrateInTheOnlyDoorwayIsPushedIntoTheNextRoomAndDrivenRound) {
   auto sc = world::loadScenario(configDir() / "scenarios" / "namo_doorway.yaml");
   ASSERT_TRUE(sc.ok()) << sc.error().toString();

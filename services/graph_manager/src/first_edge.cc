@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "tamp/core/log.h"
 #include "tamp/graph_manager/graph_manager.h"
 
 namespace tamp::graph_manager {
@@ -78,8 +79,13 @@ bool GraphManager::plannedIn(EdgeId id, EdgeId next, const BranchContext& ctx) c
   const auto m = e.motion_by_next.find(key);
   const auto effort = e.effort_by_next.find(key);
   if (m == e.motion_by_next.end() || effort == e.effort_by_next.end() ||
-      !std::isfinite(effort->second.first))
+      !std::isfinite(effort->second.first)) {
+    log::get("graph_manager")->debug("plannedIn {}: no motion for this next ({})", e.action, key);
     return false;
+  }
+  if (m->second.planned_in != contextKey(ctx))
+    log::get("graph_manager")->debug("plannedIn {}: planned in '{}', now '{}' (prepared {}, deferred {})", e.action,
+                                     m->second.planned_in, contextKey(ctx), m->second.prepared.has_value(), m->second.deferred);
   return key >= 0 && m->second.prepared && !m->second.deferred && !m->second.trajectory.empty() &&
          !m->second.planned_in.empty() && m->second.planned_in == contextKey(ctx);
 }

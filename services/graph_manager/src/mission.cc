@@ -197,7 +197,8 @@ bool GraphManager::Run::planBranch(std::string& why) {
   const int evaluations0 = gm.counters_.evaluations;
   // After an event the next command waits for the first edge only (first_edge.cc).
   continuation.reset();
-  TraverseResult t = event_at && gm.params_.replan_first_edge ? gm.traverseFirstEdge(current, ctx) : gm.traverse(current, ctx);
+  auto search = [&] { return event_at && gm.params_.replan_first_edge ? gm.traverseFirstEdge(current, ctx) : gm.traverse(current, ctx); };
+  TraverseResult t = search();
   // The geometry refuted a region-level reach (a pick from too far on a large region): plan again
   // from the refined state, where those objects are on slots of their own. Each round adds at
   // least one slot, so this ends; the bound keeps it short.
@@ -208,7 +209,7 @@ bool GraphManager::Run::planBranch(std::string& why) {
     if (gm.graph_.out(current).empty() && !gm.isGoal(current)) {
       if (!gm.planFrom(current, gm.goal_.atoms, "plan after refining the abstraction")) break;
     }
-    t = gm.traverse(current, ctx);
+    t = search();
   }
   if (!t.found && attempts > 0 && planned_from_scratch.insert(current).second) {
     // Every re-joining branch goes through an action that can no longer be done (it failed too
@@ -220,7 +221,7 @@ bool GraphManager::Run::planBranch(std::string& why) {
         report.replanning.back().how = "from scratch";
         report.replanning.back().planner_calls += gm.counters_.planner_calls - planner0;
       }
-      t = gm.traverse(current, ctx);
+      t = search();
     }
   }
   if (!t.found) {
@@ -231,6 +232,8 @@ bool GraphManager::Run::planBranch(std::string& why) {
     pending.traverse_s += since(t0);
     pending.evaluations += gm.counters_.evaluations - evaluations0;
   }
+  log::get("graph_manager")->debug("traverse from n{}: {} edges, {} proven first, {:.2f} s", current, t.branch.size(),
+                                   t.proven_edges, t.cost_s);
   branch = t.branch;
   branch_total = done_effort + t.cost_s;
   report.predicted_effort_s = branch_total;
@@ -255,7 +258,9 @@ GraphManager::Run::Prepared GraphManager::Run::prepare(EdgeId id, EdgeId next) {
     // A manipulation is never sent deferred: its grasp is planned now or it is a failure (unless
     // it was planned from where the robot is, in the world as it is: the Traverse after an event
     // plans the first edge so).
-    const bool priced = (gm.params_.replan_first_edge && gm.plannedIn(id, -1, ctx)) || std::isfinite(gm.evaluate(id, -1, ctx, 0));
+    const bool planned = gm.params_.replan_first_edge && gm.plannedIn(id, -1, ctx);
+    if (!planned) log::get("graph_manager")->debug("prepare {}: planned in the world as it is now", gm.graph_.edge(id).action);
+    const bool priced = planned || std::isfinite(gm.evaluate(id, -1, ctx, 0));
     Edge& m = gm.graph_.edge(id);
     ok = priced && m.motion && !m.motion->deferred && !m.motion->trajectory.empty();
     if (!ok && m.reason.empty()) m.reason = "no grasp or placement in the world as it is now";
@@ -265,6 +270,8 @@ GraphManager::Run::Prepared GraphManager::Run::prepare(EdgeId id, EdgeId next) {
     // Unless it was planned from where the robot is, in the world as it is (the Traverse after an
     // event plans the first edge so).
     if (!gm.params_.replan_first_edge || !gm.plannedIn(id, next, ctx)) {
+      log::get("graph_manager")->debug("prepare {}: the arm motion into it is planned again in the world as it is now",
+                                       gm.graph_.edge(next).action);
       Edge& arm = gm.graph_.edge(id);
       arm.motion_by_next.erase(gm.armKey(id, next));
       arm.effort_by_next.erase(gm.armKey(id, next));
@@ -303,6 +310,8 @@ Result<EdgeCommand> GraphManager::Run::commandFor(EdgeId id, EdgeId next) {
   // The robot must be where the edge's motion starts; otherwise plan the motion again from it.
   if (cmd && e.kind != ActionKind::kPick && e.kind != ActionKind::kPlace &&
       startDistance(cmd->trajectory, ctx.state, e.kind) > gm.params_.start_tolerance) {
+    log::get("graph_manager")->debug("{}: the robot is {:.3f} from where its motion starts: planned again", e.action,
+                                     startDistance(cmd->trajectory, ctx.state, e.kind));
     if (e.kind == ActionKind::kMoveBase) {
       e.state = EdgeState::kUnevaluated;
       e.motion.reset();

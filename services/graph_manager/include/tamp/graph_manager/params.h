@@ -94,9 +94,11 @@ struct GraphManagerParams {
   /// Online replanning: the next command goes out once Traverse has proven the branch's first
   /// edge best (traverseFirstEdge), the rest of the branch is priced while the robot executes
   /// it, and an arm motion planned from where the robot is, in the world as it is, is not
-  /// planned again before it is sent. false (the default until the blocked stow arm motion in
-  /// namo_corridor_slippery is understood, docs/benchmarks.md): the whole branch first, as before.
-  bool replan_first_edge{false};
+  /// planned again before it is sent. false: the whole branch is priced before the command.
+  /// (Off from the third to the eleventh session for a stow motion stopped before the box in
+  /// namo_corridor_slippery; the cause was arm paths clipping objects between checked states,
+  /// fixed by the swept check, docs/benchmarks.md.)
+  bool replan_first_edge{true};
   /// Conditional planning: the nodes of the first plan given a prebuilt "the gripper is not
   /// empty" branch before execution starts (the start and the states before each pick, in plan
   /// order); each costs up to `max_rejoin_targets` planner calls at the start; >= 0 (0: none).

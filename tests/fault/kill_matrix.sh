@@ -88,67 +88,15 @@ for svc in $SERVICES; do
     wait "$runner"
     rc=$?
     dir=$OUT/$rid
-    read -r status resumptions reason < <(python3 - "$dir/report.json" << 'EOF'
-import json, sys
-try:
-    r = json.load(open(sys.argv[1]))
-    print(r.get("status", "?"), r.get("resumptions", 0), (r.get("reason") or "-").replace("\t", " ").replace("\n", " ")[:160])
-except Exception as e:
-    print("no-report", 0, "no report.json: " + str(e)[:100])
-EOF
-)
-    # What physically happened (the simulator's action log) against the estimator's store: every
-    # command id once in the log, and a record in the store for every succeeded action (records
-    # are de-duplicated by id: a resent one is not stored twice).
-    read -r repeated succeeded records unlogged < <(python3 - "$dir/sim_final_world.json" "$store/effort_store.sqlite" "$dir/report.json" << 'EOF'
-import collections, json, sqlite3, sys
-try:
-    w = json.load(open(sys.argv[1]))
-except Exception:
-    print("no-world 0 0 -"); sys.exit()
-log = w.get("action_log", [])
-ids = [a["command_id"] if isinstance(a, dict) else a for a in log]
-rep = [i for i, n in collections.Counter(ids).items() if n > 1]
-ok = sum(1 for a in log if isinstance(a, dict) and a.get("outcome") == "succeeded")
-try:
-    n = sqlite3.connect(sys.argv[2]).execute("select count(distinct record_id) from records").fetchone()[0]
-except Exception:
-    n = -1
-# The robot's log names a command "<mission id>/<command id>", the report "<command id>".
-logged = {i.split("/")[-1] for i in ids}
-try:
-    acts = json.load(open(sys.argv[3])).get("actions", [])
-except Exception:
-    acts = []
-lost = [a["command_id"] for a in acts if a.get("outcome") == "succeeded" and a.get("command_id")
-        and a["command_id"] not in logged]
-print(",".join(rep) if rep else "none", ok, n, ",".join(lost) if lost else "none")
-EOF
-)
-    restarts=$(python3 - "$dir/events.jsonl" "$svc" << 'EOF'
-import json, sys
-n = 0
-try:
-    for line in open(sys.argv[1]):
-        try:
-            e = json.loads(line)
-        except ValueError:
-            continue
-        if e.get("service") == sys.argv[2] and e.get("event") == "restarted":
-            n += 1
-except OSError:
-    pass
-print(n)
-EOF
-)
+    # What physically happened (the simulator's action log) against the report and the
+    # estimator's store (records are de-duplicated by id: a resent one is not stored twice).
+    IFS=$'\t' read -r status resumptions repeated succeeded records restarts unlogged reason verdict < <(
+      python3 "$ROOT/tests/fault/judge_run.py" "$dir" "$store/effort_store.sqlite" "$svc" --verdict)
     printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$svc" "$seed" "$k" "$delay" "$killed" "$rc" "$status" \
       "$resumptions" "$repeated" "$succeeded" "$records" "${restarts:-0}" "$unlogged" "$reason" >> "$TSV"
     echo "$svc seed $seed: kill at command $k +${delay}s killed=$killed exit $rc $status repeated=$repeated" \
       "records=$records/$succeeded restarts=${restarts:-0} unlogged=$unlogged"
-    if [ "$repeated" != "none" ] || [ "$unlogged" != "none" ] || { [ "$status" != "succeeded" ] && [ "$status" != "failed" ]; } || \
-       { [ "$status" = "failed" ] && [ "$reason" = "-" ]; } || [ "$records" -lt "$succeeded" ]; then
-      bad=$((bad + 1))
-    fi
+    [ "$verdict" = ok ] || bad=$((bad + 1))
   done
 done
 echo "kill_matrix: $runs runs, $bad bad (table: $TSV)"

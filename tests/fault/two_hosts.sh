@@ -6,6 +6,12 @@
 #   tests/fault/two_hosts.sh BUILD_DIR [--discovery server|multicast] [--scenario FILE]
 #        [--netem "loss 10%"|"delay 50ms"|"duplicate 10%"|...] [--partition-at S --partition-for S]
 #        [--seed N] [--out DIR] [--run-id ID] [--one-host] [--ping N] [--loss PCT] [--duplicate PCT]
+#        [--kill SERVICE --kill-at S]
+#
+# --kill SERVICE --kill-at S: SIGKILL to that service's process S s after the mission started,
+# on whichever host runs it (its launcher restarts it); the run is then judged by
+# tests/fault/judge_run.py (nothing executed twice, no execution record lost, ended succeeded or
+# failed with a reason), its line appended to OUT/RUN_ID/faults.log and the exit code 50 when bad.
 #
 # --loss PCT / --duplicate PCT drop / duplicate that percentage of the UDP datagrams each host
 # sends on the link (nftables `numgen random` on both namespaces' output; needs `nft`, Debian
@@ -33,6 +39,7 @@ BUILD=${1:?usage: two_hosts.sh BUILD_DIR [options]}; shift
 ROOT=$(cd "$(dirname "$0")/../.." && pwd)
 DISCOVERY=server SCENARIO=$ROOT/config/scenarios/namo_corridor_short.yaml NETEM="" SEED=1
 PART_AT="" PART_FOR=5 OUT=${TMPDIR:-/tmp}/tamp-two-hosts RUN_ID="" ONE_HOST=0 PING=0 LOSS=0 DUP=0
+KILL="" KILL_AT=""
 while [ $# -gt 0 ]; do
   case $1 in
     --discovery) DISCOVERY=$2; shift 2;;
@@ -47,10 +54,17 @@ while [ $# -gt 0 ]; do
     --ping) PING=$2; shift 2;;
     --loss) LOSS=$2; shift 2;;
     --duplicate) DUP=$2; shift 2;;
+    --kill) KILL=$2; shift 2;;
+    --kill-at) KILL_AT=$2; shift 2;;
     *) echo "two_hosts.sh: unknown option $1" >&2; exit 30;;
   esac
 done
 case $DISCOVERY in server|multicast) ;; *) echo "two_hosts.sh: --discovery server|multicast, got '$DISCOVERY'" >&2; exit 30;; esac
+SERVICES_ALL="sim perception execution_monitor graph_manager symbolic_planner motion_planner effort_estimator"
+if [ -n "$KILL" ]; then
+  [[ " $SERVICES_ALL " == *" $KILL "* ]] || { echo "two_hosts.sh: --kill takes one of: $SERVICES_ALL; got '$KILL'" >&2; exit 30; }
+  [[ $KILL_AT =~ ^[0-9]+(\.[0-9]+)?$ ]] || { echo "two_hosts.sh: --kill needs --kill-at SECONDS, got '$KILL_AT'" >&2; exit 30; }
+fi
 for pct in "$LOSS" "$DUP"; do
   if ! [[ $pct =~ ^[0-9]+$ ]] || [ "$pct" -gt 100 ]; then echo "two_hosts.sh: --loss/--duplicate take a percentage 0..100, got '$pct'" >&2; exit 30; fi
 done
@@ -162,6 +176,21 @@ if [ -n "$PART_AT" ]; then
   PIDS+=($!)
 fi
 
+if [ -n "$KILL" ]; then
+  (
+    # SIGKILL KILL_AT s after the mission started; the service's launcher restarts it.
+    until grep -q "tamp mission: run" "$OUT/$RUN_ID/mission.out" 2>/dev/null; do sleep 0.2; done
+    sleep "$KILL_AT"
+    pid=$(pgrep -f -- "tamp_${KILL}_service --name $KILL .*--run-id $RUN_ID" | head -1)
+    if [ -n "$pid" ] && kill -9 "$pid" 2>/dev/null; then
+      echo "kill: SIGKILL to $KILL (pid $pid) at $(date -u +%T.%N)" >> "$OUT/$RUN_ID/faults.log"
+    else
+      echo "kill: no running $KILL to kill at $(date -u +%T.%N)" >> "$OUT/$RUN_ID/faults.log"
+    fi
+  ) &
+  PIDS+=($!)
+fi
+
 START=$(date +%s.%N)
 set +e
 ip netns exec "$NS_W" "$BIN/tamp" mission "$SCENARIO" --deployment "$DEPLOY" --run-id "$RUN_ID" --seed "$SEED" \
@@ -184,6 +213,11 @@ cleanup; trap - EXIT
 # The simulator writes its final world on a clean stop (cleanup sends SIGTERM to the launchers).
 if [ "$RC" = 0 ] && [ ! -s "$OUT/$RUN_ID/sim_final_world.json" ]; then
   echo "two_hosts.sh: mission succeeded but the simulator wrote no final world" >&2; exit 50
+fi
+if [ -n "$KILL" ]; then
+  verdict_line=$(python3 "$ROOT/tests/fault/judge_run.py" "$RUN_DIR" "$RUN_DIR/store/effort_store.sqlite" "$KILL" --verdict)
+  echo "judge: $KILL at +${KILL_AT}s: $verdict_line" | tee -a "$RUN_DIR/faults.log"
+  if [ "${verdict_line##*$'\t'}" != ok ]; then echo 50 > "$OUT/$RUN_ID/exit_code"; exit 50; fi
 fi
 echo "$RC" > "$OUT/$RUN_ID/exit_code"
 exit "$RC"

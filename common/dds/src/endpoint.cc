@@ -102,6 +102,12 @@ int WriterBase::matchedReaders() const {
   return st.current_count;
 }
 
+int WriterBase::readersEverMatched() const {
+  fdds::PublicationMatchedStatus st;
+  if (writer_->get_publication_matched_status(st) != ReturnCode_t::RETCODE_OK) return 0;
+  return st.total_count;
+}
+
 bool WriterBase::waitForReaders(const Termination& until, int count) const {
   while (matchedReaders() < count) {
     if (until()) return false;

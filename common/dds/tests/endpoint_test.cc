@@ -1,6 +1,7 @@
 #include "tamp/dds/endpoint.h"
 
 #include <atomic>
+#include <memory>
 #include <thread>
 
 #include <gmock/gmock.h>
@@ -149,6 +150,31 @@ TEST(EndpointTest, KeyedCommandsAndEventsAreNotLimitedToTenInstances) {
   }
   EXPECT_EQ(got_commands, kCommands);
   EXPECT_EQ(got_statuses, kCommands);
+}
+
+TEST(EndpointTest, AReaderThatComesBackCountsAsANewMatch) {
+  // A restarted reader (a new participant) matches again: the writer's ever-matched count rises
+  // while its current count returns to one, so a writer can tell that a reader may have missed
+  // what it wrote (volatile commands).
+  auto p = makeParticipant();
+  ASSERT_TRUE(p);
+  Writer<msg::ExecuteCommand> writer(p, topics::kExecuteCommand);
+  auto first = makeParticipant();
+  ASSERT_TRUE(first);
+  auto reader = std::make_unique<Reader<msg::ExecuteCommand>>(first, topics::kExecuteCommand);
+  ASSERT_TRUE(writer.waitForReaders(Termination::after(5.0)));
+  EXPECT_EQ(writer.readersEverMatched(), 1);
+  reader.reset();
+  first.reset();
+  const Deadline gone = Deadline::in(10.0);
+  while (writer.matchedReaders() > 0 && !gone.expired()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  ASSERT_EQ(writer.matchedReaders(), 0);
+  auto second = makeParticipant();
+  ASSERT_TRUE(second);
+  Reader<msg::ExecuteCommand> again(second, topics::kExecuteCommand);
+  ASSERT_TRUE(writer.waitForReaders(Termination::after(5.0)));
+  EXPECT_EQ(writer.matchedReaders(), 1);
+  EXPECT_EQ(writer.readersEverMatched(), 2);
 }
 
 TEST(EndpointTest, ThrowingCallbackIsContainedAndCounted) {

@@ -315,13 +315,14 @@ ExecutionReport DdsExecutor::execute(const EdgeCommand& c, double budget_s) {
   m.expected_duration_s(c.expected_s);
   m.expected_stddev_s(c.expected_stddev_s);
   m.world_version(c.world_version);
+  const int matches = writer_.readersEverMatched();
   if (Status s = writer_.write(m); !s) {
     r.outcome = ExecOutcome::kUnavailable;
     r.reason = s.error().message;
     return r;
   }
   std::unique_lock lock(mutex_);
-  r = finalOf(lock, wire, budget_s);
+  r = finalOf(lock, wire, budget_s, &m, matches);
   if (r.outcome == ExecOutcome::kTimeout) {
     lock.unlock();
     msg::ExecuteCommand cancel = m;
@@ -336,13 +337,30 @@ ExecutionReport DdsExecutor::await(const std::string& command_id, double budget_
   return finalOf(lock, wireId(command_id), budget_s);
 }
 
-ExecutionReport DdsExecutor::finalOf(std::unique_lock<std::mutex>& lock, const std::string& wire, double budget_s) {
+ExecutionReport DdsExecutor::finalOf(std::unique_lock<std::mutex>& lock, const std::string& wire, double budget_s,
+                                     const msg::ExecuteCommand* resend, int matches) {
   ExecutionReport r;
   const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(budget_s));
-  if (!cv_.wait_until(lock, deadline, [&] { return final_.count(wire) > 0; })) {
-    r.outcome = ExecOutcome::kTimeout;
-    r.reason = "no result within " + std::to_string(budget_s) + " s";
-    return r;
+  const auto done = [&] { return final_.count(wire) > 0; };
+  while (!done()) {
+    const auto slice = resend ? std::min(deadline, Clock::now() + std::chrono::milliseconds(250)) : deadline;
+    if (cv_.wait_until(lock, slice, done)) break;
+    if (Clock::now() >= deadline) {
+      r.outcome = ExecOutcome::kTimeout;
+      r.reason = "no result within " + std::to_string(budget_s) + " s";
+      return r;
+    }
+    // Commands are volatile: a monitor restarted while this one was out never received it. Sent
+    // again, it is answered from the monitor's journal or the robot's own results, never executed
+    // twice (the monitor and the robot are idempotent on command ids).
+    if (const int now = writer_.readersEverMatched(); now > matches) {
+      matches = now;
+      lock.unlock();
+      const Status s = writer_.write(*resend);
+      log::get("graph_manager")->info("a reader of {} matched while '{}' was out (a restarted execution monitor?): "
+                                      "sent again{}", writer_.topicName(), wire, s ? "" : ": " + s.error().message);
+      lock.lock();
+    }
   }
   const msg::ExecuteStatus s = final_.at(wire);
   final_.erase(wire);

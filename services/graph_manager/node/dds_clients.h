@@ -60,8 +60,10 @@ class DdsExecutor : public Executor {
  private:
   void onStatus(const msg::ExecuteStatus& s);
   /// Waits (lock held) up to `budget_s` for the final status of `wire`; the report from it, or
-  /// kTimeout.
-  ExecutionReport finalOf(std::unique_lock<std::mutex>& lock, const std::string& wire, double budget_s);
+  /// kTimeout. With `resend`, every quarter of a second: a reader matched since `matches`
+  /// (a restarted execution monitor, which never saw the command) gets it again.
+  ExecutionReport finalOf(std::unique_lock<std::mutex>& lock, const std::string& wire, double budget_s,
+                          const msg::ExecuteCommand* resend = nullptr, int matches = 0);
   std::string mission_id_;
   dds::Writer<msg::ExecuteCommand> writer_;
   std::mutex mutex_;

@@ -705,8 +705,13 @@ bool GraphManager::Run::replan(const MissionEvent& ev, EdgeId failed, std::strin
     // The arm out of its driving configuration: where the node before the event had it.
     std::string armconf = "stow";
     const NodeId was = failed >= 0 ? gm.graph_.edge(failed).from : current;
-    if (!gm.armStowed(ctx.state.arm) && !gm.graph_.node(was).atoms.empty())
+    if (!gm.armStowed(ctx.state.arm) && !gm.graph_.node(was).atoms.empty()) {
       armconf = gm.abstraction_.bind(gm.graph_.node(was).atoms).armconf;
+      // The node had the arm stowed and the robot has it out (a move_arm out of stow that ended,
+      // or stopped part-way, without its result reaching the graph): a symbol of its own, which a
+      // plan can only leave; a base motion with the arm out would be refused.
+      if (armconf == "stow") armconf = gm.abstraction_.addObservedArmconf("arm_observed");
+    }
     const auto atoms = gm.abstraction_.dynamicAtoms(live, ctx.state.base, armconf, now.valid ? now.held_object_id : "");
     current = gm.graph_.addNode(atoms, "observed after " + ev.action);
     const auto joined = gm.rejoin(current, ahead, fresh, "re-join after " + std::string(toString(ev.kind)));

@@ -84,6 +84,9 @@ class WriterBase {
   const std::string& topicName() const { return topic_name_; }
   /// Number of readers currently matched.
   int matchedReaders() const;
+  /// Readers matched since the writer was created, past ones included: a reader that restarted
+  /// (a new participant) counts again, so a rise says a reader may have missed what was written.
+  int readersEverMatched() const;
   /// Waits until at least `count` readers are matched or the termination fires.
   bool waitForReaders(const Termination& until, int count = 1) const;
 

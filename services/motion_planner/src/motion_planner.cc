@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <mutex>
 
@@ -663,47 +664,74 @@ Result<PrepareStats> MotionPlanner::prepare(PlanningGroup group, const robot::Ro
   return out;
 }
 
-MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& termination) {
-  Impl& impl = *impl_;
-  const auto& P = impl.params;
+namespace {
+
+/// Frees a state of `space` (a start, an escape): OMPL states belong to their space.
+struct StateFree {
+  const ob::StateSpace* space;
+  void operator()(ob::State* s) const { space->freeState(s); }
+};
+using StatePtr = std::unique_ptr<ob::State, StateFree>;
+
+/// Frees the goal states when the request ends.
+struct GoalFree {
+  std::vector<ob::State*>& v;
+  const ob::StateSpacePtr& sp;
+  ~GoalFree() {
+    for (auto* s : v) sp->freeState(s);
+  }
+};
+
+/// Set when a phase of plan() ends the request: plan() returns it.
+using Outcome = std::optional<MotionResult>;
+
+/// What plan() returns, filled in by its phases, and the clock of its planning time.
+struct PlanOutput {
   Stopwatch clock;
   MotionResult res;
-  auto finish = [&](MotionStatus st, std::string reason, std::string object = {}) {
+  /// `res` with its outcome and the planning time so far.
+  MotionResult finish(MotionStatus st, std::string reason, std::string object = {}) {
     res.status = st;
     res.reason = std::move(reason);
     res.colliding_object = std::move(object);
     res.planning_time_s = clock.seconds();
     return res;
-  };
-  const std::vector<std::string> names = groupJointNames(req.group);
-  if (auto why = validateRequest(req, impl, names)) return finish(MotionStatus::kInvalidRequest, *why);
-  // The request's world: the planner's with the overrides applied, restored on every return
-  // (declared before the attachment so that the held object is detached first).
-  WorldRestore restore;
-  if (!req.object_overrides.empty()) {
-    auto hypothetical = overriddenWorld(impl.world, req.object_overrides, req.held_object);
-    if (!hypothetical) return finish(MotionStatus::kInvalidRequest, hypothetical.error().message);
-    restore = WorldRestore(impl, std::move(*hypothetical));
   }
-  // The held object with its margin (the world restored afterwards, as for overrides).
-  std::optional<world::Shape> held_shape;  // its modelled shape, when grown
-  if (req.held_padding_m > 0) {
-    world::World padded = impl.world;
-    const std::string id = !req.held_object.empty() ? req.held_object : impl.world.held()->object_id;
-    world::Object o = padded.object(id);
-    held_shape = o.shape;
-    o.shape = grownShape(o.shape, req.held_padding_m);
-    if (Status s = padded.updateObject(o); !s) {
-      return finish(MotionStatus::kInvalidRequest, "held_padding_m: " + s.error().message);
-    }
-    if (restore.active()) {
-      restore.replaceWorld(std::move(padded));
-    } else {
-      restore = WorldRestore(impl, std::move(padded));
-    }
-  }
+};
 
-  // Base bounds: the world, the start and a base goal.
+/// The request's world in place of the planner's while the request is planned.
+struct RequestWorld {
+  // The planner's world with the overrides applied, restored on every return (declared before the
+  // attachment so that the held object is detached first).
+  WorldRestore restore;
+  std::optional<world::Shape> held_shape;  // the held object's modelled shape, when grown
+  Aabb bounds;                             // of the base
+  std::string held;                        // the object that moves with the robot, or none
+  MotionPlanner::Impl::AttachGuard guard;
+  std::string held_link;
+  Eigen::Isometry3d link_T_held = Eigen::Isometry3d::Identity();
+};
+
+/// The held object with its margin (the world restored afterwards, as for overrides); the
+/// problem, if any.
+std::optional<std::string> padHeldObject(MotionPlanner::Impl& impl, const MotionRequest& req, RequestWorld& rw) {
+  if (!(req.held_padding_m > 0)) return std::nullopt;
+  world::World padded = impl.world;
+  const std::string id = !req.held_object.empty() ? req.held_object : impl.world.held()->object_id;
+  world::Object o = padded.object(id);
+  rw.held_shape = o.shape;
+  o.shape = grownShape(o.shape, req.held_padding_m);
+  if (Status s = padded.updateObject(o); !s) return "held_padding_m: " + s.error().message;
+  if (rw.restore.active()) {
+    rw.restore.replaceWorld(std::move(padded));
+  } else {
+    rw.restore = WorldRestore(impl, std::move(padded));
+  }
+  return std::nullopt;
+}
+
+/// Base bounds: the world, the start and a base goal.
+Aabb requestBounds(const MotionPlanner::Impl& impl, const MotionRequest& req) {
   std::vector<Eigen::Vector2d> extra{{req.start.base.x, req.start.base.y}};
   if (req.goal.kind == MotionGoal::Kind::kBasePose) extra.emplace_back(req.goal.base.x, req.goal.base.y);
   if (req.goal.kind == MotionGoal::Kind::kConfiguration && req.group != PlanningGroup::kArm) {
@@ -712,25 +740,177 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
   if (req.goal.kind == MotionGoal::Kind::kEndEffectorPose) {
     extra.emplace_back(req.goal.end_effector.translation().x(), req.goal.end_effector.translation().y());
   }
-  const Aabb bounds = impl.baseBounds(extra);
+  return impl.baseBounds(extra);
+}
 
-  // The held object moves with the robot for this request.
-  const std::string held = !req.held_object.empty() ? req.held_object
-                           : impl.world.held() ? impl.world.held()->object_id
-                                               : std::string();
-  Impl::AttachGuard guard;
-  std::string held_link;
-  Eigen::Isometry3d link_T_held = Eigen::Isometry3d::Identity();
-  if (!held.empty()) {
-    auto g = impl.attach(held, req.start, req.held_object.empty() ? "world.held" : "held_object",
-                         req.held_grasp ? &*req.held_grasp : nullptr, &held_link, &link_T_held);
-    if (!g) return finish(MotionStatus::kInvalidRequest, g.error().message);
-    guard = std::move(*g);
+/// Puts the request's world in place (overrides, the held object's margin), its base bounds and
+/// the held object attached to the robot into `rw`; the first problem (an invalid request).
+std::optional<std::string> enterRequestWorld(MotionPlanner::Impl& impl, const MotionRequest& req,
+                                             RequestWorld& rw) {
+  if (!req.object_overrides.empty()) {
+    auto hypothetical = overriddenWorld(impl.world, req.object_overrides, req.held_object);
+    if (!hypothetical) return hypothetical.error().message;
+    rw.restore = WorldRestore(impl, std::move(*hypothetical));
   }
+  if (auto why = padHeldObject(impl, req, rw)) return why;
+  rw.bounds = requestBounds(impl, req);
+  // The held object moves with the robot for this request.
+  rw.held = !req.held_object.empty() ? req.held_object
+            : impl.world.held()      ? impl.world.held()->object_id
+                                     : std::string();
+  if (!rw.held.empty()) {
+    auto g = impl.attach(rw.held, req.start, req.held_object.empty() ? "world.held" : "held_object",
+                         req.held_grasp ? &*req.held_grasp : nullptr, &rw.held_link, &rw.link_T_held);
+    if (!g) return g.error().message;
+    rw.guard = std::move(*g);
+  }
+  return std::nullopt;
+}
 
-  detail::GroupSpace gs(impl.robot, req.group, req.start, bounds, P.sampling);
-  const auto& space = gs.space();
-  std::vector<std::string> ignored = req.ignored_objects;
+/// One plan() call in the request's world: its state space, checkers and start state (set up on
+/// construction), then its phases in the order plan() calls them. A phase that ends the request
+/// returns its result. Members are declared in the order they are made, so that they are
+/// destroyed in reverse (the planner before the goal states, the checkers before the space).
+struct Planning {
+  Planning(MotionPlanner::Impl& planner_impl, const MotionRequest& request, const Termination& term,
+           const RequestWorld& rw, PlanOutput& output);
+
+  /// The start: free, or left by a short straight motion (`escaped`); not in self-collision.
+  Outcome leaveStart();
+  /// The problem definition: the start and the goal, checked (a goal state, or IK solutions).
+  Outcome setGoal();
+  /// Lazy mode: the cached roadmap of the static free space, searched first when it is known.
+  void searchRoadmapFirst();
+  /// A path: the roadmap's, the direct motion or the sampling planner's.
+  Outcome search();
+  /// The path found by search() (its length reported).
+  og::PathGeometric rawPath();
+  /// Lazy mode: `raw` improved on the roadmap and by effort shortcuts; the objects it crosses.
+  og::PathGeometric improveLazyPath(const og::PathGeometric& raw);
+  /// Full mode: `path` simplified and (arm) repaired where the arm sweeps through an object.
+  Outcome refineFullPath(og::PathGeometric& path);
+  /// The result for `path`: joint path and trajectory.
+  MotionResult finishSolved(const og::PathGeometric& path);
+
+  // The steps of the phases, in the order of their definitions below.
+  Outcome finish(MotionStatus st, std::string reason, std::string object = {}) {
+    return out.finish(st, std::move(reason), std::move(object));
+  }
+  detail::Oracle requestOracle();
+  std::vector<double> sweepRadii() const;
+  ob::SpaceInformationPtr makeSi(detail::Oracle& checker, bool full) const;
+  void setUpClearance();
+  bool collides(const ob::State* s);
+  collision::Scene& plainScene();
+  std::string selfHit(const ob::State* s);
+  void escapeTouchedMovables(const std::vector<int>& touching);
+  void escapeHeldMargin();
+  bool checkGoal(ob::State* s, std::string& who);
+  Outcome setStateGoal();
+  Outcome setEndEffectorGoal();
+  std::vector<Pose2D> goalBases() const;
+  collision::Filter requestFilter() const;
+  void ensureSampled();
+  void densify(og::PathGeometric& path, int s, const std::vector<int>& goals, const std::vector<int>& objects);
+  void tryDirect();
+  Outcome sample(const Stopwatch& phase, bool solved);
+  og::PathGeometric improveByRoadmap(const og::PathGeometric& raw, const detail::PathCost& raw_cost);
+  void simplify(og::PathGeometric& path);
+  Outcome repairSwept(og::PathGeometric& path);
+  void prependEscapeAndAlign(og::PathGeometric& path);
+
+  MotionPlanner::Impl& impl;
+  const MotionPlannerParams& P;
+  const MotionRequest& req;
+  const Termination& termination;
+  PlanOutput& out;
+  MotionResult& res;
+  // The request's world (see RequestWorld).
+  const std::optional<world::Shape>& held_shape;
+  const Aabb& bounds;
+  const std::string& held;
+  const std::string& held_link;
+  const Eigen::Isometry3d& link_T_held;
+
+  const bool lazy;
+  detail::GroupSpace gs;
+  const ob::StateSpacePtr& space;
+  const std::vector<std::string> ignored;
+  detail::Oracle oracle;
+  // How far a point of the arm (or the object it holds) moves per radian of each joint.
+  const std::vector<double> sweep_radii;
+  const ob::SpaceInformationPtr si;
+  // Full-mode base paths: a clearance round objects where there is room for it (not for a push,
+  // whose object rides on the base and drives into contact).
+  std::unique_ptr<collision::Scene> padded_scene;
+  std::unique_ptr<detail::Oracle> padded_oracle;
+  std::shared_ptr<detail::ClearanceValidityChecker> clearance;
+  StatePtr start;
+  // The request's scene with the held object as modelled (no margin), built when first needed:
+  // its contacts with the robot itself, and a start that touches something only with the margin.
+  std::unique_ptr<collision::Scene> plain;
+  // A full-mode start that touches movables only leaves them by a short straight motion first.
+  StatePtr escaped;
+
+  // ---- goal ----
+  std::shared_ptr<ob::ProblemDefinition> pdef;
+  std::optional<Eigen::Vector2d> base_goal;  // for the proof
+  std::vector<ob::State*> goal_states;
+  GoalFree goal_free{goal_states, space};
+
+  // ---- lazy: the cached roadmap of the static free space ----
+  const double spu;
+  const double res_check;
+  detail::StaticRoadmap* roadmap = nullptr;
+  std::unique_ptr<detail::StaticRoadmap> uncached;  // roadmap_cache_entries == 0
+  std::optional<og::PathGeometric> from_roadmap;
+
+  // ---- search (+ infeasibility proof, interleaved) ----
+  ob::PlannerPtr planner;
+  // Full mode: the direct motion to a goal state, when it is free, needs no sampling.
+  std::optional<og::PathGeometric> direct;
+};
+
+// ---- set-up: state space, validity and clearance checkers, start state ----
+
+Planning::Planning(MotionPlanner::Impl& planner_impl, const MotionRequest& request, const Termination& term,
+                   const RequestWorld& rw, PlanOutput& output)
+    : impl(planner_impl),
+      P(planner_impl.params),
+      req(request),
+      termination(term),
+      out(output),
+      res(output.res),
+      held_shape(rw.held_shape),
+      bounds(rw.bounds),
+      held(rw.held),
+      held_link(rw.held_link),
+      link_T_held(rw.link_T_held),
+      lazy(request.mode == MotionMode::kLazy),
+      gs(impl.robot, req.group, req.start, bounds, P.sampling),
+      space(gs.space()),
+      ignored(req.ignored_objects),
+      oracle(requestOracle()),
+      sweep_radii(sweepRadii()),
+      si(makeSi(oracle, !lazy)),
+      start(nullptr, StateFree{space.get()}),
+      escaped(nullptr, StateFree{space.get()}),
+      spu(gs.secondsPerUnit(P.cost)),
+      res_check(P.sampling.validity_resolution) {
+  const bool pushes = !held.empty() && held_link == impl.robot.geometry().links.front();
+  if (!lazy && req.group == PlanningGroup::kBase && P.sampling.base_clearance > 0.0 && !pushes) setUpClearance();
+  start.reset(space->allocState());
+  {
+    std::vector<double> v;
+    if (gs.hasBase()) v = {req.start.base.x, req.start.base.y, wrapAngle(req.start.base.theta)};
+    if (gs.movesArm()) v.insert(v.end(), req.start.arm.begin(), req.start.arm.end());
+    gs.setValues(v, start.get());
+  }
+  if (held_shape) oracle.setSelfScene(&plainScene());
+}
+
+/// The request's checker: the movables but the held and the ignored ones, with their effort.
+detail::Oracle Planning::requestOracle() {
   std::vector<detail::MovableInfo> movables;
   for (const auto& o : impl.world.objects()) {
     if (o.kind != world::ObjectKind::kMovable || o.id == held) continue;
@@ -746,129 +926,89 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
   }
   const double reach =
       req.group == PlanningGroup::kBase ? impl.reachRadius(req.start, held, held_link, link_T_held) : 0.0;
-  detail::Oracle oracle(impl.scene, gs, ignored, std::move(movables), reach);
-  const bool lazy = req.mode == MotionMode::kLazy;
+  return detail::Oracle(impl.scene, gs, ignored, std::move(movables), reach);
+}
 
-  // How far a point of the arm (or the object it holds) moves per radian of each joint.
-  std::vector<double> sweep_radii = impl.robot.armJointRadii();
+std::vector<double> Planning::sweepRadii() const {
+  std::vector<double> sweep = impl.robot.armJointRadii();
   if (!held.empty() && impl.robot.armReachTo(held_link) >= 0.0) {
     // The held object rides on `held_link`, below every arm joint: its reach from each joint is
     // at most that joint's radius plus the object's extent beyond the link.
     const Aabb box = impl.world.object(held).shape.aabb(Eigen::Isometry3d::Identity());
     const double extent = link_T_held.translation().norm() + 0.5 * (box.max - box.min).norm() + req.held_padding_m;
-    for (double& r : sweep_radii) r += extent;
+    for (double& r : sweep) r += extent;
   }
-  auto makeSi = [&](detail::Oracle& checker, bool full) {
-    auto si = std::make_shared<ob::SpaceInformation>(space);
-    si->setStateValidityChecker(std::make_shared<detail::OracleValidityChecker>(si, checker, full));
-    si->setStateValidityCheckingResolution(
-        std::min(1.0, P.sampling.validity_resolution / std::max(1e-9, space->getMaximumExtent())));
-    if (detail::isStopAndTurn(*space)) si->setMotionValidator(std::make_shared<detail::CornerMotionValidator>(si));
-    si->setup();
-    return si;
-  };
-  const ob::SpaceInformationPtr si = makeSi(oracle, !lazy);
-  // Full-mode base paths: a clearance round objects where there is room for it (not for a push,
-  // whose object rides on the base and drives into contact).
-  std::unique_ptr<collision::Scene> padded_scene;
-  std::unique_ptr<detail::Oracle> padded_oracle;
-  std::shared_ptr<detail::ClearanceValidityChecker> clearance;
-  const bool pushes = !held.empty() && held_link == impl.robot.geometry().links.front();
-  if (!lazy && req.group == PlanningGroup::kBase && P.sampling.base_clearance > 0.0 && !pushes) {
-    padded_scene = std::make_unique<collision::Scene>(impl.world);
-    padded_scene->setRobot(grownGeometry(impl.robot.geometry(), P.sampling.base_clearance));
-    if (!held.empty()) (void)padded_scene->attach(held, held_link, link_T_held);
-    padded_oracle = std::make_unique<detail::Oracle>(*padded_scene, gs, ignored, oracle.movables(), reach);
-    std::vector<Eigen::Vector2d> ends{{req.start.base.x, req.start.base.y}};
-    if (req.goal.kind == MotionGoal::Kind::kBasePose) ends.emplace_back(req.goal.base.x, req.goal.base.y);
-    if (req.goal.kind == MotionGoal::Kind::kConfiguration && req.goal.configuration.size() >= 2)
-      ends.emplace_back(req.goal.configuration[0], req.goal.configuration[1]);
-    // Grown boxes, cylinders and spheres contain the originals (a grown prism need not); the
-    // grown scene has no unknown space.
-    const auto& parts = impl.robot.geometry().parts;
-    const bool contains = !impl.scene.hasUnknownSpace() && std::all_of(parts.begin(), parts.end(), [](const auto& part) {
-      return part.shape.kind != world::ShapeKind::kPrism;
-    });
-    clearance = std::make_shared<detail::ClearanceValidityChecker>(si, oracle, *padded_oracle, gs, std::move(ends),
-                                                                   P.sampling.base_clearance_near_ends, contains);
-    si->setStateValidityChecker(clearance);
+  return sweep;
+}
+
+ob::SpaceInformationPtr Planning::makeSi(detail::Oracle& checker, bool full) const {
+  auto info = std::make_shared<ob::SpaceInformation>(space);
+  info->setStateValidityChecker(std::make_shared<detail::OracleValidityChecker>(info, checker, full));
+  info->setStateValidityCheckingResolution(
+      std::min(1.0, P.sampling.validity_resolution / std::max(1e-9, space->getMaximumExtent())));
+  if (detail::isStopAndTurn(*space)) info->setMotionValidator(std::make_shared<detail::CornerMotionValidator>(info));
+  info->setup();
+  return info;
+}
+
+void Planning::setUpClearance() {
+  padded_scene = std::make_unique<collision::Scene>(impl.world);
+  padded_scene->setRobot(grownGeometry(impl.robot.geometry(), P.sampling.base_clearance));
+  if (!held.empty()) (void)padded_scene->attach(held, held_link, link_T_held);
+  padded_oracle = std::make_unique<detail::Oracle>(*padded_scene, gs, ignored, oracle.movables(), oracle.reachRadius());
+  std::vector<Eigen::Vector2d> ends{{req.start.base.x, req.start.base.y}};
+  if (req.goal.kind == MotionGoal::Kind::kBasePose) ends.emplace_back(req.goal.base.x, req.goal.base.y);
+  if (req.goal.kind == MotionGoal::Kind::kConfiguration && req.goal.configuration.size() >= 2)
+    ends.emplace_back(req.goal.configuration[0], req.goal.configuration[1]);
+  // Grown boxes, cylinders and spheres contain the originals (a grown prism need not); the
+  // grown scene has no unknown space.
+  const auto& parts = impl.robot.geometry().parts;
+  const bool contains = !impl.scene.hasUnknownSpace() && std::all_of(parts.begin(), parts.end(), [](const auto& part) {
+    return part.shape.kind != world::ShapeKind::kPrism;
+  });
+  clearance = std::make_shared<detail::ClearanceValidityChecker>(si, oracle, *padded_oracle, gs, std::move(ends),
+                                                                 P.sampling.base_clearance_near_ends, contains);
+  si->setStateValidityChecker(clearance);
+}
+
+bool Planning::collides(const ob::State* s) { return lazy ? !oracle.staticFree(s) : !oracle.allFree(s); }
+
+collision::Scene& Planning::plainScene() {
+  if (!plain) {
+    world::World w = impl.world;
+    world::Object o = w.object(held);
+    o.shape = *held_shape;
+    (void)w.updateObject(o);
+    plain = std::make_unique<collision::Scene>(w);
+    plain->setRobot(impl.robot.geometry());
+    (void)plain->attach(held, held_link, link_T_held);
   }
-  auto freeState = [&](ob::State* s) { space->freeState(s); };
-  std::unique_ptr<ob::State, decltype(freeState)> start(space->allocState(), freeState);
-  {
-    std::vector<double> v;
-    if (gs.hasBase()) v = {req.start.base.x, req.start.base.y, wrapAngle(req.start.base.theta)};
-    if (gs.movesArm()) v.insert(v.end(), req.start.arm.begin(), req.start.arm.end());
-    gs.setValues(v, start.get());
+  return *plain;
+}
+
+// Contacts of the robot with itself at `s` (placed in the scene by the caller).
+std::string Planning::selfHit(const ob::State* s) {
+  if (impl.scene.attachedObjects().empty() && !gs.movesArm()) return {};
+  collision::Scene* sc = &impl.scene;
+  if (held_shape) {
+    sc = &plainScene();
+    gs.placeRobot(s, *sc);
   }
-  auto collides = [&](const ob::State* s) { return lazy ? !oracle.staticFree(s) : !oracle.allFree(s); };
-  // The request's scene with the held object as modelled (no margin), built when first needed:
-  // its contacts with the robot itself, and a start that touches something only with the margin.
-  std::unique_ptr<collision::Scene> plain;
-  auto plainScene = [&]() -> collision::Scene& {
-    if (!plain) {
-      world::World w = impl.world;
-      world::Object o = w.object(held);
-      o.shape = *held_shape;
-      (void)w.updateObject(o);
-      plain = std::make_unique<collision::Scene>(w);
-      plain->setRobot(impl.robot.geometry());
-      (void)plain->attach(held, held_link, link_T_held);
-    }
-    return *plain;
-  };
-  if (held_shape) oracle.setSelfScene(&plainScene());
-  // Contacts of the robot with itself at `s` (placed in the scene by the caller).
-  auto selfHit = [&](const ob::State* s) -> std::string {
-    if (impl.scene.attachedObjects().empty() && !gs.movesArm()) return {};
-    collision::Scene* sc = &impl.scene;
-    if (held_shape) {
-      sc = &plainScene();
-      gs.placeRobot(s, *sc);
-    }
-    const auto self = sc->selfCollisions();
-    return self.empty() ? std::string() : "self:" + self.front().first + "/" + self.front().second;
-  };
-  // A full-mode start that touches movables only leaves them by a short straight motion first.
-  std::unique_ptr<ob::State, decltype(freeState)> escaped(nullptr, freeState);
+  const auto self = sc->selfCollisions();
+  return self.empty() ? std::string() : "self:" + self.front().first + "/" + self.front().second;
+}
+
+// ---- the start ----
+
+Outcome Planning::leaveStart() {
   if (collides(start.get())) {
     const std::string who = oracle.collidingObject(start.get(), !lazy);
     std::vector<int> touching;
     if (!lazy && oracle.staticFree(start.get())) oracle.touched(start.get(), touching);
-    if (!touching.empty() && P.sampling.start_escape_distance > 0.0) {
-      std::vector<std::string> ignore = ignored;
-      std::vector<detail::MovableInfo> others;
-      for (std::size_t i = 0; i < oracle.movables().size(); ++i) {
-        const auto& m = oracle.movables()[i];
-        if (std::binary_search(touching.begin(), touching.end(), static_cast<int>(i))) {
-          ignore.push_back(m.id);
-        } else {
-          others.push_back(m);
-        }
-      }
-      detail::Oracle escape_oracle(impl.scene, gs, ignore, std::move(others), reach);
-      if (held_shape) escape_oracle.setSelfScene(&plainScene());
-      escaped.reset(space->allocState());
-      if (detail::escapeStart(si, makeSi(escape_oracle, true), start.get(), P.sampling.start_escape_distance,
-                              P.sampling.start_escape_attempts, escaped.get())) {
-        for (int i : touching) res.start_contacts.push_back(oracle.movables()[static_cast<std::size_t>(i)].id);
-      } else {
-        escaped.reset();
-      }
-    }
+    if (!touching.empty() && P.sampling.start_escape_distance > 0.0) escapeTouchedMovables(touching);
     // Touching only with the held object's margin: leave by a short straight motion checked
     // without it (the robot was stopped before the contact it is now given room for).
-    if (!escaped && held_shape && P.sampling.start_escape_distance > 0.0) {
-      detail::Oracle plain_oracle(plainScene(), gs, ignored, oracle.movables(), reach);
-      if (lazy ? plain_oracle.staticFree(start.get()) : plain_oracle.allFree(start.get())) {
-        escaped.reset(space->allocState());
-        if (!detail::escapeStart(si, makeSi(plain_oracle, !lazy), start.get(), P.sampling.start_escape_distance,
-                                 P.sampling.start_escape_attempts, escaped.get())) {
-          escaped.reset();
-        }
-      }
-      gs.placeRobot(start.get(), impl.scene);
-    }
+    if (!escaped && held_shape && P.sampling.start_escape_distance > 0.0) escapeHeldMargin();
     if (!escaped) {
       return finish(MotionStatus::kStartInCollision, "the start state touches '" + who + "'" +
                                                          (touching.empty() ? "" : " (no way out of the contact found)"),
@@ -879,211 +1019,280 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
   if (std::string s = selfHit(start.get()); !s.empty()) {
     return finish(MotionStatus::kStartInCollision, "the start state is in self-collision (" + s + ")", s);
   }
+  return std::nullopt;
+}
 
-  // ---- goal ----
+/// Out of the contact with the `touching` movables (indices into the oracle's), checked against
+/// everything else; `escaped` stays empty when there is no way out.
+void Planning::escapeTouchedMovables(const std::vector<int>& touching) {
+  std::vector<std::string> ignore = ignored;
+  std::vector<detail::MovableInfo> others;
+  for (std::size_t i = 0; i < oracle.movables().size(); ++i) {
+    const auto& m = oracle.movables()[i];
+    if (std::binary_search(touching.begin(), touching.end(), static_cast<int>(i))) {
+      ignore.push_back(m.id);
+    } else {
+      others.push_back(m);
+    }
+  }
+  detail::Oracle escape_oracle(impl.scene, gs, ignore, std::move(others), oracle.reachRadius());
+  if (held_shape) escape_oracle.setSelfScene(&plainScene());
+  escaped.reset(space->allocState());
+  if (detail::escapeStart(si, makeSi(escape_oracle, true), start.get(), P.sampling.start_escape_distance,
+                          P.sampling.start_escape_attempts, escaped.get())) {
+    for (int i : touching) res.start_contacts.push_back(oracle.movables()[static_cast<std::size_t>(i)].id);
+  } else {
+    escaped.reset();
+  }
+}
+
+/// Out of a contact that only the held object's margin makes; `escaped` stays empty when the
+/// start touches something without the margin too, or there is no way out.
+void Planning::escapeHeldMargin() {
+  detail::Oracle plain_oracle(plainScene(), gs, ignored, oracle.movables(), oracle.reachRadius());
+  if (lazy ? plain_oracle.staticFree(start.get()) : plain_oracle.allFree(start.get())) {
+    escaped.reset(space->allocState());
+    if (!detail::escapeStart(si, makeSi(plain_oracle, !lazy), start.get(), P.sampling.start_escape_distance,
+                             P.sampling.start_escape_attempts, escaped.get())) {
+      escaped.reset();
+    }
+  }
+  gs.placeRobot(start.get(), impl.scene);
+}
+
+// ---- goal ----
+
+Outcome Planning::setGoal() {
   Stopwatch goal_clock;
-  auto pdef = std::make_shared<ob::ProblemDefinition>(si);
+  pdef = std::make_shared<ob::ProblemDefinition>(si);
   pdef->addStartState(escaped ? escaped.get() : start.get());
-  std::optional<Eigen::Vector2d> base_goal;  // for the proof
-  std::vector<ob::State*> goal_states;
-  struct GoalFree {
-    std::vector<ob::State*>& v;
-    const ob::StateSpacePtr& sp;
-    ~GoalFree() {
-      for (auto* s : v) sp->freeState(s);
-    }
-  } goal_free{goal_states, space};
   const auto& G = req.goal;
-  auto checkGoal = [&](ob::State* s, std::string& who) {
-    if (collides(s)) {
-      who = oracle.collidingObject(s, !lazy);
-      return false;
+  if (auto done = G.kind == MotionGoal::Kind::kConfiguration || G.kind == MotionGoal::Kind::kBasePose
+                      ? setStateGoal()
+                      : setEndEffectorGoal()) {
+    return done;
+  }
+  res.stats.goal_ms = goal_clock.millis();
+  return std::nullopt;
+}
+
+/// Whether `s` is free (as the mode checks it) and not in self-collision; else who it touches.
+bool Planning::checkGoal(ob::State* s, std::string& who) {
+  if (collides(s)) {
+    who = oracle.collidingObject(s, !lazy);
+    return false;
+  }
+  gs.placeRobot(s, impl.scene);
+  who = gs.movesArm() ? selfHit(s) : std::string();
+  return who.empty();
+}
+
+/// A configuration or base pose goal (with any yaw: the first of 16 that is free).
+Outcome Planning::setStateGoal() {
+  const auto& G = req.goal;
+  std::vector<double> v;
+  if (G.kind == MotionGoal::Kind::kConfiguration) {
+    v = G.configuration;
+  } else {
+    v = {G.base.x, G.base.y, wrapAngle(G.base.theta)};
+    if (gs.movesArm()) v.insert(v.end(), req.start.arm.begin(), req.start.arm.end());
+  }
+  ob::State* gsState = space->allocState();
+  goal_states.push_back(gsState);
+  gs.setValues(v, gsState);
+  if (gs.hasBase()) base_goal = Eigen::Vector2d(v[0], v[1]);
+  std::string who;
+  const bool any_yaw = G.kind == MotionGoal::Kind::kBasePose && G.any_base_yaw;
+  bool free = checkGoal(gsState, who);
+  if (!free && any_yaw) {  // another yaw may fit
+    auto vv = v;
+    for (int k = 1; k < 16 && !free; ++k) {
+      vv[2] = wrapAngle(v[2] + k * M_PI / 8);
+      gs.setValues(vv, gsState);
+      std::string w2;
+      free = checkGoal(gsState, w2);
     }
-    gs.placeRobot(s, impl.scene);
-    who = gs.movesArm() ? selfHit(s) : std::string();
-    return who.empty();
-  };
-  if (G.kind == MotionGoal::Kind::kConfiguration || G.kind == MotionGoal::Kind::kBasePose) {
+  }
+  if (!free) return finish(MotionStatus::kGoalInCollision, "the goal state touches '" + who + "'", who);
+  if (any_yaw) {
+    pdef->setGoal(std::make_shared<AnyYawGoal>(si, gs, gsState, v[0], v[1], P.sampling.goal_position_tolerance));
+  } else {
+    pdef->setGoalState(gsState, gs.hasBase() ? P.sampling.goal_position_tolerance
+                                             : P.sampling.goal_orientation_tolerance);
+  }
+  return std::nullopt;
+}
+
+/// An end-effector pose goal through IK: up to three free solutions from the goalBases().
+Outcome Planning::setEndEffectorGoal() {
+  const auto& G = req.goal;
+  const auto* m = impl.robot.model();
+  collision::Filter filter = requestFilter();
+  const std::vector<Pose2D> bases = goalBases();
+  std::string reject;
+  int found = 0;
+  for (std::size_t bi = 0; bi < bases.size() && found < 3; ++bi) {
+    if (termination()) return finish(MotionStatus::kTimeout, "the deadline passed while solving IK for the goal");
+    auto q = solveIk(impl, bases[bi], G.end_effector, req.start.arm, filter, req.start.gripper,
+                     P.seed + static_cast<std::uint32_t>(bi), 16, termination);
+    if (!q) continue;
     std::vector<double> v;
-    if (G.kind == MotionGoal::Kind::kConfiguration) {
-      v = G.configuration;
-    } else {
-      v = {G.base.x, G.base.y, wrapAngle(G.base.theta)};
-      if (gs.movesArm()) v.insert(v.end(), req.start.arm.begin(), req.start.arm.end());
+    if (gs.hasBase()) v = {bases[bi].x, bases[bi].y, bases[bi].theta};
+    // (Not insert(): GCC 12 at -O3 reports a false -Warray-bounds for it here.)
+    std::copy(q->begin(), q->end(), std::back_inserter(v));
+    ob::State* s = space->allocState();
+    goal_states.push_back(s);
+    gs.setValues(v, s);
+    if (!checkGoal(s, reject)) {
+      space->freeState(s);
+      goal_states.pop_back();
+      continue;
     }
-    ob::State* gsState = space->allocState();
-    goal_states.push_back(gsState);
-    gs.setValues(v, gsState);
-    if (gs.hasBase()) base_goal = Eigen::Vector2d(v[0], v[1]);
-    std::string who;
-    const bool any_yaw = G.kind == MotionGoal::Kind::kBasePose && G.any_base_yaw;
-    bool free = checkGoal(gsState, who);
-    if (!free && any_yaw) {  // another yaw may fit
-      auto vv = v;
-      for (int k = 1; k < 16 && !free; ++k) {
-        vv[2] = wrapAngle(v[2] + k * M_PI / 8);
-        gs.setValues(vv, gsState);
-        std::string w2;
-        free = checkGoal(gsState, w2);
-      }
-    }
-    if (!free) return finish(MotionStatus::kGoalInCollision, "the goal state touches '" + who + "'", who);
-    if (any_yaw) {
-      pdef->setGoal(std::make_shared<AnyYawGoal>(si, gs, gsState, v[0], v[1], P.sampling.goal_position_tolerance));
-    } else {
-      pdef->setGoalState(gsState, gs.hasBase() ? P.sampling.goal_position_tolerance
-                                               : P.sampling.goal_orientation_tolerance);
-    }
-  } else {  // end-effector pose through IK
-    const auto* m = impl.robot.model();
-    collision::Filter filter = lazy ? collision::Filter{collision::kStaticObjects | collision::kUnknownSpace, {}, ignored}
-                                    : collision::Filter{collision::kAllGroups, {}, ignored};
-    std::vector<Pose2D> bases;
-    if (req.group == PlanningGroup::kArm) {
-      bases.push_back(req.start.base);
-    } else {
-      const Eigen::Vector3d t = G.end_effector.translation();
-      const auto& gp = P.grasp;
-      for (int ring = 0; ring < 3; ++ring) {
-        const double d = gp.base_distance_min + (gp.base_distance_max - gp.base_distance_min) * ring / 2.0;
-        for (int k = 0; k < gp.base_poses; ++k) {
-          // Start from the direction of the robot, alternate around it.
-          const double a0 = std::atan2(req.start.base.y - t.y(), req.start.base.x - t.x());
-          const double a = a0 + ((k % 2) ? 1 : -1) * ((k + 1) / 2) * (2 * M_PI / gp.base_poses);
-          Pose2D b{t.x() + d * std::cos(a), t.y() + d * std::sin(a), wrapAngle(a + M_PI)};
-          if (b.x < bounds.min.x() || b.x > bounds.max.x() || b.y < bounds.min.y() || b.y > bounds.max.y()) continue;
-          bases.push_back(b);
-        }
-      }
-    }
-    std::string reject;
-    int found = 0;
-    for (std::size_t bi = 0; bi < bases.size() && found < 3; ++bi) {
-      if (termination()) return finish(MotionStatus::kTimeout, "the deadline passed while solving IK for the goal");
-      auto q = solveIk(impl, bases[bi], G.end_effector, req.start.arm, filter, req.start.gripper,
-                       P.seed + static_cast<std::uint32_t>(bi), 16, termination);
-      if (!q) continue;
-      std::vector<double> v;
-      if (gs.hasBase()) v = {bases[bi].x, bases[bi].y, bases[bi].theta};
-      v.insert(v.end(), q->begin(), q->end());
+    ++found;
+  }
+  if (found == 0) {
+    // Distinguish "unreachable" from "reachable only in collision".
+    auto q = m->inverseKinematics(req.start.base.toIsometry().inverse() * G.end_effector, req.start.arm);
+    if (req.group == PlanningGroup::kArm && q.ok()) {
       ob::State* s = space->allocState();
       goal_states.push_back(s);
-      gs.setValues(v, s);
-      if (!checkGoal(s, reject)) {
-        space->freeState(s);
-        goal_states.pop_back();
-        continue;
+      gs.setValues(q.q, s);
+      std::string who = oracle.collidingObject(s, !lazy);
+      if (!who.empty()) {
+        return finish(MotionStatus::kGoalInCollision, "every IK solution of the goal touches an object, e.g. '" + who + "'",
+                      who);
       }
-      ++found;
     }
-    if (found == 0) {
-      // Distinguish "unreachable" from "reachable only in collision".
-      const auto* mm = m;
-      auto q = mm->inverseKinematics(req.start.base.toIsometry().inverse() * G.end_effector, req.start.arm);
-      if (req.group == PlanningGroup::kArm && q.ok()) {
-        ob::State* s = space->allocState();
-        goal_states.push_back(s);
-        gs.setValues(q.q, s);
-        std::string who = oracle.collidingObject(s, !lazy);
-        if (!who.empty()) {
-          return finish(MotionStatus::kGoalInCollision, "every IK solution of the goal touches an object, e.g. '" + who + "'",
-                        who);
-        }
+    return finish(MotionStatus::kNoPath, "goal.end_effector: no collision-free IK solution (" +
+                                             std::to_string(bases.size()) + " base pose(s) tried)");
+  }
+  auto goals = std::make_shared<ob::GoalStates>(si);
+  for (auto* s : goal_states) goals->addState(s);
+  goals->setThreshold(P.sampling.goal_orientation_tolerance);
+  pdef->setGoal(goals);
+  return std::nullopt;
+}
+
+/// Where the base may stand for an end-effector goal: the start's (arm group), else rings round
+/// the goal within the bounds.
+std::vector<Pose2D> Planning::goalBases() const {
+  std::vector<Pose2D> bases;
+  if (req.group == PlanningGroup::kArm) {
+    bases.push_back(req.start.base);
+  } else {
+    const Eigen::Vector3d t = req.goal.end_effector.translation();
+    const auto& gp = P.grasp;
+    for (int ring = 0; ring < 3; ++ring) {
+      const double d = gp.base_distance_min + (gp.base_distance_max - gp.base_distance_min) * ring / 2.0;
+      for (int k = 0; k < gp.base_poses; ++k) {
+        // Start from the direction of the robot, alternate around it.
+        const double a0 = std::atan2(req.start.base.y - t.y(), req.start.base.x - t.x());
+        const double a = a0 + ((k % 2) ? 1 : -1) * ((k + 1) / 2) * (2 * M_PI / gp.base_poses);
+        Pose2D b{t.x() + d * std::cos(a), t.y() + d * std::sin(a), wrapAngle(a + M_PI)};
+        if (b.x < bounds.min.x() || b.x > bounds.max.x() || b.y < bounds.min.y() || b.y > bounds.max.y()) continue;
+        bases.push_back(b);
       }
-      return finish(MotionStatus::kNoPath, "goal.end_effector: no collision-free IK solution (" +
-                                               std::to_string(bases.size()) + " base pose(s) tried)");
     }
-    auto goals = std::make_shared<ob::GoalStates>(si);
-    for (auto* s : goal_states) goals->addState(s);
-    goals->setThreshold(P.sampling.goal_orientation_tolerance);
-    pdef->setGoal(goals);
   }
+  return bases;
+}
 
-  res.stats.goal_ms = goal_clock.millis();
+/// What the mode checks: static objects and unknown space (lazy) or everything (full), but the
+/// ignored objects.
+collision::Filter Planning::requestFilter() const {
+  return lazy ? collision::Filter{collision::kStaticObjects | collision::kUnknownSpace, {}, ignored}
+              : collision::Filter{collision::kAllGroups, {}, ignored};
+}
 
-  // ---- lazy: the cached roadmap of the static free space ----
-  const double spu = gs.secondsPerUnit(P.cost);
-  const double res_check = P.sampling.validity_resolution;
-  detail::StaticRoadmap* roadmap = nullptr;
-  std::unique_ptr<detail::StaticRoadmap> uncached;  // roadmap_cache_entries == 0
-  std::optional<og::PathGeometric> from_roadmap;
-  // A new roadmap draws its samples when it is first searched (arm requests whose lazy path
-  // crosses nothing never need it). Bridge-test samples for the base group only (narrow
-  // passages of the floor plan; in joint space they would cost many attempts, unmeasured).
-  auto ensureSampled = [&] {
-    if (roadmap->uniformSamples() == 0 && P.lazy.roadmap_samples > 0) {
-      roadmap->addSamples(oracle, gs, P.lazy.roadmap_samples, termination,
-                          req.group == PlanningGroup::kBase ? P.lazy.roadmap_bridge_samples : 0,
-                          P.lazy.roadmap_bridge_distance);
-    }
-  };
-  // When the roadmap's best path crosses movables: samples around them, and the roadmap searched
-  // again (the result can only get cheaper: the old path is still in the roadmap).
-  // `objects`: those `path` crosses, as the search reported them.
-  auto densify = [&](og::PathGeometric& path, int s, const std::vector<int>& goals, const std::vector<int>& objects) {
-    if (objects.empty() || P.lazy.object_ring_samples <= 0 || req.group != PlanningGroup::kBase ||
-        roadmap->nodeCount() >= static_cast<std::size_t>(P.lazy.roadmap_max_nodes)) {
-      return;
-    }
-    if (roadmap->addObjectRingSamples(oracle, gs, objects, P.lazy.object_ring_samples, termination) == 0) return;
-    auto again = roadmap->search(oracle, si, s, goals, P.lazy, res_check, spu, termination, res.stats);
-    auto cost = [&](const og::PathGeometric& p) {
-      return detail::evaluatePath(oracle, p, res_check, 0.0).cost(oracle, spu).cost;
-    };
-    if (again && cost(*again) < cost(path)) path = *again;
-  };
-  if (lazy && P.lazy.optimize) {
-    Stopwatch rw;
-    roadmap = impl.roadmapFor(staticWorldKey(impl, req.group, req.start, held, held_link, link_T_held, ignored),
-                              space, res.stats.roadmap_reused, uncached);
-    // A roadmap new in this request knows no edge yet: lazy KPIECE goes first and seeds it.
-    if (req.group == PlanningGroup::kBase && P.lazy.roadmap_first && res.stats.roadmap_reused &&
-        !goal_states.empty()) {
-      ensureSampled();
-      res.stats.roadmap_pruned =
-          roadmap->pruneRequestNodes(static_cast<std::size_t>(P.lazy.roadmap_max_request_nodes));
-      const std::uint64_t request = ++impl.requests;
-      const int s = roadmap->addRequestState(start.get(), request);
-      std::vector<int> goals;
-      for (const auto* g : goal_states) goals.push_back(roadmap->addRequestState(g, request));
-      std::vector<int> crossed;
-      from_roadmap = roadmap->search(oracle, si, s, goals, P.lazy, res_check, spu, termination, res.stats,
-                                     P.lazy.roadmap_max_new_invalid, &crossed);
-      if (from_roadmap) densify(*from_roadmap, s, goals, crossed);
-    }
-    res.stats.optimize_ms += rw.millis();
+// ---- lazy: the cached roadmap of the static free space ----
+
+void Planning::searchRoadmapFirst() {
+  if (!lazy || !P.lazy.optimize) return;
+  Stopwatch rw;
+  roadmap = impl.roadmapFor(staticWorldKey(impl, req.group, req.start, held, held_link, link_T_held, ignored), space,
+                            res.stats.roadmap_reused, uncached);
+  // A roadmap new in this request knows no edge yet: lazy KPIECE goes first and seeds it.
+  if (req.group == PlanningGroup::kBase && P.lazy.roadmap_first && res.stats.roadmap_reused && !goal_states.empty()) {
+    ensureSampled();
+    res.stats.roadmap_pruned = roadmap->pruneRequestNodes(static_cast<std::size_t>(P.lazy.roadmap_max_request_nodes));
+    const std::uint64_t request = ++impl.requests;
+    const int s = roadmap->addRequestState(start.get(), request);
+    std::vector<int> goals;
+    for (const auto* g : goal_states) goals.push_back(roadmap->addRequestState(g, request));
+    std::vector<int> crossed;
+    from_roadmap = roadmap->search(oracle, si, s, goals, P.lazy, res_check, spu, termination, res.stats,
+                                   P.lazy.roadmap_max_new_invalid, &crossed);
+    if (from_roadmap) densify(*from_roadmap, s, goals, crossed);
   }
+  res.stats.optimize_ms += rw.millis();
+}
 
-  // ---- search (+ infeasibility proof, interleaved) ----
+// A new roadmap draws its samples when it is first searched (arm requests whose lazy path
+// crosses nothing never need it). Bridge-test samples for the base group only (narrow
+// passages of the floor plan; in joint space they would cost many attempts, unmeasured).
+void Planning::ensureSampled() {
+  if (roadmap->uniformSamples() == 0 && P.lazy.roadmap_samples > 0) {
+    roadmap->addSamples(oracle, gs, P.lazy.roadmap_samples, termination,
+                        req.group == PlanningGroup::kBase ? P.lazy.roadmap_bridge_samples : 0,
+                        P.lazy.roadmap_bridge_distance);
+  }
+}
+
+// When the roadmap's best path crosses movables: samples around them, and the roadmap searched
+// again (the result can only get cheaper: the old path is still in the roadmap).
+// `objects`: those `path` crosses, as the search reported them.
+void Planning::densify(og::PathGeometric& path, int s, const std::vector<int>& goals,
+                       const std::vector<int>& objects) {
+  if (objects.empty() || P.lazy.object_ring_samples <= 0 || req.group != PlanningGroup::kBase ||
+      roadmap->nodeCount() >= static_cast<std::size_t>(P.lazy.roadmap_max_nodes)) {
+    return;
+  }
+  if (roadmap->addObjectRingSamples(oracle, gs, objects, P.lazy.object_ring_samples, termination) == 0) return;
+  auto again = roadmap->search(oracle, si, s, goals, P.lazy, res_check, spu, termination, res.stats);
+  auto cost = [&](const og::PathGeometric& p) {
+    return detail::evaluatePath(oracle, p, res_check, 0.0).cost(oracle, spu).cost;
+  };
+  if (again && cost(*again) < cost(path)) path = *again;
+}
+
+// ---- search (+ infeasibility proof, interleaved) ----
+
+Outcome Planning::search() {
   Stopwatch phase;
   const PlannerKind kind = req.group != PlanningGroup::kBase ? P.sampling.arm_planner
                            : lazy                            ? P.sampling.lazy_planner
                                                              : P.sampling.full_planner;
-  auto planner = makePlanner(kind, si, P.sampling.range);
+  planner = makePlanner(kind, si, P.sampling.range);
   planner->setProblemDefinition(pdef);
   planner->setup();
+  tryDirect();
+  const bool solved = from_roadmap.has_value() || direct.has_value();
+  res.stats.lazy_planner_used = !solved;
+  return sample(phase, solved);
+}
+
+void Planning::tryDirect() {
+  if (lazy || !P.sampling.direct_first || termination()) return;
+  const ob::State* from = escaped ? escaped.get() : start.get();
+  for (const ob::State* g : goal_states) {
+    if (!si->checkMotion(from, g)) continue;
+    direct.emplace(si, from, g);
+    res.stats.direct = true;
+    break;
+  }
+}
+
+/// Unless `solved`: the sampling planner in doubling time slices until it finds a path, a proof
+/// on a finer grid each slice shows there is none, or the time is up; the base clearance is
+/// dropped when no path kept it in time. Sampling time is reported either way.
+Outcome Planning::sample(const Stopwatch& phase, bool solved) {
   std::vector<double> proof_cells;
   if (P.proof.enabled && gs.hasBase() && base_goal) {
     for (double c = P.proof.cell_size; c >= P.proof.min_cell_size - 1e-12; c *= 0.5) proof_cells.push_back(c);
   }
-  const collision::Filter proof_filter =
-      lazy ? collision::Filter{collision::kStaticObjects | collision::kUnknownSpace, {}, ignored}
-           : collision::Filter{collision::kAllGroups, {}, ignored};
+  const collision::Filter proof_filter = requestFilter();
   std::size_t proof_level = 0;
   double slice = lazy ? 0.25 : 0.05;
-  // Full mode: the direct motion to a goal state, when it is free, needs no sampling.
-  std::optional<og::PathGeometric> direct;
-  if (!lazy && P.sampling.direct_first && !termination()) {
-    const ob::State* from = escaped ? escaped.get() : start.get();
-    for (const ob::State* g : goal_states) {
-      if (!si->checkMotion(from, g)) continue;
-      direct.emplace(si, from, g);
-      res.stats.direct = true;
-      break;
-    }
-  }
-  bool solved = from_roadmap.has_value() || direct.has_value();
-  res.stats.lazy_planner_used = !solved;
   bool first = true;
   while (!solved) {
     if (proof_level < proof_cells.size() && (!lazy || !first)) {
@@ -1127,90 +1336,153 @@ MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& te
                       (proof_cells.empty() ? std::string(" (no infeasibility proof for this group)")
                                            : std::string(" (infeasibility not proven)")));
   }
+  return std::nullopt;
+}
+
+og::PathGeometric Planning::rawPath() {
   og::PathGeometric raw = from_roadmap ? *from_roadmap
                           : direct     ? *direct
                                        : *pdef->getSolutionPath()->as<og::PathGeometric>();
   res.stats.raw_path_length = detail::reportedLength(gs, raw);
+  return raw;
+}
 
-  og::PathGeometric final_path(si);
-  if (lazy) {
-    phase.reset();
-    detail::EvaluatedPath raw_eval = detail::evaluatePath(oracle, raw, res_check, 0.0);
-    const detail::PathCost raw_cost = raw_eval.cost(oracle, spu);
-    res.stats.raw_cost_s = raw_cost.cost;
-    for (int o : raw_cost.objects) res.stats.raw_blocking.push_back(oracle.movables()[static_cast<std::size_t>(o)].id);
-    og::PathGeometric best = raw;
-    const bool improve = req.group == PlanningGroup::kBase || (req.object_cost_scale > 0 && !raw_cost.objects.empty());
-    if (roadmap && !from_roadmap && improve) {
-      // Lazy KPIECE's path (statically valid) joins the roadmap, which also grows where it is.
-      ensureSampled();
-      const auto [s, g] = roadmap->addPath(raw, P.lazy.path_node_spacing);
-      if (roadmap->nodeCount() < static_cast<std::size_t>(P.lazy.roadmap_max_nodes)) {
-        roadmap->addSamples(oracle, gs, P.lazy.roadmap_growth_samples, termination);
-      }
-      std::vector<int> crossed;
-      auto rm = roadmap->search(oracle, si, s, {g}, P.lazy, res_check, spu, termination, res.stats, 0, &crossed);
-      if (rm) densify(*rm, s, {g}, crossed);
-      if (rm) {
-        detail::EvaluatedPath rm_eval = detail::evaluatePath(oracle, *rm, res_check, 0.0);
-        if (rm_eval.cost(oracle, spu).cost < raw_cost.cost) best = *rm;
-      }
+// ---- lazy: roadmap improvement, effort shortcut, blocking report ----
+
+og::PathGeometric Planning::improveLazyPath(const og::PathGeometric& raw) {
+  Stopwatch phase;
+  detail::EvaluatedPath raw_eval = detail::evaluatePath(oracle, raw, res_check, 0.0);
+  const detail::PathCost raw_cost = raw_eval.cost(oracle, spu);
+  res.stats.raw_cost_s = raw_cost.cost;
+  for (int o : raw_cost.objects) res.stats.raw_blocking.push_back(oracle.movables()[static_cast<std::size_t>(o)].id);
+  const og::PathGeometric best = improveByRoadmap(raw, raw_cost);
+  res.stats.optimize_ms += phase.millis();
+  phase.reset();
+  detail::EvaluatedPath ep = detail::evaluatePath(oracle, best, res_check, P.lazy.path_node_spacing * 0.5);
+  std::mt19937 rng(P.seed);
+  detail::effortShortcut(oracle, ep, P.lazy.shortcut_attempts, res_check, spu, rng, termination);
+  res.cost_s = ep.cost(oracle, spu).cost;
+  og::PathGeometric final_path = ep.path;
+  prependEscapeAndAlign(final_path);
+  res.stats.shortcut_ms = phase.millis();
+  phase.reset();
+  res.blocking = detail::blockingReport(oracle, final_path, P.lazy.contact_resolution, P.lazy.swept_spacing);
+  res.stats.analysis_ms = phase.millis();
+  return final_path;
+}
+
+/// `raw`, or the roadmap's path between its ends when that is cheaper (base group, or a request
+/// that gives the objects `raw` crosses a cost).
+og::PathGeometric Planning::improveByRoadmap(const og::PathGeometric& raw, const detail::PathCost& raw_cost) {
+  og::PathGeometric best = raw;
+  const bool improve = req.group == PlanningGroup::kBase || (req.object_cost_scale > 0 && !raw_cost.objects.empty());
+  if (roadmap && !from_roadmap && improve) {
+    // Lazy KPIECE's path (statically valid) joins the roadmap, which also grows where it is.
+    ensureSampled();
+    const auto [s, g] = roadmap->addPath(raw, P.lazy.path_node_spacing);
+    if (roadmap->nodeCount() < static_cast<std::size_t>(P.lazy.roadmap_max_nodes)) {
+      roadmap->addSamples(oracle, gs, P.lazy.roadmap_growth_samples, termination);
     }
-    res.stats.optimize_ms += phase.millis();
-    phase.reset();
-    detail::EvaluatedPath ep = detail::evaluatePath(oracle, best, res_check, P.lazy.path_node_spacing * 0.5);
-    std::mt19937 rng(P.seed);
-    detail::effortShortcut(oracle, ep, P.lazy.shortcut_attempts, res_check, spu, rng, termination);
-    res.cost_s = ep.cost(oracle, spu).cost;
-    final_path = ep.path;
-    if (escaped) final_path.prepend(start.get());
-    if (req.group == PlanningGroup::kBase && P.sampling.base_turn_in_place) detail::alignBaseHeadings(si, final_path);
-    res.stats.shortcut_ms = phase.millis();
-    phase.reset();
-    res.blocking = detail::blockingReport(oracle, final_path, P.lazy.contact_resolution, P.lazy.swept_spacing);
-    res.stats.analysis_ms = phase.millis();
-  } else {
-    phase.reset();
-    final_path = raw;
-    og::PathSimplifier simplifier(si);
-    const Termination simp = termination.tightened(Deadline::in(0.05));
-    for (int round = 0; round < 4 && !direct && !simp(); ++round) {
-      bool better = simplifier.shortcutPath(final_path, 0, 0, 0.33, 0.005);
-      better |= simplifier.reduceVertices(final_path);
-      if (!better) break;
+    std::vector<int> crossed;
+    auto rm = roadmap->search(oracle, si, s, {g}, P.lazy, res_check, spu, termination, res.stats, 0, &crossed);
+    if (rm) densify(*rm, s, {g}, crossed);
+    if (rm) {
+      detail::EvaluatedPath rm_eval = detail::evaluatePath(oracle, *rm, res_check, 0.0);
+      if (rm_eval.cost(oracle, spu).cost < raw_cost.cost) best = *rm;
     }
-    simplifier.collapseCloseVertices(final_path);
-    // The path as the robot sweeps it: segments that touch something between two states checked
-    // at validity_resolution are planned again at the swept resolution.
-    if (req.group == PlanningGroup::kArm && P.sampling.arm_swept_step > 0.0 && !sweep_radii.empty()) {
-      auto fine_si = std::make_shared<ob::SpaceInformation>(space);
-      fine_si->setStateValidityChecker(si->getStateValidityChecker());
-      fine_si->setStateValidityCheckingResolution(si->getStateValidityCheckingResolution());
-      fine_si->setMotionValidator(
-          std::make_shared<detail::SweptArmMotionValidator>(fine_si, gs, sweep_radii, P.sampling.arm_swept_step));
-      fine_si->setup();
-      const PlannerKind arm_kind = P.sampling.arm_planner;
-      res.stats.swept_repairs = detail::repairSegments(
-          fine_si, final_path, [&](const ob::SpaceInformationPtr& s) { return makePlanner(arm_kind, s, P.sampling.range); },
-          termination);
-      if (res.stats.swept_repairs < 0) {
-        return finish(MotionStatus::kTimeout,
-                      "a segment of the path touches an object between two checked states and could not be planned "
-                      "again at the swept resolution (arm_swept_step " + formatNumber(P.sampling.arm_swept_step) +
-                          " m) in time");
-      }
-    }
-    if (escaped) final_path.prepend(start.get());
-    if (req.group == PlanningGroup::kBase && P.sampling.base_turn_in_place) detail::alignBaseHeadings(si, final_path);
-    res.stats.shortcut_ms = phase.millis();
   }
+  return best;
+}
+
+// ---- full: simplification, swept-arm repair ----
+
+Outcome Planning::refineFullPath(og::PathGeometric& path) {
+  Stopwatch phase;
+  simplify(path);
+  if (auto done = repairSwept(path)) return done;
+  prependEscapeAndAlign(path);
+  res.stats.shortcut_ms = phase.millis();
+  return std::nullopt;
+}
+
+void Planning::simplify(og::PathGeometric& path) {
+  og::PathSimplifier simplifier(si);
+  const Termination simp = termination.tightened(Deadline::in(0.05));
+  for (int round = 0; round < 4 && !direct && !simp(); ++round) {
+    bool better = simplifier.shortcutPath(path, 0, 0, 0.33, 0.005);
+    better |= simplifier.reduceVertices(path);
+    if (!better) break;
+  }
+  simplifier.collapseCloseVertices(path);
+}
+
+// The path as the robot sweeps it: segments that touch something between two states checked
+// at validity_resolution are planned again at the swept resolution.
+Outcome Planning::repairSwept(og::PathGeometric& path) {
+  if (!(req.group == PlanningGroup::kArm && P.sampling.arm_swept_step > 0.0 && !sweep_radii.empty())) {
+    return std::nullopt;
+  }
+  auto fine_si = std::make_shared<ob::SpaceInformation>(space);
+  fine_si->setStateValidityChecker(si->getStateValidityChecker());
+  fine_si->setStateValidityCheckingResolution(si->getStateValidityCheckingResolution());
+  fine_si->setMotionValidator(
+      std::make_shared<detail::SweptArmMotionValidator>(fine_si, gs, sweep_radii, P.sampling.arm_swept_step));
+  fine_si->setup();
+  const PlannerKind arm_kind = P.sampling.arm_planner;
+  res.stats.swept_repairs = detail::repairSegments(
+      fine_si, path, [&](const ob::SpaceInformationPtr& s) { return makePlanner(arm_kind, s, P.sampling.range); },
+      termination);
+  if (res.stats.swept_repairs < 0) {
+    return finish(MotionStatus::kTimeout,
+                  "a segment of the path touches an object between two checked states and could not be planned "
+                  "again at the swept resolution (arm_swept_step " + formatNumber(P.sampling.arm_swept_step) +
+                      " m) in time");
+  }
+  return std::nullopt;
+}
+
+/// The escape from the start prepended; a stop-and-turn base's headings along its drives.
+void Planning::prependEscapeAndAlign(og::PathGeometric& path) {
+  if (escaped) path.prepend(start.get());
+  if (req.group == PlanningGroup::kBase && P.sampling.base_turn_in_place) detail::alignBaseHeadings(si, path);
+}
+
+// ---- finish ----
+
+MotionResult Planning::finishSolved(const og::PathGeometric& path) {
   res.stats.validity_checks = oracle.checks();
-  res.path = detail::toJointPath(gs, final_path);
-  res.path_length = detail::reportedLength(gs, final_path);
+  res.path = detail::toJointPath(gs, path);
+  res.path_length = detail::reportedLength(gs, path);
   auto traj = timeParameterize(res.path, impl.timingLimits());
-  if (!traj) return finish(MotionStatus::kInvalidRequest, "time parameterization: " + traj.error().message);
+  if (!traj) return out.finish(MotionStatus::kInvalidRequest, "time parameterization: " + traj.error().message);
   res.trajectory = std::move(*traj);
-  return finish(MotionStatus::kSolved, {});
+  return out.finish(MotionStatus::kSolved, {});
+}
+
+}  // namespace
+
+MotionResult MotionPlanner::plan(const MotionRequest& req, const Termination& termination) {
+  Impl& impl = *impl_;
+  PlanOutput out;
+  if (auto why = validateRequest(req, impl, groupJointNames(req.group))) {
+    return out.finish(MotionStatus::kInvalidRequest, *why);
+  }
+  // The request's world, restored on every return: declared before the planning state, which
+  // checks in it, so that it outlives it.
+  RequestWorld request_world;
+  if (auto why = enterRequestWorld(impl, req, request_world)) return out.finish(MotionStatus::kInvalidRequest, *why);
+  Planning planning(impl, req, termination, request_world, out);
+  if (auto done = planning.leaveStart()) return *done;
+  if (auto done = planning.setGoal()) return *done;
+  planning.searchRoadmapFirst();
+  if (auto done = planning.search()) return *done;
+  og::PathGeometric path = planning.rawPath();
+  if (planning.lazy) {
+    path = planning.improveLazyPath(path);
+  } else if (auto done = planning.refineFullPath(path)) {
+    return *done;
+  }
+  return planning.finishSolved(path);
 }
 
 }  // namespace tamp::motion_planner

@@ -140,6 +140,11 @@ struct GraphManager::Run {
   /// it cannot be (an event, handled).
   enum class Prepared { kReady, kReplanned, kGaveUp };
   Prepared prepare(EdgeId id, EdgeId next);
+  /// The edge cannot be sent (`reason`): reported as "not prepared", its motion forgotten, and
+  /// online replanning from where the robot is.
+  Prepared notPrepared(EdgeId id, EdgeId next, const std::string& reason);
+  /// The command for the edge; its motion planned again when the robot is not where it starts
+  /// (an error of kind kNotFound when that fails: not prepared).
   Result<EdgeCommand> commandFor(EdgeId id, EdgeId next);
   ExecutionReport execute(Edge& e, EdgeCommand& cmd);
   /// Sends `cmd` and waits for its outcome; the first of a continuation's proven edges is
@@ -280,11 +285,15 @@ GraphManager::Run::Prepared GraphManager::Run::prepare(EdgeId id, EdgeId next) {
     what = gm.graph_.edge(next).action;
   }
   if (ok) return Prepared::kReady;
+  return notPrepared(id, next, "cannot prepare " + what + ": " + gm.graph_.edge(id).reason);
+}
+
+GraphManager::Run::Prepared GraphManager::Run::notPrepared(EdgeId id, EdgeId next, const std::string& reason) {
   Edge& e = gm.graph_.edge(id);
   ExecutedAction a;
   a.action = e.action;
   a.outcome = "not prepared";
-  a.reason = "cannot prepare " + what + ": " + e.reason;
+  a.reason = reason;
   report.actions.push_back(a);
   if (observer.on_action) observer.on_action(a, done_effort, branch_total);
   gm.clearWorldCaches();
@@ -304,25 +313,30 @@ GraphManager::Run::Prepared GraphManager::Run::prepare(EdgeId id, EdgeId next) {
 }
 
 Result<EdgeCommand> GraphManager::Run::commandFor(EdgeId id, EdgeId next) {
-  Edge& e = gm.graph_.edge(id);
   const std::string command_id = id_prefix + "m" + std::to_string(step) + "-e" + std::to_string(id);
   auto cmd = gm.command(id, next, ctx, command_id);
+  const ActionKind kind = gm.graph_.edge(id).kind;
+  const bool manipulation = kind == ActionKind::kPick || kind == ActionKind::kPlace;
   // The robot must be where the edge's motion starts; otherwise plan the motion again from it.
-  if (cmd && e.kind != ActionKind::kPick && e.kind != ActionKind::kPlace &&
-      startDistance(cmd->trajectory, ctx.state, e.kind) > gm.params_.start_tolerance) {
-    log::get("graph_manager")->debug("{}: the robot is {:.3f} from where its motion starts: planned again", e.action,
-                                     startDistance(cmd->trajectory, ctx.state, e.kind));
-    if (e.kind == ActionKind::kMoveBase) {
-      e.state = EdgeState::kUnevaluated;
-      e.motion.reset();
-    } else {
-      e.motion_by_next.erase(gm.armKey(id, next));
-      e.effort_by_next.erase(gm.armKey(id, next));
-    }
-    gm.evaluate(id, next, ctx, 0);
-    cmd = gm.command(id, next, ctx, command_id);
+  // An edge without a motion (none kept for the way the branch goes on) is planned now.
+  const double off = cmd && !manipulation ? startDistance(cmd->trajectory, ctx.state, kind) : 0.0;
+  if (cmd && off <= gm.params_.start_tolerance) return cmd;
+  Edge& e = gm.graph_.edge(id);
+  if (cmd)
+    log::get("graph_manager")->debug("{}: the robot is {:.3f} from where its motion starts: planned again", e.action, off);
+  else
+    log::get("graph_manager")->warn("{}: {}: planned now", e.action, cmd.error().message);
+  if (e.kind == ActionKind::kMoveArm) {
+    e.motion_by_next.erase(gm.armKey(id, next));
+    e.effort_by_next.erase(gm.armKey(id, next));
+  } else {
+    e.state = EdgeState::kUnevaluated;
+    e.motion.reset();
   }
-  return cmd;
+  if (!std::isfinite(gm.evaluate(id, next, ctx, 0)))
+    return Error(ErrorCode::kNotFound,
+                 "cannot plan " + e.action + " from where the robot is: " + gm.graph_.edge(id).reason);
+  return gm.command(id, next, ctx, command_id);
 }
 
 void GraphManager::Run::noteCommand() {
@@ -780,6 +794,10 @@ MissionReport GraphManager::Run::run() {
     if (p == Prepared::kGaveUp) return report;
     if (p == Prepared::kReplanned) continue;
     auto cmd = commandFor(id, next);
+    if (!cmd && cmd.error().code == ErrorCode::kNotFound) {
+      if (notPrepared(id, next, cmd.error().message) == Prepared::kGaveUp) return report;
+      continue;
+    }
     if (!cmd) return finish(MissionOutcome::kFailed, cmd.error().message);
     models_before = gm.services_.effortModelVersion();
     const ExecutionReport rep = execute(gm.graph_.edge(id), *cmd);

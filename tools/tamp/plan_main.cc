@@ -189,7 +189,7 @@ int main(int argc, char** argv) {
   app.add_flag("--no-landmarks", no_landmarks, "lazy: h_FF only (no landmark-count heuristic)");
   std::string landmark_generator = defaults.landmark_generator == sp::LandmarkGenerator::kRhw ? "rhw" : "zg";
   size_t rhw_max_disjunction = defaults.rhw.max_disjunction_size;
-  bool rhw_no_zg = !defaults.rhw.add_zhu_givan, rhw_reasonable = defaults.rhw.reasonable_orders;
+  bool rhw_no_zg = !defaults.rhw.add_zhu_givan, rhw_keep_one_action = !defaults.rhw.skip_one_action_disjunctions;
   app.add_option("--landmarks", landmark_generator,
                  "lazy: the landmarks counted: rhw (Richter-Helmert-Westphal: disjunctive landmarks, greedy-necessary "
                  "orders, landmarks required again) or zg (Zhu-Givan fact landmarks)")
@@ -197,7 +197,9 @@ int main(int argc, char** argv) {
   app.add_option("--rhw-max-disjunction", rhw_max_disjunction,
                  "lazy with rhw: disjunctive landmarks of at most this many facts (< 2: none)");
   app.add_flag("--rhw-no-zg", rhw_no_zg, "lazy with rhw: do not add the Zhu-Givan landmarks the back-chaining misses");
-  app.add_flag("--rhw-reasonable", rhw_reasonable, "lazy with rhw: reasonable orders between goals (approximated)");
+  app.add_flag("--rhw-one-action-disjunctions", rhw_keep_one_action,
+               "lazy with rhw: also the disjunctive landmarks that restate one action's disjunctive precondition (as Fast "
+               "Downward)");
   app.add_flag("--no-ehc-lazy-beside", no_lazy_beside,
                "ehc: the lazy search only after the hill-climbing fails (FF's order), not beside it");
   app.add_option("--ehc-lazy-after", lazy_after,
@@ -241,7 +243,7 @@ int main(int argc, char** argv) {
   req.search.landmark_generator = landmark_generator == "rhw" ? sp::LandmarkGenerator::kRhw : sp::LandmarkGenerator::kZhuGivan;
   req.search.rhw.max_disjunction_size = rhw_max_disjunction;
   req.search.rhw.add_zhu_givan = !rhw_no_zg;
-  req.search.rhw.reasonable_orders = rhw_reasonable;
+  req.search.rhw.skip_one_action_disjunctions = !rhw_keep_one_action;
   req.search.ehc_lazy_beside = !no_lazy_beside;
   req.search.ehc_lazy_after = lazy_after;
   req.search.ehc_lazy_turn_ehc = lazy_turn_ehc;

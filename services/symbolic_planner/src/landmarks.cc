@@ -242,7 +242,6 @@ class RhwBuilder {
     graph.is_goal.assign(graph.landmarks.size(), 0);
     for (FactId g : goals) graph.is_goal[static_cast<size_t>(simple_of_[g])] = 1;
     for (const auto& [key, kind] : orders_) graph.orders.push_back({key.first, key.second, kind});
-    if (opt_.reasonable_orders) addReasonableGoalOrders(graph);
     return graph;
   }
 
@@ -386,6 +385,7 @@ class RhwBuilder {
     std::sort(achievers.begin(), achievers.end());
     achievers.erase(std::unique(achievers.begin(), achievers.end()), achievers.end());
     std::vector<std::vector<FactId>> result;
+    achiever_names_.clear();
     for (size_t i = 0; i < achievers.size();) {
       const OpId o = achievers[i].first;
       const Operator& op = task_.ops[o];
@@ -412,8 +412,18 @@ class RhwBuilder {
       std::sort(pre.begin(), pre.end());
       pre.erase(std::unique(pre.begin(), pre.end()), pre.end());
       result.push_back(std::move(pre));
+      achiever_names_.push_back(&op.name);
     }
     return result;
+  }
+
+  /// The `n` first achievers last collected are one ground action, split by grounding into one
+  /// operator per alternative of its disjunctive precondition (they share its name).
+  bool oneGroundAction(size_t n) const {
+    for (size_t i = 1; i < n; ++i) {
+      if (*achiever_names_[i] != *achiever_names_[0]) return false;
+    }
+    return true;
   }
 
   void backchain(uint32_t l) {
@@ -436,6 +446,7 @@ class RhwBuilder {
     std::sort(shared.begin(), shared.end());
     for (FactId f : shared) foundSimple(f, l, LandmarkOrderKind::kGreedyNecessary);
     if (opt_.max_disjunction_size < 2) return;
+    if (opt_.skip_one_action_disjunctions && oneGroundAction(pres.size())) return;
     // Disjunctive preconditions: one fact of one predicate from every achiever.
     std::vector<int32_t> classes;
     for (uint32_t i = 0; i < num_ops; ++i) {
@@ -466,33 +477,6 @@ class RhwBuilder {
     }
   }
 
-  /// Goal g2 is ordered reasonably before goal g1 when achieving g1 first means deleting it again
-  /// to achieve g2: every operator adding g2 deletes g1 (Hoffmann et al.'s condition without
-  /// mutexes).
-  void addReasonableGoalOrders(LandmarkGraph& graph) const {
-    const EffectIndex& E = task_.effects;
-    std::vector<uint32_t> goals;
-    for (uint32_t l = 0; l < graph.landmarks.size(); ++l) {
-      if (graph.is_goal[l]) goals.push_back(l);
-    }
-    auto allAddersDelete = [&](FactId a, FactId b) {
-      bool any = false;
-      for (uint32_t k = E.adders_begin[a]; k < E.adders_begin[a + 1]; ++k) {
-        const Operator& op = task_.ops[E.op[E.adders[k]]];
-        if (E.ce[E.adders[k]] >= 0 || !std::binary_search(op.del.begin(), op.del.end(), b)) return false;
-        any = true;
-      }
-      return any;
-    };
-    for (uint32_t l1 : goals) {
-      for (uint32_t l2 : goals) {
-        if (l1 == l2) continue;
-        const FactId g1 = graph.landmarks[l1][0], g2 = graph.landmarks[l2][0];
-        if (allAddersDelete(g2, g1)) graph.orders.push_back({l2, l1, LandmarkOrderKind::kReasonable});
-      }
-    }
-  }
-
   const Task& task_;
   const StateBits& init_;
   const RhwLandmarkOptions& opt_;
@@ -510,6 +494,8 @@ class RhwBuilder {
   std::vector<std::vector<FactId>> class_facts_;
   uint32_t stamp_{0};
   uint64_t work_{0};
+  /// The names of the operators `firstAchieverPreconditions` returned, in its order.
+  mutable std::vector<const std::string*> achiever_names_;
 };
 
 }  // namespace

@@ -88,10 +88,12 @@ struct RhwLandmarkOptions {
   /// one per landmark): past it, no further landmark is back-chained from; those found stay.
   /// Must be > 0.
   uint64_t max_work{400'000'000};
-  /// Hoffmann, Porteous & Sebastia's reasonable orders between goal landmarks (approximated
-  /// without mutexes: every achiever of the one deletes the other, or adds a fact that the
-  /// other's achievers all delete).
-  bool reasonable_orders{false};
+  /// No disjunctive landmark from first achievers that are all one ground action, split by
+  /// grounding into one operator per alternative of its disjunctive precondition: such a
+  /// disjunction restates that precondition, and counting it rewards progress towards one
+  /// alternative (Fast Downward keeps them; on pathways they cost 3 of 5 instances, see
+  /// docs/benchmarks.md, issue 14, sixteenth round).
+  bool skip_one_action_disjunctions{true};
 
   /// @throws std::invalid_argument naming the bad field.
   void validate() const;

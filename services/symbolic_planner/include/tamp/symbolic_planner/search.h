@@ -134,7 +134,7 @@ struct SearchOptions {
   /// lazy: the landmarks it counts: kZhuGivan (fact landmarks, counted with
   /// kAcceptedAfterParents) or kRhw (RHW's, with disjunctive landmarks and greedy-necessary
   /// orders, counted with kPastAndFuture, as LAMA in Fast Downward today).
-  LandmarkGenerator landmark_generator{LandmarkGenerator::kZhuGivan};
+  LandmarkGenerator landmark_generator{LandmarkGenerator::kRhw};
   RhwLandmarkOptions rhw;  ///< kRhw's options
   /// ehc/gbfs/lazy: drop redundant actions from the plan found (greedy action elimination).
   bool eliminate_redundant_actions{true};

@@ -1082,6 +1082,7 @@ void SearchOptions::validate() const {
                                 std::to_string(ehc_lazy_turn_ehc) + " and " + std::to_string(ehc_lazy_turn_lazy));
   }
   if (ehc_lazy_after == 0) throw std::invalid_argument("SearchOptions::ehc_lazy_after must be > 0, got 0");
+  rhw.validate();
   if (preferred_boost < 0) {
     throw std::invalid_argument("SearchOptions::preferred_boost must be >= 0, got " + std::to_string(preferred_boost));
   }

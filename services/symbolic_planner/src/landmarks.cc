@@ -12,12 +12,13 @@
 namespace tamp::symbolic_planner {
 
 size_t LandmarkGraph::numDisjunctive() const {
-  return static_cast<size_t>(
-      std::count_if(landmarks.begin(), landmarks.end(), [](const auto& l) { return l.size() > 1; }));
+  return static_cast<size_t>(std::count_if(landmarks.begin(), landmarks.end(),
+                                           [](const auto& l) { return l.size() > 1; }));
 }
 
 size_t LandmarkGraph::numOrders(LandmarkOrderKind kind) const {
-  return static_cast<size_t>(std::count_if(orders.begin(), orders.end(), [&](const auto& o) { return o.kind == kind; }));
+  return static_cast<size_t>(
+      std::count_if(orders.begin(), orders.end(), [&](const auto& o) { return o.kind == kind; }));
 }
 
 namespace {
@@ -64,11 +65,14 @@ const std::vector<FactId>& effectAdds(const Task& task, uint32_t e) {
   return E.ce[e] < 0 ? op.add : op.cond_effects[static_cast<size_t>(E.ce[e])].add;
 }
 
-bool positiveConjunctiveGoal(const Goal& goal) { return goal.conjuncts.size() == 1 && goal.conjuncts[0].neg.empty(); }
+bool positiveConjunctiveGoal(const Goal& goal) {
+  return goal.conjuncts.size() == 1 && goal.conjuncts[0].neg.empty();
+}
 
 }  // namespace
 
-LandmarkGraph zhuGivanLandmarks(const Task& task, const StateBits& init, const Goal& goal, size_t max_label_entries) {
+LandmarkGraph zhuGivanLandmarks(const Task& task, const StateBits& init, const Goal& goal,
+                                size_t max_label_entries) {
   LandmarkGraph graph;
   if (!positiveConjunctiveGoal(goal)) return graph;
   const std::vector<FactId>& goals = goal.conjuncts[0].pos;
@@ -123,7 +127,8 @@ LandmarkGraph zhuGivanLandmarks(const Task& task, const StateBits& init, const G
     for (FactId f : effectAdds(task, e)) {
       if (testBit(init.data(), f)) continue;  // label {f}: cannot shrink
       tmp = lab;
-      if (!std::binary_search(tmp.begin(), tmp.end(), f)) tmp.insert(std::lower_bound(tmp.begin(), tmp.end(), f), f);
+      if (!std::binary_search(tmp.begin(), tmp.end(), f))
+        tmp.insert(std::lower_bound(tmp.begin(), tmp.end(), f), f);
       bool changed = false;
       if (!reached[f]) {
         entries += tmp.size();
@@ -132,7 +137,8 @@ LandmarkGraph zhuGivanLandmarks(const Task& task, const StateBits& init, const G
         changed = true;
       } else {
         std::vector<FactId> inter;
-        std::set_intersection(label[f].begin(), label[f].end(), tmp.begin(), tmp.end(), std::back_inserter(inter));
+        std::set_intersection(label[f].begin(), label[f].end(), tmp.begin(), tmp.end(),
+                              std::back_inserter(inter));
         if (inter.size() != label[f].size()) {
           entries -= label[f].size() - inter.size();
           label[f].swap(inter);
@@ -171,7 +177,8 @@ LandmarkGraph zhuGivanLandmarks(const Task& task, const StateBits& init, const G
   for (FactId g : goals) graph.is_goal[static_cast<size_t>(index[g])] = 1;
   for (uint32_t i = 0; i < lms.size(); ++i) {
     for (FactId p : label[lms[i]]) {
-      if (p != lms[i] && index[p] >= 0) graph.orders.push_back({static_cast<uint32_t>(index[p]), i, LandmarkOrderKind::kNatural});
+      if (p != lms[i] && index[p] >= 0)
+        graph.orders.push_back({static_cast<uint32_t>(index[p]), i, LandmarkOrderKind::kNatural});
     }
   }
   return graph;
@@ -253,7 +260,8 @@ class RhwBuilder {
   }
 
   bool holdsInit(uint32_t l) const {
-    return std::any_of(lms_[l].begin(), lms_[l].end(), [&](FactId f) { return testBit(init_.data(), f); });
+    return std::any_of(lms_[l].begin(), lms_[l].end(),
+                       [&](FactId f) { return testBit(init_.data(), f); });
   }
 
   void push(uint32_t l) {
@@ -278,7 +286,8 @@ class RhwBuilder {
     if (kind == LandmarkOrderKind::kReasonable) {
       auto rev = orders_.find({to, from});
       if (rev != orders_.end()) {
-        if (rev->second != LandmarkOrderKind::kReasonable) return;  // a stronger order the other way
+        if (rev->second != LandmarkOrderKind::kReasonable)
+          return;  // a stronger order the other way
         orders_.erase(rev);
       }
     }
@@ -403,7 +412,8 @@ class RhwBuilder {
           first = false;
         } else {
           std::vector<FactId> both;
-          std::set_intersection(cond.begin(), cond.end(), c.begin(), c.end(), std::back_inserter(both));
+          std::set_intersection(cond.begin(), cond.end(), c.begin(), c.end(),
+                                std::back_inserter(both));
           cond.swap(both);
         }
       }
@@ -500,7 +510,8 @@ class RhwBuilder {
 
 }  // namespace
 
-LandmarkGraph rhwLandmarks(const Task& task, const StateBits& init, const Goal& goal, const RhwLandmarkOptions& options) {
+LandmarkGraph rhwLandmarks(const Task& task, const StateBits& init, const Goal& goal,
+                           const RhwLandmarkOptions& options) {
   options.validate();
   if (!positiveConjunctiveGoal(goal)) return {};
   RhwBuilder builder(task, init, options);
@@ -509,8 +520,8 @@ LandmarkGraph rhwLandmarks(const Task& task, const StateBits& init, const Goal& 
 
 namespace {
 
-void buildCsr(size_t n, const std::vector<std::pair<uint32_t, uint32_t>>& edges, std::vector<uint32_t>& begin,
-              std::vector<uint32_t>& items) {
+void buildCsr(size_t n, const std::vector<std::pair<uint32_t, uint32_t>>& edges,
+              std::vector<uint32_t>& begin, std::vector<uint32_t>& items) {
   begin.assign(n + 1, 0);
   for (const auto& [key, value] : edges) ++begin[key + 1];
   for (size_t i = 0; i < n; ++i) begin[i + 1] += begin[i];
@@ -521,25 +532,30 @@ void buildCsr(size_t n, const std::vector<std::pair<uint32_t, uint32_t>>& edges,
 
 }  // namespace
 
-LandmarkCounter::LandmarkCounter(const Task& task, LandmarkGraph graph, LandmarkProgression progression)
+LandmarkCounter::LandmarkCounter(const Task& task, LandmarkGraph graph,
+                                 LandmarkProgression progression)
     : task_(task), graph_(std::move(graph)), progression_(progression) {
   const size_t n = graph_.landmarks.size();
-  if (graph_.is_goal.size() != n) throw std::invalid_argument("LandmarkCounter: is_goal must have one entry per landmark");
+  if (graph_.is_goal.size() != n)
+    throw std::invalid_argument("LandmarkCounter: is_goal must have one entry per landmark");
   for (const auto& l : graph_.landmarks) {
     if (l.empty()) throw std::invalid_argument("LandmarkCounter: a landmark without facts");
     if (l.size() > 1 && progression_ == LandmarkProgression::kAcceptedAfterParents) {
-      throw std::invalid_argument("LandmarkCounter: kAcceptedAfterParents counts simple landmarks only, got one of " +
-                                  std::to_string(l.size()) + " facts");
+      throw std::invalid_argument(
+          "LandmarkCounter: kAcceptedAfterParents counts simple landmarks only, got one of " +
+          std::to_string(l.size()) + " facts");
     }
     for (FactId f : l) {
-      if (f >= task.numFacts()) throw std::invalid_argument("LandmarkCounter: fact " + std::to_string(f) + " out of range");
+      if (f >= task.numFacts())
+        throw std::invalid_argument("LandmarkCounter: fact " + std::to_string(f) + " out of range");
     }
   }
   std::vector<std::pair<uint32_t, uint32_t>> parents, gn_children, reasonable_parents;
   for (const LandmarkOrder& o : graph_.orders) {
     if (o.from >= n || o.to >= n) {
-      throw std::invalid_argument("LandmarkCounter: order " + std::to_string(o.from) + " -> " + std::to_string(o.to) +
-                                  " names no landmark (" + std::to_string(n) + " landmarks)");
+      throw std::invalid_argument("LandmarkCounter: order " + std::to_string(o.from) + " -> " +
+                                  std::to_string(o.to) + " names no landmark (" +
+                                  std::to_string(n) + " landmarks)");
     }
     if (o.kind != LandmarkOrderKind::kReasonable) parents.emplace_back(o.to, o.from);
     if (o.kind == LandmarkOrderKind::kGreedyNecessary) gn_children.emplace_back(o.from, o.to);
@@ -551,7 +567,8 @@ LandmarkCounter::LandmarkCounter(const Task& task, LandmarkGraph graph, Landmark
   lm_words_ = (n + 63) / 64;
 }
 
-LandmarkCounter::LandmarkCounter(const Task& task, const StateBits& init, const Goal& goal, size_t max_label_entries)
+LandmarkCounter::LandmarkCounter(const Task& task, const StateBits& init, const Goal& goal,
+                                 size_t max_label_entries)
     : LandmarkCounter(task, zhuGivanLandmarks(task, init, goal, max_label_entries),
                       LandmarkProgression::kAcceptedAfterParents) {}
 
@@ -582,8 +599,8 @@ void LandmarkCounter::initial(const uint64_t* state, uint64_t* out) const {
   }
 }
 
-void LandmarkCounter::progress(const uint64_t* parent_state, const uint64_t* parent, const uint64_t* state,
-                               uint64_t* out) const {
+void LandmarkCounter::progress(const uint64_t* parent_state, const uint64_t* parent,
+                               const uint64_t* state, uint64_t* out) const {
   const auto n = static_cast<uint32_t>(graph_.landmarks.size());
   if (progression_ == LandmarkProgression::kAcceptedAfterParents) {
     std::copy(parent, parent + lm_words_, out);
@@ -609,14 +626,16 @@ void LandmarkCounter::progress(const uint64_t* parent_state, const uint64_t* par
   }
   for (uint32_t l = 0; l < n; ++l) {
     const bool h = testBit(now.data(), l);
-    bool fut = testBit(parent_future, l) && (!h || holds(l, parent_state));  // not added by this step
+    bool fut =
+        testBit(parent_future, l) && (!h || holds(l, parent_state));  // not added by this step
     if (!fut && !h && graph_.is_goal[l]) fut = true;
     if (!fut && !h) {
       for (uint32_t k = gn_children_begin_[l]; k < gn_children_begin_[l + 1] && !fut; ++k) {
         fut = !testBit(past, gn_children_[k]);  // required again
       }
     }
-    for (uint32_t k = reasonable_parents_begin_[l]; k < reasonable_parents_begin_[l + 1] && !fut; ++k) {
+    for (uint32_t k = reasonable_parents_begin_[l]; k < reasonable_parents_begin_[l + 1] && !fut;
+         ++k) {
       fut = !testBit(past, reasonable_parents_[k]);
     }
     if (fut) setBit(future, l);
@@ -641,7 +660,8 @@ Cost LandmarkCounter::value(const uint64_t* state, const uint64_t* status) const
   return h;
 }
 
-void LandmarkCounter::preferred(const uint64_t* state, const uint64_t* status, std::vector<OpId>& out) const {
+void LandmarkCounter::preferred(const uint64_t* state, const uint64_t* status,
+                                std::vector<OpId>& out) const {
   const EffectIndex& E = task_.effects;
   const auto n = static_cast<uint32_t>(graph_.landmarks.size());
   for (uint32_t l = 0; l < n; ++l) {
@@ -657,7 +677,8 @@ void LandmarkCounter::preferred(const uint64_t* state, const uint64_t* status, s
         if (!task_.applicable(state, o)) continue;
         if (E.ce[e] >= 0) {
           bool ok = true;
-          for (FactId c : task_.ops[o].cond_effects[static_cast<size_t>(E.ce[e])].cond) ok = ok && testBit(state, c);
+          for (FactId c : task_.ops[o].cond_effects[static_cast<size_t>(E.ce[e])].cond)
+            ok = ok && testBit(state, c);
           if (!ok) continue;
         }
         out.push_back(o);

@@ -121,12 +121,15 @@ class LandmarkCounter {
   size_t numLandmarks() const { return graph_.landmarks.size(); }
   const LandmarkGraph& graph() const { return graph_; }
   /// Words of a landmark status (per state): the accepted set, or the past then the future set.
-  size_t words() const { return progression_ == LandmarkProgression::kPastAndFuture ? 2 * lm_words_ : lm_words_; }
+  size_t words() const {
+    return progression_ == LandmarkProgression::kPastAndFuture ? 2 * lm_words_ : lm_words_;
+  }
 
   /// Status of the initial state `state` into `out` (words() words).
   void initial(const uint64_t* state, uint64_t* out) const;
   /// Status of `state`, reached from `parent_state` whose status is `parent`, into `out`.
-  void progress(const uint64_t* parent_state, const uint64_t* parent, const uint64_t* state, uint64_t* out) const;
+  void progress(const uint64_t* parent_state, const uint64_t* parent, const uint64_t* state,
+                uint64_t* out) const;
   /// The heuristic value of `state` with status `status`.
   Cost value(const uint64_t* state, const uint64_t* status) const;
   /// Appends the preferred operators of `state` (see above) to `out`.

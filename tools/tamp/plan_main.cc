@@ -187,6 +187,19 @@ int main(int argc, char** argv) {
                  "the share of the time left that the unit-cost first run may use, in (0, 1]")
       ->check(CLI::Range(1e-9, 1.0));
   app.add_flag("--no-landmarks", no_landmarks, "lazy: h_FF only (no landmark-count heuristic)");
+  std::string landmark_generator = defaults.landmark_generator == sp::LandmarkGenerator::kRhw ? "rhw" : "zg";
+  size_t rhw_max_disjunction = defaults.rhw.max_disjunction_size;
+  bool rhw_no_zg = !defaults.rhw.add_zhu_givan, rhw_keep_one_action = !defaults.rhw.skip_one_action_disjunctions;
+  app.add_option("--landmarks", landmark_generator,
+                 "lazy: the landmarks counted: rhw (Richter-Helmert-Westphal: disjunctive landmarks, greedy-necessary "
+                 "orders, landmarks required again) or zg (Zhu-Givan fact landmarks)")
+      ->check(CLI::IsMember({"rhw", "zg"}));
+  app.add_option("--rhw-max-disjunction", rhw_max_disjunction,
+                 "lazy with rhw: disjunctive landmarks of at most this many facts (< 2: none)");
+  app.add_flag("--rhw-no-zg", rhw_no_zg, "lazy with rhw: do not add the Zhu-Givan landmarks the back-chaining misses");
+  app.add_flag("--rhw-one-action-disjunctions", rhw_keep_one_action,
+               "lazy with rhw: also the disjunctive landmarks that restate one action's disjunctive precondition (as Fast "
+               "Downward)");
   app.add_flag("--no-ehc-lazy-beside", no_lazy_beside,
                "ehc: the lazy search only after the hill-climbing fails (FF's order), not beside it");
   app.add_option("--ehc-lazy-after", lazy_after,
@@ -227,6 +240,10 @@ int main(int argc, char** argv) {
   req.search.ehc_fallback_budget_min = fallback_min;
   req.search.ehc_fallback_budget_max = fallback_max;
   req.search.landmarks = !no_landmarks;
+  req.search.landmark_generator = landmark_generator == "rhw" ? sp::LandmarkGenerator::kRhw : sp::LandmarkGenerator::kZhuGivan;
+  req.search.rhw.max_disjunction_size = rhw_max_disjunction;
+  req.search.rhw.add_zhu_givan = !rhw_no_zg;
+  req.search.rhw.skip_one_action_disjunctions = !rhw_keep_one_action;
   req.search.ehc_lazy_beside = !no_lazy_beside;
   req.search.ehc_lazy_after = lazy_after;
   req.search.ehc_lazy_turn_ehc = lazy_turn_ehc;
@@ -253,7 +270,7 @@ int main(int argc, char** argv) {
                  "; status %s; parse %.4f s, ground %.4f s, search %.4f s; facts %zu, operators %zu; "
                  "expanded %llu, evaluated %llu, initial h %lld; ehc plateau retries %llu (%llu abandoned); ehc fallbacks "
                  "%llu (%llu in a goal-agenda entry before the last); anytime %llu "
-                 "iterations, %llu improvements%s%s%s%s%s\n",
+                 "iterations, %llu improvements; landmarks %llu (%llu disjunctive, %llu greedy-necessary orders)%s%s%s%s%s\n",
                  sp::toString(reply.status).c_str(), reply.stats.parse_seconds, reply.stats.ground_seconds,
                  reply.stats.search_seconds, reply.stats.facts, reply.stats.operators,
                  static_cast<unsigned long long>(reply.stats.expanded),
@@ -264,6 +281,9 @@ int main(int argc, char** argv) {
                  static_cast<unsigned long long>(reply.stats.ehc_fallbacks_in_agenda),
                  static_cast<unsigned long long>(reply.stats.anytime_iterations),
                  static_cast<unsigned long long>(reply.stats.anytime_improvements),
+                 static_cast<unsigned long long>(reply.stats.landmarks),
+                 static_cast<unsigned long long>(reply.stats.landmarks_disjunctive),
+                 static_cast<unsigned long long>(reply.stats.landmark_gn_orders),
                  reply.stats.ehc_ff_failed ? "; ehc with FF-v2.3's relaxed plan failed, restarted" : "",
                  reply.stats.ehc_second_won   ? "; second ehc run gave the shorter plan"
                  : reply.stats.ehc_second_ran ? "; second ehc run, first plan kept"

@@ -311,6 +311,9 @@ PlanReply PlanningSession::solve(const Query& q, const Termination& term) {
   reply.stats.anytime_iterations = sr.stats.anytime_iterations;
   reply.stats.anytime_improvements = sr.stats.anytime_improvements;
   reply.stats.unit_first_failed = sr.stats.unit_first_failed;
+  reply.stats.landmarks = sr.stats.landmarks;
+  reply.stats.landmarks_disjunctive = sr.stats.landmarks_disjunctive;
+  reply.stats.landmark_gn_orders = sr.stats.landmark_gn_orders;
   reply.status = fromSearch(sr.status);
   if (sr.status == SearchStatus::kSolved) {
     reply.cost = sr.cost;

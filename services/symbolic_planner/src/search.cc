@@ -669,7 +669,7 @@ class Searcher {
     // LAMA's second heuristic: landmark count, with its own accepted-landmark set per state.
     std::unique_ptr<LandmarkCounter> lm;
     if (opt_.landmarks) {
-      lm = std::make_unique<LandmarkCounter>(task_, init_, goal_);
+      lm = makeLandmarkCounter();
       if (!lm->enabled()) lm.reset();
     }
     const size_t lw = lm ? lm->words() : 0;
@@ -678,9 +678,11 @@ class Searcher {
     std::vector<uint64_t> acc_tmp(lw);
     if (lm) {
       accepted.resize(lw);
-      lm->initialAccepted(reg_.get(root), accepted.data());
+      lm->initial(reg_.get(root), accepted.data());
       hlm.push_back(lm->value(reg_.get(root), accepted.data()));
       stats_.landmarks = lm->numLandmarks();
+      stats_.landmarks_disjunctive = lm->graph().numDisjunctive();
+      stats_.landmark_gn_orders = lm->graph().numOrders(LandmarkOrderKind::kGreedyNecessary);
     }
     // Lists: 0 h_FF, 1 h_FF preferred, 2 landmarks, 3 landmarks preferred.
     LazyOpen lists[4];
@@ -741,7 +743,8 @@ class Searcher {
       g_[sid] = g_[e.parent] + opCost(e.op);
       if (task_.goalReached(succ_.data(), goal_)) co_return finish(SearchStatus::kSolved, path(sid, kNone));
       if (lm) {
-        lm->progress(accepted.data() + static_cast<size_t>(e.parent) * lw, succ_.data(), acc_tmp.data());
+        lm->progress(reg_.get(e.parent), accepted.data() + static_cast<size_t>(e.parent) * lw, succ_.data(),
+                     acc_tmp.data());
         accepted.insert(accepted.end(), acc_tmp.begin(), acc_tmp.end());
         hlm.push_back(lm->value(succ_.data(), acc_tmp.data()));
       }
@@ -765,6 +768,14 @@ class Searcher {
   }
 
   Cost opCost(OpId o) const { return task_.unit_cost ? 1 : task_.ops[o].cost; }
+
+  std::unique_ptr<LandmarkCounter> makeLandmarkCounter() const {
+    if (opt_.landmark_generator == LandmarkGenerator::kRhw) {
+      return std::make_unique<LandmarkCounter>(task_, rhwLandmarks(task_, init_, goal_, opt_.rhw),
+                                               LandmarkProgression::kPastAndFuture);
+    }
+    return std::make_unique<LandmarkCounter>(task_, init_, goal_);
+  }
 
   // --- lazy weighted A* with a cost bound (LAMA's later iterations) ------------------------------
   // Entries (parent, operator) keyed by g(parent) + cost(op) + w * h(parent); two queues, all and
@@ -1009,6 +1020,11 @@ void addRunCosts(SearchStatistics& into, const SearchStatistics& from) {
   into.ehc_fallbacks_in_agenda += from.ehc_fallbacks_in_agenda;
   into.registered_states += from.registered_states;
   into.seconds += from.seconds;
+  if (from.landmarks > into.landmarks) {  // the landmarks of the run that used them
+    into.landmarks = from.landmarks;
+    into.landmarks_disjunctive = from.landmarks_disjunctive;
+    into.landmark_gn_orders = from.landmark_gn_orders;
+  }
 }
 
 }  // namespace
@@ -1066,6 +1082,7 @@ void SearchOptions::validate() const {
                                 std::to_string(ehc_lazy_turn_ehc) + " and " + std::to_string(ehc_lazy_turn_lazy));
   }
   if (ehc_lazy_after == 0) throw std::invalid_argument("SearchOptions::ehc_lazy_after must be > 0, got 0");
+  rhw.validate();
   if (preferred_boost < 0) {
     throw std::invalid_argument("SearchOptions::preferred_boost must be >= 0, got " + std::to_string(preferred_boost));
   }

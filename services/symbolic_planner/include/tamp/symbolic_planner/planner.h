@@ -93,6 +93,9 @@ struct PlanStatistics {
   uint64_t anytime_iterations{0};    ///< SearchOptions::anytime_seconds: iterations run
   uint64_t anytime_improvements{0};  ///< ... that found a cheaper plan
   bool unit_first_failed{false};  ///< the unit-cost first run failed; see SearchOptions::unit_cost_first
+  uint64_t landmarks{0};  ///< landmarks of the lazy search's landmark count (0: not used)
+  uint64_t landmarks_disjunctive{0};  ///< ... of which disjunctive
+  uint64_t landmark_gn_orders{0};     ///< ... greedy-necessary orders between them
 };
 
 /// A self-contained request (maps 1:1 to the plan-request message).

@@ -41,9 +41,13 @@
 
 #include "tamp/core/termination.h"
 #include "tamp/symbolic_planner/heuristic.h"
+#include "tamp/symbolic_planner/landmarks.h"
 #include "tamp/symbolic_planner/task.h"
 
 namespace tamp::symbolic_planner {
+
+/// The landmark generator of the lazy search's landmark count (landmarks.h).
+enum class LandmarkGenerator { kZhuGivan, kRhw };
 
 enum class SearchAlgorithm { kEhc, kGbfs, kLazy, kWAstar, kAstar };
 
@@ -127,6 +131,11 @@ struct SearchOptions {
   bool preferred_operators{true};  ///< gbfs/lazy: use the helpful-action open list(s)
   /// lazy: alternate h_FF with LAMA's landmark-count heuristic (landmarks.h), four queues.
   bool landmarks{true};
+  /// lazy: the landmarks it counts: kZhuGivan (fact landmarks, counted with
+  /// kAcceptedAfterParents) or kRhw (RHW's, with disjunctive landmarks and greedy-necessary
+  /// orders, counted with kPastAndFuture, as LAMA in Fast Downward today).
+  LandmarkGenerator landmark_generator{LandmarkGenerator::kRhw};
+  RhwLandmarkOptions rhw;  ///< kRhw's options
   /// ehc/gbfs/lazy: drop redundant actions from the plan found (greedy action elimination).
   bool eliminate_redundant_actions{true};
   int preferred_boost{1000};    ///< gbfs/lazy: preferred-queue priority boost on progress
@@ -188,7 +197,9 @@ struct SearchStatistics {
   /// gave the answer while the hill-climbing was still running.
   bool lazy_beside_started{false};
   bool lazy_beside_won{false};
-  uint64_t landmarks{0};    ///< lazy: number of fact landmarks found (0: landmark count not used)
+  uint64_t landmarks{0};    ///< lazy: number of landmarks found (0: landmark count not used)
+  uint64_t landmarks_disjunctive{0};  ///< ... of which disjunctive
+  uint64_t landmark_gn_orders{0};     ///< ... greedy-necessary orders between them
   uint64_t eliminated_actions{0};  ///< removed by action elimination
   uint64_t anytime_iterations{0};    ///< weighted A* iterations of the anytime phase
   uint64_t anytime_improvements{0};  ///< ... that found a cheaper plan

@@ -83,11 +83,12 @@ bool GraphManager::plannedIn(EdgeId id, EdgeId next, const BranchContext& ctx) c
     log::get("graph_manager")->debug("plannedIn {}: no motion for this next ({})", e.action, key);
     return false;
   }
-  if (m->second.planned_in != contextKey(ctx))
+  const std::string now = contextKey(ctx);
+  if (m->second.planned_in != now)
     log::get("graph_manager")->debug("plannedIn {}: planned in '{}', now '{}' (prepared {}, deferred {})", e.action,
-                                     m->second.planned_in, contextKey(ctx), m->second.prepared.has_value(), m->second.deferred);
+                                     m->second.planned_in, now, m->second.prepared.has_value(), m->second.deferred);
   return key >= 0 && m->second.prepared && !m->second.deferred && !m->second.trajectory.empty() &&
-         !m->second.planned_in.empty() && m->second.planned_in == contextKey(ctx);
+         !m->second.planned_in.empty() && m->second.planned_in == now;
 }
 
 TraverseResult GraphManager::traverseFirstEdge(NodeId from, const BranchContext& context) {

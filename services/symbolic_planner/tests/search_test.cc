@@ -117,18 +117,23 @@ TEST(Search, SecondEhcRunKeepsTheCheaperPlan) {
   EXPECT_GT(two.stats.evaluated, one.stats.evaluated);
 }
 
+/// Appends an operator to a hand-built task.
+void addOp(Task& t, const char* name, std::vector<FactId> pre, std::vector<FactId> add, std::vector<FactId> del = {}) {
+  Operator o;
+  o.name = name;
+  o.pre = std::move(pre);
+  o.add = std::move(add);
+  o.del = std::move(del);
+  t.ops.push_back(o);
+}
+
 /// a -> b (o1), b -> c (o2), a -> c (o3), c -> g (o4); g -> not g, d (o5).
 Task diamondTask() {
   Task t;
   t.fact_names = {"(a)", "(b)", "(c)", "(g)", "(d)"};
   t.complement.assign(5, -1);
   auto op = [&](const char* name, std::vector<FactId> pre, std::vector<FactId> add, std::vector<FactId> del = {}) {
-    Operator o;
-    o.name = name;
-    o.pre = std::move(pre);
-    o.add = std::move(add);
-    o.del = std::move(del);
-    t.ops.push_back(o);
+    addOp(t, name, std::move(pre), std::move(add), std::move(del));
   };
   op("(o1)", {0}, {1});
   op("(o2)", {1}, {2});
@@ -181,12 +186,7 @@ Task tentTask(bool same_walk_name) {
   t.fact_names = {"(at t0 p)", "(at t1 p)", "(key)", "(g)", "(start)"};
   t.complement.assign(5, -1);
   auto op = [&](const char* name, std::vector<FactId> pre, std::vector<FactId> add, std::vector<FactId> del = {}) {
-    Operator o;
-    o.name = name;
-    o.pre = std::move(pre);
-    o.add = std::move(add);
-    o.del = std::move(del);
-    t.ops.push_back(o);
+    addOp(t, name, std::move(pre), std::move(add), std::move(del));
   };
   op(same_walk_name ? "(walk)" : "(walk t0)", {0, 2}, {3});
   op(same_walk_name ? "(walk)" : "(walk t1)", {1, 2}, {3});

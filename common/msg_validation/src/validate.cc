@@ -328,6 +328,7 @@ Status validate(const msg::MotionRequest& m, const Limits& limits) {
     }
   }
   c.nonNegative("movable_cost_weight", m.movable_cost_weight());
+  c.ids("fixed_objects", m.fixed_objects(), limits.max_items);
   return c.status();
 }
 

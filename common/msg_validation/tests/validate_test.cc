@@ -87,6 +87,9 @@ TEST(MsgValidation, MotionRequest) {
   m.ignored_objects(std::vector<std::string>(200001, "x"));
   EXPECT_EQ(why(m), "MotionRequest.ignored_objects: 200001 elements (limit 100000)");
   m = validMotion();
+  m.fixed_objects({"can", ""});
+  EXPECT_EQ(why(m), "MotionRequest.fixed_objects[1]: empty (an id is required)");
+  m = validMotion();
   m.movable_cost_weight(-1);
   EXPECT_EQ(why(m), "MotionRequest.movable_cost_weight: must be >= 0, got -1.000000");
   m = validMotion();

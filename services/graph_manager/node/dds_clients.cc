@@ -132,6 +132,7 @@ MotionAnswer DdsServiceClients::motion(const MotionQuery& q) {
   req.ignored_objects(q.ignored);
   for (const auto& o : q.overrides) req.object_overrides().push_back(toMsg(o));
   req.movable_cost_weight(q.movable_cost_weight);
+  req.fixed_objects(q.fixed);
   MotionAnswer a;
   const auto t0 = Clock::now();
   auto rep = checked(motion_.call(req, dds::CallOptions{q.budget_s, {}}), dds::services::kMotion.name);

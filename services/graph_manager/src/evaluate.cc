@@ -89,6 +89,7 @@ MotionQuery GraphManager::baseQuery(const Edge& e, const BranchContext& ctx) con
   q.held = ctx.held;
   q.overrides = overridesOf(ctx);
   q.movable_cost_weight = 0.0;  // the pure static-only lazy path
+  if (q.mode == Mode::kLazy) q.fixed.assign(fixed_objects_.begin(), fixed_objects_.end());
   q.budget_s = params_.motion_budget_s;
   return q;
 }
@@ -158,6 +159,11 @@ double GraphManager::evaluateBase(Edge& e, const BranchContext& ctx, int depth) 
   if (!a.ok()) {
     e.state = EdgeState::kInfeasible;
     e.reason = std::string(toString(a.status)) + (a.reason.empty() ? "" : ": " + a.reason);
+    if (!q.fixed.empty()) {
+      std::string fixed;
+      for (const auto& o : q.fixed) fixed += (fixed.empty() ? "" : ", ") + o;
+      e.reason += " (going round what the robot can neither carry nor push: " + fixed + ")";
+    }
     if (e.variant == Variant::kAround && params_.policy == Policy::kInfeasible && a.status == MotionOutcome::kNoPath &&
         depth < params_.max_subtask_depth + 1) {
       // Policy `infeasible`: only a proof that there is no way around lets objects be moved.
@@ -167,8 +173,9 @@ double GraphManager::evaluateBase(Edge& e, const BranchContext& ctx, int depth) 
       const std::string action = e.action;
       for (EdgeId twin : twins) {
         const Edge& d = graph_.edge(twin);
-        if (d.to == to && d.action == action && d.variant == Variant::kDirect && d.state == EdgeState::kLazy)
-          spawnSubtasks(twin, ctx, depth);
+        if (d.to == to && d.action == action && d.variant == Variant::kDirect && d.state == EdgeState::kLazy &&
+            spawnSubtasks(twin, ctx, depth) > 0)
+          (void)evaluateBaseAgain(twin, ctx, depth);
       }
     }
     return kInfinity;
@@ -203,7 +210,9 @@ double GraphManager::evaluateBase(Edge& e, const BranchContext& ctx, int depth) 
     const EdgeId id = e.id;
     const std::string origin = e.origin;
     graph_.addVariant(id, Variant::kAround, origin);
-    if (params_.policy != Policy::kInfeasible && depth <= params_.max_subtask_depth) spawnSubtasks(id, ctx, depth);
+    const bool may_move = params_.policy != Policy::kInfeasible || aroundProvenImpossible(graph_.edge(id));
+    if (may_move && depth <= params_.max_subtask_depth && spawnSubtasks(id, ctx, depth) > 0)
+      return evaluateBaseAgain(id, ctx, depth);
     return kInfinity;
   }
   e.state = EdgeState::kFeasible;
@@ -213,6 +222,28 @@ double GraphManager::evaluateBase(Edge& e, const BranchContext& ctx, int depth) 
                                    e.variant == Variant::kAround ? " [around]" : "", a.path_length,
                                    a.path.waypoints.size(), mean);
   return mean;
+}
+
+double GraphManager::evaluateBaseAgain(EdgeId id, const BranchContext& ctx, int depth) {
+  Edge& e = graph_.edge(id);
+  std::string fixed;
+  for (const auto& o : fixed_objects_) fixed += (fixed.empty() ? "" : ", ") + o;
+  log::get("graph_manager")->info("{}: planned again round what the robot cannot move ({})", e.action, fixed);
+  e.state = EdgeState::kUnevaluated;
+  e.subtasks_spawned = false;
+  e.motion.reset();
+  e.reason.clear();
+  return evaluateBase(e, ctx, depth);
+}
+
+bool GraphManager::aroundProvenImpossible(const Edge& e) const {
+  for (EdgeId twin : graph_.out(e.from)) {
+    const Edge& d = graph_.edge(twin);
+    if (d.to == e.to && d.action == e.action && d.variant == Variant::kAround && d.state == EdgeState::kInfeasible &&
+        d.reason.rfind(std::string(toString(MotionOutcome::kNoPath)), 0) == 0)
+      return true;
+  }
+  return false;
 }
 
 bool GraphManager::occludesFromBase(const std::string& object, const std::string& region,
@@ -266,6 +297,8 @@ void GraphManager::clearWorldCaches() {
   grasp_cache_.clear();
   placement_cache_.clear();
   push_cache_.clear();
+  fixed_objects_.clear();
+  removable_objects_.clear();
 }
 
 std::optional<std::pair<GraspOption, Eigen::Isometry3d>> GraphManager::preparePlace(

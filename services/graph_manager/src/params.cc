@@ -47,6 +47,7 @@ const config::Schema<GraphManagerParams>& schema() {
         .field("push_gap_m", &P::push_gap_m, config::nonNegative("m"))
         .field("push_backoff_m", &P::push_backoff_m, config::nonNegative("m"))
         .field("pushes_per_object", &P::pushes_per_object, atLeast(0))
+        .field("push_budget_s", &P::push_budget_s, positive())
         .field("keep_clear_margin_m", &P::keep_clear_margin_m, config::nonNegative("m"))
         .field("held_padding_step_m", &P::held_padding_step_m, config::nonNegative("m"))
         .field("held_padding_max_m", &P::held_padding_max_m,

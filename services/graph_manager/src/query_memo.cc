@@ -52,6 +52,7 @@ std::string QueryMemo::key(const MotionQuery& q) {
     put(k, q.held_padding_m);
   }
   for (const auto& id : q.ignored) k += "|ignore " + id;
+  for (const auto& id : q.fixed) k += "|fixed " + id;
   put(k, q.overrides);
   k += "|w";
   put(k, q.movable_cost_weight);

@@ -11,9 +11,9 @@
 
 namespace tamp::graph_manager {
 
-void GraphManager::spawnSubtasks(EdgeId id, const BranchContext& ctx, int depth) {
+int GraphManager::spawnSubtasks(EdgeId id, const BranchContext& ctx, int depth) {
   Edge& blocked = graph_.edge(id);
-  if (blocked.subtasks_spawned || !blocked.motion) return;
+  if (blocked.subtasks_spawned || !blocked.motion) return 0;
   blocked.subtasks_spawned = true;
   const NodeId v = blocked.from;
   const NodeId child = blocked.to;
@@ -39,6 +39,7 @@ void GraphManager::spawnSubtasks(EdgeId id, const BranchContext& ctx, int depth)
   std::vector<std::string> crossed;
   for (const auto& c : motion.crossings) crossed.push_back(c.object_id);
   int objects = 0;
+  int fixed = 0;
   std::vector<std::string> unmovable;  // why a crossed object spawned no sub-task (for the failure reason)
   std::vector<std::pair<std::string, std::string>> first_slots;  // per movable object, for the oracle's subsets
   for (const auto& crossing : motion.crossings) {
@@ -61,9 +62,12 @@ void GraphManager::spawnSubtasks(EdgeId id, const BranchContext& ctx, int depth)
       if (no_push.empty()) slots = spawnPushes(*o, supportAt(v, o->id), ctx, swept, crossed, radius, why_push);
       if (slots.empty()) {
         unmovable.push_back(why_not + (why_push.empty() ? "" : "; " + why_push));
+        // Neither carried nor pushed in this world: later lazy paths go round it if they can.
+        if (!removable_objects_.count(o->id) && fixed_objects_.insert(o->id).second) ++fixed;
         continue;
       }
     }
+    removable_objects_.insert(o->id);
     // What the blocked action achieved: the sub-task's second plan must achieve it too.
     const auto& va = graph_.node(v).atoms;
     const auto& ca = graph_.node(child).atoms;
@@ -79,8 +83,8 @@ void GraphManager::spawnSubtasks(EdgeId id, const BranchContext& ctx, int depth)
   // The edge may have moved: the graph grew.
   Edge& e = graph_.edge(id);
   for (const auto& why : unmovable) e.reason += "; " + why;
-  (void)ctx;
   (void)depth;
+  return fixed;
 }
 
 std::string GraphManager::supportAt(NodeId v, const std::string& object) const {

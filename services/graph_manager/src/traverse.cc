@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <set>
 
 #include "tamp/core/log.h"
@@ -262,25 +263,41 @@ struct GraphManager::Search {
     }
   }
 
+  /// Records an edge's state when its try ends (however the loop body leaves).
+  struct TriedMark {
+    GraphManager& gm;
+    std::map<EdgeId, EdgeState>& tried;
+    EdgeId id;
+    TriedMark(GraphManager& g, std::map<EdgeId, EdgeState>& t, EdgeId e) : gm(g), tried(t), id(e) {
+      tried[id] = gm.graph_.edge(id).state;
+    }
+    ~TriedMark() { tried[id] = gm.graph_.edge(id).state; }
+    TriedMark(const TriedMark&) = delete;
+    TriedMark& operator=(const TriedMark&) = delete;
+  };
+
   void dfs(NodeId v, const BranchContext& ctx, double cost, int depth) {
     if (gm.isGoal(v)) {
       complete(cost);
       return;
     }
-    std::set<EdgeId> tried;
+    // Each out-edge with its state when it was last tried: an edge priced again since (policy
+    // infeasible prices a blocked edge again round what the robot cannot move, once the way
+    // round everything is proven impossible) is tried again.
+    std::map<EdgeId, EdgeState> tried;
     while (!settled() && !outOfBudget()) {
       // The untried out-edge with the least known or bounded effort (out(v) grows with sub-tasks).
       EdgeId pick = -1;
       double pick_cost = kInfinity;
       for (EdgeId e : gm.graph_.out(v)) {
-        if (tried.count(e)) continue;
+        if (auto t = tried.find(e); t != tried.end() && t->second == gm.graph_.edge(e).state) continue;
         Edge& x = gm.graph_.edge(e);
         if (x.state == EdgeState::kUnevaluated && x.lower_bound_s == 0.0) x.lower_bound_s = gm.lowerBound(x);
         const double k = known(e);
         if (pick < 0 || k < pick_cost) pick = e, pick_cost = k;
       }
       if (pick < 0) return;
-      tried.insert(pick);
+      TriedMark mark{gm, tried, pick};
       Edge& e = gm.graph_.edge(pick);
       if (e.to == v || onBranch(e.to)) continue;
       if (!std::isfinite(pick_cost)) continue;

@@ -29,6 +29,10 @@ class ScriptedServices : public ServiceClients {
   int motion_calls{0};
   int batches{0};                   ///< motions() calls (concurrent queries)
   bool block_static_lazy{false};    ///< static-only lazy paths cross "box"; effort-aware ones do not
+  /// Every lazy path crosses "box" unless the query fixes it (then it goes round); no push is
+  /// free.
+  bool box_immovable{false};
+  std::vector<std::vector<std::string>> fixed_asked;  ///< MotionQuery::fixed of every lazy query
 
   std::vector<MotionAnswer> motions(const std::vector<MotionQuery>& qs) override {
     ++batches;
@@ -62,8 +66,13 @@ class ScriptedServices : public ServiceClients {
   MotionAnswer motion(const MotionQuery& q) override {
     ++motion_calls;
     if (!q.held.object_id.empty()) held_paddings.push_back(q.held_padding_m);
+    if (q.mode == Mode::kLazy) fixed_asked.push_back(q.fixed);
     MotionAnswer a;
     a.status = MotionOutcome::kSolved;
+    if (box_immovable && q.group == Group::kBase && q.mode == Mode::kFull && !q.held.object_id.empty()) {
+      a.status = MotionOutcome::kNoPath;  // a push
+      return a;
+    }
     if (q.group == Group::kArm) {
       a.path.joint_names = std::vector<std::string>(q.goal_arm.size(), "j");
       a.path.waypoints = {q.start.arm, q.goal_arm};
@@ -79,7 +88,9 @@ class ScriptedServices : public ServiceClients {
     a.trajectory.joint_names = a.path.joint_names;
     a.trajectory.points = {TrajectoryPoint{0.0, a.path.waypoints[0], {}},
                            TrajectoryPoint{a.path_length, a.path.waypoints[1], {}}};
-    if (block_static_lazy && q.mode == Mode::kLazy && q.movable_cost_weight == 0.0) {
+    const bool box_fixed = std::find(q.fixed.begin(), q.fixed.end(), "box") != q.fixed.end();
+    if ((block_static_lazy && q.mode == Mode::kLazy && q.movable_cost_weight == 0.0) ||
+        (box_immovable && q.mode == Mode::kLazy && !box_fixed)) {
       Crossing c;
       c.object_id = "box";
       c.enter_fraction = 0.4;
@@ -366,6 +377,31 @@ TEST_F(FirstEdgeTest, AStopBeforeAWallWhileHoldingGrowsTheHeldObjectInLaterMotio
   ASSERT_TRUE(s.gm->traverse(s.gm->root(), s.ctx).found);
   ASSERT_FALSE(services.held_paddings.empty());
   for (double p : services.held_paddings) EXPECT_NEAR(p, defaults.held_padding_max_m, 1e-12);
+}
+
+// An object the robot can neither carry (no placement off the path) nor push (no straight push
+// is free) is fixed: the blocked edge's lazy path is asked again with it as an obstacle, and the
+// way round it is a feasible edge; later lazy questions fix it from the start.
+TEST_F(FirstEdgeTest, AnObjectTheRobotCanNeitherCarryNorPushIsGoneRound) {
+  ScriptedServices services;
+  services.box_immovable = true;
+  Setup s = make(services);
+  const TraverseResult t = s.gm->traverse(s.gm->root(), s.ctx);
+  ASSERT_TRUE(t.found) << t.reason;
+  EXPECT_EQ(actions(*s.gm, t.branch),
+            (std::vector<std::string>{"(move_base start a)", "(move_base a goal)"}));
+  for (EdgeId e : t.branch) EXPECT_EQ(s.gm->graph().edge(e).state, EdgeState::kFeasible);
+  // The first lazy question fixed nothing; after the box was found immovable, every one fixes it.
+  ASSERT_GE(services.fixed_asked.size(), 3u);
+  EXPECT_TRUE(services.fixed_asked.front().empty());
+  const auto first_fixed = std::find_if(services.fixed_asked.begin(), services.fixed_asked.end(),
+                                        [](const auto& f) { return !f.empty(); });
+  ASSERT_NE(first_fixed, services.fixed_asked.end());
+  for (auto it = first_fixed; it != services.fixed_asked.end(); ++it)
+    EXPECT_EQ(*it, std::vector<std::string>{"box"});
+  // The two drives and nothing else: the box is not moved.
+  const double straight = std::hypot(5.0 - 1.5, 2.2 - 1.2) + std::hypot(8.5 - 5.0, 1.2 - 2.2);
+  EXPECT_NEAR(t.cost_s, straight, 1e-6);
 }
 
 }  // namespace

@@ -117,6 +117,7 @@ Result<MotionRequest> fromMsg(const msg::MotionRequest& m, const MotionPlanner& 
   const double w = m.movable_cost_weight();
   if (!std::isfinite(w) || w < 0) return bad("movable_cost_weight", "must be finite and >= 0");
   r.object_cost_scale = w;
+  r.fixed_objects.assign(m.fixed_objects().begin(), m.fixed_objects().end());
   return r;
 }
 

@@ -433,6 +433,13 @@ std::optional<std::string> validateRequest(const MotionRequest& r, const MotionP
       return "ignored_objects[" + std::to_string(i) + "]: no object '" + r.ignored_objects[i] + "' in the world";
     }
   }
+  for (std::size_t i = 0; i < r.fixed_objects.size(); ++i) {
+    const world::Object* o = impl.world.findObject(r.fixed_objects[i]);
+    if (!o) return "fixed_objects[" + std::to_string(i) + "]: no object '" + r.fixed_objects[i] + "' in the world";
+    if (o->kind != world::ObjectKind::kMovable) {
+      return "fixed_objects[" + std::to_string(i) + "]: object '" + r.fixed_objects[i] + "' is static already";
+    }
+  }
   if (!std::isfinite(r.held_padding_m) || r.held_padding_m < 0 || r.held_padding_m > kMaxHeldPadding_m) {
     return "held_padding_m: must be finite and in [0, " + formatNumber(kMaxHeldPadding_m) + "], got " +
            formatNumber(r.held_padding_m);
@@ -730,6 +737,25 @@ std::optional<std::string> padHeldObject(MotionPlanner::Impl& impl, const Motion
   return std::nullopt;
 }
 
+/// Lazy mode: the request's fixed objects made static for it (the world restored afterwards, as
+/// for overrides): the lazy path goes round them, and the roadmap of that static world is used.
+std::optional<std::string> fixObjects(MotionPlanner::Impl& impl, const MotionRequest& req, RequestWorld& rw) {
+  if (req.mode != MotionMode::kLazy || req.fixed_objects.empty()) return std::nullopt;
+  world::World fixed = impl.world;
+  for (std::size_t i = 0; i < req.fixed_objects.size(); ++i) {
+    world::Object o = fixed.object(req.fixed_objects[i]);
+    o.kind = world::ObjectKind::kStatic;
+    o.graspable = false;
+    if (Status s = fixed.updateObject(o); !s) return "fixed_objects[" + std::to_string(i) + "]: " + s.error().message;
+  }
+  if (rw.restore.active()) {
+    rw.restore.replaceWorld(std::move(fixed));
+  } else {
+    rw.restore = WorldRestore(impl, std::move(fixed));
+  }
+  return std::nullopt;
+}
+
 /// Base bounds: the world, the start and a base goal.
 Aabb requestBounds(const MotionPlanner::Impl& impl, const MotionRequest& req) {
   std::vector<Eigen::Vector2d> extra{{req.start.base.x, req.start.base.y}};
@@ -752,6 +778,7 @@ std::optional<std::string> enterRequestWorld(MotionPlanner::Impl& impl, const Mo
     if (!hypothetical) return hypothetical.error().message;
     rw.restore = WorldRestore(impl, std::move(*hypothetical));
   }
+  if (auto why = fixObjects(impl, req, rw)) return why;
   if (auto why = padHeldObject(impl, req, rw)) return why;
   rw.bounds = requestBounds(impl, req);
   // The held object moves with the robot for this request.

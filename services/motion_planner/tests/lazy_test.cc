@@ -132,6 +132,61 @@ TEST_F(LazyTest, ReportMatchesIndependentCheckForAnyCostScale) {
   }
 }
 
+TEST_F(LazyTest, FixedObjectsAreObstaclesOfTheLazyPath) {
+  const world::World w = testing::twoDoorWorld();
+  // The pure static-only path takes door A, through the two heavy objects.
+  MotionRequest req = baseRequest({2, 0.9, 0}, {8, 0.9, 0});
+  req.object_cost_scale = 0.0;
+  {
+    MotionPlanner mp = planner(w);
+    const MotionResult r = mp.plan(req, Termination::after(5.0));
+    ASSERT_EQ(r.status, MotionStatus::kSolved) << r.reason;
+    EXPECT_EQ(blockingIds(r.blocking), (std::vector<std::string>{"heavy_a", "heavy_b"}));
+  }
+  // The robot cannot move them: the path goes through door B, whatever the cost scale, and
+  // the planner's world is the same afterwards.
+  req.fixed_objects = {"heavy_a", "heavy_b"};
+  ASSERT_TRUE(w.object("light").graspable);  // fixed below too: fixing a graspable object is fine
+  for (double scale : {0.0, 1.0}) {
+    MotionPlanner mp = planner(w);
+    req.object_cost_scale = scale;
+    const MotionResult r = mp.plan(req, Termination::after(5.0));
+    ASSERT_EQ(r.status, MotionStatus::kSolved) << r.reason;
+    EXPECT_EQ(blockingIds(r.blocking), std::vector<std::string>{"light"}) << "scale " << scale;
+    EXPECT_EQ(discTouches(w, r.path, kRadius, 0.005), std::vector<std::string>{"light"}) << "scale " << scale;
+  }
+  {
+    // The planner's world is its own again after such a request.
+    MotionPlanner mp = planner(w);
+    (void)mp.plan(req, Termination::after(5.0));
+    MotionRequest plain = baseRequest({2, 0.9, 0}, {8, 0.9, 0});
+    plain.object_cost_scale = 0.0;
+    const MotionResult r = mp.plan(plain, Termination::after(5.0));
+    ASSERT_EQ(r.status, MotionStatus::kSolved) << r.reason;
+    EXPECT_EQ(blockingIds(r.blocking), (std::vector<std::string>{"heavy_a", "heavy_b"}));
+  }
+  // Nothing can be moved: no lazy path.
+  req.fixed_objects = {"heavy_a", "heavy_b", "light"};
+  MotionPlanner mp = planner(w);
+  const MotionResult r = mp.plan(req, Termination::after(3.0));
+  EXPECT_TRUE(r.status == MotionStatus::kNoPath || r.status == MotionStatus::kTimeout)
+      << toString(r.status) << ": " << r.reason;
+}
+
+TEST_F(LazyTest, FixedObjectsMustBeMovablesOfTheWorld) {
+  const world::World w = testing::twoDoorWorld();
+  MotionPlanner mp = planner(w);
+  MotionRequest req = baseRequest({2, 0.9, 0}, {8, 0.9, 0});
+  req.fixed_objects = {"heavy_a", "no_such_thing"};
+  MotionResult r = mp.plan(req, Termination::after(5.0));
+  EXPECT_EQ(r.status, MotionStatus::kInvalidRequest);
+  EXPECT_NE(r.reason.find("fixed_objects[1]: no object 'no_such_thing'"), std::string::npos) << r.reason;
+  req.fixed_objects = {"wall_mid_a"};
+  r = mp.plan(req, Termination::after(5.0));
+  EXPECT_EQ(r.status, MotionStatus::kInvalidRequest);
+  EXPECT_NE(r.reason.find("fixed_objects[0]: object 'wall_mid_a' is static"), std::string::npos) << r.reason;
+}
+
 TEST_F(LazyTest, IgnoredObjectsAreNeitherObstaclesNorReported) {
   const world::World w = testing::corridorWorld(true);
   MotionPlanner mp = planner(w);

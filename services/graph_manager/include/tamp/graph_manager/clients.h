@@ -72,6 +72,8 @@ struct MotionQuery {
   std::vector<std::string> ignored;   ///< treated as absent
   std::vector<ObjectOverride> overrides;
   double movable_cost_weight{0.0};    ///< lazy: 0 = the pure static-only lazy path
+  /// Lazy: movables the robot cannot move (over the payload, no push): obstacles for this path.
+  std::vector<std::string> fixed;
   double held_padding_m{0.0};         ///< the held object grown by this much (m); set by the graph manager
   double budget_s{5.0};
 };

@@ -42,6 +42,7 @@
 #include <chrono>
 #include <functional>
 #include <map>
+#include <set>
 #include <memory>
 #include <optional>
 #include <string>
@@ -395,7 +396,15 @@ class GraphManager {
   /// stowed_tolerance_rad): what the symbol `stow` stands for.
   bool armStowed(const std::vector<double>& arm) const;
   double lowerBound(const Edge& e) const;
-  void spawnSubtasks(EdgeId e, const BranchContext& ctx, int depth);
+  /// Removal sub-tasks for the objects `e`'s lazy path crosses; returns how many of them it
+  /// found the robot cannot move at all (added to fixed_objects_).
+  int spawnSubtasks(EdgeId e, const BranchContext& ctx, int depth);
+  /// `e` priced again (its lazy path now goes round fixed_objects_ where it can); the sub-tasks
+  /// spawned for its earlier path stay alternatives.
+  double evaluateBaseAgain(EdgeId e, const BranchContext& ctx, int depth);
+  /// Policy infeasible: whether the full-mode variant of the direct edge `e` was proven to have
+  /// no path (only then may objects be moved).
+  bool aroundProvenImpossible(const Edge& e) const;
   /// The support (region or slot) of `object` in node `v`'s state (its world region if none).
   std::string supportAt(NodeId v, const std::string& object) const;
   /// findPossibleActions by pick and place: a base pose beside `o` from which the arm grasps it,
@@ -562,6 +571,12 @@ class GraphManager {
     std::string why;
   };
   std::map<std::string, PushCacheEntry> push_cache_;
+  /// Movables the robot can neither carry nor push in this world (found by spawnSubtasks): base
+  /// lazy paths go round them where a way exists (MotionQuery::fixed). Cleared with the world.
+  std::set<std::string> fixed_objects_;
+  /// Movables a removal (a placement or a push) was found for in this world: never fixed, though
+  /// the way another path crosses them may have none.
+  std::set<std::string> removable_objects_;
   /// Failed executions in this mission: per move edge, and per manipulation of an object ("pick
   /// box"), whichever edge carried it (a grasp that misses from one stand misses from the next).
   int failuresOf(const Edge& e) const;

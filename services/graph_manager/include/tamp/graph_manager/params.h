@@ -50,6 +50,10 @@ struct GraphManagerParams {
   /// push_step_m + push_gap_m.
   double push_backoff_m{0.15};
   int pushes_per_object{2};        ///< >= 0 (0: never push)
+  /// Budget of the full-mode motion that checks one push or its back-off; > 0. Only a straight
+  /// motion is kept, which the planner finds at once when it is free (the slowest solved in the
+  /// Moghaddam worlds took 0.19 s); a push that is not free otherwise costs motion_budget_s.
+  double push_budget_s{1.0};
   double keep_clear_margin_m{0.10};  ///< placements keep this much more than the robot's radius off the path
   /// A held object is planned grown by a margin that starts at 0 and rises by this step each
   /// time the robot is stopped before touching an object whose place it knew while holding (where it sits

@@ -165,6 +165,12 @@ struct MotionRequest {
   /// model as it is; 0: ignore objects (the shortest static-free path); larger values avoid
   /// objects at the price of longer detours. Must be finite and >= 0.
   double object_cost_scale{1.0};
+  /// Lazy mode: movables the caller cannot move (over the payload, no push), obstacles like the
+  /// static objects for this request: the lazy path goes round them, or there is none (`no
+  /// path`). Selects (and may build) the roadmap of that static world, as overriding a static
+  /// object does. Each must be a movable of the world; ignored in full mode (every object is
+  /// an obstacle there).
+  std::vector<std::string> fixed_objects;
 };
 
 /// A movable object a lazy path sweeps through.

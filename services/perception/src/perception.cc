@@ -124,11 +124,15 @@ struct Track {
   bool pushed{false};  ///< moved out of the base this frame (keepOutOfBase)
 };
 
-/// Fraction of `points` inside the track's shape at its pose, grown by `margin`.
-double explainedFraction(const Track& t, const std::vector<Eigen::Vector3d>& points, double margin) {
+/// Fraction of `points` inside the track's shape at its pose, grown by `margin` plus the range
+/// noise where each point was seen (`noise(range)`: from afar a face spreads over a band many
+/// centimetres deep, which is no evidence that the object moved).
+template <typename Noise>
+double explainedFraction(const Track& t, const std::vector<Eigen::Vector3d>& points, double margin,
+                         const Eigen::Vector3d& sensor, Noise noise) {
   if (points.empty()) return 0.0;
   std::size_t inside = 0;
-  for (const auto& p : points) inside += pointInShape(t.shape, t.pose, p, margin) ? 1 : 0;
+  for (const auto& p : points) inside += pointInShape(t.shape, t.pose, p, margin + noise((p - sensor).norm())) ? 1 : 0;
   return static_cast<double>(inside) / static_cast<double>(points.size());
 }
 
@@ -751,7 +755,9 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
     // the visible part. Points that the object where it stands explains are no evidence that it
     // moved: the pose stays.
     if (jump > T.explained_margin && t.size_known && (t.from_prior || t.hits > 2) &&
-        explainedFraction(t, dets[i].points, T.explained_margin) >= T.explained_fraction) {
+        explainedFraction(t, dets[i].points, T.explained_margin, sensor,
+                          [&](double range) { return P.planes.noise_sigmas * P.sensor.stddev(range); }) >=
+            T.explained_fraction) {
       meas = t.pose;
       jump = 0.0;
     }

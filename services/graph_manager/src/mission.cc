@@ -699,12 +699,25 @@ bool GraphManager::Run::replan(const MissionEvent& ev, EdgeId failed, std::strin
     if (known) gm.widenHeldMargin(held_before.object_id, ev.object_id);
   }
   rec.held_padding_m = gm.held_padding_m_;
+  // Failed or refused because of an object the graph did not know, or knew elsewhere (the world
+  // model changed since the edge was planned, e.g. a new object's estimate still growing): the
+  // world changed under the plan, the action did not fail, so it is not counted towards
+  // max_action_failures (max_replans still bounds the attempts).
+  const bool stale = ev.kind == EventKind::kActionFailed && !ev.object_id.empty() &&
+                     (std::find(fresh.begin(), fresh.end(), ev.object_id) != fresh.end() ||
+                      std::any_of(changed.begin(), changed.end(),
+                                  [&](const world::Object& o) { return o.id == ev.object_id; }));
   changed.insert(changed.end(), refused.begin(), refused.end());
   gm.invalidateNear(changed);
   if (failed >= 0) {
     // Planned again in the world as it is now, unless it failed too often (then infeasible).
     Edge& f = gm.graph_.edge(failed);
-    gm.noteFailure(f);
+    if (stale)
+      log::get("graph_manager")
+          ->info("{}: not counted as a failure: '{}' changed in the world model since it was planned", f.action,
+                 ev.object_id);
+    else
+      gm.noteFailure(f);
     f.state = EdgeState::kUnevaluated;
     f.motion.reset();
     f.motion_by_next.clear();

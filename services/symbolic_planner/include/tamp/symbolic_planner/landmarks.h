@@ -96,9 +96,9 @@ struct RhwLandmarkOptions {
   /// docs/benchmarks.md, issue 14, sixteenth round).
   bool skip_one_action_disjunctions{true};
   /// Add Hoffmann, Porteous & Sebastia's reasonable orders (`addReasonableOrders`), with h^2
-  /// mutexes (`mutexes`), as LAMA-first's `lm_reasonable_orders_hps(lm_rhw())`. Off by default:
-  /// measured in docs/benchmarks.md, issue 14, seventeenth round.
-  bool reasonable_orders{false};
+  /// mutexes (`mutexes`), as LAMA-first's `lm_reasonable_orders_hps(lm_rhw())` (measured in
+  /// docs/benchmarks.md, issue 14, seventeenth round).
+  bool reasonable_orders{true};
   H2MutexOptions mutexes;
   /// Bound of `addReasonableOrders`: interference tests; past it, the orders found stay.
   uint64_t max_interference_tests{20'000'000};

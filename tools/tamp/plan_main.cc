@@ -190,6 +190,7 @@ int main(int argc, char** argv) {
   std::string landmark_generator = defaults.landmark_generator == sp::LandmarkGenerator::kRhw ? "rhw" : "zg";
   size_t rhw_max_disjunction = defaults.rhw.max_disjunction_size;
   bool rhw_no_zg = !defaults.rhw.add_zhu_givan, rhw_keep_one_action = !defaults.rhw.skip_one_action_disjunctions;
+  bool rhw_reasonable = defaults.rhw.reasonable_orders;
   app.add_option("--landmarks", landmark_generator,
                  "lazy: the landmarks counted: rhw (Richter-Helmert-Westphal: disjunctive landmarks, greedy-necessary "
                  "orders, landmarks required again) or zg (Zhu-Givan fact landmarks)")
@@ -200,6 +201,9 @@ int main(int argc, char** argv) {
   app.add_flag("--rhw-one-action-disjunctions", rhw_keep_one_action,
                "lazy with rhw: also the disjunctive landmarks that restate one action's disjunctive precondition (as Fast "
                "Downward)");
+  app.add_option("--rhw-reasonable-orders", rhw_reasonable,
+                 "lazy with rhw: reasonable orders (Hoffmann et al.'s, from h^2 mutexes) between the landmarks: "
+                 "true or false");
   app.add_flag("--no-ehc-lazy-beside", no_lazy_beside,
                "ehc: the lazy search only after the hill-climbing fails (FF's order), not beside it");
   app.add_option("--ehc-lazy-after", lazy_after,
@@ -244,6 +248,7 @@ int main(int argc, char** argv) {
   req.search.rhw.max_disjunction_size = rhw_max_disjunction;
   req.search.rhw.add_zhu_givan = !rhw_no_zg;
   req.search.rhw.skip_one_action_disjunctions = !rhw_keep_one_action;
+  req.search.rhw.reasonable_orders = rhw_reasonable;
   req.search.ehc_lazy_beside = !no_lazy_beside;
   req.search.ehc_lazy_after = lazy_after;
   req.search.ehc_lazy_turn_ehc = lazy_turn_ehc;
@@ -270,7 +275,7 @@ int main(int argc, char** argv) {
                  "; status %s; parse %.4f s, ground %.4f s, search %.4f s; facts %zu, operators %zu; "
                  "expanded %llu, evaluated %llu, initial h %lld; ehc plateau retries %llu (%llu abandoned); ehc fallbacks "
                  "%llu (%llu in a goal-agenda entry before the last); anytime %llu "
-                 "iterations, %llu improvements; landmarks %llu (%llu disjunctive, %llu greedy-necessary orders)%s%s%s%s%s\n",
+                 "iterations, %llu improvements; landmarks %llu (%llu disjunctive, %llu greedy-necessary, %llu reasonable orders)%s%s%s%s%s\n",
                  sp::toString(reply.status).c_str(), reply.stats.parse_seconds, reply.stats.ground_seconds,
                  reply.stats.search_seconds, reply.stats.facts, reply.stats.operators,
                  static_cast<unsigned long long>(reply.stats.expanded),
@@ -284,6 +289,7 @@ int main(int argc, char** argv) {
                  static_cast<unsigned long long>(reply.stats.landmarks),
                  static_cast<unsigned long long>(reply.stats.landmarks_disjunctive),
                  static_cast<unsigned long long>(reply.stats.landmark_gn_orders),
+                 static_cast<unsigned long long>(reply.stats.landmark_reasonable_orders),
                  reply.stats.ehc_ff_failed ? "; ehc with FF-v2.3's relaxed plan failed, restarted" : "",
                  reply.stats.ehc_second_won   ? "; second ehc run gave the shorter plan"
                  : reply.stats.ehc_second_ran ? "; second ehc run, first plan kept"

@@ -186,6 +186,7 @@ LandmarkGraph zhuGivanLandmarks(const Task& task, const StateBits& init, const G
 
 void RhwLandmarkOptions::validate() const {
   if (max_work == 0) throw std::invalid_argument("RhwLandmarkOptions::max_work must be > 0, got 0");
+  mutexes.validate();
 }
 
 namespace {
@@ -515,7 +516,189 @@ LandmarkGraph rhwLandmarks(const Task& task, const StateBits& init, const Goal& 
   options.validate();
   if (!positiveConjunctiveGoal(goal)) return {};
   RhwBuilder builder(task, init, options);
-  return builder.run(goal.conjuncts[0].pos);
+  LandmarkGraph graph = builder.run(goal.conjuncts[0].pos);
+  if (options.reasonable_orders && !graph.empty()) {
+    const MutexTable mutexes(task, init, options.mutexes);
+    addReasonableOrders(task, init, mutexes, graph, options.max_interference_tests);
+  }
+  return graph;
+}
+
+namespace {
+
+/// addReasonableOrders' state: the graph's orders by landmark, the interference tests.
+class ReasonableOrderer {
+ public:
+  ReasonableOrderer(const Task& task, const MutexTable& mutexes, LandmarkGraph& graph,
+                    uint64_t max_tests)
+      : task_(task), mutexes_(mutexes), graph_(graph), max_tests_(max_tests) {
+    const size_t n = graph.landmarks.size();
+    parents_.resize(n);
+    gn_children_.resize(n);
+    for (const LandmarkOrder& o : graph.orders) {
+      orders_[{o.from, o.to}] = o.kind;
+      if (o.kind != LandmarkOrderKind::kReasonable) parents_[o.to].push_back({o.from, o.kind});
+      if (o.kind == LandmarkOrderKind::kGreedyNecessary) gn_children_[o.from].push_back(o.to);
+    }
+    shared_.resize(n);
+  }
+
+  /// Adds the orders into B, a simple landmark not true initially.
+  void ordersInto(uint32_t b) {
+    if (graph_.is_goal[b]) {
+      for (uint32_t a = 0; a < graph_.landmarks.size(); ++a) test(a, b);
+      return;
+    }
+    std::vector<uint8_t> interesting(graph_.landmarks.size(), 0);
+    std::vector<uint32_t> list;
+    for (uint32_t c : gn_children_[b]) {
+      for (const auto& [p, kind] : parents_[c]) {
+        if (p == b || graph_.landmarks[p].size() > 1) continue;
+        collectWithAncestors(p, interesting, list);
+      }
+    }
+    for (uint32_t a : list) test(a, b);
+  }
+
+  void writeBack() {
+    graph_.orders.clear();
+    for (const auto& [key, kind] : orders_) graph_.orders.push_back({key.first, key.second, kind});
+  }
+  size_t added() const { return added_; }
+
+ private:
+  /// What every operator adding fact `a` also adds, and what it surely deletes.
+  struct SharedEffects {
+    bool computed{false};
+    std::vector<FactId> adds, dels;
+  };
+
+  void collectWithAncestors(uint32_t p, std::vector<uint8_t>& seen, std::vector<uint32_t>& list) {
+    if (seen[p]) return;
+    seen[p] = 1;
+    list.push_back(p);
+    for (size_t head = list.size() - 1; head < list.size(); ++head) {
+      for (const auto& [q, kind] : parents_[list[head]]) {
+        if (!seen[q]) {
+          seen[q] = 1;
+          list.push_back(q);
+        }
+      }
+    }
+  }
+
+  void test(uint32_t a, uint32_t b) {
+    if (a == b || graph_.landmarks[a].size() > 1 || tests_ >= max_tests_) return;
+    ++tests_;
+    if (interferes(a, b)) addReasonable(a, b);
+  }
+
+  void addReasonable(uint32_t from, uint32_t to) {
+    auto rev = orders_.find({to, from});
+    if (rev != orders_.end()) {
+      if (rev->second != LandmarkOrderKind::kReasonable) return;  // a stronger order the other way
+      orders_.erase(rev);
+      --added_;
+    }
+    if (orders_.emplace(std::make_pair(from, to), LandmarkOrderKind::kReasonable).second) ++added_;
+  }
+
+  /// Achieving landmark `a` after landmark `b` would delete b (see addReasonableOrders).
+  bool interferes(uint32_t a, uint32_t b) {
+    const FactId fa = graph_.landmarks[a][0], fb = graph_.landmarks[b][0];
+    if (fa == fb) return false;
+    if (mutexes_.mutex(fa, fb)) return true;
+    const SharedEffects& s = shared(a);
+    if (std::binary_search(s.dels.begin(), s.dels.end(), fb)) return true;
+    for (FactId e : s.adds) {
+      if (e != fa && e != fb && mutexes_.mutex(e, fb)) return true;
+    }
+    for (const auto& [x, kind] : parents_[a]) {
+      if (kind != LandmarkOrderKind::kGreedyNecessary) continue;
+      const auto& facts = graph_.landmarks[x];
+      if (std::all_of(facts.begin(), facts.end(), [&](FactId f) { return mutexes_.mutex(f, fb); }))
+        return true;
+    }
+    return false;
+  }
+
+  const SharedEffects& shared(uint32_t a) {
+    SharedEffects& s = shared_[a];
+    if (s.computed) return s;
+    s.computed = true;
+    const FactId fa = graph_.landmarks[a][0];
+    const EffectIndex& E = task_.effects;
+    bool first = true;
+    for (uint32_t k = E.adders_begin[fa]; k < E.adders_begin[fa + 1]; ++k) {
+      std::vector<FactId> adds, dels;
+      effectsOf(E.adders[k], adds, dels);
+      if (first) {
+        s.adds = std::move(adds);
+        s.dels = std::move(dels);
+        first = false;
+      } else {
+        intersectInto(s.adds, adds);
+        intersectInto(s.dels, dels);
+      }
+      if (s.adds.empty() && s.dels.empty()) break;
+    }
+    return s;
+  }
+
+  /// The facts effect `e` adds with its operator, and those it deletes and does not add.
+  void effectsOf(uint32_t e, std::vector<FactId>& adds, std::vector<FactId>& dels) const {
+    const Operator& op = task_.ops[task_.effects.op[e]];
+    const int32_t ce = task_.effects.ce[e];
+    adds = op.add;
+    dels = op.del;
+    if (ce >= 0) {
+      const ConditionalEffect& c = op.cond_effects[static_cast<size_t>(ce)];
+      adds.insert(adds.end(), c.add.begin(), c.add.end());
+      dels.insert(dels.end(), c.del.begin(), c.del.end());
+    }
+    std::sort(adds.begin(), adds.end());
+    adds.erase(std::unique(adds.begin(), adds.end()), adds.end());
+    std::sort(dels.begin(), dels.end());
+    std::vector<FactId> kept;
+    std::set_difference(dels.begin(), dels.end(), adds.begin(), adds.end(),
+                        std::back_inserter(kept));
+    kept.erase(std::unique(kept.begin(), kept.end()), kept.end());
+    dels.swap(kept);
+  }
+
+  static void intersectInto(std::vector<FactId>& into, const std::vector<FactId>& other) {
+    std::vector<FactId> both;
+    std::set_intersection(into.begin(), into.end(), other.begin(), other.end(),
+                          std::back_inserter(both));
+    into.swap(both);
+  }
+
+  const Task& task_;
+  const MutexTable& mutexes_;
+  LandmarkGraph& graph_;
+  const uint64_t max_tests_;
+  uint64_t tests_{0};
+  size_t added_{0};
+  std::map<std::pair<uint32_t, uint32_t>, LandmarkOrderKind> orders_;
+  std::vector<std::vector<std::pair<uint32_t, LandmarkOrderKind>>> parents_;
+  std::vector<std::vector<uint32_t>> gn_children_;
+  std::vector<SharedEffects> shared_;
+};
+
+}  // namespace
+
+size_t addReasonableOrders(const Task& task, const StateBits& init, const MutexTable& mutexes,
+                           LandmarkGraph& graph, uint64_t max_tests) {
+  if (graph.is_goal.size() != graph.landmarks.size())
+    throw std::invalid_argument("addReasonableOrders: is_goal must have one entry per landmark");
+  ReasonableOrderer orderer(task, mutexes, graph, max_tests);
+  for (uint32_t b = 0; b < graph.landmarks.size(); ++b) {
+    const auto& facts = graph.landmarks[b];
+    if (facts.size() != 1 || testBit(init.data(), facts[0])) continue;
+    orderer.ordersInto(b);
+  }
+  orderer.writeBack();
+  return orderer.added();
 }
 
 namespace {

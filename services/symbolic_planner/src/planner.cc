@@ -314,6 +314,7 @@ PlanReply PlanningSession::solve(const Query& q, const Termination& term) {
   reply.stats.landmarks = sr.stats.landmarks;
   reply.stats.landmarks_disjunctive = sr.stats.landmarks_disjunctive;
   reply.stats.landmark_gn_orders = sr.stats.landmark_gn_orders;
+  reply.stats.landmark_reasonable_orders = sr.stats.landmark_reasonable_orders;
   reply.status = fromSearch(sr.status);
   if (sr.status == SearchStatus::kSolved) {
     reply.cost = sr.cost;

@@ -683,6 +683,7 @@ class Searcher {
       stats_.landmarks = lm->numLandmarks();
       stats_.landmarks_disjunctive = lm->graph().numDisjunctive();
       stats_.landmark_gn_orders = lm->graph().numOrders(LandmarkOrderKind::kGreedyNecessary);
+      stats_.landmark_reasonable_orders = lm->graph().numOrders(LandmarkOrderKind::kReasonable);
     }
     // Lists: 0 h_FF, 1 h_FF preferred, 2 landmarks, 3 landmarks preferred.
     LazyOpen lists[4];
@@ -1024,6 +1025,7 @@ void addRunCosts(SearchStatistics& into, const SearchStatistics& from) {
     into.landmarks = from.landmarks;
     into.landmarks_disjunctive = from.landmarks_disjunctive;
     into.landmark_gn_orders = from.landmark_gn_orders;
+    into.landmark_reasonable_orders = from.landmark_reasonable_orders;
   }
 }
 

@@ -191,6 +191,20 @@ TEST_F(Cli, HeapReserveStartsAtAHugePage) {
   EXPECT_LE(most, 200) << "page faults of the most costly of 5 runs";
 }
 
+TEST_F(Cli, ReasonableOrdersAreCountedInTheStatsWhenAskedFor) {
+  const auto blocks = test::benchmarksDir() / "pddl/blocks";
+  const std::string task = (blocks / "domain.pddl").string() + " " + (blocks / "instance-10.pddl").string();
+  CliRun on = runCli(task + " --search lazy --stats --rhw-reasonable-orders true");
+  ASSERT_EQ(on.code, 0) << on.out;
+  EXPECT_EQ(on.out.find(" 0 reasonable orders)"), std::string::npos) << on.out;
+  EXPECT_NE(on.out.find(" reasonable orders)"), std::string::npos) << on.out;
+  CliRun off = runCli(task + " --search lazy --stats --rhw-reasonable-orders false");
+  ASSERT_EQ(off.code, 0) << off.out;
+  EXPECT_NE(off.out.find(" 0 reasonable orders)"), std::string::npos) << off.out;
+  CliRun bad = runCli(task + " --rhw-reasonable-orders sometimes");
+  EXPECT_EQ(bad.code, 30) << bad.out;
+}
+
 TEST_F(Cli, ExitCodes) {
   // 30: input error, with file:line:column.
   const std::string broken = tmpFile("broken.pddl", "(define (problem x)\n  (:domain mobile-manipulation)\n  (:init (robot-at nowhere))\n  (:goal (hand-empty)))\n");

@@ -43,6 +43,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "tamp/symbolic_planner/mutexes.h"
 #include "tamp/symbolic_planner/task.h"
 
 namespace tamp::symbolic_planner {
@@ -94,6 +95,13 @@ struct RhwLandmarkOptions {
   /// alternative (Fast Downward keeps them; on pathways they cost 3 of 5 instances, see
   /// docs/benchmarks.md, issue 14, sixteenth round).
   bool skip_one_action_disjunctions{true};
+  /// Add Hoffmann, Porteous & Sebastia's reasonable orders (`addReasonableOrders`), with h^2
+  /// mutexes (`mutexes`), as LAMA-first's `lm_reasonable_orders_hps(lm_rhw())` (measured in
+  /// docs/benchmarks.md, issue 14, seventeenth round).
+  bool reasonable_orders{true};
+  H2MutexOptions mutexes;
+  /// Bound of `addReasonableOrders`: interference tests; past it, the orders found stay.
+  uint64_t max_interference_tests{20'000'000};
 
   /// @throws std::invalid_argument naming the bad field.
   void validate() const;
@@ -104,6 +112,19 @@ struct RhwLandmarkOptions {
 /// @throws std::invalid_argument when `options` are invalid.
 LandmarkGraph rhwLandmarks(const Task& task, const StateBits& init, const Goal& goal,
                            const RhwLandmarkOptions& options);
+
+/// Hoffmann, Porteous & Sebastia's reasonable orders ("Ordered landmarks in planning", JAIR 22,
+/// 2004) as Fast Downward approximates them (`LandmarkFactoryReasonableOrdersHPS`): A ->r B
+/// ("B is better achieved after A") between simple landmarks, B not true in `init`, when A
+/// *interferes* with B (achieving A after B would delete B): a and b are mutex, or every operator
+/// adding a also adds a fact mutex with b or deletes b, or a greedy-necessary predecessor of A is
+/// mutex with b (every fact of it, when disjunctive). Candidates A: every landmark when B is a
+/// goal; otherwise the natural or greedy-necessary predecessors of B's greedy-necessary
+/// successors and their ancestors. An order against a stronger one the other way is not added;
+/// a reasonable one the other way is replaced. At most `max_tests` interference tests.
+/// @returns the number of reasonable orders added.
+size_t addReasonableOrders(const Task& task, const StateBits& init, const MutexTable& mutexes,
+                           LandmarkGraph& graph, uint64_t max_tests = 20'000'000);
 
 enum class LandmarkProgression { kAcceptedAfterParents, kPastAndFuture };
 

@@ -96,6 +96,7 @@ struct PlanStatistics {
   uint64_t landmarks{0};  ///< landmarks of the lazy search's landmark count (0: not used)
   uint64_t landmarks_disjunctive{0};  ///< ... of which disjunctive
   uint64_t landmark_gn_orders{0};     ///< ... greedy-necessary orders between them
+  uint64_t landmark_reasonable_orders{0};  ///< ... reasonable orders between them
 };
 
 /// A self-contained request (maps 1:1 to the plan-request message).

@@ -200,6 +200,7 @@ struct SearchStatistics {
   uint64_t landmarks{0};    ///< lazy: number of landmarks found (0: landmark count not used)
   uint64_t landmarks_disjunctive{0};  ///< ... of which disjunctive
   uint64_t landmark_gn_orders{0};     ///< ... greedy-necessary orders between them
+  uint64_t landmark_reasonable_orders{0};  ///< ... reasonable orders between them
   uint64_t eliminated_actions{0};  ///< removed by action elimination
   uint64_t anytime_iterations{0};    ///< weighted A* iterations of the anytime phase
   uint64_t anytime_improvements{0};  ///< ... that found a cheaper plan

@@ -29,6 +29,14 @@ Trajectory timed(const std::vector<std::string>& names, const std::vector<std::v
   return t;
 }
 
+/// "a, b, c": object ids for a reason or a log line.
+template <typename Ids>
+std::string joinIds(const Ids& ids) {
+  std::string out;
+  for (const auto& id : ids) out += (out.empty() ? "" : ", ") + id;
+  return out;
+}
+
 double maxJointDelta(const std::vector<double>& a, const std::vector<double>& b) {
   double d = 0.0;
   for (std::size_t i = 0; i < std::min(a.size(), b.size()); ++i) d = std::max(d, std::abs(a[i] - b[i]));
@@ -159,11 +167,7 @@ double GraphManager::evaluateBase(Edge& e, const BranchContext& ctx, int depth) 
   if (!a.ok()) {
     e.state = EdgeState::kInfeasible;
     e.reason = std::string(toString(a.status)) + (a.reason.empty() ? "" : ": " + a.reason);
-    if (!q.fixed.empty()) {
-      std::string fixed;
-      for (const auto& o : q.fixed) fixed += (fixed.empty() ? "" : ", ") + o;
-      e.reason += " (going round what the robot can neither carry nor push: " + fixed + ")";
-    }
+    if (!q.fixed.empty()) e.reason += " (going round what the robot can neither carry nor push: " + joinIds(q.fixed) + ")";
     if (e.variant == Variant::kAround && params_.policy == Policy::kInfeasible && a.status == MotionOutcome::kNoPath &&
         depth < params_.max_subtask_depth + 1) {
       // Policy `infeasible`: only a proof that there is no way around lets objects be moved.
@@ -194,9 +198,7 @@ double GraphManager::evaluateBase(Edge& e, const BranchContext& ctx, int depth) 
     // Not executable as is: the detour is a parallel edge, removals are sub-tasks.
     e.state = EdgeState::kLazy;
     e.effort_mean_s = kInfinity;
-    std::string objs;
-    for (const auto& b : m.blocking) objs += (objs.empty() ? "" : ", ") + b;
-    e.reason = "the lazy path crosses " + objs;
+    e.reason = "the lazy path crosses " + joinIds(m.blocking);
     {
       const Crossing& c0 = m.crossings.front();
       const Pose2D at = c0.swept_base.empty() ? Pose2D{} : c0.swept_base.front();
@@ -226,9 +228,8 @@ double GraphManager::evaluateBase(Edge& e, const BranchContext& ctx, int depth) 
 
 double GraphManager::evaluateBaseAgain(EdgeId id, const BranchContext& ctx, int depth) {
   Edge& e = graph_.edge(id);
-  std::string fixed;
-  for (const auto& o : fixed_objects_) fixed += (fixed.empty() ? "" : ", ") + o;
-  log::get("graph_manager")->info("{}: planned again round what the robot cannot move ({})", e.action, fixed);
+  log::get("graph_manager")->info("{}: planned again round what the robot cannot move ({})", e.action,
+                                  joinIds(fixed_objects_));
   e.state = EdgeState::kUnevaluated;
   e.subtasks_spawned = false;
   e.motion.reset();

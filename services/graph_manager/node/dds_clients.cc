@@ -104,6 +104,7 @@ TaskPlan DdsServiceClients::plan(const TaskQuery& q) {
 
 MotionAnswer DdsServiceClients::motion(const MotionQuery& q) {
   msg::MotionRequest req;
+  req.world_version(q.world_version);
   req.group(q.group == Group::kBase ? msg::PlanningGroup::GROUP_BASE : msg::PlanningGroup::GROUP_ARM);
   req.mode(q.mode == Mode::kLazy ? msg::MotionMode::MOTION_LAZY : msg::MotionMode::MOTION_FULL);
   req.start_base(dds::toMsg(q.start.base));

@@ -78,6 +78,7 @@ class DdsWorldSource : public WorldSource {
   /// The mission's robot (joint values of robot states). Not concurrent with `robot()`.
   void setRobot(robot::RobotModel robot) { robot_ = std::move(robot); }
   world::World world() override { return mirror_.snapshot(); }
+  std::uint64_t version() override { return mirror_.publishedVersion(); }
   Observation robot() override;
   /// Waits until a robot state and a world model have arrived. On a timeout, says which did not.
   Status waitReady(const Termination& until);

@@ -41,6 +41,7 @@ class OracleWorldSource : public WorldSource {
       : live_(live), hidden_(std::move(hidden)) {}
   world::World world() override { return withHidden(live_.world(), hidden_); }
   Observation robot() override { return live_.robot(); }
+  std::uint64_t version() override { return live_.version(); }
 
  private:
   WorldSource& live_;

@@ -8,6 +8,7 @@ namespace tamp::graph_manager {
 MotionQuery GraphManager::withHeldMargin(MotionQuery q) const {
   const bool in_hand = !q.held.object_id.empty() && q.held.link != abstraction_.robot().options().base_link;
   q.held_padding_m = in_hand ? held_padding_m_ : 0.0;
+  q.world_version = world_version_;
   return q;
 }
 

@@ -77,17 +77,39 @@ Result<EdgeCommand> GraphManager::command(EdgeId id, EdgeId next, const BranchCo
   c.object_target = m->object_target;
   c.expected_s = mean;
   c.expected_stddev_s = sd;
+  c.world_version = world_version_;
   (void)ctx;
   return c;
 }
 
+namespace {
+/// The mission's world source, remembering the newest world model version it gave out.
+class SeenWorld final : public WorldSource {
+ public:
+  SeenWorld(WorldSource& s, std::uint64_t& newest) : source_(s), newest_(newest) {}
+  world::World world() override {
+    const std::uint64_t v = source_.version();  // before the snapshot, which holds at least v
+    world::World w = source_.world();
+    newest_ = std::max(newest_, v);
+    return w;
+  }
+  Observation robot() override { return source_.robot(); }
+  std::uint64_t version() override { return source_.version(); }
+
+ private:
+  WorldSource& source_;
+  std::uint64_t& newest_;
+};
+}  // namespace
+
 /// One mission: the state of the loop and its steps.
 struct GraphManager::Run {
   Run(GraphManager& g, WorldSource& s, Executor& x, const MissionObserver& o)
-      : gm(g), source(s), executor(x), observer(o), start_calls(g.logged_.mark()) {}
+      : gm(g), seen(s, g.world_version_), executor(x), observer(o), start_calls(g.logged_.mark()) {}
 
   GraphManager& gm;
-  WorldSource& source;
+  SeenWorld seen;
+  WorldSource& source{seen};
   Executor& executor;
   const MissionObserver& observer;
   std::size_t start_calls{0};  ///< the call log's mark at the mission's start

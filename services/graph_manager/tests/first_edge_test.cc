@@ -63,8 +63,10 @@ class ScriptedServices : public ServiceClients {
     return p;
   }
   std::vector<double> held_paddings;  ///< of every motion query holding an object
+  std::vector<std::uint64_t> world_versions;  ///< MotionQuery::world_version of every query
   MotionAnswer motion(const MotionQuery& q) override {
     ++motion_calls;
+    world_versions.push_back(q.world_version);
     if (!q.held.object_id.empty()) held_paddings.push_back(q.held_padding_m);
     if (q.mode == Mode::kLazy) fixed_asked.push_back(q.fixed);
     MotionAnswer a;
@@ -308,12 +310,6 @@ TEST_F(FirstEdgeTest, AnEmptyBranchHasNoFirstEdge) {
   EXPECT_TRUE(s.gm->firstEdgeOf({}).empty());
 }
 
-}  // namespace
-}  // namespace tamp::graph_manager
-
-namespace tamp::graph_manager {
-namespace {
-
 // A second plan through other symbolic states (here one more fact) asks the motion planner the
 // same questions as the first, from the same poses in the same world: the memo answers them
 // (issue 12, replanning latency), and the decision and its cost are unchanged.
@@ -402,6 +398,67 @@ TEST_F(FirstEdgeTest, AnObjectTheRobotCanNeitherCarryNorPushIsGoneRound) {
   // The two drives and nothing else: the box is not moved.
   const double straight = std::hypot(5.0 - 1.5, 2.2 - 1.2) + std::hypot(8.5 - 5.0, 1.2 - 2.2);
   EXPECT_NEAR(t.cost_s, straight, 1e-6);
+}
+
+/// A world model at a given version and a robot that the executor moves to where each drive ends.
+class VersionedWorld : public WorldSource {
+ public:
+  world::World live;
+  std::uint64_t at_version{0};
+  Observation robot_now;
+  world::World world() override { return live; }
+  Observation robot() override { return robot_now; }
+  std::uint64_t version() override { return at_version; }
+};
+
+class DrivingExecutor : public Executor {
+ public:
+  explicit DrivingExecutor(VersionedWorld& w) : world_(w) {}
+  std::vector<std::uint64_t> world_versions;  ///< EdgeCommand::world_version of every command
+  ExecutionReport execute(const EdgeCommand& c, double) override {
+    world_versions.push_back(c.world_version);
+    const auto& end = c.trajectory.points.back().positions;
+    if (c.kind == ActionKind::kMoveBase && end.size() == 3) world_.robot_now.robot.base = Pose2D{end[0], end[1], end[2]};
+    ExecutionReport r;
+    r.outcome = ExecOutcome::kSucceeded;
+    r.measured_s = c.expected_s;
+    return r;
+  }
+
+ private:
+  VersionedWorld& world_;
+};
+
+// The services are asked in the world model the graph manager planned in: a motion planner whose
+// mirror lags behind (a host that discovered the world model later) waits for that version
+// instead of answering from an older or empty world. The two-host CI run drove into a box that
+// the motion planner had not received yet: no question carried a version. So do the commands,
+// which the monitor validates.
+TEST(MissionWorldVersionTest, MotionQuestionsAndCommandsCarryTheWorldVersionTheGraphPlannedIn) {
+  auto sc = world::loadScenario(configDir() / "scenarios" / "namo_corridor.yaml");
+  ASSERT_TRUE(sc.ok()) << sc.error().toString();
+  auto robot = robot::RobotModel::loadDescription(sc->robot.description);
+  ASSERT_TRUE(robot.ok());
+  Abstraction a(sc->plannerWorld(), *robot);
+  ScriptedServices services;
+  services.plans = {{"(move_base start goal)"}};
+  GraphManagerParams params;
+  params.max_contingencies = 0;
+  params.concurrent_motions = false;
+  GraphManager gm(std::move(a), "", MissionGoal{{"(robot-at goal)"}}, services, params);
+  VersionedWorld source;
+  source.live = sc->plannerWorld();
+  source.at_version = 7;
+  source.robot_now.valid = true;
+  source.robot_now.robot.base = sc->robot.start;
+  source.robot_now.robot.arm = *robot->namedConfiguration("stow");
+  DrivingExecutor robot_x(source);
+  const MissionReport r = gm.runMission(source, robot_x);
+  ASSERT_EQ(r.status, MissionOutcome::kSucceeded) << r.reason;
+  ASSERT_FALSE(services.world_versions.empty());
+  for (std::uint64_t v : services.world_versions) EXPECT_EQ(v, 7u);
+  ASSERT_EQ(robot_x.world_versions.size(), 1u);
+  EXPECT_EQ(robot_x.world_versions.front(), 7u);
 }
 
 }  // namespace

@@ -75,6 +75,9 @@ struct MotionQuery {
   /// Lazy: movables the robot cannot move (over the payload, no push): obstacles for this path.
   std::vector<std::string> fixed;
   double held_padding_m{0.0};         ///< the held object grown by this much (m); set by the graph manager
+  /// The world model version the question is asked in (0: the server's latest). A server whose
+  /// mirror lags waits for it within the budget, or answers kUnavailable; set by the graph manager.
+  std::uint64_t world_version{0};
   double budget_s{5.0};
 };
 

@@ -256,6 +256,9 @@ class WorldSource {
   virtual ~WorldSource() = default;
   virtual world::World world() = 0;
   virtual Observation robot() = 0;
+  /// A world model version that the next world() holds at least (0: unknown). The services are
+  /// asked in it, so a planner whose mirror lags behind waits for the world the graph planned in.
+  virtual std::uint64_t version() { return 0; }
 };
 
 class GraphManager {
@@ -554,6 +557,9 @@ class GraphManager {
   /// The margin a held object is planned with (params_.held_padding_step_m per static contact
   /// the robot was stopped before while holding; see Run::replan).
   double held_padding_m_{0.0};
+  /// The newest world model version the mission took from its WorldSource (0: unknown): motion
+  /// questions and commands carry it, so no service answers from an older world than the graph's.
+  std::uint64_t world_version_{0};
   QueryMemo memo_;
   std::map<std::string, std::vector<GraspOption>> grasp_cache_;
   /// Placements of a held object from a base pose in a world (sampledPlace): asked for a few

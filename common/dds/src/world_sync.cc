@@ -175,7 +175,7 @@ Status WorldPublisher::publish(const world::World& w) {
     return Error(ErrorCode::kInvalidArgument, "refusing to publish a world with " + std::to_string(w.hiddenCount()) +
                                                   " hidden object(s): publish its plannerView()");
   }
-  const uint64_t v = w.version();
+  const uint64_t v = versionOf(w);
   for (const auto& o : w.objects()) {
     const world::Object* before = last_ ? last_->findObject(o.id) : nullptr;
     if (before != nullptr && *before == o) continue;
@@ -191,6 +191,7 @@ Status WorldPublisher::publish(const world::World& w) {
     }
   }
   msg::WorldMeta meta = metaToMsg(w, world_id_);
+  meta.version(v);
   std::vector<std::string> ids;
   std::vector<uint64_t> versions;
   ids.reserve(written_.size());

@@ -80,6 +80,41 @@ TEST(WorldSyncTest, MirrorAssemblesThePublishedWorldAndFollowsChanges) {
   }));
 }
 
+// A restarted publisher (perception after kill -9) rebuilds its world from the scenario, whose
+// version counter starts low again. Continuing above the versions published before it, its
+// worlds reach a mirror that held the old ones: the mirror's version follows it, and moved
+// objects arrive. Without the floor the mirror would keep the old version and never complete one.
+TEST(WorldSyncTest, ARestartedPublisherContinuesAboveTheVersionsBeforeIt) {
+  auto p = testing::makeParticipant();
+  ASSERT_TRUE(p);
+  world::World w = sampleWorld();
+  Eigen::Isometry3d moved = w.object("can").pose;
+  for (int i = 0; i < 5; ++i) {
+    moved.translation().y() += 0.01;
+    ASSERT_TRUE(w.setObjectPose("can", moved).ok());
+  }
+  auto first = std::make_unique<WorldPublisher>(p);
+  ASSERT_TRUE(first->publish(w).ok());
+  const std::uint64_t before = first->publishedVersion();
+  WorldMirror mirror(p);
+  ASSERT_TRUE(mirror.waitForPublishedVersion(before, Termination::after(10.0)));
+  first.reset();
+
+  world::World again = sampleWorld();  // the restarted publisher's world: a low version
+  ASSERT_LT(again.version(), before);
+  WorldPublisher second(p);
+  second.continueAbove(before);
+  EXPECT_EQ(second.versionOf(again), before + again.version());
+  ASSERT_TRUE(second.publish(again).ok());
+  EXPECT_GT(second.publishedVersion(), before);
+  ASSERT_TRUE(mirror.waitForPublishedVersion(second.publishedVersion(), Termination::after(10.0)));
+  ASSERT_TRUE(waitFor([&] {
+    auto s = mirror.snapshot();
+    return s.findObject("can") != nullptr &&
+           std::abs(s.object("can").pose.translation().y() - sampleWorld().object("can").pose.translation().y()) < 1e-12;
+  }));
+}
+
 TEST(WorldSyncTest, PublisherRefusesHiddenObjects) {
   auto p = testing::makeParticipant();
   ASSERT_TRUE(p);

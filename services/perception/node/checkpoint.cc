@@ -19,10 +19,12 @@ Error parseError(const std::string& file, int line, const std::string& field, co
 
 }  // namespace
 
-std::string formatCheckpoint(const world::World& w, const std::optional<Perception::HeldGrasp>& held) {
+std::string formatCheckpoint(const world::World& w, const std::optional<Perception::HeldGrasp>& held,
+                             std::uint64_t world_version) {
   std::ostringstream out;
   out.precision(17);
   out << kHeader << "\n";
+  if (world_version > 0) out << "world_version " << world_version << "\n";
   if (held) {
     out << "held " << held->object_id;
     const Eigen::Matrix4d m = held->tool_T_object.matrix();
@@ -48,7 +50,15 @@ Result<PerceptionCheckpoint> parseCheckpoint(const std::string& text, const std:
     std::istringstream fields(line);
     std::string kind;
     fields >> kind;
-    if (kind == "held") {
+    if (kind == "world_version") {
+      if (c.world_version > 0) return parseError(file, n, "world_version", "a second world version");
+      std::string v, rest;
+      fields >> v >> rest;
+      const bool digits = !v.empty() && v.size() < 20 && v.find_first_not_of("0123456789") == std::string::npos;
+      if (!digits || !rest.empty() || std::stoull(v) == 0)
+        return parseError(file, n, "world_version", "expected one positive integer, got '" + v + "'");
+      c.world_version = std::stoull(v);
+    } else if (kind == "held") {
       if (c.held) return parseError(file, n, "held", "a second grasp");
       Perception::HeldGrasp g;
       fields >> g.object_id;

@@ -63,6 +63,7 @@ PerceptionNode::PerceptionNode(const dds::ServiceArgs& args, PerceptionNodeOptio
       log::get(name())->warn("checkpoint: the grasp not taken up: {}", s.error().toString());
   }
   checkpointed_grasp_ = perception_->heldGrasp();
+  world_pub_.continueAbove(options_.resume_world_version);
   snapshot_ = perception_->world();
   if (Status s = world_pub_.publish(snapshot_); !s.ok()) {
     throw std::runtime_error("publishing the prior world: " + s.error().toString());
@@ -113,6 +114,7 @@ void resumeFromCheckpoint(PerceptionNodeOptions& options, const std::string& nod
   }
   options.prior = std::move(*restored);
   options.resume_grasp = parsed->held;
+  options.resume_world_version = parsed->world_version;
   log->info("resumed from checkpoint {}: {} movable object(s){}", options.checkpoint_file.string(),
             parsed->movables.size(), parsed->held ? ", holding '" + parsed->held->object_id + "'" : std::string());
 }
@@ -261,6 +263,9 @@ void PerceptionNode::process(const PointCloudFrame& frame, std::stop_token stop)
     return;
   }
   ++processed_;
+  // The checkpoint first: it records the version about to be published, above which a restarted
+  // node publishes.
+  checkpoint(r->world_changed);
   if (r->world_changed) {
     {
       std::lock_guard lock(mutex_);
@@ -270,7 +275,6 @@ void PerceptionNode::process(const PointCloudFrame& frame, std::stop_token stop)
       log::get(name())->error("publishing the world model failed: {}", s.error().toString());
     }
   }
-  checkpoint(r->world_changed);
   for (const WorldEvent& e : r->events) {
     log::get(name())->info("world event: {} {} ({})", toString(e.type), e.object_id, e.description);
     if (Status s = events_.write(toMsg(e, ++event_seq_)); !s.ok()) {
@@ -296,7 +300,7 @@ void PerceptionNode::checkpoint(bool world_changed) {
                              (grasp && (grasp->object_id != checkpointed_grasp_->object_id ||
                                         !grasp->tool_T_object.isApprox(checkpointed_grasp_->tool_T_object)));
   if (!world_changed && !grasp_changed) return;
-  const Status s = writeFileAtomically(options_.checkpoint_file, formatCheckpoint(perception_->world(), grasp),
+  const Status s = writeFileAtomically(options_.checkpoint_file, formatCheckpoint(perception_->world(), grasp, world_pub_.versionOf(perception_->world())),
                                        "perception's checkpoint");
   if (!s.ok()) {
     if (!checkpoint_failed_) log::get(name())->error("{} (a restart would start from the prior)", s.error().toString());

@@ -55,6 +55,7 @@ struct PerceptionNodeOptions {
   /// restored and `resume_grasp` set.
   std::filesystem::path checkpoint_file;
   std::optional<Perception::HeldGrasp> resume_grasp;
+  std::uint64_t resume_world_version{0};  ///< the checkpoint's: versions are published above it
 };
 
 /// Node options from the service's YAML (`config/services/perception.yaml`): the perception

@@ -41,9 +41,11 @@ TEST(CheckpointTest, TheWorldAndTheGraspAreReadBackAsWritten) {
   EXPECT_EQ(c->movables[0].shape.size, box.shape.size);
   EXPECT_DOUBLE_EQ(c->movables[0].mass, 2.0);
   EXPECT_TRUE(c->movables[0].graspable);
-  auto empty_hand = parseCheckpoint(formatCheckpoint(w, std::nullopt), "perception.checkpoint");
+  EXPECT_EQ(c->world_version, 0u) << "none recorded";
+  auto empty_hand = parseCheckpoint(formatCheckpoint(w, std::nullopt, 41), "perception.checkpoint");
   ASSERT_TRUE(empty_hand) << empty_hand.error().toString();
   EXPECT_FALSE(empty_hand->held.has_value());
+  EXPECT_EQ(empty_hand->world_version, 41u);
 }
 
 TEST(CheckpointTest, ABrokenCheckpointIsRefusedNamingTheLineAndField) {
@@ -58,6 +60,12 @@ TEST(CheckpointTest, ABrokenCheckpointIsRefusedNamingTheLineAndField) {
   EXPECT_NE(why(good + "object 00ff\n").find("object"), std::string::npos) << why(good + "object 00ff\n");
   EXPECT_NE(why(good + "object zz\n").find(":4"), std::string::npos);
   EXPECT_NE(why(good + "pose box 1 2 3\n").find("unknown record 'pose'"), std::string::npos);
+  for (const char* bad : {"world_version x\n", "world_version 0\n", "world_version -3\n", "world_version 4 5\n",
+                          "world_version\n", "world_version 99999999999999999999999\n"}) {
+    EXPECT_NE(why(good + bad).find("world_version"), std::string::npos) << bad << ": " << why(good + bad);
+    EXPECT_NE(why(good + bad).find(":4"), std::string::npos) << bad << ": " << why(good + bad);
+  }
+  EXPECT_NE(why(good + "world_version 3\nworld_version 4\n").find("a second world version"), std::string::npos);
   // A torn last line (a crash while writing is excluded by the atomic write, a hand edit is not).
   EXPECT_NE(why(good.substr(0, good.size() - 10)).find("object"), std::string::npos);
 }

@@ -38,6 +38,13 @@ class WorldPublisher {
   /// Publishes `w` (its planner view). kInvalidArgument if `w` contains hidden objects.
   Status publish(const world::World& w);
   uint64_t publishedVersion() const { return published_version_; }
+  /// A restarted publisher continues above the versions published before it (its checkpoint's):
+  /// from now on `w` is published at w.version() + floor. Mirrors that hold the older versions
+  /// take the new ones in, clients naming an older version are served, and no version names two
+  /// worlds.
+  void continueAbove(uint64_t floor) { floor_ = floor; }
+  /// The version publish(w) gives `w`.
+  uint64_t versionOf(const world::World& w) const { return w.version() + floor_; }
 
  private:
   std::string world_id_;
@@ -46,6 +53,7 @@ class WorldPublisher {
   std::optional<world::World> last_;
   std::map<std::string, uint64_t> written_;  ///< object id -> version it was last written at
   uint64_t published_version_{0};
+  uint64_t floor_{0};
 };
 
 class WorldMirror {

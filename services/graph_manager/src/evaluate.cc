@@ -164,6 +164,7 @@ MotionAnswer GraphManager::planBase(const MotionQuery& q) {
 double GraphManager::evaluateBase(Edge& e, const BranchContext& ctx, int depth) {
   const MotionQuery q = baseQuery(e, ctx);
   MotionAnswer a = planBase(q);
+  e.motion_outcome = a.status;
   if (!a.ok()) {
     e.state = EdgeState::kInfeasible;
     e.reason = std::string(toString(a.status)) + (a.reason.empty() ? "" : ": " + a.reason);
@@ -241,7 +242,7 @@ bool GraphManager::aroundProvenImpossible(const Edge& e) const {
   for (EdgeId twin : graph_.out(e.from)) {
     const Edge& d = graph_.edge(twin);
     if (d.to == e.to && d.action == e.action && d.variant == Variant::kAround && d.state == EdgeState::kInfeasible &&
-        d.reason.rfind(std::string(toString(MotionOutcome::kNoPath)), 0) == 0)
+        d.motion_outcome == MotionOutcome::kNoPath)
       return true;
   }
   return false;

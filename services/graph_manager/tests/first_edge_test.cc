@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <functional>
 
 #include <gtest/gtest.h>
 
@@ -415,8 +416,22 @@ class DrivingExecutor : public Executor {
  public:
   explicit DrivingExecutor(VersionedWorld& w) : world_(w) {}
   std::vector<std::uint64_t> world_versions;  ///< EdgeCommand::world_version of every command
+  /// The first `fail_first` commands are refused before moving, naming `fail_naming`;
+  /// `before_failure(n)` changes the world first (n = 0, 1, ...).
+  int fail_first{0};
+  std::string fail_naming;
+  std::function<void(int)> before_failure;
   ExecutionReport execute(const EdgeCommand& c, double) override {
     world_versions.push_back(c.world_version);
+    if (failed_ < fail_first) {
+      if (before_failure) before_failure(failed_);
+      ++failed_;
+      ExecutionReport r;
+      r.outcome = ExecOutcome::kFailed;
+      r.reason = "path: the robot would touch '" + fail_naming + "' of the world model";
+      r.blocking_object_id = fail_naming;
+      return r;
+    }
     const auto& end = c.trajectory.points.back().positions;
     if (c.kind == ActionKind::kMoveBase && end.size() == 3) world_.robot_now.robot.base = Pose2D{end[0], end[1], end[2]};
     ExecutionReport r;
@@ -427,6 +442,7 @@ class DrivingExecutor : public Executor {
 
  private:
   VersionedWorld& world_;
+  int failed_{0};
 };
 
 // The services are asked in the world model the graph manager planned in: a motion planner whose
@@ -459,6 +475,79 @@ TEST(MissionWorldVersionTest, MotionQuestionsAndCommandsCarryTheWorldVersionTheG
   for (std::uint64_t v : services.world_versions) EXPECT_EQ(v, 7u);
   ASSERT_EQ(robot_x.world_versions.size(), 1u);
   EXPECT_EQ(robot_x.world_versions.front(), 7u);
+}
+
+/// A mission on namo_corridor from start to goal over scripted services (straight drives),
+/// executed by `x` in `source`.
+MissionReport corridorMission(VersionedWorld& source, DrivingExecutor& x, ScriptedServices& services,
+                              const std::vector<world::Object>& more = {}) {
+  auto sc = world::loadScenario(configDir() / "scenarios" / "namo_corridor.yaml");
+  EXPECT_TRUE(sc.ok());
+  auto robot = robot::RobotModel::loadDescription(sc->robot.description);
+  EXPECT_TRUE(robot.ok());
+  world::World planned = sc->plannerWorld();
+  for (const auto& o : more) EXPECT_TRUE(planned.addObject(o).ok());
+  Abstraction a(planned, *robot);
+  for (int i = 0; i < 8; ++i) services.plans.push_back({"(move_base start goal)"});
+  GraphManagerParams params;
+  params.max_contingencies = 0;
+  params.concurrent_motions = false;
+  params.max_replans = 6;
+  GraphManager gm(std::move(a), "", MissionGoal{{"(robot-at goal)"}}, services, params);
+  source.live = sc->plannerWorld();
+  for (const auto& o : more) EXPECT_TRUE(source.live.addObject(o).ok());
+  source.at_version = 1;
+  source.robot_now.valid = true;
+  source.robot_now.robot.base = sc->robot.start;
+  source.robot_now.robot.arm = *robot->namedConfiguration("stow");
+  return gm.runMission(source, x);
+}
+
+// A drive refused because of an object that the world model had elsewhere when the drive was
+// planned (a new object's estimate still growing) did not fail: the world changed under the
+// plan. It is planned again and not counted towards max_action_failures (2). The same refusals
+// naming an object the graph knew where it stands are counted: the mission fails at the second.
+// (An object new to the graph makes a new symbolic state, whose edges have no failures yet.)
+TEST(MissionFailureCountTest, RefusalsNamingAnObjectTheWorldModelChangedAreNotCountedAsFailures) {
+  auto crate = [] {
+    world::Object o;
+    o.id = "crate";
+    o.label = "crate";
+    o.kind = world::ObjectKind::kMovable;
+    o.shape = world::Shape::box(0.2, 0.2, 0.2);
+    o.mass = 5.0;
+    o.region = "box_floor";  // its symbolic state stays (on crate box_floor) as it moves
+    o.pose.translation() = Eigen::Vector3d(4.45, 1.2, 0.1);
+    return o;
+  };
+  {
+    ScriptedServices services;
+    VersionedWorld source;
+    DrivingExecutor x(source);
+    x.fail_first = 3;
+    x.fail_naming = "crate";
+    x.before_failure = [&](int n) {
+      world::Object o = crate();
+      o.pose.translation().x() += 0.2 * (n + 1);  // seen 0.2 m further each time (tolerance 0.15 m)
+      ASSERT_TRUE(source.live.updateObject(o).ok());
+      ++source.at_version;
+    };
+    const MissionReport r = corridorMission(source, x, services, {crate()});
+    EXPECT_EQ(r.status, MissionOutcome::kSucceeded) << r.reason;
+    EXPECT_EQ(x.world_versions.size(), 4u);
+    EXPECT_EQ(x.world_versions.back(), 4u) << "the last command planned in the world of the third refusal";
+  }
+  {
+    ScriptedServices services;
+    VersionedWorld source;
+    DrivingExecutor x(source);
+    x.fail_first = 3;
+    x.fail_naming = "box";  // in the planner's world from the start, where it stands
+    const MissionReport r = corridorMission(source, x, services);
+    EXPECT_EQ(r.status, MissionOutcome::kFailed);
+    EXPECT_NE(r.reason.find("max_action_failures"), std::string::npos) << r.reason;
+    EXPECT_EQ(x.world_versions.size(), 2u);
+  }
 }
 
 }  // namespace

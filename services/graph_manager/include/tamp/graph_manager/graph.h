@@ -85,6 +85,9 @@ struct Edge {
   double effort_mean_s{kInfinity}; ///< predicted execution time once evaluated
   double effort_stddev_s{0.0};
   std::string reason;              ///< why infeasible / failed
+  /// The motion planner's outcome of the last motion asked for this edge (kSolved: none failed).
+  /// Policy `infeasible` moves objects only once a way round is kNoPath (proven, not timed out).
+  MotionOutcome motion_outcome{MotionOutcome::kSolved};
   std::optional<EdgeMotion> motion;
   /// move_arm edges: the motion depends on the manipulation that follows (the pre-grasp of the
   /// object picked next); evaluated per next edge.

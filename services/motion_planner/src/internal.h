@@ -343,6 +343,9 @@ struct StaticWorldKey {
   Eigen::Isometry3d link_T_held{Eigen::Isometry3d::Identity()};
   std::vector<double> fixed;
   bool operator==(const StaticWorldKey& o) const;
+  /// Equal to `base` but for more static objects (base's statics a strict subset of these):
+  /// the world of a request whose fixed objects became obstacles. `added` receives the extra ones.
+  bool extends(const StaticWorldKey& base, std::vector<std::shared_ptr<const world::Object>>& added) const;
 };
 
 /// A roadmap of the static free space of one group and StaticWorldKey, kept across requests
@@ -396,6 +399,13 @@ class StaticRoadmap {
   /// Adds a statically valid path cut every `spacing` (its edges are known valid); returns the
   /// nodes of its first and last states.
   std::pair<int, int> addPath(const og::PathGeometric& path, double spacing);
+  /// Makes this (empty) roadmap of a world with more static obstacles (`added`, their boxes) from
+  /// `base`'s: its nodes that stay static-free (checked by `oracle`, of this world, when near an
+  /// added box), its edges between them, its samples' counts and its movable cache. An edge whose
+  /// swept box (its ends' base positions grown by the reach radius) meets an added box is unknown
+  /// again, evaluated when a search needs it; the others keep base's static validity. Rigid base
+  /// groups only (`oracle.rigid()`). Returns the number of base nodes dropped.
+  std::size_t deriveFrom(const StaticRoadmap& base, Oracle& oracle, const std::vector<Aabb>& added);
 
   /// The effort-aware LazySP search (see roadmap.cc) from node `start` to any of `goals` under
   /// the request's movables; nothing when they are not connected within the budgets

@@ -21,6 +21,7 @@
 #include <limits>
 #include <numeric>
 #include <queue>
+#include <stdexcept>
 #include <unordered_set>
 
 #include <ompl/base/spaces/RealVectorStateSpace.h>
@@ -153,6 +154,94 @@ bool StaticRoadmap::syncMovables(const Oracle& oracle, std::vector<int>& g2r) {
     drop(c.edges);
   }
   return true;
+}
+
+bool StaticWorldKey::extends(const StaticWorldKey& base,
+                             std::vector<std::shared_ptr<const world::Object>>& added) const {
+  added.clear();
+  if (group != base.group || fixed != base.fixed || statics.size() <= base.statics.size()) return false;
+  if (!held != !base.held) return false;
+  if (held && (held != base.held && (held->id != base.held->id || !(held->shape == base.held->shape)))) return false;
+  if (held && (held_link != base.held_link || !link_T_held.matrix().isApprox(base.link_T_held.matrix(), 1e-12)))
+    return false;
+  // Both sorted by id: every base static must appear, unchanged.
+  std::size_t j = 0;
+  for (const auto& s : statics) {
+    if (j < base.statics.size() && base.statics[j]->id == s->id) {
+      if (!sameObject(s, base.statics[j])) return false;
+      ++j;
+    } else {
+      added.push_back(s);
+    }
+  }
+  return j == base.statics.size();
+}
+
+std::size_t StaticRoadmap::deriveFrom(const StaticRoadmap& base, Oracle& oracle, const std::vector<Aabb>& added) {
+  if (!nodes_.empty()) throw std::logic_error("StaticRoadmap::deriveFrom: the roadmap is not empty");
+  if (!oracle.rigid()) throw std::logic_error("StaticRoadmap::deriveFrom: not a rigid base group");
+  const double r = oracle.reachRadius();
+  auto near = [&](double x0, double y0, double x1, double y1) {
+    return std::any_of(added.begin(), added.end(), [&](const Aabb& b) {
+      return !(b.max.x() + r < x0 || b.min.x() - r > x1 || b.max.y() + r < y0 || b.min.y() - r > y1);
+    });
+  };
+  std::vector<int> remap(base.nodes_.size(), -1);
+  std::vector<Pose2D> at(base.nodes_.size());
+  std::size_t dropped = 0;
+  for (std::size_t i = 0; i < base.nodes_.size(); ++i) {
+    const Pose2D p = oracle.group().basePose(base.nodes_[i]);
+    at[i] = p;
+    if (near(p.x, p.y, p.x, p.y) && !oracle.staticFree(base.nodes_[i])) {
+      ++dropped;
+      continue;
+    }
+    remap[i] = static_cast<int>(nodes_.size());
+    nodes_.push_back(space_->cloneState(base.nodes_[i]));
+    request_stamp_.push_back(base.request_stamp_[i]);
+    if (base.request_stamp_[i] > 0) ++request_nodes_;
+    adj_.emplace_back();
+  }
+  std::vector<int> all(nodes_.size());
+  std::iota(all.begin(), all.end(), 0);
+  impl_->nn.add(all);
+  std::vector<std::size_t> kept_edges;
+  for (std::size_t ei = 0; ei < base.edges_.size(); ++ei) {
+    Edge e = base.edges_[ei];
+    const auto ua = static_cast<std::size_t>(e.a), ub = static_cast<std::size_t>(e.b);
+    e.a = remap[ua];
+    e.b = remap[ub];
+    if (e.a < 0 || e.b < 0) continue;
+    if (e.status == Edge::kValid && near(std::min(at[ua].x, at[ub].x), std::min(at[ua].y, at[ub].y),
+                                         std::max(at[ua].x, at[ub].x), std::max(at[ua].y, at[ub].y)))
+      e.status = Edge::kUnknown;
+    const int ni = static_cast<int>(edges_.size());
+    edges_.push_back(e);
+    kept_edges.push_back(ei);
+    adj_[static_cast<std::size_t>(e.a)].push_back(ni);
+    adj_[static_cast<std::size_t>(e.b)].push_back(ni);
+    impl_->edge_keys.insert((static_cast<std::uint64_t>(std::min(e.a, e.b)) << 32) |
+                            static_cast<std::uint32_t>(std::max(e.a, e.b)));
+  }
+  if (base.mcache_) {
+    // Entries stay true: the added obstacles were movables there, absent from this world's
+    // movables (their numbers are dropped when read); the edges near them are unknown again.
+    mcache_ = std::make_unique<MovableCache>(*base.mcache_);
+    std::vector<MovableCache::Entry> node_cache(nodes_.size()), edge_cache(edges_.size());
+    for (std::size_t i = 0; i < remap.size() && i < base.mcache_->nodes.size(); ++i)
+      if (remap[i] >= 0) node_cache[static_cast<std::size_t>(remap[i])] = base.mcache_->nodes[i];
+    for (std::size_t k = 0; k < kept_edges.size(); ++k)
+      if (kept_edges[k] < base.mcache_->edges.size()) edge_cache[k] = base.mcache_->edges[kept_edges[k]];
+    mcache_->nodes = std::move(node_cache);
+    mcache_->edges = std::move(edge_cache);
+  }
+  densified_ = base.densified_;
+  uniform_ = base.uniform_;
+  plain_ = base.plain_;
+  bridges_ = base.bridges_;
+  sampling_interrupted_ = base.sampling_interrupted_;
+  impl_->rng = base.impl_->rng;
+  return dropped;
 }
 
 StaticRoadmap::~StaticRoadmap() {

@@ -173,6 +173,35 @@ TEST_F(LazyTest, FixedObjectsAreObstaclesOfTheLazyPath) {
       << toString(r.status) << ": " << r.reason;
 }
 
+// The roadmap of a world with fixed objects is made from the cached one of the world without
+// them (the fixed objects' boxes checked again), not sampled anew behind lazy KPIECE: the
+// request is answered from the roadmap, and its path is as independent checks require.
+TEST_F(LazyTest, AFixedObjectsRoadmapIsDerivedFromTheCachedOne) {
+  const world::World w = testing::twoDoorWorld();
+  MotionPlanner mp = planner(w);
+  MotionRequest req = baseRequest({2, 0.9, 0}, {8, 0.9, 0});
+  req.object_cost_scale = 0.0;
+  const MotionResult first = mp.plan(req, Termination::after(5.0));
+  ASSERT_EQ(first.status, MotionStatus::kSolved) << first.reason;
+  EXPECT_FALSE(first.stats.roadmap_derived);
+  for (int k = 0; k < 2; ++k) {  // the second: the derived roadmap is cached itself
+    MotionRequest fixed = req;
+    fixed.fixed_objects = {"heavy_a", "heavy_b"};
+    const MotionResult r = mp.plan(fixed, Termination::after(5.0));
+    ASSERT_EQ(r.status, MotionStatus::kSolved) << r.reason;
+    EXPECT_EQ(r.stats.roadmap_derived, k == 0) << k;
+    EXPECT_TRUE(r.stats.roadmap_reused) << k;
+    EXPECT_FALSE(r.stats.lazy_planner_used) << "answered from the roadmap, " << k;
+    EXPECT_EQ(blockingIds(r.blocking), std::vector<std::string>{"light"}) << k;
+    EXPECT_EQ(discTouches(w, r.path, kRadius, 0.005), std::vector<std::string>{"light"}) << k;
+    EXPECT_GT(discClearance(w, r.path, kRadius, 0.005, {}, /*movables=*/false), -1e-3) << k;
+  }
+  // The world without them is the cached one still: the same answer as the first.
+  const MotionResult again = mp.plan(req, Termination::after(5.0));
+  ASSERT_EQ(again.status, MotionStatus::kSolved) << again.reason;
+  EXPECT_EQ(blockingIds(again.blocking), blockingIds(first.blocking));
+}
+
 TEST_F(LazyTest, FixedObjectsMustBeMovablesOfTheWorld) {
   const world::World w = testing::twoDoorWorld();
   MotionPlanner mp = planner(w);

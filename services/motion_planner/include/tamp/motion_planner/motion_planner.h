@@ -214,6 +214,9 @@ struct PlanningStats {
   double raw_cost_s{0.0};       ///< J of the raw lazy path
   bool optimize_completed{false};  ///< the roadmap search finished before its budget
   bool roadmap_reused{false};   ///< lazy: the cached roadmap of this static world was reused
+  /// lazy: this static world's roadmap was new, made from a cached one of the same world with
+  /// fewer obstacles (the request's fixed objects made static): roadmap_reused is set too.
+  bool roadmap_derived{false};
   bool lazy_planner_used{false};  ///< lazy: lazy KPIECE ran (roadmap_first off, or the roadmap could not connect)
   bool direct{false};           ///< full mode: the direct motion to a goal state was free (no sampling)
 };

@@ -401,10 +401,12 @@ class StaticRoadmap {
   std::pair<int, int> addPath(const og::PathGeometric& path, double spacing);
   /// Makes this (empty) roadmap of a world with more static obstacles (`added`, their boxes) from
   /// `base`'s: its nodes that stay static-free (checked by `oracle`, of this world, when near an
-  /// added box), its edges between them, its samples' counts and its movable cache. An edge whose
-  /// swept box (its ends' base positions grown by the reach radius) meets an added box is unknown
-  /// again, evaluated when a search needs it; the others keep base's static validity. Rigid base
-  /// groups only (`oracle.rigid()`). Returns the number of base nodes dropped.
+  /// added box), its edges between them, its samples' counts and its movable cache. An edge that
+  /// base knew valid and whose swept box (its ends' base positions grown by the reach radius)
+  /// meets an added box is unknown again (`recheck`), evaluated when a search needs it; found
+  /// invalid, it does not count towards the search's `max_new_invalid` (the sign of a roadmap that
+  /// does not connect: these are the added obstacles, known). The others keep base's static
+  /// validity. Rigid base groups only (`oracle.rigid()`). Returns the number of base nodes dropped.
   std::size_t deriveFrom(const StaticRoadmap& base, Oracle& oracle, const std::vector<Aabb>& added);
 
   /// The effort-aware LazySP search (see roadmap.cc) from node `start` to any of `goals` under
@@ -431,6 +433,7 @@ class StaticRoadmap {
     int a{0}, b{0};
     double len{0.0};
     enum Status : unsigned char { kUnknown, kValid, kInvalid } status{kUnknown};  // static validity
+    bool recheck{false};  // unknown again in a derived roadmap (deriveFrom): near an added obstacle
   };
   std::vector<Edge> edges_;
   std::vector<std::vector<int>> adj_;

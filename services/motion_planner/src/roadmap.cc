@@ -213,8 +213,10 @@ std::size_t StaticRoadmap::deriveFrom(const StaticRoadmap& base, Oracle& oracle,
     e.b = remap[ub];
     if (e.a < 0 || e.b < 0) continue;
     if (e.status == Edge::kValid && near(std::min(at[ua].x, at[ub].x), std::min(at[ua].y, at[ub].y),
-                                         std::max(at[ua].x, at[ub].x), std::max(at[ua].y, at[ub].y)))
+                                         std::max(at[ua].x, at[ub].x), std::max(at[ua].y, at[ub].y))) {
       e.status = Edge::kUnknown;
+      e.recheck = true;
+    }
     const int ni = static_cast<int>(edges_.size());
     edges_.push_back(e);
     kept_edges.push_back(ei);
@@ -717,7 +719,7 @@ std::optional<og::PathGeometric> StaticRoadmap::search(Oracle& oracle, const ob:
           // wall somewhere, and one A* run per invalid edge found would dominate the time.
           e.status = Edge::kInvalid;
           changed = true;
-          if (invalid_cap > 0 && ++new_invalid >= invalid_cap) return Outcome::kUnconnected;
+          if (invalid_cap > 0 && !e.recheck && ++new_invalid >= invalid_cap) return Outcome::kUnconnected;
           continue;
         }
         e.status = Edge::kValid;

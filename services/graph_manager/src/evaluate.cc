@@ -97,7 +97,7 @@ MotionQuery GraphManager::baseQuery(const Edge& e, const BranchContext& ctx) con
   q.held = ctx.held;
   q.overrides = overridesOf(ctx);
   q.movable_cost_weight = 0.0;  // the pure static-only lazy path
-  if (q.mode == Mode::kLazy) q.fixed.assign(fixed_objects_.begin(), fixed_objects_.end());
+  if (q.mode == Mode::kLazy) q.fixed = fixedIn(ctx);
   q.budget_s = params_.motion_budget_s;
   return q;
 }
@@ -227,10 +227,17 @@ double GraphManager::evaluateBase(Edge& e, const BranchContext& ctx, int depth) 
   return mean;
 }
 
+std::vector<std::string> GraphManager::fixedIn(const BranchContext& ctx) const {
+  std::set<std::string> all = fixed_objects_;
+  if (auto it = fixed_in_world_.find(objectsKey(ctx)); it != fixed_in_world_.end())
+    all.insert(it->second.begin(), it->second.end());
+  return {all.begin(), all.end()};
+}
+
 double GraphManager::evaluateBaseAgain(EdgeId id, const BranchContext& ctx, int depth) {
   Edge& e = graph_.edge(id);
   log::get("graph_manager")->info("{}: planned again round what the robot cannot move ({})", e.action,
-                                  joinIds(fixed_objects_));
+                                  joinIds(fixedIn(ctx)));
   e.state = EdgeState::kUnevaluated;
   e.subtasks_spawned = false;
   e.motion.reset();
@@ -300,6 +307,7 @@ void GraphManager::clearWorldCaches() {
   placement_cache_.clear();
   push_cache_.clear();
   fixed_objects_.clear();
+  fixed_in_world_.clear();
   removable_objects_.clear();
 }
 

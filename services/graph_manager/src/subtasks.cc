@@ -62,8 +62,11 @@ int GraphManager::spawnSubtasks(EdgeId id, const BranchContext& ctx, int depth) 
       if (no_push.empty()) slots = spawnPushes(*o, supportAt(v, o->id), ctx, swept, crossed, radius, why_push);
       if (slots.empty()) {
         unmovable.push_back(why_not + (why_push.empty() ? "" : "; " + why_push));
-        // Neither carried nor pushed in this world: later lazy paths go round it if they can.
-        if (!removable_objects_.count(o->id) && fixed_objects_.insert(o->id).second) ++fixed;
+        // Neither carried nor pushed in this world: later lazy paths go round it if they can (in
+        // every branch, or in those whose objects stand as here: see fixed_in_world_).
+        const bool intrinsic = !abstraction_.whyNotGraspable(*o).empty() && !no_push.empty();
+        std::set<std::string>& into = intrinsic ? fixed_objects_ : fixed_in_world_[objectsKey(ctx)];
+        if (!removable_objects_.count(o->id) && into.insert(o->id).second) ++fixed;
         continue;
       }
     }

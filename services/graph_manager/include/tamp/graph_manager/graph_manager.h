@@ -579,7 +579,16 @@ class GraphManager {
   std::map<std::string, PushCacheEntry> push_cache_;
   /// Movables the robot can neither carry nor push in this world (found by spawnSubtasks): base
   /// lazy paths go round them where a way exists (MotionQuery::fixed). Cleared with the world.
+  /// In every branch when it follows from the object itself (no grasp or above the payload, and
+  /// above the push limit); otherwise (no placement or push free where the objects stand) only
+  /// in branches whose objects stand as where it was found (`fixed_in_world_`, by objectsKey):
+  /// a push blocked by a neighbour may be free once the neighbour is moved. namo_moghaddam_07
+  /// failed so: a box whose push another box blocked at the start was fixed in every branch,
+  /// also in the one that had pushed the other box away, the only way to the goal.
   std::set<std::string> fixed_objects_;
+  std::map<std::string, std::set<std::string>> fixed_in_world_;
+  /// The movables fixed in the branch world of `ctx` (both kinds, sorted).
+  std::vector<std::string> fixedIn(const BranchContext& ctx) const;
   /// Movables a removal (a placement or a push) was found for in this world: never fixed, though
   /// the way another path crosses them may have none.
   std::set<std::string> removable_objects_;

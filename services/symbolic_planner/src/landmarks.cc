@@ -870,4 +870,49 @@ void LandmarkCounter::preferred(const uint64_t* state, const uint64_t* status,
   }
 }
 
+void LandmarkCounter::preferredAmong(const uint64_t* state, const uint64_t* status,
+                                     const std::vector<OpId>& applicable,
+                                     std::vector<OpId>& out) const {
+  if (fact_mark_.size() != task_.numFacts()) {
+    fact_mark_.assign(task_.numFacts(), 0);
+    fact_epoch_ = 0;
+  }
+  if (++fact_epoch_ == 0) {
+    std::fill(fact_mark_.begin(), fact_mark_.end(), 0);
+    fact_epoch_ = 1;
+  }
+  const auto n = static_cast<uint32_t>(graph_.landmarks.size());
+  bool any = false;
+  for (uint32_t l = 0; l < n; ++l) {
+    if (progression_ == LandmarkProgression::kPastAndFuture) {
+      if (!testBit(status + lm_words_, l) || holds(l, state)) continue;
+    } else if (testBit(status, l) || !parentsAccepted(l, status)) {
+      continue;
+    }
+    for (FactId f : graph_.landmarks[l]) fact_mark_[f] = fact_epoch_;
+    any = true;
+  }
+  if (!any) return;
+  for (OpId o : applicable) {
+    const Operator& op = task_.ops[o];
+    bool adds = false;
+    for (FactId f : op.add) {
+      if (fact_mark_[f] == fact_epoch_) {
+        adds = true;
+        break;
+      }
+    }
+    for (size_t c = 0; !adds && c < op.cond_effects.size(); ++c) {
+      const ConditionalEffect& ce = op.cond_effects[c];
+      bool marked = false;
+      for (FactId f : ce.add) marked = marked || fact_mark_[f] == fact_epoch_;
+      if (!marked) continue;
+      bool holds_all = true;
+      for (FactId f : ce.cond) holds_all = holds_all && testBit(state, f);
+      adds = holds_all;
+    }
+    if (adds) out.push_back(o);
+  }
+}
+
 }  // namespace tamp::symbolic_planner

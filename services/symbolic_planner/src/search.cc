@@ -696,13 +696,13 @@ class Searcher {
       ++stats_.expanded;
       ++mark;
       for (uint32_t i = 0; i < pref_count_[id]; ++i) pref_mark[pref_pool_[pref_begin_[id] + i]] = mark;
-      if (lm && use_pref) {
-        lm_pref.clear();
-        lm->preferred(reg_.get(id), accepted.data() + static_cast<size_t>(id) * lw, lm_pref);
-        for (OpId o : lm_pref) pref_mark[o] = mark;
-      }
       ops.clear();
       task_.applicableOps(reg_.get(id), ops);
+      if (lm && use_pref) {
+        lm_pref.clear();
+        lm->preferredAmong(reg_.get(id), accepted.data() + static_cast<size_t>(id) * lw, ops, lm_pref);
+        for (OpId o : lm_pref) pref_mark[o] = mark;
+      }
       const Cost hf = h_cache_[id];
       const Cost hl = lm ? hlm[id] : 0;
       for (OpId o : ops) {

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "tamp/symbolic_planner/heuristic.h"
+#include "tamp/symbolic_planner/landmarks.h"
 #include "tamp/symbolic_planner/search.h"
 #include "test_util.h"
 
@@ -31,7 +32,8 @@ class HeuristicContract : public ::testing::TestWithParam<std::tuple<HeuristicKi
 TEST_P(HeuristicContract, ZeroAtGoalNonNegativeAndDeadEndsOnRandomWalks) {
   const auto [kind, ct] = GetParam();
   const std::string dir = (test::benchmarksDir() / "pddl/gripper").string();
-  auto s = PlanningSession::fromText(test::readFile(dir + "/domain.pddl"), test::readFile(dir + "/instance-4.pddl"));
+  auto s = PlanningSession::fromText(test::readFile(dir + "/domain.pddl"),
+                                     test::readFile(dir + "/instance-4.pddl"));
   ASSERT_TRUE(s.ok());
   Query q;
   q.init = *(*s)->problemInit();
@@ -57,7 +59,8 @@ TEST_P(HeuristicContract, ZeroAtGoalNonNegativeAndDeadEndsOnRandomWalks) {
   ASSERT_EQ(gc.pos.size(), (*s)->problem().goal.children.size());
   goal.conjuncts.push_back(gc);
   h->setGoal(goal);
-  // Random walks (fixed seed): h >= 0 everywhere, h = 0 exactly on goal states for h_ff/h_add/h_max.
+  // Random walks (fixed seed): h >= 0 everywhere, h = 0 exactly on goal states for
+  // h_ff/h_add/h_max.
   std::mt19937 rng(42);
   std::vector<OpId> ops;
   StateBits next(st.size());
@@ -93,7 +96,8 @@ TEST_P(HeuristicContract, ZeroAtGoalNonNegativeAndDeadEndsOnRandomWalks) {
 
 INSTANTIATE_TEST_SUITE_P(
     All, HeuristicContract,
-    ::testing::Combine(::testing::Values(HeuristicKind::kFF, HeuristicKind::kAdd, HeuristicKind::kMax, HeuristicKind::kBlind),
+    ::testing::Combine(::testing::Values(HeuristicKind::kFF, HeuristicKind::kAdd,
+                                         HeuristicKind::kMax, HeuristicKind::kBlind),
                        ::testing::Values(CostType::kUnit, CostType::kCost, CostType::kPlusOne)));
 
 TEST(Heuristic, OperatorsThatDifferInOnePreconditionGiveTheRelaxedPlanAndHelpfulActionsOfEach) {
@@ -104,7 +108,8 @@ TEST(Heuristic, OperatorsThatDifferInOnePreconditionGiveTheRelaxedPlanAndHelpful
   Task t;
   t.fact_names = {"(at a)", "(at b)", "(at c)", "(at g)", "(at w)", "(k)"};
   t.complement.assign(t.fact_names.size(), -1);
-  auto op = [&](const char* name, std::vector<FactId> pre, std::vector<FactId> add, std::vector<FactId> del) {
+  auto op = [&](const char* name, std::vector<FactId> pre, std::vector<FactId> add,
+                std::vector<FactId> del) {
     Operator o;
     o.name = name;
     o.pre = std::move(pre);
@@ -155,7 +160,8 @@ TEST(Heuristic, SharedPreconditionsCountedOnceGiveTheSameLayers) {
   // ship-0 (operator 1) before pick (operator 3), so {gA} and h = 2. A node completed a layer
   // late (gA at layer 3) or the rops of m3 fired in another order gives {gB, gB2} and 3.
   Task t;
-  t.fact_names = {"(m1)", "(m2)", "(m3)", "(s0)", "(s1)", "(w)", "(gA)", "(z0)", "(z1)", "(gB)", "(gB2)"};
+  t.fact_names = {"(m1)", "(m2)", "(m3)", "(s0)", "(s1)", "(w)",
+                  "(gA)", "(z0)", "(z1)", "(gB)", "(gB2)"};
   t.complement.assign(t.fact_names.size(), -1);
   auto op = [&](const char* name, std::vector<FactId> pre, std::vector<FactId> add) {
     Operator o;
@@ -261,6 +267,146 @@ TEST(Heuristic, SharedPreconditionNodesChangeNoValueNorHelpfulActionOnRandomWalk
     }
     EXPECT_GT(states, 500U);
     EXPECT_GT(positive, states);  // most states are neither goal states nor dead ends
+  }
+}
+
+TEST(Heuristic, HelpfulActionsAreTheApplicableAddersOfTheFirstLayerSubGoalsOnRandomWalks) {
+  // The helpful actions (the default order) are taken from the sub-goals' adders at layer 0
+  // rather than by testing every achiever for applicability: in every state of random walks
+  // (fixed seed) they must be distinct and applicable, and the same set as FF-v2.3's order
+  // gives (collected from the layer-0 effects separately). hiking-4: sub-goals with hundreds of
+  // achievers, shared-precondition nodes; openstacks: merged operators and nodes; gripper.
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"pddl-more/hiking/domain.pddl", "pddl-more/hiking/instance-4.pddl"},
+      {"pddl-more/openstacks/domain.pddl", "pddl-more/openstacks/instance-6.pddl"},
+      {"pddl/gripper/domain.pddl", "pddl/gripper/instance-4.pddl"},
+  };
+  for (const auto& [dom, prob] : cases) {
+    SCOPED_TRACE(prob);
+    auto s = PlanningSession::fromText(test::readFile(test::benchmarksDir() / dom),
+                                       test::readFile(test::benchmarksDir() / prob));
+    ASSERT_TRUE(s.ok());
+    Query q;
+    q.init = *(*s)->problemInit();
+    q.goal_formula = (*s)->problem().goal;
+    ASSERT_EQ((*s)->solve(q, Termination()).status, PlanStatus::kSolved);
+    const Task& t = *(*s)->task();
+    const StateBits init = initialStateByName(**s);
+    Goal goal;
+    GoalConjunct gc = goalFactsByName(**s);
+    ASSERT_EQ(gc.pos.size(), (*s)->problem().goal.children.size());
+    std::sort(gc.pos.begin(), gc.pos.end());
+    goal.conjuncts.push_back(gc);
+    auto h = makeHeuristic(HeuristicKind::kFF, t, CostType::kUnit);
+    h->setGoal(goal);
+    std::mt19937 rng(11);
+    std::vector<OpId> ops;
+    StateBits next(init.size());
+    size_t states = 0, with_helpful = 0;
+    for (int walk = 0; walk < 10; ++walk) {
+      StateBits cur = init;
+      for (int step = 0; step < 60; ++step) {
+        ASSERT_TRUE(h->setFFStyle(false));
+        const Cost v = h->evaluate(cur.data());
+        std::vector<OpId> helpful = h->preferred();
+        ASSERT_TRUE(h->setFFStyle(true));
+        ASSERT_EQ(h->evaluate(cur.data()), v);
+        std::vector<OpId> ff = h->preferred();
+        for (OpId o : helpful) ASSERT_TRUE(t.applicable(cur.data(), o)) << t.ops[o].name;
+        std::vector<OpId> sorted = helpful;
+        std::sort(sorted.begin(), sorted.end());
+        ASSERT_EQ(std::adjacent_find(sorted.begin(), sorted.end()), sorted.end())
+            << "walk " << walk << " step " << step;
+        std::sort(ff.begin(), ff.end());
+        ASSERT_EQ(sorted, ff) << "walk " << walk << " step " << step;
+        ++states;
+        with_helpful += helpful.empty() ? 0 : 1;
+        ops.clear();
+        t.applicableOps(cur.data(), ops);
+        if (ops.empty()) break;
+        t.apply(cur.data(), ops[rng() % ops.size()], next.data());
+        cur.swap(next);
+      }
+    }
+    EXPECT_GT(states, 200U);
+    EXPECT_GT(with_helpful * 2, states);
+  }
+}
+
+TEST(Landmarks, PreferredAmongTheApplicableOperatorsIsThePreferredSet) {
+  // preferredAmong (what the lazy search calls, with the applicable operators it generates
+  // anyway) gives the same operators as preferred (every adder of the landmarks in question
+  // tested for applicability), each once, in the order of the applicable operators: in every
+  // state of random walks (fixed seed). hiking-4: RHW landmarks (disjunctive), past and future;
+  // schedule-30: conditional effects, RHW and Zhu-Givan (accepted after parents); gripper-4.
+  struct Case {
+    std::string domain, problem;
+    bool rhw;
+  };
+  const std::vector<Case> cases = {
+      {"pddl-more/hiking/domain.pddl", "pddl-more/hiking/instance-4.pddl", true},
+      {"pddl-more/schedule/domain.pddl", "pddl-more/schedule/instance-30.pddl", true},
+      {"pddl-more/schedule/domain.pddl", "pddl-more/schedule/instance-30.pddl", false},
+      {"pddl/gripper/domain.pddl", "pddl/gripper/instance-4.pddl", false},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.problem + (c.rhw ? " rhw" : " zhu-givan"));
+    auto s = PlanningSession::fromText(test::readFile(test::benchmarksDir() / c.domain),
+                                       test::readFile(test::benchmarksDir() / c.problem));
+    ASSERT_TRUE(s.ok());
+    Query q;
+    q.init = *(*s)->problemInit();
+    q.goal_formula = (*s)->problem().goal;
+    ASSERT_EQ((*s)->solve(q, Termination()).status, PlanStatus::kSolved);
+    const Task& t = *(*s)->task();
+    const StateBits init = initialStateByName(**s);
+    Goal goal;
+    GoalConjunct gc = goalFactsByName(**s);
+    ASSERT_EQ(gc.pos.size(), (*s)->problem().goal.children.size());
+    std::sort(gc.pos.begin(), gc.pos.end());
+    goal.conjuncts.push_back(gc);
+    LandmarkCounter lm = c.rhw
+                             ? LandmarkCounter(t, rhwLandmarks(t, init, goal, RhwLandmarkOptions{}),
+                                               LandmarkProgression::kPastAndFuture)
+                             : LandmarkCounter(t, init, goal);
+    ASSERT_TRUE(lm.enabled());
+    std::mt19937 rng(5);
+    std::vector<OpId> ops, all, among;
+    StateBits next(init.size());
+    std::vector<uint64_t> status(lm.words()), next_status(lm.words());
+    size_t states = 0, with_preferred = 0;
+    for (int walk = 0; walk < 10; ++walk) {
+      StateBits cur = init;
+      lm.initial(cur.data(), status.data());
+      for (int step = 0; step < 40; ++step) {
+        ops.clear();
+        t.applicableOps(cur.data(), ops);
+        all.clear();
+        among.clear();
+        lm.preferred(cur.data(), status.data(), all);
+        lm.preferredAmong(cur.data(), status.data(), ops, among);
+        std::sort(all.begin(), all.end());
+        all.erase(std::unique(all.begin(), all.end()), all.end());
+        std::vector<OpId> sorted = among;
+        std::sort(sorted.begin(), sorted.end());
+        ASSERT_EQ(sorted, all) << "walk " << walk << " step " << step;
+        ASSERT_EQ(std::adjacent_find(sorted.begin(), sorted.end()), sorted.end());
+        size_t at = 0;  // in the order of the applicable operators
+        for (OpId o : among) {
+          while (at < ops.size() && ops[at] != o) ++at;
+          ASSERT_LT(at, ops.size());
+        }
+        ++states;
+        with_preferred += among.empty() ? 0 : 1;
+        if (ops.empty()) break;
+        t.apply(cur.data(), ops[rng() % ops.size()], next.data());
+        lm.progress(cur.data(), status.data(), next.data(), next_status.data());
+        cur.swap(next);
+        status.swap(next_status);
+      }
+    }
+    EXPECT_GT(states, 100U);
+    EXPECT_GT(with_preferred * 4, states);  // gripper-4 with Zhu-Givan's: 127 of 400
   }
 }
 

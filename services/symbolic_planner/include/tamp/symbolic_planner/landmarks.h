@@ -155,6 +155,13 @@ class LandmarkCounter {
   Cost value(const uint64_t* state, const uint64_t* status) const;
   /// Appends the preferred operators of `state` (see above) to `out`.
   void preferred(const uint64_t* state, const uint64_t* status, std::vector<OpId>& out) const;
+  /// The same operators as `preferred`, each once, in the order of `applicable`, which must be
+  /// every operator applicable in `state` (`Task::applicableOps`): marks the facts of the
+  /// landmarks in question and tests the applicable operators' effects, instead of testing every
+  /// adder of those facts for applicability (on hiking-16, 28 000 operators, the adders of a
+  /// landmark `at_person` are thousands, the applicable operators a few hundred).
+  void preferredAmong(const uint64_t* state, const uint64_t* status,
+                      const std::vector<OpId>& applicable, std::vector<OpId>& out) const;
 
  private:
   bool holds(uint32_t l, const uint64_t* state) const;
@@ -169,7 +176,9 @@ class LandmarkCounter {
   std::vector<uint32_t> parents_begin_, parents_;
   std::vector<uint32_t> gn_children_begin_, gn_children_;
   std::vector<uint32_t> reasonable_parents_begin_, reasonable_parents_;
-  mutable std::vector<uint64_t> now_;  ///< scratch of progress(): the landmarks that hold
+  mutable std::vector<uint64_t> now_;        ///< scratch of progress(): the landmarks that hold
+  mutable std::vector<uint32_t> fact_mark_;  ///< scratch of preferredAmong(): epoch per fact
+  mutable uint32_t fact_epoch_{0};
 };
 
 }  // namespace tamp::symbolic_planner

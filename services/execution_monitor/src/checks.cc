@@ -361,26 +361,9 @@ std::vector<robot::RobotState> stopAndTurn(const std::vector<robot::RobotState>&
   return out;
 }
 
-/// The robot's shapes `by` smaller on each side (boxes, cylinders, spheres; never below 1 mm).
+/// The robot's shapes `by` smaller on each side (see `world::shrunk`).
 collision::RobotGeometry shrunk(collision::RobotGeometry g, double by) {
-  if (by <= 0.0) return g;
-  for (auto& part : g.parts) {
-    world::Shape& sh = part.shape;
-    switch (sh.kind) {
-      case world::ShapeKind::kBox:
-        sh.size = (sh.size.array() - 2.0 * by).max(1e-3).matrix();
-        break;
-      case world::ShapeKind::kCylinder:
-        sh.radius = std::max(1e-3, sh.radius - by);
-        sh.height = std::max(1e-3, sh.height - 2.0 * by);
-        break;
-      case world::ShapeKind::kSphere:
-        sh.radius = std::max(1e-3, sh.radius - by);
-        break;
-      default:
-        break;  // prisms: as they are
-    }
-  }
+  for (auto& part : g.parts) part.shape = world::shrunk(part.shape, by);
   return g;
 }
 
@@ -425,6 +408,21 @@ std::vector<std::string> PathChecker::contactsAt(const robot::RobotState& state)
   robot_->linkPoses(state, poses_);
   scene_.setLinkPoses(poses_);
   return scene_.robotCollisions();
+}
+
+std::vector<std::string> PathChecker::startContactsAt(const robot::RobotState& state) {
+  std::vector<std::string> out = contactsAt(state);
+  if (!(params_.start_contact_m > 0.0)) return out;
+  // Nearest first, one distance query per object found (few objects are ever this near).
+  for (;;) {
+    const collision::DistanceResult d = scene_.robotDistance(collision::Filter::allBut(out));
+    if (!d.found() || d.distance > params_.start_contact_m ||
+        std::find(out.begin(), out.end(), d.object) != out.end())
+      break;
+    out.push_back(d.object);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
 }
 
 std::optional<PathChecker::Hit> PathChecker::firstContact(const SweptPath& path, double from,

@@ -284,7 +284,7 @@ struct ExecutionMonitor::Impl {
     a.path = makePath(c, state->state, robot);
     a.held_at_start = state->held_object_id;
     a.ignore = allowedContacts(c, state->held_object_id);
-    for (const auto& id : checker.contactsAt(state->state)) a.ignore.push_back(id);
+    for (const auto& id : checker.startContactsAt(state->state)) a.ignore.push_back(id);
     // The manipulated object's support: where it rests (pick) or will rest (place).
     if (const world::Object* o = world->findObject(c.object_id); o && c.kind == ActionKind::kPick) {
       for (const auto& id : checker.supportsOf(*o, o->pose)) a.ignore.push_back(id);

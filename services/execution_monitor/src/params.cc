@@ -35,7 +35,9 @@ const config::Schema<MonitorParams>& schema() {
     s.section("path_check", &P::path_check)
         .field("step_m", &PathCheckParams::step_m, inRange(0, 1, Ends::kOpenClosed, "m"))
         .field("step_rad", &PathCheckParams::step_rad, inRange(0, 1, Ends::kOpenClosed, "rad"))
-        .field("tolerance_m", &PathCheckParams::tolerance_m, inRange(0, 0.05, Ends::kClosed, "m"));
+        .field("tolerance_m", &PathCheckParams::tolerance_m, inRange(0, 0.05, Ends::kClosed, "m"))
+        .field("start_contact_m", &PathCheckParams::start_contact_m,
+               inRange(0, 0.05, Ends::kClosed, "m"));
     s.section("timeout", &P::timeout)
         .field("stddevs", &TimeoutParams::stddevs, nonNegative())
         .field("margin_s", &TimeoutParams::margin_s, positive())

@@ -155,6 +155,37 @@ TEST_F(ChecksTest, PathCheckFindsTheFirstObjectOnThePath) {
   EXPECT_EQ(checker.contactsAt(clear.at(crate_hit->fraction)), std::vector<std::string>{"crate"});
 }
 
+// What the planner found touching at the start (its robot is not shrunk; an object just put
+// down) is a few mm away from the monitor's shrunk robot: it counts as a start contact, which the
+// path may leave; an object a few cm away does not.
+TEST_F(ChecksTest, AnObjectJustOutOfReachOfTheShrunkRobotIsAStartContact) {
+  PathChecker checker(robot_, {});
+  checker.setWorld(withCrate(world_, "crate", 2.3, 1.2));
+  // Where the robot driving at the crate first touches it (bisection on the base's x).
+  auto at = [&](double x) {
+    robot::RobotState s = start_;
+    s.base = {x, 1.2, 0.0};
+    return s;
+  };
+  double free_x = 1.5, touching_x = 2.3;
+  ASSERT_TRUE(checker.contactsAt(at(free_x)).empty());
+  ASSERT_FALSE(checker.contactsAt(at(touching_x)).empty());
+  while (touching_x - free_x > 1e-4) {
+    const double mid = 0.5 * (free_x + touching_x);
+    (checker.contactsAt(at(mid)).empty() ? free_x : touching_x) = mid;
+  }
+  const std::vector<std::string> crate{"crate"};
+  EXPECT_TRUE(checker.contactsAt(at(free_x - 0.005)).empty());
+  EXPECT_EQ(checker.startContactsAt(at(free_x - 0.005)), crate);
+  EXPECT_EQ(checker.startContactsAt(at(touching_x)), crate);
+  EXPECT_TRUE(checker.startContactsAt(at(free_x - 0.03)).empty());
+  PathCheckParams exact;
+  exact.start_contact_m = 0.0;
+  PathChecker strict(robot_, exact);
+  strict.setWorld(withCrate(world_, "crate", 2.3, 1.2));
+  EXPECT_TRUE(strict.startContactsAt(at(free_x - 0.005)).empty());
+}
+
 // The base drives stop-and-turn (as the robot does): straight through the 0.7 m corridor at its
 // heading, then the turn to the goal's yaw in the open. A blend of yaw and position would turn
 // the 0.6 m base across the corridor and touch its walls.

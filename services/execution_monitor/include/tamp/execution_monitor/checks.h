@@ -95,6 +95,9 @@ class PathChecker {
 
   /// Objects touching the robot at `state` (sorted).
   std::vector<std::string> contactsAt(const robot::RobotState& state);
+  /// Objects touching the robot at `state` or within `PathCheckParams::start_contact_m` of it
+  /// (sorted): those an action starting at `state` may leave (see `start_contact_m`).
+  std::vector<std::string> startContactsAt(const robot::RobotState& state);
 
   struct Hit {
     std::string object_id;

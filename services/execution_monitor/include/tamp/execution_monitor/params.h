@@ -6,7 +6,7 @@
 ///   robot_description: ""        # robot description YAML ("" = the scenario's, else the default)
 ///   world_id: world              # the world model instance mirrored (tamp/world/*)
 ///   start_tolerance: {position_m: 0.05, angle_rad: 0.05}  # trajectory start vs robot state
-///   path_check: {step_m: 0.02, step_rad: 0.02}             # sampling of the swept path check
+///   path_check: {step_m: 0.02, step_rad: 0.02, tolerance_m: 0.005, start_contact_m: 0.01}  # see PathCheckParams
 ///   object_tolerance_m: 0.15     # pick: world-model object vs commanded object_target
 ///   moved_tolerance_m: 0.05      # while running: a known object counts as new when it moved more
 ///   timeout: {stddevs: 3.0, margin_s: 5.0, stall_s: 5.0, max_factor: 3.0}  # overrun: see TimeoutParams
@@ -42,6 +42,12 @@ struct PathCheckParams {
   /// millimetres: its checks sample the same motion differently, and a location a few cm from a
   /// table otherwise fails a path the planner proved free by 2 mm at the final turn.
   double tolerance_m{0.005};
+  /// m, in [0, 0.05]: at the start of an action, objects this near the (shrunk) robot count as
+  /// touching it, and the path may leave them. The planner's robot is not shrunk and it starts
+  /// from where the plan put things (an object it has just put down, at its planned placement):
+  /// what the planner found touching and left by its start escape is within `tolerance_m` of the
+  /// shrunk robot, plus the few mm between the planned placement and what perception sees.
+  double start_contact_m{0.01};
 };
 
 /// An action overruns when its elapsed time exceeds

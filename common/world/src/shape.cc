@@ -1,5 +1,6 @@
 #include "tamp/world/shape.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -210,6 +211,26 @@ bool operator==(const Shape& a, const Shape& b) {
       return a.height == b.height && a.polygon == b.polygon;
   }
   return false;
+}
+
+Shape shrunk(Shape sh, double by) {
+  if (!(by > 0.0)) return sh;
+  constexpr double kMin = 1e-3;
+  switch (sh.kind) {
+    case ShapeKind::kBox:
+      sh.size = (sh.size.array() - 2.0 * by).max(kMin).matrix();
+      break;
+    case ShapeKind::kCylinder:
+      sh.radius = std::max(kMin, sh.radius - by);
+      sh.height = std::max(kMin, sh.height - 2.0 * by);
+      break;
+    case ShapeKind::kSphere:
+      sh.radius = std::max(kMin, sh.radius - by);
+      break;
+    case ShapeKind::kPrism:
+      break;  // as it is
+  }
+  return sh;
 }
 
 bool samePose(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b, double tolerance) {

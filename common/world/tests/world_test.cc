@@ -60,6 +60,18 @@ TEST(ShapeTest, AabbOfRotatedBox) {
   EXPECT_NEAR(a.min.z(), 2.5, 1e-12);
 }
 
+TEST(ShapeTest, ShrunkIsSmallerOnEachSideAndNeverEmpty) {
+  const Shape box = shrunk(Shape::box(0.4, 0.2, 0.1), 0.01);
+  EXPECT_TRUE(box.size.isApprox(Eigen::Vector3d(0.38, 0.18, 0.08)));
+  const Shape cyl = shrunk(Shape::cylinder(0.035, 0.10), 0.005);
+  EXPECT_DOUBLE_EQ(cyl.radius, 0.03);
+  EXPECT_DOUBLE_EQ(cyl.height, 0.09);
+  EXPECT_DOUBLE_EQ(shrunk(Shape::sphere(0.002), 0.01).radius, 1e-3);
+  EXPECT_TRUE(shrunk(Shape::box(0.4, 0.2, 0.1), 0.0) == Shape::box(0.4, 0.2, 0.1));
+  const Shape prism = Shape::prism({{0, 0}, {1, 0}, {0, 1}}, 0.5);
+  EXPECT_TRUE(shrunk(prism, 0.01) == prism);
+}
+
 TEST(ShapeTest, VolumeAndPrismFootprint) {
   EXPECT_NEAR(Shape::cylinder(1, 2).volume(), 2 * M_PI, 1e-12);
   const Shape p = Shape::prism({{0, 0}, {0, 2}, {2, 2}, {2, 0}}, 0.5);  // clockwise in

@@ -828,11 +828,14 @@ struct Planning {
   detail::Oracle requestOracle();
   std::vector<double> sweepRadii() const;
   ob::SpaceInformationPtr makeSi(detail::Oracle& checker, bool full) const;
+  ob::SpaceInformationPtr sweptSi(detail::Oracle& checker) const;
   void setUpClearance();
   bool collides(const ob::State* s);
   collision::Scene& plainScene();
   std::string selfHit(const ob::State* s);
   void escapeTouchedMovables(const std::vector<int>& touching);
+  bool escapeNoDeeper(const std::vector<int>& touching);
+  bool escapeThrough(const std::vector<int>& touching);
   void escapeHeldMargin();
   bool checkGoal(ob::State* s, std::string& who);
   Outcome setStateGoal();
@@ -980,6 +983,22 @@ ob::SpaceInformationPtr Planning::makeSi(detail::Oracle& checker, bool full) con
   return info;
 }
 
+/// Full checks, and an arm's motions checked as the robot sweeps them (`arm_swept_step`), as the
+/// rest of its path is: a straight way out checked at `validity_resolution` moves a fingertip
+/// centimetres between two checks, across an object a few cm wide.
+ob::SpaceInformationPtr Planning::sweptSi(detail::Oracle& checker) const {
+  if (!(req.group == PlanningGroup::kArm && P.sampling.arm_swept_step > 0.0 && !sweep_radii.empty()))
+    return makeSi(checker, true);
+  auto info = std::make_shared<ob::SpaceInformation>(space);
+  info->setStateValidityChecker(std::make_shared<detail::OracleValidityChecker>(info, checker, true));
+  info->setStateValidityCheckingResolution(
+      std::min(1.0, P.sampling.validity_resolution / std::max(1e-9, space->getMaximumExtent())));
+  info->setMotionValidator(
+      std::make_shared<detail::SweptArmMotionValidator>(info, gs, sweep_radii, P.sampling.arm_swept_step));
+  info->setup();
+  return info;
+}
+
 void Planning::setUpClearance() {
   padded_scene = std::make_unique<collision::Scene>(impl.world);
   padded_scene->setRobot(grownGeometry(impl.robot.geometry(), P.sampling.base_clearance));
@@ -1052,8 +1071,42 @@ Outcome Planning::leaveStart() {
 }
 
 /// Out of the contact with the `touching` movables (indices into the oracle's), checked against
-/// everything else; `escaped` stays empty when there is no way out.
+/// everything else; `escaped` stays empty when there is no way out. A way out that goes no deeper
+/// into what it touches is taken first: a straight motion that slides a finger across an object
+/// just put down pushes it, and the robot is stopped before it. A start deeper in an object than
+/// `start_escape_depth` has no such way; it leaves through the objects it touches.
 void Planning::escapeTouchedMovables(const std::vector<int>& touching) {
+  const bool no_deeper = P.sampling.start_escape_depth > 0.0 && escapeNoDeeper(touching);
+  if (!no_deeper)
+    log::get("motion_planner")->debug("no way out of the start's contact going no deeper than {} m: through it",
+                                      P.sampling.start_escape_depth);
+  const bool left = no_deeper || escapeThrough(touching);
+  if (left)
+    for (int i : touching) res.start_contacts.push_back(oracle.movables()[static_cast<std::size_t>(i)].id);
+}
+
+/// The way out checked against everything, the touched objects `start_escape_depth` smaller.
+bool Planning::escapeNoDeeper(const std::vector<int>& touching) {
+  world::World w = impl.scene.world();
+  for (int i : touching) {
+    world::Object o = w.object(oracle.movables()[static_cast<std::size_t>(i)].id);
+    o.shape = world::shrunk(o.shape, P.sampling.start_escape_depth);
+    (void)w.updateObject(std::move(o));
+  }
+  collision::Scene smaller(impl.scene);
+  smaller.syncWorld(w);
+  detail::Oracle escape_oracle(smaller, gs, ignored, oracle.movables(), oracle.reachRadius());
+  if (held_shape) escape_oracle.setSelfScene(&plainScene());
+  escaped.reset(space->allocState());
+  const bool found = detail::escapeStart(si, sweptSi(escape_oracle), start.get(), P.sampling.start_escape_distance,
+                                         P.sampling.start_escape_attempts, escaped.get());
+  if (!found) escaped.reset();
+  gs.placeRobot(start.get(), impl.scene);
+  return found;
+}
+
+/// The way out checked against everything but the touched objects.
+bool Planning::escapeThrough(const std::vector<int>& touching) {
   std::vector<std::string> ignore = ignored;
   std::vector<detail::MovableInfo> others;
   for (std::size_t i = 0; i < oracle.movables().size(); ++i) {
@@ -1067,12 +1120,10 @@ void Planning::escapeTouchedMovables(const std::vector<int>& touching) {
   detail::Oracle escape_oracle(impl.scene, gs, ignore, std::move(others), oracle.reachRadius());
   if (held_shape) escape_oracle.setSelfScene(&plainScene());
   escaped.reset(space->allocState());
-  if (detail::escapeStart(si, makeSi(escape_oracle, true), start.get(), P.sampling.start_escape_distance,
-                          P.sampling.start_escape_attempts, escaped.get())) {
-    for (int i : touching) res.start_contacts.push_back(oracle.movables()[static_cast<std::size_t>(i)].id);
-  } else {
-    escaped.reset();
-  }
+  const bool found = detail::escapeStart(si, makeSi(escape_oracle, true), start.get(), P.sampling.start_escape_distance,
+                                         P.sampling.start_escape_attempts, escaped.get());
+  if (!found) escaped.reset();
+  return found;
 }
 
 /// Out of a contact that only the held object's margin makes; `escaped` stays empty when the

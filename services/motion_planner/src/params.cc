@@ -42,6 +42,7 @@ const config::Schema<MotionPlannerParams>& schema() {
         .field("workspace_margin", &S::workspace_margin, nonNegative())
         .field("start_escape_distance", &S::start_escape_distance, nonNegative())
         .field("start_escape_attempts", &S::start_escape_attempts, atLeast(1))
+        .field("start_escape_depth", &S::start_escape_depth, nonNegative())
         .field("direct_first", &S::direct_first)
         .field("arm_swept_step", &S::arm_swept_step, nonNegative())
         .field("base_clearance", &S::base_clearance, nonNegative())

@@ -148,6 +148,63 @@ TEST_F(ManipulationTest, BoxGraspsWithSampledBasePosesAreCollisionFree) {
   (void)side;
 }
 
+// Right after a release the fingers still touch the can (here 3 mm into it on each side). The
+// arm leaves it first by a straight motion that goes no deeper into it than
+// `start_escape_depth`: a way out sliding a finger across the can would push it (the robot is
+// stopped before it). Checked from several grasps, each escape sampled every 2 mrad of joint
+// motion against the can made that much smaller, less the planner's sweep resolution
+// (`arm_swept_step`: a point moves no more between two of its checks).
+TEST_F(ManipulationTest, AnArmStartingAgainstAnObjectLeavesItWithoutGoingDeeper) {
+  MotionPlanner mp = planner();
+  GraspRequest greq;
+  greq.object_id = "can";
+  greq.base_pose = Pose2D{1.05, 0.1, 0.0};
+  greq.max_grasps = 6;
+  auto grasps = mp.generateGrasps(greq, Termination::after(20.0));
+  ASSERT_TRUE(grasps.ok()) << grasps.error().toString();
+  ASSERT_GE(grasps->size(), 3u);
+  const double depth = mp.params().sampling.start_escape_depth;
+  ASSERT_GT(depth, 0.003);
+  world::World smaller = world_;
+  world::Object can = smaller.object("can");
+  can.shape = world::shrunk(can.shape, depth + mp.params().sampling.arm_swept_step);
+  ASSERT_TRUE(smaller.updateObject(can).ok());
+  collision::Scene scene(smaller);
+  scene.setRobot(model_->collisionGeometry());
+  std::vector<Eigen::Isometry3d> poses;
+  int escapes = 0;
+  for (const Grasp& g : *grasps) {
+    MotionRequest req;
+    req.group = PlanningGroup::kArm;
+    req.mode = MotionMode::kFull;
+    req.start = model_->defaultState(g.base_pose);
+    req.start.arm = g.grasp_configuration;
+    req.start.gripper = 0.5 * g.width - 0.003;
+    req.goal = MotionGoal::configurationGoal(g.pregrasp_configuration);
+    const MotionResult r = mp.plan(req, Termination::after(10.0));
+    if (!r.ok()) continue;  // no way out of this grasp: not what is tested
+    ASSERT_EQ(r.start_contacts, std::vector<std::string>{"can"}) << "the start does not touch the can";
+    ++escapes;
+    ASSERT_GE(r.path.waypoints.size(), 2u);
+    const auto& a = r.path.waypoints[0];
+    const auto& b = r.path.waypoints[1];
+    double d = 0;
+    for (std::size_t j = 0; j < a.size(); ++j) d = std::max(d, std::abs(b[j] - a[j]));
+    const int n = std::max(1, static_cast<int>(std::ceil(d / 0.002)));
+    for (int k = 1; k <= n; ++k) {
+      std::vector<double> q(a.size());
+      for (std::size_t j = 0; j < a.size(); ++j) q[j] = a[j] + (b[j] - a[j]) * k / n;
+      auto s = model_->fromJointValues(r.path.joint_names, q, req.start);
+      ASSERT_TRUE(s.ok()) << s.error().toString();
+      model_->linkPoses(*s, poses);
+      scene.setLinkPoses(poses);
+      ASSERT_FALSE(scene.robotInCollision(collision::Filter::objects({"can"})))
+          << "the way out goes deeper into the can, grasp " << escapes << ", step " << k << " of " << n;
+    }
+  }
+  EXPECT_GE(escapes, 3);
+}
+
 TEST_F(ManipulationTest, GraspErrorsNameTheProblem) {
   MotionPlanner mp = planner();
   GraspRequest req;

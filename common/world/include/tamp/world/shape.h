@@ -63,6 +63,10 @@ struct Shape {
   friend bool operator==(const Shape& a, const Shape& b);
 };
 
+/// `shape` `by` metres smaller on each side (boxes, cylinders, spheres; never below 1 mm per
+/// extent); prisms are returned as they are. `by` <= 0: unchanged.
+Shape shrunk(Shape shape, double by);
+
 /// Bitwise-equal poses (used by diffs); `tolerance` > 0 compares translation (m) and rotation
 /// (max matrix element) within it.
 bool samePose(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b, double tolerance = 0.0);

@@ -57,6 +57,10 @@ struct SamplingParams {
   /// the same). 0: such a start is kStartInCollision. >= 0.
   double start_escape_distance{0.15};
   int start_escape_attempts{400};  ///< >= 1
+  /// m, >= 0: the way out goes no deeper than this into the objects the start touches (it is
+  /// checked against them this much smaller, as the execution monitor checks a shrunk robot);
+  /// only when there is no such way does it leave through them. 0: always through them.
+  double start_escape_depth{0.005};
   /// Full mode: the direct motion from the start to a goal state (a straight line in joint
   /// space; for a stop-and-turn base, turn, drive, turn) is checked first and taken when it is
   /// free, before any sampling. Arm motions between nearby configurations usually are. Off by

@@ -204,6 +204,7 @@ Result<std::vector<PlacementOption>> DdsServiceClients::placements(const Placeme
   }
   req.approach(q.approach_m);
   for (const auto& o : q.overrides) req.object_overrides().push_back(toMsg(o));
+  req.world_version(q.world_version);
   auto rep = checked(placement_.call(req, dds::CallOptions{q.budget_s, {}}), dds::services::kPlacement.name);
   if (!rep) return rep.error();
   if (rep->header().code() != msg::StatusCode::STATUS_OK)
@@ -230,6 +231,7 @@ Result<std::vector<GraspOption>> DdsServiceClients::grasps(const GraspQuery& q) 
   if (q.base) req.base_pose(dds::toMsg(*q.base));
   req.max_grasps(q.max_grasps);
   for (const auto& o : q.overrides) req.object_overrides().push_back(toMsg(o));
+  req.world_version(q.world_version);
   auto rep = checked(grasp_.call(req, dds::CallOptions{q.budget_s, {}}), dds::services::kGrasp.name);
   if (!rep) return rep.error();
   if (rep->header().code() != msg::StatusCode::STATUS_OK)

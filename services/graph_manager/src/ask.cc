@@ -50,7 +50,8 @@ std::vector<MotionAnswer> GraphManager::askMotions(const std::vector<MotionQuery
   return out;
 }
 
-Result<std::vector<GraspOption>> GraphManager::askGrasps(const GraspQuery& q) {
+Result<std::vector<GraspOption>> GraphManager::askGrasps(GraspQuery q) {
+  q.world_version = world_version_;
   if (const std::vector<GraspOption>* kept = params_.memoise_answers ? memo_.grasps(q) : nullptr) {
     ++counters_.memo_hits;
     return *kept;
@@ -59,6 +60,12 @@ Result<std::vector<GraspOption>> GraphManager::askGrasps(const GraspQuery& q) {
   auto g = services_.grasps(q);
   if (g && params_.memoise_answers) memo_.keep(q, *g);
   return g;
+}
+
+Result<std::vector<PlacementOption>> GraphManager::askPlacements(PlacementQuery q) {
+  q.world_version = world_version_;
+  ++counters_.placement_calls;
+  return services_.placements(q);
 }
 
 }  // namespace tamp::graph_manager

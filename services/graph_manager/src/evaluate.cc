@@ -359,9 +359,8 @@ std::optional<std::pair<GraspOption, Eigen::Isometry3d>> GraphManager::sampledPl
     pq.object_T_tool = ctx.held.link_T_object.inverse();
     pq.approach_m = params_.approach_m;
     pq.overrides = overridesOf(ctx, object);
-    ++counters_.placement_calls;
     entry.asked = pq.max_placements;
-    auto p = services_.placements(pq);
+    auto p = askPlacements(pq);
     entry.exhausted = !p || p->size() < pq.max_placements;
     if (!p) {  // the placements kept from a smaller request stay
       entry.why = "placements of " + object + " on " + region + ": " + p.error().message;

@@ -131,8 +131,7 @@ std::vector<std::string> GraphManager::placeSlots(const world::Object& o, const 
     pq.keep_clear_path = swept;
     pq.keep_clear_radius = radius;
     pq.max_placements = static_cast<unsigned>(params_.placements_per_object);
-    ++counters_.placement_calls;
-    auto ps = services_.placements(pq);
+    auto ps = askPlacements(pq);
     if (!ps) continue;
     for (const auto& p : *ps) {
       if (static_cast<int>(slots.size()) >= params_.placements_per_object) break;

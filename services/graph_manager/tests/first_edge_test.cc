@@ -102,10 +102,13 @@ class ScriptedServices : public ServiceClients {
     }
     return a;
   }
-  Result<std::vector<PlacementOption>> placements(const PlacementQuery&) override {
+  std::vector<std::uint64_t> placement_versions, grasp_versions;  ///< world_version of each
+  Result<std::vector<PlacementOption>> placements(const PlacementQuery& q) override {
+    placement_versions.push_back(q.world_version);
     return std::vector<PlacementOption>{};
   }
   Result<std::vector<GraspOption>> grasps(const GraspQuery& q) override {
+    grasp_versions.push_back(q.world_version);
     GraspOption g;
     g.base_pose = q.base ? *q.base : Pose2D{};
     g.pregrasp = pregrasp;
@@ -448,8 +451,8 @@ class DrivingExecutor : public Executor {
 // The services are asked in the world model the graph manager planned in: a motion planner whose
 // mirror lags behind (a host that discovered the world model later) waits for that version
 // instead of answering from an older or empty world. The two-host CI run drove into a box that
-// the motion planner had not received yet: no question carried a version. So do the commands,
-// which the monitor validates.
+// the motion planner had not received yet: no question carried a version. So do the grasp and
+// placement questions, and the commands, which the monitor validates.
 TEST(MissionWorldVersionTest, MotionQuestionsAndCommandsCarryTheWorldVersionTheGraphPlannedIn) {
   auto sc = world::loadScenario(configDir() / "scenarios" / "namo_corridor.yaml");
   ASSERT_TRUE(sc.ok()) << sc.error().toString();
@@ -458,6 +461,7 @@ TEST(MissionWorldVersionTest, MotionQuestionsAndCommandsCarryTheWorldVersionTheG
   Abstraction a(sc->plannerWorld(), *robot);
   ScriptedServices services;
   services.plans = {{"(move_base start goal)"}};
+  services.box_immovable = true;
   GraphManagerParams params;
   params.max_contingencies = 0;
   params.concurrent_motions = false;
@@ -475,6 +479,12 @@ TEST(MissionWorldVersionTest, MotionQuestionsAndCommandsCarryTheWorldVersionTheG
   for (std::uint64_t v : services.world_versions) EXPECT_EQ(v, 7u);
   ASSERT_EQ(robot_x.world_versions.size(), 1u);
   EXPECT_EQ(robot_x.world_versions.front(), 7u);
+  // The box in the way can be neither carried nor pushed: placements and grasps were asked for it,
+  // in the same world.
+  ASSERT_FALSE(services.placement_versions.empty());
+  ASSERT_FALSE(services.grasp_versions.empty());
+  for (std::uint64_t v : services.placement_versions) EXPECT_EQ(v, 7u);
+  for (std::uint64_t v : services.grasp_versions) EXPECT_EQ(v, 7u);
 }
 
 /// A mission on namo_corridor from start to goal over scripted services (straight drives),

@@ -374,7 +374,7 @@ msg::PlacementReply MotionPlannerNode::handlePlacement(const msg::PlacementReque
                                                       const dds::RequestContext& ctx) {
   if (Status bad = msgv::screen(req, dds::services::kPlacement.name, rejects_); !bad.ok())
     return errorReply<msg::PlacementReply>(bad.error());
-  auto term = termination(0, ctx);
+  auto term = termination(req.world_version(), ctx);
   if (!term) return errorReply<msg::PlacementReply>(term.error());
   auto lease = acquire(*term);
   if (!lease) return errorReply<msg::PlacementReply>(busy());
@@ -390,7 +390,7 @@ msg::PlacementReply MotionPlannerNode::handlePlacement(const msg::PlacementReque
 msg::GraspReply MotionPlannerNode::handleGrasp(const msg::GraspRequest& req, const dds::RequestContext& ctx) {
   if (Status bad = msgv::screen(req, dds::services::kGrasp.name, rejects_); !bad.ok())
     return errorReply<msg::GraspReply>(bad.error());
-  auto term = termination(0, ctx);
+  auto term = termination(req.world_version(), ctx);
   if (!term) return errorReply<msg::GraspReply>(term.error());
   auto lease = acquire(*term);
   if (!lease) return errorReply<msg::GraspReply>(busy());

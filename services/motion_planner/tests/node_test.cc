@@ -181,10 +181,26 @@ TEST_F(NodeTest, MalformedRequestsGetInvalidRequestNamingTheField) {
 }
 
 TEST_F(NodeTest, PlacementAndGraspRequests) {
-  // Make sure the world is there (a motion call waits for its version).
-  ASSERT_TRUE(motion_->call(lazyRequest(), dds::CallOptions{30.0, {}}).ok());
   dds::RpcClient<msg::PlacementRequest, msg::PlacementReply> placement(client_, dds::services::kPlacement);
   msg::PlacementRequest pr;
+  // Asked in a world version the node has not received: it waits (world_wait_s), then says so.
+  pr.world_version(publisher_->publishedVersion() + 1000);
+  pr.object_id("crate");
+  pr.region_id("floor");
+  auto early = placement.call(pr, dds::CallOptions{30.0, {}});
+  ASSERT_FALSE(early.ok());
+  EXPECT_EQ(early.error().code, ErrorCode::kUnavailable) << early.error().toString();
+  EXPECT_NE(early.error().message.find("world_version"), std::string::npos) << early.error().toString();
+  dds::RpcClient<msg::GraspRequest, msg::GraspReply> grasp_early(client_, dds::services::kGrasp);
+  msg::GraspRequest ge;
+  ge.object_id("crate");
+  ge.world_version(publisher_->publishedVersion() + 1000);
+  auto g_early = grasp_early.call(ge, dds::CallOptions{30.0, {}});
+  ASSERT_FALSE(g_early.ok());
+  EXPECT_EQ(g_early.error().code, ErrorCode::kUnavailable) << g_early.error().toString();
+  // In the version published (the request waits for the world to be there).
+  pr = msg::PlacementRequest();
+  pr.world_version(publisher_->publishedVersion());
   pr.object_id("crate");
   pr.region_id("floor");
   for (double x = 2.0; x <= 8.0; x += 0.2) pr.keep_clear_path().push_back(dds::toMsg(Pose2D{x, 2.0, 0.0}));

@@ -118,6 +118,7 @@ struct PlacementQuery {
   std::optional<Eigen::Isometry3d> object_T_tool;  ///< with base: the grasp the object is held with
   double approach_m{0.0};                          ///< pre-place height above the place pose
   std::vector<ObjectOverride> overrides;           ///< the branch's hypothetical world
+  std::uint64_t world_version{0};                  ///< answered in this world model version or later (0: any)
 };
 
 struct PlacementOption {
@@ -134,6 +135,7 @@ struct GraspQuery {
   unsigned max_grasps{4};
   double budget_s{3.0};
   std::vector<ObjectOverride> overrides;  ///< the branch's hypothetical world
+  std::uint64_t world_version{0};         ///< answered in this world model version or later (0: any)
 };
 
 struct GraspOption {

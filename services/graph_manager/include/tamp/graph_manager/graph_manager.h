@@ -535,7 +535,9 @@ class GraphManager {
   MotionQuery withHeldMargin(MotionQuery q) const;
   /// Independent motion queries at once (ServiceClients::motions), those not in the memo.
   std::vector<MotionAnswer> askMotions(const std::vector<MotionQuery>& qs);
-  Result<std::vector<GraspOption>> askGrasps(const GraspQuery& q);
+  /// Grasps and placements asked in the world model version the graph plans in (as motions).
+  Result<std::vector<GraspOption>> askGrasps(GraspQuery q);
+  Result<std::vector<PlacementOption>> askPlacements(PlacementQuery q);
   MotionQuery baseQuery(const Edge& e, const BranchContext& ctx) const;
   std::vector<std::string> withStatics(const std::vector<std::string>& dynamic) const;
   void recordDecisions(NodeId from, const std::map<EdgeId, double>& best_through, const std::vector<EdgeId>& branch,

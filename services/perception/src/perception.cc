@@ -73,6 +73,12 @@ double footprintMajor(const world::Shape& s) {
   const Aabb b = s.localAabb();
   return std::max(b.max.x() - b.min.x(), b.max.y() - b.min.y());
 }
+/// The farthest point of the footprint from the shape's centre (m).
+double footprintReach(const world::Shape& s) {
+  double r = 0.0;
+  for (const auto& v : s.footprint(16)) r = std::max(r, v.norm());
+  return r;
+}
 double footprintMinor(const world::Shape& s) {
   const Aabb b = s.localAabb();
   return std::min(b.max.x() - b.min.x(), b.max.y() - b.min.y());
@@ -986,7 +992,10 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
     }
     const double moved = (t.event_pose.translation() - t.pose.translation()).norm();
     const double turned = yawError(t.shape, yawOf(t.event_pose), yawOf(t.pose));
-    if (moved > T.move_event_distance || turned > T.move_event_angle) {
+    // A turn is an event when it also moves the footprint's farthest point as far as a move
+    // would: the fitted yaw of a small box wobbles by more than the angle without moving it.
+    const bool turned_far = turned > T.move_event_angle && turned * footprintReach(t.shape) > T.move_event_distance;
+    if (moved > T.move_event_distance || turned_far) {
       char why[200];
       std::snprintf(why, sizeof(why), "moved %.2f m, turned %.2f rad, now at %s", moved, turned,
                     describePose(t.pose).c_str());

@@ -100,14 +100,16 @@ struct TrackingParams {
   int gone_frames{2};              ///< frames its place is seen empty before an object is gone, >= 1
   double smoothing{0.5};           ///< weight of a new measurement in (0, 1]
   double snap_distance{0.08};      ///< m, a larger jump replaces the pose (the object was moved)
-  /// A known-size object keeps its pose when at least `explained_fraction` of a detection's
-  /// points lie within `explained_margin` of it where it stands (a partial view is no motion).
+  /// A known-size object (or one grown from views that no longer grow it) keeps its pose when at
+  /// least `explained_fraction` of a detection's points lie within `explained_margin` of it where
+  /// it stands (a partial view is no motion).
   double explained_margin{0.02};   ///< m, > 0
   double explained_fraction{0.9};  ///< in (0, 1]
   double update_distance{0.01};    ///< m, world pose updated when the track moved this much
   double update_angle{0.05};       ///< rad
   double move_event_distance{0.10};  ///< m, a MOVED event when the object moved this much
-  double move_event_angle{0.35};     ///< rad
+  /// rad: ... or turned this much, and its footprint's farthest point by `move_event_distance`
+  double move_event_angle{0.35};
   // Visibility test of an expected object (is its place seen, empty, or hidden?).
   double visibility_bin{0.01};     ///< angular bin, tangent units (~0.6 deg), > 0
   double visibility_margin{0.05};  ///< m, range margin of the see-through/occluded tests, > 0

@@ -97,6 +97,16 @@ StaticRoadmap::StaticRoadmap(ob::StateSpacePtr space, StaticWorldKey key, std::u
   });
 }
 
+namespace {
+/// Whether any of `boxes`, grown by `r` in x and y, meets the rectangle [x0, x1] x [y0, y1]: the
+/// rigid robot at a base pose in it (reach radius `r`) may touch that box.
+bool nearAny(const std::vector<Aabb>& boxes, double r, double x0, double y0, double x1, double y1) {
+  return std::any_of(boxes.begin(), boxes.end(), [&](const Aabb& b) {
+    return !(b.max.x() + r < x0 || b.min.x() - r > x1 || b.max.y() + r < y0 || b.min.y() - r > y1);
+  });
+}
+}  // namespace
+
 bool StaticRoadmap::syncMovables(const Oracle& oracle, std::vector<int>& g2r) {
   if (!oracle.rigid()) return false;
   if (!mcache_) mcache_ = std::make_unique<MovableCache>();
@@ -140,14 +150,9 @@ bool StaticRoadmap::syncMovables(const Oracle& oracle, std::vector<int>& g2r) {
   if (!changed.empty()) {
     auto drop = [&](std::vector<MovableCache::Entry>& entries) {
       for (auto& e : entries) {
-        if (!e.cached) continue;
-        for (const Aabb& b : changed) {
-          const double r = c.reach;
-          if (b.max.x() + r < e.x0 || b.min.x() - r > e.x1 || b.max.y() + r < e.y0 || b.min.y() - r > e.y1) continue;
-          e.cached = false;
-          e.touched.clear();
-          break;
-        }
+        if (!e.cached || !nearAny(changed, c.reach, e.x0, e.y0, e.x1, e.y1)) continue;
+        e.cached = false;
+        e.touched.clear();
       }
     };
     drop(c.nodes);
@@ -181,11 +186,7 @@ std::size_t StaticRoadmap::deriveFrom(const StaticRoadmap& base, Oracle& oracle,
   if (!nodes_.empty()) throw std::logic_error("StaticRoadmap::deriveFrom: the roadmap is not empty");
   if (!oracle.rigid()) throw std::logic_error("StaticRoadmap::deriveFrom: not a rigid base group");
   const double r = oracle.reachRadius();
-  auto near = [&](double x0, double y0, double x1, double y1) {
-    return std::any_of(added.begin(), added.end(), [&](const Aabb& b) {
-      return !(b.max.x() + r < x0 || b.min.x() - r > x1 || b.max.y() + r < y0 || b.min.y() - r > y1);
-    });
-  };
+  auto near = [&](double x0, double y0, double x1, double y1) { return nearAny(added, r, x0, y0, x1, y1); };
   std::vector<int> remap(base.nodes_.size(), -1);
   std::vector<Pose2D> at(base.nodes_.size());
   std::size_t dropped = 0;

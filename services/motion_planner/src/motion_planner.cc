@@ -845,6 +845,7 @@ struct Planning {
   void ensureSampled();
   void densify(og::PathGeometric& path, int s, const std::vector<int>& goals, const std::vector<int>& objects);
   void tryDirect();
+  bool directKeepsClear(const ob::State* from, const ob::State* to);
   Outcome sample(const Stopwatch& phase, bool solved);
   og::PathGeometric improveByRoadmap(const og::PathGeometric& raw, const detail::PathCost& raw_cost);
   void simplify(og::PathGeometric& path);
@@ -876,6 +877,9 @@ struct Planning {
   // whose object rides on the base and drives into contact).
   std::unique_ptr<collision::Scene> padded_scene;
   std::unique_ptr<detail::Oracle> padded_oracle;
+  std::unique_ptr<collision::Scene> direct_scene;  // the robot grown by direct_clearance
+  std::unique_ptr<detail::Oracle> direct_oracle;
+  ob::SpaceInformationPtr direct_si;
   std::shared_ptr<detail::ClearanceValidityChecker> clearance;
   StatePtr start;
   // The request's scene with the held object as modelled (no margin), built when first needed:
@@ -1377,11 +1381,32 @@ void Planning::tryDirect() {
   if (lazy || !P.sampling.direct_first || termination()) return;
   const ob::State* from = escaped ? escaped.get() : start.get();
   for (const ob::State* g : goal_states) {
-    if (!si->checkMotion(from, g)) continue;
+    if (!si->checkMotion(from, g) || !directKeepsClear(from, g)) continue;
     direct.emplace(si, from, g);
     res.stats.direct = true;
     break;
   }
+}
+
+/// An arm's direct motion is taken only when the robot grown by `direct_clearance` sweeps it
+/// free: a straight joint-space motion runs as close to what it passes as the check allows, and
+/// objects are where perception saw them to within centimetres (right after a place, the fingers
+/// swept past the object just put down and the robot was stopped before it). Sampled paths are
+/// shortcut too, but from a tree grown through free space.
+bool Planning::directKeepsClear(const ob::State* from, const ob::State* to) {
+  if (!gs.movesArm() || !(P.sampling.direct_clearance > 0.0)) return true;
+  if (!direct_si) {
+    direct_scene = std::make_unique<collision::Scene>(impl.world);
+    direct_scene->setRobot(grownGeometry(impl.robot.geometry(), P.sampling.direct_clearance));
+    if (!held.empty()) (void)direct_scene->attach(held, held_link, link_T_held);
+    direct_oracle = std::make_unique<detail::Oracle>(*direct_scene, gs, ignored, oracle.movables(), oracle.reachRadius());
+    // Contacts of the robot with itself as modelled: grown, its links touch one another.
+    direct_oracle->setSelfScene(held_shape ? &plainScene() : &impl.scene);
+    direct_si = sweptSi(*direct_oracle);
+  }
+  const bool clear = direct_si->checkMotion(from, to);
+  gs.placeRobot(start.get(), impl.scene);
+  return clear;
 }
 
 /// Unless `solved`: the sampling planner in doubling time slices until it finds a path, a proof

@@ -44,6 +44,7 @@ const config::Schema<MotionPlannerParams>& schema() {
         .field("start_escape_attempts", &S::start_escape_attempts, atLeast(1))
         .field("start_escape_depth", &S::start_escape_depth, nonNegative())
         .field("direct_first", &S::direct_first)
+        .field("direct_clearance", &S::direct_clearance, nonNegative())
         .field("arm_swept_step", &S::arm_swept_step, nonNegative())
         .field("base_clearance", &S::base_clearance, nonNegative())
         .field("base_clearance_near_ends", &S::base_clearance_near_ends, nonNegative())

@@ -115,6 +115,54 @@ TEST_F(ArmTest, ANearbyFreeConfigurationIsReachedByTheDirectMotion) {
   for (std::size_t j = 0; j < goal.size(); ++j) EXPECT_NEAR(r.path.waypoints.back()[j], goal[j], 1e-9);
 }
 
+// A block placed just beyond the direct motion's sweep (found by moving it out from the tool, at
+// the motion's middle, until the direct motion with no clearance is free): the direct motion
+// passes it by millimetres, and with `direct_clearance` it is not taken; the motion is sampled
+// and still solved.
+TEST_F(ArmTest, TheDirectMotionKeepsItsClearanceOrIsNotTaken) {
+  MotionPlannerParams p;
+  p.sampling.direct_first = true;
+  p.sampling.direct_clearance = 0.0;
+  const robot::RobotState start = model_->defaultState(Pose2D{0, 0, 0});
+  std::vector<double> goal = start.arm;
+  goal[0] += 0.3;
+  robot::RobotState mid = start;
+  mid.arm[0] += 0.15;
+  const Eigen::Vector3d tool = model_->toolPoseInWorld(mid).translation();
+  const Eigen::Vector3d out = Eigen::Vector3d(tool.x(), tool.y(), 0.0).normalized();
+  MotionRequest req;
+  req.group = PlanningGroup::kArm;
+  req.mode = MotionMode::kFull;
+  req.start = start;
+  req.goal = MotionGoal::configurationGoal(goal);
+  auto withBlock = [&](double d) {
+    world::World w = world_;
+    world::Object block = testing::box("block", 0, 0, 0.03, 0.03, true, 0.03, 0.1);
+    block.pose.translation() = tool + d * out;
+    EXPECT_TRUE(w.addObject(block).ok());
+    return w;
+  };
+  double d = 0.0;
+  for (; d < 0.3; d += 0.004) {
+    MotionPlanner plain(*model_, p);
+    plain.setWorld(withBlock(d));
+    const MotionResult r = plain.plan(req, Termination::after(10.0));
+    if (r.ok() && r.stats.direct) break;  // (near the tool the goal itself touches the block)
+  }
+  ASSERT_LT(d, 0.3) << "the direct motion was never free";
+  ASSERT_GT(d, 0.0) << "the block did not touch the direct motion at the tool";
+  p.sampling.direct_clearance = MotionPlannerParams{}.sampling.direct_clearance;
+  ASSERT_GT(p.sampling.direct_clearance, 0.01);
+  MotionPlanner careful(*model_, p);
+  careful.setWorld(withBlock(d));
+  const MotionResult r = careful.plan(req, Termination::after(10.0));
+  ASSERT_EQ(r.status, MotionStatus::kSolved) << r.reason;
+  EXPECT_FALSE(r.stats.direct) << "taken " << d << " m out from the tool";
+  MotionPlanner far(*model_, p);
+  far.setWorld(withBlock(d + 0.1));
+  EXPECT_TRUE(far.plan(req, Termination::after(10.0)).stats.direct) << "a block 10 cm further out";
+}
+
 // The margin of a held object keeps it off the world, not off the robot that holds it: a small
 // block in the hand, grown by 12 cm into the wrist and fingers, still moves (its contacts with
 // the robot are checked as modelled). Grown into the table, the start is left first.

@@ -67,6 +67,10 @@ struct SamplingParams {
   /// default: a direct arm motion right after a place swept the fingers past the object just put
   /// down with no clearance, and the robot was stopped before it (holding_unknown, 3 of 12 runs).
   bool direct_first{false};
+  /// m, >= 0: with `direct_first`, an arm's direct motion is taken only when the robot grown
+  /// sideways by this much sweeps it free (objects are where perception saw them, to within
+  /// centimetres); else the motion is sampled. 0: no clearance asked.
+  double direct_clearance{0.02};
   /// Full-mode arm paths are checked again as the robot sweeps them: no point of the robot or
   /// the held object moves more than this (m) between two checked states (the simulator stops
   /// before a contact at 1 cm); a segment that touches something is planned again at that

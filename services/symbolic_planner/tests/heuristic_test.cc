@@ -349,6 +349,82 @@ TEST(Heuristic, HelpfulActionsAreTheApplicableAddersOfTheFirstLayerSubGoalsOnRan
   }
 }
 
+TEST(Heuristic, RelaxedPlanPreferredAreTheRelaxedPlansApplicableOperatorsOnRandomWalks) {
+  // setRelaxedPlanPreferred (LAMA's preferred operators: the relaxed plan's applicable
+  // operators) against FF's helpful actions, for FF's layered graph (unit costs) and the relaxed
+  // plan through h_add's best supporters (cost + 1 on tasks whose costs differ): in every state
+  // of random walks (fixed seed) the same h; the relaxed plan's operators are distinct,
+  // applicable and among the helpful actions, at most h of them (unit costs: one per
+  // relaxed-plan operator), at least one whenever 0 < h < dead end; on hiking and transport in
+  // some states strictly fewer than the helpful actions (a sub-goal such as "a person at a
+  // place" has several applicable adders, the relaxed plan uses one; on gripper and pegsol each
+  // sub-goal here has one). Switching back gives FF's helpful actions again.
+  struct Case {
+    std::string domain, problem;
+    CostType cost_type;
+    bool fewer;  // some state has fewer relaxed-plan operators than helpful actions
+  };
+  const std::string hiking = "pddl-more/hiking/", transport = "pddl-more/transport/";
+  const std::vector<Case> cases = {
+      {"pddl/gripper/domain.pddl", "pddl/gripper/instance-4.pddl", CostType::kUnit, false},
+      {hiking + "domain.pddl", hiking + "instance-4.pddl", CostType::kUnit, true},
+      {"pddl-more/pegsol/domain.pddl", "pddl-more/pegsol/instance-6.pddl", CostType::kPlusOne,
+       false},
+      {transport + "domain.pddl", transport + "instance-6.pddl", CostType::kPlusOne, true},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.problem + (c.cost_type == CostType::kUnit ? " layered" : " h_add supporters"));
+    SolvedInstance in;
+    ASSERT_NO_FATAL_FAILURE(loadSolvedInstance(c.domain, c.problem, in));
+    const Task& t = in.task();
+    auto h = makeHeuristic(HeuristicKind::kFF, t, c.cost_type);
+    h->setGoal(in.goal);
+    size_t states = 0, fewer = 0;
+    forEachRandomWalkState(
+        t, in.init, /*seed=*/3, /*walks=*/10, /*steps=*/40,
+        [&](const StateBits& cur, int walk, int step) {
+          ASSERT_TRUE(h->setRelaxedPlanPreferred(false));
+          const Cost v = h->evaluate(cur.data());
+          std::vector<OpId> helpful = h->preferred();
+          ASSERT_TRUE(h->setRelaxedPlanPreferred(true));
+          ASSERT_EQ(h->evaluate(cur.data()), v) << "walk " << walk << " step " << step;
+          std::vector<OpId> plan = h->preferred();
+          for (OpId o : plan) ASSERT_TRUE(t.applicable(cur.data(), o)) << t.ops[o].name;
+          std::sort(plan.begin(), plan.end());
+          std::sort(helpful.begin(), helpful.end());
+          ASSERT_EQ(std::adjacent_find(plan.begin(), plan.end()), plan.end());
+          ASSERT_TRUE(std::includes(helpful.begin(), helpful.end(), plan.begin(), plan.end()))
+              << "walk " << walk << " step " << step;
+          if (v > 0 && v != Heuristic::kDeadEnd) {
+            ASSERT_FALSE(plan.empty()) << "walk " << walk << " step " << step;
+            if (c.cost_type == CostType::kUnit) {
+              ASSERT_LE(static_cast<Cost>(plan.size()), v);
+            }
+          }
+          fewer += plan.size() < helpful.size() ? 1 : 0;
+          ASSERT_TRUE(h->setRelaxedPlanPreferred(false));
+          ASSERT_EQ(h->evaluate(cur.data()), v);
+          std::vector<OpId> again = h->preferred();
+          std::sort(again.begin(), again.end());
+          ASSERT_EQ(again, helpful);
+          ++states;
+        });
+    if (HasFatalFailure()) return;
+    EXPECT_GT(states, 50U);
+    if (c.fewer) {
+      EXPECT_GT(fewer, 0U);
+    }
+  }
+  // Heuristics without helpful actions have no such variant.
+  SolvedInstance in;
+  ASSERT_NO_FATAL_FAILURE(
+      loadSolvedInstance("pddl/gripper/domain.pddl", "pddl/gripper/instance-4.pddl", in));
+  EXPECT_FALSE(makeHeuristic(HeuristicKind::kAdd, in.task(), CostType::kUnit)
+                   ->setRelaxedPlanPreferred(true));
+  EXPECT_FALSE(makeHeuristic(HeuristicKind::kBlind, in.task(), CostType::kUnit)
+                   ->setRelaxedPlanPreferred(true));
+}
+
 TEST(Landmarks, PreferredAmongTheApplicableOperatorsIsThePreferredSet) {
   // preferredAmong (what the lazy search calls, with the applicable operators it generates
   // anyway) gives the same operators as preferred (every adder of the landmarks in question

@@ -191,7 +191,6 @@ int main(int argc, char** argv) {
   size_t rhw_max_disjunction = defaults.rhw.max_disjunction_size;
   bool rhw_no_zg = !defaults.rhw.add_zhu_givan, rhw_keep_one_action = !defaults.rhw.skip_one_action_disjunctions;
   bool rhw_reasonable = defaults.rhw.reasonable_orders;
-  bool landmark_preferred = defaults.landmark_preferred, lazy_plan_preferred = defaults.lazy_plan_preferred;
   app.add_option("--landmarks", landmark_generator,
                  "lazy: the landmarks counted: rhw (Richter-Helmert-Westphal: disjunctive landmarks, greedy-necessary "
                  "orders, landmarks required again) or zg (Zhu-Givan fact landmarks)")
@@ -205,12 +204,6 @@ int main(int argc, char** argv) {
   app.add_option("--rhw-reasonable-orders", rhw_reasonable,
                  "lazy with rhw: reasonable orders (Hoffmann et al.'s, from h^2 mutexes) between the landmarks: "
                  "true or false");
-  app.add_option("--landmark-preferred", landmark_preferred,
-                 "lazy: the landmark count's preferred operators (achievers of the landmarks still needed) join "
-                 "h_FF's: true or false (default, as lama-first)");
-  app.add_option("--lazy-plan-preferred", lazy_plan_preferred,
-                 "ehc: the lazy search beside or after the hill-climbing prefers the relaxed plan's applicable "
-                 "operators (LAMA's): true (default) or false (FF's helpful actions)");
   app.add_flag("--no-ehc-lazy-beside", no_lazy_beside,
                "ehc: the lazy search only after the hill-climbing fails (FF's order), not beside it");
   app.add_option("--ehc-lazy-after", lazy_after,
@@ -256,8 +249,6 @@ int main(int argc, char** argv) {
   req.search.rhw.add_zhu_givan = !rhw_no_zg;
   req.search.rhw.skip_one_action_disjunctions = !rhw_keep_one_action;
   req.search.rhw.reasonable_orders = rhw_reasonable;
-  req.search.landmark_preferred = landmark_preferred;
-  req.search.lazy_plan_preferred = lazy_plan_preferred;
   req.search.ehc_lazy_beside = !no_lazy_beside;
   req.search.ehc_lazy_after = lazy_after;
   req.search.ehc_lazy_turn_ehc = lazy_turn_ehc;

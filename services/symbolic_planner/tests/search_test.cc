@@ -336,7 +336,6 @@ TEST(Search, LazySearchWithRhwLandmarksNeedsFewerEvaluations) {
     SCOPED_TRACE(folder);
     PlanRequest req = benchmarkRequest(folder, instance);
     req.search.algorithm = SearchAlgorithm::kLazy;
-    req.search.landmark_preferred = true;  // the counts here: with them, until the nineteenth round
     req.timeout_seconds = 120;
     ASSERT_EQ(req.search.landmark_generator, LandmarkGenerator::kRhw);  // the default
     ASSERT_TRUE(req.search.rhw.reasonable_orders);                       // the default
@@ -409,7 +408,6 @@ TEST(Search, EhcFallbackInsideAGoalAgendaEntryIsFinal) {
   PlanRequest req = benchmarkRequest("pddl-more/psr-small/instance-40", "instance-40.pddl");
   req.timeout_seconds = 120;
   req.search.ehc_lazy_beside = false;  // the fallback after the hill-climbing, alone
-  req.search.lazy_plan_preferred = false;  // the fallback's preferred operators as kLazy's
   PlanReply with = plan(req, Termination());
   ASSERT_EQ(with.status, PlanStatus::kSolved) << with.message;  // replayed by the checker
   EXPECT_EQ(with.stats.ehc_fallbacks, 1U);
@@ -450,35 +448,6 @@ TEST(Search, LazySearchBesideTheHillClimbingGivesThePlanWithFewerEvaluationsTheS
   EXPECT_TRUE(after.stats.ehc_failed);
   EXPECT_LT(beside.stats.evaluated, after.stats.evaluated);
   EXPECT_GT(beside.stats.evaluated, req.search.ehc_lazy_after);  // the hill-climbing's share included
-}
-
-TEST(Search, LazySearchBesidePreferringTheRelaxedPlansOperatorsNeedsFewerEvaluations) {
-  // hiking-4 (deterministic counts): the default search (the lazy search beside the
-  // hill-climbing preferring the relaxed plan's applicable operators, none from the landmark
-  // count, as LAMA-first) gives the plan from the lazy search after 20821 evaluations; with
-  // the eighteenth round's preferred operators (FF's helpful actions and the landmark count's)
-  // 26422. Either half alone gives another search. Checked plans.
-  PlanRequest req = benchmarkRequest("pddl-more/hiking", "instance-4.pddl");
-  req.timeout_seconds = 120;
-  ASSERT_TRUE(req.search.lazy_plan_preferred);  // the default
-  ASSERT_FALSE(req.search.landmark_preferred);  // the default
-  PlanReply lama = plan(req, Termination());
-  req.search.lazy_plan_preferred = false;
-  req.search.landmark_preferred = true;
-  PlanReply ff = plan(req, Termination());
-  ASSERT_EQ(lama.status, PlanStatus::kSolved) << lama.message;
-  ASSERT_EQ(ff.status, PlanStatus::kSolved) << ff.message;
-  EXPECT_TRUE(lama.stats.lazy_beside_won);
-  EXPECT_LT(lama.stats.evaluated, ff.stats.evaluated);
-  req.search.lazy_plan_preferred = true;  // the landmark count's kept
-  PlanReply plan_only = plan(req, Termination());
-  req.search.lazy_plan_preferred = false;
-  req.search.landmark_preferred = false;  // FF's helpful actions, none from the landmark count
-  PlanReply landmarks_off = plan(req, Termination());
-  ASSERT_EQ(plan_only.status, PlanStatus::kSolved) << plan_only.message;
-  ASSERT_EQ(landmarks_off.status, PlanStatus::kSolved) << landmarks_off.message;
-  EXPECT_NE(plan_only.stats.evaluated, lama.stats.evaluated);
-  EXPECT_NE(landmarks_off.stats.evaluated, lama.stats.evaluated);
 }
 
 TEST(Search, LazySearchBesideNotStartedChangesNothing) {

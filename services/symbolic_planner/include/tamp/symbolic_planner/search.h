@@ -136,17 +136,6 @@ struct SearchOptions {
   /// orders, counted with kPastAndFuture, as LAMA in Fast Downward today).
   LandmarkGenerator landmark_generator{LandmarkGenerator::kRhw};
   RhwLandmarkOptions rhw;  ///< kRhw's options
-  /// lazy: the landmark count's preferred operators (`LandmarkCounter::preferredAmong`: the
-  /// applicable achievers of the landmarks still needed) join h_FF's. Off, as in Fast Downward's
-  /// `lama-first` (`pref=false`; docs/benchmarks.md, issue 14, nineteenth round).
-  bool landmark_preferred{false};
-  /// ehc with the lazy fallback: the lazy search beside the hill-climbing (`ehc_lazy_beside`) or
-  /// after it prefers the relaxed plan's applicable operators (`Heuristic::setRelaxedPlanPreferred`,
-  /// LAMA's preferred operators of h_FF) instead of FF's helpful actions, in a heuristic of its
-  /// own. The hill-climbing keeps FF's helpful actions; so do `kLazy` and the anytime phase,
-  /// which use the search's heuristic. false: FF's helpful actions there too (the eighteenth
-  /// round's).
-  bool lazy_plan_preferred{true};
   /// ehc/gbfs/lazy: drop redundant actions from the plan found (greedy action elimination).
   bool eliminate_redundant_actions{true};
   int preferred_boost{1000};    ///< gbfs/lazy: preferred-queue priority boost on progress

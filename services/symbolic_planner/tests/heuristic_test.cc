@@ -212,6 +212,58 @@ StateBits initialStateByName(const PlanningSession& s) {
   return st;
 }
 
+/// A benchmark instance its session has solved once (so that its task is grounded), with the
+/// problem's initial state and goal (one conjunct, facts sorted) as task facts.
+struct SolvedInstance {
+  std::unique_ptr<PlanningSession> session;
+  StateBits init;
+  Goal goal;
+  const Task& task() const { return *session->task(); }
+};
+
+/// Loads `problem` of `domain` (paths under the benchmarks directory) into `out` and solves it.
+/// Call through ASSERT_NO_FATAL_FAILURE.
+void loadSolvedInstance(const std::string& domain, const std::string& problem,
+                        SolvedInstance& out) {
+  auto s = PlanningSession::fromText(test::readFile(test::benchmarksDir() / domain),
+                                     test::readFile(test::benchmarksDir() / problem));
+  ASSERT_TRUE(s.ok());
+  out.session = std::move(*s);
+  Query q;
+  q.init = *out.session->problemInit();
+  q.goal_formula = out.session->problem().goal;
+  ASSERT_EQ(out.session->solve(q, Termination()).status, PlanStatus::kSolved);
+  out.init = initialStateByName(*out.session);
+  GoalConjunct gc = goalFactsByName(*out.session);
+  ASSERT_EQ(gc.pos.size(), out.session->problem().goal.children.size());
+  std::sort(gc.pos.begin(), gc.pos.end());
+  out.goal.conjuncts = {gc};
+}
+
+/// Calls `visit(state, walk, step)` on every state of `walks` random walks of at most `steps`
+/// steps from `init`, each step an applicable operator drawn with a generator of fixed `seed`.
+/// A walk ends early in a state without applicable operators; the walks stop at the first
+/// fatal failure (an ASSERT in `visit`).
+template <typename Visit>
+void forEachRandomWalkState(const Task& t, const StateBits& init, uint32_t seed, int walks,
+                            int steps, Visit&& visit) {
+  std::mt19937 rng(seed);
+  std::vector<OpId> ops;
+  StateBits next(init.size());
+  for (int walk = 0; walk < walks; ++walk) {
+    StateBits cur = init;
+    for (int step = 0; step < steps; ++step) {
+      visit(static_cast<const StateBits&>(cur), walk, step);
+      if (::testing::Test::HasFatalFailure()) return;
+      ops.clear();
+      t.applicableOps(cur.data(), ops);
+      if (ops.empty()) break;
+      t.apply(cur.data(), ops[rng() % ops.size()], next.data());
+      cur.swap(next);
+    }
+  }
+}
+
 TEST(Heuristic, SharedPreconditionNodesChangeNoValueNorHelpfulActionOnRandomWalks) {
   // h_FF's layered graph with and without the conjunction nodes, on openstacks (whose
   // ship-order(o, s, s') share all preconditions but the stack count: the nodes are used) and
@@ -223,48 +275,30 @@ TEST(Heuristic, SharedPreconditionNodesChangeNoValueNorHelpfulActionOnRandomWalk
   };
   for (const auto& [dom, prob] : cases) {
     SCOPED_TRACE(prob);
-    auto s = PlanningSession::fromText(test::readFile(test::benchmarksDir() / dom),
-                                       test::readFile(test::benchmarksDir() / prob));
-    ASSERT_TRUE(s.ok());
-    Query q;
-    q.init = *(*s)->problemInit();
-    q.goal_formula = (*s)->problem().goal;
-    ASSERT_EQ((*s)->solve(q, Termination()).status, PlanStatus::kSolved);
-    const Task& t = *(*s)->task();
-    const StateBits init = initialStateByName(**s);
-    Goal goal;
-    GoalConjunct gc = goalFactsByName(**s);
-    ASSERT_EQ(gc.pos.size(), (*s)->problem().goal.children.size());
-    std::sort(gc.pos.begin(), gc.pos.end());
-    goal.conjuncts.push_back(gc);
+    SolvedInstance in;
+    ASSERT_NO_FATAL_FAILURE(loadSolvedInstance(dom, prob, in));
+    const Task& t = in.task();
+    const Goal& goal = in.goal;
     auto with = detail::makeLayeredFF(t, CostType::kUnit, true);
     auto without = detail::makeLayeredFF(t, CostType::kUnit, false);
     with->setGoal(goal);
     without->setGoal(goal);
-    std::mt19937 rng(7);
-    std::vector<OpId> ops;
-    StateBits next(init.size());
     size_t states = 0, positive = 0;
-    for (int walk = 0; walk < 20; ++walk) {
-      StateBits cur = init;
-      for (int step = 0; step < 80; ++step) {
-        for (bool ff_style : {false, true}) {
-          with->setFFStyle(ff_style);
-          without->setFFStyle(ff_style);
-          const Cost a = with->evaluate(cur.data());
-          const Cost b = without->evaluate(cur.data());
-          ASSERT_EQ(a, b) << "walk " << walk << " step " << step;
-          ASSERT_EQ(with->preferred(), without->preferred()) << "walk " << walk << " step " << step;
-          positive += a > 0 && a != Heuristic::kDeadEnd ? 1 : 0;
-        }
-        ++states;
-        ops.clear();
-        t.applicableOps(cur.data(), ops);
-        if (ops.empty()) break;
-        t.apply(cur.data(), ops[rng() % ops.size()], next.data());
-        cur.swap(next);
-      }
-    }
+    forEachRandomWalkState(t, in.init, /*seed=*/7, /*walks=*/20, /*steps=*/80,
+                           [&](const StateBits& cur, int walk, int step) {
+                             for (bool ff_style : {false, true}) {
+                               with->setFFStyle(ff_style);
+                               without->setFFStyle(ff_style);
+                               const Cost a = with->evaluate(cur.data());
+                               const Cost b = without->evaluate(cur.data());
+                               ASSERT_EQ(a, b) << "walk " << walk << " step " << step;
+                               ASSERT_EQ(with->preferred(), without->preferred())
+                                   << "walk " << walk << " step " << step;
+                               positive += a > 0 && a != Heuristic::kDeadEnd ? 1 : 0;
+                             }
+                             ++states;
+                           });
+    if (HasFatalFailure()) return;
     EXPECT_GT(states, 500U);
     EXPECT_GT(positive, states);  // most states are neither goal states nor dead ends
   }
@@ -283,51 +317,33 @@ TEST(Heuristic, HelpfulActionsAreTheApplicableAddersOfTheFirstLayerSubGoalsOnRan
   };
   for (const auto& [dom, prob] : cases) {
     SCOPED_TRACE(prob);
-    auto s = PlanningSession::fromText(test::readFile(test::benchmarksDir() / dom),
-                                       test::readFile(test::benchmarksDir() / prob));
-    ASSERT_TRUE(s.ok());
-    Query q;
-    q.init = *(*s)->problemInit();
-    q.goal_formula = (*s)->problem().goal;
-    ASSERT_EQ((*s)->solve(q, Termination()).status, PlanStatus::kSolved);
-    const Task& t = *(*s)->task();
-    const StateBits init = initialStateByName(**s);
-    Goal goal;
-    GoalConjunct gc = goalFactsByName(**s);
-    ASSERT_EQ(gc.pos.size(), (*s)->problem().goal.children.size());
-    std::sort(gc.pos.begin(), gc.pos.end());
-    goal.conjuncts.push_back(gc);
+    SolvedInstance in;
+    ASSERT_NO_FATAL_FAILURE(loadSolvedInstance(dom, prob, in));
+    const Task& t = in.task();
+    const Goal& goal = in.goal;
     auto h = makeHeuristic(HeuristicKind::kFF, t, CostType::kUnit);
     h->setGoal(goal);
-    std::mt19937 rng(11);
-    std::vector<OpId> ops;
-    StateBits next(init.size());
     size_t states = 0, with_helpful = 0;
-    for (int walk = 0; walk < 10; ++walk) {
-      StateBits cur = init;
-      for (int step = 0; step < 60; ++step) {
-        ASSERT_TRUE(h->setFFStyle(false));
-        const Cost v = h->evaluate(cur.data());
-        std::vector<OpId> helpful = h->preferred();
-        ASSERT_TRUE(h->setFFStyle(true));
-        ASSERT_EQ(h->evaluate(cur.data()), v);
-        std::vector<OpId> ff = h->preferred();
-        for (OpId o : helpful) ASSERT_TRUE(t.applicable(cur.data(), o)) << t.ops[o].name;
-        std::vector<OpId> sorted = helpful;
-        std::sort(sorted.begin(), sorted.end());
-        ASSERT_EQ(std::adjacent_find(sorted.begin(), sorted.end()), sorted.end())
-            << "walk " << walk << " step " << step;
-        std::sort(ff.begin(), ff.end());
-        ASSERT_EQ(sorted, ff) << "walk " << walk << " step " << step;
-        ++states;
-        with_helpful += helpful.empty() ? 0 : 1;
-        ops.clear();
-        t.applicableOps(cur.data(), ops);
-        if (ops.empty()) break;
-        t.apply(cur.data(), ops[rng() % ops.size()], next.data());
-        cur.swap(next);
-      }
-    }
+    forEachRandomWalkState(
+        t, in.init, /*seed=*/11, /*walks=*/10, /*steps=*/60,
+        [&](const StateBits& cur, int walk, int step) {
+          ASSERT_TRUE(h->setFFStyle(false));
+          const Cost v = h->evaluate(cur.data());
+          std::vector<OpId> helpful = h->preferred();
+          ASSERT_TRUE(h->setFFStyle(true));
+          ASSERT_EQ(h->evaluate(cur.data()), v);
+          std::vector<OpId> ff = h->preferred();
+          for (OpId o : helpful) ASSERT_TRUE(t.applicable(cur.data(), o)) << t.ops[o].name;
+          std::vector<OpId> sorted = helpful;
+          std::sort(sorted.begin(), sorted.end());
+          ASSERT_EQ(std::adjacent_find(sorted.begin(), sorted.end()), sorted.end())
+              << "walk " << walk << " step " << step;
+          std::sort(ff.begin(), ff.end());
+          ASSERT_EQ(sorted, ff) << "walk " << walk << " step " << step;
+          ++states;
+          with_helpful += helpful.empty() ? 0 : 1;
+        });
+    if (HasFatalFailure()) return;
     EXPECT_GT(states, 200U);
     EXPECT_GT(with_helpful * 2, states);
   }
@@ -351,60 +367,52 @@ TEST(Landmarks, PreferredAmongTheApplicableOperatorsIsThePreferredSet) {
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.problem + (c.rhw ? " rhw" : " zhu-givan"));
-    auto s = PlanningSession::fromText(test::readFile(test::benchmarksDir() / c.domain),
-                                       test::readFile(test::benchmarksDir() / c.problem));
-    ASSERT_TRUE(s.ok());
-    Query q;
-    q.init = *(*s)->problemInit();
-    q.goal_formula = (*s)->problem().goal;
-    ASSERT_EQ((*s)->solve(q, Termination()).status, PlanStatus::kSolved);
-    const Task& t = *(*s)->task();
-    const StateBits init = initialStateByName(**s);
-    Goal goal;
-    GoalConjunct gc = goalFactsByName(**s);
-    ASSERT_EQ(gc.pos.size(), (*s)->problem().goal.children.size());
-    std::sort(gc.pos.begin(), gc.pos.end());
-    goal.conjuncts.push_back(gc);
+    SolvedInstance in;
+    ASSERT_NO_FATAL_FAILURE(loadSolvedInstance(c.domain, c.problem, in));
+    const Task& t = in.task();
+    const StateBits& init = in.init;
+    const Goal& goal = in.goal;
     LandmarkCounter lm = c.rhw
                              ? LandmarkCounter(t, rhwLandmarks(t, init, goal, RhwLandmarkOptions{}),
                                                LandmarkProgression::kPastAndFuture)
                              : LandmarkCounter(t, init, goal);
     ASSERT_TRUE(lm.enabled());
-    std::mt19937 rng(5);
     std::vector<OpId> ops, all, among;
-    StateBits next(init.size());
+    StateBits prev;
     std::vector<uint64_t> status(lm.words()), next_status(lm.words());
     size_t states = 0, with_preferred = 0;
-    for (int walk = 0; walk < 10; ++walk) {
-      StateBits cur = init;
-      lm.initial(cur.data(), status.data());
-      for (int step = 0; step < 40; ++step) {
-        ops.clear();
-        t.applicableOps(cur.data(), ops);
-        all.clear();
-        among.clear();
-        lm.preferred(cur.data(), status.data(), all);
-        lm.preferredAmong(cur.data(), status.data(), ops, among);
-        std::sort(all.begin(), all.end());
-        all.erase(std::unique(all.begin(), all.end()), all.end());
-        std::vector<OpId> sorted = among;
-        std::sort(sorted.begin(), sorted.end());
-        ASSERT_EQ(sorted, all) << "walk " << walk << " step " << step;
-        ASSERT_EQ(std::adjacent_find(sorted.begin(), sorted.end()), sorted.end());
-        size_t at = 0;  // in the order of the applicable operators
-        for (OpId o : among) {
-          while (at < ops.size() && ops[at] != o) ++at;
-          ASSERT_LT(at, ops.size());
-        }
-        ++states;
-        with_preferred += among.empty() ? 0 : 1;
-        if (ops.empty()) break;
-        t.apply(cur.data(), ops[rng() % ops.size()], next.data());
-        lm.progress(cur.data(), status.data(), next.data(), next_status.data());
-        cur.swap(next);
-        status.swap(next_status);
-      }
-    }
+    forEachRandomWalkState(
+        t, init, /*seed=*/5, /*walks=*/10, /*steps=*/40,
+        [&](const StateBits& cur, int walk, int step) {
+          // The landmark status of `cur`: initial at a walk's start, else progressed from `prev`.
+          if (step == 0) {
+            lm.initial(cur.data(), status.data());
+          } else {
+            lm.progress(prev.data(), status.data(), cur.data(), next_status.data());
+            status.swap(next_status);
+          }
+          prev = cur;
+          ops.clear();
+          t.applicableOps(cur.data(), ops);
+          all.clear();
+          among.clear();
+          lm.preferred(cur.data(), status.data(), all);
+          lm.preferredAmong(cur.data(), status.data(), ops, among);
+          std::sort(all.begin(), all.end());
+          all.erase(std::unique(all.begin(), all.end()), all.end());
+          std::vector<OpId> sorted = among;
+          std::sort(sorted.begin(), sorted.end());
+          ASSERT_EQ(sorted, all) << "walk " << walk << " step " << step;
+          ASSERT_EQ(std::adjacent_find(sorted.begin(), sorted.end()), sorted.end());
+          size_t at = 0;  // in the order of the applicable operators
+          for (OpId o : among) {
+            while (at < ops.size() && ops[at] != o) ++at;
+            ASSERT_LT(at, ops.size());
+          }
+          ++states;
+          with_preferred += among.empty() ? 0 : 1;
+        });
+    if (HasFatalFailure()) return;
     EXPECT_GT(states, 100U);
     EXPECT_GT(with_preferred * 4, states);  // gripper-4 with Zhu-Givan's: 127 of 400
   }

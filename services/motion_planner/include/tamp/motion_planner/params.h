@@ -63,9 +63,11 @@ struct SamplingParams {
   double start_escape_depth{0.005};
   /// Full mode: the direct motion from the start to a goal state (a straight line in joint
   /// space; for a stop-and-turn base, turn, drive, turn) is checked first and taken when it is
-  /// free, before any sampling. Arm motions between nearby configurations usually are. Off by
-  /// default: a direct arm motion right after a place swept the fingers past the object just put
-  /// down with no clearance, and the robot was stopped before it (holding_unknown, 3 of 12 runs).
+  /// free, before any sampling. Arm motions between nearby configurations usually are. Without
+  /// `direct_clearance`, a direct arm motion right after a place swept the fingers past the
+  /// object just put down, and the robot was stopped before it (holding_unknown, 3 of 12 runs).
+  /// Off here (the library's default, which its tests assume); the shipped service configuration
+  /// turns it on with the clearance (config/services/motion_planner.yaml).
   bool direct_first{false};
   /// m, >= 0: with `direct_first`, an arm's direct motion is taken only when the robot grown
   /// sideways by this much sweeps it free (objects are where perception saw them, to within

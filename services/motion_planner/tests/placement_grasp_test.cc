@@ -67,6 +67,14 @@ class ManipulationTest : public ::testing::Test {
     s.arm = arm;
     return model_->toolPoseInWorld(s);
   }
+  /// Up to six grasps of the can from a base pose in front of the table.
+  Result<std::vector<Grasp>> canGrasps(MotionPlanner& mp) const {
+    GraspRequest req;
+    req.object_id = "can";
+    req.base_pose = Pose2D{1.05, 0.1, 0.0};
+    req.max_grasps = 6;
+    return mp.generateGrasps(req, Termination::after(20.0));
+  }
   static double poseError(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
     return (a.translation() - b.translation()).norm();
   }
@@ -79,11 +87,7 @@ class ManipulationTest : public ::testing::Test {
 
 TEST_F(ManipulationTest, CylinderGraspsReachTheirPosesThroughIk) {
   MotionPlanner mp = planner();
-  GraspRequest req;
-  req.object_id = "can";
-  req.base_pose = Pose2D{1.05, 0.1, 0.0};
-  req.max_grasps = 6;
-  auto grasps = mp.generateGrasps(req, Termination::after(20.0));
+  auto grasps = canGrasps(mp);
   ASSERT_TRUE(grasps.ok()) << grasps.error().toString();
   ASSERT_FALSE(grasps->empty());
   bool top = false;
@@ -156,11 +160,7 @@ TEST_F(ManipulationTest, BoxGraspsWithSampledBasePosesAreCollisionFree) {
 // (`arm_swept_step`: a point moves no more between two of its checks).
 TEST_F(ManipulationTest, AnArmStartingAgainstAnObjectLeavesItWithoutGoingDeeper) {
   MotionPlanner mp = planner();
-  GraspRequest greq;
-  greq.object_id = "can";
-  greq.base_pose = Pose2D{1.05, 0.1, 0.0};
-  greq.max_grasps = 6;
-  auto grasps = mp.generateGrasps(greq, Termination::after(20.0));
+  auto grasps = canGrasps(mp);
   ASSERT_TRUE(grasps.ok()) << grasps.error().toString();
   ASSERT_GE(grasps->size(), 3u);
   const double depth = mp.params().sampling.start_escape_depth;

@@ -579,6 +579,18 @@ TEST(SelfFilterTest, AnObjectSeenEmptyInTheAirFellOntoTheSupportBelow) {
   EXPECT_EQ(count(run.events, EventType::kGone), 0) << events;
 }
 
+/// A frame at robot state `s` in which the camera sees nothing (every return NaN: the object
+/// below its view, or filtered as the robot's own), processed with the robot's body at `s`
+/// (`with_body`) or without one; `stamp` advances by a frame period.
+Result<FrameResult> blindFrame(Perception& p, sim::DepthSensor& camera, const robot::RobotState& s, int64_t& stamp,
+                               bool with_body) {
+  PointCloudFrame f = camera.capture(floorOnly(), robotModel(), s, stamp);
+  std::fill(f.xyz.begin(), f.xyz.end(), std::numeric_limits<float>::quiet_NaN());
+  const RobotBody body = robotBodyAt(robotModel(), s, "", stamp);
+  stamp += kSecond / 5;
+  return p.processFrame(f, Termination(), with_body ? &body : nullptr);
+}
+
 // The robot pushes a crate 1 m, 10 cm between frames, and the camera sees none of it (frames
 // without a return: the crate below its view, or its returns filtered as the robot's own). The
 // estimate must not stay where the base drives through it (a pushed box was believed 0.5 m behind
@@ -600,11 +612,7 @@ TEST(SelfFilterTest, AnUnseenObjectThePushingBaseDrivesIntoStaysAheadOfIt) {
     robot::RobotState s = robotModel().defaultState(Pose2D{0.0, 0.0, 0.0});
     for (int k = 0; k <= 10; ++k) {
       s.base.x = 0.1 * k;
-      PointCloudFrame f = camera.capture(floorOnly(), robotModel(), s, stamp);
-      std::fill(f.xyz.begin(), f.xyz.end(), std::numeric_limits<float>::quiet_NaN());
-      const RobotBody body = robotBodyAt(robotModel(), s, "", stamp);
-      stamp += kSecond / 5;
-      auto r = p.processFrame(f, Termination(), with_body ? &body : nullptr);
+      auto r = blindFrame(p, camera, s, stamp, with_body);
       ASSERT_TRUE(r.ok()) << r.error().toString();
       const auto t = p.track("crate");
       ASSERT_TRUE(t.has_value());
@@ -648,11 +656,7 @@ TEST(SelfFilterTest, AnEstimateBesideThePassingBaseLeavesItSidewaysNotAhead) {
   bool moved = false;
   for (int k = 0; k <= 10; ++k) {
     s.base.x = 0.1 * k;
-    PointCloudFrame f = camera.capture(floorOnly(), robotModel(), s, stamp);
-    std::fill(f.xyz.begin(), f.xyz.end(), std::numeric_limits<float>::quiet_NaN());
-    const RobotBody body = robotBodyAt(robotModel(), s, "", stamp);
-    stamp += kSecond / 5;
-    auto r = p.processFrame(f, Termination(), &body);
+    auto r = blindFrame(p, camera, s, stamp, true);
     ASSERT_TRUE(r.ok()) << r.error().toString();
     const world::Object* o = p.world().findObject("crate");
     ASSERT_NE(o, nullptr) << "frame " << k;

@@ -243,13 +243,20 @@ bool SweptArmMotionValidator::checkMotion(const ob::State* s1, const ob::State* 
   return ok;
 }
 
+bool ClearanceValidityChecker::nearEnd(const Eigen::Vector2d& at, std::size_t from) const {
+  for (std::size_t i = from; i < ends_.size(); ++i)
+    if ((at - ends_[i]).norm() <= near_) return true;
+  return false;
+}
+
 bool ClearanceValidityChecker::isValid(const ob::State* s) const {
   if (!si_->satisfiesBounds(s)) return false;
-  bool near = relaxed_;
   const Pose2D p = gs_.basePose(s);
-  for (std::size_t i = 0; i < ends_.size() && !near; ++i) near = (Eigen::Vector2d(p.x, p.y) - ends_[i]).norm() <= near_;
-  if (near) return oracle_.allFree(s);
-  if (!padded_.allFree(s)) return false;
+  const Eigen::Vector2d at(p.x, p.y);
+  const bool near_start = !ends_.empty() && (at - ends_.front()).norm() <= near_;
+  if (near_start && floor_ > 0.0) return oracle_.allFree(s) && oracle_.movableDistance(s) >= floor_;
+  if (relaxed_ || near_start || nearEnd(at, 1)) return oracle_.allFree(s);
+  if (!padded_->allFree(s)) return false;
   return implied_ || oracle_.allFree(s);
 }
 
@@ -551,6 +558,12 @@ bool Oracle::allFree(const ob::State* s) {
   if (self_check_ && !gs_.armAboveFloor()) return false;
   if (scene_.robotInCollision(all_filter_)) return false;
   return !self_check_ || selfFree(s);
+}
+
+double Oracle::movableDistance(const ob::State* s) {
+  ++checks_;
+  gs_.placeRobot(s, scene_);
+  return scene_.robotDistance(movable_filter_).distance;
 }
 
 bool Oracle::mayTouch(const ob::State* s, int index) const {

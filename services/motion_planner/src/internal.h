@@ -151,6 +151,9 @@ class Oracle {
   void touched(const ob::State* s, std::vector<int>& out);
   /// Whether movable `index` touches the robot at `s`.
   bool touches(const ob::State* s, int index);
+  /// Distance (m) from the robot at `s` to the nearest movable (0 or less in contact; +inf when
+  /// there is none).
+  double movableDistance(const ob::State* s);
   /// False when movable `index` cannot touch the robot at `s` (its AABB is outside the reach
   /// square about the base; rigid base groups only); true otherwise.
   bool mayTouch(const ob::State* s, int index) const;
@@ -232,27 +235,35 @@ class SweptArmMotionValidator : public ob::MotionValidator {
 /// the robot has room for it: away from the request's start and goal (within `near_ends_m` of
 /// either only the plain check applies: a robot parked beside a table must still leave it), a
 /// state must also be free for the robot grown sideways by the clearance (`padded`, an oracle over
-/// a scene with the grown robot). relax() drops that once no path kept the clearance in time.
+/// a scene with the grown robot; null: no clearance). relax() drops that once no path kept the
+/// clearance in time. With a start floor (`setStartFloor`), a state within `near_ends_m` of the
+/// start must also stand at least that far from every movable; relax() keeps it.
 class ClearanceValidityChecker : public ob::StateValidityChecker {
  public:
+  /// `ends`: the start first, then the goal if it has a base position.
   /// `padded_contains_plain`: the grown robot contains the robot and `padded`'s scene has every
   /// object of `oracle`'s, so a state free for the former is free for the latter (one check).
-  ClearanceValidityChecker(const ob::SpaceInformationPtr& si, Oracle& oracle, Oracle& padded, const GroupSpace& gs,
+  ClearanceValidityChecker(const ob::SpaceInformationPtr& si, Oracle& oracle, Oracle* padded, const GroupSpace& gs,
                            std::vector<Eigen::Vector2d> ends, double near_ends_m, bool padded_contains_plain)
       : ob::StateValidityChecker(si), oracle_(oracle), padded_(padded), gs_(gs), ends_(std::move(ends)),
-        near_(near_ends_m), implied_(padded_contains_plain) {}
+        near_(near_ends_m), implied_(padded_contains_plain), relaxed_(padded == nullptr) {}
   bool isValid(const ob::State* s) const override;
   void relax() { relaxed_ = true; }
   bool relaxed() const { return relaxed_; }
+  /// m, > 0: the least distance to the movables near the start; 0: none.
+  void setStartFloor(double floor_m) { floor_ = floor_m; }
+  double startFloor() const { return floor_; }
 
  private:
+  bool nearEnd(const Eigen::Vector2d& at, std::size_t from) const;
   Oracle& oracle_;
-  Oracle& padded_;
+  Oracle* padded_;
   const GroupSpace& gs_;
   std::vector<Eigen::Vector2d> ends_;
   double near_;
   bool implied_;
-  bool relaxed_{false};
+  bool relaxed_;
+  double floor_{0.0};
 };
 
 /// OMPL validity checker over the oracle (static only, or everything).

@@ -827,9 +827,10 @@ struct Planning {
   }
   detail::Oracle requestOracle();
   std::vector<double> sweepRadii() const;
-  ob::SpaceInformationPtr makeSi(detail::Oracle& checker, bool full) const;
+  ob::SpaceInformationPtr makeSi(detail::Oracle& checker, bool full, bool swept = false) const;
   ob::SpaceInformationPtr sweptSi(detail::Oracle& checker) const;
   void setUpClearance();
+  void setUpStartFloor();
   bool collides(const ob::State* s);
   collision::Scene& plainScene();
   std::string selfHit(const ob::State* s);
@@ -934,7 +935,8 @@ Planning::Planning(MotionPlanner::Impl& planner_impl, const MotionRequest& reque
       spu(gs.secondsPerUnit(P.cost)),
       res_check(P.sampling.validity_resolution) {
   const bool pushes = !held.empty() && held_link == impl.robot.geometry().links.front();
-  if (!lazy && req.group == PlanningGroup::kBase && P.sampling.base_clearance > 0.0 && !pushes) setUpClearance();
+  const bool keeps_room = P.sampling.base_clearance > 0.0 || P.sampling.base_start_margin > 0.0;
+  if (!lazy && req.group == PlanningGroup::kBase && keeps_room && !pushes) setUpClearance();
   start.reset(space->allocState());
   {
     std::vector<double> v;
@@ -942,6 +944,7 @@ Planning::Planning(MotionPlanner::Impl& planner_impl, const MotionRequest& reque
     if (gs.movesArm()) v.insert(v.end(), req.start.arm.begin(), req.start.arm.end());
     gs.setValues(v, start.get());
   }
+  if (clearance) setUpStartFloor();
   if (held_shape) oracle.setSelfScene(&plainScene());
 }
 
@@ -977,12 +980,17 @@ std::vector<double> Planning::sweepRadii() const {
   return sweep;
 }
 
-ob::SpaceInformationPtr Planning::makeSi(detail::Oracle& checker, bool full) const {
+ob::SpaceInformationPtr Planning::makeSi(detail::Oracle& checker, bool full, bool swept) const {
   auto info = std::make_shared<ob::SpaceInformation>(space);
   info->setStateValidityChecker(std::make_shared<detail::OracleValidityChecker>(info, checker, full));
   info->setStateValidityCheckingResolution(
       std::min(1.0, P.sampling.validity_resolution / std::max(1e-9, space->getMaximumExtent())));
-  if (detail::isStopAndTurn(*space)) info->setMotionValidator(std::make_shared<detail::CornerMotionValidator>(info));
+  if (swept) {
+    info->setMotionValidator(
+        std::make_shared<detail::SweptArmMotionValidator>(info, gs, sweep_radii, P.sampling.arm_swept_step));
+  } else if (detail::isStopAndTurn(*space)) {
+    info->setMotionValidator(std::make_shared<detail::CornerMotionValidator>(info));
+  }
   info->setup();
   return info;
 }
@@ -991,23 +999,18 @@ ob::SpaceInformationPtr Planning::makeSi(detail::Oracle& checker, bool full) con
 /// rest of its path is: a straight way out checked at `validity_resolution` moves a fingertip
 /// centimetres between two checks, across an object a few cm wide.
 ob::SpaceInformationPtr Planning::sweptSi(detail::Oracle& checker) const {
-  if (!(req.group == PlanningGroup::kArm && P.sampling.arm_swept_step > 0.0 && !sweep_radii.empty()))
-    return makeSi(checker, true);
-  auto info = std::make_shared<ob::SpaceInformation>(space);
-  info->setStateValidityChecker(std::make_shared<detail::OracleValidityChecker>(info, checker, true));
-  info->setStateValidityCheckingResolution(
-      std::min(1.0, P.sampling.validity_resolution / std::max(1e-9, space->getMaximumExtent())));
-  info->setMotionValidator(
-      std::make_shared<detail::SweptArmMotionValidator>(info, gs, sweep_radii, P.sampling.arm_swept_step));
-  info->setup();
-  return info;
+  const bool swept = req.group == PlanningGroup::kArm && P.sampling.arm_swept_step > 0.0 && !sweep_radii.empty();
+  return makeSi(checker, true, swept);
 }
 
 void Planning::setUpClearance() {
-  padded_scene = std::make_unique<collision::Scene>(impl.world);
-  padded_scene->setRobot(grownGeometry(impl.robot.geometry(), P.sampling.base_clearance));
-  if (!held.empty()) (void)padded_scene->attach(held, held_link, link_T_held);
-  padded_oracle = std::make_unique<detail::Oracle>(*padded_scene, gs, ignored, oracle.movables(), oracle.reachRadius());
+  if (P.sampling.base_clearance > 0.0) {
+    padded_scene = std::make_unique<collision::Scene>(impl.world);
+    padded_scene->setRobot(grownGeometry(impl.robot.geometry(), P.sampling.base_clearance));
+    if (!held.empty()) (void)padded_scene->attach(held, held_link, link_T_held);
+    padded_oracle =
+        std::make_unique<detail::Oracle>(*padded_scene, gs, ignored, oracle.movables(), oracle.reachRadius());
+  }
   std::vector<Eigen::Vector2d> ends{{req.start.base.x, req.start.base.y}};
   if (req.goal.kind == MotionGoal::Kind::kBasePose) ends.emplace_back(req.goal.base.x, req.goal.base.y);
   if (req.goal.kind == MotionGoal::Kind::kConfiguration && req.goal.configuration.size() >= 2)
@@ -1018,9 +1021,30 @@ void Planning::setUpClearance() {
   const bool contains = !impl.scene.hasUnknownSpace() && std::all_of(parts.begin(), parts.end(), [](const auto& part) {
     return part.shape.kind != world::ShapeKind::kPrism;
   });
-  clearance = std::make_shared<detail::ClearanceValidityChecker>(si, oracle, *padded_oracle, gs, std::move(ends),
+  clearance = std::make_shared<detail::ClearanceValidityChecker>(si, oracle, padded_oracle.get(), gs, std::move(ends),
                                                                  P.sampling.base_clearance_near_ends, contains);
   si->setStateValidityChecker(clearance);
+}
+
+/// A start nearer than `base_start_margin` to a movable (and not touching it: that start is left
+/// by `leaveStart`) keeps its distance near the start: no nearer than the start, nor than a goal
+/// state that stands nearer still, less 1 mm for the distance query's own error.
+void Planning::setUpStartFloor() {
+  if (!(P.sampling.base_start_margin > 0.0)) return;
+  double floor = oracle.movableDistance(start.get());
+  if (!(floor > 0.0) || floor >= P.sampling.base_start_margin) return;
+  std::vector<double> goal;
+  if (req.goal.kind == MotionGoal::Kind::kBasePose)
+    goal = {req.goal.base.x, req.goal.base.y, wrapAngle(req.goal.base.theta)};
+  if (req.goal.kind == MotionGoal::Kind::kConfiguration) goal = req.goal.configuration;
+  if (goal.size() == space->getDimension()) {
+    StatePtr g(space->allocState(), StateFree{space.get()});
+    gs.setValues(goal, g.get());
+    floor = std::min(floor, oracle.movableDistance(g.get()));
+  }
+  constexpr double kDistanceError = 0.001;
+  if (floor - kDistanceError > 0.0) clearance->setStartFloor(floor - kDistanceError);
+  gs.placeRobot(start.get(), impl.scene);
 }
 
 bool Planning::collides(const ob::State* s) { return lazy ? !oracle.staticFree(s) : !oracle.allFree(s); }

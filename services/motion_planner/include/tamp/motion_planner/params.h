@@ -90,6 +90,12 @@ struct SamplingParams {
   double base_clearance{0.05};
   double base_clearance_near_ends{0.3};  ///< m, >= 0
   double base_clearance_time_s{0.25};    ///< s, > 0
+  /// m, >= 0: a full-mode base path whose start is nearer than this to a movable object goes no
+  /// nearer to the movables than its start is (nor than its goal is), within
+  /// `base_clearance_near_ends` of the start. A robot stopped before an object stands millimetres
+  /// from it; a turn in place there swings a corner towards it, free in the world model by
+  /// millimetres and not in the world (namo_room_hidden: stopped three times). 0: off.
+  double base_start_margin{0.02};
 };
 
 /// Lazy mode: making the lazy path worth executing (see motion_planner.h). The roadmap of the

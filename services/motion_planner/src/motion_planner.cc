@@ -1043,7 +1043,11 @@ void Planning::setUpStartFloor() {
     floor = std::min(floor, oracle.movableDistance(g.get()));
   }
   constexpr double kDistanceError = 0.001;
-  if (floor - kDistanceError > 0.0) clearance->setStartFloor(floor - kDistanceError);
+  if (floor - kDistanceError > 0.0) {
+    clearance->setStartFloor(floor - kDistanceError);
+    log::get("motion_planner")->debug("the start stands {:.4f} m from a movable: no nearer within {} m of it", floor,
+                                      P.sampling.base_clearance_near_ends);
+  }
   gs.placeRobot(start.get(), impl.scene);
 }
 

@@ -349,6 +349,82 @@ TEST(Heuristic, HelpfulActionsAreTheApplicableAddersOfTheFirstLayerSubGoalsOnRan
   }
 }
 
+TEST(Heuristic, RelaxedPlanPreferredAreTheRelaxedPlansApplicableOperatorsOnRandomWalks) {
+  // setRelaxedPlanPreferred (LAMA's preferred operators: the relaxed plan's applicable
+  // operators) against FF's helpful actions, for FF's layered graph (unit costs) and the relaxed
+  // plan through h_add's best supporters (cost + 1 on tasks whose costs differ): in every state
+  // of random walks (fixed seed) the same h; the relaxed plan's operators are distinct,
+  // applicable and among the helpful actions, at most h of them (unit costs: one per
+  // relaxed-plan operator), at least one whenever 0 < h < dead end; on hiking and transport in
+  // some states strictly fewer than the helpful actions (a sub-goal such as "a person at a
+  // place" has several applicable adders, the relaxed plan uses one; on gripper and pegsol each
+  // sub-goal here has one). Switching back gives FF's helpful actions again.
+  struct Case {
+    std::string domain, problem;
+    CostType cost_type;
+    bool fewer;  // some state has fewer relaxed-plan operators than helpful actions
+  };
+  const std::string hiking = "pddl-more/hiking/", transport = "pddl-more/transport/";
+  const std::vector<Case> cases = {
+      {"pddl/gripper/domain.pddl", "pddl/gripper/instance-4.pddl", CostType::kUnit, false},
+      {hiking + "domain.pddl", hiking + "instance-4.pddl", CostType::kUnit, true},
+      {"pddl-more/pegsol/domain.pddl", "pddl-more/pegsol/instance-6.pddl", CostType::kPlusOne,
+       false},
+      {transport + "domain.pddl", transport + "instance-6.pddl", CostType::kPlusOne, true},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.problem + (c.cost_type == CostType::kUnit ? " layered" : " h_add supporters"));
+    SolvedInstance in;
+    ASSERT_NO_FATAL_FAILURE(loadSolvedInstance(c.domain, c.problem, in));
+    const Task& t = in.task();
+    auto h = makeHeuristic(HeuristicKind::kFF, t, c.cost_type);
+    h->setGoal(in.goal);
+    size_t states = 0, fewer = 0;
+    forEachRandomWalkState(
+        t, in.init, /*seed=*/3, /*walks=*/10, /*steps=*/40,
+        [&](const StateBits& cur, int walk, int step) {
+          ASSERT_TRUE(h->setRelaxedPlanPreferred(false));
+          const Cost v = h->evaluate(cur.data());
+          std::vector<OpId> helpful = h->preferred();
+          ASSERT_TRUE(h->setRelaxedPlanPreferred(true));
+          ASSERT_EQ(h->evaluate(cur.data()), v) << "walk " << walk << " step " << step;
+          std::vector<OpId> plan = h->preferred();
+          for (OpId o : plan) ASSERT_TRUE(t.applicable(cur.data(), o)) << t.ops[o].name;
+          std::sort(plan.begin(), plan.end());
+          std::sort(helpful.begin(), helpful.end());
+          ASSERT_EQ(std::adjacent_find(plan.begin(), plan.end()), plan.end());
+          ASSERT_TRUE(std::includes(helpful.begin(), helpful.end(), plan.begin(), plan.end()))
+              << "walk " << walk << " step " << step;
+          if (v > 0 && v != Heuristic::kDeadEnd) {
+            ASSERT_FALSE(plan.empty()) << "walk " << walk << " step " << step;
+            if (c.cost_type == CostType::kUnit) {
+              ASSERT_LE(static_cast<Cost>(plan.size()), v);
+            }
+          }
+          fewer += plan.size() < helpful.size() ? 1 : 0;
+          ASSERT_TRUE(h->setRelaxedPlanPreferred(false));
+          ASSERT_EQ(h->evaluate(cur.data()), v);
+          std::vector<OpId> again = h->preferred();
+          std::sort(again.begin(), again.end());
+          ASSERT_EQ(again, helpful);
+          ++states;
+        });
+    if (HasFatalFailure()) return;
+    EXPECT_GT(states, 50U);
+    if (c.fewer) {
+      EXPECT_GT(fewer, 0U);
+    }
+  }
+  // Heuristics without helpful actions have no such variant.
+  SolvedInstance in;
+  ASSERT_NO_FATAL_FAILURE(
+      loadSolvedInstance("pddl/gripper/domain.pddl", "pddl/gripper/instance-4.pddl", in));
+  EXPECT_FALSE(makeHeuristic(HeuristicKind::kAdd, in.task(), CostType::kUnit)
+                   ->setRelaxedPlanPreferred(true));
+  EXPECT_FALSE(makeHeuristic(HeuristicKind::kBlind, in.task(), CostType::kUnit)
+                   ->setRelaxedPlanPreferred(true));
+}
+
 TEST(Landmarks, PreferredAmongTheApplicableOperatorsIsThePreferredSet) {
   // preferredAmong (what the lazy search calls, with the applicable operators it generates
   // anyway) gives the same operators as preferred (every adder of the landmarks in question
@@ -416,6 +492,123 @@ TEST(Landmarks, PreferredAmongTheApplicableOperatorsIsThePreferredSet) {
     EXPECT_GT(states, 100U);
     EXPECT_GT(with_preferred * 4, states);  // gripper-4 with Zhu-Givan's: 127 of 400
   }
+}
+
+TEST(Landmarks, LeafPreferredAreTheApplicableAchieversOfTheLeaves) {
+  // leafPreferredAmong (LAMA 2011's preferred operators of the landmark count) against an oracle
+  // written from the graph's orders: in every state of random walks (fixed seed), the leaves
+  // are the landmarks not past whose predecessors (every kind of order) are all past, or, once
+  // every landmark is past, the false goal landmarks; the operators are the applicable ones that
+  // add a fact of a simple leaf (a conditional effect: with its condition true), or of a
+  // disjunctive leaf when none adds a simple one; each once, in the order of the applicable
+  // operators. Before every landmark is past they are among preferredAmong's (the achievers of
+  // every landmark still needed), and on hiking-4 strictly fewer in some states. hiking-4: RHW
+  // with disjunctive landmarks; schedule-30: conditional effects.
+  struct Case {
+    std::string domain, problem;
+    bool fewer;  // some state has fewer leaf achievers than achievers of the landmarks needed
+  };
+  const std::vector<Case> cases = {
+      {"pddl-more/hiking/domain.pddl", "pddl-more/hiking/instance-4.pddl", true},
+      {"pddl-more/schedule/domain.pddl", "pddl-more/schedule/instance-30.pddl", false},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.problem);
+    SolvedInstance in;
+    ASSERT_NO_FATAL_FAILURE(loadSolvedInstance(c.domain, c.problem, in));
+    const Task& t = in.task();
+    LandmarkCounter lm(t, rhwLandmarks(t, in.init, in.goal, RhwLandmarkOptions{}),
+                       LandmarkProgression::kPastAndFuture);
+    ASSERT_TRUE(lm.enabled());
+    const LandmarkGraph& g = lm.graph();
+    const size_t n = g.landmarks.size();
+    std::vector<std::vector<uint32_t>> preds(n);
+    for (const LandmarkOrder& o : g.orders) preds[o.to].push_back(o.from);
+    auto adds = [&](const StateBits& st, OpId o, FactId f) {
+      const Operator& op = t.ops[o];
+      if (std::find(op.add.begin(), op.add.end(), f) != op.add.end()) return true;
+      for (const ConditionalEffect& ce : op.cond_effects) {
+        if (std::find(ce.add.begin(), ce.add.end(), f) == ce.add.end()) continue;
+        bool on = true;
+        for (FactId x : ce.cond) on = on && testBit(st.data(), x);
+        if (on) return true;
+      }
+      return false;
+    };
+    std::vector<OpId> ops, leaves, needed;
+    StateBits prev;
+    std::vector<uint64_t> status(lm.words()), next_status(lm.words());
+    size_t states = 0, with_leaves = 0, fewer = 0;
+    forEachRandomWalkState(
+        t, in.init, /*seed=*/7, /*walks=*/10, /*steps=*/40,
+        [&](const StateBits& cur, int walk, int step) {
+          if (step == 0) {
+            lm.initial(cur.data(), status.data());
+          } else {
+            lm.progress(prev.data(), status.data(), cur.data(), next_status.data());
+            status.swap(next_status);
+          }
+          prev = cur;
+          const uint64_t* past = status.data();  // the first half of a past-and-future status
+          bool all_past = true;
+          for (uint32_t l = 0; l < n; ++l) all_past = all_past && testBit(past, l);
+          std::vector<uint8_t> leaf(n, 0);
+          for (uint32_t l = 0; l < n; ++l) {
+            bool holds = false;
+            for (FactId f : g.landmarks[l]) holds = holds || testBit(cur.data(), f);
+            if (all_past) {
+              leaf[l] = g.is_goal[l] && !holds;
+            } else if (!testBit(past, l)) {
+              leaf[l] = std::all_of(preds[l].begin(), preds[l].end(),
+                                    [&](uint32_t p) { return testBit(past, p); });
+            }
+          }
+          ops.clear();
+          t.applicableOps(cur.data(), ops);
+          std::vector<OpId> expected;
+          for (bool disjunctive : {false, true}) {
+            if (!expected.empty()) break;
+            for (OpId o : ops) {
+              bool pick = false;
+              for (uint32_t l = 0; l < n && !pick; ++l) {
+                if (!leaf[l] || (g.landmarks[l].size() > 1) != disjunctive) continue;
+                for (FactId f : g.landmarks[l]) pick = pick || adds(cur, o, f);
+              }
+              if (pick) expected.push_back(o);
+            }
+          }
+          leaves.clear();
+          lm.leafPreferredAmong(cur.data(), status.data(), ops, leaves);
+          ASSERT_EQ(leaves, expected) << "walk " << walk << " step " << step;
+          needed.clear();
+          lm.preferredAmong(cur.data(), status.data(), ops, needed);
+          if (!all_past) {
+            for (OpId o : leaves) {
+              ASSERT_NE(std::find(needed.begin(), needed.end(), o), needed.end())
+                  << t.ops[o].name << ", walk " << walk << " step " << step;
+            }
+          }
+          ++states;
+          with_leaves += leaves.empty() ? 0 : 1;
+          fewer += leaves.size() < needed.size() ? 1 : 0;
+        });
+    if (HasFatalFailure()) return;
+    EXPECT_GT(states, 100U);
+    EXPECT_GT(with_leaves, 0U);
+    if (c.fewer) {
+      EXPECT_GT(fewer, 0U);
+    }
+  }
+  // Leaves need the past set: not with the count of accepted landmarks.
+  SolvedInstance in;
+  ASSERT_NO_FATAL_FAILURE(
+      loadSolvedInstance("pddl/gripper/domain.pddl", "pddl/gripper/instance-4.pddl", in));
+  LandmarkCounter zg(in.task(), in.init, in.goal);
+  std::vector<uint64_t> st(zg.words());
+  zg.initial(in.init.data(), st.data());
+  std::vector<OpId> ops, out;
+  in.task().applicableOps(in.init.data(), ops);
+  EXPECT_THROW(zg.leafPreferredAmong(in.init.data(), st.data(), ops, out), std::logic_error);
 }
 
 TEST(Heuristic, RelaxedDeadEndProvesUnsolvable) {

@@ -191,17 +191,6 @@ int main(int argc, char** argv) {
   size_t rhw_max_disjunction = defaults.rhw.max_disjunction_size;
   bool rhw_no_zg = !defaults.rhw.add_zhu_givan, rhw_keep_one_action = !defaults.rhw.skip_one_action_disjunctions;
   bool rhw_reasonable = defaults.rhw.reasonable_orders;
-  auto lm_pref_name = [](sp::LandmarkPreferred p) {
-    return p == sp::LandmarkPreferred::kNone ? "none" : p == sp::LandmarkPreferred::kNeeded ? "needed" : "leaves";
-  };
-  auto lm_pref_value = [](const std::string& n) {
-    return n == "none" ? sp::LandmarkPreferred::kNone
-                       : n == "needed" ? sp::LandmarkPreferred::kNeeded : sp::LandmarkPreferred::kLeaves;
-  };
-  std::string landmark_preferred = lm_pref_name(defaults.landmark_preferred);
-  std::string lazy_landmark_preferred = lm_pref_name(defaults.lazy_landmark_preferred);
-  bool lazy_plan_preferred = defaults.lazy_plan_preferred;
-  bool lm_own_queue = defaults.lazy_landmark_preferred_own_queue;
   app.add_option("--landmarks", landmark_generator,
                  "lazy: the landmarks counted: rhw (Richter-Helmert-Westphal: disjunctive landmarks, greedy-necessary "
                  "orders, landmarks required again) or zg (Zhu-Givan fact landmarks)")
@@ -215,20 +204,6 @@ int main(int argc, char** argv) {
   app.add_option("--rhw-reasonable-orders", rhw_reasonable,
                  "lazy with rhw: reasonable orders (Hoffmann et al.'s, from h^2 mutexes) between the landmarks: "
                  "true or false");
-  app.add_option("--landmark-preferred", landmark_preferred,
-                 "lazy (--search lazy, the anytime phase): the landmark count's preferred operators that join h_FF's: "
-                 "none (as lama-first), needed (the achievers of every landmark still needed) or leaves (LAMA 2011's: "
-                 "of the landmarks whose predecessors are all reached)")
-      ->check(CLI::IsMember({"none", "needed", "leaves"}));
-  app.add_option("--lazy-landmark-preferred", lazy_landmark_preferred,
-                 "ehc with --lazy-plan-preferred true: the same for the lazy search beside or after the hill-climbing")
-      ->check(CLI::IsMember({"none", "needed", "leaves"}));
-  app.add_option("--lazy-landmark-preferred-own-queue", lm_own_queue,
-                 "ehc with --lazy-plan-preferred true: the landmark count's preferred operators feed its own preferred queue only, h_FF's h_FF's: "
-                 "true or false (both preferred queues take either's)");
-  app.add_option("--lazy-plan-preferred", lazy_plan_preferred,
-                 "ehc: the lazy search beside or after the hill-climbing prefers the relaxed plan's applicable "
-                 "operators (LAMA's): true (default) or false (FF's helpful actions)");
   app.add_flag("--no-ehc-lazy-beside", no_lazy_beside,
                "ehc: the lazy search only after the hill-climbing fails (FF's order), not beside it");
   app.add_option("--ehc-lazy-after", lazy_after,
@@ -274,10 +249,6 @@ int main(int argc, char** argv) {
   req.search.rhw.add_zhu_givan = !rhw_no_zg;
   req.search.rhw.skip_one_action_disjunctions = !rhw_keep_one_action;
   req.search.rhw.reasonable_orders = rhw_reasonable;
-  req.search.landmark_preferred = lm_pref_value(landmark_preferred);
-  req.search.lazy_landmark_preferred = lm_pref_value(lazy_landmark_preferred);
-  req.search.lazy_landmark_preferred_own_queue = lm_own_queue;
-  req.search.lazy_plan_preferred = lazy_plan_preferred;
   req.search.ehc_lazy_beside = !no_lazy_beside;
   req.search.ehc_lazy_after = lazy_after;
   req.search.ehc_lazy_turn_ehc = lazy_turn_ehc;

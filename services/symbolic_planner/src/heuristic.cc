@@ -481,10 +481,6 @@ class LayeredFF : public Heuristic {
     ff_style_ = on;
     return true;
   }
-  bool setRelaxedPlanPreferred(bool on) override {
-    plan_preferred_ = on;
-    return true;
-  }
 
   Cost evaluate(const uint64_t* s) override {
     preferred_.clear();
@@ -734,13 +730,12 @@ class LayeredFF : public Heuristic {
   /// sub-goal (for a conditional effect: with its condition true).
   void collectHelpful(const uint64_t* s) {
     if (goals_at_.size() < 2) return;
-    if (ff_style_ && !plan_preferred_) return collectHelpfulFF(s);
+    if (ff_style_) return collectHelpfulFF(s);
     for (OpId o : plan_first_) {
       if (op_mark_[o] == epoch_ || !task_.applicable(s, o)) continue;
       op_mark_[o] = epoch_;
       preferred_.push_back(o);
     }
-    if (plan_preferred_) return;  // the relaxed plan's own (Fast Downward's), not FF's others
     // The operators applicable in s that add g are those of g's adders at layer 0 (a merged
     // rop: its members whose own fact is true), taken in operator order as from
     // `task_.achievers[g]`, without testing each achiever's preconditions against s (hiking-16:
@@ -835,7 +830,6 @@ class LayeredFF : public Heuristic {
   std::vector<uint32_t> goal_mark_, op_mark_, op_used_;
   std::vector<std::pair<uint32_t, OpId>> cand_;
   bool ff_style_{false};
-  bool plan_preferred_{false};  // setRelaxedPlanPreferred
   std::vector<OpId> plan_first_;
   std::vector<OpId> layer0_;       ///< collectHelpful(): a sub-goal's adders applicable in the state
   bool several_conjuncts_{false};  ///< the goal is a disjunction of conjuncts
@@ -896,11 +890,6 @@ class RelaxationHeuristic : public Heuristic {
 
   bool computesPreferred() const override { return mode_ == Mode::kFF; }
   const std::vector<OpId>& preferred() const override { return preferred_; }
-  bool setRelaxedPlanPreferred(bool on) override {
-    if (mode_ != Mode::kFF) return false;
-    plan_preferred_ = on;
-    return true;
-  }
 
   Cost evaluate(const uint64_t* s) override {
     preferred_.clear();
@@ -1025,7 +1014,6 @@ class RelaxationHeuristic : public Heuristic {
       pref_stamp_.assign(task_.ops.size(), 0);
       pref_mark_ = 1;
     }
-    if (plan_preferred_) return collectPlanOperators();
     for (FactId g : g1_) {
       for (OpId o : task_.achievers[g]) {
         if (pref_stamp_[o] == pref_mark_) continue;
@@ -1033,17 +1021,6 @@ class RelaxationHeuristic : public Heuristic {
         pref_stamp_[o] = pref_mark_;
         preferred_.push_back(o);
       }
-    }
-  }
-
-  /// The relaxed plan's first-layer operators: the best supporters of the first-layer sub-goals,
-  /// whose preconditions (a conditional effect's condition included) hold in the state.
-  void collectPlanOperators() {
-    for (FactId g : g1_) {
-      const OpId o = R_.op[supporter_[g]];
-      if (pref_stamp_[o] == pref_mark_) continue;
-      pref_stamp_[o] = pref_mark_;
-      preferred_.push_back(o);
     }
   }
 
@@ -1076,7 +1053,6 @@ class RelaxationHeuristic : public Heuristic {
   uint32_t mark_{0}, pref_mark_{0};
   std::vector<FactId> stack_, g1_;
   std::vector<OpId> preferred_;
-  bool plan_preferred_{false};  // setRelaxedPlanPreferred
 };
 
 class BlindHeuristic : public Heuristic {

@@ -870,8 +870,9 @@ void LandmarkCounter::preferred(const uint64_t* state, const uint64_t* status,
   }
 }
 
-template <class Pick>
-bool LandmarkCounter::markFacts(Pick pick) const {
+void LandmarkCounter::preferredAmong(const uint64_t* state, const uint64_t* status,
+                                     const std::vector<OpId>& applicable,
+                                     std::vector<OpId>& out) const {
   if (fact_mark_.size() != task_.numFacts()) {
     fact_mark_.assign(task_.numFacts(), 0);
     fact_epoch_ = 0;
@@ -883,76 +884,34 @@ bool LandmarkCounter::markFacts(Pick pick) const {
   const auto n = static_cast<uint32_t>(graph_.landmarks.size());
   bool any = false;
   for (uint32_t l = 0; l < n; ++l) {
-    if (!pick(l)) continue;
+    if (progression_ == LandmarkProgression::kPastAndFuture) {
+      if (!testBit(status + lm_words_, l) || holds(l, state)) continue;
+    } else if (testBit(status, l) || !parentsAccepted(l, status)) {
+      continue;
+    }
     for (FactId f : graph_.landmarks[l]) fact_mark_[f] = fact_epoch_;
     any = true;
   }
-  return any;
-}
-
-bool LandmarkCounter::addsMarked(const uint64_t* state, OpId o) const {
-  const Operator& op = task_.ops[o];
-  for (FactId f : op.add) {
-    if (fact_mark_[f] == fact_epoch_) return true;
-  }
-  for (const ConditionalEffect& ce : op.cond_effects) {
-    bool marked = false;
-    for (FactId f : ce.add) marked = marked || fact_mark_[f] == fact_epoch_;
-    if (!marked) continue;
-    bool holds_all = true;
-    for (FactId f : ce.cond) holds_all = holds_all && testBit(state, f);
-    if (holds_all) return true;
-  }
-  return false;
-}
-
-void LandmarkCounter::preferredAmong(const uint64_t* state, const uint64_t* status,
-                                     const std::vector<OpId>& applicable,
-                                     std::vector<OpId>& out) const {
-  const bool any = markFacts([&](uint32_t l) {
-    if (progression_ == LandmarkProgression::kPastAndFuture) {
-      return testBit(status + lm_words_, l) && !holds(l, state);
-    }
-    return !testBit(status, l) && parentsAccepted(l, status);
-  });
   if (!any) return;
   for (OpId o : applicable) {
-    if (addsMarked(state, o)) out.push_back(o);
-  }
-}
-
-void LandmarkCounter::leafPreferredAmong(const uint64_t* state, const uint64_t* status,
-                                         const std::vector<OpId>& applicable,
-                                         std::vector<OpId>& out) const {
-  if (progression_ != LandmarkProgression::kPastAndFuture) {
-    throw std::logic_error("LandmarkCounter::leafPreferredAmong needs kPastAndFuture");
-  }
-  const uint64_t* past = status;
-  const auto n = static_cast<uint32_t>(graph_.landmarks.size());
-  bool all_past = true;
-  for (uint32_t l = 0; l < n && all_past; ++l) all_past = testBit(past, l);
-  auto leaf = [&](uint32_t l) {
-    if (all_past) return graph_.is_goal[l] != 0 && !holds(l, state);
-    if (testBit(past, l)) return false;
-    for (uint32_t k = parents_begin_[l]; k < parents_begin_[l + 1]; ++k) {
-      if (!testBit(past, parents_[k])) return false;
+    const Operator& op = task_.ops[o];
+    bool adds = false;
+    for (FactId f : op.add) {
+      if (fact_mark_[f] == fact_epoch_) {
+        adds = true;
+        break;
+      }
     }
-    for (uint32_t k = reasonable_parents_begin_[l]; k < reasonable_parents_begin_[l + 1]; ++k) {
-      if (!testBit(past, reasonable_parents_[k])) return false;
+    for (size_t c = 0; !adds && c < op.cond_effects.size(); ++c) {
+      const ConditionalEffect& ce = op.cond_effects[c];
+      bool marked = false;
+      for (FactId f : ce.add) marked = marked || fact_mark_[f] == fact_epoch_;
+      if (!marked) continue;
+      bool holds_all = true;
+      for (FactId f : ce.cond) holds_all = holds_all && testBit(state, f);
+      adds = holds_all;
     }
-    return true;
-  };
-  // Simple leaves first; the disjunctive ones only when no applicable operator adds a simple one.
-  const size_t first = out.size();
-  if (markFacts([&](uint32_t l) { return graph_.landmarks[l].size() == 1 && leaf(l); })) {
-    for (OpId o : applicable) {
-      if (addsMarked(state, o)) out.push_back(o);
-    }
-  }
-  if (out.size() > first) return;
-  if (!markFacts([&](uint32_t l) { return graph_.landmarks[l].size() > 1 && leaf(l); })) return;
-  for (OpId o : applicable) {
-    if (addsMarked(state, o)) out.push_back(o);
+    if (adds) out.push_back(o);
   }
 }
 

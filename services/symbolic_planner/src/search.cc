@@ -297,31 +297,13 @@ std::vector<OpId> eliminateRedundantActions(const Task& task, const StateBits& i
   return plan;
 }
 
-std::unique_ptr<Heuristic> makeLazyHeuristic(const Task& task, const SearchOptions& options);
-
 class Searcher {
  public:
   Searcher(const Task& task, const StateBits& init, const Goal& goal, const SearchOptions& opt, Heuristic& h,
            const Termination& term)
-      : task_(task),
-        init_(init),
-        goal_(goal),
-        opt_(opt),
-        h_(&h),
-        term_(term),
-        reg_(task.numWords()),
-        lm_preferred_(opt.landmark_preferred) {
+      : task_(task), init_(init), goal_(goal), opt_(opt), h_(h), term_(term), reg_(task.numWords()) {
     buf_.resize(task.numWords());
     succ_.resize(task.numWords());
-  }
-
-  /// The lazy search beside or after the hill-climbing (its heuristic from `makeLazyHeuristic`):
-  /// with `lazy_plan_preferred`, the landmark count's preferred operators are
-  /// `lazy_landmark_preferred`, in their own queue with `lazy_landmark_preferred_own_queue`.
-  void useLazyHeuristicMode() {
-    if (!opt_.lazy_plan_preferred) return;
-    lm_preferred_ = opt_.lazy_landmark_preferred;
-    lm_own_queue_ = opt_.lazy_landmark_preferred_own_queue;
   }
 
   /// The counters so far.
@@ -333,7 +315,7 @@ class Searcher {
   /// The lazy search (`kLazy`) from the start, suspended after every `turn` evaluations (> 0).
   SearchCoroutine lazyInTurns(uint64_t turn) {
     Stopwatch sw;
-    h_->setGoal(goal_);
+    h_.setGoal(goal_);
     SearchCoroutine steps = lazySteps(std::numeric_limits<Cost>::max(), turn);
     for (steps.resume(); !steps.done(); steps.resume()) co_await std::suspend_always{};
     co_return finished(std::move(steps.result()), sw, true);
@@ -341,7 +323,7 @@ class Searcher {
 
   SearchResult run() {
     Stopwatch sw;
-    h_->setGoal(goal_);
+    h_.setGoal(goal_);
     SearchResult r;
     if (goal_.unsatisfiable()) {
       r.status = SearchStatus::kUnsolvable;
@@ -364,7 +346,7 @@ class Searcher {
   /// redundant actions eliminated.
   SearchResult improve(double w, Cost bound) {
     Stopwatch sw;
-    h_->setGoal(goal_);
+    h_.setGoal(goal_);
     SearchResult r = w > 0 ? lazyWAstar(w, bound) : lazy(bound);
     return finished(std::move(r), sw, true);
   }
@@ -407,10 +389,10 @@ class Searcher {
   Cost evaluate(uint32_t id) {
     if (h_cache_[id] != kUnknown) return h_cache_[id];
     ++stats_.evaluated;
-    const Cost h = h_->evaluate(reg_.get(id));
+    const Cost h = h_.evaluate(reg_.get(id));
     h_cache_[id] = h;
-    if (h_->computesPreferred()) {
-      const auto& p = h_->preferred();
+    if (h_.computesPreferred()) {
+      const auto& p = h_.preferred();
       pref_begin_[id] = pref_pool_.size();
       pref_count_[id] = static_cast<uint32_t>(p.size());
       pref_pool_.insert(pref_pool_.end(), p.begin(), p.end());
@@ -496,7 +478,7 @@ class Searcher {
   /// whole plan so far; on failure returns `fallback()`'s result: the complete search from the
   /// initial state to the full goal `goal_`, not to `goal` (a plan for the whole task).
   SearchResult ehcTo(const Goal& goal, uint32_t cur, std::vector<OpId>& plan, bool first) {
-    h_->setGoal(goal);
+    h_.setGoal(goal);
     std::fill(h_cache_.begin(), h_cache_.end(), kUnknown);
     pref_pool_.clear();
     bool is_new = false;
@@ -610,12 +592,7 @@ class Searcher {
     if (!opt_.ehc_fallback) return finish(SearchStatus::kFailed);
     ++stats_.ehc_fallbacks;
     if (in_agenda_entry_before_last_) ++stats_.ehc_fallbacks_in_agenda;
-    if (opt_.fallback == SearchAlgorithm::kLazy && opt_.lazy_plan_preferred) {
-      lazy_h_ = makeLazyHeuristic(task_, opt_);  // as the lazy search beside would have
-      h_ = lazy_h_.get();
-      useLazyHeuristicMode();
-    }
-    h_->setGoal(goal_);
+    h_.setGoal(goal_);
     return opt_.fallback == SearchAlgorithm::kGbfs ? gbfs() : lazy();
   }
 
@@ -688,7 +665,7 @@ class Searcher {
     const Cost h0 = evaluate(root);
     if (stats_.initial_h == 0) stats_.initial_h = h0;
     if (h0 == Heuristic::kDeadEnd) co_return finish(SearchStatus::kUnsolvable);
-    const bool use_pref = opt_.preferred_operators && h_->computesPreferred();
+    const bool use_pref = opt_.preferred_operators && h_.computesPreferred();
     // LAMA's second heuristic: landmark count, with its own accepted-landmark set per state.
     std::unique_ptr<LandmarkCounter> lm;
     if (opt_.landmarks) {
@@ -714,10 +691,6 @@ class Searcher {
     const bool active[4] = {true, use_pref, lm != nullptr, lm != nullptr && use_pref};
     std::vector<uint32_t> pref_mark(task_.ops.size(), 0);
     uint32_t mark = 0;
-    std::vector<uint32_t> lm_mark(lm_own_queue_ ? task_.ops.size() : 0, 0);
-    uint32_t lm_epoch = 0;
-    // Leaves need the past set (kPastAndFuture); Zhu-Givan's count takes every landmark needed.
-    const bool lm_leaves = opt_.landmark_generator == LandmarkGenerator::kRhw;
     std::vector<OpId> ops, lm_pref;
     auto expand = [&](uint32_t id) {
       ++stats_.expanded;
@@ -725,22 +698,10 @@ class Searcher {
       for (uint32_t i = 0; i < pref_count_[id]; ++i) pref_mark[pref_pool_[pref_begin_[id] + i]] = mark;
       ops.clear();
       task_.applicableOps(reg_.get(id), ops);
-      bool own = false;
-      if (lm && use_pref && lm_preferred_ != LandmarkPreferred::kNone) {
+      if (lm && use_pref) {
         lm_pref.clear();
-        const uint64_t* status = accepted.data() + static_cast<size_t>(id) * lw;
-        if (lm_preferred_ == LandmarkPreferred::kLeaves && lm_leaves) {
-          lm->leafPreferredAmong(reg_.get(id), status, ops, lm_pref);
-        } else {
-          lm->preferredAmong(reg_.get(id), status, ops, lm_pref);
-        }
-        own = lm_own_queue_;
-        if (!own) {
-          for (OpId o : lm_pref) pref_mark[o] = mark;
-        } else {
-          ++lm_epoch;
-          for (OpId o : lm_pref) lm_mark[o] = lm_epoch;
-        }
+        lm->preferredAmong(reg_.get(id), accepted.data() + static_cast<size_t>(id) * lw, ops, lm_pref);
+        for (OpId o : lm_pref) pref_mark[o] = mark;
       }
       const Cost hf = h_cache_[id];
       const Cost hl = lm ? hlm[id] : 0;
@@ -752,7 +713,7 @@ class Searcher {
         if (pref) lists[1].push(hf, id, o);
         if (lm) {
           lists[2].push(hl, id, o);
-          if (own ? lm_mark[o] == lm_epoch : pref) lists[3].push(hl, id, o);
+          if (pref) lists[3].push(hl, id, o);
         }
       }
     };
@@ -831,7 +792,7 @@ class Searcher {
     stats_.initial_h = h0;
     if (h0 == Heuristic::kDeadEnd) return finish(SearchStatus::kUnsolvable);
     g_[root] = 0;
-    const bool use_pref = opt_.preferred_operators && h_->computesPreferred();
+    const bool use_pref = opt_.preferred_operators && h_.computesPreferred();
     LazyOpen lists[2];
     int64_t prio[2] = {0, 0};
     std::vector<uint32_t> pref_mark(task_.ops.size(), 0);
@@ -898,7 +859,7 @@ class Searcher {
     const Cost h0 = evaluate(root);
     if (stats_.initial_h == 0) stats_.initial_h = h0;
     if (h0 == Heuristic::kDeadEnd) return finish(SearchStatus::kUnsolvable);
-    const bool use_pref = opt_.preferred_operators && h_->computesPreferred();
+    const bool use_pref = opt_.preferred_operators && h_.computesPreferred();
     OpenList regular, preferred;
     regular.push(h0, 0, root);
     if (use_pref) preferred.push(h0, 0, root);
@@ -1014,14 +975,9 @@ class Searcher {
   const StateBits& init_;
   const Goal& goal_;
   const SearchOptions& opt_;
-  Heuristic* h_;  ///< the search's heuristic; the fallback's own (`lazy_h_`) once it runs
-  std::unique_ptr<Heuristic> lazy_h_;  ///< SearchOptions::lazy_plan_preferred: the lazy fallback's heuristic
+  Heuristic& h_;
   const Termination& term_;
   StateRegistry reg_;
-  /// The lazy search's landmark preferred operators: `opt_.landmark_preferred`, or
-  /// `opt_.lazy_landmark_preferred` beside or after the hill-climbing (`useLazyHeuristicMode`).
-  LandmarkPreferred lm_preferred_;
-  bool lm_own_queue_{false};  ///< the landmark count's preferred operators in list 3 only
   std::vector<uint32_t> parent_, op_;
   std::vector<Cost> g_, h_cache_;
   std::vector<size_t> pref_begin_;
@@ -1199,14 +1155,6 @@ SearchResult configuredSearch(const Task& task, const StateBits& init, const Goa
   return s.run();
 }
 
-/// The heuristic of the lazy search beside or after the hill-climbing
-/// (SearchOptions::lazy_plan_preferred).
-std::unique_ptr<Heuristic> makeLazyHeuristic(const Task& task, const SearchOptions& options) {
-  std::unique_ptr<Heuristic> h = makeHeuristic(defaultHeuristic(options), task, defaultCostType(options, task));
-  if (options.lazy_plan_preferred) h->setRelaxedPlanPreferred(true);
-  return h;
-}
-
 /// SearchOptions::ehc_lazy_beside: the lazy search, started once the hill-climbing has used
 /// `ehc_lazy_after` evaluations, then run for `ehc_lazy_turn_lazy` evaluations after every
 /// `ehc_lazy_turn_ehc` of the hill-climbing's, inside the hill-climbing's own call (one thread:
@@ -1247,9 +1195,8 @@ class LazyBeside : public TurnTaker {
  private:
   void start() {
     if (steps_) return;
-    heuristic_ = makeLazyHeuristic(task_, options_);
+    heuristic_ = makeHeuristic(defaultHeuristic(options_), task_, defaultCostType(options_, task_));
     searcher_ = std::make_unique<Searcher>(task_, init_, goal_, options_, *heuristic_, term_);
-    searcher_->useLazyHeuristicMode();
     steps_.emplace(searcher_->lazyInTurns(options_.ehc_lazy_turn_lazy));
   }
 

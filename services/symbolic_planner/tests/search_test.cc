@@ -336,7 +336,6 @@ TEST(Search, LazySearchWithRhwLandmarksNeedsFewerEvaluations) {
     SCOPED_TRACE(folder);
     PlanRequest req = benchmarkRequest(folder, instance);
     req.search.algorithm = SearchAlgorithm::kLazy;
-    ASSERT_EQ(req.search.landmark_preferred, LandmarkPreferred::kNeeded);  // kLazy's default: the counts here
     req.timeout_seconds = 120;
     ASSERT_EQ(req.search.landmark_generator, LandmarkGenerator::kRhw);  // the default
     ASSERT_TRUE(req.search.rhw.reasonable_orders);                       // the default
@@ -409,7 +408,6 @@ TEST(Search, EhcFallbackInsideAGoalAgendaEntryIsFinal) {
   PlanRequest req = benchmarkRequest("pddl-more/psr-small/instance-40", "instance-40.pddl");
   req.timeout_seconds = 120;
   req.search.ehc_lazy_beside = false;  // the fallback after the hill-climbing, alone
-  req.search.lazy_plan_preferred = false;  // the fallback's preferred operators as kLazy's
   PlanReply with = plan(req, Termination());
   ASSERT_EQ(with.status, PlanStatus::kSolved) << with.message;  // replayed by the checker
   EXPECT_EQ(with.stats.ehc_fallbacks, 1U);
@@ -450,51 +448,6 @@ TEST(Search, LazySearchBesideTheHillClimbingGivesThePlanWithFewerEvaluationsTheS
   EXPECT_TRUE(after.stats.ehc_failed);
   EXPECT_LT(beside.stats.evaluated, after.stats.evaluated);
   EXPECT_GT(beside.stats.evaluated, req.search.ehc_lazy_after);  // the hill-climbing's share included
-}
-
-TEST(Search, LazySearchBesideTakesTheLandmarkCountsPreferredOperatorsInTheirOwnQueue) {
-  // The default search: the lazy search beside the hill-climbing prefers the relaxed plan's
-  // applicable operators in h_FF's preferred queue and the achievers of the landmarks still
-  // needed in the landmark count's (docs/benchmarks.md, issue 14, twentieth round).
-  // Deterministic counts, checked plans. hiking-4: 9426 evaluations (the lazy search gives the
-  // plan); both preferred queues taking either's preferred operators: 26117; none from the
-  // landmark count (the nineteenth round's, not adopted): 20821; FF's helpful actions and the
-  // landmark count's in both queues (the eighteenth round's): 26422.
-  PlanRequest req = benchmarkRequest("pddl-more/hiking", "instance-4.pddl");
-  req.timeout_seconds = 120;
-  ASSERT_TRUE(req.search.lazy_plan_preferred);                                 // the default
-  ASSERT_EQ(req.search.lazy_landmark_preferred, LandmarkPreferred::kNeeded);  // the default
-  ASSERT_TRUE(req.search.lazy_landmark_preferred_own_queue);                   // the default
-  const PlanReply own = plan(req, Termination());
-  ASSERT_EQ(own.status, PlanStatus::kSolved) << own.message;
-  EXPECT_TRUE(own.stats.lazy_beside_won);
-  req.search.lazy_landmark_preferred_own_queue = false;
-  const PlanReply shared = plan(req, Termination());
-  req.search.lazy_landmark_preferred_own_queue = true;
-  req.search.lazy_landmark_preferred = LandmarkPreferred::kNone;
-  const PlanReply none = plan(req, Termination());
-  req.search.lazy_landmark_preferred = LandmarkPreferred::kNeeded;
-  req.search.lazy_plan_preferred = false;
-  const PlanReply eighteenth = plan(req, Termination());
-  for (const PlanReply* r : {&shared, &none, &eighteenth}) {
-    ASSERT_EQ(r->status, PlanStatus::kSolved) << r->message;
-    EXPECT_LT(own.stats.evaluated, r->stats.evaluated);
-  }
-  EXPECT_LT(own.stats.evaluated, 15000U);  // 9426
-
-  // trucks-12, the nineteenth round's loss: the lazy search solves it after both hill-climbing
-  // runs fail with the landmark count's preferred operators (3991 evaluations), not without them
-  // (2.8 million evaluations in 29 s without a plan; here at least 100 000 or out of time).
-  PlanRequest trucks = benchmarkRequest("pddl-more/trucks", "instance-12.pddl");
-  trucks.timeout_seconds = 120;
-  const PlanReply with = plan(trucks, Termination());
-  ASSERT_EQ(with.status, PlanStatus::kSolved) << with.message;
-  EXPECT_LT(with.stats.evaluated, 10000U);
-  trucks.timeout_seconds = 3;
-  trucks.search.lazy_landmark_preferred = LandmarkPreferred::kNone;
-  const PlanReply without = plan(trucks, Termination());
-  EXPECT_TRUE(without.status != PlanStatus::kSolved || without.stats.evaluated > 100000U)
-      << without.stats.evaluated << " evaluations";
 }
 
 TEST(Search, LazySearchBesideNotStartedChangesNothing) {

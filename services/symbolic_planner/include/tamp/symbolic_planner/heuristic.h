@@ -55,15 +55,6 @@ class Heuristic {
     (void)on;
     return false;
   }
-  /// Switches `preferred()` to the relaxed plan's own operators that are applicable in the state
-  /// (Fast Downward's preferred operators of h_FF, so LAMA's: one supporter per first-layer
-  /// sub-goal, each operator once) or back to FF's helpful actions (every applicable operator
-  /// that adds a first-layer sub-goal: a superset). Takes precedence over `setFFStyle`. Returns
-  /// false (and changes nothing) when the heuristic computes no helpful actions.
-  virtual bool setRelaxedPlanPreferred(bool on) {
-    (void)on;
-    return false;
-  }
 
  protected:
   std::vector<OpId> no_ops_;

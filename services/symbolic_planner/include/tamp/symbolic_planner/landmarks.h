@@ -36,8 +36,7 @@
 ///   value is the number of future landmarks.
 ///
 /// Its preferred operators are the applicable operators that add a fact of a landmark that is
-/// still needed and false (`preferredAmong`), or, LAMA 2011's, of a leaf: a landmark not yet
-/// reached whose predecessors all were (`leafPreferredAmong`). Values are counts (every landmark counts 1, as in lama-first's
+/// still needed and false. Values are counts (every landmark counts 1, as in lama-first's
 /// `cost_type=one`), never `Heuristic::kDeadEnd` (dead ends are left to h_FF).
 
 #include <bit>
@@ -163,16 +162,6 @@ class LandmarkCounter {
   /// landmark `at_person` are thousands, the applicable operators a few hundred).
   void preferredAmong(const uint64_t* state, const uint64_t* status,
                       const std::vector<OpId>& applicable, std::vector<OpId>& out) const;
-  /// LAMA 2011's preferred operators of the landmark count (Fast Downward's
-  /// `LandmarkHeuristic::generate_preferred_operators`), kPastAndFuture only: the operators of
-  /// `applicable` (as for `preferredAmong`) that add a fact of a *leaf*: a landmark not past
-  /// whose predecessors (natural, greedy-necessary and reasonable) are all past; once every
-  /// landmark is past, a goal landmark that is false. Achievers of simple leaves only, when there
-  /// are any; otherwise those of disjunctive leaves. Each operator once, in the order of
-  /// `applicable`; a subset of `preferredAmong`'s except for goals false again once all are past.
-  /// @throws std::logic_error with kAcceptedAfterParents.
-  void leafPreferredAmong(const uint64_t* state, const uint64_t* status,
-                          const std::vector<OpId>& applicable, std::vector<OpId>& out) const;
 
  private:
   bool holds(uint32_t l, const uint64_t* state) const;
@@ -190,12 +179,6 @@ class LandmarkCounter {
   mutable std::vector<uint64_t> now_;        ///< scratch of progress(): the landmarks that hold
   mutable std::vector<uint32_t> fact_mark_;  ///< scratch of preferredAmong(): epoch per fact
   mutable uint32_t fact_epoch_{0};
-  /// Marks the facts of the landmarks selected by `pick(l)` with a new epoch; false if none was.
-  template <class Pick>
-  bool markFacts(Pick pick) const;
-  /// Whether applicable operator `o` adds a fact marked in this epoch (a conditional effect: with
-  /// its condition true in `state`).
-  bool addsMarked(const uint64_t* state, OpId o) const;
 };
 
 }  // namespace tamp::symbolic_planner

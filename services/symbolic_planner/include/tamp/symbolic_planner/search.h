@@ -49,13 +49,6 @@ namespace tamp::symbolic_planner {
 /// The landmark generator of the lazy search's landmark count (landmarks.h).
 enum class LandmarkGenerator { kZhuGivan, kRhw };
 
-/// The landmark count's preferred operators in the lazy search (`LandmarkCounter`).
-enum class LandmarkPreferred {
-  kNone,    ///< none (Fast Downward's `lama-first`, `pref=false`)
-  kNeeded,  ///< the applicable achievers of every landmark still needed (`preferredAmong`)
-  kLeaves,  ///< those of the leaves only (`leafPreferredAmong`, LAMA 2011's); kNeeded with kZhuGivan
-};
-
 enum class SearchAlgorithm { kEhc, kGbfs, kLazy, kWAstar, kAstar };
 
 /// Parses "ehc", "gbfs", "lazy", "wastar", "astar"; nullopt otherwise.
@@ -143,23 +136,6 @@ struct SearchOptions {
   /// orders, counted with kPastAndFuture, as LAMA in Fast Downward today).
   LandmarkGenerator landmark_generator{LandmarkGenerator::kRhw};
   RhwLandmarkOptions rhw;  ///< kRhw's options
-  /// lazy (`kLazy`, the anytime phase's first iteration): the landmark count's preferred
-  /// operators that join h_FF's (docs/benchmarks.md, issue 14, nineteenth and twentieth rounds).
-  LandmarkPreferred landmark_preferred{LandmarkPreferred::kNeeded};
-  /// The same for the lazy search beside or after the hill-climbing when it prefers the relaxed
-  /// plan's operators (`lazy_plan_preferred`; otherwise `landmark_preferred` holds there too).
-  LandmarkPreferred lazy_landmark_preferred{LandmarkPreferred::kNeeded};
-  /// The lazy search beside or after the hill-climbing, with `lazy_plan_preferred`: the landmark
-  /// count's preferred operators go to the landmark count's preferred queue only, h_FF's to h_FF's
-  /// (false: both preferred queues take the successors of either, as Fast Downward's lazy search).
-  bool lazy_landmark_preferred_own_queue{true};
-  /// ehc with the lazy fallback: the lazy search beside the hill-climbing (`ehc_lazy_beside`) or
-  /// after it prefers the relaxed plan's applicable operators (`Heuristic::setRelaxedPlanPreferred`,
-  /// LAMA's preferred operators of h_FF) instead of FF's helpful actions, in a heuristic of its
-  /// own. The hill-climbing keeps FF's helpful actions; so do `kLazy` and the anytime phase,
-  /// which use the search's heuristic. false: FF's helpful actions there too (the eighteenth
-  /// round's).
-  bool lazy_plan_preferred{true};
   /// ehc/gbfs/lazy: drop redundant actions from the plan found (greedy action elimination).
   bool eliminate_redundant_actions{true};
   int preferred_boost{1000};    ///< gbfs/lazy: preferred-queue priority boost on progress

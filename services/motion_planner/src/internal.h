@@ -252,7 +252,6 @@ class ClearanceValidityChecker : public ob::StateValidityChecker {
   bool relaxed() const { return relaxed_; }
   /// m, > 0: the least distance to the movables near the start; 0: none.
   void setStartFloor(double floor_m) { floor_ = floor_m; }
-  double startFloor() const { return floor_; }
 
  private:
   bool nearEnd(const Eigen::Vector2d& at, std::size_t from) const;

@@ -309,6 +309,7 @@ void GraphManager::clearWorldCaches() {
   fixed_objects_.clear();
   fixed_in_world_.clear();
   removable_objects_.clear();
+  removals_.clear();
 }
 
 std::optional<std::pair<GraspOption, Eigen::Isometry3d>> GraphManager::preparePlace(

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <set>
 
 #include "tamp/core/log.h"
@@ -77,16 +78,19 @@ int GraphManager::spawnSubtasks(EdgeId id, const BranchContext& ctx, int depth) 
     std::vector<std::string> progress;
     for (const auto& a : ca)
       if (!std::binary_search(va.begin(), va.end(), a)) progress.push_back(a);
+    Removal removal{v, objectsKey(ctx), o->id, id, depth, {}};
     for (const auto& s : slots) {
-      addSubtask(v, {"(on " + o->id + " " + s + ")"}, progress, "sub-task: move " + o->id + " to " + s);
+      const EdgeId first =
+          addSubtask(v, {"(on " + o->id + " " + s + ")"}, progress, "sub-task: move " + o->id + " to " + s);
+      if (first >= 0) removal.firsts.push_back(first);
     }
+    if (!removal.firsts.empty()) removals_.push_back(std::move(removal));
     first_slots.emplace_back(o->id, slots.front());
   }
   if (params_.policy == Policy::kOracle) spawnSubsetSubtasks(v, child, first_slots);
   // The edge may have moved: the graph grew.
   Edge& e = graph_.edge(id);
   for (const auto& why : unmovable) e.reason += "; " + why;
-  (void)depth;
   return fixed;
 }
 
@@ -147,18 +151,39 @@ std::vector<std::string> GraphManager::placeSlots(const world::Object& o, const 
   return slots;
 }
 
-void GraphManager::addSubtask(NodeId v, const std::vector<std::string>& moved, const std::vector<std::string>& progress,
-                              const std::string& origin) {
+EdgeId GraphManager::addSubtask(NodeId v, const std::vector<std::string>& moved, const std::vector<std::string>& progress,
+                                const std::string& origin) {
   auto before = planFrom(v, moved, origin);
-  if (!before) return;
+  if (!before) return -1;
   ++counters_.subtasks;
+  EdgeId first = before->empty() ? -1 : before->front();
   NodeId end = before->empty() ? v : graph_.edge(before->back()).to;
   if (!progress.empty()) {
     auto after = planFrom(end, progress, origin);
-    if (!after) return;
+    if (!after) return first;
+    if (first < 0 && !after->empty()) first = after->front();
     if (!after->empty()) end = graph_.edge(after->back()).to;
   }
-  if (!isGoal(end)) (void)planFrom(end, goal_.atoms, origin);
+  if (!isGoal(end)) {
+    auto rest = planFrom(end, goal_.atoms, origin);
+    if (first < 0 && rest && !rest->empty()) first = rest->front();
+  }
+  return first;
+}
+
+bool GraphManager::fixUnremovable(NodeId v, const BranchContext& ctx, const std::function<bool(EdgeId)>& dead) {
+  const std::string world = objectsKey(ctx);
+  std::map<EdgeId, int> blocked;  // edge -> the depth it was priced at
+  for (const Removal& r : removals_) {
+    if (r.from != v || r.world != world || fixed_objects_.count(r.object)) continue;
+    if (!std::all_of(r.firsts.begin(), r.firsts.end(), dead)) continue;
+    if (!fixed_in_world_[world].insert(r.object).second) continue;
+    log::get("graph_manager")
+        ->info("every removal of {} failed at its first step from n{}: going round it in this world", r.object, v);
+    blocked.emplace(r.blocked, r.depth);
+  }
+  for (const auto& [e, depth] : blocked) (void)evaluateBaseAgain(e, ctx, depth);
+  return !blocked.empty();
 }
 
 

@@ -263,6 +263,20 @@ struct GraphManager::Search {
     }
   }
 
+  /// Edges on a branch that was cut on its bound (at it or below): a way on that was priced, not
+  /// one that failed.
+  std::set<EdgeId> bounded;
+
+  void cut(EdgeId e, double bound) {
+    gm.graph_.edge(e).cut = true;
+    cut_bound[e] = bound;
+    bounded.insert(e);
+    bounded.insert(branch.begin(), branch.end());
+  }
+
+  /// Whether no branch through `e` reached the goal or was cut on its bound: it failed.
+  bool failedThrough(EdgeId e) const { return !best_through.count(e) && !bounded.count(e); }
+
   /// Records an edge's state when its try ends (however the loop body leaves).
   struct TriedMark {
     GraphManager& gm;
@@ -296,14 +310,19 @@ struct GraphManager::Search {
         const double k = known(e);
         if (pick < 0 || k < pick_cost) pick = e, pick_cost = k;
       }
-      if (pick < 0) return;
+      if (pick < 0) {
+        // Every way on was tried: an object whose every removal failed at its first step is gone
+        // round instead (the edges it blocked are planned again, and tried again when changed).
+        auto dead = [&](EdgeId x) { return tried.count(x) && failedThrough(x); };
+        if (gm.fixUnremovable(v, ctx, dead)) continue;
+        return;
+      }
       TriedMark mark{gm, tried, pick};
       Edge& e = gm.graph_.edge(pick);
       if (e.to == v || onBranch(e.to)) continue;
       if (!std::isfinite(pick_cost)) continue;
       if (!exhaustive && cost + pick_cost >= best) {
-        e.cut = true;
-        cut_bound[pick] = cost + pick_cost;
+        cut(pick, cost + pick_cost);
         continue;
       }
       if (e.kind == ActionKind::kMoveArm) {
@@ -317,8 +336,7 @@ struct GraphManager::Search {
       Edge& done = gm.graph_.edge(pick);
       if (!std::isfinite(c)) continue;
       if (!exhaustive && cost + c >= best) {
-        done.cut = true;
-        cut_bound[pick] = cost + c;
+        cut(pick, cost + c);
         continue;
       }
       branch.push_back(pick);
@@ -346,8 +364,7 @@ struct GraphManager::Search {
       const double c = gm.evaluate(arm, f, ctx, depth);
       if (!std::isfinite(c)) continue;
       if (!exhaustive && cost + c >= best) {
-        gm.graph_.edge(arm).cut = true;
-        cut_bound[arm] = cost + c;
+        cut(arm, cost + c);
         continue;
       }
       const auto sd = gm.graph_.edge(arm).effort_by_next[f].second;
@@ -362,6 +379,7 @@ struct GraphManager::Search {
         const Edge& fe = gm.graph_.edge(f);
         ++evaluations;
         const double cf = gm.evaluate(f, -1, next_ctx, depth);
+        if (std::isfinite(cf) && !exhaustive && cost + c + cf >= best) bounded.insert(branch.begin(), branch.end());
         if (std::isfinite(cf) && (exhaustive || cost + c + cf < best) && !onBranch(fe.to)) {
           branch.push_back(f);
           branch_sd2.push_back(fe.effort_stddev_s * fe.effort_stddev_s);

@@ -419,8 +419,28 @@ class GraphManager {
                                       const std::vector<Pose2D>& swept, double radius, std::string& why);
   /// One sub-task from `v`: TP(v, `moved`), then TP(that, `progress`) (what the blocked action
   /// achieved; skipped when empty), then TP(that, goal), each merged into the graph.
-  void addSubtask(NodeId v, const std::vector<std::string>& moved, const std::vector<std::string>& progress,
-                  const std::string& origin);
+  /// Returns the sub-task's first edge from `v` (-1 when the planner found none).
+  EdgeId addSubtask(NodeId v, const std::vector<std::string>& moved, const std::vector<std::string>& progress,
+                    const std::string& origin);
+  /// One object's removal sub-tasks spawned from a node in one branch world (objectsKey): the edge
+  /// its lazy path blocked, and the sub-tasks' first edges from the node.
+  struct Removal {
+    NodeId from{-1};
+    std::string world;
+    std::string object;
+    EdgeId blocked{-1};
+    int depth{0};
+    std::vector<EdgeId> firsts;
+  };
+  /// Every removal whose sub-tasks all failed at their first edge from `v` (`dead`: tried, and no
+  /// branch through it reached the goal or was cut on its bound), in ctx's world: its object is
+  /// fixed in that world (a push whose stand lies behind other objects, a placement out of reach),
+  /// and the edges it blocked are planned again round it (evaluateBaseAgain); the failed removals
+  /// stay alternatives. Whether any edge was planned again. namo_moghaddam_07's world failed with
+  /// "no branch" so: its lazy path crossed two boxes whose push stands no drive reached, and
+  /// nothing made the next lazy path go round them.
+  bool fixUnremovable(NodeId v, const BranchContext& ctx, const std::function<bool(EdgeId)>& dead);
+  std::vector<Removal> removals_;
   // ---- policy oracle (oracle.cc) ----
   /// Blocking objects of one edge given removal sub-tasks under the current policy.
   int blockingObjectsConsidered() const;

@@ -206,6 +206,7 @@ struct GraphManager::Search {
   std::map<EdgeId, double> best_through;
   std::map<EdgeId, double> cut_bound;
   int evaluations{0};
+  int completions{0};  ///< complete branches found (however costly)
   bool exhausted{false};
   std::vector<EdgeId> branch;
   std::vector<double> branch_sd2;
@@ -249,6 +250,7 @@ struct GraphManager::Search {
   }
 
   void complete(double branch_cost) {
+    ++completions;
     const double cost = branch_cost + gm.oraclePenalty(steps);
     if (first_edge_only && first_edge.empty() && !branch.empty()) first_edge = gm.firstEdgeOf(branch);
     if (cost < best) {
@@ -299,6 +301,7 @@ struct GraphManager::Search {
     // infeasible prices a blocked edge again round what the robot cannot move, once the way
     // round everything is proven impossible) is tried again.
     std::map<EdgeId, EdgeState> tried;
+    const int completed_before = completions;
     while (!settled() && !outOfBudget()) {
       // The untried out-edge with the least known or bounded effort (out(v) grows with sub-tasks).
       EdgeId pick = -1;
@@ -311,10 +314,12 @@ struct GraphManager::Search {
         if (pick < 0 || k < pick_cost) pick = e, pick_cost = k;
       }
       if (pick < 0) {
-        // Every way on was tried: an object whose every removal failed at its first step is gone
-        // round instead (the edges it blocked are planned again, and tried again when changed).
+        // Every way on was tried and none reached the goal: an object whose every removal failed
+        // at its first step is gone round instead (the edges it blocked are planned again, and
+        // tried again when changed). Not when a way on reached it: the rescue costs motions (on
+        // namo_moghaddam_07, 7 s more before the first command, and the oracle's budget).
         auto dead = [&](EdgeId x) { return tried.count(x) && failedThrough(x); };
-        if (gm.fixUnremovable(v, ctx, dead)) continue;
+        if (completions == completed_before && gm.fixUnremovable(v, ctx, dead)) continue;
         return;
       }
       TriedMark mark{gm, tried, pick};

@@ -432,6 +432,7 @@ class GraphManager {
     int depth{0};
     std::vector<EdgeId> firsts;
   };
+  /// Traverse calls it when every way on from `v` was tried and none reached the goal.
   /// Every removal whose sub-tasks all failed at their first edge from `v` (`dead`: tried, and no
   /// branch through it reached the goal or was cut on its bound), in ctx's world: its object is
   /// fixed in that world (a push whose stand lies behind other objects, a placement out of reach),

@@ -191,6 +191,7 @@ int main(int argc, char** argv) {
   size_t rhw_max_disjunction = defaults.rhw.max_disjunction_size;
   bool rhw_no_zg = !defaults.rhw.add_zhu_givan, rhw_keep_one_action = !defaults.rhw.skip_one_action_disjunctions;
   bool rhw_reasonable = defaults.rhw.reasonable_orders;
+  bool h2_restart = defaults.ehc_h2_restart;
   app.add_option("--landmarks", landmark_generator,
                  "lazy: the landmarks counted: rhw (Richter-Helmert-Westphal: disjunctive landmarks, greedy-necessary "
                  "orders, landmarks required again) or zg (Zhu-Givan fact landmarks)")
@@ -204,6 +205,9 @@ int main(int argc, char** argv) {
   app.add_option("--rhw-reasonable-orders", rhw_reasonable,
                  "lazy with rhw: reasonable orders (Hoffmann et al.'s, from h^2 mutexes) between the landmarks: "
                  "true or false");
+  app.add_option("--ehc-h2-restart", h2_restart,
+                 "ehc: after a hill-climbing run proves a state it committed to a dead end, run it again "
+                 "from the start, testing every state it commits to with h^2 from that state: true or false");
   app.add_flag("--no-ehc-lazy-beside", no_lazy_beside,
                "ehc: the lazy search only after the hill-climbing fails (FF's order), not beside it");
   app.add_option("--ehc-lazy-after", lazy_after,
@@ -250,6 +254,7 @@ int main(int argc, char** argv) {
   req.search.rhw.skip_one_action_disjunctions = !rhw_keep_one_action;
   req.search.rhw.reasonable_orders = rhw_reasonable;
   req.search.ehc_lazy_beside = !no_lazy_beside;
+  req.search.ehc_h2_restart = h2_restart;
   req.search.ehc_lazy_after = lazy_after;
   req.search.ehc_lazy_turn_ehc = lazy_turn_ehc;
   req.search.ehc_lazy_turn_lazy = lazy_turn_lazy;
@@ -275,7 +280,7 @@ int main(int argc, char** argv) {
                  "; status %s; parse %.4f s, ground %.4f s, search %.4f s; facts %zu, operators %zu; "
                  "expanded %llu, evaluated %llu, initial h %lld; ehc plateau retries %llu (%llu abandoned); ehc fallbacks "
                  "%llu (%llu in a goal-agenda entry before the last); anytime %llu "
-                 "iterations, %llu improvements; landmarks %llu (%llu disjunctive, %llu greedy-necessary, %llu reasonable orders)%s%s%s%s%s\n",
+                 "iterations, %llu improvements; landmarks %llu (%llu disjunctive, %llu greedy-necessary, %llu reasonable orders); ehc h^2 restarts %llu (%llu tests, %llu dead ends)%s%s%s%s%s\n",
                  sp::toString(reply.status).c_str(), reply.stats.parse_seconds, reply.stats.ground_seconds,
                  reply.stats.search_seconds, reply.stats.facts, reply.stats.operators,
                  static_cast<unsigned long long>(reply.stats.expanded),
@@ -290,6 +295,9 @@ int main(int argc, char** argv) {
                  static_cast<unsigned long long>(reply.stats.landmarks_disjunctive),
                  static_cast<unsigned long long>(reply.stats.landmark_gn_orders),
                  static_cast<unsigned long long>(reply.stats.landmark_reasonable_orders),
+                 static_cast<unsigned long long>(reply.stats.ehc_h2_restarts),
+                 static_cast<unsigned long long>(reply.stats.ehc_h2_tests),
+                 static_cast<unsigned long long>(reply.stats.ehc_h2_dead_ends),
                  reply.stats.ehc_ff_failed ? "; ehc with FF-v2.3's relaxed plan failed, restarted" : "",
                  reply.stats.ehc_second_won   ? "; second ehc run gave the shorter plan"
                  : reply.stats.ehc_second_ran ? "; second ehc run, first plan kept"

@@ -38,6 +38,21 @@ struct ChangeClock {
 }  // namespace
 
 MutexTable::MutexTable(const Task& task, const StateBits& init, const H2MutexOptions& options) {
+  compute(task, init, options, nullptr);
+}
+
+std::optional<bool> MutexTable::reachesTogether(const Task& task, const StateBits& from,
+                                                const std::vector<FactId>& facts,
+                                                const H2MutexOptions& options, uint64_t* work) {
+  MutexTable t;
+  t.compute(task, from, options, &facts);
+  if (work != nullptr) *work = t.work_;
+  if (t.n_ == 0) return std::nullopt;
+  return t.stop_left_ == 0;
+}
+
+void MutexTable::compute(const Task& task, const StateBits& init, const H2MutexOptions& options,
+                         const std::vector<FactId>* stop_facts) {
   options.validate();
   if (init.size() < task.numWords()) {
     throw std::invalid_argument("MutexTable: the initial state has " + std::to_string(init.size()) +
@@ -52,6 +67,24 @@ MutexTable::MutexTable(const Task& task, const StateBits& init, const H2MutexOpt
   adds_.assign(words_, 0);
   for (FactId f = 0; f < n; ++f) {
     if (testBit(init.data(), f)) std::copy(init.begin(), init.begin() + words_, row(f));
+  }
+  if (stop_facts != nullptr) {
+    stop_flag_.assign(n, 0);
+    std::vector<FactId> distinct;
+    for (FactId f : *stop_facts) {
+      if (f >= n)
+        throw std::invalid_argument("MutexTable::reachesTogether: fact " + std::to_string(f) +
+                                    " of " + std::to_string(n));
+      if (stop_flag_[f] == 0) distinct.push_back(f);
+      stop_flag_[f] = 1;
+    }
+    stop_left_ = distinct.size() * (distinct.size() + 1) / 2;
+    for (size_t i = 0; i < distinct.size(); ++i) {
+      for (size_t j = i; j < distinct.size(); ++j) {
+        if (pairReachable(distinct[i], distinct[j])) --stop_left_;
+      }
+    }
+    if (stop_left_ == 0) return;
   }
   ChangeClock clock;
   clock.row_tick.assign(n, 1);
@@ -70,9 +103,12 @@ MutexTable::MutexTable(const Task& task, const StateBits& init, const H2MutexOpt
         if (pairReachable(f, f)) clock.reached_tick = clock.now;
       }
       if (work_ > options.max_work) {
+        const uint64_t work = work_;
         *this = MutexTable();
+        work_ = work;
         return;
       }
+      if (stop_facts != nullptr && stop_left_ == 0) return;
     }
   }
 }
@@ -141,6 +177,7 @@ bool MutexTable::markPairs(FactId p, const uint64_t* with) {
     while (fresh != 0) {
       const auto q = static_cast<FactId>(w * 64 + static_cast<size_t>(std::countr_zero(fresh)));
       fresh &= fresh - 1;
+      if (stop_left_ > 0 && stop_flag_[p] != 0 && stop_flag_[q] != 0) --stop_left_;
       setBit(row(q), p);
       new_bits_.push_back(q);
     }

@@ -304,6 +304,9 @@ PlanReply PlanningSession::solve(const Query& q, const Termination& term) {
   reply.stats.ehc_second_won = sr.stats.ehc_second_won;
   reply.stats.ehc_retries = sr.stats.ehc_retries;
   reply.stats.ehc_retries_abandoned = sr.stats.ehc_retries_abandoned;
+  reply.stats.ehc_h2_restarts = sr.stats.ehc_h2_restarts;
+  reply.stats.ehc_h2_tests = sr.stats.ehc_h2_tests;
+  reply.stats.ehc_h2_dead_ends = sr.stats.ehc_h2_dead_ends;
   reply.stats.ehc_fallbacks = sr.stats.ehc_fallbacks;
   reply.stats.ehc_fallbacks_in_agenda = sr.stats.ehc_fallbacks_in_agenda;
   reply.stats.lazy_beside_started = sr.stats.lazy_beside_started;

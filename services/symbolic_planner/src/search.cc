@@ -456,7 +456,10 @@ class Searcher {
       partial.conjuncts.push_back(GoalConjunct{so_far, {}});
       const bool last = k + 1 == agenda.size();
       in_agenda_entry_before_last_ = !last;
+      const uint64_t restarts = stats_.ehc_h2_restarts;
       SearchResult r = ehcTo(last ? goal_ : partial, cur, plan, k == 0);
+      // A restart (ehc_h2_restart) inside the entry has hill-climbed to the whole goal.
+      if (stats_.ehc_h2_restarts != restarts) return r;
       // After a fallback, the complete search has searched for the whole goal from the initial
       // state (FF): its answer (plan, proof, or limit) is final, whichever entry the hill-climbing
       // failed in. Going on to the next entry from the hill-climbing's own plan would discard
@@ -500,6 +503,7 @@ class Searcher {
     }
     if (hcur == Heuristic::kDeadEnd) {
       if (first && &goal == &goal_) return finish(SearchStatus::kUnsolvable);
+      dead_end_proven_ = true;
       return fallback();
     }
     std::vector<uint32_t> queue;
@@ -558,6 +562,10 @@ class Searcher {
           const Cost h = evaluate(sid);
           if (h == Heuristic::kDeadEnd) continue;
           if (h < hcur && (found == kNone || h < h_cache_[found])) {
+            if (h2_commits_ && !term_() && h2DeadEnd(succ_.data())) {
+              h_cache_[sid] = Heuristic::kDeadEnd;
+              continue;
+            }
             // A better state: finish this node's successors and keep the best of them
             // (FF takes the first; the best sibling gives shorter plans at little cost).
             found = sid;
@@ -575,6 +583,8 @@ class Searcher {
           ++stats_.ehc_retries;
           continue;
         }
+        // Searched without pruning, the plateau held every state reachable from `cur`.
+        dead_end_proven_ = !helpful_only;
         return fallback();
       }
       helpful_only = true;
@@ -588,6 +598,14 @@ class Searcher {
   }
 
   SearchResult fallback() {
+    if (dead_end_proven_ && opt_.ehc_h2_restart && !h2_commits_ && !term_()) {
+      // The hill-climbing committed to a dead end: again from the start, testing what it
+      // commits to with h^2 (SearchOptions::ehc_h2_restart).
+      dead_end_proven_ = false;
+      h2_commits_ = true;
+      ++stats_.ehc_h2_restarts;
+      return ehc();
+    }
     stats_.ehc_failed = true;
     if (!opt_.ehc_fallback) return finish(SearchStatus::kFailed);
     ++stats_.ehc_fallbacks;
@@ -994,6 +1012,28 @@ class Searcher {
   uint32_t iter_{0};
   TurnTaker* turns_{nullptr};  // another search taking turns with this hill-climbing, if any
   bool in_agenda_entry_before_last_{false};  // ehc: hill-climbing to a goal-agenda entry, not the last
+  bool dead_end_proven_{false};  // ehc: the state the hill-climbing stands on is a proven dead end
+  bool h2_commits_{opt_.ehc_h2_commits};  // ehc: test states before committing to them (h^2)
+  StateBits h2_state_;
+  uint64_t h2_work_{0};  // ehc: words of work of this run's h^2 tests
+
+  /// True when h^2 from `s` finds every conjunct of the goal unreachable (a goal fact or a pair of
+  /// them): `s` is a dead end. False, untested, once the run's tests have done
+  /// `ehc_h2_work_budget` words of work.
+  bool h2DeadEnd(const uint64_t* s) {
+    if (opt_.ehc_h2_work_budget > 0 && h2_work_ >= opt_.ehc_h2_work_budget) return false;
+    ++stats_.ehc_h2_tests;
+    h2_state_.assign(s, s + task_.numWords());
+    for (const GoalConjunct& c : goal_.conjuncts) {
+      uint64_t work = 0;
+      const std::optional<bool> reached =
+          MutexTable::reachesTogether(task_, h2_state_, c.pos, opt_.ehc_h2_mutexes, &work);
+      h2_work_ += work;
+      if (!reached || *reached) return false;
+    }
+    ++stats_.ehc_h2_dead_ends;
+    return true;
+  }
 };
 
 CostType defaultCostType(const SearchOptions& o, const Task& t) {
@@ -1017,6 +1057,9 @@ void addRunCosts(SearchStatistics& into, const SearchStatistics& from) {
   into.evaluated += from.evaluated;
   into.ehc_retries += from.ehc_retries;
   into.ehc_retries_abandoned += from.ehc_retries_abandoned;
+  into.ehc_h2_restarts += from.ehc_h2_restarts;
+  into.ehc_h2_tests += from.ehc_h2_tests;
+  into.ehc_h2_dead_ends += from.ehc_h2_dead_ends;
   into.ehc_fallbacks += from.ehc_fallbacks;
   into.ehc_fallbacks_in_agenda += from.ehc_fallbacks_in_agenda;
   into.registered_states += from.registered_states;
@@ -1078,6 +1121,9 @@ void SearchOptions::validate() const {
   if (!(ehc_retry_budget_share >= 0.0 && ehc_retry_budget_share <= 1.0)) {
     throw std::invalid_argument("SearchOptions::ehc_retry_budget_share must be in [0, 1], got " +
                                 std::to_string(ehc_retry_budget_share));
+  }
+  if (ehc_h2_mutexes.max_work == 0) {
+    throw std::invalid_argument("SearchOptions::ehc_h2_mutexes.max_work must be > 0, got 0");
   }
   if (ehc_lazy_turn_ehc == 0 || ehc_lazy_turn_lazy == 0) {
     throw std::invalid_argument("SearchOptions::ehc_lazy_turn_ehc and ehc_lazy_turn_lazy must be > 0, got " +
@@ -1219,6 +1265,9 @@ SearchResult withBothRuns(SearchResult winner, const SearchStatistics& other, co
   winner.stats.ehc_ff_failed = ehc.ehc_ff_failed;
   winner.stats.ehc_retries = ehc.ehc_retries;
   winner.stats.ehc_retries_abandoned = ehc.ehc_retries_abandoned;
+  winner.stats.ehc_h2_restarts = ehc.ehc_h2_restarts;
+  winner.stats.ehc_h2_tests = ehc.ehc_h2_tests;
+  winner.stats.ehc_h2_dead_ends = ehc.ehc_h2_dead_ends;
   return winner;
 }
 

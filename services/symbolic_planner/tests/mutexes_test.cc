@@ -6,6 +6,7 @@
 #include <unordered_set>
 
 #include "tamp/symbolic_planner/grounding.h"
+#include "tamp/symbolic_planner/heuristic.h"
 #include "tamp/symbolic_planner/landmarks.h"
 #include "tamp/symbolic_planner/mutexes.h"
 #include "test_util.h"
@@ -219,6 +220,82 @@ TEST(Mutexes, ReasonableOrdersPutTheLowerGoalOfATowerFirst) {
   LandmarkGraph bad = without;
   bad.is_goal.pop_back();
   EXPECT_THROW(addReasonableOrders(*g.task, g.init, MutexTable(), bad), std::invalid_argument);
+}
+
+// A vehicle on one-way roads that turn it round: from a it may enter b facing north, and from b
+// only c, where it faces south; the road b -> g needs it facing south at b, which it never is.
+// The delete relaxation keeps (at b) and reaches (facing south), so it sees a way to g from b;
+// h^2 does not, since (at b) and (facing south) never hold together.
+const char* kOneWayDomain = R"(
+(define (domain oneway)
+  (:requirements :strips)
+  (:predicates (at ?l) (facing ?d) (road ?from ?to ?d1 ?d2))
+  (:action drive :parameters (?from ?to ?d1 ?d2)
+    :precondition (and (at ?from) (facing ?d1) (road ?from ?to ?d1 ?d2))
+    :effect (and (not (at ?from)) (at ?to) (not (facing ?d1)) (facing ?d2))))
+)";
+const char* kOneWayProblem = R"(
+(define (problem trap) (:domain oneway)
+  (:objects a b c d e f g north south)
+  (:init (at a) (facing north)
+         (road a b north north) (road b c north south) (road b g south south)
+         (road a d north north) (road d e north north) (road e f north north) (road f g north north))
+  (:goal (at g)))
+)";
+
+TEST(Mutexes, ReachesTogetherAgreesWithTheTableAndStopsEarly) {
+  const Instance g = groundInstance(kBlocksDomain, kBlocksProblem);
+  const MutexTable m(*g.task, g.init, H2MutexOptions{});
+  ASSERT_TRUE(m.enabled());
+  // Every pair of facts (and every fact alone): reached together exactly when the full table
+  // has both facts reachable and not mutex.
+  size_t together = 0, apart = 0, early = 0;
+  for (FactId a = 0; a < g.task->numFacts(); ++a) {
+    for (FactId b = a; b < g.task->numFacts(); ++b) {
+      uint64_t work = 0;
+      const std::optional<bool> r =
+          MutexTable::reachesTogether(*g.task, g.init, {a, b}, H2MutexOptions{}, &work);
+      ASSERT_TRUE(r.has_value());
+      const bool expected = m.reachable(a) && m.reachable(b) && !m.mutex(a, b);
+      EXPECT_EQ(*r, expected) << g.task->fact_names[a] << " " << g.task->fact_names[b];
+      (expected ? together : apart) += 1;
+      if (expected && work < m.work()) ++early;
+      if (!expected) {
+        EXPECT_EQ(work, m.work());  // a false answer is the whole fixpoint
+      }
+    }
+  }
+  EXPECT_GT(together, 0U);
+  EXPECT_GT(apart, 0U);
+  EXPECT_GT(early, 0U);  // some true answers stopped before the fixpoint's end
+  EXPECT_TRUE(
+      *MutexTable::reachesTogether(*g.task, g.init, g.goal.conjuncts[0].pos, H2MutexOptions{}));
+  EXPECT_TRUE(*MutexTable::reachesTogether(*g.task, g.init, {}, H2MutexOptions{}));
+  // Over the bounds: nothing known; bad input refused.
+  H2MutexOptions little;
+  little.max_work = 1;
+  EXPECT_FALSE(
+      MutexTable::reachesTogether(*g.task, g.init, g.goal.conjuncts[0].pos, little).has_value());
+  EXPECT_THROW(MutexTable::reachesTogether(
+                   *g.task, g.init, {static_cast<FactId>(g.task->numFacts())}, H2MutexOptions{}),
+               std::invalid_argument);
+  EXPECT_THROW(MutexTable::reachesTogether(*g.task, StateBits{}, {}, H2MutexOptions{}),
+               std::invalid_argument);
+}
+
+TEST(Mutexes, ReachesTogetherSeesADeadEndTheRelaxationDoesNot) {
+  const Instance g = groundInstance(kOneWayDomain, kOneWayProblem);
+  const FactId at_g = g.fact("(at g)");
+  StateBits at_b = g.init;  // a -> b facing north
+  clearBit(at_b.data(), g.fact("(at a)"));
+  setBit(at_b.data(), g.fact("(at b)"));
+  EXPECT_TRUE(*MutexTable::reachesTogether(*g.task, g.init, {at_g}, H2MutexOptions{}));
+  EXPECT_FALSE(*MutexTable::reachesTogether(*g.task, at_b, {at_g}, H2MutexOptions{}));
+  // The delete relaxation reaches (at g) from b: h_FF is finite there.
+  auto h = makeHeuristic(HeuristicKind::kFF, *g.task, CostType::kUnit);
+  h->setGoal(g.goal);
+  EXPECT_NE(h->evaluate(at_b.data()), Heuristic::kDeadEnd);
+  EXPECT_LT(h->evaluate(at_b.data()), h->evaluate(g.init.data()));  // and b looks closer than a
 }
 
 }  // namespace

@@ -511,6 +511,81 @@ TEST(Search, LazySearchBesideProvesUnsolvabilityAndGoesOnAloneWhenTheHillClimbin
   EXPECT_EQ(r.stats.ehc_fallbacks, 1U);
 }
 
+// One-way roads (as mutexes_test.cc's): from a, b looks one step closer to g than d does (the
+// delete relaxation goes b -> c, turns south, and takes b -> g, which the vehicle at b never can,
+// facing north), but from b the only road leads to c, a dead end; the way is a -> d -> e -> f -> g.
+const char* kOneWayDomain = R"(
+(define (domain oneway)
+  (:requirements :strips)
+  (:predicates (at ?l) (facing ?d) (road ?from ?to ?d1 ?d2))
+  (:action drive :parameters (?from ?to ?d1 ?d2)
+    :precondition (and (at ?from) (facing ?d1) (road ?from ?to ?d1 ?d2))
+    :effect (and (not (at ?from)) (at ?to) (not (facing ?d1)) (facing ?d2))))
+)";
+const char* kOneWayProblem = R"(
+(define (problem trap) (:domain oneway)
+  (:objects a b c d e f g north south)
+  (:init (at a) (facing north)
+         (road a b north north) (road b c north south) (road b g south south)
+         (road a d north north) (road d e north north) (road e f north north) (road f g north north))
+  (:goal (at g)))
+)";
+
+TEST(Search, EhcStartsAgainTestingWithH2AfterCommittingToADeadEnd) {
+  PlanRequest req;
+  req.domain_text = kOneWayDomain;
+  req.problem_text = kOneWayProblem;
+  req.timeout_seconds = 60;
+  req.check_plan = true;
+  req.search.ehc_fallback = false;  // the hill-climbing alone
+  req.search.ehc_lazy_beside = false;
+  for (bool ff_first : {true, false}) {
+    SCOPED_TRACE(ff_first ? "with the first run" : "default run only");
+    req.search.ehc_ff_first = ff_first;
+    // Without the restart the hill-climbing commits to b (h_FF lower than d's), proves it a dead
+    // end, and gives up.
+    req.search.ehc_h2_restart = false;
+    const PlanReply without = plan(req, Termination());
+    EXPECT_EQ(without.status, PlanStatus::kFailed) << without.message;
+    EXPECT_EQ(without.stats.ehc_h2_restarts, 0U);
+    EXPECT_EQ(without.stats.ehc_h2_tests, 0U);
+    // With it, the run starts again and h^2 from b rejects b: a -> d -> e -> f -> g.
+    req.search.ehc_h2_restart = true;
+    const PlanReply with = plan(req, Termination());
+    ASSERT_EQ(with.status, PlanStatus::kSolved) << with.message;  // replayed by the checker
+    EXPECT_EQ(with.plan.size(), 4U);
+    // Each run restarts once: the default run alone; with the first run, that one and, its plan
+    // being long for its initial h, the default run beside it (`ehc_second_budget_per_step`).
+    EXPECT_EQ(with.stats.ehc_h2_restarts, ff_first ? 2U : 1U);
+    EXPECT_GE(with.stats.ehc_h2_dead_ends, 1U);
+    EXPECT_GT(with.stats.ehc_h2_tests, with.stats.ehc_h2_dead_ends);  // d's and e's successors pass
+    // Testing from the start needs no restart.
+    req.search.ehc_h2_commits = true;
+    const PlanReply from_start = plan(req, Termination());
+    ASSERT_EQ(from_start.status, PlanStatus::kSolved) << from_start.message;
+    EXPECT_EQ(from_start.stats.ehc_h2_restarts, 0U);
+    EXPECT_EQ(from_start.plan, with.plan);
+    EXPECT_LT(from_start.stats.evaluated, with.stats.evaluated);
+    req.search.ehc_h2_commits = false;
+  }
+}
+
+TEST(Search, EhcWithoutADeadEndNeverTestsWithH2) {
+  // openstacks-6: the hill-climbing solves it without ever proving a dead end, so nothing is
+  // tested and the search is the same with the restart on or off.
+  PlanRequest req = benchmarkRequest("pddl-more/openstacks", "instance-6.pddl");
+  req.timeout_seconds = 60;
+  const PlanReply on = plan(req, Termination());
+  ASSERT_EQ(on.status, PlanStatus::kSolved) << on.message;
+  EXPECT_EQ(on.stats.ehc_h2_restarts, 0U);
+  EXPECT_EQ(on.stats.ehc_h2_tests, 0U);
+  req.search.ehc_h2_restart = false;
+  const PlanReply off = plan(req, Termination());
+  ASSERT_EQ(off.status, PlanStatus::kSolved) << off.message;
+  EXPECT_EQ(on.plan, off.plan);
+  EXPECT_EQ(on.stats.evaluated, off.stats.evaluated);
+}
+
 TEST(Search, EhcFirstRunContinuesFromTheFirstBetterState) {
   // openstacks-12: the first run (FF-v2.3 variant) solves it; continuing from the first better
   // state instead of evaluating every sibling needs fewer evaluations. Both plans are checked.
@@ -657,6 +732,14 @@ TEST(Search, OptionsAreValidated) {
   SearchOptions r = o;
   r.rhw.max_work = 0;
   EXPECT_THROW(r.validate(), std::invalid_argument);
+  SearchOptions h2 = o;
+  h2.ehc_h2_mutexes.max_work = 0;
+  try {
+    h2.validate();
+    ADD_FAILURE() << "ehc_h2_mutexes.max_work 0 accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("ehc_h2_mutexes.max_work"), std::string::npos) << e.what();
+  }
   EXPECT_EQ(parseSearchAlgorithm("astar"), SearchAlgorithm::kAstar);
   EXPECT_EQ(parseSearchAlgorithm("lazy"), SearchAlgorithm::kLazy);
   EXPECT_FALSE(parseSearchAlgorithm("dfs").has_value());

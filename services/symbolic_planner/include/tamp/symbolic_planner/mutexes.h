@@ -20,6 +20,7 @@
 /// a task over the bound gets an empty table (no pair mutex), never a partial one.
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "tamp/symbolic_planner/task.h"
@@ -52,12 +53,28 @@ class MutexTable {
     if (n_ == 0 || a == b) return false;
     return !testBit(rows_.data() + static_cast<size_t>(a) * words_, b);
   }
+  /// True when `f` holds in some state h^2 reaches (always true when the table is not enabled).
+  bool reachable(FactId f) const { return n_ == 0 || pairReachable(f, f); }
   /// Fact pairs {a, b}, a < b, both reachable, that are mutex.
   size_t numMutexPairs() const;
   /// Work the fixpoint took (words touched), for statistics.
   uint64_t work() const { return work_; }
 
+  /// Whether h^2 from `from` reaches every fact of `facts` and every pair of them (a dead-end
+  /// test stronger than the delete relaxation: false means no state reachable from `from` holds
+  /// them all). The fixpoint stops as soon as the last pair is reached, so a true answer usually
+  /// costs a fraction of a full table. nullopt when the task is over the bounds of `options`
+  /// (nothing known). `work`, when given, receives the words touched.
+  /// @throws std::invalid_argument as the constructor.
+  static std::optional<bool> reachesTogether(const Task& task, const StateBits& from,
+                                             const std::vector<FactId>& facts,
+                                             const H2MutexOptions& options,
+                                             uint64_t* work = nullptr);
+
  private:
+  /// The fixpoint; with `stop_facts`, it returns as soon as all their pairs are reachable.
+  void compute(const Task& task, const StateBits& init, const H2MutexOptions& options,
+               const std::vector<FactId>* stop_facts);
   bool pairReachable(FactId a, FactId b) const {
     return testBit(rows_.data() + static_cast<size_t>(a) * words_, b);
   }
@@ -73,6 +90,10 @@ class MutexTable {
   // Scratch of processOperator.
   std::vector<uint64_t> compat_, adds_;
   std::vector<FactId> add_list_, new_bits_;
+  // reachesTogether(): per fact 1 if it is one of the facts, and the pairs of them (a fact with
+  // itself included) not reached yet; the fixpoint stops when that count is 0.
+  std::vector<uint8_t> stop_flag_;
+  size_t stop_left_{0};
 };
 
 }  // namespace tamp::symbolic_planner

@@ -86,6 +86,9 @@ struct PlanStatistics {
   bool ehc_second_won{false};  ///< ... and its plan was the cheaper one
   uint64_t ehc_retries{0};  ///< plateaus searched again without helpful-action pruning (every run)
   uint64_t ehc_retries_abandoned{0};  ///< ... given up at SearchOptions::ehc_retry_budget_share
+  uint64_t ehc_h2_restarts{0};        ///< hill-climbing runs started again after a proven dead end
+  uint64_t ehc_h2_tests{0};           ///< ... h^2 tests of states to commit to in them
+  uint64_t ehc_h2_dead_ends{0};       ///< ... that found the state a dead end
   uint64_t ehc_fallbacks{0};  ///< complete searches the hill-climbing fell back to
   uint64_t ehc_fallbacks_in_agenda{0};  ///< ... started inside a goal-agenda entry that is not the last
   bool lazy_beside_started{false};  ///< the lazy search ran beside the hill-climbing; see SearchOptions

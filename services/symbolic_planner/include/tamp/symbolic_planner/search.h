@@ -15,7 +15,11 @@
 ///   FF-v2.3's variant (`Heuristic::setFFStyle`), a first hill-climbing run uses that variant
 ///   within a budget of evaluations (it tends to give shorter plans); when it fails or runs
 ///   out of budget, the search starts again from the initial state with the default heuristic,
-///   exactly as without the first run.
+///   exactly as without the first run. A run that proves a state it committed to a dead end
+///   (`ehc_h2_restart`) starts again once from the initial state, testing every state it would
+///   commit to with h^2 from that state, which sees dead ends the delete relaxation does not
+///   (Haslum & Geffner 2000; an irreversible move, as in airport, where FF's own path avoids one
+///   by its tie-breaking).
 /// - `kGbfs`: eager greedy best-first search on h_FF with a second open list for successors through
 ///   helpful (preferred) operators, alternating with a boost on progress (as Fast Downward's
 ///   `eager_greedy([ff], preferred=[ff])`). Complete: it proves unsolvability by exhaustion.
@@ -42,6 +46,7 @@
 #include "tamp/core/termination.h"
 #include "tamp/symbolic_planner/heuristic.h"
 #include "tamp/symbolic_planner/landmarks.h"
+#include "tamp/symbolic_planner/mutexes.h"
 #include "tamp/symbolic_planner/task.h"
 
 namespace tamp::symbolic_planner {
@@ -125,6 +130,23 @@ struct SearchOptions {
   /// evaluations (a TAMP query: about 30) never meets the lazy search. false: the lazy search
   /// only after the hill-climbing has failed (FF's order).
   bool ehc_lazy_beside{true};
+  /// ehc: when a hill-climbing run proves that a state it committed to is a dead end (h_FF finds
+  /// the goal unreachable from it, or its plateau searched again without pruning holds
+  /// everything reachable from it), the run starts again from the initial state, once, and from
+  /// then on tests every state it would commit to with h^2 from that state (mutexes.h): a state
+  /// from which h^2 finds a goal fact or pair unreachable is a dead end the delete relaxation
+  /// does not see (airport: an aircraft that cannot turn round), skipped as h_FF's dead ends are.
+  /// The restarted run shares the run's budgets. false: a proven dead end ends the run (FF).
+  bool ehc_h2_restart{true};
+  /// ehc: test committed states with h^2 from the start of every hill-climbing run (the
+  /// restart's mode; set for the default run by `search()` after a first run that restarted).
+  bool ehc_h2_commits{false};
+  /// The bounds of one h^2 test of a committed state (over them: not a dead end).
+  H2MutexOptions ehc_h2_mutexes{20'000, 200'000'000};
+  /// The h^2 tests of one hill-climbing run stop (states are committed to untested) once they
+  /// have done this many words of work in all (about 3 x 10^8 a second here); 0 = unbounded.
+  /// airport-30's restart: 500 tests, 3.1 x 10^9 words, 10 s.
+  uint64_t ehc_h2_work_budget{4'000'000'000};
   uint64_t ehc_lazy_after{4000};
   uint64_t ehc_lazy_turn_ehc{100};
   uint64_t ehc_lazy_turn_lazy{100};
@@ -195,6 +217,11 @@ struct SearchStatistics {
   uint64_t ehc_fallbacks_in_agenda{0};
   /// `ehc_lazy_beside`: the lazy search started beside the hill-climbing; `lazy_beside_won`: it
   /// gave the answer while the hill-climbing was still running.
+  /// `ehc_h2_restart`: hill-climbing runs started again after a proven dead end; h^2 tests of
+  /// committed states, and how many found the state a dead end.
+  uint64_t ehc_h2_restarts{0};
+  uint64_t ehc_h2_tests{0};
+  uint64_t ehc_h2_dead_ends{0};
   bool lazy_beside_started{false};
   bool lazy_beside_won{false};
   uint64_t landmarks{0};    ///< lazy: number of landmarks found (0: landmark count not used)

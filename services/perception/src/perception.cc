@@ -132,16 +132,15 @@ struct Track {
   bool pushed{false};  ///< moved out of the base this frame (keepOutOfBase)
 };
 
-/// Fraction of `points` on the surface of the track's shape at its pose, within `margin` plus the
-/// range noise where each point was seen (`noise(range)`: from afar a face spreads over a band
-/// many centimetres deep, which is no evidence that the object moved). On, not inside: a face seen
-/// 10 cm inside the estimate (a pushed box whose estimate lags) is evidence that it moved.
+/// Fraction of `points` inside the track's shape at its pose, grown by `margin` plus the range
+/// noise where each point was seen (`noise(range)`: from afar a face spreads over a band many
+/// centimetres deep, which is no evidence that the object moved).
 template <typename Noise>
 double explainedFraction(const Track& t, const std::vector<Eigen::Vector3d>& points, double margin,
                          const Eigen::Vector3d& sensor, Noise noise) {
   if (points.empty()) return 0.0;
   std::size_t inside = 0;
-  for (const auto& p : points) inside += pointNearSurface(t.shape, t.pose, p, margin + noise((p - sensor).norm())) ? 1 : 0;
+  for (const auto& p : points) inside += pointInShape(t.shape, t.pose, p, margin + noise((p - sensor).norm())) ? 1 : 0;
   return static_cast<double>(inside) / static_cast<double>(points.size());
 }
 

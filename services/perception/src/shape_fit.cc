@@ -527,27 +527,6 @@ double yawError(const world::Shape& shape, double a, double b) {
   return std::abs(d);
 }
 
-bool pointNearSurface(const world::Shape& shape, const Eigen::Isometry3d& pose, const Eigen::Vector3d& p,
-                      double tolerance) {
-  if (!pointInShape(shape, pose, p, tolerance)) return false;
-  const Eigen::Vector3d q = pose.inverse() * p;
-  switch (shape.kind) {
-    case world::ShapeKind::kBox:
-      return !(q.array().abs() < (shape.size.array() / 2 - tolerance)).all();
-    case world::ShapeKind::kCylinder:
-      return !(std::abs(q.z()) < shape.height / 2 - tolerance && q.head<2>().norm() < shape.radius - tolerance);
-    case world::ShapeKind::kSphere:
-      return !(q.norm() < shape.radius - tolerance);
-    case world::ShapeKind::kPrism: {
-      const Eigen::Vector2d xy = q.head<2>();
-      const bool deep = std::abs(q.z()) < shape.height / 2 - tolerance && world::containsPoint(shape.polygon, xy) &&
-                        ringDistance(xy, shape.polygon) > tolerance;
-      return !deep;
-    }
-  }
-  return false;
-}
-
 bool pointInShape(const world::Shape& shape, const Eigen::Isometry3d& pose, const Eigen::Vector3d& p, double margin) {
   const Eigen::Vector3d q = pose.inverse() * p;
   switch (shape.kind) {

@@ -494,31 +494,6 @@ TEST(SceneTest, APushedCrateEstimatedOffStaysOnItWhenDrivenRoundClose) {
   }
 }
 
-// A pushed chair (0.6 x 0.6 x 0.9 m, of known size) whose estimate lags 10 cm behind it, seen
-// from the robot that backed off 0.6-1 m: its near face stands 10 cm inside the estimate. Points
-// inside the estimate counted as explained by it, so the estimate stayed 10 cm short (namo_big_
-// crossing: the next drive, planned past the chair's estimate, was refused, and the pushes from
-// there rejected, 5 replans). A face is explained by the estimate's surface, not its inside: the
-// estimate follows the chair.
-TEST(SceneTest, ALaggingEstimateOfAPushedBoxFollowsItsSeenFace) {
-  world::World prior("room");
-  ASSERT_TRUE(prior.addRegion(testing::floorRegion()).ok());
-  world::Object chair = box("chair", 0.6, 0.6, 0.9, 3.0, 0.0, 0.0);
-  chair.mass = 50.0;
-  ASSERT_TRUE(prior.addObject(chair).ok());
-  world::World truth = prior;
-  const Eigen::Isometry3d real(Eigen::Translation3d(3.1, 0.0, 0.45));
-  ASSERT_TRUE(truth.setObjectPose("chair", real).ok());
-  for (double gap : {0.6, 0.8, 1.0}) {
-    SCOPED_TRACE("the robot's camera " + std::to_string(gap) + " m before the chair's near face");
-    Perception perception(prior, PerceptionParams());
-    Runner run(perception);
-    for (int k = 0; k < 12; ++k) run.frame(truth, testing::mastCamera(real.translation().x() - 0.3 - gap, 0.0, 0.0));
-    EXPECT_LT(poseError(chair.shape, real, perception.world().object("chair").pose).xy, 0.04);
-    EXPECT_TRUE(run.eventsOf(EventType::kAdded).empty());
-  }
-}
-
 TEST(SceneTest, GoneOnlyWhenItsPlaceIsVisibleAndUnoccluded) {
   world::World prior = tableWorld();
   world::Object target = box("target", 0.25, 0.25, 0.25, 3.0, -0.2, 0.0);

@@ -117,11 +117,6 @@ double yawSymmetry(const world::Shape& shape, double square_tolerance = 0.01);
 /// |a - b| modulo the shape's yaw symmetry, in [0, symmetry/2] (0 for rotation-invariant shapes).
 double yawError(const world::Shape& shape, double a, double b);
 
-/// True when world point `p` lies within `tolerance` (m, > 0) of the surface of `shape` placed at
-/// `pose`: inside it grown by `tolerance`, not inside it shrunk by `tolerance`.
-bool pointNearSurface(const world::Shape& shape, const Eigen::Isometry3d& pose, const Eigen::Vector3d& p,
-                      double tolerance);
-
 /// True when world point `p` is inside `shape` placed at `pose`, grown by `margin` (m).
 bool pointInShape(const world::Shape& shape, const Eigen::Isometry3d& pose, const Eigen::Vector3d& p,
                   double margin);

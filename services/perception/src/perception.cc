@@ -723,14 +723,6 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
     if (t.state != TrackInfo::State::kGone && id != I.held_id) candidates.push_back(&t);
   }
   const auto& dets = result.detections;
-  // Returns binned by direction, built when first asked: is a place seen free, hidden, or out of
-  // the image (the fits of tracked boxes ask whether a seen end is a face; gone objects below).
-  std::optional<RangeImage> image;
-  auto seenFree = [&](const Eigen::Vector3d& p) {
-    if (!image) image.emplace(frame, T.visibility_bin);
-    const Eigen::Vector3d half(0.01, 0.01, 0.01);
-    return image->seenThrough(p - half, p + half, T.visibility_margin);
-  };
   std::vector<std::vector<double>> cost(dets.size(), std::vector<double>(candidates.size(), kInf));
   std::vector<std::vector<ShapeFit>> fits(dets.size(), std::vector<ShapeFit>(candidates.size()));
   for (std::size_t i = 0; i < dets.size(); ++i) {
@@ -738,7 +730,7 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
       const Track& t = *candidates[j];
       ShapeFit f;
       if (t.size_known) {
-        f = fitShape(dets[i], t.shape, sensor, T, yawOf(t.pose), t.pose.translation().head<2>(), seenFree);
+        f = fitShape(dets[i], t.shape, sensor, T, yawOf(t.pose));
         if (!f.compatible) continue;
       } else {
         f.pose = dets[i].pose;
@@ -776,7 +768,7 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
     if (!t.size_known) {
       I.growShape(t, dets[i]);
       // Refit the grown shape (anchored on the seen faces) for the pose.
-      meas = fitShape(dets[i], t.shape, sensor, T, yawOf(t.pose), t.pose.translation().head<2>(), seenFree).pose;
+      meas = fitShape(dets[i], t.shape, sensor, T, yawOf(t.pose)).pose;
       log::get("perception")->debug("{} grown to {:.2f} x {:.2f}: detection rect {:.2f} x {:.2f} yaw {:.2f} at ({:.2f}, {:.2f}); fit ({:.2f}, {:.2f}) yaw {:.2f}, track ({:.2f}, {:.2f})",
                                     t.id, t.shape.size.x(), t.shape.size.y(), dets[i].rect.extents.x(), dets[i].rect.extents.y(),
                                     dets[i].rect.yaw, dets[i].pose.translation().x(), dets[i].pose.translation().y(),
@@ -882,6 +874,7 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
 
   // ---- expected objects not detected: seen empty, hidden, or out of view ------------------------
   watch.reset();
+  std::optional<RangeImage> image;
   std::vector<std::string> dropped;
   for (auto& [id, t] : I.tracks) {
     if (t.matched || t.state == TrackInfo::State::kGone || id == I.held_id || &t == held_elsewhere) continue;

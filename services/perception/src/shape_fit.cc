@@ -380,8 +380,7 @@ Detection describeCluster(std::vector<Eigen::Vector3d> points, double support_z,
 // ---- known shapes -------------------------------------------------------------------------------
 
 ShapeFit fitShape(const Detection& det, const world::Shape& shape, const Eigen::Vector3d& sensor,
-                  const TrackingParams& params, double yaw_hint, const std::optional<Eigen::Vector2d>& origin_hint,
-                  const std::function<bool(const Eigen::Vector3d&)>& seen_free) {
+                  const TrackingParams& params, double yaw_hint) {
   ShapeFit fit;
   const bool hinted = std::isfinite(yaw_hint);  // a track's yaw; NaN: a first sighting
   const double hint = hinted ? yaw_hint : 0.0;
@@ -446,25 +445,12 @@ ShapeFit fitShape(const Detection& det, const world::Shape& shape, const Eigen::
     const double su[2] = {s.dot(a0), s.dot(a1)};
     double c[2] = {0, 0};
     const double anchor_tol = 0.5 * params.size_tolerance;
-    // The track's box centre (its frame origin plus the bounding box's offset, at its yaw).
-    std::optional<Eigen::Vector2d> centre_hint;
-    if (origin_hint) centre_hint = *origin_hint + offset.x() * axis(hint) + offset.y() * axis(hint + kPi / 2);
-    // Whether the seen end on side `sign` of axis `i` is a face: the space just beyond it, at
-    // half the detection's height, is seen free.
-    auto faceAt = [&](int i, double sign) {
-      if (!centre_hint || !seen_free) return true;
-      const Eigen::Vector2d p = det.rect.centre + sign * (e(i) / 2 + 2 * anchor_tol) * (i == 0 ? a0 : a1);
-      return seen_free(Eigen::Vector3d(p.x(), p.y(), det.support_z + det.height / 2));
-    };
     for (int i = 0; i < 2; ++i) {
       if (e(i) >= L(i) - anchor_tol) continue;
-      const bool beyond = std::abs(su[i]) > e(i) / 2;
-      const double sign = su[i] < 0 ? -1.0 : 1.0;
-      if (beyond && faceAt(i, sign)) {
-        c[i] = sign * (e(i) / 2 - L(i) / 2);
-      } else if (centre_hint) {
-        const double slack = (L(i) - e(i)) / 2;
-        c[i] = std::clamp((*centre_hint - det.rect.centre).dot(i == 0 ? a0 : a1), -slack, slack);
+      if (su[i] < -e(i) / 2) {
+        c[i] = -e(i) / 2 + L(i) / 2;
+      } else if (su[i] > e(i) / 2) {
+        c[i] = e(i) / 2 - L(i) / 2;
       }
     }
     const Eigen::Vector2d centre = det.rect.centre + c[0] * a0 + c[1] * a1;

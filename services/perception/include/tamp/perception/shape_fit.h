@@ -14,7 +14,6 @@
 /// coincides with the observed near face. Heights come from the support surface (the floor or
 /// table below), not from the lowest point seen, so occluded bottoms do not bias them.
 
-#include <functional>
 #include <limits>
 #include <optional>
 #include <vector>
@@ -94,18 +93,8 @@ struct ShapeFit {
 /// which side of the box a face belongs to when the view cannot tell (both fit within
 /// `size_tolerance`). NaN (the default, a first sighting): yaw 0 for the equivalents, the
 /// detection's extents for the side.
-/// Less of a box seen along an axis than its side: the box is anchored on the seen end nearer to
-/// the sensor, taken for a face. With `origin_hint` (a track's pose origin, xy), that end is a
-/// face only when `seen_free` says the space just beyond it is seen free (not out of the image,
-/// not hidden); along an axis with no face seen (the sensor abreast of the seen part, or its near
-/// end cut by the image's edge), every centre within the unseen length explains the points, and
-/// the one nearest the track's is taken. Without a hint (a first sighting): the near end is a
-/// face, and abreast the seen part's centre is taken. A crate driven past close, its near end
-/// below the image, was anchored on that cut 0.9 m off, and taken for a new crate (namo_doorway).
 ShapeFit fitShape(const Detection& detection, const world::Shape& shape, const Eigen::Vector3d& sensor,
-                  const TrackingParams& params, double yaw_hint = std::numeric_limits<double>::quiet_NaN(),
-                  const std::optional<Eigen::Vector2d>& origin_hint = std::nullopt,
-                  const std::function<bool(const Eigen::Vector3d&)>& seen_free = {});
+                  const TrackingParams& params, double yaw_hint = std::numeric_limits<double>::quiet_NaN());
 
 /// Yaw of an upright pose (rotation about world z), in [-pi, pi).
 double yawOf(const Eigen::Isometry3d& pose);

@@ -448,6 +448,20 @@ TEST_F(FirstEdgeTest, AnObjectTheRobotCanNeitherCarryNorPushIsGoneRound) {
   EXPECT_NEAR(t.cost_s, straight, 1e-6);
 }
 
+/// A 20 cm crate of `mass` kg on namo_corridor's floor at (x, 1.2), its region box_floor (its
+/// symbolic state stays (on crate box_floor) as it moves).
+world::Object corridorCrate(double x, double mass) {
+  world::Object o;
+  o.id = "crate";
+  o.label = "crate";
+  o.kind = world::ObjectKind::kMovable;
+  o.shape = world::Shape::box(0.2, 0.2, 0.2);
+  o.mass = mass;
+  o.region = "box_floor";
+  o.pose.translation() = Eigen::Vector3d(x, 1.2, 0.1);
+  return o;
+}
+
 // A removal whose every sub-task fails at its first drive (its stand lies behind other objects:
 // no path there) does not end the search: the object is fixed in that world and the blocked
 // drive is planned again round it; the new lazy path crosses another object, whose removal
@@ -458,15 +472,8 @@ TEST(UnremovableObjectTest, AnObjectWhoseEveryRemovalFailsAtItsFirstDriveIsGoneR
   auto robot = robot::RobotModel::loadDescription(sc->robot.description);
   ASSERT_TRUE(robot.ok());
   world::World planned = sc->plannerWorld();
-  world::Object crate;
-  crate.id = "crate";
-  crate.label = "crate";
-  crate.kind = world::ObjectKind::kMovable;
-  crate.shape = world::Shape::box(0.2, 0.2, 0.2);
-  crate.mass = 2.0;
+  world::Object crate = corridorCrate(6.5, 2.0);
   crate.graspable = true;
-  crate.region = "box_floor";
-  crate.pose.translation() = Eigen::Vector3d(6.5, 1.2, 0.1);
   ASSERT_TRUE(planned.addObject(crate).ok());
   const world::Location* goal = planned.findLocation("goal");
   ASSERT_NE(goal, nullptr);
@@ -617,17 +624,7 @@ MissionReport corridorMission(VersionedWorld& source, DrivingExecutor& x, Script
 // naming an object the graph knew where it stands are counted: the mission fails at the second.
 // (An object new to the graph makes a new symbolic state, whose edges have no failures yet.)
 TEST(MissionFailureCountTest, RefusalsNamingAnObjectTheWorldModelChangedAreNotCountedAsFailures) {
-  auto crate = [] {
-    world::Object o;
-    o.id = "crate";
-    o.label = "crate";
-    o.kind = world::ObjectKind::kMovable;
-    o.shape = world::Shape::box(0.2, 0.2, 0.2);
-    o.mass = 5.0;
-    o.region = "box_floor";  // its symbolic state stays (on crate box_floor) as it moves
-    o.pose.translation() = Eigen::Vector3d(4.45, 1.2, 0.1);
-    return o;
-  };
+  auto crate = [] { return corridorCrate(4.45, 5.0); };
   {
     ScriptedServices services;
     VersionedWorld source;

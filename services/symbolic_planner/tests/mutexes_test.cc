@@ -222,27 +222,6 @@ TEST(Mutexes, ReasonableOrdersPutTheLowerGoalOfATowerFirst) {
   EXPECT_THROW(addReasonableOrders(*g.task, g.init, MutexTable(), bad), std::invalid_argument);
 }
 
-// A vehicle on one-way roads that turn it round: from a it may enter b facing north, and from b
-// only c, where it faces south; the road b -> g needs it facing south at b, which it never is.
-// The delete relaxation keeps (at b) and reaches (facing south), so it sees a way to g from b;
-// h^2 does not, since (at b) and (facing south) never hold together.
-const char* kOneWayDomain = R"(
-(define (domain oneway)
-  (:requirements :strips)
-  (:predicates (at ?l) (facing ?d) (road ?from ?to ?d1 ?d2))
-  (:action drive :parameters (?from ?to ?d1 ?d2)
-    :precondition (and (at ?from) (facing ?d1) (road ?from ?to ?d1 ?d2))
-    :effect (and (not (at ?from)) (at ?to) (not (facing ?d1)) (facing ?d2))))
-)";
-const char* kOneWayProblem = R"(
-(define (problem trap) (:domain oneway)
-  (:objects a b c d e f g north south)
-  (:init (at a) (facing north)
-         (road a b north north) (road b c north south) (road b g south south)
-         (road a d north north) (road d e north north) (road e f north north) (road f g north north))
-  (:goal (at g)))
-)";
-
 TEST(Mutexes, ReachesTogetherAgreesWithTheTableAndStopsEarly) {
   const Instance g = groundInstance(kBlocksDomain, kBlocksProblem);
   const MutexTable m(*g.task, g.init, H2MutexOptions{});
@@ -284,7 +263,7 @@ TEST(Mutexes, ReachesTogetherAgreesWithTheTableAndStopsEarly) {
 }
 
 TEST(Mutexes, ReachesTogetherSeesADeadEndTheRelaxationDoesNot) {
-  const Instance g = groundInstance(kOneWayDomain, kOneWayProblem);
+  const Instance g = groundInstance(test::kOneWayDomain, test::kOneWayProblem);
   const FactId at_g = g.fact("(at g)");
   StateBits at_b = g.init;  // a -> b facing north
   clearBit(at_b.data(), g.fact("(at a)"));

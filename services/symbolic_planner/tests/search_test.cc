@@ -511,30 +511,13 @@ TEST(Search, LazySearchBesideProvesUnsolvabilityAndGoesOnAloneWhenTheHillClimbin
   EXPECT_EQ(r.stats.ehc_fallbacks, 1U);
 }
 
-// One-way roads (as mutexes_test.cc's): from a, b looks one step closer to g than d does (the
+// One-way roads (test::kOneWayDomain): from a, b looks one step closer to g than d does (the
 // delete relaxation goes b -> c, turns south, and takes b -> g, which the vehicle at b never can,
 // facing north), but from b the only road leads to c, a dead end; the way is a -> d -> e -> f -> g.
-const char* kOneWayDomain = R"(
-(define (domain oneway)
-  (:requirements :strips)
-  (:predicates (at ?l) (facing ?d) (road ?from ?to ?d1 ?d2))
-  (:action drive :parameters (?from ?to ?d1 ?d2)
-    :precondition (and (at ?from) (facing ?d1) (road ?from ?to ?d1 ?d2))
-    :effect (and (not (at ?from)) (at ?to) (not (facing ?d1)) (facing ?d2))))
-)";
-const char* kOneWayProblem = R"(
-(define (problem trap) (:domain oneway)
-  (:objects a b c d e f g north south)
-  (:init (at a) (facing north)
-         (road a b north north) (road b c north south) (road b g south south)
-         (road a d north north) (road d e north north) (road e f north north) (road f g north north))
-  (:goal (at g)))
-)";
-
 TEST(Search, EhcStartsAgainTestingWithH2AfterCommittingToADeadEnd) {
   PlanRequest req;
-  req.domain_text = kOneWayDomain;
-  req.problem_text = kOneWayProblem;
+  req.domain_text = test::kOneWayDomain;
+  req.problem_text = test::kOneWayProblem;
   req.timeout_seconds = 60;
   req.check_plan = true;
   req.search.ehc_fallback = false;  // the hill-climbing alone

@@ -80,4 +80,25 @@ inline PlanReply planText(const std::string& domain, const std::string& problem,
   return plan(req, Termination());
 }
 
+/// A vehicle on one-way roads that turn it round: from a it may enter b facing north, and from b
+/// only c, where it faces south; the road b -> g needs it facing south at b, which it never is.
+/// The delete relaxation sees a way to g from b; h^2 does not ((at b) and (facing south) never
+/// hold together). The way is a -> d -> e -> f -> g.
+inline const char* kOneWayDomain = R"(
+(define (domain oneway)
+  (:requirements :strips)
+  (:predicates (at ?l) (facing ?d) (road ?from ?to ?d1 ?d2))
+  (:action drive :parameters (?from ?to ?d1 ?d2)
+    :precondition (and (at ?from) (facing ?d1) (road ?from ?to ?d1 ?d2))
+    :effect (and (not (at ?from)) (at ?to) (not (facing ?d1)) (facing ?d2))))
+)";
+inline const char* kOneWayProblem = R"(
+(define (problem trap) (:domain oneway)
+  (:objects a b c d e f g north south)
+  (:init (at a) (facing north)
+         (road a b north north) (road b c north south) (road b g south south)
+         (road a d north north) (road d e north north) (road e f north north) (road f g north north))
+  (:goal (at g)))
+)";
+
 }  // namespace tamp::symbolic_planner::test

@@ -544,8 +544,30 @@ std::vector<std::pair<std::string, std::string>> Oracle::selfContacts(const ob::
 
 bool Oracle::selfFree(const ob::State* s) { return selfContacts(s).empty(); }
 
+void Oracle::setClearance(std::shared_ptr<const collision::ClearanceGrid> grid, std::vector<Eigen::Vector3d> cover) {
+  const bool usable = rigid_ && !self_check_ && !scene_.hasUnknownSpace() && !cover.empty();
+  clearance_ = usable ? std::move(grid) : nullptr;
+  cover_ = usable ? std::move(cover) : std::vector<Eigen::Vector3d>{};
+  // A round robot: the reach circle about the base origin is the tighter cover.
+  double widest = 0.0;
+  for (const auto& k : cover_) widest = std::max(widest, k.z());
+  if (usable && reach_radius_ <= widest) cover_ = {Eigen::Vector3d(0.0, 0.0, reach_radius_)};
+}
+
+bool Oracle::clearOfStatics(const ob::State* s) {
+  if (!clearance_) return false;
+  const Pose2D p = gs_.basePose(s);
+  const double c = std::cos(p.theta), sn = std::sin(p.theta);
+  for (const Eigen::Vector3d& k : cover_) {
+    if (clearance_->clearance(p.x + c * k.x() - sn * k.y(), p.y + sn * k.x() + c * k.y()) <= k.z()) return false;
+  }
+  ++grid_answers_;
+  return true;
+}
+
 bool Oracle::staticFree(const ob::State* s) {
   ++checks_;
+  if (clearOfStatics(s)) return true;
   gs_.placeRobot(s, scene_);
   if (self_check_ && !gs_.armAboveFloor()) return false;
   if (scene_.robotInCollision(static_filter_)) return false;
@@ -554,6 +576,14 @@ bool Oracle::staticFree(const ob::State* s) {
 
 bool Oracle::allFree(const ob::State* s) {
   ++checks_;
+  if (clearOfStatics(s)) {
+    // Only the movables within reach remain (rigid: the reach square prefilter holds).
+    bool near = false;
+    for (std::size_t i = 0; i < movables_.size() && !near; ++i) near = mayTouch(s, static_cast<int>(i));
+    if (!near) return true;
+    gs_.placeRobot(s, scene_);
+    return !scene_.robotInCollision(movable_filter_);
+  }
   gs_.placeRobot(s, scene_);
   if (self_check_ && !gs_.armAboveFloor()) return false;
   if (scene_.robotInCollision(all_filter_)) return false;

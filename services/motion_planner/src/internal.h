@@ -18,6 +18,7 @@
 #include <ompl/base/StateSpace.h>
 #include <ompl/geometric/PathGeometric.h>
 
+#include "tamp/collision/clearance_grid.h"
 #include "tamp/collision/scene.h"
 #include "tamp/core/geometry.h"
 #include "tamp/core/termination.h"
@@ -167,6 +168,14 @@ class Oracle {
   /// rigid robot); all of them otherwise.
   void candidates(const ob::State* a, const ob::State* b, std::vector<int>& out) const;
   std::uint64_t checks() const { return checks_; }
+  /// Static checks answered by the clearance grid (no FCL query).
+  std::uint64_t gridAnswers() const { return grid_answers_; }
+  /// A rigid base group's static and full checks ask `grid` first: where its clearance exceeds
+  /// the radius of each circle of `cover` (x, y in the base frame, radius: together they cover
+  /// the robot from above) the robot touches no static object (collision/clearance_grid.h), and
+  /// only the movables within reach are asked of FCL. The grid must be of this scene's static
+  /// objects, or more; the scene must have no unknown space. Null or an empty cover: off.
+  void setClearance(std::shared_ptr<const collision::ClearanceGrid> grid, std::vector<Eigen::Vector3d> cover);
   const GroupSpace& group() const { return gs_; }
   collision::Scene& scene() { return scene_; }
   /// Contacts of the robot with itself are checked in `self` (placed at each state) instead of
@@ -175,6 +184,8 @@ class Oracle {
 
  private:
   bool selfFree(const ob::State* s);
+  /// Whether the clearance grid shows no static object within reach at `s` (counted).
+  bool clearOfStatics(const ob::State* s);
   std::vector<std::pair<std::string, std::string>> selfContacts(const ob::State* s);
   collision::Scene& scene_;
   collision::Scene* self_scene_{nullptr};
@@ -185,7 +196,10 @@ class Oracle {
   bool self_check_{false};
   double reach_radius_{0.0};  // xy radius of the robot (+ held object) around the base origin
   bool rigid_{false};
+  std::shared_ptr<const collision::ClearanceGrid> clearance_;
+  std::vector<Eigen::Vector3d> cover_;  ///< circles (x, y in the base frame, radius)
   std::uint64_t checks_{0};
+  std::uint64_t grid_answers_{0};
 };
 
 /// Fractions of the motion a -> b at the corners of a stop-and-turn base's motion (where a turn

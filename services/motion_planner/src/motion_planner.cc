@@ -228,6 +228,31 @@ detail::StaticRoadmap* MotionPlanner::Impl::roadmapFor(detail::StaticWorldKey ke
   return roadmaps.back().get();
 }
 
+std::shared_ptr<const collision::ClearanceGrid> MotionPlanner::Impl::clearanceGrid() {
+  const double h = params.sampling.clearance_grid_resolution;
+  if (!(h > 0.0)) return nullptr;
+  std::vector<std::shared_ptr<const world::Object>> statics;
+  for (const auto& o : world.objects())
+    if (o.kind == world::ObjectKind::kStatic) statics.push_back(world.objectPtr(o.id));
+  auto same = [](const std::shared_ptr<const world::Object>& a, const std::shared_ptr<const world::Object>& b) {
+    return a == b || (a && b && *a == *b);
+  };
+  for (auto it = clearance_grids.begin(); it != clearance_grids.end(); ++it) {
+    if (!std::equal(it->statics.begin(), it->statics.end(), statics.begin(), statics.end(), same)) continue;
+    std::rotate(it, it + 1, clearance_grids.end());
+    return clearance_grids.back().grid;
+  }
+  std::vector<world::Polygon2> footprints;
+  for (const auto& o : statics) footprints.push_back(collision::floorFootprint(*o));
+  Aabb bounds = baseBounds({});
+  bounds.min.head<2>() -= Eigen::Vector2d::Constant(1.0);
+  bounds.max.head<2>() += Eigen::Vector2d::Constant(1.0);
+  constexpr std::size_t kKept = 4;
+  if (clearance_grids.size() >= kKept) clearance_grids.erase(clearance_grids.begin());
+  clearance_grids.push_back({std::move(statics), std::make_shared<const collision::ClearanceGrid>(footprints, bounds, h)});
+  return clearance_grids.back().grid;
+}
+
 double MotionPlanner::Impl::reachRadius(const robot::RobotState& s, const std::string& held, const std::string& link,
                                         const Eigen::Isometry3d& link_T_held) const {
   std::vector<Eigen::Isometry3d> poses;
@@ -247,6 +272,42 @@ double MotionPlanner::Impl::reachRadius(const robot::RobotState& s, const std::s
     }
   }
   return r + 1e-3;
+}
+
+std::vector<Eigen::Vector3d> MotionPlanner::Impl::reachCover(const robot::RobotState& s, const std::string& held,
+                                                             const std::string& link,
+                                                             const Eigen::Isometry3d& link_T_held) const {
+  std::vector<Eigen::Isometry3d> poses;
+  robot.linkPoses(s, poses);
+  const Eigen::Isometry3d base_T_world = s.base.toIsometry().inverse();
+  Aabb box;
+  for (const auto& p : robot.geometry().parts)
+    box.extend(p.shape.aabb(base_T_world * poses[static_cast<std::size_t>(p.link)] * p.link_T_shape));
+  if (!held.empty()) {
+    if (const world::Object* o = world.findObject(held)) {
+      const auto world_T_link = linkPose(s, link);
+      if (world_T_link) {
+        box.extend(o->shape.aabb(base_T_world * *world_T_link * link_T_held));
+      } else {
+        const Aabb w = o->aabb();
+        for (double x : {w.min.x(), w.max.x()})
+          for (double y : {w.min.y(), w.max.y()}) box.extend(base_T_world * Eigen::Vector3d(x, y, w.min.z()));
+      }
+    }
+  }
+  if (box.empty()) return {};
+  const Eigen::Vector2d lo = box.min.head<2>(), size = (box.max - box.min).head<2>();
+  const int axis = size.x() >= size.y() ? 0 : 1;
+  const double along = size[axis], across = size[1 - axis];
+  const int slabs = std::clamp(static_cast<int>(std::ceil(along / std::max(across, 1e-6))), 1, 4);
+  const double step = along / slabs;
+  std::vector<Eigen::Vector3d> cover;
+  for (int i = 0; i < slabs; ++i) {
+    Eigen::Vector2d c = lo + 0.5 * size;
+    c[axis] = lo[axis] + (i + 0.5) * step;
+    cover.emplace_back(c.x(), c.y(), 0.5 * std::hypot(step, across) + 1e-3);
+  }
+  return cover;
 }
 
 Aabb MotionPlanner::Impl::baseBounds(const std::vector<Eigen::Vector2d>& extra) const {
@@ -965,7 +1026,10 @@ detail::Oracle Planning::requestOracle() {
   }
   const double reach =
       req.group == PlanningGroup::kBase ? impl.reachRadius(req.start, held, held_link, link_T_held) : 0.0;
-  return detail::Oracle(impl.scene, gs, ignored, std::move(movables), reach);
+  detail::Oracle o(impl.scene, gs, ignored, std::move(movables), reach);
+  if (req.group == PlanningGroup::kBase)
+    o.setClearance(impl.clearanceGrid(), impl.reachCover(req.start, held, held_link, link_T_held));
+  return o;
 }
 
 std::vector<double> Planning::sweepRadii() const {
@@ -1004,23 +1068,29 @@ ob::SpaceInformationPtr Planning::sweptSi(detail::Oracle& checker) const {
 }
 
 void Planning::setUpClearance() {
-  if (P.sampling.base_clearance > 0.0) {
-    padded_scene = std::make_unique<collision::Scene>(impl.world);
-    padded_scene->setRobot(grownGeometry(impl.robot.geometry(), P.sampling.base_clearance));
-    if (!held.empty()) (void)padded_scene->attach(held, held_link, link_T_held);
-    padded_oracle =
-        std::make_unique<detail::Oracle>(*padded_scene, gs, ignored, oracle.movables(), oracle.reachRadius());
-  }
-  std::vector<Eigen::Vector2d> ends{{req.start.base.x, req.start.base.y}};
-  if (req.goal.kind == MotionGoal::Kind::kBasePose) ends.emplace_back(req.goal.base.x, req.goal.base.y);
-  if (req.goal.kind == MotionGoal::Kind::kConfiguration && req.goal.configuration.size() >= 2)
-    ends.emplace_back(req.goal.configuration[0], req.goal.configuration[1]);
   // Grown boxes, cylinders and spheres contain the originals (a grown prism need not); the
   // grown scene has no unknown space.
   const auto& parts = impl.robot.geometry().parts;
   const bool contains = !impl.scene.hasUnknownSpace() && std::all_of(parts.begin(), parts.end(), [](const auto& part) {
     return part.shape.kind != world::ShapeKind::kPrism;
   });
+  if (P.sampling.base_clearance > 0.0) {
+    padded_scene = std::make_unique<collision::Scene>(impl.world);
+    padded_scene->setRobot(grownGeometry(impl.robot.geometry(), P.sampling.base_clearance));
+    if (!held.empty()) (void)padded_scene->attach(held, held_link, link_T_held);
+    // Those shapes grown by d reach at most d*sqrt(2) farther in xy (a box's corner).
+    const double reach = oracle.reachRadius() + (contains ? std::sqrt(2.0) * P.sampling.base_clearance : 0.0);
+    padded_oracle = std::make_unique<detail::Oracle>(*padded_scene, gs, ignored, oracle.movables(), reach);
+    if (contains && oracle.reachRadius() > 0.0) {
+      std::vector<Eigen::Vector3d> cover = impl.reachCover(req.start, held, held_link, link_T_held);
+      for (auto& c : cover) c.z() += std::sqrt(2.0) * P.sampling.base_clearance;
+      padded_oracle->setClearance(impl.clearanceGrid(), std::move(cover));
+    }
+  }
+  std::vector<Eigen::Vector2d> ends{{req.start.base.x, req.start.base.y}};
+  if (req.goal.kind == MotionGoal::Kind::kBasePose) ends.emplace_back(req.goal.base.x, req.goal.base.y);
+  if (req.goal.kind == MotionGoal::Kind::kConfiguration && req.goal.configuration.size() >= 2)
+    ends.emplace_back(req.goal.configuration[0], req.goal.configuration[1]);
   clearance = std::make_shared<detail::ClearanceValidityChecker>(si, oracle, padded_oracle.get(), gs, std::move(ends),
                                                                  P.sampling.base_clearance_near_ends, contains);
   si->setStateValidityChecker(clearance);
@@ -1460,6 +1530,7 @@ Outcome Planning::sample(const Stopwatch& phase, bool solved) {
       if (outcome == detail::ProofOutcome::kDisconnected) {
         res.stats.sampling_ms = phase.millis() - res.stats.proof_ms;
         res.stats.validity_checks = oracle.checks();
+        res.stats.grid_answers = oracle.gridAnswers();
         return finish(MotionStatus::kNoPath,
                       std::string("no path: start and goal are in different components of the ") +
                           (lazy ? "static " : "") + "free space of the base (proven on a " +
@@ -1484,6 +1555,7 @@ Outcome Planning::sample(const Stopwatch& phase, bool solved) {
   res.stats.sampling_ms = phase.millis() - res.stats.proof_ms;
   if (!solved) {
     res.stats.validity_checks = oracle.checks();
+    res.stats.grid_answers = oracle.gridAnswers();
     const bool stop = termination.reason() == StopReason::kStopRequested;
     return finish(MotionStatus::kTimeout,
                   std::string(stop ? "stop requested" : "the deadline passed") + " before a " + (lazy ? "lazy " : "") +
@@ -1606,6 +1678,7 @@ void Planning::prependEscapeAndAlign(og::PathGeometric& path) {
 
 MotionResult Planning::finishSolved(const og::PathGeometric& path) {
   res.stats.validity_checks = oracle.checks();
+  res.stats.grid_answers = oracle.gridAnswers();
   res.path = detail::toJointPath(gs, path);
   res.path_length = detail::reportedLength(gs, path);
   auto traj = timeParameterize(res.path, impl.timingLimits());

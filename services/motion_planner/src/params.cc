@@ -50,6 +50,7 @@ const config::Schema<MotionPlannerParams>& schema() {
         .field("base_clearance_near_ends", &S::base_clearance_near_ends, nonNegative())
         .field("base_clearance_time_s", &S::base_clearance_time_s, positive())
         .field("base_start_margin", &S::base_start_margin, nonNegative())
+        .field("clearance_grid_resolution", &S::clearance_grid_resolution, nonNegative())
         .convert<std::string>("lazy_planner", &S::lazy_planner, planner)
         .convert<std::string>("full_planner", &S::full_planner, planner)
         .convert<std::string>("arm_planner", &S::arm_planner, planner);

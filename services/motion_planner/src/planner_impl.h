@@ -62,10 +62,26 @@ struct MotionPlanner::Impl {
   detail::StaticRoadmap* roadmapFor(detail::StaticWorldKey key, const detail::ob::StateSpacePtr& space,
                                     bool& reused, std::unique_ptr<detail::StaticRoadmap>& scratch);
 
+  /// The clearance grid of the world's static objects (SamplingParams::clearance_grid_resolution),
+  /// kept for the last few sets of static objects; null when off.
+  std::shared_ptr<const collision::ClearanceGrid> clearanceGrid();
+  struct ClearanceEntry {
+    std::vector<std::shared_ptr<const world::Object>> statics;
+    std::shared_ptr<const collision::ClearanceGrid> grid;
+  };
+  std::vector<ClearanceEntry> clearance_grids;  ///< least recently used first
+
   /// The robot's xy radius about its base origin in state `s`, the object `held` (or none)
   /// included where it sits on `link` at `link_T_held`.
   double reachRadius(const robot::RobotState& s, const std::string& held = {}, const std::string& link = {},
                      const Eigen::Isometry3d& link_T_held = Eigen::Isometry3d::Identity()) const;
+  /// Circles (x, y in the base frame, radius) that together cover the robot and the object
+  /// `held` seen from above in state `s` (the clearance grid's test of a rigid base): the xy box
+  /// of its parts in the base frame cut along its longer side into near-square slabs, each in
+  /// the circle through its corners.
+  std::vector<Eigen::Vector3d> reachCover(const robot::RobotState& s, const std::string& held = {},
+                                          const std::string& link = {},
+                                          const Eigen::Isometry3d& link_T_held = Eigen::Isometry3d::Identity()) const;
   /// World pose of `link` (a collision geometry link) in state `s`; nothing when unknown.
   std::optional<Eigen::Isometry3d> linkPose(const robot::RobotState& s, const std::string& link) const;
   /// Base xy bounds: the world's bounds plus `extra` points, grown by the workspace margin.

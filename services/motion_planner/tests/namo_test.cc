@@ -85,5 +85,47 @@ TEST_F(NamoTest, JsonWorldWithoutMovablesIsSolvedCollisionFreeInBothModes) {
   }
 }
 
+// The clearance grid (sampling.clearance_grid_resolution) answers a share of the lazy mode's
+// static checks without FCL, and its paths stay free of static contact (checked at 5 mm here).
+// (That it changes no path is measured across processes by tamp_motion_planner_namo_bench:
+// OMPL's samplers are seeded once per process, so two planners in one process differ anyway.)
+TEST_F(NamoTest, TheClearanceGridAnswersStaticChecksAndItsPathsTouchNoWall) {
+  const std::vector<std::filesystem::path> worlds{
+      namoDir() / "moghaddam_planning_2016_benchmark" / "moghaddam_planning_2016_benchmark_05.svg",
+      namoDir() / "s-namo_cases" / "04_after_the_feast" / "04_after_the_feast.json"};
+  for (const auto& file : worlds) {
+    auto loaded = world::loadNamo(file);
+    ASSERT_TRUE(loaded.ok()) << loaded.error().toString();
+    const auto& nw = *loaded;
+    for (double h : {0.05, 0.0}) {
+      MotionPlannerParams params;
+      params.sampling.clearance_grid_resolution = h;
+      MotionPlanner mp(collision::RobotGeometry::disc(nw.robot_radius, 1.0), params);
+      mp.setWorld(nw.world);
+      std::uint64_t answered = 0, checks = 0;
+      // There and back, then there again (the roadmap answers the later ones).
+      const std::vector<std::pair<Pose2D, Pose2D>> legs{
+          {nw.start, nw.goals[0].pose}, {nw.goals[0].pose, nw.start}, {nw.start, nw.goals[0].pose}};
+      for (const auto& [from, to] : legs) {
+        MotionRequest req;
+        req.start.base = from;
+        req.goal = MotionGoal::basePoseGoal(to, true);
+        const MotionResult r = mp.plan(req, Termination::after(30.0));
+        ASSERT_EQ(r.status, MotionStatus::kSolved) << file << ": " << r.reason;
+        std::vector<std::string> reported;
+        for (const auto& b : r.blocking) reported.push_back(b.object_id);
+        std::sort(reported.begin(), reported.end());
+        EXPECT_EQ(recheck(nw.world, nw.robot_radius, r.path), reported) << file;
+        answered += r.stats.grid_answers;
+        checks += r.stats.validity_checks;
+      }
+      if (h > 0.0)
+        EXPECT_GT(answered, checks / 10) << file << ": the grid answered " << answered << " of " << checks << " checks";
+      else
+        EXPECT_EQ(answered, 0U) << file;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace tamp::motion_planner

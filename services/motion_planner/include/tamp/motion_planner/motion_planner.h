@@ -196,6 +196,8 @@ struct PlanningStats {
   double proof_ms{0.0};         ///< full mode: infeasibility grid
   double goal_ms{0.0};          ///< goal states: IK for an end-effector goal, validity of the goal
   std::uint64_t validity_checks{0};
+  /// Of those, static checks the clearance grid answered without FCL (clearance_grid_resolution).
+  std::uint64_t grid_answers{0};
   /// Full-mode arm paths: segments planned again because they touched something between two
   /// checked states at the swept resolution (SamplingParams::arm_swept_step).
   int swept_repairs{0};

@@ -96,6 +96,11 @@ struct SamplingParams {
   /// from it; a turn in place there swings a corner towards it, free in the world model by
   /// millimetres and not in the world (namo_room_hidden: stopped three times). 0: off.
   double base_start_margin{0.02};
+  /// m, >= 0: base motions of a rigid robot (arm still) first ask a distance grid of the static
+  /// objects' footprints with cells this size, and skip the FCL check where the nearest one is
+  /// farther than the robot's reach radius (collision/clearance_grid.h). Answers only "free" where
+  /// FCL would: paths and decisions are the same, found sooner. 0: off.
+  double clearance_grid_resolution{0.05};
 };
 
 /// Lazy mode: making the lazy path worth executing (see motion_planner.h). The roadmap of the

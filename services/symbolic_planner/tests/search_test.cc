@@ -51,6 +51,23 @@ TEST_P(EverySearch, ProvesUnsolvabilityByExhaustion) {
   EXPECT_GT(r.stats.expanded, 0U);
 }
 
+TEST_P(EverySearch, SolvesATaskWithoutFactsWithTheEmptyPlan) {
+  // No action changes anything, so grounding leaves no fact at all (the goal atom is static and
+  // true): the state is zero bits long. It used to have zero words, and the search read past an
+  // empty buffer (a crash, found on a PDDL file written for the twenty-second round).
+  const std::string dom = R"((define (domain still) (:requirements :strips) (:predicates (p))
+    (:action wait :parameters () :precondition (and) :effect (and))))";
+  for (const char* goal : {"(and)", "(p)"}) {
+    const std::string prob = std::string("(define (problem x) (:domain still) (:init (p)) (:goal ") + goal + "))";
+    PlanReply r = test::planText(dom, prob, GetParam());
+    ASSERT_EQ(r.status, PlanStatus::kSolved) << goal << ": " << r.message;
+    EXPECT_TRUE(r.plan.empty()) << goal;
+  }
+  // The same task whose goal atom is static and false is proven unsolvable.
+  PlanReply r = test::planText(dom, "(define (problem y) (:domain still) (:init) (:goal (p)))", GetParam());
+  EXPECT_EQ(r.status, PlanStatus::kUnsolvable) << r.message;
+}
+
 INSTANTIATE_TEST_SUITE_P(All, EverySearch,
                          ::testing::Values(SearchAlgorithm::kEhc, SearchAlgorithm::kGbfs, SearchAlgorithm::kLazy,
                                            SearchAlgorithm::kWAstar, SearchAlgorithm::kAstar),

@@ -422,7 +422,8 @@ class Searcher {
   /// nullopt.
   std::optional<SearchStatus> checkLimits() {
     if (turns_ != nullptr && turns_->stopped()) return SearchStatus::kCancelled;
-    if ((++checks_ & 255) != 0 && stats_.evaluated < evaluated_at_check_ + kEvalsPerCheck) return std::nullopt;
+    const bool few_evaluations = stats_.evaluated < evaluated_at_check_ + kEvalsPerCheck;
+    if ((++checks_ & 255) != 0 && few_evaluations) return std::nullopt;
     evaluated_at_check_ = stats_.evaluated;
     const StopReason why = term_.reason();
     if (why == StopReason::kDeadline) return SearchStatus::kTimeout;

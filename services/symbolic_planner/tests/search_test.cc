@@ -167,7 +167,8 @@ Task diamondTask() {
 /// h_FF that takes at least `spin` per evaluation, as it does on a task with 10^5 operators.
 class SlowFF : public Heuristic {
  public:
-  SlowFF(const Task& t, std::chrono::microseconds spin) : ff_(makeHeuristic(HeuristicKind::kFF, t, CostType::kUnit)), spin_(spin) {}
+  SlowFF(const Task& t, std::chrono::microseconds spin)
+      : ff_(makeHeuristic(HeuristicKind::kFF, t, CostType::kUnit)), spin_(spin) {}
   void setGoal(const Goal& goal) override { ff_->setGoal(goal); }
   Cost evaluate(const uint64_t* state) override {
     const auto until = std::chrono::steady_clock::now() + spin_;

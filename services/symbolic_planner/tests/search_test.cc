@@ -207,7 +207,7 @@ TEST(Search, EhcStopsAtTheDeadlineWithinANodeOfManySlowSuccessors) {
   const Stopwatch clock;
   const SearchResult r = search(t, StateBits(t.numWords(), 0), goal, opt, h, Termination::after(0.02));
   EXPECT_EQ(r.status, SearchStatus::kTimeout);
-  EXPECT_LT(clock.seconds(), 0.2);
+  EXPECT_LT(clock.seconds(), 0.5);  // about 0.03 s; 0.5 leaves room for a loaded machine
   EXPECT_LT(r.stats.evaluated, 100U);
 }
 

@@ -416,10 +416,15 @@ class Searcher {
            open_bytes_;
   }
 
-  /// Checks time and memory every 256 calls; returns a terminal status or nullopt.
+  /// Checks time and memory every 256 calls, or sooner once kEvalsPerCheck states were evaluated
+  /// since the last check (one evaluation of a task with 10^5 operators takes milliseconds, and
+  /// a hill-climbing node may evaluate hundreds of successors); returns a terminal status or
+  /// nullopt.
   std::optional<SearchStatus> checkLimits() {
     if (turns_ != nullptr && turns_->stopped()) return SearchStatus::kCancelled;
-    if ((++checks_ & 255) != 0) return std::nullopt;
+    const bool few_evaluations = stats_.evaluated < evaluated_at_check_ + kEvalsPerCheck;
+    if ((++checks_ & 255) != 0 && few_evaluations) return std::nullopt;
+    evaluated_at_check_ = stats_.evaluated;
     const StopReason why = term_.reason();
     if (why == StopReason::kDeadline) return SearchStatus::kTimeout;
     if (why == StopReason::kStopRequested) return SearchStatus::kCancelled;
@@ -560,6 +565,7 @@ class Searcher {
             break;
           }
           const Cost h = evaluate(sid);
+          if (auto st = checkLimits()) return finish(*st);
           if (h == Heuristic::kDeadEnd) continue;
           if (h < hcur && (found == kNone || h < h_cache_[found])) {
             if (h2_commits_ && !term_() && h2DeadEnd(succ_.data())) {
@@ -1005,6 +1011,8 @@ class Searcher {
   StateBits buf_, succ_;
   SearchStatistics stats_;
   uint64_t checks_{0};
+  uint64_t evaluated_at_check_{0};            ///< stats_.evaluated at the last clock read
+  static constexpr uint64_t kEvalsPerCheck = 16;
   size_t open_bytes_{0};
   std::vector<uint32_t> stamp_;  // ehc: BFS iteration that reached each state
   uint64_t eval_budget_{0};      // ehc: give up after this many evaluations (0 = unlimited)

@@ -1,10 +1,13 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <tuple>
 #include <thread>
 
+#include "tamp/core/termination.h"
+#include "tamp/symbolic_planner/heuristic.h"
 #include "tamp/symbolic_planner/landmarks.h"
 #include "tamp/symbolic_planner/search.h"
 #include "test_util.h"
@@ -49,6 +52,23 @@ TEST_P(EverySearch, ProvesUnsolvabilityByExhaustion) {
   PlanReply r = test::planText(dom, prob, GetParam());
   EXPECT_EQ(r.status, PlanStatus::kUnsolvable) << r.message;
   EXPECT_GT(r.stats.expanded, 0U);
+}
+
+TEST_P(EverySearch, SolvesATaskWithoutFactsWithTheEmptyPlan) {
+  // No action changes anything, so grounding leaves no fact at all (the goal atom is static and
+  // true): the state is zero bits long. It used to have zero words, and the search read past an
+  // empty buffer (a crash, found on a PDDL file written for the twenty-second round).
+  const std::string dom = R"((define (domain still) (:requirements :strips) (:predicates (p))
+    (:action wait :parameters () :precondition (and) :effect (and))))";
+  for (const char* goal : {"(and)", "(p)"}) {
+    const std::string prob = std::string("(define (problem x) (:domain still) (:init (p)) (:goal ") + goal + "))";
+    PlanReply r = test::planText(dom, prob, GetParam());
+    ASSERT_EQ(r.status, PlanStatus::kSolved) << goal << ": " << r.message;
+    EXPECT_TRUE(r.plan.empty()) << goal;
+  }
+  // The same task whose goal atom is static and false is proven unsolvable.
+  PlanReply r = test::planText(dom, "(define (problem y) (:domain still) (:init) (:goal (p)))", GetParam());
+  EXPECT_EQ(r.status, PlanStatus::kUnsolvable) << r.message;
 }
 
 INSTANTIATE_TEST_SUITE_P(All, EverySearch,
@@ -142,6 +162,53 @@ Task diamondTask() {
   op("(o5)", {3}, {4}, {3});
   t.finalize();
   return t;
+}
+
+/// h_FF that takes at least `spin` per evaluation, as it does on a task with 10^5 operators.
+class SlowFF : public Heuristic {
+ public:
+  SlowFF(const Task& t, std::chrono::microseconds spin)
+      : ff_(makeHeuristic(HeuristicKind::kFF, t, CostType::kUnit)), spin_(spin) {}
+  void setGoal(const Goal& goal) override { ff_->setGoal(goal); }
+  Cost evaluate(const uint64_t* state) override {
+    const auto until = std::chrono::steady_clock::now() + spin_;
+    while (std::chrono::steady_clock::now() < until) {
+    }
+    return ff_->evaluate(state);
+  }
+  const std::vector<OpId>& preferred() const override { return ff_->preferred(); }
+  bool computesPreferred() const override { return ff_->computesPreferred(); }
+
+ private:
+  std::unique_ptr<Heuristic> ff_;
+  std::chrono::microseconds spin_;
+};
+
+TEST(Search, EhcStopsAtTheDeadlineWithinANodeOfManySlowSuccessors) {
+  // 200 independent goals, one operator each: every operator is helpful, so each hill-climbing
+  // node evaluates up to 200 successors (300 us each here). The clock used to be read every 256
+  // nodes only; the whole 200-node plan (about 6 s) then came before the first read and the
+  // 20 ms deadline was overrun 300-fold. It is now also read after every 16 evaluations.
+  Task t;
+  Goal goal;
+  goal.conjuncts.emplace_back();
+  for (FactId f = 0; f < 200; ++f) {
+    t.fact_names.push_back("(g" + std::to_string(f) + ")");
+    addOp(t, "(set)", {}, {f});
+    goal.conjuncts[0].pos.push_back(f);
+  }
+  t.complement.assign(t.fact_names.size(), -1);
+  t.finalize();
+  SearchOptions opt;
+  opt.goal_agenda = false;  // all goals at once: one node, 200 helpful successors
+  opt.ehc_lazy_beside = false;
+  opt.ehc_ff_first = false;
+  SlowFF h(t, std::chrono::microseconds(300));
+  const Stopwatch clock;
+  const SearchResult r = search(t, StateBits(t.numWords(), 0), goal, opt, h, Termination::after(0.02));
+  EXPECT_EQ(r.status, SearchStatus::kTimeout);
+  EXPECT_LT(clock.seconds(), 0.5);  // about 0.03 s; 0.5 leaves room for a loaded machine
+  EXPECT_LT(r.stats.evaluated, 100U);
 }
 
 TEST(Landmarks, FindsTheCausalLandmarksAndCountsThemAlongAPath) {

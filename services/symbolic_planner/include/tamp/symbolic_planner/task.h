@@ -9,6 +9,7 @@
 /// operators with the same name (ground DNF); quantifiers are expanded over the objects. Static
 /// atoms (of predicates no action changes) are evaluated during grounding and do not appear.
 
+#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -87,7 +88,9 @@ class Task {
   EffectIndex effects;                       ///< built by finalize()
 
   size_t numFacts() const { return fact_names.size(); }
-  size_t numWords() const { return (fact_names.size() + 63) / 64; }
+  /// Words of a state: at least one, so that a task without facts (every predicate static or
+  /// unused) still has a state to store, hash and compare.
+  size_t numWords() const { return std::max<size_t>(1, (fact_names.size() + 63) / 64); }
 
   /// Rebuilds the derived tables (achievers, effect index, successor index). Call once after
   /// filling.

@@ -510,5 +510,13 @@ JointPath toJointPath(const GroupSpace& gs, const og::PathGeometric& path);
 /// executed (effort_model::baseSteps). Kept only when every changed motion is still valid
 /// (`si`'s motion validator); returns whether the path changed. Base group paths only.
 bool alignBaseHeadings(const ob::SpaceInformationPtr& si, og::PathGeometric& path);
+/// A stop-and-turn base path with the corners of each motion (where its first turn in place ends,
+/// where its drive ends) made waypoints: the robot turns in place exactly where and as far as the
+/// motion was checked. The executor (effort_model::baseSteps: the simulator, the monitor) turns only
+/// at waypoints that do not move, straight from the heading it arrives with to the next drive's:
+/// an inner waypoint whose heading is neither (alignBaseHeadings could not change it: the aligned
+/// motion touched something) was turned through the other way round, unchecked, and the simulator
+/// stopped the robot before a wall (docs/reliability.md, session 18). Other spaces: unchanged.
+void explicitBaseTurns(const ob::SpaceInformationPtr& si, og::PathGeometric& path);
 
 }  // namespace tamp::motion_planner::detail

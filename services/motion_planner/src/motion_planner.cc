@@ -1671,7 +1671,10 @@ Outcome Planning::repairSwept(og::PathGeometric& path) {
 /// The escape from the start prepended; a stop-and-turn base's headings along its drives.
 void Planning::prependEscapeAndAlign(og::PathGeometric& path) {
   if (escaped) path.prepend(start.get());
-  if (req.group == PlanningGroup::kBase && P.sampling.base_turn_in_place) detail::alignBaseHeadings(si, path);
+  if (req.group == PlanningGroup::kBase && P.sampling.base_turn_in_place) {
+    detail::alignBaseHeadings(si, path);
+    detail::explicitBaseTurns(si, path);
+  }
 }
 
 // ---- finish ----

@@ -414,4 +414,23 @@ bool alignBaseHeadings(const ob::SpaceInformationPtr& si, og::PathGeometric& pat
   return true;
 }
 
+void explicitBaseTurns(const ob::SpaceInformationPtr& si, og::PathGeometric& path) {
+  const ob::StateSpacePtr& space = si->getStateSpace();
+  if (!isStopAndTurn(*space) || path.getStateCount() < 2) return;
+  og::PathGeometric out(si);
+  out.append(path.getState(0));
+  ScopedState corner(space);
+  for (std::size_t i = 0; i + 1 < path.getStateCount(); ++i) {
+    const ob::State* a = path.getState(i);
+    const ob::State* b = path.getState(i + 1);
+    for (double f : turnCorners(*space, a, b)) {
+      if (f <= 1e-9 || f >= 1.0 - 1e-9) continue;
+      space->interpolate(a, b, f, corner.get());
+      if (space->distance(corner.get(), out.getState(out.getStateCount() - 1)) > 1e-9) out.append(corner.get());
+    }
+    if (space->distance(b, out.getState(out.getStateCount() - 1)) > 1e-12) out.append(b);
+  }
+  path = out;
+}
+
 }  // namespace tamp::motion_planner::detail

@@ -132,15 +132,16 @@ struct Track {
   bool pushed{false};  ///< moved out of the base this frame (keepOutOfBase)
 };
 
-/// Fraction of `points` inside the track's shape at its pose, grown by `margin` plus the range
-/// noise where each point was seen (`noise(range)`: from afar a face spreads over a band many
-/// centimetres deep, which is no evidence that the object moved).
+/// Fraction of `points` on the surface of the track's shape at its pose, within `margin` plus the
+/// range noise where each point was seen (`noise(range)`: from afar a face spreads over a band
+/// many centimetres deep, which is no evidence that the object moved). On, not inside: a face seen
+/// 10 cm inside the estimate (a pushed box whose estimate lags) is evidence that it moved.
 template <typename Noise>
 double explainedFraction(const Track& t, const std::vector<Eigen::Vector3d>& points, double margin,
                          const Eigen::Vector3d& sensor, Noise noise) {
   if (points.empty()) return 0.0;
   std::size_t inside = 0;
-  for (const auto& p : points) inside += pointInShape(t.shape, t.pose, p, margin + noise((p - sensor).norm())) ? 1 : 0;
+  for (const auto& p : points) inside += pointNearSurface(t.shape, t.pose, p, margin + noise((p - sensor).norm())) ? 1 : 0;
   return static_cast<double>(inside) / static_cast<double>(points.size());
 }
 
@@ -723,6 +724,14 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
     if (t.state != TrackInfo::State::kGone && id != I.held_id) candidates.push_back(&t);
   }
   const auto& dets = result.detections;
+  // Returns binned by direction, built when first asked: is a place seen free, hidden, or out of
+  // the image (the fits of tracked boxes ask whether a seen end is a face; gone objects below).
+  std::optional<RangeImage> image;
+  auto seenFree = [&](const Eigen::Vector3d& p) {
+    if (!image) image.emplace(frame, T.visibility_bin);
+    const Eigen::Vector3d half(0.01, 0.01, 0.01);
+    return image->seenThrough(p - half, p + half, T.visibility_margin);
+  };
   std::vector<std::vector<double>> cost(dets.size(), std::vector<double>(candidates.size(), kInf));
   std::vector<std::vector<ShapeFit>> fits(dets.size(), std::vector<ShapeFit>(candidates.size()));
   for (std::size_t i = 0; i < dets.size(); ++i) {
@@ -730,7 +739,7 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
       const Track& t = *candidates[j];
       ShapeFit f;
       if (t.size_known) {
-        f = fitShape(dets[i], t.shape, sensor, T, yawOf(t.pose));
+        f = fitShape(dets[i], t.shape, sensor, T, yawOf(t.pose), t.pose.translation().head<2>(), seenFree);
         if (!f.compatible) continue;
       } else {
         f.pose = dets[i].pose;
@@ -768,7 +777,7 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
     if (!t.size_known) {
       I.growShape(t, dets[i]);
       // Refit the grown shape (anchored on the seen faces) for the pose.
-      meas = fitShape(dets[i], t.shape, sensor, T, yawOf(t.pose)).pose;
+      meas = fitShape(dets[i], t.shape, sensor, T, yawOf(t.pose), t.pose.translation().head<2>(), seenFree).pose;
       log::get("perception")->debug("{} grown to {:.2f} x {:.2f}: detection rect {:.2f} x {:.2f} yaw {:.2f} at ({:.2f}, {:.2f}); fit ({:.2f}, {:.2f}) yaw {:.2f}, track ({:.2f}, {:.2f})",
                                     t.id, t.shape.size.x(), t.shape.size.y(), dets[i].rect.extents.x(), dets[i].rect.extents.y(),
                                     dets[i].rect.yaw, dets[i].pose.translation().x(), dets[i].pose.translation().y(),
@@ -874,7 +883,6 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
 
   // ---- expected objects not detected: seen empty, hidden, or out of view ------------------------
   watch.reset();
-  std::optional<RangeImage> image;
   std::vector<std::string> dropped;
   for (auto& [id, t] : I.tracks) {
     if (t.matched || t.state == TrackInfo::State::kGone || id == I.held_id || &t == held_elsewhere) continue;

@@ -380,7 +380,8 @@ Detection describeCluster(std::vector<Eigen::Vector3d> points, double support_z,
 // ---- known shapes -------------------------------------------------------------------------------
 
 ShapeFit fitShape(const Detection& det, const world::Shape& shape, const Eigen::Vector3d& sensor,
-                  const TrackingParams& params, double yaw_hint) {
+                  const TrackingParams& params, double yaw_hint, const std::optional<Eigen::Vector2d>& origin_hint,
+                  const std::function<bool(const Eigen::Vector3d&)>& seen_free) {
   ShapeFit fit;
   const bool hinted = std::isfinite(yaw_hint);  // a track's yaw; NaN: a first sighting
   const double hint = hinted ? yaw_hint : 0.0;
@@ -445,12 +446,25 @@ ShapeFit fitShape(const Detection& det, const world::Shape& shape, const Eigen::
     const double su[2] = {s.dot(a0), s.dot(a1)};
     double c[2] = {0, 0};
     const double anchor_tol = 0.5 * params.size_tolerance;
+    // The track's box centre (its frame origin plus the bounding box's offset, at its yaw).
+    std::optional<Eigen::Vector2d> centre_hint;
+    if (origin_hint) centre_hint = *origin_hint + offset.x() * axis(hint) + offset.y() * axis(hint + kPi / 2);
+    // Whether the seen end on side `sign` of axis `i` is a face: the space just beyond it, at
+    // half the detection's height, is seen free.
+    auto faceAt = [&](int i, double sign) {
+      if (!centre_hint || !seen_free) return true;
+      const Eigen::Vector2d p = det.rect.centre + sign * (e(i) / 2 + 2 * anchor_tol) * (i == 0 ? a0 : a1);
+      return seen_free(Eigen::Vector3d(p.x(), p.y(), det.support_z + det.height / 2));
+    };
     for (int i = 0; i < 2; ++i) {
       if (e(i) >= L(i) - anchor_tol) continue;
-      if (su[i] < -e(i) / 2) {
-        c[i] = -e(i) / 2 + L(i) / 2;
-      } else if (su[i] > e(i) / 2) {
-        c[i] = e(i) / 2 - L(i) / 2;
+      const bool beyond = std::abs(su[i]) > e(i) / 2;
+      const double sign = su[i] < 0 ? -1.0 : 1.0;
+      if (beyond && faceAt(i, sign)) {
+        c[i] = sign * (e(i) / 2 - L(i) / 2);
+      } else if (centre_hint) {
+        const double slack = (L(i) - e(i)) / 2;
+        c[i] = std::clamp((*centre_hint - det.rect.centre).dot(i == 0 ? a0 : a1), -slack, slack);
       }
     }
     const Eigen::Vector2d centre = det.rect.centre + c[0] * a0 + c[1] * a1;
@@ -511,6 +525,27 @@ double yawError(const world::Shape& shape, double a, double b) {
   double d = a - b;
   d -= sym * std::round(d / sym);
   return std::abs(d);
+}
+
+bool pointNearSurface(const world::Shape& shape, const Eigen::Isometry3d& pose, const Eigen::Vector3d& p,
+                      double tolerance) {
+  if (!pointInShape(shape, pose, p, tolerance)) return false;
+  const Eigen::Vector3d q = pose.inverse() * p;
+  switch (shape.kind) {
+    case world::ShapeKind::kBox:
+      return !(q.array().abs() < (shape.size.array() / 2 - tolerance)).all();
+    case world::ShapeKind::kCylinder:
+      return !(std::abs(q.z()) < shape.height / 2 - tolerance && q.head<2>().norm() < shape.radius - tolerance);
+    case world::ShapeKind::kSphere:
+      return !(q.norm() < shape.radius - tolerance);
+    case world::ShapeKind::kPrism: {
+      const Eigen::Vector2d xy = q.head<2>();
+      const bool deep = std::abs(q.z()) < shape.height / 2 - tolerance && world::containsPoint(shape.polygon, xy) &&
+                        ringDistance(xy, shape.polygon) > tolerance;
+      return !deep;
+    }
+  }
+  return false;
 }
 
 bool pointInShape(const world::Shape& shape, const Eigen::Isometry3d& pose, const Eigen::Vector3d& p, double margin) {

@@ -449,6 +449,76 @@ TEST(SceneTest, FarNoisyViewsOfAKnownBoxWhereItStandsAreNoMotion) {
   EXPECT_LT(worst, 0.05);
 }
 
+// namo_doorway: a crate of known size (0.9 x 0.9 x 0.6 m) pushed through a doorway, its estimate
+// off where the push left it (5-25 cm), then driven round close by: beside it, the part of it the
+// camera sees ends at the image's lower edge, not at a face. The known-size fit anchored the box
+// on that cut, 0.9 m off the crate: no match for the track, a new crate there, gone two frames
+// later (in CI: "moved", "gone", found again 0.6 m away; every change blocked the drive). Now the
+// cut is no face (the space beyond it is not seen free) and the track's centre is kept within
+// what the view allows: no new or gone object, and the estimate no farther off than it began.
+TEST(SceneTest, APushedCrateEstimatedOffStaysOnItWhenDrivenRoundClose) {
+  world::World prior("doorway");
+  ASSERT_TRUE(prior.addRegion(testing::floorRegion()).ok());
+  ASSERT_TRUE(prior.addObject(box("divider_south", 0.2, 3.4, 1.0, 5.1, 1.7, 0.0, 0.0, world::ObjectKind::kStatic)).ok());
+  ASSERT_TRUE(prior.addObject(box("divider_north", 0.2, 3.4, 1.0, 5.1, 6.3, 0.0, 0.0, world::ObjectKind::kStatic)).ok());
+  world::Object crate = box("crate", 0.9, 0.9, 0.6, 6.56, 4.0, 0.0);
+  crate.mass = 40.0;
+  ASSERT_TRUE(prior.addObject(crate).ok());
+  // The drive round its north side: base x, y, yaw.
+  std::vector<Eigen::Vector3d> poses;
+  for (int k = 0; k <= 5; ++k) poses.emplace_back(5.5, 4.0, 0.2 * k);
+  for (int k = 1; k <= 8; ++k) poses.emplace_back(5.5 + 0.07 * k, 4.0 + 0.12 * k, 1.0);
+  for (int k = 0; k <= 5; ++k) poses.emplace_back(6.06, 4.96, 1.0 - 0.2 * k);
+  for (int k = 1; k <= 20; ++k) poses.emplace_back(6.06 + 0.1 * k, 4.96, 0.0);  // 0.96 m off its axis
+  for (int k = 1; k <= 6; ++k) poses.emplace_back(8.06 + 0.1 * k, 4.96 - 0.08 * k, -0.6);
+  for (const Eigen::Vector2d& off : {Eigen::Vector2d(0.05, 0.0), Eigen::Vector2d(0.15, 0.05),
+                                     Eigen::Vector2d(-0.15, 0.05), Eigen::Vector2d(0.25, 0.1),
+                                     Eigen::Vector2d(0.0, -0.1)}) {
+    SCOPED_TRACE("the crate " + std::to_string(off.x()) + ", " + std::to_string(off.y()) + " m off its estimate");
+    world::World truth = prior;
+    const Eigen::Isometry3d real(Eigen::Translation3d(6.56 + off.x(), 4.0 + off.y(), 0.3));
+    ASSERT_TRUE(truth.setObjectPose("crate", real).ok());
+    Perception perception(prior, PerceptionParams());
+    Runner run(perception);
+    double worst = 0.0;
+    for (std::size_t k = 0; k < poses.size(); ++k) {
+      const Eigen::Vector3d& b = poses[k];
+      run.frame(truth, testing::mastCamera(b.x(), b.y(), b.z()));
+      const world::Object* o = perception.world().findObject("crate");
+      ASSERT_NE(o, nullptr) << "frame " << k << ": the crate was declared gone";
+      worst = std::max(worst, poseError(crate.shape, real, o->pose).xy);
+    }
+    EXPECT_LT(worst, off.norm() + 0.01) << "the estimate left the crate while driving round it";
+    EXPECT_TRUE(run.eventsOf(EventType::kAdded).empty()) << run.eventsOf(EventType::kAdded).front().description;
+    EXPECT_TRUE(run.eventsOf(EventType::kGone).empty());
+  }
+}
+
+// A pushed chair (0.6 x 0.6 x 0.9 m, of known size) whose estimate lags 10 cm behind it, seen
+// from the robot that backed off 0.6-1 m: its near face stands 10 cm inside the estimate. Points
+// inside the estimate counted as explained by it, so the estimate stayed 10 cm short (namo_big_
+// crossing: the next drive, planned past the chair's estimate, was refused, and the pushes from
+// there rejected, 5 replans). A face is explained by the estimate's surface, not its inside: the
+// estimate follows the chair.
+TEST(SceneTest, ALaggingEstimateOfAPushedBoxFollowsItsSeenFace) {
+  world::World prior("room");
+  ASSERT_TRUE(prior.addRegion(testing::floorRegion()).ok());
+  world::Object chair = box("chair", 0.6, 0.6, 0.9, 3.0, 0.0, 0.0);
+  chair.mass = 50.0;
+  ASSERT_TRUE(prior.addObject(chair).ok());
+  world::World truth = prior;
+  const Eigen::Isometry3d real(Eigen::Translation3d(3.1, 0.0, 0.45));
+  ASSERT_TRUE(truth.setObjectPose("chair", real).ok());
+  for (double gap : {0.6, 0.8, 1.0}) {
+    SCOPED_TRACE("the robot's camera " + std::to_string(gap) + " m before the chair's near face");
+    Perception perception(prior, PerceptionParams());
+    Runner run(perception);
+    for (int k = 0; k < 12; ++k) run.frame(truth, testing::mastCamera(real.translation().x() - 0.3 - gap, 0.0, 0.0));
+    EXPECT_LT(poseError(chair.shape, real, perception.world().object("chair").pose).xy, 0.04);
+    EXPECT_TRUE(run.eventsOf(EventType::kAdded).empty());
+  }
+}
+
 TEST(SceneTest, GoneOnlyWhenItsPlaceIsVisibleAndUnoccluded) {
   world::World prior = tableWorld();
   world::Object target = box("target", 0.25, 0.25, 0.25, 3.0, -0.2, 0.0);

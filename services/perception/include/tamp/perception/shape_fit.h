@@ -14,6 +14,7 @@
 /// coincides with the observed near face. Heights come from the support surface (the floor or
 /// table below), not from the lowest point seen, so occluded bottoms do not bias them.
 
+#include <functional>
 #include <limits>
 #include <optional>
 #include <vector>
@@ -93,8 +94,18 @@ struct ShapeFit {
 /// which side of the box a face belongs to when the view cannot tell (both fit within
 /// `size_tolerance`). NaN (the default, a first sighting): yaw 0 for the equivalents, the
 /// detection's extents for the side.
+/// Less of a box seen along an axis than its side: the box is anchored on the seen end nearer to
+/// the sensor, taken for a face. With `origin_hint` (a track's pose origin, xy), that end is a
+/// face only when `seen_free` says the space just beyond it is seen free (not out of the image,
+/// not hidden); along an axis with no face seen (the sensor abreast of the seen part, or its near
+/// end cut by the image's edge), every centre within the unseen length explains the points, and
+/// the one nearest the track's is taken. Without a hint (a first sighting): the near end is a
+/// face, and abreast the seen part's centre is taken. A crate driven past close, its near end
+/// below the image, was anchored on that cut 0.9 m off, and taken for a new crate (namo_doorway).
 ShapeFit fitShape(const Detection& detection, const world::Shape& shape, const Eigen::Vector3d& sensor,
-                  const TrackingParams& params, double yaw_hint = std::numeric_limits<double>::quiet_NaN());
+                  const TrackingParams& params, double yaw_hint = std::numeric_limits<double>::quiet_NaN(),
+                  const std::optional<Eigen::Vector2d>& origin_hint = std::nullopt,
+                  const std::function<bool(const Eigen::Vector3d&)>& seen_free = {});
 
 /// Yaw of an upright pose (rotation about world z), in [-pi, pi).
 double yawOf(const Eigen::Isometry3d& pose);
@@ -105,6 +116,11 @@ Eigen::Isometry3d uprightPose(double x, double y, double z, double yaw);
 double yawSymmetry(const world::Shape& shape, double square_tolerance = 0.01);
 /// |a - b| modulo the shape's yaw symmetry, in [0, symmetry/2] (0 for rotation-invariant shapes).
 double yawError(const world::Shape& shape, double a, double b);
+
+/// True when world point `p` lies within `tolerance` (m, > 0) of the surface of `shape` placed at
+/// `pose`: inside it grown by `tolerance`, not inside it shrunk by `tolerance`.
+bool pointNearSurface(const world::Shape& shape, const Eigen::Isometry3d& pose, const Eigen::Vector3d& p,
+                      double tolerance);
 
 /// True when world point `p` is inside `shape` placed at `pose`, grown by `margin` (m).
 bool pointInShape(const world::Shape& shape, const Eigen::Isometry3d& pose, const Eigen::Vector3d& p,

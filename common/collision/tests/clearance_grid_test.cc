@@ -30,19 +30,6 @@ world::Polygon2 rect(double x, double y, double a, double b, double yaw) {
   return out;
 }
 
-double segmentDistance(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-  const Eigen::Vector2d ab = b - a;
-  const double t = std::clamp((p - a).dot(ab) / std::max(1e-18, ab.squaredNorm()), 0.0, 1.0);
-  return (a + t * ab - p).norm();
-}
-
-/// Exact distance from a point to a polygon (0 inside).
-double distanceTo(const world::Polygon2& poly, const Eigen::Vector2d& p) {
-  if (world::containsPoint(poly, p)) return 0.0;
-  double d = std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < poly.size(); ++i) d = std::min(d, segmentDistance(p, poly[i], poly[(i + 1) % poly.size()]));
-  return d;
-}
 
 // The contract the motion planner relies on: never more than the true distance, so "clearance
 // above the robot's radius" is never said of a point where the robot could touch an obstacle.
@@ -62,7 +49,7 @@ TEST(ClearanceGridTest, IsALowerBoundOfTheDistanceToEveryFootprintAndATightOne) 
     for (int k = 0; k < 2000; ++k) {
       const Eigen::Vector2d p(in(rng), in(rng));
       double truth = std::numeric_limits<double>::infinity();
-      for (const auto& poly : polys) truth = std::min(truth, poly.size() == 2 ? segmentDistance(p, poly[0], poly[1]) : distanceTo(poly, p));
+      for (const auto& poly : polys) truth = std::min(truth, poly.size() == 2 ? world::segmentDistance(p, poly[0], poly[1]) : world::polygonDistance(poly, p));
       const double c = grid.clearance(p.x(), p.y());
       ASSERT_LE(c, truth + 1e-9) << "world " << world << " at (" << p.transpose() << ")";
       ASSERT_GE(c, truth - 3 * std::sqrt(2.0) * grid.resolution()) << "world " << world << " at (" << p.transpose() << ")";

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <stdexcept>
 #include <unordered_map>
 
@@ -91,6 +92,20 @@ bool containsPoint(const Polygon2& poly, const Point2& p) {
     }
   }
   return inside;
+}
+
+double segmentDistance(const Point2& p, const Point2& a, const Point2& b) {
+  const Point2 ab = b - a;
+  const double l2 = ab.squaredNorm();
+  const double t = l2 > 0.0 ? std::clamp((p - a).dot(ab) / l2, 0.0, 1.0) : 0.0;
+  return (a + t * ab - p).norm();
+}
+
+double polygonDistance(const Polygon2& poly, const Point2& p) {
+  if (containsPoint(poly, p)) return 0.0;
+  double d = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < poly.size(); ++i) d = std::min(d, segmentDistance(p, poly[i], poly[(i + 1) % poly.size()]));
+  return d;
 }
 
 double circumradius(const Polygon2& poly, const Point2& centre) {

@@ -40,6 +40,16 @@ TEST(PolygonTest, SignedAreaAndOrientation) {
   EXPECT_DOUBLE_EQ(signedArea(Polygon2{{0, 0}, {1, 1}}), 0.0);
 }
 
+TEST(PolygonTest, DistancesToASegmentAndToAPolygon) {
+  EXPECT_DOUBLE_EQ(segmentDistance({0.0, 1.0}, {-1.0, 0.0}, {1.0, 0.0}), 1.0);
+  EXPECT_DOUBLE_EQ(segmentDistance({4.0, 4.0}, {-1.0, 0.0}, {1.0, 0.0}), 5.0);  // to the end (1, 0)
+  EXPECT_DOUBLE_EQ(segmentDistance({3.0, 4.0}, {0.0, 0.0}, {0.0, 0.0}), 5.0);   // a point
+  const Polygon2 unit{{0.0, 0.0}, {1.0, 0.0}, {1.0, 1.0}, {0.0, 1.0}};
+  EXPECT_DOUBLE_EQ(polygonDistance(unit, {0.5, 0.5}), 0.0);
+  EXPECT_DOUBLE_EQ(polygonDistance(unit, {0.5, 3.0}), 2.0);
+  EXPECT_DOUBLE_EQ(polygonDistance(unit, {4.0, 5.0}), 5.0);  // to the corner (1, 1)
+}
+
 TEST(PolygonTest, AreaCentroidOfLShapeByHand) {
   // Rectangles [0,2]x[0,1] (area 2, centroid (1, .5)) and [0,1]x[1,2] (area 1, centroid (.5, 1.5)).
   const Point2 c = areaCentroid(lShape());

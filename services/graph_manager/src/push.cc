@@ -26,19 +26,6 @@ world::Polygon2 worldFootprint(const world::Object& o, const Eigen::Isometry3d& 
   return out;
 }
 
-double distanceToPolygon(const world::Polygon2& poly, const Eigen::Vector2d& p) {
-  if (world::containsPoint(poly, p)) return 0.0;
-  double best = std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < poly.size(); ++i) {
-    const Eigen::Vector2d a = poly[i], b = poly[(i + 1) % poly.size()];
-    const Eigen::Vector2d ab = b - a;
-    const double len2 = ab.squaredNorm();
-    const double t = len2 > 0.0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-    best = std::min(best, (a + t * ab - p).norm());
-  }
-  return best;
-}
-
 /// Push directions: along the footprint's longest edge and across it, both ways.
 std::vector<Eigen::Vector2d> pushDirections(const world::Polygon2& footprint) {
   Eigen::Vector2d u(1.0, 0.0);
@@ -61,7 +48,7 @@ double reach(const world::Polygon2& poly, const Eigen::Vector2d& c, const Eigen:
 /// Whether every pose keeps farther than `keep_clear` from the polygon.
 bool clearOf(const world::Polygon2& poly, const std::vector<Pose2D>& poses, double keep_clear) {
   return std::all_of(poses.begin(), poses.end(),
-                     [&](const Pose2D& s) { return distanceToPolygon(poly, Eigen::Vector2d(s.x, s.y)) > keep_clear; });
+                     [&](const Pose2D& s) { return world::polygonDistance(poly, Eigen::Vector2d(s.x, s.y)) > keep_clear; });
 }
 
 /// The way's direction where it passes closest to `c` (over about 0.5 m of it); zero when

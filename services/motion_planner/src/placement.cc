@@ -10,21 +10,6 @@ namespace {
 
 constexpr double kSupportGap = 0.002;  // m
 
-double pointSegmentDistance(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-  const Eigen::Vector2d ab = b - a;
-  const double l2 = ab.squaredNorm();
-  const double t = l2 > 0 ? std::clamp((p - a).dot(ab) / l2, 0.0, 1.0) : 0.0;
-  return (a + t * ab - p).norm();
-}
-
-/// Distance from p to polygon `poly` (0 inside).
-double pointPolygonDistance(const Eigen::Vector2d& p, const world::Polygon2& poly) {
-  if (world::containsPoint(poly, p)) return 0.0;
-  double d = std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < poly.size(); ++i) d = std::min(d, pointSegmentDistance(p, poly[i], poly[(i + 1) % poly.size()]));
-  return d;
-}
-
 bool segmentsCross(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c, const Eigen::Vector2d& d) {
   auto orient = [](const Eigen::Vector2d& p, const Eigen::Vector2d& q, const Eigen::Vector2d& r) {
     return (q.x() - p.x()) * (r.y() - p.y()) - (q.y() - p.y()) * (r.x() - p.x());
@@ -38,7 +23,7 @@ bool insideWithMargin(const world::Polygon2& inner, const world::Polygon2& outer
   for (const auto& v : inner) {
     if (!world::containsPoint(outer, v)) return false;
     for (std::size_t i = 0; i < outer.size(); ++i) {
-      if (pointSegmentDistance(v, outer[i], outer[(i + 1) % outer.size()]) < margin) return false;
+      if (world::segmentDistance(v, outer[i], outer[(i + 1) % outer.size()]) < margin) return false;
     }
   }
   // A non-convex region: no boundary edge may cut through the footprint.
@@ -206,7 +191,7 @@ Result<std::vector<Placement>> MotionPlanner::samplePlacements(const PlacementRe
     // Clear of the swept base path.
     bool clear = true;
     for (const auto& p : req.keep_clear_path) {
-      if (pointPolygonDistance(Eigen::Vector2d(p.x, p.y), fp) <= req.keep_clear_radius) {
+      if (world::polygonDistance(fp, Eigen::Vector2d(p.x, p.y)) <= req.keep_clear_radius) {
         clear = false;
         break;
       }

@@ -28,6 +28,10 @@ Point2 areaCentroid(const Polygon2& poly);
 bool isConvex(const Polygon2& poly);
 /// Even-odd point-in-polygon test. Points exactly on the boundary may go either way.
 bool containsPoint(const Polygon2& poly, const Point2& p);
+/// Distance from `p` to the segment a-b (a point when a == b).
+double segmentDistance(const Point2& p, const Point2& a, const Point2& b);
+/// Distance from `p` to the polygon: 0 inside (even-odd, as containsPoint), else to its nearest edge.
+double polygonDistance(const Polygon2& poly, const Point2& p);
 /// Largest distance from `centre` to a vertex.
 double circumradius(const Polygon2& poly, const Point2& centre);
 

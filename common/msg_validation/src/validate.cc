@@ -267,6 +267,29 @@ using Scope = Check::Scope;
 
 bool isPickOrPlace(msg::ActionKind k) { return k == msg::ACTION_PICK || k == msg::ACTION_PLACE; }
 
+/// A request's hypothetical world: objects moved or removed for it.
+void objectOverrides(Check& c, const std::vector<msg::ObjectOverride>& v) {
+  if (!c.size("object_overrides", v, c.limits().max_items)) return;
+  for (std::size_t i = 0; i < v.size() && c.ok(); ++i) {
+    Scope s(c, "object_overrides", i);
+    c.id("object_id", v[i].object_id(), true);
+    c.pose3("pose", v[i].pose(), !v[i].removed());
+  }
+}
+
+/// Whole objects in a message (a request's added objects, the oracle's hidden ones).
+void worldObjects(Check& c, const char* field, const std::vector<msg::WorldObject>& v) {
+  if (!c.size(field, v, c.limits().max_items)) return;
+  for (std::size_t i = 0; i < v.size() && c.ok(); ++i) {
+    Scope s(c, field, i);
+    c.id("id", v[i].id(), true);
+    c.enumIn("kind", v[i].kind(), msg::OBJECT_HIDDEN);
+    c.shape("shape", v[i].shape());
+    c.pose3("pose", v[i].pose(), true);
+    c.nonNegative("mass", v[i].mass());
+  }
+}
+
 }  // namespace
 
 // ---- requests ----------------------------------------------------------------------------------
@@ -319,14 +342,8 @@ Status validate(const msg::MotionRequest& m, const Limits& limits) {
   c.pose3("held_link_T_object", m.held_link_T_object(), m.held_grasp_given());
   c.inRange("held_padding_m", m.held_padding_m(), 0.0, 0.25);
   c.ids("ignored_objects", m.ignored_objects(), limits.max_items);
-  if (c.size("object_overrides", m.object_overrides(), limits.max_items)) {
-    for (std::size_t i = 0; i < m.object_overrides().size() && c.ok(); ++i) {
-      const auto& o = m.object_overrides()[i];
-      Scope s(c, "object_overrides", i);
-      c.id("object_id", o.object_id(), true);
-      c.pose3("pose", o.pose(), !o.removed());
-    }
-  }
+  objectOverrides(c, m.object_overrides());
+  worldObjects(c, "added_objects", m.added_objects());
   c.nonNegative("movable_cost_weight", m.movable_cost_weight());
   c.ids("fixed_objects", m.fixed_objects(), limits.max_items);
   return c.status();
@@ -341,6 +358,8 @@ Status validate(const msg::PlacementRequest& m, const Limits& limits) {
   c.nonNegative("keep_clear_radius", m.keep_clear_radius());
   if (m.max_placements() > limits.max_items)
     c.fail("max_placements", std::to_string(m.max_placements()) + " (limit " + std::to_string(limits.max_items) + ")");
+  objectOverrides(c, m.object_overrides());
+  worldObjects(c, "added_objects", m.added_objects());
   return c.status();
 }
 
@@ -351,6 +370,8 @@ Status validate(const msg::GraspRequest& m, const Limits& limits) {
   c.pose2("base_pose", m.base_pose());
   if (m.max_grasps() > limits.max_items)
     c.fail("max_grasps", std::to_string(m.max_grasps()) + " (limit " + std::to_string(limits.max_items) + ")");
+  objectOverrides(c, m.object_overrides());
+  worldObjects(c, "added_objects", m.added_objects());
   return c.status();
 }
 
@@ -494,16 +515,8 @@ Status validate(const msg::OracleReply& m, const Limits& limits) {
       c.nonNegative("stddev_s", e.stddev_s());
     }
   }
-  if (!c.size("hidden_objects", m.hidden_objects(), limits.max_items)) return c.status();
-  for (std::size_t i = 0; i < m.hidden_objects().size() && c.ok(); ++i) {
-    const auto& o = m.hidden_objects()[i];
-    Scope s(c, "hidden_objects", i);
-    c.id("id", o.id(), true);
-    c.enumIn("kind", o.kind(), msg::OBJECT_HIDDEN);
-    c.shape("shape", o.shape());
-    c.pose3("pose", o.pose(), true);
-    c.nonNegative("mass", o.mass());
-  }
+  worldObjects(c, "hidden_objects", m.hidden_objects());
+  if (!c.ok()) return c.status();
   if (!c.size("faults", m.faults(), limits.max_items)) return c.status();
   for (std::size_t i = 0; i < m.faults().size() && c.ok(); ++i) {
     const auto& f = m.faults()[i];

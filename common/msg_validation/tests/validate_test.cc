@@ -83,6 +83,21 @@ TEST(MsgValidation, MotionRequest) {
   EXPECT_EQ(why(m), "MotionRequest.object_overrides[1].object_id: empty (an id is required)");
   m.object_overrides()[1].object_id("can");
   EXPECT_EQ(why(m), "MotionRequest.object_overrides[1].pose.orientation: zero quaternion");
+  // Added objects (the oracle's hidden ones) are whole objects: id, shape and pose checked.
+  m = validMotion();
+  m.added_objects().resize(1);
+  m.added_objects()[0].id("crate");
+  m.added_objects()[0].shape().type(msg::SHAPE_BOX);
+  m.added_objects()[0].shape().dimensions({0.4, 0.4, 0.4});
+  m.added_objects()[0].pose(identity());
+  EXPECT_EQ(why(m), "(ok)");
+  m.added_objects()[0].pose().position().y(kNaN);
+  EXPECT_EQ(why(m), "MotionRequest.added_objects[0].pose.position.y: NaN");
+  msg::GraspRequest g;
+  fillHeader(g.header());
+  g.object_id("crate");
+  g.added_objects(m.added_objects());
+  EXPECT_EQ(why(g), "GraspRequest.added_objects[0].pose.position.y: NaN");
   m = validMotion();
   m.ignored_objects(std::vector<std::string>(200001, "x"));
   EXPECT_EQ(why(m), "MotionRequest.ignored_objects: 200001 elements (limit 100000)");

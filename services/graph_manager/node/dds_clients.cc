@@ -1,5 +1,7 @@
 #include "dds_clients.h"
 
+#include "tamp/dds/world_sync.h"
+
 #include "tamp/msg_validation/validate.h"
 
 #include <chrono>
@@ -132,6 +134,7 @@ MotionAnswer DdsServiceClients::motion(const MotionQuery& q) {
   }
   req.ignored_objects(q.ignored);
   for (const auto& o : q.overrides) req.object_overrides().push_back(toMsg(o));
+  for (const auto& o : q.added) req.added_objects().push_back(dds::toMsg(o, 0));
   req.movable_cost_weight(q.movable_cost_weight);
   req.fixed_objects(q.fixed);
   MotionAnswer a;
@@ -204,6 +207,7 @@ Result<std::vector<PlacementOption>> DdsServiceClients::placements(const Placeme
   }
   req.approach(q.approach_m);
   for (const auto& o : q.overrides) req.object_overrides().push_back(toMsg(o));
+  for (const auto& o : q.added) req.added_objects().push_back(dds::toMsg(o, 0));
   req.world_version(q.world_version);
   auto rep = checked(placement_.call(req, dds::CallOptions{q.budget_s, {}}), dds::services::kPlacement.name);
   if (!rep) return rep.error();
@@ -231,6 +235,7 @@ Result<std::vector<GraspOption>> DdsServiceClients::grasps(const GraspQuery& q) 
   if (q.base) req.base_pose(dds::toMsg(*q.base));
   req.max_grasps(q.max_grasps);
   for (const auto& o : q.overrides) req.object_overrides().push_back(toMsg(o));
+  for (const auto& o : q.added) req.added_objects().push_back(dds::toMsg(o, 0));
   req.world_version(q.world_version);
   auto rep = checked(grasp_.call(req, dds::CallOptions{q.budget_s, {}}), dds::services::kGrasp.name);
   if (!rep) return rep.error();

@@ -7,6 +7,8 @@
 /// adds the hidden objects to the live world, so that the graph is built in the true world.
 
 #include <memory>
+#include <mutex>
+#include <set>
 
 #include "dds_clients.h"
 
@@ -39,13 +41,19 @@ class OracleWorldSource : public WorldSource {
  public:
   OracleWorldSource(WorldSource& live, std::vector<world::Object> hidden)
       : live_(live), hidden_(std::move(hidden)) {}
-  world::World world() override { return withHidden(live_.world(), hidden_); }
+  world::World world() override {
+    world::World live = live_.world();
+    std::lock_guard<std::mutex> lock(mu_);
+    return withHidden(live, hidden_, &found_);
+  }
   Observation robot() override { return live_.robot(); }
   std::uint64_t version() override { return live_.version(); }
 
  private:
   WorldSource& live_;
   std::vector<world::Object> hidden_;
+  std::mutex mu_;
+  std::set<std::string> found_;  ///< hidden objects perception has found: never added again
 };
 
 }  // namespace tamp::graph_manager

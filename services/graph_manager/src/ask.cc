@@ -9,6 +9,7 @@ MotionQuery GraphManager::withHeldMargin(MotionQuery q) const {
   const bool in_hand = !q.held.object_id.empty() && q.held.link != abstraction_.robot().options().base_link;
   q.held_padding_m = in_hand ? held_padding_m_ : 0.0;
   q.world_version = world_version_;
+  q.added = unseenObjects();
   return q;
 }
 
@@ -52,6 +53,7 @@ std::vector<MotionAnswer> GraphManager::askMotions(const std::vector<MotionQuery
 
 Result<std::vector<GraspOption>> GraphManager::askGrasps(GraspQuery q) {
   q.world_version = world_version_;
+  q.added = unseenObjects();
   if (const std::vector<GraspOption>* kept = params_.memoise_answers ? memo_.grasps(q) : nullptr) {
     ++counters_.memo_hits;
     return *kept;
@@ -64,6 +66,7 @@ Result<std::vector<GraspOption>> GraphManager::askGrasps(GraspQuery q) {
 
 Result<std::vector<PlacementOption>> GraphManager::askPlacements(PlacementQuery q) {
   q.world_version = world_version_;
+  q.added = unseenObjects();
   ++counters_.placement_calls;
   return services_.placements(q);
 }

@@ -52,18 +52,35 @@ double faultRetryPenalty(const std::vector<OracleFault>& faults, int action_coun
   return given_up ? penalty + kGivenUpPenaltyS : penalty;
 }
 
-world::World withHidden(const world::World& live, const std::vector<world::Object>& hidden) {
+namespace {
+
+/// Whether perception has `hidden` under an id of its own: a live object's centre lies within its
+/// bounding box, or a live movable's footprint box overlaps its own (a thin box's estimate may be
+/// centred a little off it).
+bool perceivedAs(const world::World& live, const world::Object& hidden) {
+  const Aabb box = hidden.shape.aabb(hidden.pose);
+  return std::any_of(live.objects().begin(), live.objects().end(), [&](const world::Object& x) {
+    const Eigen::Vector3d c = x.pose.translation();
+    if (c.x() >= box.min.x() && c.x() <= box.max.x() && c.y() >= box.min.y() && c.y() <= box.max.y())
+      return true;
+    if (x.kind != world::ObjectKind::kMovable) return false;
+    const Aabb b = x.shape.aabb(x.pose);
+    return std::min(b.max.x(), box.max.x()) > std::max(b.min.x(), box.min.x()) &&
+           std::min(b.max.y(), box.max.y()) > std::max(b.min.y(), box.min.y());
+  });
+}
+
+}  // namespace
+
+world::World withHidden(const world::World& live, const std::vector<world::Object>& hidden,
+                        std::set<std::string>* found) {
   world::World out = live;
   for (world::Object o : hidden) {
-    if (out.findObject(o.id) != nullptr) continue;
-    const Aabb box = o.shape.aabb(o.pose);
-    const bool seen =
-        std::any_of(live.objects().begin(), live.objects().end(), [&](const world::Object& x) {
-          const Eigen::Vector3d c = x.pose.translation();
-          return c.x() >= box.min.x() && c.x() <= box.max.x() && c.y() >= box.min.y() &&
-                 c.y() <= box.max.y();
-        });
-    if (seen) continue;
+    if (found && found->count(o.id)) continue;
+    if (out.findObject(o.id) != nullptr || perceivedAs(live, o)) {
+      if (found) found->insert(o.id);
+      continue;
+    }
     o.hidden = false;
     if (Status s = out.addObject(o); !s)
       log::get("graph_manager")
@@ -94,6 +111,17 @@ void GraphManager::refreshOracle() {
 double GraphManager::oraclePenalty(const std::vector<BranchStep>& steps) const {
   if (params_.policy != Policy::kOracle || !oracle_) return 0.0;
   return faultRetryPenalty(oracle_->faults, oracle_->action_count, steps, params_.max_action_failures);
+}
+
+std::vector<world::Object> GraphManager::unseenObjects() const {
+  std::vector<world::Object> out;
+  if (params_.policy != Policy::kOracle || !oracle_) return out;
+  for (const world::Object& h : oracle_->hidden) {
+    // In the graph's world as told (`withHidden`), not a perceived object under the same id.
+    const world::Object* o = abstraction_.world().findObject(h.id);
+    if (o && (o->pose.translation() - h.pose.translation()).norm() < 1e-6) out.push_back(*o);
+  }
+  return out;
 }
 
 void GraphManager::spawnSubsetSubtasks(

@@ -34,6 +34,14 @@ void put(std::string& k, const std::vector<ObjectOverride>& overrides) {
   }
 }
 
+/// Added objects by id and pose (their shapes are the oracle's, fixed for a mission).
+void put(std::string& k, const std::vector<world::Object>& added) {
+  for (const auto& o : added) {
+    k += "|add " + o.id + "@";
+    put(k, o.pose);
+  }
+}
+
 }  // namespace
 
 std::string QueryMemo::key(const MotionQuery& q) {
@@ -54,6 +62,7 @@ std::string QueryMemo::key(const MotionQuery& q) {
   for (const auto& id : q.ignored) k += "|ignore " + id;
   for (const auto& id : q.fixed) k += "|fixed " + id;
   put(k, q.overrides);
+  put(k, q.added);
   k += "|w";
   put(k, q.movable_cost_weight);
   put(k, q.budget_s);
@@ -67,6 +76,7 @@ std::string QueryMemo::key(const GraspQuery& q) {
   k += "|n" + std::to_string(q.max_grasps) + "|";
   put(k, q.budget_s);
   put(k, q.overrides);
+  put(k, q.added);
   return k;
 }
 

@@ -117,6 +117,24 @@ TEST(OracleTest, HiddenObjectsJoinTheWorldUntilPerceptionHasThem) {
   EXPECT_NEAR(w.findObject("box_1")->pose.translation().x(), 5.02, 1e-12);
 }
 
+TEST(OracleTest, AHiddenObjectFoundOffCentreOrMovedAwayIsNotAddedAgain) {
+  world::Object slab = boxAt("slab", 6.1, 1.2);  // a thin box: 5 cm along x
+  slab.shape = world::Shape::box(0.05, 0.3, 0.3);
+  slab.hidden = true;
+  std::set<std::string> found;
+  world::World live;
+  EXPECT_NE(withHidden(live, {slab}, &found).findObject("slab"), nullptr);
+  EXPECT_TRUE(found.empty());
+  // Perception's estimate is centred 4 cm beyond it (outside its box) but overlaps it.
+  ASSERT_TRUE(live.addObject(boxAt("light_box_1", 6.14, 1.2)).ok());
+  EXPECT_EQ(withHidden(live, {slab}, &found).findObject("slab"), nullptr);
+  EXPECT_EQ(found, std::set<std::string>{"slab"});
+  // The robot moved it away: no ghost where it was hidden.
+  ASSERT_TRUE(live.setObjectPose("light_box_1", boxAt("x", 1.0, 3.0).pose).ok());
+  EXPECT_EQ(withHidden(live, {slab}, &found).findObject("slab"), nullptr);
+  EXPECT_NE(withHidden(live, {slab}).findObject("slab"), nullptr);  // without memory it would be
+}
+
 TEST(OracleTest, ThePolicyAndItsBoundAreValidatedParameters) {
   EXPECT_EQ(policyFromString("oracle"), Policy::kOracle);
   EXPECT_EQ(toString(Policy::kOracle), "oracle");

@@ -27,6 +27,13 @@ class ScriptedServices : public ServiceClients {
   std::vector<std::string> blocking{"box"};
   std::optional<OracleKnowledge> knowledge;
   std::vector<std::vector<std::string>> removal_goals;  // the "(on o s)" goals asked for
+  std::vector<std::string> added;  // per question asked: the ids of its added objects, joined
+
+  static std::string ids(const std::vector<world::Object>& v) {
+    std::string s;
+    for (const auto& o : v) s += (s.empty() ? "" : " ") + o.id;
+    return s;
+  }
 
   TaskPlan plan(const TaskQuery& q) override {
     TaskPlan p;
@@ -58,6 +65,7 @@ class ScriptedServices : public ServiceClients {
   }
 
   MotionAnswer motion(const MotionQuery& q) override {
+    added.push_back(ids(q.added));
     MotionAnswer a;
     a.status = MotionOutcome::kSolved;
     const Pose2D s = q.start.base, g = q.goal_base;
@@ -92,6 +100,7 @@ class ScriptedServices : public ServiceClients {
   }
 
   Result<std::vector<PlacementOption>> placements(const PlacementQuery& q) override {
+    added.push_back(ids(q.added));
     PlacementOption p;
     p.object_pose = Eigen::Isometry3d::Identity();
     p.object_pose.translation() = Eigen::Vector3d(4.2, q.object_id == "box" ? 1.85 : 2.0, 0.15);
@@ -100,6 +109,7 @@ class ScriptedServices : public ServiceClients {
   }
 
   Result<std::vector<GraspOption>> grasps(const GraspQuery& q) override {
+    added.push_back(ids(q.added));
     GraspOption g;
     g.base_pose = q.base.value_or(Pose2D{3.85, 1.2, 0.0});
     return std::vector<GraspOption>{g};
@@ -150,13 +160,18 @@ struct Outcome {
   double around_effort{kInfinity};
 };
 
-Outcome traverseWith(Policy policy, ScriptedServices& services, bool with_crate = false) {
+/// `extra`: objects in the graph's world beside the scenario's (e.g. the oracle's hidden ones, as
+/// the node's OracleWorldSource adds them).
+Outcome traverseWith(Policy policy, ScriptedServices& services, bool with_crate = false,
+                     const std::vector<world::Object>& extra = {}) {
   const Corridor c = corridor(with_crate);
   GraphManagerParams p;
   p.policy = policy;
   p.max_contingencies = 0;
   p.placements_per_object = 1;
-  const world::World told = c.sc.plannerWorld();
+  world::World told = c.sc.plannerWorld();
+  for (const auto& o : extra)
+    if (Status s = told.addObject(o); !s) throw std::runtime_error(s.error().toString());
   GraphManager gm(Abstraction(told, c.robot), "(define (domain scripted))",
                   MissionGoal{{"(robot-at goal)"}}, services, p);
   Observation obs;
@@ -240,6 +255,41 @@ TEST(OracleTraverseTest, TwoBlockingObjectsAreAlsoRemovedTogether) {
   EXPECT_EQ(e.removal_goals.size(), 2u) << "one sub-task per object";
   for (const auto& g : e.removal_goals)
     EXPECT_EQ(g.size(), 1u) << "policy effort removes one object per sub-task";
+}
+
+world::Object chairAt(double x, double y) {
+  world::Object o;
+  o.id = "chair";
+  o.kind = world::ObjectKind::kMovable;
+  o.shape = world::Shape::box(0.4, 0.4, 0.8);
+  o.pose = Eigen::Isometry3d::Identity();
+  o.pose.translation() = Eigen::Vector3d(x, y, 0.4);
+  o.mass = 5.0;
+  return o;
+}
+
+TEST(OracleTraverseTest, EveryQuestionCarriesTheHiddenObjectsTheServicesLack) {
+  // The oracle told of a hidden chair; perception has not found it, so the graph's world has it
+  // (withHidden) and the motion planner's does not: every question carries it.
+  const world::Object chair = chairAt(2.5, 3.0);
+  ScriptedServices s;
+  s.knowledge = OracleKnowledge{{chair}, {}, 0, 0.0};
+  ASSERT_TRUE(traverseWith(Policy::kOracle, s, false, {chair}).result.found);
+  ASSERT_GE(s.added.size(), 3u);
+  for (const auto& a : s.added) EXPECT_EQ(a, "chair");
+
+  // Another policy adds nothing, whatever the world holds.
+  ScriptedServices e;
+  e.knowledge = s.knowledge;
+  ASSERT_TRUE(traverseWith(Policy::kEffort, e, false, {chair}).result.found);
+  ASSERT_FALSE(e.added.empty());
+  for (const auto& a : e.added) EXPECT_EQ(a, "");
+
+  // An object of the world under the hidden one's id but elsewhere is perception's: not added.
+  ScriptedServices n;
+  n.knowledge = s.knowledge;
+  ASSERT_TRUE(traverseWith(Policy::kOracle, n, false, {chairAt(7.0, 5.0)}).result.found);
+  for (const auto& a : n.added) EXPECT_EQ(a, "");
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "tamp/dds/convert.h"
+#include "tamp/dds/world_sync.h"
 
 namespace tamp::motion_planner {
 namespace {
@@ -33,6 +34,17 @@ Result<std::vector<ObjectOverride>> overridesFromMsg(const std::vector<msg::Obje
       ov.pose = *p;
     }
     out.push_back(std::move(ov));
+  }
+  return out;
+}
+
+Result<AddedObjects> addedFromMsg(const std::vector<msg::WorldObject>& in) {
+  AddedObjects out;
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    auto o = dds::fromMsg(in[i]);
+    if (!o) return bad("added_objects[" + std::to_string(i) + "]", o.error().message);
+    o->hidden = false;  // in this request's world, the caller knows it
+    out.push_back(std::move(*o));
   }
   return out;
 }
@@ -114,6 +126,9 @@ Result<MotionRequest> fromMsg(const msg::MotionRequest& m, const MotionPlanner& 
   auto overrides = overridesFromMsg(m.object_overrides());
   if (!overrides) return overrides.error();
   r.object_overrides = std::move(*overrides);
+  auto added = addedFromMsg(m.added_objects());
+  if (!added) return added.error();
+  r.added_objects = std::move(*added);
   const double w = m.movable_cost_weight();
   if (!std::isfinite(w) || w < 0) return bad("movable_cost_weight", "must be finite and >= 0");
   r.object_cost_scale = w;
@@ -196,6 +211,9 @@ Result<PlacementRequest> fromMsg(const msg::PlacementRequest& m) {
   auto overrides = overridesFromMsg(m.object_overrides());
   if (!overrides) return overrides.error();
   r.object_overrides = std::move(*overrides);
+  auto added = addedFromMsg(m.added_objects());
+  if (!added) return added.error();
+  r.added_objects = std::move(*added);
   return r;
 }
 
@@ -226,6 +244,9 @@ Result<GraspRequest> fromMsg(const msg::GraspRequest& m) {
   auto overrides = overridesFromMsg(m.object_overrides());
   if (!overrides) return overrides.error();
   r.object_overrides = std::move(*overrides);
+  auto added = addedFromMsg(m.added_objects());
+  if (!added) return added.error();
+  r.added_objects = std::move(*added);
   return r;
 }
 

@@ -73,7 +73,11 @@ Result<std::vector<Grasp>> MotionPlanner::generateGrasps(const GraspRequest& req
   const auto& P = impl.params.grasp;
   const robot::RobotModel* m = impl.robot.model();
   if (!m) return Error(ErrorCode::kUnsupported, "grasps need a robot with an arm (this robot is planar)");
-  const world::Object* obj = impl.world.findObject(req.object_id);
+  // The request's world: the planner's with the added objects and the overrides; the scene goes
+  // back after.
+  auto hypothetical = overriddenWorld(impl.world, req.added_objects, req.object_overrides, req.object_id);
+  if (!hypothetical) return hypothetical.error();
+  const world::Object* obj = hypothetical->findObject(req.object_id);
   if (!obj) return Error(ErrorCode::kNotFound, "object_id: no object '" + req.object_id + "' in the world");
   if (obj->kind != world::ObjectKind::kMovable || !obj->graspable) {
     return Error(ErrorCode::kInvalidArgument, "object_id: object '" + req.object_id + "' is not graspable");
@@ -96,17 +100,11 @@ Result<std::vector<Grasp>> MotionPlanner::generateGrasps(const GraspRequest& req
     }
   }
   if (req.max_grasps == 0) return Error(ErrorCode::kInvalidArgument, "max_grasps: must be >= 1");
-  // The request's world: the planner's with the overrides applied; the scene goes back after.
-  auto hypothetical = overriddenWorld(impl.world, req.object_overrides, req.object_id);
-  if (!hypothetical) return hypothetical.error();
   struct Restore {
     MotionPlanner::Impl& impl;
     ~Restore() { impl.scene.syncWorld(impl.world); }
   } restore{impl};
-  if (!req.object_overrides.empty()) {
-    impl.scene.syncWorld(*hypothetical);
-    obj = hypothetical->findObject(req.object_id);
-  }
+  if (!req.object_overrides.empty() || !req.added_objects.empty()) impl.scene.syncWorld(*hypothetical);
 
   const double max_open = m->gripperLimits().upper;
   const robot::RobotModel::ReachSphere reach = m->armReach();

@@ -525,13 +525,21 @@ std::optional<std::string> validateRequest(const MotionRequest& r, const MotionP
 }  // namespace
 
 /// The planner's world with the request's object overrides applied; errors name the override.
-Result<world::World> overriddenWorld(const world::World& base, const std::vector<ObjectOverride>& overrides,
-                                     const std::string& held_object) {
+Result<world::World> overriddenWorld(const world::World& base, const AddedObjects& added,
+                                     const std::vector<ObjectOverride>& overrides, const std::string& held_object) {
   world::World w = base;
+  for (std::size_t i = 0; i < added.size(); ++i) {
+    const std::string field = "added_objects[" + std::to_string(i) + "]";
+    if (base.findObject(added[i].id)) {
+      return Error(ErrorCode::kInvalidArgument, field + ".id: '" + added[i].id + "' is already in the world");
+    }
+    if (auto why = invalidPose(added[i].pose)) return Error(ErrorCode::kInvalidArgument, field + ".pose: " + *why);
+    if (Status s = w.addObject(added[i]); !s) return Error(ErrorCode::kInvalidArgument, field + ": " + s.error().message);
+  }
   for (std::size_t i = 0; i < overrides.size(); ++i) {
     const ObjectOverride& o = overrides[i];
     const std::string field = "object_overrides[" + std::to_string(i) + "]";
-    if (!base.findObject(o.object_id)) {
+    if (!w.findObject(o.object_id)) {
       return Error(ErrorCode::kInvalidArgument, field + ".object_id: no object '" + o.object_id + "' in the world");
     }
     for (std::size_t j = 0; j < i; ++j) {
@@ -834,8 +842,8 @@ Aabb requestBounds(const MotionPlanner::Impl& impl, const MotionRequest& req) {
 /// the held object attached to the robot into `rw`; the first problem (an invalid request).
 std::optional<std::string> enterRequestWorld(MotionPlanner::Impl& impl, const MotionRequest& req,
                                              RequestWorld& rw) {
-  if (!req.object_overrides.empty()) {
-    auto hypothetical = overriddenWorld(impl.world, req.object_overrides, req.held_object);
+  if (!req.object_overrides.empty() || !req.added_objects.empty()) {
+    auto hypothetical = overriddenWorld(impl.world, req.added_objects, req.object_overrides, req.held_object);
     if (!hypothetical) return hypothetical.error().message;
     rw.restore = WorldRestore(impl, std::move(*hypothetical));
   }

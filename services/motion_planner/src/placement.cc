@@ -94,7 +94,10 @@ Result<std::vector<Placement>> MotionPlanner::samplePlacements(const PlacementRe
                                                                const Termination& termination) {
   Impl& impl = *impl_;
   const auto& P = impl.params.placement;
-  const world::Object* obj = impl.world.findObject(req.object_id);
+  auto hypothetical = overriddenWorld(impl.world, req.added_objects, req.object_overrides, req.object_id);
+  if (!hypothetical) return hypothetical.error();
+  const world::World original = std::move(*hypothetical);  // the request's world
+  const world::Object* obj = original.findObject(req.object_id);
   if (!obj) return Error(ErrorCode::kNotFound, "object_id: no object '" + req.object_id + "' in the world");
   if (obj->kind != world::ObjectKind::kMovable) {
     return Error(ErrorCode::kInvalidArgument, "object_id: object '" + req.object_id + "' is static");
@@ -158,9 +161,6 @@ Result<std::vector<Placement>> MotionPlanner::samplePlacements(const PlacementRe
   const robot::RobotModel* m = impl.robot.model();
   const auto tops = m ? graspCandidates(obj->shape, impl.params.grasp, m->gripperLimits().upper)
                       : std::vector<GraspCandidate>{};
-  auto hypothetical = overriddenWorld(impl.world, req.object_overrides, req.object_id);
-  if (!hypothetical) return hypothetical.error();
-  const world::World original = std::move(*hypothetical);
   struct Restore {  // the scene goes back to the planner's world
     Impl& impl;
     ~Restore() { impl.scene.syncWorld(impl.world); }

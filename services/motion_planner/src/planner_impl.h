@@ -97,10 +97,10 @@ std::optional<std::vector<double>> solveIk(MotionPlanner::Impl& impl, const Pose
                                            double gripper, std::uint32_t seed_rng, int attempts,
                                            const Termination& termination);
 
-/// `base` with the overrides applied; errors name the override (`object_overrides[i]...`).
-/// `held_object` may be moved but not removed.
-Result<world::World> overriddenWorld(const world::World& base, const std::vector<ObjectOverride>& overrides,
-                                     const std::string& held_object);
+/// `base` with the added objects, then the overrides applied; errors name the field
+/// (`added_objects[i]...`, `object_overrides[i]...`). `held_object` may be moved but not removed.
+Result<world::World> overriddenWorld(const world::World& base, const AddedObjects& added,
+                                     const std::vector<ObjectOverride>& overrides, const std::string& held_object);
 
 /// A grasp candidate in the object's frame (see grasps.h).
 struct GraspCandidate {

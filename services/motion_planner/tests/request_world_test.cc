@@ -110,6 +110,48 @@ TEST_F(RequestWorldTest, BadOverridesNameTheField) {
   EXPECT_TRUE(mp.world().findObject("crate"));  // nothing applied
 }
 
+TEST_F(RequestWorldTest, AddedObjectsAreInThatRequestsWorldOnly) {
+  const world::World w = testing::corridorWorld(false);  // the door is free
+  MotionPlanner mp = testing::discPlanner(w, testing::untimedParams());
+  MotionRequest req = baseRequest({2, 2, 0}, {8, 2, 0});
+  const MotionResult free = mp.plan(req, Termination::after(5.0));
+  ASSERT_EQ(free.status, MotionStatus::kSolved) << free.reason;
+  ASSERT_TRUE(free.blocking.empty());
+
+  // What the caller knows and the planner's world lacks: a crate in the door. A lazy path
+  // reports it as it reports the planner's own movables; an independent check agrees.
+  const world::World with_crate = testing::corridorWorld(true);
+  world::Object crate = with_crate.object("crate");
+  crate.id = "told_crate";
+  req.added_objects = {crate};
+  const MotionResult r = mp.plan(req, Termination::after(5.0));
+  ASSERT_EQ(r.status, MotionStatus::kSolved) << r.reason;
+  EXPECT_EQ(blockingIds(r.blocking), std::vector<std::string>{"told_crate"});
+  world::World hypothetical = w;
+  ASSERT_TRUE(hypothetical.addObject(crate).ok());
+  EXPECT_EQ(discTouches(hypothetical, r.path, kRadius, 0.005), blockingIds(r.blocking));
+
+  // An override applies after the addition: the added crate moved out of the way.
+  req.object_overrides = {{"told_crate", false, at(1.0, 3.3, 0.4)}};
+  const MotionResult moved = mp.plan(req, Termination::after(5.0));
+  ASSERT_EQ(moved.status, MotionStatus::kSolved) << moved.reason;
+  EXPECT_TRUE(moved.blocking.empty()) << moved.blocking.front().object_id;
+
+  // An id the planner's world has is refused, naming the field; nothing stays behind.
+  req.object_overrides.clear();
+  req.added_objects = {with_crate.object("crate"), w.object("far_box")};
+  req.added_objects[0].id = "another";
+  const MotionResult dup = mp.plan(req, Termination::after(5.0));
+  EXPECT_EQ(dup.status, MotionStatus::kInvalidRequest);
+  EXPECT_NE(dup.reason.find("added_objects[1].id"), std::string::npos) << dup.reason;
+  EXPECT_EQ(mp.world().findObject("told_crate"), nullptr);
+  EXPECT_EQ(mp.world().findObject("another"), nullptr);
+  req.added_objects.clear();
+  const MotionResult after = mp.plan(req, Termination::after(5.0));
+  ASSERT_EQ(after.status, MotionStatus::kSolved) << after.reason;
+  EXPECT_TRUE(after.blocking.empty());
+}
+
 /// The held box's centre along a base path, for a box held at `offset` (base frame), densified
 /// every 1 cm in (x, y, yaw).
 JointPath heldCentres(const JointPath& path, const Eigen::Vector2d& offset) {

@@ -440,6 +440,16 @@ msg::OracleReply SimNode::onOracle(const msg::OracleRequest& req) {
         told.hidden = false;
         rep.hidden_objects().push_back(dds::toMsg(told, 0));
       }
+      // An object a scripted fault puts down is known where it will appear (or, once it has,
+      // where it is): the planner's view learns of it only when perception sees it.
+      for (const Fault& f : scripted_) {
+        if (f.type != FaultType::kSpawnObject) continue;
+        const world::Object* now = sim.world().findObject(f.object.id);
+        if (now && now->hidden) continue;  // listed above
+        world::Object told = now ? *now : f.object;
+        told.hidden = false;
+        rep.hidden_objects().push_back(dds::toMsg(told, 0));
+      }
     });
     if (req.want_truth()) {
       for (const Fault& f : scripted_) {

@@ -287,6 +287,40 @@ TEST(SimNodeOracleTest, DurationsAreTheSimulatorsNominalOnesAndTheTruthIsReveale
   EXPECT_NEAR(measured, rep->durations()[0].mean_s(), 1e-6);
 }
 
+// An object a scripted fault will put down is part of the truth before it appears: where it will.
+TEST(SimNodeOracleTest, AnObjectAScriptedFaultWillPutDownIsToldWhereItWillAppear) {
+  const OracleEnv env(true);
+  const int domain = dds::testing::isolatedDomain();
+  dds::ServiceArgs args;
+  args.name = "sim_oracle_spawn_test";
+  args.domain_id = domain;
+  Fault spawn;
+  spawn.id = "someone_leaves_a_box";
+  spawn.type = FaultType::kSpawnObject;
+  spawn.trigger.time_s = 1e6;  // not during this test
+  spawn.object = box("parcel", 0.3, 0.3, 0.3, at(2.5, 1.0, 0.15), true, false);
+  SimNode node(args, SimSetup(emptyRoom(), robotModel(), upright(), {spawn}), exactParams());
+  auto p = dds::testing::makeParticipant(domain);
+  ASSERT_TRUE(p);
+  dds::RpcClient<msg::OracleRequest, msg::OracleReply> oracle(p, dds::services::kOracle);
+  ASSERT_TRUE(oracle.waitForServer(Termination::after(20)));
+  msg::OracleRequest req;
+  req.want_truth(true);
+  auto rep = oracle.call(req, dds::CallOptions{10.0, {}});
+  ASSERT_TRUE(rep) << rep.error().toString();
+  ASSERT_EQ(rep->header().code(), msg::STATUS_OK) << rep->header().message();
+  bool in_world = true;
+  node.loop().withSimulator([&](Simulator& s) { in_world = s.world().findObject("parcel") != nullptr; });
+  EXPECT_FALSE(in_world);  // not there yet
+  ASSERT_EQ(rep->hidden_objects().size(), 1u);
+  EXPECT_EQ(rep->hidden_objects()[0].id(), "parcel");
+  EXPECT_EQ(rep->hidden_objects()[0].kind(), msg::OBJECT_MOVABLE);
+  EXPECT_NEAR(rep->hidden_objects()[0].pose().position().x(), 2.5, 1e-9);
+  ASSERT_EQ(rep->faults().size(), 1u);
+  EXPECT_EQ(rep->faults()[0].type(), msg::FaultType::FAULT_SPAWN_OBJECT);
+  EXPECT_EQ(rep->faults()[0].object_id(), "parcel");
+}
+
 // A normal deployment does not expose the truth: without $TAMP_ORACLE no oracle is served
 // (judged after the node's other request/reply service, echo, is matched).
 TEST(SimNodeOracleTest, NoOracleIsServedUnlessEnabled) {

@@ -71,6 +71,9 @@ struct MotionQuery {
   HeldGrasp held;
   std::vector<std::string> ignored;   ///< treated as absent
   std::vector<ObjectOverride> overrides;
+  /// Objects the services' world model lacks, in the world of this question (applied before the
+  /// overrides): the oracle's hidden objects perception has not found; set by the graph manager.
+  std::vector<world::Object> added;
   double movable_cost_weight{0.0};    ///< lazy: 0 = the pure static-only lazy path
   /// Lazy: movables the robot cannot move (over the payload, no push): obstacles for this path.
   std::vector<std::string> fixed;
@@ -118,6 +121,7 @@ struct PlacementQuery {
   std::optional<Eigen::Isometry3d> object_T_tool;  ///< with base: the grasp the object is held with
   double approach_m{0.0};                          ///< pre-place height above the place pose
   std::vector<ObjectOverride> overrides;           ///< the branch's hypothetical world
+  std::vector<world::Object> added;                ///< as MotionQuery::added
   std::uint64_t world_version{0};                  ///< answered in this world model version or later (0: any)
 };
 
@@ -135,6 +139,7 @@ struct GraspQuery {
   unsigned max_grasps{4};
   double budget_s{3.0};
   std::vector<ObjectOverride> overrides;  ///< the branch's hypothetical world
+  std::vector<world::Object> added;       ///< as MotionQuery::added
   std::uint64_t world_version{0};         ///< answered in this world model version or later (0: any)
 };
 

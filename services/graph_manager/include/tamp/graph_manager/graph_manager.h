@@ -454,6 +454,10 @@ class GraphManager {
   void refreshOracle();
   /// Policy oracle: what the scripted failures cost `steps` (0 for the other policies).
   double oraclePenalty(const std::vector<BranchStep>& steps) const;
+  /// Policy oracle: the hidden objects in the graph's world as the oracle told them (perception
+  /// has not found them, so the services' world model lacks them): every motion, grasp and
+  /// placement question carries them (`MotionQuery::added`). Empty for the other policies.
+  std::vector<world::Object> unseenObjects() const;
   std::optional<OracleKnowledge> oracle_;
   double evaluateBase(Edge& e, const BranchContext& ctx, int depth);
   // ---- pushes (push.cc) ----

@@ -18,6 +18,7 @@
 
 #include <cstddef>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -51,9 +52,12 @@ struct OracleKnowledge {
 std::vector<std::vector<std::size_t>> removalSubsets(std::size_t n, int max_size);
 
 /// `live` with the oracle's hidden objects added, except those the live world already has: under
-/// the same id, or a movable or static object whose centre lies within the hidden one's
-/// bounding box (perception found it and gave it an id of its own). Their `hidden` flag is off.
-world::World withHidden(const world::World& live, const std::vector<world::Object>& hidden);
+/// the same id, or as an object of perception's own (an object's centre lies within the hidden
+/// one's bounding box, or a movable's footprint box overlaps it). Their `hidden` flag is off.
+/// With `found`: the ids of hidden objects found so far, never added again (an object the robot
+/// has moved away from where it was hidden is not there twice); those found now are inserted.
+world::World withHidden(const world::World& live, const std::vector<world::Object>& hidden,
+                        std::set<std::string>* found = nullptr);
 
 /// One action of a branch as the robot will execute it.
 struct BranchStep {

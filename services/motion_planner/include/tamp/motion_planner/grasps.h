@@ -42,6 +42,7 @@ struct GraspRequest {
   std::vector<double> start_arm;    ///< IK seed (arm joints); empty: the arm's zero configuration
   std::uint32_t max_grasps{8};      ///< >= 1
   std::vector<ObjectOverride> object_overrides;  ///< plan in this hypothetical world; each id at most once
+  AddedObjects added_objects;                    ///< applied before the overrides; may name `object_id`
 };
 
 struct Grasp {

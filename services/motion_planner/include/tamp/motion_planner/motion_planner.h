@@ -161,6 +161,9 @@ struct MotionRequest {
   /// roadmap of the static world (movables are costs, see "Roadmap cache"); overriding a static
   /// object selects (and may build) the roadmap of another static world.
   std::vector<ObjectOverride> object_overrides;
+  /// Objects added to the planner's world for this request, before the overrides (a lazy path
+  /// reports an added movable it crosses; a full path goes round it).
+  AddedObjects added_objects;
   /// Lazy mode: multiplier on every object's effort in the path cost. 1 (default): the effort
   /// model as it is; 0: ignore objects (the shortest static-free path); larger values avoid
   /// objects at the price of longer detours. Must be finite and >= 0.

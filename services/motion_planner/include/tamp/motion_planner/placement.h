@@ -48,6 +48,7 @@ struct PlacementRequest {
   std::optional<Eigen::Isometry3d> held_object_T_tool;
   double approach{0.0};                     ///< m >= 0, height of the pre-place pose above the place pose
   std::vector<ObjectOverride> object_overrides;  ///< each id at most once
+  AddedObjects added_objects;                    ///< applied before the overrides
 };
 
 struct Placement {

@@ -6,6 +6,7 @@
 #include <unordered_map>
 
 #include "tamp/core/termination.h"
+#include "tamp/symbolic_planner/flat_index.h"
 
 namespace tamp::symbolic_planner {
 namespace {
@@ -194,10 +195,12 @@ uint64_t mixIn(uint64_t h, uint64_t x) {
   return h;
 }
 
-uint64_t hashFacts(uint64_t h, const std::vector<FactId>& v) {
-  h = mixIn(h, v.size());
-  for (FactId f : v) h = mixIn(h, f);
-  return h;
+/// Mixes the kept facts of `v` (by their new ids) into `h`, then a separator.
+uint64_t hashKept(uint64_t h, const std::vector<FactId>& v, const std::vector<int32_t>& fact_map) {
+  for (FactId f : v) {
+    if (fact_map[f] >= 0) h = mixIn(h, static_cast<uint64_t>(fact_map[f]));
+  }
+  return mixIn(h, 0xFFFFFFFFFFULL);
 }
 
 /// The same precondition and effects (costs aside).
@@ -256,6 +259,37 @@ PrunedTask pruneIrrelevant(const Task& task, const Goal& goal) {
       if (out.fact_map[f] >= 0) res.push_back(static_cast<FactId>(out.fact_map[f]));
     }
   };
+  // Each relevant operator's hash on the kept facts; when no fact, operator or conditional effect
+  // is dropped and no two hashes meet (no operators the same on the kept facts), the task stays
+  // as it is, without building anything.
+  std::vector<uint64_t> op_hash(task.ops.size(), 0);
+  size_t relevant = 0;
+  bool hashes_meet = false;
+  {
+    U64IdMap seen(task.ops.size());
+    for (OpId o = 0; o < task.ops.size(); ++o) {
+      if (!a.opRelevant(o)) continue;
+      ++relevant;
+      const Operator& src = task.ops[o];
+      uint64_t h = hashKept(hashKept(hashKept(0, src.pre, out.fact_map), src.add, out.fact_map), src.del, out.fact_map);
+      for (size_t c = 0; c < src.cond_effects.size(); ++c) {
+        if (!a.ceKept(o, c)) {
+          ++st.cond_effects_dropped;
+          continue;
+        }
+        const ConditionalEffect& ce = src.cond_effects[c];
+        h = hashKept(hashKept(hashKept(mixIn(h, 0xCE), ce.cond, out.fact_map), ce.add, out.fact_map), ce.del, out.fact_map);
+      }
+      op_hash[o] = h;
+      hashes_meet = !seen.tryEmplace(h, o).second || hashes_meet;
+    }
+  }
+  st.ops_relevant = relevant;
+  if (kept_facts == nf && relevant == task.ops.size() && st.cond_effects_dropped == 0 && !hashes_meet) {
+    out.fact_map.clear();
+    st.seconds = sw.seconds();
+    return out;  // nothing to drop: the original task
+  }
   auto pruned = std::make_shared<Task>();
   pruned->unit_cost = task.unit_cost;
   pruned->fact_names.reserve(kept_facts);
@@ -269,10 +303,9 @@ PrunedTask pruneIrrelevant(const Task& task, const Goal& goal) {
   // Relevant operators on the kept facts; of those the same on them, the cheapest at the first
   // one's place.
   std::unordered_map<uint64_t, std::vector<uint32_t>> by_hash;
-  size_t relevant = 0;
+  by_hash.reserve(relevant);
   for (OpId o = 0; o < task.ops.size(); ++o) {
     if (!a.opRelevant(o)) continue;
-    ++relevant;
     const Operator& src = task.ops[o];
     Operator op;
     op.cost = src.cost;
@@ -281,19 +314,14 @@ PrunedTask pruneIrrelevant(const Task& task, const Goal& goal) {
     mapAll(src.add, op.add);
     mapAll(src.del, op.del);
     for (size_t c = 0; c < src.cond_effects.size(); ++c) {
-      if (!a.ceKept(o, c)) {
-        ++st.cond_effects_dropped;
-        continue;
-      }
+      if (!a.ceKept(o, c)) continue;
       ConditionalEffect ce;
       mapAll(src.cond_effects[c].cond, ce.cond);
       mapAll(src.cond_effects[c].add, ce.add);
       mapAll(src.cond_effects[c].del, ce.del);
       op.cond_effects.push_back(std::move(ce));
     }
-    uint64_t h = hashFacts(hashFacts(hashFacts(0, op.pre), op.add), op.del);
-    for (const auto& ce : op.cond_effects) h = hashFacts(hashFacts(hashFacts(h, ce.cond), ce.add), ce.del);
-    std::vector<uint32_t>& same = by_hash[h];
+    std::vector<uint32_t>& same = by_hash[op_hash[o]];
     bool merged = false;
     for (uint32_t j : same) {
       if (!sameOnFacts(pruned->ops[j], op)) continue;
@@ -312,13 +340,12 @@ PrunedTask pruneIrrelevant(const Task& task, const Goal& goal) {
     out.op_origin.push_back(o);
   }
   st.facts_after = kept_facts;
-  st.ops_relevant = relevant;
   st.ops_after = pruned->ops.size();
-  if (st.facts_after == nf && st.ops_after == task.ops.size() && st.cond_effects_dropped == 0) {
-    out.fact_map.clear();
+  if (st.ops_after == task.ops.size() && kept_facts == nf && st.cond_effects_dropped == 0) {
+    out.fact_map.clear();  // hashes met by chance only: the original task
     out.op_origin.clear();
     st.seconds = sw.seconds();
-    return out;  // nothing to drop: the original task
+    return out;
   }
   for (const auto& c : goal.conjuncts) {
     GoalConjunct gc;

@@ -11,6 +11,9 @@
 ///    preconditions (static atoms and equality evaluated exactly), then ground operators with
 ///    quantifiers expanded, disjunctions split (DNF) and negation compiled into complement facts
 ///    (as FF does). The result is a compact integer `Task` (`task.h`) with bitset states.
+///    Before the heuristic tables are built, a backward relevance analysis for the goal
+///    (`relevance.h`) drops the facts and operators no goal needs and merges operators that are
+///    the same on the rest (`Query::prune_irrelevant`).
 /// 3. **Heuristics** (`heuristic.h`): counter-based relaxed exploration; h_FF with FF's helpful
 ///    actions, h_add, h_max (admissible).
 /// 4. **Search** (`search.h`): FF's enforced hill-climbing on helpful actions, falling back to

@@ -192,6 +192,7 @@ int main(int argc, char** argv) {
   bool rhw_no_zg = !defaults.rhw.add_zhu_givan, rhw_keep_one_action = !defaults.rhw.skip_one_action_disjunctions;
   bool rhw_reasonable = defaults.rhw.reasonable_orders;
   bool h2_restart = defaults.ehc_h2_restart;
+  bool prune_irrelevant = sp::PlanRequest{}.prune_irrelevant;
   app.add_option("--landmarks", landmark_generator,
                  "lazy: the landmarks counted: rhw (Richter-Helmert-Westphal: disjunctive landmarks, greedy-necessary "
                  "orders, landmarks required again) or zg (Zhu-Givan fact landmarks)")
@@ -208,6 +209,9 @@ int main(int argc, char** argv) {
   app.add_option("--ehc-h2-restart", h2_restart,
                  "ehc: after a hill-climbing run proves a state it committed to a dead end, run it again "
                  "from the start, testing every state it commits to with h^2 from that state: true or false");
+  app.add_option("--prune-irrelevant", prune_irrelevant,
+                 "search a task pruned to the facts and operators relevant to the goal (backward relevance, "
+                 "operators the same on them merged): true or false");
   app.add_flag("--no-ehc-lazy-beside", no_lazy_beside,
                "ehc: the lazy search only after the hill-climbing fails (FF's order), not beside it");
   app.add_option("--ehc-lazy-after", lazy_after,
@@ -270,6 +274,7 @@ int main(int argc, char** argv) {
   if (cost_type == "plusone") req.search.cost_type = sp::CostType::kPlusOne;
   req.timeout_seconds = timeout;
   req.check_plan = !no_check;
+  req.prune_irrelevant = prune_irrelevant;
   // The planner (and the grounding its cache keeps) is deliberately never destroyed: freeing the
   // grounding piece by piece at exit costs 0.2-0.3 ms per run, which is what a process-per-instance
   // benchmark measures; the OS reclaims it. Reachable through this static, so no leak report.
@@ -280,7 +285,7 @@ int main(int argc, char** argv) {
                  "; status %s; parse %.4f s, ground %.4f s, search %.4f s; facts %zu, operators %zu; "
                  "expanded %llu, evaluated %llu, initial h %lld; ehc plateau retries %llu (%llu abandoned); ehc fallbacks "
                  "%llu (%llu in a goal-agenda entry before the last); anytime %llu "
-                 "iterations, %llu improvements; landmarks %llu (%llu disjunctive, %llu greedy-necessary, %llu reasonable orders); ehc h^2 restarts %llu (%llu tests, %llu dead ends)%s%s%s%s%s\n",
+                 "iterations, %llu improvements; landmarks %llu (%llu disjunctive, %llu greedy-necessary, %llu reasonable orders); ehc h^2 restarts %llu (%llu tests, %llu dead ends)%s%s%s%s%s",
                  sp::toString(reply.status).c_str(), reply.stats.parse_seconds, reply.stats.ground_seconds,
                  reply.stats.search_seconds, reply.stats.facts, reply.stats.operators,
                  static_cast<unsigned long long>(reply.stats.expanded),
@@ -307,6 +312,13 @@ int main(int argc, char** argv) {
                  : reply.stats.lazy_beside_started ? "; lazy search beside ehc started"
                                                    : "",
                  reply.stats.unit_first_failed ? "; unit-cost first run failed, first plan with cost + 1" : "");
+    if (reply.stats.relevance_ran) {
+      const sp::RelevanceStats& r = reply.stats.relevance;
+      std::fprintf(stderr, "; relevance %.4f s: facts %zu -> %zu, operators %zu -> %zu relevant -> %zu merged%s",
+                   r.seconds, r.facts_before, r.facts_after, r.ops_before, r.ops_relevant, r.ops_after,
+                   r.unsafe ? " (not complete here: nothing pruned)" : reply.stats.pruned ? "" : " (nothing pruned)");
+    }
+    std::fputc('\n', stderr);
   }
   if (reply.status != sp::PlanStatus::kSolved) {
     std::cerr << (reply.status == sp::PlanStatus::kInputError ? "error: " : "") << reply.message << "\n";

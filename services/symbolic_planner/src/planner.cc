@@ -49,6 +49,14 @@ PlanStep stepOf(const std::string& ipc) {
   return st;
 }
 
+bool sameGoal(const Goal& a, const Goal& b) {
+  if (a.conjuncts.size() != b.conjuncts.size()) return false;
+  for (size_t c = 0; c < a.conjuncts.size(); ++c) {
+    if (a.conjuncts[c].pos != b.conjuncts[c].pos || a.conjuncts[c].neg != b.conjuncts[c].neg) return false;
+  }
+  return true;
+}
+
 bool hasCosts(const pddl::Domain& d) {
   for (const auto& a : d.actions) {
     if (!a.costs.empty()) return true;
@@ -112,6 +120,9 @@ Status PlanningSession::ensureGrounder() {
   grounder_ = std::move(*g);
   task_.reset();
   heuristics_.clear();
+  prune_tried_ = false;
+  pruned_ = PrunedTask{};
+  pruned_heuristics_.clear();
   task_statics_.clear();
   task_negated_.clear();
   return Status::Ok();
@@ -232,6 +243,9 @@ PlanReply PlanningSession::solve(const Query& q, const Termination& term) {
     task_statics_ = statics;
     task_negated_ = negated;
     heuristics_.clear();
+    prune_tried_ = false;
+    pruned_ = PrunedTask{};
+    pruned_heuristics_.clear();
     rebuilt = true;
   }
   reply.stats.grounding_reused = !rebuilt;
@@ -274,26 +288,44 @@ PlanReply PlanningSession::solve(const Query& q, const Termination& term) {
       goal.conjuncts.push_back(std::move(gc));
     }
   }
-  const StateBits init = grounder_->initialState(*task_, q.init);
-  // 4. Search, with a cached heuristic.
+  StateBits init = grounder_->initialState(*task_, q.init);
+  // 4. The task to search: pruned to what is relevant to the goal (see Query::prune_irrelevant).
+  const Task* task = task_.get();
+  std::vector<HeuristicCache>* tables = &heuristics_;
+  if (q.prune_irrelevant && !prune_tried_ && heuristics_.empty()) {
+    prune_tried_ = true;
+    pruned_ = pruneIrrelevant(*task_, goal);
+    pruned_for_ = goal;
+    pruned_heuristics_.clear();
+    reply.stats.relevance_ran = true;
+    reply.stats.relevance = pruned_.stats;
+  }
+  if (q.prune_irrelevant && pruned_.pruned() && sameGoal(goal, pruned_for_)) {
+    init = pruned_.projectState(init.data(), init.size());
+    goal = pruned_.goal;
+    task = pruned_.task.get();
+    tables = &pruned_heuristics_;
+    reply.stats.pruned = true;
+  }
+  // 5. Search, with a cached heuristic.
   SearchOptions opt = q.search;
   const bool optimal = opt.algorithm == SearchAlgorithm::kAstar || opt.algorithm == SearchAlgorithm::kWAstar;
   const HeuristicKind hk = opt.heuristic ? *opt.heuristic : (optimal ? HeuristicKind::kMax : HeuristicKind::kFF);
   const CostType ct = opt.cost_type ? *opt.cost_type
-                                    : (task_->unit_cost ? CostType::kUnit : (optimal ? CostType::kCost : CostType::kPlusOne));
+                                    : (task->unit_cost ? CostType::kUnit : (optimal ? CostType::kCost : CostType::kPlusOne));
   Heuristic* h = nullptr;
-  for (auto& c : heuristics_) {
+  for (auto& c : *tables) {
     if (c.kind == hk && c.cost_type == ct) h = c.h.get();
   }
   if (!h) {
-    heuristics_.push_back({hk, ct, makeHeuristic(hk, *task_, ct)});
-    h = heuristics_.back().h.get();
+    tables->push_back({hk, ct, makeHeuristic(hk, *task, ct)});
+    h = tables->back().h.get();
   }
   Stopwatch ssw;
-  SearchResult sr = search(*task_, init, goal, opt, *h, term);
+  SearchResult sr = search(*task, init, goal, opt, *h, term);
   reply.stats.search_seconds = ssw.seconds();
-  reply.stats.facts = task_->numFacts();
-  reply.stats.operators = task_->ops.size();
+  reply.stats.facts = task->numFacts();
+  reply.stats.operators = task->ops.size();
   reply.stats.expanded = sr.stats.expanded;
   reply.stats.generated = sr.stats.generated;
   reply.stats.evaluated = sr.stats.evaluated;
@@ -322,7 +354,7 @@ PlanReply PlanningSession::solve(const Query& q, const Termination& term) {
   if (sr.status == SearchStatus::kSolved) {
     reply.cost = sr.cost;
     reply.plan.reserve(sr.plan.size());
-    for (OpId o : sr.plan) reply.plan.push_back(stepOf(task_->ops[o].name));
+    for (OpId o : sr.plan) reply.plan.push_back(stepOf(task->ops[o].name));
   } else {
     reply.message = "search " + toString(sr.status);
   }
@@ -437,6 +469,7 @@ PlanReply Planner::solve(const PlanRequest& req, const Termination& caller_term)
     q.init = std::move(*init);
     q.goal_formula = problem.goal;
     q.search = req.search;
+    q.prune_irrelevant = req.prune_irrelevant;
     PlanReply reply = session->solve(q, term);
     reply.stats.parse_seconds = parse_s;
     if (reply.status == PlanStatus::kSolved && req.check_plan) {

@@ -11,6 +11,9 @@
 ///    preconditions (static atoms and equality evaluated exactly), then ground operators with
 ///    quantifiers expanded, disjunctions split (DNF) and negation compiled into complement facts
 ///    (as FF does). The result is a compact integer `Task` (`task.h`) with bitset states.
+///    Before the heuristic tables are built, a backward relevance analysis for the goal
+///    (`relevance.h`) drops the facts and operators no goal needs and merges operators that are
+///    the same on the rest (`Query::prune_irrelevant`).
 /// 3. **Heuristics** (`heuristic.h`): counter-based relaxed exploration; h_FF with FF's helpful
 ///    actions, h_add, h_max (admissible).
 /// 4. **Search** (`search.h`): FF's enforced hill-climbing on helpful actions, falling back to
@@ -39,6 +42,7 @@
 #include "tamp/core/termination.h"
 #include "tamp/symbolic_planner/grounding.h"
 #include "tamp/symbolic_planner/pddl.h"
+#include "tamp/symbolic_planner/relevance.h"
 #include "tamp/symbolic_planner/search.h"
 #include "tamp/symbolic_planner/validator.h"
 
@@ -100,6 +104,11 @@ struct PlanStatistics {
   uint64_t landmarks_disjunctive{0};  ///< ... of which disjunctive
   uint64_t landmark_gn_orders{0};     ///< ... greedy-necessary orders between them
   uint64_t landmark_reasonable_orders{0};  ///< ... reasonable orders between them
+  /// Relevance analysis (relevance.h) of this query, when it ran (`relevance_ran`); `facts` and
+  /// `operators` above are the searched task's, pruned when `pruned`.
+  bool relevance_ran{false};
+  bool pruned{false};
+  RelevanceStats relevance;
 };
 
 /// A self-contained request (maps 1:1 to the plan-request message).
@@ -117,6 +126,7 @@ struct PlanRequest {
   SearchOptions search;
   double timeout_seconds{60.0};  ///< on top of the caller's Termination; <= 0: none
   bool check_plan{true};     ///< replay the plan with the independent checker before replying
+  bool prune_irrelevant{true};  ///< see Query::prune_irrelevant
 };
 
 /// The answer (maps 1:1 to the plan-reply message).
@@ -139,6 +149,12 @@ struct Query {
   /// ... or as a formula (used when set; any formula of the supported fragment).
   std::optional<pddl::Formula> goal_formula;
   SearchOptions search;
+  /// Search a task pruned to what is relevant to the goal (relevance.h) when the session has no
+  /// heuristic tables for its grounded task yet: the first query on a task (a one-shot request)
+  /// is pruned for its goal, and later queries with the same goal reuse that pruned task and its
+  /// tables; queries with other goals search the whole task (its tables built once), so that a
+  /// session's many queries keep their latency.
+  bool prune_irrelevant{true};
 };
 
 /// One domain and object set; grounding cached across queries. Not thread-safe (one per thread,
@@ -197,6 +213,12 @@ class PlanningSession {
     std::unique_ptr<Heuristic> h;
   };
   std::vector<HeuristicCache> heuristics_;
+  /// The task pruned for the first goal queried on `task_` (Query::prune_irrelevant), with its
+  /// own heuristic tables; `prune_tried_` once that goal was analysed.
+  bool prune_tried_{false};
+  PrunedTask pruned_;
+  Goal pruned_for_;
+  std::vector<HeuristicCache> pruned_heuristics_;
   uint64_t generation_{0};
 };
 

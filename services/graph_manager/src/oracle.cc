@@ -58,15 +58,15 @@ namespace {
 /// bounding box, or a live movable's footprint box overlaps its own (a thin box's estimate may be
 /// centred a little off it).
 bool perceivedAs(const world::World& live, const world::Object& hidden) {
-  const Aabb box = hidden.shape.aabb(hidden.pose);
+  auto footprint = [](Aabb b) {  // seen from above
+    b.min.z() = b.max.z() = 0.0;
+    return b;
+  };
+  const Aabb box = footprint(hidden.shape.aabb(hidden.pose));
   return std::any_of(live.objects().begin(), live.objects().end(), [&](const world::Object& x) {
     const Eigen::Vector3d c = x.pose.translation();
-    if (c.x() >= box.min.x() && c.x() <= box.max.x() && c.y() >= box.min.y() && c.y() <= box.max.y())
-      return true;
-    if (x.kind != world::ObjectKind::kMovable) return false;
-    const Aabb b = x.shape.aabb(x.pose);
-    return std::min(b.max.x(), box.max.x()) > std::max(b.min.x(), box.min.x()) &&
-           std::min(b.max.y(), box.max.y()) > std::max(b.min.y(), box.min.y());
+    if (box.contains(Eigen::Vector3d(c.x(), c.y(), 0.0))) return true;
+    return x.kind == world::ObjectKind::kMovable && footprint(x.shape.aabb(x.pose)).overlaps(box);
   });
 }
 

@@ -140,6 +140,16 @@ class Analysis {
     const int32_t c = t_.complement[f];
     if (c >= 0) markRel(static_cast<FactId>(c));
   }
+  /// The complements of the kept facts an effect adds or deletes (negative preconditions).
+  template <class Facts>
+  void markComplementsOfKept(const Facts& add, const Facts& del) {
+    for (FactId f : add) {
+      if (kept(f)) markComplement(f);
+    }
+    for (FactId f : del) {
+      if (kept(f)) markComplement(f);
+    }
+  }
   bool touchesKept(const ConditionalEffect& ce) const {
     for (FactId f : ce.add) {
       if (kept(f)) return true;
@@ -154,14 +164,7 @@ class Analysis {
     op_rel_[o] = 1;
     const Operator& op = t_.ops[o];
     for (FactId f : op.pre) markRel(f);
-    if (op.needs_fixup) {
-      for (FactId f : op.add) {
-        if (kept(f)) markComplement(f);
-      }
-      for (FactId f : op.del) {
-        if (kept(f)) markComplement(f);
-      }
-    }
+    if (op.needs_fixup) markComplementsOfKept(op.add, op.del);
     for (uint32_t c = 0; c < op.cond_effects.size(); ++c) {
       if (touchesKept(op.cond_effects[c])) keepCe(o, c);
     }
@@ -173,14 +176,7 @@ class Analysis {
     const Operator& op = t_.ops[o];
     const ConditionalEffect& ce = op.cond_effects[c];
     for (FactId f : ce.cond) markRel(f);
-    if (op.needs_fixup) {
-      for (FactId f : ce.add) {
-        if (kept(f)) markComplement(f);
-      }
-      for (FactId f : ce.del) {
-        if (kept(f)) markComplement(f);
-      }
-    }
+    if (op.needs_fixup) markComplementsOfKept(ce.add, ce.del);
   }
 
   const Task& t_;

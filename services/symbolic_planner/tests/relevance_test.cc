@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <stdexcept>
 #include <string>
 
 #include "tamp/symbolic_planner/relevance.h"
@@ -53,6 +54,16 @@ const char* kDecorDomain = R"(
     :effect (and (painted ?r) (increase (total-cost) 1))))
 )";
 
+/// The problem's own question: its initial state and goal (the init is the parser's, so valid).
+Query problemQuery(PlanningSession& s) {
+  Query q;
+  auto init = s.problemInit();
+  if (!init.ok()) throw std::runtime_error(init.error().toString());
+  q.init = *init;
+  q.goal_formula = s.problem().goal;
+  return q;
+}
+
 const char* kDecorProblem = R"(
 (define (problem decor-1) (:domain decor)
   (:objects r1 r2 r3 - room h1 h2 - hat)
@@ -64,11 +75,7 @@ const char* kDecorProblem = R"(
 TEST(Relevance, DropsWhatNoGoalNeedsAndKeepsTheCheapestOfTheSameOperators) {
   auto s = PlanningSession::fromText(kDecorDomain, kDecorProblem);
   ASSERT_TRUE(s.ok()) << s.error().toString();
-  auto init = (*s)->problemInit();
-  ASSERT_TRUE(init.ok());
-  Query q;
-  q.init = *init;
-  q.goal_formula = (*s)->problem().goal;
+  Query q = problemQuery(**s);
   q.prune_irrelevant = false;
   PlanReply full = (*s)->solve(q, Termination());
   ASSERT_EQ(full.status, PlanStatus::kSolved) << full.message;
@@ -121,11 +128,7 @@ TEST(Relevance, DropsWhatNoGoalNeedsAndKeepsTheCheapestOfTheSameOperators) {
 TEST(Relevance, ASessionPrunesForItsFirstGoalOnlyAndReusesThatTask) {
   auto s = PlanningSession::fromText(kDecorDomain, kDecorProblem);
   ASSERT_TRUE(s.ok()) << s.error().toString();
-  auto init = (*s)->problemInit();
-  ASSERT_TRUE(init.ok());
-  Query q;
-  q.init = *init;
-  q.goal_formula = (*s)->problem().goal;
+  Query q = problemQuery(**s);
   PlanReply first = (*s)->solve(q, Termination());
   ASSERT_EQ(first.status, PlanStatus::kSolved);
   EXPECT_TRUE(first.stats.relevance_ran);
@@ -168,11 +171,7 @@ const char* kTrapProblem = "(define (problem trap-1) (:domain trap) (:init (p) (
 TEST(Relevance, PrunesNothingWhereLeavingAnOperatorOutChangesAKeptConditionalEffect) {
   auto s = PlanningSession::fromText(kTrapDomain, kTrapProblem);
   ASSERT_TRUE(s.ok()) << s.error().toString();
-  auto init = (*s)->problemInit();
-  ASSERT_TRUE(init.ok());
-  Query q;
-  q.init = *init;
-  q.goal_formula = (*s)->problem().goal;
+  Query q = problemQuery(**s);
   const PlanReply r = (*s)->solve(q, Termination());
   ASSERT_EQ(r.status, PlanStatus::kSolved) << r.message;
   EXPECT_TRUE(r.stats.relevance_ran);

@@ -8,6 +8,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <queue>
 #include <random>
 #include <string>
 #include <unordered_map>
@@ -491,12 +492,54 @@ std::vector<BlockingObject> blockingReport(Oracle& oracle, const og::PathGeometr
 /// Outcome of the infeasibility proof.
 enum class ProofOutcome { kDisconnected, kConnected, kSkipped, kStopped };
 
-/// Grid flood fill of the base's inscribed disc from start to goal (see ProofParams) with cell
-/// edge `cell`, objects of `filter`. kDisconnected proves that no base path exists.
-ProofOutcome proveDisconnected(const collision::Scene& scene, const collision::Filter& filter,
-                               const RobotBinding& robot, const Aabb& bounds, const Pose2D& start,
-                               const Eigen::Vector2d& goal, double goal_tolerance, double cell,
-                               int max_cells, const Termination& termination);
+/// The `no path` proof on one grid (see ProofParams and proof.cc): the base's inscribed disc
+/// over cells of edge `cell`, objects of `filter`, grown from the start and from the goal region
+/// at once. Resumable: advance() works until it decides or `termination` says stop (kStopped,
+/// undecided so far; the next call goes on). kDisconnected proves that no base path exists;
+/// kSkipped: this grid cannot say (too many cells, cells too coarse for the disc, the start
+/// outside the bounds). `statics`, when given, is a clearance grid of (at least) the scene's
+/// static objects: where it shows none within the disc, FCL is asked of the other groups only.
+class DisconnectionProof {
+ public:
+  DisconnectionProof(const collision::Scene& scene, const collision::Filter& filter,
+                     const collision::ClearanceGrid* statics, const RobotBinding& robot, const Aabb& bounds,
+                     const Pose2D& start, const Eigen::Vector2d& goal, double goal_tolerance, double cell,
+                     int max_cells);
+  ProofOutcome advance(const Termination& termination);
+  double cell() const { return cell_; }
+  /// Cells whose disc was tested, and of those the ones the clearance grid cleared of statics.
+  std::size_t tested() const { return tested_; }
+  std::size_t gridAnswers() const { return grid_answers_; }
+
+ private:
+  struct Entry {
+    double to_other_end;  ///< m, from the cell's centre to the other end's point
+    long ix, iy;
+    bool operator<(const Entry& o) const { return to_other_end > o.to_other_end; }  // nearest on top
+  };
+  using Frontier = std::priority_queue<Entry>;
+  void push(Frontier& frontier, const Eigen::Vector2d& towards, long ix, long iy);
+  bool cellOf(double x, double y, long& ix, long& iy) const;
+  std::size_t index(long ix, long iy) const { return static_cast<std::size_t>(iy * nx_ + ix); }
+  bool kept(long ix, long iy);
+
+  const collision::Scene& scene_;
+  collision::Filter filter_;
+  collision::Filter others_;  ///< filter_ without the static objects
+  const collision::ClearanceGrid* statics_;
+  Eigen::Vector2d min_;
+  double cell_;
+  double r_test_{0.0};
+  long nx_{0}, ny_{0};
+  world::Shape disc_{world::Shape::sphere(1.0)};
+  Eigen::Isometry3d pose_{Eigen::Isometry3d::Identity()};
+  std::vector<unsigned char> state_;
+  Eigen::Vector2d start_{Eigen::Vector2d::Zero()}, goal_{Eigen::Vector2d::Zero()};
+  Frontier from_start_, from_goal_;
+  std::size_t expanded_start_{0}, expanded_goal_{0};
+  ProofOutcome decided_{ProofOutcome::kSkipped};
+  std::size_t tested_{0}, grid_answers_{0};
+};
 
 /// xy length of the base part of a path (base groups), or its length in the space metric.
 double reportedLength(const GroupSpace& gs, const og::PathGeometric& path);

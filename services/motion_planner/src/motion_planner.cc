@@ -1515,38 +1515,56 @@ bool Planning::directKeepsClear(const ob::State* from, const ob::State* to) {
   return clear;
 }
 
-/// Unless `solved`: the sampling planner in doubling time slices until it finds a path, a proof
-/// on a finer grid each slice shows there is none, or the time is up; the base clearance is
-/// dropped when no path kept it in time. Sampling time is reported either way.
+/// Unless `solved`: the sampling planner in doubling time slices until it finds a path, the
+/// proof shows there is none, or the time is up; the base clearance is dropped when no path kept
+/// it in time. The proof (full mode: a first turn before sampling) gets a turn after each slice,
+/// of ProofParams::time_share times the slice, and goes on from where its last turn stopped,
+/// refining its grid each time one is too coarse to decide. Sampling time is reported either way.
 Outcome Planning::sample(const Stopwatch& phase, bool solved) {
   std::vector<double> proof_cells;
   if (P.proof.enabled && gs.hasBase() && base_goal) {
     for (double c = P.proof.cell_size; c >= P.proof.min_cell_size - 1e-12; c *= 0.5) proof_cells.push_back(c);
   }
   const collision::Filter proof_filter = requestFilter();
-  std::size_t proof_level = 0;
-  double slice = lazy ? 0.25 : 0.05;
-  bool first = true;
-  while (!solved) {
-    if (proof_level < proof_cells.size() && (!lazy || !first)) {
-      Stopwatch pw;
-      const auto outcome = detail::proveDisconnected(impl.scene, proof_filter, impl.robot, bounds, req.start.base,
-                                                     *base_goal, P.sampling.goal_position_tolerance,
-                                                     proof_cells[proof_level], P.proof.max_cells, termination);
-      res.stats.proof_ms += pw.millis();
-      ++proof_level;
-      if (outcome == detail::ProofOutcome::kDisconnected) {
-        res.stats.sampling_ms = phase.millis() - res.stats.proof_ms;
-        res.stats.validity_checks = oracle.checks();
-        res.stats.grid_answers = oracle.gridAnswers();
-        return finish(MotionStatus::kNoPath,
-                      std::string("no path: start and goal are in different components of the ") +
-                          (lazy ? "static " : "") + "free space of the base (proven on a " +
-                          formatNumber(proof_cells[proof_level - 1]) + " m grid)");
+  const std::shared_ptr<const collision::ClearanceGrid> statics = proof_cells.empty() ? nullptr : impl.clearanceGrid();
+  std::size_t level = 0;
+  std::unique_ptr<detail::DisconnectionProof> proof;
+  // One turn of the proof: true when it proved that there is no path.
+  auto proofTurn = [&](double seconds) {
+    Stopwatch pw;
+    const Termination turn = termination.tightened(Deadline::in(seconds));
+    bool proven = false;
+    while (level < proof_cells.size() && !proven && !turn()) {
+      if (!proof) {
+        proof = std::make_unique<detail::DisconnectionProof>(impl.scene, proof_filter, statics.get(), impl.robot,
+                                                             bounds, req.start.base, *base_goal,
+                                                             P.sampling.goal_position_tolerance, proof_cells[level],
+                                                             P.proof.max_cells);
       }
-      if (outcome == detail::ProofOutcome::kSkipped) proof_level = proof_cells.size();
+      const detail::ProofOutcome outcome = proof->advance(turn);
+      if (outcome == detail::ProofOutcome::kStopped) break;
+      proven = outcome == detail::ProofOutcome::kDisconnected;
+      res.stats.proof_cells += proof->tested();
+      res.stats.proof_grid_answers += proof->gridAnswers();
+      if (!proven) {
+        proof.reset();
+        ++level;
+      }
     }
-    first = false;
+    res.stats.proof_ms += pw.millis();
+    return proven;
+  };
+  auto noPath = [&] {
+    res.stats.sampling_ms = phase.millis() - res.stats.proof_ms;
+    res.stats.validity_checks = oracle.checks();
+    res.stats.grid_answers = oracle.gridAnswers();
+    return finish(MotionStatus::kNoPath, std::string("no path: start and goal are in different components of the ") +
+                                             (lazy ? "static " : "") + "free space of the base (proven on a " +
+                                             formatNumber(proof->cell()) + " m grid)");
+  };
+  double slice = lazy ? 0.25 : 0.02;
+  if (!solved && !lazy && proofTurn(P.proof.first_turn_s)) return noPath();
+  while (!solved) {
     if (termination()) break;
     // No path kept the clearance in time: on without it (every state and motion of the tree so
     // far passed the stronger check, so the tree stays valid).
@@ -1558,6 +1576,7 @@ Outcome Planning::sample(const Stopwatch& phase, bool solved) {
         clearance && !clearance->relaxed() ? std::min(slice, P.sampling.base_clearance_time_s) : slice));
     planner->solve(ptcOf(slice_term));
     solved = pdef->hasExactSolution();
+    if (!solved && proofTurn(slice * P.proof.time_share)) return noPath();
     slice *= 2;
   }
   res.stats.sampling_ms = phase.millis() - res.stats.proof_ms;

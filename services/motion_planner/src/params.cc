@@ -88,6 +88,8 @@ const config::Schema<MotionPlannerParams>& schema() {
         .field("cell_size", &R::cell_size, positive())
         .field("min_cell_size", &R::min_cell_size)
         .field("max_cells", &R::max_cells, atLeast(1))
+        .field("first_turn_s", &R::first_turn_s, nonNegative())
+        .field("time_share", &R::time_share, nonNegative())
         .rule("min_cell_size", [](const R& r) -> std::optional<std::string> {
           if (std::isfinite(r.min_cell_size) && r.min_cell_size > 0 &&
               r.min_cell_size <= r.cell_size) {

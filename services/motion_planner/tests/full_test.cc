@@ -194,6 +194,30 @@ TEST_F(FullTest, BlockedDoorIsAProvenNoPath) {
   EXPECT_LT(r.planning_time_s, 10.0);
 }
 
+// The goal is in a closed pocket of a large room: the proof grows from both ends, so it is
+// proven after about the pocket's cells, not the room's (a search from the start alone tests
+// every cell of the room, 90 000 on the first grid). Out in the room the clearance grid clears
+// cells of the static walls (only the crate is asked of FCL there).
+TEST_F(FullTest, AGoalInAClosedPocketIsProvenFromThePocketsSide) {
+  const world::World w = testing::pocketWorld();
+  MotionPlannerParams p;
+  p.proof.min_cell_size = 0.05;
+  MotionPlanner mp = planner(w, p);
+  const MotionResult r = mp.plan(request({2, 2, 0}, {25, 25, 0}), Termination::after(10.0));
+  EXPECT_EQ(r.status, MotionStatus::kNoPath) << r.reason;
+  EXPECT_NE(r.reason.find("proven"), std::string::npos) << r.reason;
+  EXPECT_GT(r.stats.proof_cells, 0u);
+  EXPECT_LT(r.stats.proof_cells, 20000u);
+  EXPECT_GT(r.stats.proof_grid_answers, 0u);
+  // With the crate moved out of the door there is a path, and no proof of the contrary.
+  MotionRequest open = request({2, 2, 0}, {25, 25, 0});
+  Eigen::Isometry3d away = w.object("crate").pose;
+  away.translation().x() = 10.0;
+  open.object_overrides.push_back({"crate", false, away});
+  const MotionResult o = mp.plan(open, Termination::after(10.0));
+  EXPECT_EQ(o.status, MotionStatus::kSolved) << o.reason;
+}
+
 TEST_F(FullTest, StartAndGoalInCollisionNameTheObject) {
   const world::World w = testing::corridorWorld(true);
   MotionPlanner mp = planner(w);

@@ -90,6 +90,18 @@ world::World twoDoorWorld() {
   return w;
 }
 
+world::World pocketWorld() {
+  world::World w("pocket");
+  room(w, 30, 30);
+  add(w, box("pocket_west", 24, 25, 0.2, 2.2, false));
+  add(w, box("pocket_east", 26, 25, 0.2, 2.2, false));
+  add(w, box("pocket_north", 25, 26, 2.2, 0.2, false));
+  add(w, box("pocket_south_a", 24.25, 24, 0.5, 0.2, false));
+  add(w, box("pocket_south_b", 25.75, 24, 0.5, 0.2, false));
+  add(w, box("crate", 25, 24, 1.0, 0.2, true, 0.8, 8.0));
+  return w;
+}
+
 world::World openRoomWorld() {
   world::World w("open_room");
   room(w, 10, 6);

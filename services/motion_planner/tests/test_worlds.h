@@ -24,6 +24,10 @@ world::World corridorWorld(bool door_blocked);
 /// (`light`).
 world::World twoDoorWorld();
 
+/// A 30 x 30 m room with a closed 2 x 2 m pocket (static walls, inner faces at x = 24.1/25.9,
+/// y = 24.1/25.9) whose 1 m door in its south wall is filled by `crate` (movable).
+world::World pocketWorld();
+
 /// An open 10 x 6 m room with one light movable box (`obstacle`, 0.6 x 0.6) at (5, 3).
 world::World openRoomWorld();
 

@@ -197,6 +197,10 @@ struct PlanningStats {
   double shortcut_ms{0.0};
   double analysis_ms{0.0};      ///< blocking report
   double proof_ms{0.0};         ///< full mode: infeasibility grid
+  /// Cells the proof tested (its disc asked of FCL or the clearance grid), and of those the ones
+  /// the static clearance grid cleared of statics (FCL asked of the movables only).
+  std::uint64_t proof_cells{0};
+  std::uint64_t proof_grid_answers{0};
   double goal_ms{0.0};          ///< goal states: IK for an end-effector goal, validity of the goal
   std::uint64_t validity_checks{0};
   /// Of those, static checks the clearance grid answered without FCL (clearance_grid_resolution).

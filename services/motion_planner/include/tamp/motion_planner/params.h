@@ -157,12 +157,16 @@ struct CostParams {
 /// A grid over the base bounds whose cells keep the robot's inscribed disc free somewhere inside
 /// them over-approximates the free space; when start and goal fall in different 8-connected
 /// components of those cells, no path exists (a proof, not a timeout). Cells are refined from
-/// `proof_cell_size` down to `proof_min_cell_size`, interleaved with the planner.
+/// `cell_size` down to `min_cell_size`, in turns interleaved with the planner's time slices:
+/// a first turn before sampling (full mode), then after each slice one of `time_share` times
+/// the slice, each going on from where the last one stopped.
 struct ProofParams {
   bool enabled{true};
   double cell_size{0.1};       ///< m, first (coarsest) grid; > 0
   double min_cell_size{0.02};  ///< m, finest grid; in (0, cell_size]
   int max_cells{4000000};      ///< grids with more cells are skipped; >= 1
+  double first_turn_s{0.005};  ///< s, the turn before sampling (full mode); >= 0
+  double time_share{1.0};      ///< proof time per second of sampling; >= 0
 };
 
 /// Trapezoidal time parameterization (stop at every waypoint; see trajectory_timing.h).

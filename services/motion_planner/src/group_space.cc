@@ -326,7 +326,8 @@ RobotBinding::RobotBinding(collision::RobotGeometry planar) : geometry_(std::mov
 
 void RobotBinding::computeFootprint() {
   // Parts rigidly on the base: link 0 (planar robots: every link sits at the base pose).
-  for (const auto& p : geometry_.parts) {
+  for (std::size_t pi = 0; pi < geometry_.parts.size(); ++pi) {
+    const collision::RobotPart& p = geometry_.parts[pi];
     if (model_ && p.link != 0) continue;
     const world::Polygon2 local = p.shape.footprint(32);
     world::Polygon2 poly;
@@ -343,6 +344,7 @@ void RobotBinding::computeFootprint() {
     // A shape's footprint polygon is inscribed in curved shapes: exact enough (32 sides).
     if (r > inscribed_radius_) {
       inscribed_radius_ = r;
+      inscribed_part_ = pi;
       const Aabb box = p.shape.aabb(p.link_T_shape);
       inscribed_zmin_ = box.min.z();
       inscribed_zmax_ = box.max.z();

@@ -54,6 +54,10 @@ class RobotBinding {
   double inscribedZMax() const { return inscribed_zmax_; }
   /// Largest xy distance from the base origin to the base's footprint, m.
   double footprintRadius() const { return footprint_radius_; }
+  /// The base part that realises the inscribed radius (geometry().parts), or null.
+  const collision::RobotPart* inscribedPart() const {
+    return inscribed_part_ < geometry_.parts.size() ? &geometry_.parts[inscribed_part_] : nullptr;
+  }
   /// Per arm joint (chain order): how far any point of the links that joint moves (links,
   /// gripper, fingers) moves per radian of it (m/rad): the chain's joint offsets out to the
   /// farthest link plus that link's parts. The displacement of any point for a joint motion dq is
@@ -75,6 +79,7 @@ class RobotBinding {
   double inscribed_zmin_{0.0};
   double inscribed_zmax_{0.0};
   double footprint_radius_{0.0};
+  std::size_t inscribed_part_{static_cast<std::size_t>(-1)};
   std::vector<double> arm_joint_radii_;
   std::vector<std::pair<std::string, double>> arm_reach_;  // link -> chain length from the first arm joint
 };
@@ -492,36 +497,50 @@ std::vector<BlockingObject> blockingReport(Oracle& oracle, const og::PathGeometr
 /// Outcome of the infeasibility proof.
 enum class ProofOutcome { kDisconnected, kConnected, kSkipped, kStopped };
 
-/// The `no path` proof on one grid (see ProofParams and proof.cc): the base's inscribed disc
-/// over cells of edge `cell`, objects of `filter`, grown from the start and from the goal region
-/// at once. Resumable: advance() works until it decides or `termination` says stop (kStopped,
-/// undecided so far; the next call goes on). kDisconnected proves that no base path exists;
-/// kSkipped: this grid cannot say (too many cells, cells too coarse for the disc, the start
-/// outside the bounds). `statics`, when given, is a clearance grid of (at least) the scene's
-/// static objects: where it shows none within the disc, FCL is asked of the other groups only.
+/// The `no path` proof on one grid (see ProofParams and proof.cc), grown from the start and from
+/// the goal region at once, objects of `filter`. Two kinds of cells:
+///  - `yaw_cells` <= 1: xy cells of edge `cell`, the base's inscribed disc (any orientation);
+///  - `yaw_cells` > 1: (x, y, yaw) cells, the base part that realises the inscribed radius (a
+///    box) shrunk by how far any of its points moves within a cell: it proves what needs the
+///    robot's orientation (it cannot turn where it stands). Cells are kept sparsely.
+/// Resumable: advance() works until it decides or `termination` says stop (kStopped, undecided
+/// so far; the next call goes on). kDisconnected proves that no base path exists; kSkipped: this
+/// grid cannot say (too many cells, cells too coarse, no box part, the start outside the bounds).
+/// `statics`, when given, is a clearance grid of (at least) the scene's static objects: where it
+/// shows none within reach of the cell's shape, FCL is asked of the other groups only.
 class DisconnectionProof {
  public:
   DisconnectionProof(const collision::Scene& scene, const collision::Filter& filter,
                      const collision::ClearanceGrid* statics, const RobotBinding& robot, const Aabb& bounds,
                      const Pose2D& start, const Eigen::Vector2d& goal, double goal_tolerance, double cell,
-                     int max_cells);
+                     int yaw_cells, int max_cells);
   ProofOutcome advance(const Termination& termination);
   double cell() const { return cell_; }
-  /// Cells whose disc was tested, and of those the ones the clearance grid cleared of statics.
+  int yawCells() const { return nt_; }
+  /// Cells whose shape was tested, and of those the ones the clearance grid cleared of statics.
   std::size_t tested() const { return tested_; }
   std::size_t gridAnswers() const { return grid_answers_; }
 
  private:
+  struct Cell {
+    long ix, iy, it;
+  };
   struct Entry {
     double to_other_end;  ///< m, from the cell's centre to the other end's point
-    long ix, iy;
+    Cell c;
     bool operator<(const Entry& o) const { return to_other_end > o.to_other_end; }  // nearest on top
   };
   using Frontier = std::priority_queue<Entry>;
-  void push(Frontier& frontier, const Eigen::Vector2d& towards, long ix, long iy);
+  bool setUpShape(const RobotBinding& robot);
+  void push(Frontier& frontier, const Eigen::Vector2d& towards, const Cell& c);
   bool cellOf(double x, double y, long& ix, long& iy) const;
-  std::size_t index(long ix, long iy) const { return static_cast<std::size_t>(iy * nx_ + ix); }
-  bool kept(long ix, long iy);
+  std::uint64_t key(const Cell& c) const {
+    return (static_cast<std::uint64_t>(c.it) * static_cast<std::uint64_t>(ny_) + static_cast<std::uint64_t>(c.iy)) *
+               static_cast<std::uint64_t>(nx_) +
+           static_cast<std::uint64_t>(c.ix);
+  }
+  unsigned char& state(const Cell& c);
+  bool kept(const Cell& c);
 
   const collision::Scene& scene_;
   collision::Filter filter_;
@@ -529,11 +548,13 @@ class DisconnectionProof {
   const collision::ClearanceGrid* statics_;
   Eigen::Vector2d min_;
   double cell_;
-  double r_test_{0.0};
-  long nx_{0}, ny_{0};
-  world::Shape disc_{world::Shape::sphere(1.0)};
-  Eigen::Isometry3d pose_{Eigen::Isometry3d::Identity()};
-  std::vector<unsigned char> state_;
+  long nx_{0}, ny_{0}, nt_{1};
+  std::size_t max_cells_{0};
+  world::Shape shape_{world::Shape::sphere(1.0)};           ///< tested at each cell's centre
+  Eigen::Isometry3d base_T_shape_{Eigen::Isometry3d::Identity()};
+  double reach_{0.0};  ///< xy distance from the base origin that the shape stays within
+  std::vector<unsigned char> dense_;                         ///< xy cells
+  std::unordered_map<std::uint64_t, unsigned char> sparse_;  ///< (x, y, yaw) cells
   Eigen::Vector2d start_{Eigen::Vector2d::Zero()}, goal_{Eigen::Vector2d::Zero()};
   Frontier from_start_, from_goal_;
   std::size_t expanded_start_{0}, expanded_goal_{0};

@@ -1521,9 +1521,11 @@ bool Planning::directKeepsClear(const ob::State* from, const ob::State* to) {
 /// of ProofParams::time_share times the slice, and goes on from where its last turn stopped,
 /// refining its grid each time one is too coarse to decide. Sampling time is reported either way.
 Outcome Planning::sample(const Stopwatch& phase, bool solved) {
-  std::vector<double> proof_cells;
+  // Proof levels: (xy cell, yaw cells); the disc on finer and finer cells, then the oriented base.
+  std::vector<std::pair<double, int>> proof_cells;
   if (P.proof.enabled && gs.hasBase() && base_goal) {
-    for (double c = P.proof.cell_size; c >= P.proof.min_cell_size - 1e-12; c *= 0.5) proof_cells.push_back(c);
+    for (double c = P.proof.cell_size; c >= P.proof.min_cell_size - 1e-12; c *= 0.5) proof_cells.emplace_back(c, 1);
+    if (P.proof.yaw_cells > 1) proof_cells.emplace_back(P.proof.oriented_cell_size, P.proof.yaw_cells);
   }
   const collision::Filter proof_filter = requestFilter();
   const std::shared_ptr<const collision::ClearanceGrid> statics = proof_cells.empty() ? nullptr : impl.clearanceGrid();
@@ -1536,10 +1538,9 @@ Outcome Planning::sample(const Stopwatch& phase, bool solved) {
     bool proven = false;
     while (level < proof_cells.size() && !proven && !turn()) {
       if (!proof) {
-        proof = std::make_unique<detail::DisconnectionProof>(impl.scene, proof_filter, statics.get(), impl.robot,
-                                                             bounds, req.start.base, *base_goal,
-                                                             P.sampling.goal_position_tolerance, proof_cells[level],
-                                                             P.proof.max_cells);
+        proof = std::make_unique<detail::DisconnectionProof>(
+            impl.scene, proof_filter, statics.get(), impl.robot, bounds, req.start.base, *base_goal,
+            P.sampling.goal_position_tolerance, proof_cells[level].first, proof_cells[level].second, P.proof.max_cells);
       }
       const detail::ProofOutcome outcome = proof->advance(turn);
       if (outcome == detail::ProofOutcome::kStopped) break;
@@ -1560,7 +1561,11 @@ Outcome Planning::sample(const Stopwatch& phase, bool solved) {
     res.stats.grid_answers = oracle.gridAnswers();
     return finish(MotionStatus::kNoPath, std::string("no path: start and goal are in different components of the ") +
                                              (lazy ? "static " : "") + "free space of the base (proven on a " +
-                                             formatNumber(proof->cell()) + " m grid)");
+                                             formatNumber(proof->cell()) + " m grid" +
+                                             (proof->yawCells() > 1 ? " with " + std::to_string(proof->yawCells()) +
+                                                                          " yaw cells"
+                                                                    : std::string()) +
+                                             ")");
   };
   double slice = lazy ? 0.25 : 0.02;
   if (!solved && !lazy && proofTurn(P.proof.first_turn_s)) return noPath();

@@ -1,21 +1,32 @@
-// The `no path` proof of the full mode (ProofParams): a grid over the base bounds whose cells
-// over-approximate the free space of the base's inscribed disc.
+// The `no path` proof of the full mode (ProofParams): a grid whose cells over-approximate the
+// free configurations of the base.
 //
-// A cell of edge h and centre c is kept when a disc of radius r_in - h/sqrt(2) (minus 1 mm
-// against numerical contact tolerance) at c is free. If the robot is free at some base position
-// p inside the cell, its inscribed disc at p is free, and that smaller disc at c lies inside it:
-// so every cell containing a free base position is kept. A continuous path of free base positions
-// visits a chain of such cells, consecutive ones sharing at least a corner (8-connectivity).
-// Hence: if no 8-connected chain of kept cells joins the start's cell to a cell within the goal
-// tolerance, no path exists for any orientation or arm configuration.
+// xy cells (the inscribed disc). A cell of edge h and centre c is kept when a disc of radius
+// r_in - h/sqrt(2) (minus 1 mm against numerical contact tolerance) at c is free. If the robot is
+// free at some base position p inside the cell, its inscribed disc at p is free, and that smaller
+// disc at c lies inside it: so every cell containing a free base position is kept. A continuous
+// path of free base positions visits a chain of such cells, consecutive ones sharing at least a
+// corner (8-connectivity). Hence: if no chain of kept cells joins the start's cell to a cell
+// within the goal tolerance, no path exists for any orientation or arm configuration.
+//
+// (x, y, yaw) cells (the base box). The disc cannot see that a rectangular base has no room to
+// turn. A cell of edge h and yaw width d keeps the base box shrunk on every side by
+// e = h/sqrt(2) + R d/2 + 1 mm, placed at the cell's centre (R: the farthest xy point of the box
+// from the base origin). For any configuration (p, yaw) in the cell, a point u of the shrunk box
+// lands, in the frame of the box at (p, yaw), within |c - p| + 2 sin(|yaw - yaw_c|/2) R <= e of
+// where it would at the centre: so the shrunk box lies inside the box at every configuration of
+// the cell, and a cell whose shrunk box touches something holds no free configuration. Chains are
+// 26-connected, yaw wrapping round; the goal is its xy cells at every yaw.
 //
 // The search grows from both ends in turn, the end that has expanded fewer cells first: when
 // the start or the goal is in a pocket, the pocket is exhausted after about its own cells,
 // however large the rest of the map. Each end expands the cell nearest the other end first
 // (greedy best-first): where they are connected through open space they meet after about the
 // cells along the way, not the area between them. The order does not matter to the proof,
-// which holds once either end has run out of cells. Where the static clearance grid shows no static footprint within the test radius, only
-// the other groups (movables, unknown space) are asked of FCL.
+// which holds once either end has run out of cells. Where the static clearance grid shows no
+// static footprint within reach of the cell's shape, only the other groups (movables, unknown
+// space) are asked of FCL.
+#include <algorithm>
 #include <cmath>
 
 #include "internal.h"
@@ -24,33 +35,38 @@ namespace tamp::motion_planner::detail {
 
 namespace {
 constexpr unsigned char kTested = 1, kFree = 2, kFromStart = 4, kFromGoal = 8;
+
+long yawCellOf(double yaw, long nt) {
+  const double u = (yaw + M_PI) / (2.0 * M_PI);
+  const long it = static_cast<long>(std::floor((u - std::floor(u)) * static_cast<double>(nt)));
+  return std::clamp(it, 0L, nt - 1);
+}
 }  // namespace
 
 DisconnectionProof::DisconnectionProof(const collision::Scene& scene, const collision::Filter& filter,
                                        const collision::ClearanceGrid* statics, const RobotBinding& robot,
                                        const Aabb& bounds, const Pose2D& start, const Eigen::Vector2d& goal,
-                                       double goal_tolerance, double cell, int max_cells)
-    : scene_(scene), filter_(filter), statics_(statics), min_(bounds.min.head<2>()), cell_(cell) {
-  r_test_ = robot.inscribedRadius() - cell * std::sqrt(0.5) - 1e-3;
+                                       double goal_tolerance, double cell, int yaw_cells, int max_cells)
+    : scene_(scene), filter_(filter), statics_(statics), min_(bounds.min.head<2>()), cell_(cell),
+      nt_(std::max(1, yaw_cells)), max_cells_(static_cast<std::size_t>(std::max(1, max_cells))) {
   const double w = bounds.max.x() - bounds.min.x(), hgt = bounds.max.y() - bounds.min.y();
-  if (!(robot.inscribedRadius() > 0) || r_test_ <= 1e-3 || !(cell > 0) || !(w > 0) || !(hgt > 0)) return;
+  if (!(cell > 0) || !(w > 0) || !(hgt > 0) || !setUpShape(robot)) return;
   nx_ = static_cast<long>(std::ceil(w / cell));
   ny_ = static_cast<long>(std::ceil(hgt / cell));
-  if (nx_ * ny_ > static_cast<long>(max_cells)) return;
-  long sx = 0, sy = 0;
-  if (!cellOf(start.x, start.y, sx, sy)) return;
-  const double zmin = robot.inscribedZMin(), zmax = robot.inscribedZMax();
-  disc_ = world::Shape::cylinder(r_test_, std::max(1e-3, zmax - zmin));
-  pose_.translation().z() = 0.5 * (zmin + zmax);
+  if (nt_ == 1) {
+    if (nx_ * ny_ > static_cast<long>(max_cells)) return;
+    dense_.assign(static_cast<std::size_t>(nx_ * ny_), 0);
+  }
   others_ = filter_;
   others_.groups = static_cast<std::uint8_t>(filter_.groups & ~collision::kStaticObjects);
-  state_.assign(static_cast<std::size_t>(nx_ * ny_), 0);
-  // The start cell contains the (free) start.
-  state_[index(sx, sy)] = kTested | kFree | kFromStart;
+  Cell s{0, 0, nt_ == 1 ? 0 : yawCellOf(start.theta, nt_)};
+  if (!cellOf(start.x, start.y, s.ix, s.iy)) return;
   start_ = {start.x, start.y};
   goal_ = goal;
-  push(from_start_, goal_, sx, sy);
-  // The goal side: the kept cells within goal_tolerance of the goal point.
+  // The start cell contains the (free) start.
+  state(s) = kTested | kFree | kFromStart;
+  push(from_start_, goal_, s);
+  // The goal side: the kept cells within goal_tolerance of the goal point, at every yaw.
   long gx0 = 0, gy0 = 0, gx1 = 0, gy1 = 0;
   cellOf(goal.x() - goal_tolerance, goal.y() - goal_tolerance, gx0, gy0);
   cellOf(goal.x() + goal_tolerance, goal.y() + goal_tolerance, gx1, gy1);
@@ -60,16 +76,48 @@ DisconnectionProof::DisconnectionProof(const collision::Scene& scene, const coll
       const double dx = std::max({x0 - goal.x(), 0.0, goal.x() - (x0 + cell)});
       const double dy = std::max({y0 - goal.y(), 0.0, goal.y() - (y0 + cell)});
       if (std::hypot(dx, dy) > goal_tolerance) continue;
-      if (state_[index(ix, iy)] & kFromStart) {
-        decided_ = ProofOutcome::kConnected;
-        return;
+      for (long it = 0; it < nt_; ++it) {
+        const Cell g{ix, iy, it};
+        if (state(g) & kFromStart) {
+          decided_ = ProofOutcome::kConnected;
+          return;
+        }
+        if (!kept(g)) continue;
+        state(g) |= kFromGoal;
+        push(from_goal_, start_, g);
       }
-      if (!kept(ix, iy)) continue;
-      state_[index(ix, iy)] |= kFromGoal;
-      push(from_goal_, start_, ix, iy);
     }
   }
   decided_ = from_goal_.empty() ? ProofOutcome::kDisconnected : ProofOutcome::kStopped;
+}
+
+bool DisconnectionProof::setUpShape(const RobotBinding& robot) {
+  if (nt_ == 1) {
+    const double r = robot.inscribedRadius() - cell_ * std::sqrt(0.5) - 1e-3;
+    if (!(robot.inscribedRadius() > 0) || r <= 1e-3) return false;
+    const double zmin = robot.inscribedZMin(), zmax = robot.inscribedZMax();
+    shape_ = world::Shape::cylinder(r, std::max(1e-3, zmax - zmin));
+    base_T_shape_.translation().z() = 0.5 * (zmin + zmax);
+    reach_ = r;
+    return true;
+  }
+  const collision::RobotPart* part = robot.inscribedPart();
+  if (part == nullptr || part->shape.kind != world::ShapeKind::kBox) return false;
+  const Eigen::Vector3d half = 0.5 * part->shape.size;
+  double far = 0.0;
+  for (const double sx : {-1.0, 1.0}) {
+    for (const double sy : {-1.0, 1.0}) {
+      const Eigen::Vector3d corner = part->link_T_shape * Eigen::Vector3d(sx * half.x(), sy * half.y(), 0.0);
+      far = std::max(far, corner.head<2>().norm());
+    }
+  }
+  const double yaw_width = 2.0 * M_PI / static_cast<double>(nt_);
+  const double e = cell_ * std::sqrt(0.5) + far * 0.5 * yaw_width + 1e-3;
+  if (half.x() - e <= 1e-3 || half.y() - e <= 1e-3) return false;
+  shape_ = world::Shape::box(2.0 * (half.x() - e), 2.0 * (half.y() - e), part->shape.size.z());
+  base_T_shape_ = part->link_T_shape;
+  reach_ = far;
+  return true;
 }
 
 bool DisconnectionProof::cellOf(double x, double y, long& ix, long& iy) const {
@@ -78,25 +126,29 @@ bool DisconnectionProof::cellOf(double x, double y, long& ix, long& iy) const {
   return ix >= 0 && iy >= 0 && ix < nx_ && iy < ny_;
 }
 
-void DisconnectionProof::push(Frontier& frontier, const Eigen::Vector2d& towards, long ix, long iy) {
-  const double x = min_.x() + (static_cast<double>(ix) + 0.5) * cell_;
-  const double y = min_.y() + (static_cast<double>(iy) + 0.5) * cell_;
-  frontier.push({std::hypot(x - towards.x(), y - towards.y()), ix, iy});
+unsigned char& DisconnectionProof::state(const Cell& c) {
+  return nt_ == 1 ? dense_[static_cast<std::size_t>(key(c))] : sparse_[key(c)];
 }
 
-bool DisconnectionProof::kept(long ix, long iy) {
-  unsigned char& st = state_[index(ix, iy)];
+void DisconnectionProof::push(Frontier& frontier, const Eigen::Vector2d& towards, const Cell& c) {
+  const double x = min_.x() + (static_cast<double>(c.ix) + 0.5) * cell_;
+  const double y = min_.y() + (static_cast<double>(c.iy) + 0.5) * cell_;
+  frontier.push({std::hypot(x - towards.x(), y - towards.y()), c});
+}
+
+bool DisconnectionProof::kept(const Cell& c) {
+  unsigned char& st = state(c);
   if (!(st & kTested)) {
-    const double x = min_.x() + (static_cast<double>(ix) + 0.5) * cell_;
-    const double y = min_.y() + (static_cast<double>(iy) + 0.5) * cell_;
-    pose_.translation().x() = x;
-    pose_.translation().y() = y;
+    const double x = min_.x() + (static_cast<double>(c.ix) + 0.5) * cell_;
+    const double y = min_.y() + (static_cast<double>(c.iy) + 0.5) * cell_;
+    const double yaw = -M_PI + (static_cast<double>(c.it) + 0.5) * 2.0 * M_PI / static_cast<double>(nt_);
+    const Eigen::Isometry3d pose = Pose2D{x, y, nt_ == 1 ? 0.0 : yaw}.toIsometry() * base_T_shape_;
     bool free = false;
-    if (statics_ && statics_->clearance(x, y) > r_test_) {
+    if (statics_ && statics_->clearance(x, y) > reach_) {
       ++grid_answers_;
-      free = others_.groups == 0 || !scene_.shapeInCollision(disc_, pose_, others_);
+      free = others_.groups == 0 || !scene_.shapeInCollision(shape_, pose, others_);
     } else {
-      free = !scene_.shapeInCollision(disc_, pose_, filter_);
+      free = !scene_.shapeInCollision(shape_, pose, filter_);
     }
     ++tested_;
     st = static_cast<unsigned char>(kTested | (free ? kFree : 0));
@@ -106,27 +158,32 @@ bool DisconnectionProof::kept(long ix, long iy) {
 
 ProofOutcome DisconnectionProof::advance(const Termination& termination) {
   if (decided_ != ProofOutcome::kStopped) return decided_;
+  const long dyaw = nt_ == 1 ? 0 : 1;
   std::size_t popped = 0;
   while (!from_start_.empty() && !from_goal_.empty()) {
     if ((++popped & 127) == 0 && termination()) return ProofOutcome::kStopped;
+    if (sparse_.size() > max_cells_) return decided_ = ProofOutcome::kSkipped;  // (x, y, yaw): too many
     const bool start_side = expanded_start_ <= expanded_goal_;
     Frontier& frontier = start_side ? from_start_ : from_goal_;
     const Eigen::Vector2d& towards = start_side ? goal_ : start_;
     const unsigned char mine = start_side ? kFromStart : kFromGoal;
     const unsigned char theirs = start_side ? kFromGoal : kFromStart;
     ++(start_side ? expanded_start_ : expanded_goal_);
-    const Entry e = frontier.top();
+    const Cell at = frontier.top().c;
     frontier.pop();
-    for (long dy = -1; dy <= 1; ++dy) {
-      for (long dx = -1; dx <= 1; ++dx) {
-        const long x = e.ix + dx, y = e.iy + dy;
-        if ((dx == 0 && dy == 0) || x < 0 || y < 0 || x >= nx_ || y >= ny_) continue;
-        unsigned char& st = state_[index(x, y)];
-        if (st & mine) continue;
-        if (!kept(x, y)) continue;
-        if (st & theirs) return decided_ = ProofOutcome::kConnected;
-        st |= mine;
-        push(frontier, towards, x, y);
+    for (long dt = -dyaw; dt <= dyaw; ++dt) {
+      for (long dy = -1; dy <= 1; ++dy) {
+        for (long dx = -1; dx <= 1; ++dx) {
+          const Cell n{at.ix + dx, at.iy + dy, (at.it + dt + nt_) % nt_};
+          if ((dx == 0 && dy == 0 && dt == 0) || n.ix < 0 || n.iy < 0 || n.ix >= nx_ || n.iy >= ny_) continue;
+          if (nt_ == 2 && dt == 1) continue;  // two yaw cells: -1 and +1 are the same neighbour
+          if (state(n) & mine) continue;
+          if (!kept(n)) continue;
+          unsigned char& st = state(n);
+          if (st & theirs) return decided_ = ProofOutcome::kConnected;
+          st |= mine;
+          push(frontier, towards, n);
+        }
       }
     }
   }

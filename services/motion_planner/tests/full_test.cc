@@ -218,6 +218,40 @@ TEST_F(FullTest, AGoalInAClosedPocketIsProvenFromThePocketsSide) {
   EXPECT_EQ(o.status, MotionStatus::kSolved) << o.reason;
 }
 
+// A long base (1.0 x 0.3 m) in a 0.4 m wide corridor that turns a right angle: it fits the
+// corridor lengthwise but cannot turn the corner. Its inscribed disc passes the corner, so only
+// the (x, y, yaw) grid proves that there is no path; without it the planner runs to the deadline.
+TEST_F(FullTest, ABaseThatCannotTurnTheCornerIsAProvenNoPath) {
+  world::World w("l_corridor");
+  auto add = [&](const world::Object& o) { ASSERT_TRUE(w.addObject(o).ok()) << o.id; };
+  add(testing::box("wall_south", 5, -0.1, 10.4, 0.2, false));
+  add(testing::box("wall_north", 5, 10.1, 10.4, 0.2, false));
+  add(testing::box("wall_west", -0.1, 5, 0.2, 10, false));
+  add(testing::box("wall_east", 10.1, 5, 0.2, 10, false));
+  add(testing::box("below", 5, 0.5, 10, 1.0, false));           // corridor: y in [1, 1.4] ...
+  add(testing::box("north_west", 2.3, 5.7, 4.6, 8.6, false));  // ... for x < 4.6, then x in [4.6, 5] ...
+  add(testing::box("east", 7.5, 3.5, 5, 5, false));             // ... up to y = 6, a room above
+  auto plan = [&](const MotionPlannerParams& p, double seconds) {
+    MotionPlanner mp(collision::RobotGeometry::box(1.0, 0.3, 0.5), p);
+    mp.setWorld(w);
+    return mp.plan(request({1.0, 1.2, 0}, {7.0, 8.0, 0}), Termination::after(seconds));
+  };
+  const MotionResult r = plan(MotionPlannerParams{}, 20.0);
+  EXPECT_EQ(r.status, MotionStatus::kNoPath) << r.reason;
+  EXPECT_NE(r.reason.find("yaw cells"), std::string::npos) << r.reason;
+  MotionPlannerParams disc_only;
+  disc_only.proof.yaw_cells = 0;
+  const MotionResult d = plan(disc_only, 1.0);
+  EXPECT_EQ(d.status, MotionStatus::kTimeout) << d.reason;
+  // The same base in a room with space to turn: no proof of the contrary, a path.
+  const MotionResult open = [&] {
+    MotionPlanner mp(collision::RobotGeometry::box(1.0, 0.3, 0.5), MotionPlannerParams{});
+    mp.setWorld(testing::openRoomWorld());
+    return mp.plan(request({1.0, 1.0, 0}, {8.0, 5.0, 1.5}), Termination::after(10.0));
+  }();
+  EXPECT_EQ(open.status, MotionStatus::kSolved) << open.reason;
+}
+
 TEST_F(FullTest, StartAndGoalInCollisionNameTheObject) {
   const world::World w = testing::corridorWorld(true);
   MotionPlanner mp = planner(w);

@@ -1540,7 +1540,8 @@ Outcome Planning::sample(const Stopwatch& phase, bool solved) {
       if (!proof) {
         proof = std::make_unique<detail::DisconnectionProof>(
             impl.scene, proof_filter, statics.get(), impl.robot, bounds, req.start.base, *base_goal,
-            P.sampling.goal_position_tolerance, proof_cells[level].first, proof_cells[level].second, P.proof.max_cells);
+            P.sampling.goal_position_tolerance, proof_cells[level].first, proof_cells[level].second,
+            proof_cells[level].second > 1 ? P.proof.oriented_max_cells : P.proof.max_cells);
       }
       const detail::ProofOutcome outcome = proof->advance(turn);
       if (outcome == detail::ProofOutcome::kStopped) break;

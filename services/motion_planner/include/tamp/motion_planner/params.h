@@ -166,10 +166,12 @@ struct ProofParams {
   double min_cell_size{0.02};  ///< m, finest grid; in (0, cell_size]
   int max_cells{4000000};      ///< grids with more cells are skipped; >= 1
   /// Then (x, y, yaw) cells for the base box (it cannot turn where it stands): yaw cells per
-  /// turn (0 or 1: off) and their xy edge (m, > 0). At most max_cells are kept, then it gives up.
+  /// turn (0 or 1: off), their xy edge (m, > 0), and how many it may keep before it gives up
+  /// (>= 1; about 50 bytes each).
   int yaw_cells{64};
   double oriented_cell_size{0.025};
-  double first_turn_s{0.005};  ///< s, the turn before sampling (full mode); >= 0
+  int oriented_max_cells{500000};
+  double first_turn_s{0.02};   ///< s, the turn before sampling (full mode); >= 0
   double time_share{1.0};      ///< proof time per second of sampling; >= 0
 };
 

@@ -1531,6 +1531,9 @@ Outcome Planning::sample(const Stopwatch& phase, bool solved) {
   const std::shared_ptr<const collision::ClearanceGrid> statics = proof_cells.empty() ? nullptr : impl.clearanceGrid();
   std::size_t level = 0;
   std::unique_ptr<detail::DisconnectionProof> proof;
+  // From where the sampler starts: a start touching movables is left first (the proof's cells
+  // beside a touching start could all touch them too).
+  const Pose2D proof_start = proof_cells.empty() ? req.start.base : gs.basePose(escaped ? escaped.get() : start.get());
   // One turn of the proof: true when it proved that there is no path.
   auto proofTurn = [&](double seconds) {
     Stopwatch pw;
@@ -1539,7 +1542,7 @@ Outcome Planning::sample(const Stopwatch& phase, bool solved) {
     while (level < proof_cells.size() && !proven && !turn()) {
       if (!proof) {
         proof = std::make_unique<detail::DisconnectionProof>(
-            impl.scene, proof_filter, statics.get(), impl.robot, bounds, req.start.base, *base_goal,
+            impl.scene, proof_filter, statics.get(), impl.robot, bounds, proof_start, *base_goal,
             P.sampling.goal_position_tolerance, proof_cells[level].first, proof_cells[level].second,
             proof_cells[level].second > 1 ? P.proof.oriented_max_cells : P.proof.max_cells);
       }

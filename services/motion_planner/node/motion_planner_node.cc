@@ -357,10 +357,11 @@ msg::MotionReply MotionPlannerNode::handleMotion(const msg::MotionRequest& req, 
   const PlanningStats& st = r.stats;
   nodeLog()->debug(
       "motion {} on planner {}: {} {} {} in {:.1f} ms (goal {:.1f}, sampling {:.1f}, proof {:.1f} over {} cells, "
-      "optimize {:.1f}, shortcut {:.1f}, analysis {:.1f}; {} checks, {} by the clearance grid), {} blocking{}",
+      "optimize {:.1f}, shortcut {:.1f}, analysis {:.1f}; {} checks, {} by the clearance grid), {} blocking{}{}{}",
       ctx.request_id, lease->index(), toString(request->group), toString(request->mode), toString(r.status),
       r.planning_time_s * 1e3, st.goal_ms, st.sampling_ms, st.proof_ms, st.proof_cells, st.optimize_ms, st.shortcut_ms,
-      st.analysis_ms, st.validity_checks, st.grid_answers, r.blocking.size(), request->object_overrides.empty() ? "" : ", overrides");
+      st.analysis_ms, st.validity_checks, st.grid_answers, r.blocking.size(), request->object_overrides.empty() ? "" : ", overrides",
+      st.proof_trace.empty() ? "" : "; proof ", st.proof_trace);
   for (const auto& id : r.start_contacts) {
     nodeLog()->info("motion {}: the start touches '{}'; the path leaves it first", ctx.request_id, id);
   }

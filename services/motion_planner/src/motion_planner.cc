@@ -1534,6 +1534,13 @@ Outcome Planning::sample(const Stopwatch& phase, bool solved) {
   // From where the sampler starts: a start touching movables is left first (the proof's cells
   // beside a touching start could all touch them too).
   const Pose2D proof_start = proof_cells.empty() ? req.start.base : gs.basePose(escaped ? escaped.get() : start.get());
+  auto traceProof = [&](const detail::DisconnectionProof& p, detail::ProofOutcome outcome) {
+    static constexpr const char* kNames[] = {"disconnected", "connected", "skipped", "undecided"};
+    std::string& t = res.stats.proof_trace;
+    if (!t.empty()) t += ", ";
+    t += formatNumber(p.cell()) + " m" + (p.yawCells() > 1 ? " x " + std::to_string(p.yawCells()) : std::string()) +
+         ": " + kNames[static_cast<int>(outcome)] + " (" + std::to_string(p.tested()) + ")";
+  };
   // One turn of the proof: true when it proved that there is no path.
   auto proofTurn = [&](double seconds) {
     Stopwatch pw;
@@ -1551,6 +1558,7 @@ Outcome Planning::sample(const Stopwatch& phase, bool solved) {
       proven = outcome == detail::ProofOutcome::kDisconnected;
       res.stats.proof_cells += proof->tested();
       res.stats.proof_grid_answers += proof->gridAnswers();
+      traceProof(*proof, outcome);
       if (!proven) {
         proof.reset();
         ++level;
@@ -1589,6 +1597,7 @@ Outcome Planning::sample(const Stopwatch& phase, bool solved) {
     slice *= 2;
   }
   res.stats.sampling_ms = phase.millis() - res.stats.proof_ms;
+  if (proof) traceProof(*proof, detail::ProofOutcome::kStopped);
   if (!solved) {
     res.stats.validity_checks = oracle.checks();
     res.stats.grid_answers = oracle.gridAnswers();
@@ -1597,7 +1606,7 @@ Outcome Planning::sample(const Stopwatch& phase, bool solved) {
                   std::string(stop ? "stop requested" : "the deadline passed") + " before a " + (lazy ? "lazy " : "") +
                       "path was found" +
                       (proof_cells.empty() ? std::string(" (no infeasibility proof for this group)")
-                                           : std::string(" (infeasibility not proven)")));
+                                           : " (infeasibility not proven: " + res.stats.proof_trace + ")"));
   }
   return std::nullopt;
 }

@@ -243,6 +243,9 @@ TEST_F(FullTest, ABaseThatCannotTurnTheCornerIsAProvenNoPath) {
   disc_only.proof.yaw_cells = 0;
   const MotionResult d = plan(disc_only, 1.0);
   EXPECT_EQ(d.status, MotionStatus::kTimeout) << d.reason;
+  // The reason says how far the proof got: every disc level found start and goal connected.
+  EXPECT_NE(d.reason.find("infeasibility not proven: 0.1 m: connected"), std::string::npos) << d.reason;
+  EXPECT_EQ(d.reason.find("x 64"), std::string::npos) << d.reason;
   // The same base in a room with space to turn: no proof of the contrary, a path.
   const MotionResult open = [&] {
     MotionPlanner mp(collision::RobotGeometry::box(1.0, 0.3, 0.5), MotionPlannerParams{});

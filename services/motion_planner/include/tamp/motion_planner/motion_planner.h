@@ -201,6 +201,8 @@ struct PlanningStats {
   /// the static clearance grid cleared of statics (FCL asked of the movables only).
   std::uint64_t proof_cells{0};
   std::uint64_t proof_grid_answers{0};
+  /// Per proof level reached: "<cell> m[ x <yaw cells>]: <outcome> (<cells>)", comma-separated.
+  std::string proof_trace;
   double goal_ms{0.0};          ///< goal states: IK for an end-effector goal, validity of the goal
   std::uint64_t validity_checks{0};
   /// Of those, static checks the clearance grid answered without FCL (clearance_grid_resolution).

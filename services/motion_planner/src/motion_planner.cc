@@ -906,6 +906,8 @@ struct Planning {
   void escapeTouchedMovables(const std::vector<int>& touching);
   bool escapeNoDeeper(const std::vector<int>& touching);
   bool escapeThrough(const std::vector<int>& touching);
+  std::vector<std::string> touchedFixedOnly();
+  void escapeFixed(const std::vector<std::string>& touched);
   void escapeHeldMargin();
   bool checkGoal(ob::State* s, std::string& who);
   Outcome setStateGoal();
@@ -1167,6 +1169,10 @@ Outcome Planning::leaveStart() {
     // Touching only with the held object's margin: leave by a short straight motion checked
     // without it (the robot was stopped before the contact it is now given room for).
     if (!escaped && held_shape && P.sampling.start_escape_distance > 0.0) escapeHeldMargin();
+    if (!escaped && lazy && P.sampling.start_escape_distance > 0.0) {
+      const std::vector<std::string> fixed = touchedFixedOnly();
+      if (!fixed.empty()) escapeFixed(fixed);
+    }
     if (!escaped) {
       return finish(MotionStatus::kStartInCollision, "the start state touches '" + who + "'" +
                                                          (touching.empty() ? "" : " (no way out of the contact found)"),
@@ -1193,6 +1199,55 @@ void Planning::escapeTouchedMovables(const std::vector<int>& touching) {
   const bool left = no_deeper || escapeThrough(touching);
   if (left)
     for (int i : touching) res.start_contacts.push_back(oracle.movables()[static_cast<std::size_t>(i)].id);
+}
+
+/// Lazy mode: the objects this request fixes (movables the caller cannot move, static for this
+/// request) that the start touches, when it touches nothing else static; empty otherwise.
+std::vector<std::string> Planning::touchedFixedOnly() {
+  std::vector<std::string> touched;
+  gs.placeRobot(start.get(), impl.scene);
+  for (const auto& id : req.fixed_objects)
+    if (impl.scene.robotInCollision(collision::Filter::objects({id}))) touched.push_back(id);
+  if (!touched.empty()) {
+    std::vector<std::string> ignore = ignored;
+    ignore.insert(ignore.end(), touched.begin(), touched.end());
+    if (impl.scene.robotInCollision(collision::Filter{collision::kStaticObjects | collision::kUnknownSpace, {}, ignore}))
+      touched.clear();
+  }
+  return touched;
+}
+
+/// Lazy mode: out of the contact with objects this request fixes (a perceived object that the
+/// caller can neither carry nor push, estimated reaching where the robot stands), as a full-mode
+/// start leaves movables: going no deeper into them first, else through them, to a state that
+/// touches nothing static (they included).
+void Planning::escapeFixed(const std::vector<std::string>& touched) {
+  auto leave = [&](collision::Scene& scene, const std::vector<std::string>& ignore) {
+    detail::Oracle escape_oracle(scene, gs, ignore, oracle.movables(), oracle.reachRadius());
+    if (held_shape) escape_oracle.setSelfScene(&plainScene());
+    escaped.reset(space->allocState());
+    if (!detail::escapeStart(si, makeSi(escape_oracle, false), start.get(), P.sampling.start_escape_distance,
+                             P.sampling.start_escape_attempts, escaped.get()))
+      escaped.reset();
+  };
+  if (P.sampling.start_escape_depth > 0.0) {
+    world::World w = impl.scene.world();
+    for (const auto& id : touched) {
+      world::Object o = w.object(id);
+      o.shape = world::shrunk(o.shape, P.sampling.start_escape_depth);
+      (void)w.updateObject(std::move(o));
+    }
+    collision::Scene smaller(impl.scene);
+    smaller.syncWorld(w);
+    leave(smaller, ignored);
+  }
+  if (!escaped) {
+    std::vector<std::string> ignore = ignored;
+    ignore.insert(ignore.end(), touched.begin(), touched.end());
+    leave(impl.scene, ignore);
+  }
+  gs.placeRobot(start.get(), impl.scene);
+  if (escaped) res.start_contacts.insert(res.start_contacts.end(), touched.begin(), touched.end());
 }
 
 /// The way out checked against everything, the touched objects `start_escape_depth` smaller.
@@ -1407,7 +1462,7 @@ void Planning::searchRoadmapFirst() {
     ensureSampled();
     res.stats.roadmap_pruned = roadmap->pruneRequestNodes(static_cast<std::size_t>(P.lazy.roadmap_max_request_nodes));
     const std::uint64_t request = ++impl.requests;
-    const int s = roadmap->addRequestState(start.get(), request);
+    const int s = roadmap->addRequestState(escaped ? escaped.get() : start.get(), request);
     std::vector<int> goals;
     for (const auto* g : goal_states) goals.push_back(roadmap->addRequestState(g, request));
     std::vector<int> crossed;

@@ -132,6 +132,33 @@ TEST_F(LazyTest, ReportMatchesIndependentCheckForAnyCostScale) {
   }
 }
 
+// A perceived object the caller can neither carry nor push, estimated 3 cm into where the robot
+// stands, is fixed for the next question: the start touches a static object for that request.
+// It is left as a movable would be in full mode (a short way out first), not `start in collision`.
+TEST_F(LazyTest, AStartTouchingAFixedObjectLeavesItFirst) {
+  const world::World w = testing::openRoomWorld();  // `obstacle`: x in [4.7, 5.3], y in [2.7, 3.3]
+  MotionPlanner mp = planner(w);
+  const Pose2D from{4.7 - kRadius + 0.03, 3.0, 0.0};
+  MotionRequest req = baseRequest(from, {2.0, 3.0, 0.0});
+  req.fixed_objects = {"obstacle"};
+  const MotionResult r = mp.plan(req, Termination::after(5.0));
+  ASSERT_EQ(r.status, MotionStatus::kSolved) << r.reason;
+  EXPECT_EQ(r.start_contacts, std::vector<std::string>{"obstacle"});
+  ASSERT_GE(r.path.waypoints.size(), 2u);
+  EXPECT_NEAR(r.path.waypoints.front()[0], from.x, 1e-9);
+  // After the start (and the turn in place there that the path states), off the object it stood in.
+  JointPath rest = r.path;
+  while (rest.waypoints.size() > 1 &&
+         std::hypot(rest.waypoints.front()[0] - from.x, rest.waypoints.front()[1] - from.y) < 1e-9)
+    rest.waypoints.erase(rest.waypoints.begin());
+  EXPECT_TRUE(discTouches(w, rest, kRadius, 0.005).empty());
+  // Touching a wall as well, there is no way out: start in collision, as before.
+  world::World walled = w;
+  ASSERT_TRUE(walled.addObject(testing::box("pillar", from.x - 0.3, 3.0, 0.1, 0.1, false)).ok());
+  MotionPlanner mp2 = planner(walled);
+  EXPECT_EQ(mp2.plan(req, Termination::after(5.0)).status, MotionStatus::kStartInCollision);
+}
+
 TEST_F(LazyTest, FixedObjectsAreObstaclesOfTheLazyPath) {
   const world::World w = testing::twoDoorWorld();
   // The pure static-only path takes door A, through the two heavy objects.

@@ -540,7 +540,8 @@ class DisconnectionProof {
            static_cast<std::uint64_t>(c.ix);
   }
   unsigned char& state(const Cell& c);
-  bool kept(const Cell& c);
+  /// Whether cell `c`, whose state is `st`, may hold a free robot (tested once, then recorded in `st`).
+  bool kept(unsigned char& st, const Cell& c);
 
   const collision::Scene& scene_;
   collision::Filter filter_;

@@ -903,6 +903,8 @@ struct Planning {
   bool collides(const ob::State* s);
   collision::Scene& plainScene();
   std::string selfHit(const ob::State* s);
+  collision::Scene shrunkScene(const std::vector<std::string>& ids);
+  bool escapeBy(const ob::SpaceInformationPtr& checker);
   void escapeTouchedMovables(const std::vector<int>& touching);
   bool escapeNoDeeper(const std::vector<int>& touching);
   bool escapeThrough(const std::vector<int>& touching);
@@ -1222,52 +1224,56 @@ std::vector<std::string> Planning::touchedFixedOnly() {
 /// start leaves movables: going no deeper into them first, else through them, to a state that
 /// touches nothing static (they included).
 void Planning::escapeFixed(const std::vector<std::string>& touched) {
-  auto leave = [&](collision::Scene& scene, const std::vector<std::string>& ignore) {
-    detail::Oracle escape_oracle(scene, gs, ignore, oracle.movables(), oracle.reachRadius());
-    if (held_shape) escape_oracle.setSelfScene(&plainScene());
-    escaped.reset(space->allocState());
-    if (!detail::escapeStart(si, makeSi(escape_oracle, false), start.get(), P.sampling.start_escape_distance,
-                             P.sampling.start_escape_attempts, escaped.get()))
-      escaped.reset();
-  };
+  bool found = false;
   if (P.sampling.start_escape_depth > 0.0) {
-    world::World w = impl.scene.world();
-    for (const auto& id : touched) {
-      world::Object o = w.object(id);
-      o.shape = world::shrunk(o.shape, P.sampling.start_escape_depth);
-      (void)w.updateObject(std::move(o));
-    }
-    collision::Scene smaller(impl.scene);
-    smaller.syncWorld(w);
-    leave(smaller, ignored);
+    collision::Scene smaller = shrunkScene(touched);
+    detail::Oracle escape_oracle(smaller, gs, ignored, oracle.movables(), oracle.reachRadius());
+    if (held_shape) escape_oracle.setSelfScene(&plainScene());
+    found = escapeBy(makeSi(escape_oracle, false));
   }
-  if (!escaped) {
+  if (!found) {
     std::vector<std::string> ignore = ignored;
     ignore.insert(ignore.end(), touched.begin(), touched.end());
-    leave(impl.scene, ignore);
+    detail::Oracle escape_oracle(impl.scene, gs, ignore, oracle.movables(), oracle.reachRadius());
+    if (held_shape) escape_oracle.setSelfScene(&plainScene());
+    found = escapeBy(makeSi(escape_oracle, false));
   }
-  gs.placeRobot(start.get(), impl.scene);
-  if (escaped) res.start_contacts.insert(res.start_contacts.end(), touched.begin(), touched.end());
+  if (found) res.start_contacts.insert(res.start_contacts.end(), touched.begin(), touched.end());
 }
 
-/// The way out checked against everything, the touched objects `start_escape_depth` smaller.
-bool Planning::escapeNoDeeper(const std::vector<int>& touching) {
+/// A copy of the request's scene with the objects `ids` `start_escape_depth` smaller.
+collision::Scene Planning::shrunkScene(const std::vector<std::string>& ids) {
   world::World w = impl.scene.world();
-  for (int i : touching) {
-    world::Object o = w.object(oracle.movables()[static_cast<std::size_t>(i)].id);
+  for (const auto& id : ids) {
+    world::Object o = w.object(id);
     o.shape = world::shrunk(o.shape, P.sampling.start_escape_depth);
     (void)w.updateObject(std::move(o));
   }
   collision::Scene smaller(impl.scene);
   smaller.syncWorld(w);
-  detail::Oracle escape_oracle(smaller, gs, ignored, oracle.movables(), oracle.reachRadius());
-  if (held_shape) escape_oracle.setSelfScene(&plainScene());
+  return smaller;
+}
+
+/// A short way out of the start, each state checked by `checker` (whose oracle sees the held
+/// object's self-collisions without its margin); sets `escaped`, or clears it when there is none.
+/// The robot is placed back at the start in the request's scene.
+bool Planning::escapeBy(const ob::SpaceInformationPtr& checker) {
   escaped.reset(space->allocState());
-  const bool found = detail::escapeStart(si, sweptSi(escape_oracle), start.get(), P.sampling.start_escape_distance,
+  const bool found = detail::escapeStart(si, checker, start.get(), P.sampling.start_escape_distance,
                                          P.sampling.start_escape_attempts, escaped.get());
   if (!found) escaped.reset();
   gs.placeRobot(start.get(), impl.scene);
   return found;
+}
+
+/// The way out checked against everything, the touched objects `start_escape_depth` smaller.
+bool Planning::escapeNoDeeper(const std::vector<int>& touching) {
+  std::vector<std::string> ids;
+  for (int i : touching) ids.push_back(oracle.movables()[static_cast<std::size_t>(i)].id);
+  collision::Scene smaller = shrunkScene(ids);
+  detail::Oracle escape_oracle(smaller, gs, ignored, oracle.movables(), oracle.reachRadius());
+  if (held_shape) escape_oracle.setSelfScene(&plainScene());
+  return escapeBy(sweptSi(escape_oracle));
 }
 
 /// The way out checked against everything but the touched objects.
@@ -1284,24 +1290,14 @@ bool Planning::escapeThrough(const std::vector<int>& touching) {
   }
   detail::Oracle escape_oracle(impl.scene, gs, ignore, std::move(others), oracle.reachRadius());
   if (held_shape) escape_oracle.setSelfScene(&plainScene());
-  escaped.reset(space->allocState());
-  const bool found = detail::escapeStart(si, makeSi(escape_oracle, true), start.get(), P.sampling.start_escape_distance,
-                                         P.sampling.start_escape_attempts, escaped.get());
-  if (!found) escaped.reset();
-  return found;
+  return escapeBy(makeSi(escape_oracle, true));
 }
 
 /// Out of a contact that only the held object's margin makes; `escaped` stays empty when the
 /// start touches something without the margin too, or there is no way out.
 void Planning::escapeHeldMargin() {
   detail::Oracle plain_oracle(plainScene(), gs, ignored, oracle.movables(), oracle.reachRadius());
-  if (lazy ? plain_oracle.staticFree(start.get()) : plain_oracle.allFree(start.get())) {
-    escaped.reset(space->allocState());
-    if (!detail::escapeStart(si, makeSi(plain_oracle, !lazy), start.get(), P.sampling.start_escape_distance,
-                             P.sampling.start_escape_attempts, escaped.get())) {
-      escaped.reset();
-    }
-  }
+  if (lazy ? plain_oracle.staticFree(start.get()) : plain_oracle.allFree(start.get())) (void)escapeBy(makeSi(plain_oracle, !lazy));
   gs.placeRobot(start.get(), impl.scene);
 }
 

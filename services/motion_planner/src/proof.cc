@@ -78,12 +78,13 @@ DisconnectionProof::DisconnectionProof(const collision::Scene& scene, const coll
       if (std::hypot(dx, dy) > goal_tolerance) continue;
       for (long it = 0; it < nt_; ++it) {
         const Cell g{ix, iy, it};
-        if (state(g) & kFromStart) {
+        unsigned char& st = state(g);
+        if (st & kFromStart) {
           decided_ = ProofOutcome::kConnected;
           return;
         }
-        if (!kept(g)) continue;
-        state(g) |= kFromGoal;
+        if (!kept(st, g)) continue;
+        st |= kFromGoal;
         push(from_goal_, start_, g);
       }
     }
@@ -136,8 +137,7 @@ void DisconnectionProof::push(Frontier& frontier, const Eigen::Vector2d& towards
   frontier.push({std::hypot(x - towards.x(), y - towards.y()), c});
 }
 
-bool DisconnectionProof::kept(const Cell& c) {
-  unsigned char& st = state(c);
+bool DisconnectionProof::kept(unsigned char& st, const Cell& c) {
   if (!(st & kTested)) {
     const double x = min_.x() + (static_cast<double>(c.ix) + 0.5) * cell_;
     const double y = min_.y() + (static_cast<double>(c.iy) + 0.5) * cell_;
@@ -177,9 +177,9 @@ ProofOutcome DisconnectionProof::advance(const Termination& termination) {
           const Cell n{at.ix + dx, at.iy + dy, (at.it + dt + nt_) % nt_};
           if ((dx == 0 && dy == 0 && dt == 0) || n.ix < 0 || n.iy < 0 || n.ix >= nx_ || n.iy >= ny_) continue;
           if (nt_ == 2 && dt == 1) continue;  // two yaw cells: -1 and +1 are the same neighbour
-          if (state(n) & mine) continue;
-          if (!kept(n)) continue;
-          unsigned char& st = state(n);
+          unsigned char& st = state(n);  // a reference that stays valid: the map is node-based
+          if (st & mine) continue;
+          if (!kept(st, n)) continue;
           if (st & theirs) return decided_ = ProofOutcome::kConnected;
           st |= mine;
           push(frontier, towards, n);

@@ -4,9 +4,11 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <sstream>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -19,8 +21,42 @@ namespace tamp::integration {
 inline std::filesystem::path binDir() { return TAMP_BIN_DIR; }
 using dds::testing::isolatedDomain;
 
-inline std::filesystem::path tempFile(const std::string& stem) {
-  return std::filesystem::temp_directory_path() / (stem + "_" + std::to_string(::getpid()));
+/// The scratch files and folders of the running test: removed when it passes, kept (and named
+/// on stderr) when it fails, so that repeated runs do not fill the temp directory.
+class Scratch : public ::testing::EmptyTestEventListener {
+ public:
+  static void add(const std::filesystem::path& p) {
+    static Scratch* const self = [] {
+      auto* s = new Scratch;  // owned by gtest's listener list
+      ::testing::UnitTest::GetInstance()->listeners().Append(s);
+      return s;
+    }();
+    self->paths_.push_back(p);
+  }
+
+  void OnTestEnd(const ::testing::TestInfo& info) override {
+    const bool passed = info.result() != nullptr && info.result()->Passed();
+    for (const auto& p : paths_) {
+      std::error_code ec;
+      if (!std::filesystem::exists(p, ec)) continue;
+      if (passed) {
+        std::filesystem::remove_all(p, ec);
+      } else {
+        std::cerr << "kept for diagnosis: " << p.string() << "\n";
+      }
+    }
+    paths_.clear();
+  }
+
+ private:
+  std::vector<std::filesystem::path> paths_;
+};
+
+/// A path in the temp directory for this process (`stem`_pid`suffix`), scratch of the running test.
+inline std::filesystem::path tempFile(const std::string& stem, const std::string& suffix = "") {
+  auto p = std::filesystem::temp_directory_path() / (stem + "_" + std::to_string(::getpid()) + suffix);
+  Scratch::add(p);
+  return p;
 }
 
 /// A service process on `domain` (stdout/stderr into a temp log, shown when a test fails).

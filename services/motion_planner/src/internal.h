@@ -508,12 +508,20 @@ enum class ProofOutcome { kDisconnected, kConnected, kSkipped, kStopped };
 /// grid cannot say (too many cells, cells too coarse, no box part, the start outside the bounds).
 /// `statics`, when given, is a clearance grid of (at least) the scene's static objects: where it
 /// shows none within reach of the cell's shape, FCL is asked of the other groups only.
+/// `carried`, when given, is a shape fixed to the base (the held object, the arm still): the
+/// (x, y, yaw) cells test it too, shrunk the same way, so that a base that cannot turn or pass
+/// with what it holds or pushes is proven so.
 class DisconnectionProof {
  public:
+  /// A shape at a fixed place on the base.
+  struct Carried {
+    world::Shape shape;
+    Eigen::Isometry3d base_T_shape{Eigen::Isometry3d::Identity()};
+  };
   DisconnectionProof(const collision::Scene& scene, const collision::Filter& filter,
                      const collision::ClearanceGrid* statics, const RobotBinding& robot, const Aabb& bounds,
                      const Pose2D& start, const Eigen::Vector2d& goal, double goal_tolerance, double cell,
-                     int yaw_cells, int max_cells);
+                     int yaw_cells, int max_cells, const std::optional<Carried>& carried = std::nullopt);
   ProofOutcome advance(const Termination& termination);
   double cell() const { return cell_; }
   int yawCells() const { return nt_; }
@@ -531,7 +539,16 @@ class DisconnectionProof {
     bool operator<(const Entry& o) const { return to_other_end > o.to_other_end; }  // nearest on top
   };
   using Frontier = std::priority_queue<Entry>;
-  bool setUpShape(const RobotBinding& robot);
+  /// A shape tested at each cell's centre (in the base frame).
+  struct Probe {
+    world::Shape shape;
+    Eigen::Isometry3d base_T_shape{Eigen::Isometry3d::Identity()};
+  };
+  bool setUpShapes(const RobotBinding& robot, const std::optional<Carried>& carried);
+  bool addRobotProbe(const RobotBinding& robot);
+  void addCarriedProbe(const Carried& carried);
+  /// Whether every probe is free with the base at (x, y, yaw).
+  bool probesFree(double x, double y, double yaw);
   void push(Frontier& frontier, const Eigen::Vector2d& towards, const Cell& c);
   bool cellOf(double x, double y, long& ix, long& iy) const;
   std::uint64_t key(const Cell& c) const {
@@ -551,9 +568,8 @@ class DisconnectionProof {
   double cell_;
   long nx_{0}, ny_{0}, nt_{1};
   std::size_t max_cells_{0};
-  world::Shape shape_{world::Shape::sphere(1.0)};           ///< tested at each cell's centre
-  Eigen::Isometry3d base_T_shape_{Eigen::Isometry3d::Identity()};
-  double reach_{0.0};  ///< xy distance from the base origin that the shape stays within
+  std::vector<Probe> probes_;
+  double reach_{0.0};  ///< xy distance from the base origin that the probes stay within
   std::vector<unsigned char> dense_;                         ///< xy cells
   std::unordered_map<std::uint64_t, unsigned char> sparse_;  ///< (x, y, yaw) cells
   Eigen::Vector2d start_{Eigen::Vector2d::Zero()}, goal_{Eigen::Vector2d::Zero()};

@@ -920,6 +920,7 @@ struct Planning {
   void densify(og::PathGeometric& path, int s, const std::vector<int>& goals, const std::vector<int>& objects);
   void tryDirect();
   bool directKeepsClear(const ob::State* from, const ob::State* to);
+  std::optional<detail::DisconnectionProof::Carried> carriedByBase() const;
   Outcome sample(const Stopwatch& phase, bool solved);
   og::PathGeometric improveByRoadmap(const og::PathGeometric& raw, const detail::PathCost& raw_cost);
   void simplify(og::PathGeometric& path);
@@ -1571,6 +1572,17 @@ bool Planning::directKeepsClear(const ob::State* from, const ob::State* to) {
 /// it in time. The proof (full mode: a first turn before sampling) gets a turn after each slice,
 /// of ProofParams::time_share times the slice, and goes on from where its last turn stopped,
 /// refining its grid each time one is too coarse to decide. Sampling time is reported either way.
+/// The held object where it rides on the base for this request (the arm still), modelled
+/// without its margin; nothing when nothing is held or the arm moves.
+std::optional<detail::DisconnectionProof::Carried> Planning::carriedByBase() const {
+  if (held.empty() || gs.movesArm()) return std::nullopt;
+  const world::Object* o = impl.scene.world().findObject(held);
+  const auto world_T_link = impl.linkPose(req.start, held_link);
+  if (o == nullptr || !world_T_link) return std::nullopt;
+  return detail::DisconnectionProof::Carried{held_shape ? *held_shape : o->shape,
+                                             req.start.base.toIsometry().inverse() * *world_T_link * link_T_held};
+}
+
 Outcome Planning::sample(const Stopwatch& phase, bool solved) {
   // Proof levels: (xy cell, yaw cells); the disc on finer and finer cells, then the oriented base.
   std::vector<std::pair<double, int>> proof_cells;
@@ -1585,6 +1597,7 @@ Outcome Planning::sample(const Stopwatch& phase, bool solved) {
   // From where the sampler starts: a start touching movables is left first (the proof's cells
   // beside a touching start could all touch them too).
   const Pose2D proof_start = proof_cells.empty() ? req.start.base : gs.basePose(escaped ? escaped.get() : start.get());
+  const auto carried = proof_cells.empty() ? std::nullopt : carriedByBase();
   auto traceProof = [&](const detail::DisconnectionProof& p, detail::ProofOutcome outcome) {
     static constexpr const char* kNames[] = {"disconnected", "connected", "skipped", "undecided"};
     std::string& t = res.stats.proof_trace;
@@ -1602,7 +1615,7 @@ Outcome Planning::sample(const Stopwatch& phase, bool solved) {
         proof = std::make_unique<detail::DisconnectionProof>(
             impl.scene, proof_filter, statics.get(), impl.robot, bounds, proof_start, *base_goal,
             P.sampling.goal_position_tolerance, proof_cells[level].first, proof_cells[level].second,
-            proof_cells[level].second > 1 ? P.proof.oriented_max_cells : P.proof.max_cells);
+            proof_cells[level].second > 1 ? P.proof.oriented_max_cells : P.proof.max_cells, carried);
       }
       const detail::ProofOutcome outcome = proof->advance(turn);
       if (outcome == detail::ProofOutcome::kStopped) break;

@@ -18,6 +18,13 @@
 // the cell, and a cell whose shrunk box touches something holds no free configuration. Chains are
 // 26-connected, yaw wrapping round; the goal is its xy cells at every yaw.
 //
+// A shape carried at a fixed place on the base (the held or pushed object, the arm still) is a
+// second probe of the (x, y, yaw) cells, by the same argument: eroded by its own e (R: its
+// farthest xy point from the base origin) in the directions its points move in (the base plane
+// when it stands upright on the base, else every direction), it lies inside the carried shape
+// at every configuration of the cell. A cell is kept when every probe is free. A base whose
+// inscribed part is no box tests its disc (yaw plays no part in it) beside the carried shape.
+//
 // The search grows from both ends in turn, the end that has expanded fewer cells first: when
 // the start or the goal is in a pocket, the pocket is exhausted after about its own cells,
 // however large the rest of the map. Each end expands the cell nearest the other end first
@@ -46,11 +53,12 @@ long yawCellOf(double yaw, long nt) {
 DisconnectionProof::DisconnectionProof(const collision::Scene& scene, const collision::Filter& filter,
                                        const collision::ClearanceGrid* statics, const RobotBinding& robot,
                                        const Aabb& bounds, const Pose2D& start, const Eigen::Vector2d& goal,
-                                       double goal_tolerance, double cell, int yaw_cells, int max_cells)
+                                       double goal_tolerance, double cell, int yaw_cells, int max_cells,
+                                       const std::optional<Carried>& carried)
     : scene_(scene), filter_(filter), statics_(statics), min_(bounds.min.head<2>()), cell_(cell),
       nt_(std::max(1, yaw_cells)), max_cells_(static_cast<std::size_t>(std::max(1, max_cells))) {
   const double w = bounds.max.x() - bounds.min.x(), hgt = bounds.max.y() - bounds.min.y();
-  if (!(cell > 0) || !(w > 0) || !(hgt > 0) || !setUpShape(robot)) return;
+  if (!(cell > 0) || !(w > 0) || !(hgt > 0) || !setUpShapes(robot, carried)) return;
   nx_ = static_cast<long>(std::ceil(w / cell));
   ny_ = static_cast<long>(std::ceil(hgt / cell));
   if (nt_ == 1) {
@@ -92,18 +100,28 @@ DisconnectionProof::DisconnectionProof(const collision::Scene& scene, const coll
   decided_ = from_goal_.empty() ? ProofOutcome::kDisconnected : ProofOutcome::kStopped;
 }
 
-bool DisconnectionProof::setUpShape(const RobotBinding& robot) {
-  if (nt_ == 1) {
+bool DisconnectionProof::setUpShapes(const RobotBinding& robot, const std::optional<Carried>& carried) {
+  if (!addRobotProbe(robot)) return false;
+  if (nt_ == 1) return true;
+  const bool box = probes_.front().shape.kind == world::ShapeKind::kBox;
+  if (carried) addCarriedProbe(*carried);
+  return box || probes_.size() > 1;  // a disc alone: the xy levels say all it can
+}
+
+/// The robot's probe: its inscribed disc (xy cells, and (x, y, yaw) cells of a base whose
+/// inscribed part is no box), or its base box shrunk by how far its points move within a cell.
+bool DisconnectionProof::addRobotProbe(const RobotBinding& robot) {
+  const collision::RobotPart* part = robot.inscribedPart();
+  if (nt_ == 1 || part == nullptr || part->shape.kind != world::ShapeKind::kBox) {
     const double r = robot.inscribedRadius() - cell_ * std::sqrt(0.5) - 1e-3;
     if (!(robot.inscribedRadius() > 0) || r <= 1e-3) return false;
     const double zmin = robot.inscribedZMin(), zmax = robot.inscribedZMax();
-    shape_ = world::Shape::cylinder(r, std::max(1e-3, zmax - zmin));
-    base_T_shape_.translation().z() = 0.5 * (zmin + zmax);
+    Probe disc{world::Shape::cylinder(r, std::max(1e-3, zmax - zmin)), Eigen::Isometry3d::Identity()};
+    disc.base_T_shape.translation().z() = 0.5 * (zmin + zmax);
+    probes_.push_back(std::move(disc));
     reach_ = r;
     return true;
   }
-  const collision::RobotPart* part = robot.inscribedPart();
-  if (part == nullptr || part->shape.kind != world::ShapeKind::kBox) return false;
   const Eigen::Vector3d half = 0.5 * part->shape.size;
   double far = 0.0;
   for (const double sx : {-1.0, 1.0}) {
@@ -115,10 +133,68 @@ bool DisconnectionProof::setUpShape(const RobotBinding& robot) {
   const double yaw_width = 2.0 * M_PI / static_cast<double>(nt_);
   const double e = cell_ * std::sqrt(0.5) + far * 0.5 * yaw_width + 1e-3;
   if (half.x() - e <= 1e-3 || half.y() - e <= 1e-3) return false;
-  shape_ = world::Shape::box(2.0 * (half.x() - e), 2.0 * (half.y() - e), part->shape.size.z());
-  base_T_shape_ = part->link_T_shape;
+  probes_.push_back({world::Shape::box(2.0 * (half.x() - e), 2.0 * (half.y() - e), part->shape.size.z()),
+                     part->link_T_shape});
   reach_ = far;
   return true;
+}
+
+namespace {
+/// The farthest xy distance from the base origin of a point of `shape` at `base_T_shape` (of its
+/// bounding box: an upper bound), or nothing for shapes without one here.
+std::optional<double> farthestXY(const world::Shape& shape, const Eigen::Isometry3d& base_T_shape) {
+  Eigen::Vector3d half;
+  switch (shape.kind) {
+    case world::ShapeKind::kBox: half = 0.5 * shape.size; break;
+    case world::ShapeKind::kCylinder: half = Eigen::Vector3d(shape.radius, shape.radius, 0.5 * shape.height); break;
+    case world::ShapeKind::kSphere: half = Eigen::Vector3d::Constant(shape.radius); break;
+    default: return std::nullopt;
+  }
+  double far = 0.0;
+  for (const double sx : {-1.0, 1.0})
+    for (const double sy : {-1.0, 1.0})
+      for (const double sz : {-1.0, 1.0})
+        far = std::max(far, (base_T_shape * Eigen::Vector3d(sx * half.x(), sy * half.y(), sz * half.z())).head<2>().norm());
+  return far;
+}
+
+/// `shape` eroded by `e` in the directions its points move in: the base plane when it stands
+/// upright in the base frame (`upright`), else every direction; nothing when too little is left.
+std::optional<world::Shape> eroded(world::Shape shape, bool upright, double e) {
+  constexpr double kLeft = 1e-3;
+  switch (shape.kind) {
+    case world::ShapeKind::kBox:
+      shape.size.x() -= 2.0 * e;
+      shape.size.y() -= 2.0 * e;
+      if (!upright) shape.size.z() -= 2.0 * e;
+      if (shape.size.minCoeff() <= kLeft) return std::nullopt;
+      return shape;
+    case world::ShapeKind::kCylinder:
+      shape.radius -= e;
+      if (!upright) shape.height -= 2.0 * e;
+      if (shape.radius <= kLeft || shape.height <= kLeft) return std::nullopt;
+      return shape;
+    case world::ShapeKind::kSphere:
+      shape.radius -= e;
+      if (shape.radius <= kLeft) return std::nullopt;
+      return shape;
+    default:
+      return std::nullopt;
+  }
+}
+}  // namespace
+
+/// The carried shape's probe ((x, y, yaw) cells only); none when too small once eroded.
+void DisconnectionProof::addCarriedProbe(const Carried& carried) {
+  const auto far = farthestXY(carried.shape, carried.base_T_shape);
+  if (!far) return;
+  const double yaw_width = 2.0 * M_PI / static_cast<double>(nt_);
+  const double e = cell_ * std::sqrt(0.5) + *far * 0.5 * yaw_width + 1e-3;
+  const bool upright = std::abs(carried.base_T_shape.linear()(2, 2)) > 1.0 - 1e-9;
+  if (auto shape = eroded(carried.shape, upright, e)) {
+    probes_.push_back({std::move(*shape), carried.base_T_shape});
+    reach_ = std::max(reach_, *far);
+  }
 }
 
 bool DisconnectionProof::cellOf(double x, double y, long& ix, long& iy) const {
@@ -142,18 +218,24 @@ bool DisconnectionProof::kept(unsigned char& st, const Cell& c) {
     const double x = min_.x() + (static_cast<double>(c.ix) + 0.5) * cell_;
     const double y = min_.y() + (static_cast<double>(c.iy) + 0.5) * cell_;
     const double yaw = -M_PI + (static_cast<double>(c.it) + 0.5) * 2.0 * M_PI / static_cast<double>(nt_);
-    const Eigen::Isometry3d pose = Pose2D{x, y, nt_ == 1 ? 0.0 : yaw}.toIsometry() * base_T_shape_;
-    bool free = false;
-    if (statics_ && statics_->clearance(x, y) > reach_) {
-      ++grid_answers_;
-      free = others_.groups == 0 || !scene_.shapeInCollision(shape_, pose, others_);
-    } else {
-      free = !scene_.shapeInCollision(shape_, pose, filter_);
-    }
+    const bool free = probesFree(x, y, nt_ == 1 ? 0.0 : yaw);
     ++tested_;
     st = static_cast<unsigned char>(kTested | (free ? kFree : 0));
   }
   return st & kFree;
+}
+
+bool DisconnectionProof::probesFree(double x, double y, double yaw) {
+  const Eigen::Isometry3d base = Pose2D{x, y, yaw}.toIsometry();
+  // Where the clearance grid shows no static footprint within the probes' reach, only the other
+  // groups are asked.
+  const bool grid = statics_ && statics_->clearance(x, y) > reach_;
+  if (grid) ++grid_answers_;
+  const collision::Filter& f = grid ? others_ : filter_;
+  if (f.groups == 0) return true;
+  for (const Probe& p : probes_)
+    if (scene_.shapeInCollision(p.shape, base * p.base_T_shape, f)) return false;
+  return true;
 }
 
 ProofOutcome DisconnectionProof::advance(const Termination& termination) {

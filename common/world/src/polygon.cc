@@ -311,4 +311,31 @@ std::vector<Polygon2> convexDecomposition(const Polygon2& input) {
   return out;
 }
 
+std::optional<Polygon2> insetConvex(const Polygon2& convex, double by) {
+  const size_t n = convex.size();
+  if (n < 3) return std::nullopt;
+  // The intersection of the half-planes at least `by` inside each edge (Sutherland-Hodgman: each
+  // clip of a convex polygon by a half-plane is convex).
+  Polygon2 out = convex;
+  for (size_t i = 0; i < n && out.size() >= 3; ++i) {
+    const Point2 a = convex[i], d = convex[(i + 1) % n] - a;
+    if (d.norm() == 0.0) continue;
+    const Point2 inward = Point2(-d.y(), d.x()) / d.norm();
+    auto depth = [&](const Point2& p) { return inward.dot(p - a) - by; };
+    Polygon2 clipped;
+    for (size_t k = 0; k < out.size(); ++k) {
+      const Point2& p = out[k];
+      const Point2& q = out[(k + 1) % out.size()];
+      const double dp = depth(p), dq = depth(q);
+      if (dp >= 0.0) clipped.push_back(p);
+      if ((dp >= 0.0) != (dq >= 0.0)) clipped.push_back(p + (q - p) * (dp / (dp - dq)));
+    }
+    out = std::move(clipped);
+  }
+  out = cleanPolygon(out);
+  if (out.size() < 3 || signedArea(out) < 1e-12) return std::nullopt;
+  return out;
+}
+
 }  // namespace tamp::world
+

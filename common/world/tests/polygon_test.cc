@@ -73,6 +73,42 @@ TEST(PolygonTest, Convexity) {
   EXPECT_FALSE(isConvex(Polygon2{{0, 0}, {1, 0}}));
 }
 
+TEST(PolygonTest, InsetOfAConvexPolygon) {
+  // A 2 x 1 rectangle inset by 0.25: 1.5 x 0.5, same centre; by 0.5 or more: nothing left.
+  const Polygon2 rect{{0, 0}, {2, 0}, {2, 1}, {0, 1}};
+  const auto in = insetConvex(rect, 0.25);
+  ASSERT_TRUE(in.has_value());
+  EXPECT_NEAR(signedArea(*in), 1.5 * 0.5, 1e-12);
+  for (const auto& p : *in) {
+    EXPECT_GE(p.x(), 0.25 - 1e-12);
+    EXPECT_LE(p.x(), 1.75 + 1e-12);
+    EXPECT_GE(p.y(), 0.25 - 1e-12);
+    EXPECT_LE(p.y(), 0.75 + 1e-12);
+  }
+  EXPECT_FALSE(insetConvex(rect, 0.5).has_value());
+  EXPECT_FALSE(insetConvex(rect, 0.6).has_value());
+  // A triangle with a short edge: the edge vanishes, what is left is still every point at least
+  // `by` from the boundary (checked at random points).
+  const Polygon2 tri{{0, 0}, {4, 0}, {0.1, 1.0}};
+  const double by = 0.2;
+  const auto t = insetConvex(tri, by);
+  ASSERT_TRUE(t.has_value());
+  EXPECT_TRUE(isConvex(*t));
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> ux(-0.5, 4.5), uy(-0.5, 1.5);
+  int inside = 0;
+  for (int k = 0; k < 20000; ++k) {
+    const Point2 p(ux(rng), uy(rng));
+    if (!containsPoint(tri, p)) continue;
+    double to_boundary = 1e9;
+    for (size_t i = 0; i < tri.size(); ++i) to_boundary = std::min(to_boundary, segmentDistance(p, tri[i], tri[(i + 1) % 3]));
+    if (std::abs(to_boundary - by) < 1e-6) continue;
+    EXPECT_EQ(containsPoint(*t, p), to_boundary > by) << p.transpose();
+    inside += containsPoint(*t, p);
+  }
+  EXPECT_GT(inside, 0);
+}
+
 TEST(PolygonTest, ContainsPoint) {
   EXPECT_TRUE(containsPoint(lShape(), {0.5, 1.5}));
   EXPECT_FALSE(containsPoint(lShape(), {1.5, 1.5}));

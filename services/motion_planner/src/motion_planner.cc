@@ -1643,8 +1643,11 @@ Outcome Planning::sample(const Stopwatch& phase, bool solved) {
                                                                     : std::string()) +
                                              ")");
   };
+  // A first turn before sampling: a goal walled off (by statics, or objects the request fixes)
+  // is answered in milliseconds, before the first slice (lazy: 0.25 s) of a search that cannot
+  // succeed. Requests the roadmap or the direct motion answered never get here.
   double slice = lazy ? 0.25 : 0.02;
-  if (!solved && !lazy && proofTurn(P.proof.first_turn_s)) return noPath();
+  if (!solved && proofTurn(P.proof.first_turn_s)) return noPath();
   while (!solved) {
     if (termination()) break;
     // No path kept the clearance in time: on without it (every state and motion of the tree so
@@ -1656,6 +1659,7 @@ Outcome Planning::sample(const Stopwatch& phase, bool solved) {
     const Termination slice_term = termination.tightened(Deadline::in(
         clearance && !clearance->relaxed() ? std::min(slice, P.sampling.base_clearance_time_s) : slice));
     planner->solve(ptcOf(slice_term));
+    ++res.stats.sampling_slices;
     solved = pdef->hasExactSolution();
     if (!solved && proofTurn(slice * P.proof.time_share)) return noPath();
     slice *= 2;

@@ -37,6 +37,7 @@
 #include <cmath>
 
 #include "internal.h"
+#include "tamp/world/polygon.h"
 
 namespace tamp::motion_planner::detail {
 
@@ -143,14 +144,18 @@ namespace {
 /// The farthest xy distance from the base origin of a point of `shape` at `base_T_shape` (of its
 /// bounding box: an upper bound), or nothing for shapes without one here.
 std::optional<double> farthestXY(const world::Shape& shape, const Eigen::Isometry3d& base_T_shape) {
-  Eigen::Vector3d half;
+  Eigen::Vector3d half = Eigen::Vector3d::Zero();
+  double far = 0.0;
   switch (shape.kind) {
     case world::ShapeKind::kBox: half = 0.5 * shape.size; break;
     case world::ShapeKind::kCylinder: half = Eigen::Vector3d(shape.radius, shape.radius, 0.5 * shape.height); break;
     case world::ShapeKind::kSphere: half = Eigen::Vector3d::Constant(shape.radius); break;
-    default: return std::nullopt;
+    case world::ShapeKind::kPrism:
+      for (const auto& v : shape.polygon)
+        for (const double sz : {-1.0, 1.0})
+          far = std::max(far, (base_T_shape * Eigen::Vector3d(v.x(), v.y(), sz * 0.5 * shape.height)).head<2>().norm());
+      return far;
   }
-  double far = 0.0;
   for (const double sx : {-1.0, 1.0})
     for (const double sy : {-1.0, 1.0})
       for (const double sz : {-1.0, 1.0})
@@ -159,7 +164,8 @@ std::optional<double> farthestXY(const world::Shape& shape, const Eigen::Isometr
 }
 
 /// `shape` eroded by `e` in the directions its points move in: the base plane when it stands
-/// upright in the base frame (`upright`), else every direction; nothing when too little is left.
+/// upright in the base frame (`upright`), else every direction; nothing when too little is left
+/// (or for a prism that does not stand upright). A prism keeps its largest convex piece.
 std::optional<world::Shape> eroded(world::Shape shape, bool upright, double e) {
   constexpr double kLeft = 1e-3;
   switch (shape.kind) {
@@ -178,9 +184,21 @@ std::optional<world::Shape> eroded(world::Shape shape, bool upright, double e) {
       shape.radius -= e;
       if (shape.radius <= kLeft) return std::nullopt;
       return shape;
-    default:
-      return std::nullopt;
+    case world::ShapeKind::kPrism: {
+      // Its largest convex piece, inset (a part of the shape is as sound a probe as the whole).
+      if (!upright) return std::nullopt;
+      std::vector<world::Polygon2> pieces{shape.polygon};
+      if (!world::isConvex(shape.polygon)) pieces = world::convexDecomposition(shape.polygon);
+      const auto largest = std::max_element(pieces.begin(), pieces.end(), [](const auto& a, const auto& b) {
+        return world::signedArea(a) < world::signedArea(b);
+      });
+      if (largest == pieces.end()) return std::nullopt;
+      auto inset = world::insetConvex(*largest, e);
+      if (!inset) return std::nullopt;
+      return world::Shape::prism(std::move(*inset), shape.height);
+    }
   }
+  return std::nullopt;
 }
 }  // namespace
 

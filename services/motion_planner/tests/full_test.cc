@@ -255,45 +255,58 @@ TEST_F(FullTest, ABaseThatCannotTurnTheCornerIsAProvenNoPath) {
   EXPECT_EQ(open.status, MotionStatus::kSolved) << open.reason;
 }
 
-TEST_F(FullTest, ABaseCarryingALongObjectThatCannotTurnTheCornerIsAProvenNoPath) {
-  // An L corridor 0.8 m wide (east along y in [1, 1.8], then north along x in [4, 4.8]) into a
-  // room (x > 4, y > 5). The disc base (0.3 m) passes it; with a 2.2 x 0.4 m object held ahead
-  // of it (0.35 .. 2.55 m), 2.85 m in all, it cannot turn north: round a corner of two 0.8 m
-  // corridors no rigid segment longer than 2^1.5 x 0.8 = 2.26 m turns.
+// An L corridor 0.8 m wide (east along y in [1, 1.8], then north along x in [4, 4.8]) into a
+// room (x > 4, y > 5). The disc base (0.3 m) passes it; with a 2.2 x 0.4 m load held ahead of it
+// (0.35 .. 2.55 m), 2.85 m in all, it cannot turn north: round a corner of two 0.8 m corridors
+// no rigid segment longer than 2^1.5 x 0.8 = 2.26 m turns. The load as a box, and as a
+// non-convex prism (the bar with a tab, as the NAMO worlds' polygons are).
+world::World lCorridorWide() {
   world::World w("l_corridor_wide");
-  auto add = [&](const world::Object& o) { ASSERT_TRUE(w.addObject(o).ok()) << o.id; };
-  add(testing::box("wall_south", 4, -0.1, 8.4, 0.2, false));
-  add(testing::box("wall_north", 4, 8.1, 8.4, 0.2, false));
-  add(testing::box("wall_west", -0.1, 4, 0.2, 8, false));
-  add(testing::box("wall_east", 8.1, 4, 0.2, 8, false));
-  add(testing::box("below", 4, 0.5, 8, 1.0, false));
-  add(testing::box("north_west", 2.0, 4.9, 4.0, 6.2, false));
-  add(testing::box("east", 6.4, 3.0, 3.2, 4.0, false));
-  world::Object plank = testing::box("plank", 9.0, 9.0, 2.2, 0.4, true, 0.2, 5.0);  // placed by the grasp
-  add(plank);
-  auto plan = [&](const world::World& in, const MotionPlannerParams& p, Pose2D from, Pose2D to, double seconds) {
-    MotionPlanner mp = planner(in, p);
+  for (const auto& o : {testing::box("wall_south", 4, -0.1, 8.4, 0.2, false),
+                        testing::box("wall_north", 4, 8.1, 8.4, 0.2, false),
+                        testing::box("wall_west", -0.1, 4, 0.2, 8, false),
+                        testing::box("wall_east", 8.1, 4, 0.2, 8, false), testing::box("below", 4, 0.5, 8, 1.0, false),
+                        testing::box("north_west", 2.0, 4.9, 4.0, 6.2, false),
+                        testing::box("east", 6.4, 3.0, 3.2, 4.0, false)})
+    EXPECT_TRUE(w.addObject(o).ok()) << o.id;
+  return w;
+}
+
+world::Object longLoad(bool prism) {
+  world::Object load = testing::box("load", 9.0, 9.0, 2.2, 0.4, true, 0.2, 5.0);  // placed by the grasp
+  if (prism) load.shape = world::Shape::prism({{-1.1, -0.2}, {1.1, -0.2}, {1.1, 0.2}, {0.9, 0.2}, {0.9, 0.35},
+                                               {-1.1, 0.35}}, 0.2);
+  return load;
+}
+
+TEST_F(FullTest, ABaseCarryingALongObjectThatCannotTurnTheCornerIsAProvenNoPath) {
+  auto plan = [&](world::World w, const world::Object& load, const MotionPlannerParams& p, Pose2D from, Pose2D to,
+                  double seconds) {
+    EXPECT_TRUE(w.addObject(load).ok());
+    MotionPlanner mp = planner(w, p);
     MotionRequest req = request(from, to);
-    req.held_object = "plank";
+    req.held_object = "load";
     Eigen::Isometry3d grasp = Eigen::Isometry3d::Identity();
     grasp.translation() = Eigen::Vector3d(1.45, 0.0, 0.5);
     req.held_grasp = HeldGrasp{"", grasp};
     return mp.plan(req, Termination::after(seconds));
   };
-  const MotionResult r = plan(w, MotionPlannerParams{}, {1.0, 1.4, 0}, {4.8, 6.5, 0}, 20.0);
-  EXPECT_EQ(r.status, MotionStatus::kNoPath) << r.reason;
-  EXPECT_NE(r.reason.find("yaw cells"), std::string::npos) << r.reason;
-  // Without the (x, y, yaw) level the discs see the corridor as connected: no proof.
   MotionPlannerParams disc_only;
   disc_only.proof.yaw_cells = 0;
-  const MotionResult d = plan(w, disc_only, {1.0, 1.4, 0}, {4.8, 6.5, 0}, 1.0);
-  EXPECT_EQ(d.status, MotionStatus::kTimeout) << d.reason;
-  EXPECT_NE(d.reason.find("infeasibility not proven: 0.1 m: connected"), std::string::npos) << d.reason;
-  // The same load in an open room: no proof of the contrary, a path.
-  world::World open = testing::openRoomWorld();
-  ASSERT_TRUE(open.addObject(plank).ok());
-  const MotionResult o = plan(open, MotionPlannerParams{}, {1.0, 1.0, 0}, {3.0, 2.5, 1.5}, 10.0);
-  EXPECT_EQ(o.status, MotionStatus::kSolved) << o.reason;
+  for (const bool prism : {false, true}) {
+    SCOPED_TRACE(prism ? "prism" : "box");
+    const world::Object load = longLoad(prism);
+    const MotionResult r = plan(lCorridorWide(), load, MotionPlannerParams{}, {1.0, 1.4, 0}, {4.8, 6.5, 0}, 20.0);
+    EXPECT_EQ(r.status, MotionStatus::kNoPath) << r.reason;
+    EXPECT_NE(r.reason.find("yaw cells"), std::string::npos) << r.reason;
+    // Without the (x, y, yaw) level the discs see the corridor as connected: no proof.
+    const MotionResult d = plan(lCorridorWide(), load, disc_only, {1.0, 1.4, 0}, {4.8, 6.5, 0}, 1.0);
+    EXPECT_EQ(d.status, MotionStatus::kTimeout) << d.reason;
+    EXPECT_NE(d.reason.find("infeasibility not proven: 0.1 m: connected"), std::string::npos) << d.reason;
+    // The same load in an open room: no proof of the contrary, a path.
+    const MotionResult o = plan(testing::openRoomWorld(), load, MotionPlannerParams{}, {1.0, 1.0, 0}, {3.0, 2.5, 1.5}, 10.0);
+    EXPECT_EQ(o.status, MotionStatus::kSolved) << o.reason;
+  }
 }
 
 TEST_F(FullTest, StartAndGoalInCollisionNameTheObject) {

@@ -159,6 +159,24 @@ TEST_F(LazyTest, AStartTouchingAFixedObjectLeavesItFirst) {
   EXPECT_EQ(mp2.plan(req, Termination::after(5.0)).status, MotionStatus::kStartInCollision);
 }
 
+// A goal walled off by statics and an object the request fixes: the proof's first turn answers
+// before any slice of the sampling planner (lazy KPIECE's first slice is 0.25 s).
+TEST_F(LazyTest, AGoalWalledOffByAFixedObjectIsProvenBeforeAnySampling) {
+  const world::World w = testing::pocketWorld();  // the crate closes the pocket's door
+  MotionPlanner mp = planner(w);
+  MotionRequest req = baseRequest({2, 2, 0}, {25, 25, 0});
+  req.fixed_objects = {"crate"};
+  const MotionResult r = mp.plan(req, Termination::after(10.0));
+  EXPECT_EQ(r.status, MotionStatus::kNoPath) << r.reason;
+  EXPECT_EQ(r.stats.sampling_slices, 0) << r.stats.proof_trace;
+  EXPECT_GT(r.stats.proof_cells, 0u);
+  // The crate free to move: the lazy path crosses it.
+  req.fixed_objects.clear();
+  const MotionResult o = mp.plan(req, Termination::after(10.0));
+  ASSERT_EQ(o.status, MotionStatus::kSolved) << o.reason;
+  EXPECT_EQ(blockingIds(o.blocking), std::vector<std::string>{"crate"});
+}
+
 TEST_F(LazyTest, FixedObjectsAreObstaclesOfTheLazyPath) {
   const world::World w = testing::twoDoorWorld();
   // The pure static-only path takes door A, through the two heavy objects.

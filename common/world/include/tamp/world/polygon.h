@@ -9,6 +9,7 @@
 /// `triangulate()` and `convexDecomposition()`.
 
 #include <array>
+#include <optional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -34,6 +35,11 @@ double segmentDistance(const Point2& p, const Point2& a, const Point2& b);
 double polygonDistance(const Polygon2& poly, const Point2& p);
 /// Largest distance from `centre` to a vertex.
 double circumradius(const Polygon2& poly, const Point2& centre);
+
+/// The points of a convex counter-clockwise polygon at least `by` (m, >= 0) from its boundary:
+/// the polygon inset by `by` (each edge moved inwards, edges that vanish dropped). Nothing when
+/// less than a polygon of non-zero area is left.
+std::optional<Polygon2> insetConvex(const Polygon2& convex, double by);
 
 /// A copy without consecutive duplicate vertices (closer than `eps`) and without vertices on a
 /// straight line between their neighbours, oriented counter-clockwise. The result may have fewer

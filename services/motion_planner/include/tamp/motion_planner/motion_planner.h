@@ -193,10 +193,11 @@ struct BlockingObject {
 /// Diagnostics of one call (milliseconds, counts).
 struct PlanningStats {
   double sampling_ms{0.0};      ///< lazy KPIECE (or the full-mode planner)
+  int sampling_slices{0};       ///< time slices the sampling planner ran (0: answered without it)
   double optimize_ms{0.0};      ///< roadmap build/growth and search (lazy)
   double shortcut_ms{0.0};
   double analysis_ms{0.0};      ///< blocking report
-  double proof_ms{0.0};         ///< full mode: infeasibility grid
+  double proof_ms{0.0};         ///< the infeasibility grid (both modes)
   /// Cells the proof tested (its disc asked of FCL or the clearance grid), and of those the ones
   /// the static clearance grid cleared of statics (FCL asked of the movables only).
   std::uint64_t proof_cells{0};

@@ -171,7 +171,7 @@ struct ProofParams {
   int yaw_cells{64};
   double oriented_cell_size{0.025};
   int oriented_max_cells{500000};
-  double first_turn_s{0.02};   ///< s, the turn before sampling (full mode); >= 0
+  double first_turn_s{0.02};   ///< s, the turn before sampling (both modes); >= 0
   double time_share{1.0};      ///< proof time per second of sampling; >= 0
 };
 

@@ -137,6 +137,7 @@ MotionAnswer DdsServiceClients::motion(const MotionQuery& q) {
   for (const auto& o : q.added) req.added_objects().push_back(dds::toMsg(o, 0));
   req.movable_cost_weight(q.movable_cost_weight);
   req.fixed_objects(q.fixed);
+  req.straight_only(q.straight_only);
   MotionAnswer a;
   const auto t0 = Clock::now();
   auto rep = checked(motion_.call(req, dds::CallOptions{q.budget_s, {}}), dds::services::kMotion.name);

@@ -13,7 +13,7 @@ double secondsSince(Clock::time_point t0) {
 std::string motionWhat(const MotionQuery& q) {
   std::string w = q.group == Group::kBase ? "base" : "arm";
   w += q.mode == Mode::kLazy ? (q.movable_cost_weight > 0.0 ? " lazy effort-aware" : " lazy")
-                             : " full";
+                             : (q.straight_only ? " straight" : " full");
   if (q.group == Group::kBase) {
     char buf[64];
     std::snprintf(buf, sizeof buf, " to (%.2f, %.2f)", q.goal_base.x, q.goal_base.y);

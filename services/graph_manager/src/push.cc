@@ -117,6 +117,7 @@ std::string GraphManager::whyNotPushable(const world::Object& o) const {
 MotionQuery GraphManager::pushQuery(const std::string& object, const Eigen::Isometry3d& object_pose, const Pose2D& from,
                                     const Pose2D& to, const BranchContext& ctx) const {
   MotionQuery q = fullBaseQuery(from, to, ctx, params_.push_budget_s);
+  q.straight_only = true;  // a push is straight (straightPush): nothing else needs planning
   q.held.object_id = object;
   q.held.link = abstraction_.robot().options().base_link;
   q.held.link_T_object = from.toIsometry(0.0).inverse() * object_pose;
@@ -175,6 +176,7 @@ std::optional<MotionAnswer> GraphManager::planPushMotion(const std::string& obje
   const bool backs_off = std::hypot(apex.x - to.x, apex.y - to.y) >= 1e-6;
   // The base backs off, straight, leaving the object where it pushed it: room to turn.
   MotionQuery back = fullBaseQuery(apex, to, ctx, params_.push_budget_s);
+  back.straight_only = true;
   back.overrides = overridesOf(ctx, object);
   back.overrides.push_back(ObjectOverride{object, false, target});
   // Straight away from the object it touches: the object is no obstacle to that.

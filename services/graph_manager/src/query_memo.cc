@@ -61,6 +61,7 @@ std::string QueryMemo::key(const MotionQuery& q) {
   }
   for (const auto& id : q.ignored) k += "|ignore " + id;
   for (const auto& id : q.fixed) k += "|fixed " + id;
+  if (q.straight_only) k += "|straight";
   put(k, q.overrides);
   put(k, q.added);
   k += "|w";

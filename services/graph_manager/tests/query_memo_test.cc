@@ -35,7 +35,7 @@ TEST(QueryMemoTest, AnIdenticalMotionQuestionIsAnsweredFromMemory) {
 TEST(QueryMemoTest, AnyFieldThatChangesTheAnswerChangesTheKey) {
   QueryMemo memo;
   memo.keep(baseQuery(), solved(3.5));
-  std::vector<MotionQuery> others(10, baseQuery());
+  std::vector<MotionQuery> others(11, baseQuery());
   others[0].mode = Mode::kLazy;
   others[1].start.base.x += 0.01;
   others[2].start.arm[1] += 0.01;
@@ -46,6 +46,7 @@ TEST(QueryMemoTest, AnyFieldThatChangesTheAnswerChangesTheKey) {
   others[7].movable_cost_weight = 1.0;
   others[8].ignored = {"box"};
   others[9].fixed = {"box"};
+  others[10].straight_only = true;
   for (std::size_t i = 0; i < others.size(); ++i) EXPECT_EQ(memo.motion(others[i]), nullptr) << "variant " << i;
   MotionQuery moved = baseQuery();
   moved.overrides.push_back(ObjectOverride{"box", false, Eigen::Isometry3d::Identity()});

@@ -133,6 +133,7 @@ Result<MotionRequest> fromMsg(const msg::MotionRequest& m, const MotionPlanner& 
   if (!std::isfinite(w) || w < 0) return bad("movable_cost_weight", "must be finite and >= 0");
   r.object_cost_scale = w;
   r.fixed_objects.assign(m.fixed_objects().begin(), m.fixed_objects().end());
+  r.straight_only = m.straight_only();
   return r;
 }
 

@@ -494,6 +494,9 @@ std::optional<std::string> validateRequest(const MotionRequest& r, const MotionP
       return "ignored_objects[" + std::to_string(i) + "]: no object '" + r.ignored_objects[i] + "' in the world";
     }
   }
+  if (r.straight_only && (r.mode != MotionMode::kFull || r.group != PlanningGroup::kBase)) {
+    return std::string("straight_only: only for full-mode base requests");
+  }
   for (std::size_t i = 0; i < r.fixed_objects.size(); ++i) {
     const world::Object* o = impl.world.findObject(r.fixed_objects[i]);
     if (!o) return "fixed_objects[" + std::to_string(i) + "]: no object '" + r.fixed_objects[i] + "' in the world";
@@ -919,6 +922,7 @@ struct Planning {
   void ensureSampled();
   void densify(og::PathGeometric& path, int s, const std::vector<int>& goals, const std::vector<int>& objects);
   void tryDirect();
+  Outcome straightOnly();
   bool directKeepsClear(const ob::State* from, const ob::State* to);
   std::optional<detail::DisconnectionProof::Carried> carriedByBase() const;
   Outcome sample(const Stopwatch& phase, bool solved);
@@ -1522,6 +1526,7 @@ void Planning::densify(og::PathGeometric& path, int s, const std::vector<int>& g
 // ---- search (+ infeasibility proof, interleaved) ----
 
 Outcome Planning::search() {
+  if (req.straight_only) return straightOnly();
   Stopwatch phase;
   const PlannerKind kind = req.group != PlanningGroup::kBase ? P.sampling.arm_planner
                            : lazy                            ? P.sampling.lazy_planner
@@ -1544,6 +1549,41 @@ void Planning::tryDirect() {
     res.stats.direct = true;
     break;
   }
+}
+
+/// MotionRequest::straight_only: the direct motion (one that keeps the base clearance first, else
+/// any free one), or `no path` at once; nothing is sampled.
+Outcome Planning::straightOnly() {
+  Stopwatch phase;
+  tryDirect();
+  const ob::State* from = escaped ? escaped.get() : start.get();
+  for (const ob::State* g : goal_states) {
+    if (direct || termination()) break;
+    if (!si->checkMotion(from, g)) continue;
+    direct.emplace(si, from, g);
+    res.stats.direct = true;
+    res.stats.clearance_relaxed = true;
+  }
+  res.stats.sampling_ms = phase.millis();
+  if (direct) return std::nullopt;
+  // What it touches: just past the last free state along it.
+  std::pair<ob::State*, double> last_valid{space->allocState(), 0.0};
+  ob::State* past = space->allocState();
+  std::string who;
+  if (!goal_states.empty()) {
+    (void)si->checkMotion(from, goal_states.front(), last_valid);
+    for (const double f : {0.002, 0.01, 0.05, 0.2, 1.0}) {
+      space->interpolate(last_valid.first, goal_states.front(), f, past);
+      if (!(who = oracle.collidingObject(past, true)).empty()) break;
+    }
+  }
+  space->freeState(past);
+  space->freeState(last_valid.first);
+  return finish(MotionStatus::kNoPath,
+                "straight_only: the straight motion to the goal is not free" +
+                    (who.empty() ? std::string() : " (it touches '" + who + "' near " +
+                                                       formatNumber(std::round(last_valid.second * 100.0)) + " % of it)"),
+                who);
 }
 
 /// An arm's direct motion is taken only when the robot grown by `direct_clearance` sweeps it

@@ -309,6 +309,36 @@ TEST_F(FullTest, ABaseCarryingALongObjectThatCannotTurnTheCornerIsAProvenNoPath)
   }
 }
 
+// A push or a back-off is straight or nothing: the straight motion when free, else `no path` at
+// once, naming what it touches, where a full request would plan the detour.
+TEST_F(FullTest, AStraightOnlyRequestIsTheDirectMotionOrNoPathAtOnce) {
+  const world::World w = testing::openRoomWorld();  // `obstacle`: x in [4.7, 5.3], y in [2.7, 3.3]
+  MotionPlanner mp = planner(w);
+  MotionRequest req = request({2.0, 3.0, 0.0}, {8.0, 3.0, 0.0});
+  req.straight_only = true;
+  const MotionResult blocked = mp.plan(req, Termination::after(5.0));
+  EXPECT_EQ(blocked.status, MotionStatus::kNoPath) << blocked.reason;
+  EXPECT_EQ(blocked.colliding_object, "obstacle") << blocked.reason;
+  EXPECT_EQ(blocked.stats.sampling_slices, 0);
+  req.straight_only = false;
+  const MotionResult detour = mp.plan(req, Termination::after(5.0));
+  ASSERT_EQ(detour.status, MotionStatus::kSolved) << detour.reason;
+  EXPECT_GT(detour.path_length, 6.0 + 1e-3);
+  MotionRequest free_line = request({2.0, 1.2, 0.0}, {8.0, 1.2, 0.0});
+  free_line.straight_only = true;
+  const MotionResult straight = mp.plan(free_line, Termination::after(5.0));
+  ASSERT_EQ(straight.status, MotionStatus::kSolved) << straight.reason;
+  EXPECT_TRUE(straight.stats.direct);
+  EXPECT_NEAR(straight.path_length, 6.0, 1e-6);
+  for (const auto& wp : straight.path.waypoints) EXPECT_NEAR(wp[1], 1.2, 1e-9);
+  // Only for full-mode base requests.
+  MotionRequest lazy = testing::baseRequest({2.0, 3.0, 0.0}, {8.0, 3.0, 0.0});
+  lazy.straight_only = true;
+  const MotionResult bad = mp.plan(lazy, Termination::after(5.0));
+  EXPECT_EQ(bad.status, MotionStatus::kInvalidRequest);
+  EXPECT_NE(bad.reason.find("straight_only"), std::string::npos) << bad.reason;
+}
+
 TEST_F(FullTest, StartAndGoalInCollisionNameTheObject) {
   const world::World w = testing::corridorWorld(true);
   MotionPlanner mp = planner(w);

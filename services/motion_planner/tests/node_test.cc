@@ -101,6 +101,12 @@ TEST_F(NodeTest, FullRequestIsAProvenNoPathAndFollowsWorldUpdates) {
   auto path = dds::fromMsg(rep->path());
   ASSERT_TRUE(path.ok());
   EXPECT_GE(testing::discClearance(world_, *path, 0.3, 0.005), 0.0);
+  // straight_only on the wire: the straight line passes the door too low (it touches the wall).
+  r.straight_only(true);
+  rep = motion_->call(r, dds::CallOptions{30.0, {}});
+  ASSERT_TRUE(rep.ok()) << rep.error().toString();
+  EXPECT_EQ(rep->status(), msg::MOTION_NO_PATH) << rep->reason();
+  EXPECT_NE(rep->reason().find("straight_only"), std::string::npos) << rep->reason();
 }
 
 // After a world update the node prepares the base group's roadmap (spinOnce calls

@@ -77,6 +77,8 @@ struct MotionQuery {
   double movable_cost_weight{0.0};    ///< lazy: 0 = the pure static-only lazy path
   /// Lazy: movables the robot cannot move (over the payload, no push): obstacles for this path.
   std::vector<std::string> fixed;
+  /// Full base motions: only the straight motion from start to goal counts (pushes, back-offs).
+  bool straight_only{false};
   double held_padding_m{0.0};         ///< the held object grown by this much (m); set by the graph manager
   /// The world model version the question is asked in (0: the server's latest). A server whose
   /// mirror lags waits for it within the budget, or answers kUnavailable; set by the graph manager.

@@ -174,6 +174,10 @@ struct MotionRequest {
   /// object does. Each must be a movable of the world; ignored in full mode (every object is
   /// an obstacle there).
   std::vector<std::string> fixed_objects;
+  /// Full mode, base group: only the direct motion from the start to the goal counts (a push, a
+  /// back-off): kSolved when it is free (the base clearance is not asked of it), kNoPath at
+  /// once when it is not; nothing is sampled. Invalid in lazy mode or for an arm group.
+  bool straight_only{false};
 };
 
 /// A movable object a lazy path sweeps through.

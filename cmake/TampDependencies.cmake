@@ -54,6 +54,14 @@ find_package(SQLite3 REQUIRED)
 tamp_wrap_dependency(sqlite LIBS SQLite::SQLite3)
 find_package(CLI11 REQUIRED)
 tamp_wrap_dependency(cli11 LIBS CLI11::CLI11)
+# Optional: libnetfilter_queue (libnetfilter-queue-dev) for tests/fault's link delayer
+# (tamp_link_delay, `two_hosts.sh --delay`); without it the delayer is not built.
+pkg_check_modules(NETFILTER_QUEUE QUIET IMPORTED_TARGET libnetfilter_queue)
+if(NETFILTER_QUEUE_FOUND)
+  tamp_wrap_dependency(netfilter_queue LIBS PkgConfig::NETFILTER_QUEUE)
+else()
+  message(STATUS "libnetfilter_queue not found: tamp_link_delay (two_hosts.sh --delay) not built")
+endif()
 
 if(TAMP_WITH_DDS)
   find_package(fastrtps 2.9 REQUIRED)    # target `fastrtps`, brings fastcdr and foonathan_memory

@@ -16,8 +16,10 @@ PACKAGES=(
   # DDS Security test material (deploy/security/make_certs.sh)
   openssl
   # tests and benchmarks (iproute2 + nftables: tests/fault/two_hosts.sh namespaces, loss, duplication;
+  # iptables + libnetfilter-queue-dev: its --delay (NFQUEUE rule, tamp_link_delay);
   # procps + python3: tests/fault/kill_matrix.sh, tools/evaluation)
-  libgtest-dev libgmock-dev libbenchmark-dev iproute2 nftables procps python3
+  libgtest-dev libgmock-dev libbenchmark-dev iproute2 nftables iptables libnetfilter-queue-dev procps
+  python3
 )
 
 missing=()

@@ -6,7 +6,7 @@
 #   tests/fault/two_hosts.sh BUILD_DIR [--discovery server|multicast] [--scenario FILE]
 #        [--netem "loss 10%"|"delay 50ms"|"duplicate 10%"|...] [--partition-at S --partition-for S]
 #        [--seed N] [--out DIR] [--run-id ID] [--one-host] [--ping N] [--loss PCT] [--duplicate PCT]
-#        [--kill SERVICE --kill-at S]
+#        [--kill SERVICE --kill-at S] [--delay MS [--jitter MS]]
 #
 # --kill SERVICE --kill-at S: SIGKILL to that service's process S s after the mission started,
 # on whichever host runs it (its launcher restarts it); the run is then judged by
@@ -16,7 +16,16 @@
 # --loss PCT / --duplicate PCT drop / duplicate that percentage of the UDP datagrams each host
 # sends on the link (nftables `numgen random` on both namespaces' output; needs `nft`, Debian
 # package nftables). --netem needs a kernel with sch_netem (CONFIG_NET_SCH_NETEM); the CI VM's
-# kernel has none, so loss and duplication go through nftables there and delay is not available.
+# kernel has none, so loss and duplication go through nftables there and delay through --delay.
+#
+# --delay MS [--jitter MS]: every UDP datagram each host sends on the link waits MS ms (+- a uniform
+# JITTER, order kept) before it leaves, both directions, so a round trip takes 2 MS more. Without
+# netem: an iptables NFQUEUE rule in each namespace (the kernel's nft has no `queue` expression
+# here, CONFIG_NFT_QUEUE unset; iptables-nft's xt NFQUEUE target works) hands the datagrams to
+# tamp_link_delay (tests/fault/link_delay.cc, built when libnetfilter-queue-dev is installed; path
+# from $TAMP_LINK_DELAY, default BUILD_DIR/bin), which gives the accept verdict MS ms later. Needs
+# `iptables` (Debian package iptables). UDP round trips across the link (tests/fault/udp_rtt.py)
+# before and after the delay is on, the delayed packets and the kernel queue's drops go to faults.log.
 #
 # --one-host runs both launchers in the workstation namespace (same deployment, discovery and
 # UDP profile; traffic stays on the host), the baseline of the two-host benchmark. --ping N: after
@@ -31,7 +40,8 @@
 # --partition-at/--partition-for take the link down for that long, that far into the mission.
 # Exit code: `tamp mission`'s (0 succeeded, 10 failed, 20 timeout, 30 input, 40 services), and 50
 # when the run's checks fail (the simulator's final world is missing), 77 when the network
-# namespaces cannot be created (not root: tests skip on it). Whether the robot reached the goal and
+# namespaces cannot be created (not root: tests skip on it) or --delay cannot be had here (no
+# iptables, tamp_link_delay or nfnetlink_queue). Whether the robot reached the goal and
 # no command id was executed twice is judged from OUT/RUN_ID/sim_final_world.json
 # (tests/fault/two_hosts_test.cc). Artefacts in OUT/RUN_ID.
 set -euo pipefail
@@ -39,7 +49,8 @@ BUILD=${1:?usage: two_hosts.sh BUILD_DIR [options]}; shift
 ROOT=$(cd "$(dirname "$0")/../.." && pwd)
 DISCOVERY=server SCENARIO=$ROOT/config/scenarios/namo_corridor_short.yaml NETEM="" SEED=1
 PART_AT="" PART_FOR=5 OUT=${TMPDIR:-/tmp}/tamp-two-hosts RUN_ID="" ONE_HOST=0 PING=0 LOSS=0 DUP=0
-KILL="" KILL_AT=""
+KILL="" KILL_AT="" DELAY="" JITTER=0
+QUEUE_NUM=13  # the nfqueue of --delay, one per namespace
 while [ $# -gt 0 ]; do
   case $1 in
     --discovery) DISCOVERY=$2; shift 2;;
@@ -56,6 +67,8 @@ while [ $# -gt 0 ]; do
     --duplicate) DUP=$2; shift 2;;
     --kill) KILL=$2; shift 2;;
     --kill-at) KILL_AT=$2; shift 2;;
+    --delay) DELAY=$2; shift 2;;
+    --jitter) JITTER=$2; shift 2;;
     *) echo "two_hosts.sh: unknown option $1" >&2; exit 30;;
   esac
 done
@@ -72,6 +85,15 @@ if { [ "$LOSS" -gt 0 ] || [ "$DUP" -gt 0 ]; } && ! command -v nft > /dev/null; t
   echo "two_hosts.sh: --loss/--duplicate need nft (Debian package nftables)" >&2; exit 30
 fi
 BIN=$(realpath "$BUILD")/bin
+DELAYER=${TAMP_LINK_DELAY:-$BIN/tamp_link_delay}
+if [ -n "$DELAY" ]; then
+  [[ $DELAY =~ ^[0-9]+(\.[0-9]+)?$ && $JITTER =~ ^[0-9]+(\.[0-9]+)?$ ]] \
+    || { echo "two_hosts.sh: --delay/--jitter take milliseconds, got '$DELAY'/'$JITTER'" >&2; exit 30; }
+  command -v iptables > /dev/null || { echo "two_hosts.sh: --delay needs iptables (Debian package iptables)" >&2; exit 77; }
+  [ -x "$DELAYER" ] || { echo "two_hosts.sh: --delay needs $DELAYER (built from tests/fault/link_delay.cc when libnetfilter-queue-dev is installed; or set TAMP_LINK_DELAY)" >&2; exit 77; }
+elif [ "$JITTER" != 0 ]; then
+  echo "two_hosts.sh: --jitter needs --delay" >&2; exit 30
+fi
 TAG=t$$
 RUN_ID=${RUN_ID:-twohost-$DISCOVERY-$TAG}
 NS_R=tamp-robot-$TAG NS_W=tamp-ws-$TAG
@@ -151,6 +173,50 @@ NFT
 link_faults "$NS_R" veth-r-$TAG 10.0.0.1
 link_faults "$NS_W" veth-w-$TAG 10.0.0.2
 
+# UDP round trips from the workstation to the robot host (tests/fault/udp_rtt.py), into faults.log.
+udp_rtt() {  # LABEL
+  ip netns exec "$NS_R" python3 "$ROOT/tests/fault/udp_rtt.py" serve 7913 & local server=$!
+  sleep 0.3
+  echo "udp rtt, $1: $(ip netns exec "$NS_W" python3 "$ROOT/tests/fault/udp_rtt.py" ping 10.0.0.2 7913 20)" >> "$RUN_DIR/faults.log"
+  kill "$server"; wait "$server" 2>/dev/null || true
+}
+# The delay of every UDP datagram NS sends on DEV: tamp_link_delay on the queue, then the rule.
+link_delay() {  # NS DEV HOST
+  local log=$RUN_DIR/delay-$3.out
+  ip netns exec "$1" "$DELAYER" --queue $QUEUE_NUM --delay-ms "$DELAY" --jitter-ms "$JITTER" --seed "$SEED" > "$log" 2>&1 &
+  PIDS+=($!) DELAY_PIDS+=($!)
+  local pid=$! rc=0
+  for _ in $(seq 50); do grep -q '^ready' "$log" && break; kill -0 $pid 2>/dev/null || break; sleep 0.1; done
+  if ! grep -q '^ready' "$log"; then
+    kill -0 $pid 2>/dev/null || { wait $pid || rc=$?; }
+    echo "two_hosts.sh: tamp_link_delay did not start in $1 (exit $rc): $(cat "$log")" >&2
+    [ "$rc" = 31 ] && exit 77  # no nfnetlink_queue or no permission here: tests skip
+    exit 30
+  fi
+  # No --queue-bypass: a datagram nobody can delay is dropped (and counted), never sent early.
+  ip netns exec "$1" iptables -A OUTPUT -o "$2" -p udp -j NFQUEUE --queue-num $QUEUE_NUM
+}
+# Counters of the delay into faults.log; the rules go first, so nothing is queued to a stopped delayer.
+stop_link_delay() {
+  local ns host
+  for ns in "$NS_R" "$NS_W"; do
+    host=robot; [ "$ns" = "$NS_W" ] && host=workstation
+    echo "$host: iptables $(ip netns exec "$ns" iptables -L OUTPUT -v -n -x | awk '/NFQUEUE/ {print $1 " datagrams to nfqueue " $NF}')" >> "$RUN_DIR/faults.log"
+    # /proc/net/netfilter/nfnetlink_queue: queue, portid, waiting, mode, range, queue_dropped, user_dropped, last id
+    echo "$host: nfnetlink_queue $(ip netns exec "$ns" awk -v q=$QUEUE_NUM '$1 == q {print "waiting " $3 ", queue_dropped " $6 ", user_dropped " $7}' /proc/net/netfilter/nfnetlink_queue)" >> "$RUN_DIR/faults.log"
+    ip netns exec "$ns" iptables -F OUTPUT
+  done
+  for p in "${DELAY_PIDS[@]}"; do kill -TERM "$p" 2>/dev/null || true; wait "$p" 2>/dev/null || true; done
+  for host in robot workstation; do echo "$host: $(grep -v '^ready' "$RUN_DIR/delay-$host.out")" >> "$RUN_DIR/faults.log"; done
+}
+DELAY_PIDS=()
+if [ -n "$DELAY" ]; then
+  udp_rtt "before the delay"
+  link_delay "$NS_R" veth-r-$TAG robot
+  link_delay "$NS_W" veth-w-$TAG workstation
+  udp_rtt "delay $DELAY ms jitter $JITTER ms each way"
+fi
+
 # The simulator (robot host) writes its final ground truth here.
 NS_ROBOT_SIDE=$NS_R
 [ "$ONE_HOST" = 1 ] && NS_ROBOT_SIDE=$NS_W
@@ -204,11 +270,12 @@ if [ "$PING" -gt 0 ]; then
   tail -1 "$RUN_DIR/ping.out"
 fi
 set -e
+[ -n "$DELAY" ] && stop_link_delay
 if [ "$LOSS" -gt 0 ] || [ "$DUP" -gt 0 ]; then
   for ns in "$NS_R" "$NS_W"; do ip netns exec "$ns" nft list table ip tamp_fault | grep counter >> "$RUN_DIR/faults.log"; done
 fi
 cat "$OUT/$RUN_ID/mission.out"
-echo "two_hosts.sh: run $RUN_ID discovery=$DISCOVERY one_host=$ONE_HOST netem='${NETEM}' loss=$LOSS% duplicate=$DUP% partition_at='${PART_AT}' seed=$SEED exit=$RC mission_s=$(awk "BEGIN{print $END - $START}")"
+echo "two_hosts.sh: run $RUN_ID discovery=$DISCOVERY one_host=$ONE_HOST netem='${NETEM}' loss=$LOSS% duplicate=$DUP% partition_at='${PART_AT}' delay='${DELAY}' jitter=$JITTER seed=$SEED exit=$RC mission_s=$(awk "BEGIN{print $END - $START}")"
 cleanup; trap - EXIT
 # The simulator writes its final world on a clean stop (cleanup sends SIGTERM to the launchers).
 if [ "$RC" = 0 ] && [ ! -s "$OUT/$RUN_ID/sim_final_world.json" ]; then

@@ -26,6 +26,7 @@ struct TwoHostRun {
   int exit_code{-1};
   std::string output;
   nlohmann::json truth;
+  std::string faults;  // OUT/RUN_ID/faults.log, the script's counters of the link faults
 };
 
 TwoHostRun runTwoHosts(const std::string& run_id, const std::vector<std::string>& options) {
@@ -38,6 +39,7 @@ TwoHostRun runTwoHosts(const std::string& run_id, const std::vector<std::string>
       runCommand(fs::path(TAMP_SOURCE_DIR) / "tests" / "fault" / "two_hosts.sh", args, 300.0);
   const fs::path truth = out / run_id / "sim_final_world.json";
   if (fs::exists(truth)) r.truth = nlohmann::json::parse(readFile(truth), nullptr, false);
+  if (fs::exists(out / run_id / "faults.log")) r.faults = readFile(out / run_id / "faults.log");
   return r;
 }
 
@@ -77,6 +79,37 @@ TEST(TwoHostsTest, MissionThroughADiscoveryServerWithoutMulticastReachesTheGoal)
 
 TEST(TwoHostsTest, MissionOverMulticastReachesTheGoal) {
   expectMissionAtGoal(runTwoHosts("ctest-two-hosts-multicast", {"--discovery", "multicast"}));
+}
+
+int occurrences(const std::string& text, const std::string& what) {
+  int n = 0;
+  for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+/// The smallest UDP round trip (ms) of faults.log's line that starts with `label`; -1 if none.
+double minUdpRoundTripMs(const std::string& faults, const std::string& label) {
+  const std::size_t line = faults.find(label);
+  if (line == std::string::npos) return -1.0;
+  const std::size_t min = faults.find(", min ", line);
+  if (min == std::string::npos || min > faults.find('\n', line)) return -1.0;
+  return std::stod(faults.substr(min + 6));
+}
+
+// The "delay (50 ms)" without tc netem (no sch_netem in the CI VM's kernel): an NFQUEUE
+// rule and tamp_link_delay in each namespace hold every UDP datagram 50 ms before it leaves.
+// Skipped where namespaces, iptables or nfnetlink_queue are missing (the script's exit 77).
+TEST(TwoHostsTest, MissionWithA50MsDelayOnTheLinkReachesTheGoal) {
+  const TwoHostRun r =
+      runTwoHosts("ctest-two-hosts-delay", {"--discovery", "server", "--delay", "50"});
+  expectMissionAtGoal(r);
+  if (HasFatalFailure() || IsSkipped()) return;
+  // The delay was on: a UDP round trip across the link took 2 x 50 ms more than before it.
+  const double before_ms = minUdpRoundTripMs(r.faults, "udp rtt, before the delay");
+  EXPECT_TRUE(before_ms >= 0.0 && before_ms < 20.0) << r.faults;
+  EXPECT_GE(minUdpRoundTripMs(r.faults, "udp rtt, delay 50 ms"), 100.0) << r.faults;
+  // Nothing dropped by the kernel's queues, on either host.
+  EXPECT_EQ(occurrences(r.faults, "queue_dropped 0, user_dropped 0"), 2) << r.faults;
 }
 
 }  // namespace

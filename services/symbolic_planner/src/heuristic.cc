@@ -872,8 +872,8 @@ class RelaxationHeuristic : public Heuristic {
     for (OpId o = 0; o < task.ops.size(); ++o) op_cost_.push_back(adjustedCost(task.ops[o], ct, task.unit_cost));
     fact_cost_.assign(nf, kInf);
     supporter_.assign(nf, UINT32_MAX);
-    rop_.resize(R_.size());
-    for (uint32_t r = 0; r < R_.size(); ++r) rop_[r] = {0, R_.count[r], R_.count[r]};
+    unsat_.resize(R_.size());
+    rop_cost_.resize(R_.size());
     goal_stamp_.assign(nf, 0);
     fact_mark_.assign(nf, 0);
     op_mark_.assign(task.ops.size(), 0);
@@ -920,27 +920,11 @@ class RelaxationHeuristic : public Heuristic {
   }
 
  private:
-  /// Resets what the last exploration changed (issue 14, twenty-third round): through the lists
-  /// of what it touched when that is a small part of the task (an exploration that stops at the
-  /// goal early), else in one sequential pass.
-  void reset() {
-    if (touched_facts_.size() * 8 < fact_cost_.size()) {
-      for (FactId f : touched_facts_) fact_cost_[f] = kInf;
-    } else {
-      std::fill(fact_cost_.begin(), fact_cost_.end(), kInf);
-    }
-    if (touched_rops_.size() * 8 < rop_.size()) {
-      for (uint32_t r : touched_rops_) rop_[r] = {0, rop_[r].count, rop_[r].count};
-    } else {
-      for (RopState& x : rop_) x = {0, x.count, x.count};
-    }
-    touched_facts_.clear();
-    touched_rops_.clear();
-  }
-
   void explore(const uint64_t* s) {
     const size_t nf = task_.numFacts();
-    reset();
+    std::fill(fact_cost_.begin(), fact_cost_.end(), kInf);
+    std::copy(R_.count.begin(), R_.count.end(), unsat_.begin());
+    std::fill(rop_cost_.begin(), rop_cost_.end(), 0);
     heap_.clear();
     ++stamp_;
     remaining_.assign(goal_.conjuncts.size(), 0);
@@ -948,7 +932,6 @@ class RelaxationHeuristic : public Heuristic {
     const size_t words = task_.numWords();
     forEachTrueFact(s, words, nf, [&](FactId f) {
       fact_cost_[f] = 0;
-      touched_facts_.push_back(f);
       supporter_[f] = UINT32_MAX;
       heap_.push(0, f);
     });
@@ -965,10 +948,12 @@ class RelaxationHeuristic : public Heuristic {
       if (done) break;
       for (uint32_t i = R_.pre_of_begin[f]; i < R_.pre_of_begin[f + 1]; ++i) {
         const uint32_t r = R_.pre_of[i];
-        RopState& x = rop_[r];
-        if (x.unsat == x.count) touched_rops_.push_back(r);
-        x.cost = mode_ == Mode::kMax ? std::max(x.cost, c) : x.cost + c;
-        if (--x.unsat == 0) fire(r, x.cost);
+        if (mode_ == Mode::kMax) {
+          rop_cost_[r] = std::max(rop_cost_[r], c);
+        } else {
+          rop_cost_[r] += c;
+        }
+        if (--unsat_[r] == 0) fire(r, rop_cost_[r]);
       }
     }
   }
@@ -978,7 +963,6 @@ class RelaxationHeuristic : public Heuristic {
     for (uint32_t i = R_.add_begin[r]; i < R_.add_begin[r + 1]; ++i) {
       const FactId g = R_.add[i];
       if (nc < fact_cost_[g]) {
-        if (fact_cost_[g] == kInf) touched_facts_.push_back(g);
         fact_cost_[g] = nc;
         supporter_[g] = r;
         heap_.push(nc, g);
@@ -1060,18 +1044,8 @@ class RelaxationHeuristic : public Heuristic {
   RelaxedOps R_;
   std::vector<Cost> op_cost_;
   // Per evaluation.
-  /// A rop's cost so far (sum or max of its reached preconditions' costs), its unreached
-  /// preconditions and their number: the one cache line an edge of the exploration touches (three
-  /// arrays were three misses per edge on tasks of 10^5 operators).
-  struct RopState {
-    Cost cost;
-    uint32_t unsat, count;
-  };
-  std::vector<RopState> rop_;
-  std::vector<Cost> fact_cost_;
-  std::vector<uint32_t> supporter_;
-  std::vector<FactId> touched_facts_;  ///< facts whose cost the last exploration set
-  std::vector<uint32_t> touched_rops_;  ///< rops whose counter it decremented
+  std::vector<Cost> fact_cost_, rop_cost_;
+  std::vector<uint32_t> supporter_, unsat_;
   std::vector<uint32_t> goal_stamp_;
   uint32_t stamp_{0};
   FactHeap heap_;

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <stdexcept>
 #include <string>
-#include <unordered_map>
 
 #include "tamp/core/termination.h"
 #include "tamp/symbolic_planner/flat_index.h"
@@ -210,6 +209,82 @@ bool sameOnFacts(const Operator& a, const Operator& b) {
   return true;
 }
 
+/// The kept facts of `in` by their new ids, into `res` (sized once: an operator's vectors are
+/// allocated once each, not grown).
+void mapKept(const std::vector<FactId>& in, const std::vector<int32_t>& fact_map, std::vector<FactId>& res) {
+  size_t n = 0;
+  for (FactId f : in) n += fact_map[f] >= 0 ? 1 : 0;
+  res.clear();
+  if (n == 0) return;
+  res.reserve(n);
+  for (FactId f : in) {
+    if (fact_map[f] >= 0) res.push_back(static_cast<FactId>(fact_map[f]));
+  }
+}
+
+/// Operator `o`'s hash on the kept facts (precondition, effects, kept conditional effects);
+/// counts its dropped conditional effects into `dropped`.
+uint64_t hashOnKept(const Operator& src, OpId o, const Analysis& a, const std::vector<int32_t>& fact_map,
+                    size_t& dropped) {
+  uint64_t h = hashKept(hashKept(hashKept(0, src.pre, fact_map), src.add, fact_map), src.del, fact_map);
+  for (size_t c = 0; c < src.cond_effects.size(); ++c) {
+    if (!a.ceKept(o, c)) {
+      ++dropped;
+      continue;
+    }
+    const ConditionalEffect& ce = src.cond_effects[c];
+    h = hashKept(hashKept(hashKept(mixIn(h, 0xCE), ce.cond, fact_map), ce.add, fact_map), ce.del, fact_map);
+  }
+  return h;
+}
+
+/// Operator `o` on the kept facts, without its name (set by the caller when it is kept).
+Operator projectOperator(const Operator& src, OpId o, const Analysis& a, const std::vector<int32_t>& fact_map) {
+  Operator op;
+  op.cost = src.cost;
+  op.needs_fixup = src.needs_fixup;
+  mapKept(src.pre, fact_map, op.pre);
+  mapKept(src.add, fact_map, op.add);
+  mapKept(src.del, fact_map, op.del);
+  for (size_t c = 0; c < src.cond_effects.size(); ++c) {
+    if (!a.ceKept(o, c)) continue;
+    ConditionalEffect ce;
+    mapKept(src.cond_effects[c].cond, fact_map, ce.cond);
+    mapKept(src.cond_effects[c].add, fact_map, ce.add);
+    mapKept(src.cond_effects[c].del, fact_map, ce.del);
+    op.cond_effects.push_back(std::move(ce));
+  }
+  return op;
+}
+
+/// The pruned operators by their hash on the kept facts: a flat map to the first one of each
+/// hash and a chain through the others (no allocation per operator).
+class SameHashChains {
+ public:
+  explicit SameHashChains(size_t expected) : head_(expected) { next_.reserve(expected); }
+
+  /// The pruned operator with hash `h` that is the same as `op` on the kept facts, or UINT32_MAX.
+  uint32_t find(uint64_t h, const Operator& op, const std::vector<Operator>& ops) const {
+    for (uint32_t j = head_.find(h); j != UINT32_MAX; j = next_[j]) {
+      if (sameOnFacts(ops[j], op)) return j;
+    }
+    return UINT32_MAX;
+  }
+  /// Records pruned operator `j` (the next index) under hash `h`.
+  void add(uint64_t h, uint32_t j) {
+    next_.resize(std::max<size_t>(next_.size(), j + 1), UINT32_MAX);
+    const auto [first, inserted] = head_.tryEmplace(h, j);
+    if (!inserted) {  // after the first of the chain
+      next_[j] = next_[first];
+      next_[first] = j;
+    }
+  }
+
+ private:
+  U64IdMap head_;
+  std::vector<uint32_t> next_;
+};
+
 }  // namespace
 
 StateBits PrunedTask::projectState(const uint64_t* s, size_t original_words) const {
@@ -249,12 +324,6 @@ PrunedTask pruneIrrelevant(const Task& task, const Goal& goal) {
   for (FactId f = 0; f < nf; ++f) {
     if (a.kept(f)) out.fact_map[f] = static_cast<int32_t>(kept_facts++);
   }
-  auto mapAll = [&](const std::vector<FactId>& in, std::vector<FactId>& res) {
-    res.clear();
-    for (FactId f : in) {
-      if (out.fact_map[f] >= 0) res.push_back(static_cast<FactId>(out.fact_map[f]));
-    }
-  };
   // Each relevant operator's hash on the kept facts; when no fact, operator or conditional effect
   // is dropped and no two hashes meet (no operators the same on the kept facts), the task stays
   // as it is, without building anything.
@@ -266,18 +335,8 @@ PrunedTask pruneIrrelevant(const Task& task, const Goal& goal) {
     for (OpId o = 0; o < task.ops.size(); ++o) {
       if (!a.opRelevant(o)) continue;
       ++relevant;
-      const Operator& src = task.ops[o];
-      uint64_t h = hashKept(hashKept(hashKept(0, src.pre, out.fact_map), src.add, out.fact_map), src.del, out.fact_map);
-      for (size_t c = 0; c < src.cond_effects.size(); ++c) {
-        if (!a.ceKept(o, c)) {
-          ++st.cond_effects_dropped;
-          continue;
-        }
-        const ConditionalEffect& ce = src.cond_effects[c];
-        h = hashKept(hashKept(hashKept(mixIn(h, 0xCE), ce.cond, out.fact_map), ce.add, out.fact_map), ce.del, out.fact_map);
-      }
-      op_hash[o] = h;
-      hashes_meet = !seen.tryEmplace(h, o).second || hashes_meet;
+      op_hash[o] = hashOnKept(task.ops[o], o, a, out.fact_map, st.cond_effects_dropped);
+      hashes_meet = !seen.tryEmplace(op_hash[o], o).second || hashes_meet;
     }
   }
   st.ops_relevant = relevant;
@@ -297,41 +356,25 @@ PrunedTask pruneIrrelevant(const Task& task, const Goal& goal) {
     pruned->complement.push_back(c >= 0 ? out.fact_map[static_cast<size_t>(c)] : -1);
   }
   // Relevant operators on the kept facts; of those the same on them, the cheapest at the first
-  // one's place.
-  std::unordered_map<uint64_t, std::vector<uint32_t>> by_hash;
-  by_hash.reserve(relevant);
+  // one's place (looked for only when two hashes met).
+  pruned->ops.reserve(relevant);
+  out.op_origin.reserve(relevant);
+  SameHashChains same(hashes_meet ? relevant : 0);
   for (OpId o = 0; o < task.ops.size(); ++o) {
     if (!a.opRelevant(o)) continue;
     const Operator& src = task.ops[o];
-    Operator op;
-    op.cost = src.cost;
-    op.needs_fixup = src.needs_fixup;
-    mapAll(src.pre, op.pre);
-    mapAll(src.add, op.add);
-    mapAll(src.del, op.del);
-    for (size_t c = 0; c < src.cond_effects.size(); ++c) {
-      if (!a.ceKept(o, c)) continue;
-      ConditionalEffect ce;
-      mapAll(src.cond_effects[c].cond, ce.cond);
-      mapAll(src.cond_effects[c].add, ce.add);
-      mapAll(src.cond_effects[c].del, ce.del);
-      op.cond_effects.push_back(std::move(ce));
-    }
-    std::vector<uint32_t>& same = by_hash[op_hash[o]];
-    bool merged = false;
-    for (uint32_t j : same) {
-      if (!sameOnFacts(pruned->ops[j], op)) continue;
+    Operator op = projectOperator(src, o, a, out.fact_map);
+    const uint32_t j = hashes_meet ? same.find(op_hash[o], op, pruned->ops) : UINT32_MAX;
+    if (j != UINT32_MAX) {
       if (src.cost < pruned->ops[j].cost) {
         pruned->ops[j].cost = src.cost;
         pruned->ops[j].name = src.name;
         out.op_origin[j] = o;
       }
-      merged = true;
-      break;
+      continue;
     }
-    if (merged) continue;
     op.name = src.name;
-    same.push_back(static_cast<uint32_t>(pruned->ops.size()));
+    if (hashes_meet) same.add(op_hash[o], static_cast<uint32_t>(pruned->ops.size()));
     pruned->ops.push_back(std::move(op));
     out.op_origin.push_back(o);
   }
@@ -345,8 +388,8 @@ PrunedTask pruneIrrelevant(const Task& task, const Goal& goal) {
   }
   for (const auto& c : goal.conjuncts) {
     GoalConjunct gc;
-    mapAll(c.pos, gc.pos);
-    mapAll(c.neg, gc.neg);
+    mapKept(c.pos, out.fact_map, gc.pos);
+    mapKept(c.neg, out.fact_map, gc.neg);
     out.goal.conjuncts.push_back(std::move(gc));
   }
   pruned->finalize();

@@ -3,6 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <map>
+#include <random>
+#include <set>
+#include <tuple>
 #include <stdexcept>
 #include <string>
 
@@ -244,6 +248,85 @@ TEST(Relevance, NothingToDropGivesNoTaskAndBadGoalsAreRefused) {
     FAIL() << "no throw";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("goal fact 7"), std::string::npos) << e.what();
+  }
+}
+
+/// A random STRIPS task (fixed seed): facts 0..kept-1 are reachable and may be goals, facts from
+/// `kept` on are "decoration" no precondition needs. Operators come in families that differ only
+/// in the decoration they add or delete, and in cost, so that many are the same on the kept
+/// facts; a few add only decoration.
+Task randomDecoratedTask(uint32_t seed, size_t kept, size_t decoration, size_t families) {
+  std::mt19937 rng(seed);
+  Task t;
+  for (size_t f = 0; f < kept + decoration; ++f) t.fact_names.push_back("(f" + std::to_string(f) + ")");
+  t.complement.assign(kept + decoration, -1);
+  t.unit_cost = false;
+  auto someOf = [&](size_t lo, size_t n, size_t k) {
+    std::set<FactId> out;
+    for (size_t i = 0; i < k; ++i) out.insert(static_cast<FactId>(lo + rng() % n));
+    return std::vector<FactId>(out.begin(), out.end());
+  };
+  for (size_t fam = 0; fam < families; ++fam) {
+    const auto pre = someOf(0, kept, rng() % 3);
+    const auto add = someOf(0, kept, 1 + rng() % 2);
+    const auto del = someOf(0, kept, rng() % 2);
+    const size_t members = 1 + rng() % 4;
+    for (size_t m = 0; m < members; ++m) {
+      std::vector<FactId> a = add, d = del;
+      for (FactId x : someOf(kept, decoration, rng() % 3)) a.push_back(x);
+      for (FactId x : someOf(kept, decoration, rng() % 2)) d.push_back(x);
+      std::sort(a.begin(), a.end());
+      a.erase(std::unique(a.begin(), a.end()), a.end());
+      std::sort(d.begin(), d.end());
+      d.erase(std::unique(d.begin(), d.end()), d.end());
+      const std::string name = "(o" + std::to_string(fam) + "-" + std::to_string(m) + ")";
+      t.ops.push_back(op(name, pre, a, d, 1 + static_cast<Cost>(rng() % 5)));
+    }
+    if (rng() % 4 == 0) t.ops.push_back(op("(deco" + std::to_string(fam) + ")", {}, someOf(kept, decoration, 1), {}));
+  }
+  t.finalize();
+  return t;
+}
+
+// The pruned operators against a brute-force grouping: the relevant operators (those adding a
+// kept fact, as the task is STRIPS without negative goals), projected on the kept facts and
+// grouped by (precondition, add, delete), give one pruned operator per group, at the place of the
+// group's first operator, with the group's least cost and that operator's name and origin (the
+// first of them on ties).
+TEST(Relevance, MergedOperatorsAreTheCheapestOfEachGroupOnRandomTasks) {
+  for (uint32_t seed = 1; seed <= 20; ++seed) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    const size_t kept = 12;
+    const Task t = randomDecoratedTask(seed, kept, 8, 60);
+    const PrunedTask p = pruneIrrelevant(t, goalOf({0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11}));
+    ASSERT_TRUE(p.pruned());
+    auto project = [&](const std::vector<FactId>& v) {
+      std::vector<FactId> out;
+      for (FactId f : v) {
+        if (f < kept) out.push_back(static_cast<FactId>(p.fact_map[f]));
+      }
+      return out;
+    };
+    using Key = std::tuple<std::vector<FactId>, std::vector<FactId>, std::vector<FactId>>;
+    std::vector<Key> order;
+    std::map<Key, OpId> best;  // the group's first cheapest operator
+    for (OpId o = 0; o < t.ops.size(); ++o) {
+      const Operator& x = t.ops[o];
+      if (std::none_of(x.add.begin(), x.add.end(), [&](FactId f) { return f < kept; })) continue;
+      const Key k{project(x.pre), project(x.add), project(x.del)};
+      const auto [it, inserted] = best.emplace(k, o);
+      if (inserted) order.push_back(k);
+      if (x.cost < t.ops[it->second].cost) it->second = o;
+    }
+    ASSERT_EQ(p.task->ops.size(), order.size());
+    for (size_t j = 0; j < order.size(); ++j) {
+      const Operator& got = p.task->ops[j];
+      const OpId want = best.at(order[j]);
+      EXPECT_EQ(Key(got.pre, got.add, got.del), order[j]) << j;
+      EXPECT_EQ(p.op_origin[j], want) << j;
+      EXPECT_EQ(got.cost, t.ops[want].cost) << j;
+      EXPECT_EQ(got.name, t.ops[want].name) << j;
+    }
   }
 }
 

@@ -1,0 +1,137 @@
+// Time per evaluation of the delete-relaxation heuristics on fixed states (issue 14, twenty-fourth
+// round): the search's counts of a time-bounded run are no per-evaluation measure (its phases
+// start and stop by time), so this evaluates the same states every repetition. The states: the
+// initial state and random walks from it (fixed seed), the goal the problem's. Cost-based h_FF
+// (cost + 1, what the search uses on tasks whose operators differ in cost), h_add, and h_FF with
+// unit costs (the layered graph).
+//
+//   tamp_symbolic_planner_heuristic_bench [--benchmark_filter=...] [DOMAIN PROBLEM]...
+//   (default instances: shipped ones of tests/data/benchmarks; more as DOMAIN PROBLEM pairs)
+#include <benchmark/benchmark.h>
+
+#include <filesystem>
+#include <iostream>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "tamp/core/paths.h"
+#include "tamp/symbolic_planner/grounding.h"
+#include "tamp/symbolic_planner/heuristic.h"
+#include "tamp/symbolic_planner/pddl.h"
+
+namespace sp = tamp::symbolic_planner;
+
+namespace {
+
+struct Instance {
+  std::string label;
+  std::shared_ptr<const sp::Task> task;
+  sp::Goal goal;
+  std::vector<sp::StateBits> states;
+};
+
+std::string readOrThrow(const std::string& path) {
+  auto t = tamp::readTextFile(path);
+  if (!t) throw std::runtime_error(t.error().toString());
+  return *t;
+}
+
+template <class T>
+T orThrow(tamp::Result<T> r, const std::string& what) {
+  if (!r) throw std::runtime_error(what + ": " + r.error().toString());
+  return std::move(*r);
+}
+
+/// The initial state and the states of `walks` random walks of up to `length` steps from it.
+std::vector<sp::StateBits> sampleStates(const sp::Task& task, const sp::StateBits& init, int walks, int length) {
+  std::mt19937 rng(14);
+  std::vector<sp::StateBits> out{init};
+  std::vector<sp::OpId> ops;
+  for (int w = 0; w < walks; ++w) {
+    sp::StateBits s = init, next(init.size());
+    const int steps = 1 + static_cast<int>(rng() % static_cast<unsigned>(length));
+    for (int k = 0; k < steps; ++k) {
+      ops.clear();
+      task.applicableOps(s.data(), ops);
+      if (ops.empty()) break;
+      task.apply(s.data(), ops[rng() % ops.size()], next.data());
+      s.swap(next);
+    }
+    out.push_back(s);
+  }
+  return out;
+}
+
+Instance load(const std::string& domain_file, const std::string& problem_file) {
+  const auto domain = orThrow(sp::pddl::parseDomain(readOrThrow(domain_file), domain_file), domain_file);
+  const auto problem = orThrow(sp::pddl::parseProblem(readOrThrow(problem_file), domain, problem_file), problem_file);
+  auto grounder = orThrow(sp::Grounder::create(domain, problem), "grounding");
+  std::vector<sp::AtomId> init;
+  for (const auto& a : problem.init) init.push_back(orThrow(grounder->atomId(a), "init atom"));
+  if (!grounder->extend(init, tamp::Termination()).ok()) throw std::runtime_error("grounding failed");
+  const auto negated = orThrow(grounder->negatedAtoms(problem.goal), "goal");
+  Instance in;
+  const std::filesystem::path p(problem_file);
+  in.label = p.parent_path().filename().string() + "/" + p.stem().string();
+  in.task = orThrow(grounder->buildTask(init, negated, true, tamp::Termination()), "task");
+  in.goal = orThrow(grounder->groundGoal(problem.goal, *in.task, init), "goal");
+  in.states = sampleStates(*in.task, grounder->initialState(*in.task, init), 255, 60);
+  return in;
+}
+
+/// Evaluates every state once per iteration; the rate is evaluations per second.
+void evaluateAll(benchmark::State& st, const Instance& in, sp::HeuristicKind kind, sp::CostType ct) {
+  auto h = sp::makeHeuristic(kind, *in.task, ct);
+  h->setGoal(in.goal);
+  int64_t sum = 0;
+  for (auto _ : st) {
+    for (const auto& s : in.states) sum += static_cast<int64_t>(h->evaluate(s.data()) % 1000003);
+  }
+  benchmark::DoNotOptimize(sum);
+  st.SetItemsProcessed(st.iterations() * static_cast<int64_t>(in.states.size()));
+  st.counters["ops"] = static_cast<double>(in.task->ops.size());
+  st.counters["facts"] = static_cast<double>(in.task->numFacts());
+}
+
+void registerInstance(const std::string& domain_file, const std::string& problem_file) {
+  auto in = std::make_shared<Instance>(load(domain_file, problem_file));
+  const bool costs = !in->task->unit_cost;
+  if (costs) {
+    benchmark::RegisterBenchmark(("BM_CostFF/" + in->label).c_str(), [in](benchmark::State& st) {
+      evaluateAll(st, *in, sp::HeuristicKind::kFF, sp::CostType::kPlusOne);
+    })->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("BM_CostAdd/" + in->label).c_str(), [in](benchmark::State& st) {
+      evaluateAll(st, *in, sp::HeuristicKind::kAdd, sp::CostType::kPlusOne);
+    })->Unit(benchmark::kMicrosecond);
+  }
+  benchmark::RegisterBenchmark(("BM_UnitFF/" + in->label).c_str(), [in](benchmark::State& st) {
+    evaluateAll(st, *in, sp::HeuristicKind::kFF, sp::CostType::kUnit);
+  })->Unit(benchmark::kMicrosecond);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  try {
+    if (argc > 1) {
+      if (argc % 2 != 1) throw std::invalid_argument("expected DOMAIN PROBLEM pairs after the benchmark flags");
+      for (int i = 1; i + 1 < argc; i += 2) registerInstance(argv[i], argv[i + 1]);
+    } else {
+      const std::string b = TAMP_BENCHMARKS_DIR;
+      for (const char* dp : {"pddl-more/transport/instance-30", "pddl-more/scanalyzer/instance-6",
+                             "pddl-more/pegsol/instance-6", "pddl-adl/citycar/instance-4"}) {
+        const std::filesystem::path p = b + "/" + dp + ".pddl";
+        registerInstance((p.parent_path() / "domain.pddl").string(), p.string());
+      }
+    }
+  } catch (const std::exception& e) {
+    std::cerr << "tamp_symbolic_planner_heuristic_bench: " << e.what() << "\n";
+    return 30;
+  }
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -20,6 +20,7 @@
 #include "tamp/symbolic_planner/grounding.h"
 #include "tamp/symbolic_planner/heuristic.h"
 #include "tamp/symbolic_planner/pddl.h"
+#include "../tests/random_walks.h"
 
 namespace sp = tamp::symbolic_planner;
 
@@ -47,21 +48,8 @@ T orThrow(tamp::Result<T> r, const std::string& what) {
 /// The initial state and the states of `walks` random walks of up to `length` steps from it.
 std::vector<sp::StateBits> sampleStates(const sp::Task& task, const sp::StateBits& init, int walks, int length) {
   std::mt19937 rng(14);
-  std::vector<sp::StateBits> out{init};
-  std::vector<sp::OpId> ops;
-  for (int w = 0; w < walks; ++w) {
-    sp::StateBits s = init, next(init.size());
-    const int steps = 1 + static_cast<int>(rng() % static_cast<unsigned>(length));
-    for (int k = 0; k < steps; ++k) {
-      ops.clear();
-      task.applicableOps(s.data(), ops);
-      if (ops.empty()) break;
-      task.apply(s.data(), ops[rng() % ops.size()], next.data());
-      s.swap(next);
-    }
-    out.push_back(s);
-  }
-  return out;
+  auto steps = [&](int) { return 1 + static_cast<int>(rng() % static_cast<unsigned>(length)); };
+  return sp::test::randomWalkStates(task, init, walks, steps, rng);
 }
 
 Instance load(const std::string& domain_file, const std::string& problem_file) {

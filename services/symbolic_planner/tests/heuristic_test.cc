@@ -9,6 +9,7 @@
 #include "tamp/symbolic_planner/heuristic.h"
 #include "tamp/symbolic_planner/landmarks.h"
 #include "tamp/symbolic_planner/search.h"
+#include "random_walks.h"
 #include "test_util.h"
 
 namespace tamp::symbolic_planner {
@@ -125,19 +126,7 @@ TEST(Heuristic, CostBasedValuesDoNotDependOnTheStatesEvaluatedBefore) {
   Goal goal;
   goal.conjuncts.push_back(goalFactsByName(**s));
   std::mt19937 rng(24);
-  std::vector<StateBits> states{init};
-  std::vector<OpId> ops;
-  for (int walk = 0; walk < 30; ++walk) {
-    StateBits cur = init, next(init.size());
-    for (int step = 0; step < 1 + walk; ++step) {
-      ops.clear();
-      t.applicableOps(cur.data(), ops);
-      if (ops.empty()) break;
-      t.apply(cur.data(), ops[rng() % ops.size()], next.data());
-      cur.swap(next);
-    }
-    states.push_back(cur);
-  }
+  const std::vector<StateBits> states = test::randomWalkStates(t, init, 30, [](int walk) { return 1 + walk; }, rng);
   for (HeuristicKind kind : {HeuristicKind::kMax, HeuristicKind::kAdd, HeuristicKind::kFF}) {
     auto forwards = makeHeuristic(kind, t, CostType::kPlusOne);
     auto backwards = makeHeuristic(kind, t, CostType::kPlusOne);

@@ -921,7 +921,7 @@ struct Planning {
   collision::Filter requestFilter() const;
   void ensureSampled();
   void densify(og::PathGeometric& path, int s, const std::vector<int>& goals, const std::vector<int>& objects);
-  void tryDirect();
+  void tryDirect(bool keep_clearance);
   Outcome straightOnly();
   bool directKeepsClear(const ob::State* from, const ob::State* to);
   std::optional<detail::DisconnectionProof::Carried> carriedByBase() const;
@@ -1534,19 +1534,22 @@ Outcome Planning::search() {
   planner = makePlanner(kind, si, P.sampling.range);
   planner->setProblemDefinition(pdef);
   planner->setup();
-  tryDirect();
+  if (P.sampling.direct_first) tryDirect(true);
   const bool solved = from_roadmap.has_value() || direct.has_value();
   res.stats.lazy_planner_used = !solved;
   return sample(phase, solved);
 }
 
-void Planning::tryDirect() {
-  if (lazy || !P.sampling.direct_first || termination()) return;
+/// Full mode: the direct motion to a goal state when it is free (and keeps the base clearance,
+/// when `keep_clearance`).
+void Planning::tryDirect(bool keep_clearance) {
+  if (lazy || termination()) return;
   const ob::State* from = escaped ? escaped.get() : start.get();
   for (const ob::State* g : goal_states) {
-    if (!si->checkMotion(from, g) || !directKeepsClear(from, g)) continue;
+    if (!si->checkMotion(from, g) || (keep_clearance && !directKeepsClear(from, g))) continue;
     direct.emplace(si, from, g);
     res.stats.direct = true;
+    res.stats.clearance_relaxed = !keep_clearance;
     break;
   }
 }
@@ -1555,17 +1558,11 @@ void Planning::tryDirect() {
 /// any free one), or `no path` at once; nothing is sampled.
 Outcome Planning::straightOnly() {
   Stopwatch phase;
-  tryDirect();
-  const ob::State* from = escaped ? escaped.get() : start.get();
-  for (const ob::State* g : goal_states) {
-    if (direct || termination()) break;
-    if (!si->checkMotion(from, g)) continue;
-    direct.emplace(si, from, g);
-    res.stats.direct = true;
-    res.stats.clearance_relaxed = true;
-  }
+  tryDirect(true);
+  if (!direct) tryDirect(false);
   res.stats.sampling_ms = phase.millis();
   if (direct) return std::nullopt;
+  const ob::State* from = escaped ? escaped.get() : start.get();
   // What it touches: just past the last free state along it.
   std::pair<ob::State*, double> last_valid{space->allocState(), 0.0};
   ob::State* past = space->allocState();

@@ -353,6 +353,8 @@ def run_matrix(cases, opts, setup, available, after_each, resumed):
     (partial results on disk when the evaluation is stopped, to --resume from)."""
     rows = []
     plan = list(matrix(cases, opts, resumed))
+    if opts.seed_major:  # seed 1 of every case and policy first (a stable sort keeps their order)
+        plan.sort(key=lambda t: t[2])
     index = 0
     for case, policy, seed, old in plan:
         if old is not None:
@@ -707,6 +709,9 @@ def parse_args(argv):
     p.add_argument("--no-plot", action="store_true", help="tables only")
     p.add_argument("--list", action="store_true", help="print the scenarios and worlds that would run, then exit")
     p.add_argument("--keep-runs", default="", help="copy every run folder (reports, logs) under this folder")
+    p.add_argument("--seed-major", action="store_true",
+                   help="run seed 1 of every case and policy, then seed 2, ... (an evaluation stopped "
+                        "early, or resumed across days, has every case at the same depth)")
     p.add_argument("--resume", default="", help="CSV of an earlier evaluation: its runs are kept, not run again")
     p.add_argument("--notes", default="", help="Markdown file inserted after the aims section")
     opts = p.parse_args(argv)

@@ -913,6 +913,8 @@ struct Planning {
   bool escapeThrough(const std::vector<int>& touching);
   std::vector<std::string> touchedFixedOnly();
   void escapeFixed(const std::vector<std::string>& touched);
+  std::vector<std::string> touchedStaticsShallowly();
+  void escapeStatics(const std::vector<std::string>& touched);
   void escapeHeldMargin();
   bool checkGoal(ob::State* s, std::string& who);
   Outcome setStateGoal();
@@ -1180,6 +1182,10 @@ Outcome Planning::leaveStart() {
       const std::vector<std::string> fixed = touchedFixedOnly();
       if (!fixed.empty()) escapeFixed(fixed);
     }
+    if (!escaped && P.sampling.start_escape_distance > 0.0 && P.sampling.start_escape_depth > 0.0) {
+      const std::vector<std::string> statics = touchedStaticsShallowly();
+      if (!statics.empty()) escapeStatics(statics);
+    }
     if (!escaped) {
       return finish(MotionStatus::kStartInCollision, "the start state touches '" + who + "'" +
                                                          (touching.empty() ? "" : " (no way out of the contact found)"),
@@ -1244,6 +1250,38 @@ void Planning::escapeFixed(const std::vector<std::string>& touched) {
     found = escapeBy(makeSi(escape_oracle, false));
   }
   if (found) res.start_contacts.insert(res.start_contacts.end(), touched.begin(), touched.end());
+}
+
+/// The static objects (and, lazy, the ones the request fixes) that the start touches, when it is
+/// free of them `start_escape_depth` smaller and touches nothing else; empty otherwise. A robot
+/// stopped at a wall by its own safety (or localised a few millimetres off) stands there: the
+/// planner's model of the robot and the world is not the world.
+std::vector<std::string> Planning::touchedStaticsShallowly() {
+  std::vector<std::string> touched;
+  gs.placeRobot(start.get(), impl.scene);
+  for (const auto& o : impl.world.objects()) {  // (lazy: the fixed objects are static for the request)
+    if (o.kind != world::ObjectKind::kStatic) continue;
+    if (std::find(ignored.begin(), ignored.end(), o.id) != ignored.end()) continue;
+    if (impl.scene.robotInCollision(collision::Filter::objects({o.id}))) touched.push_back(o.id);
+  }
+  if (touched.empty()) return touched;
+  collision::Scene smaller = shrunkScene(touched);
+  detail::Oracle shallow(smaller, gs, ignored, oracle.movables(), oracle.reachRadius());
+  if (!(lazy ? shallow.staticFree(start.get()) : shallow.allFree(start.get()))) touched.clear();
+  gs.placeRobot(start.get(), impl.scene);
+  return touched;
+}
+
+/// Out of a shallow contact with static objects `touched`: a short straight motion going no
+/// deeper into them (checked against them `start_escape_depth` smaller), to a free state. Never
+/// through them, as a movable may be left.
+void Planning::escapeStatics(const std::vector<std::string>& touched) {
+  collision::Scene smaller = shrunkScene(touched);
+  detail::Oracle escape_oracle(smaller, gs, ignored, oracle.movables(), oracle.reachRadius());
+  if (held_shape) escape_oracle.setSelfScene(&plainScene());
+  if (escapeBy(makeSi(escape_oracle, !lazy))) {
+    res.start_contacts.insert(res.start_contacts.end(), touched.begin(), touched.end());
+  }
 }
 
 /// A copy of the request's scene with the objects `ids` `start_escape_depth` smaller.

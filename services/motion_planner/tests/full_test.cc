@@ -635,6 +635,40 @@ TEST_F(FullTest, AStartTouchingAStaticWallOrDeepInAMovableIsStartInCollision) {
   EXPECT_NE(r.reason.find("no way out"), std::string::npos) << r.reason;
 }
 
+// A robot stopped at a wall by its own safety stands where the planner's model of it touches the
+// wall by a few millimetres (the models differ). It leaves by a short motion going no deeper, in
+// both modes, and the contact is reported; deeper than start_escape_depth it is start in collision
+// (above), and it never leaves through the wall.
+TEST_F(FullTest, AStartAFewMillimetresIntoAStaticWallLeavesItGoingNoDeeper) {
+  const world::World w = testing::openRoomWorld();
+  MotionPlanner mp = planner(w);
+  for (const MotionMode mode : {MotionMode::kFull, MotionMode::kLazy}) {
+    SCOPED_TRACE(toString(mode));
+    const MotionResult r = mp.plan(testing::baseRequest({kRadius - 0.003, 3.0, 0.0}, {2, 3, 0}, mode),
+                                   Termination::after(5.0));
+    ASSERT_EQ(r.status, MotionStatus::kSolved) << r.reason;
+    EXPECT_EQ(r.start_contacts, std::vector<std::string>{"wall_west"});
+    ASSERT_GE(r.path.waypoints.size(), 2u);
+    // The first motion goes no deeper into the wall: x never below the start's.
+    for (const auto& wp : r.path.waypoints) EXPECT_GE(wp[0], kRadius - 0.003 - 1e-9);
+    EXPECT_NEAR(r.path.waypoints.back()[0], 2.0, 0.011);
+    // A corner: two walls, each touched by 3 mm.
+    const MotionResult c = mp.plan(testing::baseRequest({kRadius - 0.003, kRadius - 0.003, 0.0}, {2, 3, 0}, mode),
+                                   Termination::after(5.0));
+    ASSERT_EQ(c.status, MotionStatus::kSolved) << c.reason;
+    EXPECT_EQ(c.start_contacts.size(), 2u);
+    const MotionResult deep = mp.plan(testing::baseRequest({kRadius - 0.02, 3.0, 0.0}, {2, 3, 0}, mode),
+                                      Termination::after(5.0));
+    EXPECT_EQ(deep.status, MotionStatus::kStartInCollision) << deep.reason;
+    EXPECT_EQ(deep.colliding_object, "wall_west");
+  }
+  MotionPlannerParams no_escape;
+  no_escape.sampling.start_escape_depth = 0.0;
+  MotionPlanner strict = planner(w, no_escape);
+  EXPECT_EQ(strict.plan(request({kRadius - 0.003, 3.0, 0.0}, {2, 3, 0}), Termination::after(5.0)).status,
+            MotionStatus::kStartInCollision);
+}
+
 TEST_F(FullTest, WithoutAnEscapeDistanceAStartTouchingAMovableIsStartInCollision) {
   MotionPlannerParams p;
   p.sampling.start_escape_distance = 0.0;

@@ -1663,7 +1663,12 @@ Outcome Planning::sample(const Stopwatch& phase, bool solved) {
   std::vector<std::pair<double, int>> proof_cells;
   if (P.proof.enabled && gs.hasBase() && base_goal) {
     for (double c = P.proof.cell_size; c >= P.proof.min_cell_size - 1e-12; c *= 0.5) proof_cells.emplace_back(c, 1);
-    if (P.proof.yaw_cells > 1) proof_cells.emplace_back(P.proof.oriented_cell_size, P.proof.yaw_cells);
+    if (P.proof.yaw_cells > 1) {
+      proof_cells.emplace_back(P.proof.oriented_cell_size, P.proof.yaw_cells);
+      for (int k = 1; k <= P.proof.oriented_refinements; ++k) {
+        proof_cells.emplace_back(P.proof.oriented_cell_size / (1 << k), P.proof.yaw_cells << k);
+      }
+    }
   }
   const collision::Filter proof_filter = requestFilter();
   const std::shared_ptr<const collision::ClearanceGrid> statics = proof_cells.empty() ? nullptr : impl.clearanceGrid();
@@ -1699,8 +1704,12 @@ Outcome Planning::sample(const Stopwatch& phase, bool solved) {
       res.stats.proof_grid_answers += proof->gridAnswers();
       traceProof(*proof, outcome);
       if (!proven) {
+        // A finer (x, y, yaw) grid tests about eight times the cells: only where that fits.
+        const bool refinement_next = level + 1 < proof_cells.size() && proof->yawCells() > 1;
+        const bool small = outcome == detail::ProofOutcome::kConnected &&
+                           8 * proof->tested() <= static_cast<std::size_t>(P.proof.oriented_max_cells);
         proof.reset();
-        ++level;
+        level = refinement_next && !small ? proof_cells.size() : level + 1;
       }
     }
     res.stats.proof_ms += pw.millis();

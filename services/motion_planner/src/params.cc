@@ -91,6 +91,7 @@ const config::Schema<MotionPlannerParams>& schema() {
         .field("yaw_cells", &R::yaw_cells, nonNegative())
         .field("oriented_cell_size", &R::oriented_cell_size, positive())
         .field("oriented_max_cells", &R::oriented_max_cells, atLeast(1))
+        .field("oriented_refinements", &R::oriented_refinements, nonNegative())
         .field("first_turn_s", &R::first_turn_s, nonNegative())
         .field("time_share", &R::time_share, nonNegative())
         .rule("min_cell_size", [](const R& r) -> std::optional<std::string> {

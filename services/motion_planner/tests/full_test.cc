@@ -255,6 +255,43 @@ TEST_F(FullTest, ABaseThatCannotTurnTheCornerIsAProvenNoPath) {
   EXPECT_EQ(open.status, MotionStatus::kSolved) << open.reason;
 }
 
+// The same corner, and a base a few centimetres too long to turn it (0.66 m; 0.72 m is proven on
+// the first (x, y, yaw) grid): that grid keeps a box 4.4 cm smaller on each side than the base and
+// finds the corner passable, so without finer grids the request runs to its deadline; the finer
+// grid (1.25 cm, 128 yaw cells; ProofParams::oriented_refinements) proves it, where the coarser
+// one was small enough for eight times its cells.
+TEST_F(FullTest, ABaseAFewCentimetresTooLongToTurnTheCornerIsProvenOnAFinerGrid) {
+  world::World w("l_corridor");
+  for (const auto& o : {testing::box("wall_south", 5, -0.1, 10.4, 0.2, false),
+                        testing::box("wall_north", 5, 10.1, 10.4, 0.2, false),
+                        testing::box("wall_west", -0.1, 5, 0.2, 10, false),
+                        testing::box("wall_east", 10.1, 5, 0.2, 10, false), testing::box("below", 5, 0.5, 10, 1.0, false),
+                        testing::box("north_west", 2.3, 5.7, 4.6, 8.6, false),
+                        testing::box("east", 7.5, 3.5, 5, 5, false)})
+    ASSERT_TRUE(w.addObject(o).ok()) << o.id;
+  auto plan = [&](const MotionPlannerParams& p, double seconds) {
+    MotionPlanner mp(collision::RobotGeometry::box(0.66, 0.3, 0.5), p);
+    mp.setWorld(w);
+    return mp.plan(request({1.0, 1.2, 0}, {7.0, 8.0, 0}), Termination::after(seconds));
+  };
+  const MotionResult r = plan(MotionPlannerParams{}, 20.0);
+  EXPECT_EQ(r.status, MotionStatus::kNoPath) << r.reason;
+  EXPECT_NE(r.reason.find("with 128 yaw cells"), std::string::npos) << r.reason;
+  EXPECT_NE(r.stats.proof_trace.find("0.025 m x 64: connected"), std::string::npos) << r.stats.proof_trace;
+  MotionPlannerParams coarse;
+  coarse.proof.oriented_refinements = 0;
+  const MotionResult c = plan(coarse, 1.0);
+  EXPECT_EQ(c.status, MotionStatus::kTimeout) << c.reason;
+  EXPECT_EQ(c.reason.find("x 128"), std::string::npos) << c.reason;
+  // A cap that eight times the first grid's cells exceed: no finer grid, a timeout.
+  MotionPlannerParams capped;
+  capped.proof.oriented_max_cells = 40000;
+  const MotionResult k = plan(capped, 1.0);
+  EXPECT_EQ(k.status, MotionStatus::kTimeout) << k.reason;
+  EXPECT_NE(k.reason.find("x 64: connected"), std::string::npos) << k.reason;
+  EXPECT_EQ(k.reason.find("x 128"), std::string::npos) << k.reason;
+}
+
 // An L corridor 0.8 m wide (east along y in [1, 1.8], then north along x in [4, 4.8]) into a
 // room (x > 4, y > 5). The disc base (0.3 m) passes it; with a 2.2 x 0.4 m load held ahead of it
 // (0.35 .. 2.55 m), 2.85 m in all, it cannot turn north: round a corner of two 0.8 m corridors

@@ -221,21 +221,29 @@ TEST_F(FullTest, AGoalInAClosedPocketIsProvenFromThePocketsSide) {
 // A long base (1.0 x 0.3 m) in a 0.4 m wide corridor that turns a right angle: it fits the
 // corridor lengthwise but cannot turn the corner. Its inscribed disc passes the corner, so only
 // the (x, y, yaw) grid proves that there is no path; without it the planner runs to the deadline.
-TEST_F(FullTest, ABaseThatCannotTurnTheCornerIsAProvenNoPath) {
+/// An L corridor 0.4 m wide: east along y in [1, 1.4] for x < 4.6, then north along x in
+/// [4.6, 5] up to y = 6, a room above.
+world::World lCorridor() {
   world::World w("l_corridor");
-  auto add = [&](const world::Object& o) { ASSERT_TRUE(w.addObject(o).ok()) << o.id; };
-  add(testing::box("wall_south", 5, -0.1, 10.4, 0.2, false));
-  add(testing::box("wall_north", 5, 10.1, 10.4, 0.2, false));
-  add(testing::box("wall_west", -0.1, 5, 0.2, 10, false));
-  add(testing::box("wall_east", 10.1, 5, 0.2, 10, false));
-  add(testing::box("below", 5, 0.5, 10, 1.0, false));           // corridor: y in [1, 1.4] ...
-  add(testing::box("north_west", 2.3, 5.7, 4.6, 8.6, false));  // ... for x < 4.6, then x in [4.6, 5] ...
-  add(testing::box("east", 7.5, 3.5, 5, 5, false));             // ... up to y = 6, a room above
-  auto plan = [&](const MotionPlannerParams& p, double seconds) {
-    MotionPlanner mp(collision::RobotGeometry::box(1.0, 0.3, 0.5), p);
-    mp.setWorld(w);
-    return mp.plan(request({1.0, 1.2, 0}, {7.0, 8.0, 0}), Termination::after(seconds));
-  };
+  for (const auto& o : {testing::box("wall_south", 5, -0.1, 10.4, 0.2, false),
+                        testing::box("wall_north", 5, 10.1, 10.4, 0.2, false),
+                        testing::box("wall_west", -0.1, 5, 0.2, 10, false),
+                        testing::box("wall_east", 10.1, 5, 0.2, 10, false), testing::box("below", 5, 0.5, 10, 1.0, false),
+                        testing::box("north_west", 2.3, 5.7, 4.6, 8.6, false),
+                        testing::box("east", 7.5, 3.5, 5, 5, false)})
+    EXPECT_TRUE(w.addObject(o).ok()) << o.id;
+  return w;
+}
+
+/// A box base `length` x 0.3 m from the L corridor's east arm to the room above its north arm.
+MotionResult roundTheCorner(double length, const MotionPlannerParams& p, double seconds) {
+  MotionPlanner mp(collision::RobotGeometry::box(length, 0.3, 0.5), p);
+  mp.setWorld(lCorridor());
+  return mp.plan(testing::baseRequest({1.0, 1.2, 0}, {7.0, 8.0, 0}, MotionMode::kFull), Termination::after(seconds));
+}
+
+TEST_F(FullTest, ABaseThatCannotTurnTheCornerIsAProvenNoPath) {
+  auto plan = [](const MotionPlannerParams& p, double seconds) { return roundTheCorner(1.0, p, seconds); };
   const MotionResult r = plan(MotionPlannerParams{}, 20.0);
   EXPECT_EQ(r.status, MotionStatus::kNoPath) << r.reason;
   EXPECT_NE(r.reason.find("yaw cells"), std::string::npos) << r.reason;
@@ -261,19 +269,7 @@ TEST_F(FullTest, ABaseThatCannotTurnTheCornerIsAProvenNoPath) {
 // grid (1.25 cm, 128 yaw cells; ProofParams::oriented_refinements) proves it, where the coarser
 // one was small enough for eight times its cells.
 TEST_F(FullTest, ABaseAFewCentimetresTooLongToTurnTheCornerIsProvenOnAFinerGrid) {
-  world::World w("l_corridor");
-  for (const auto& o : {testing::box("wall_south", 5, -0.1, 10.4, 0.2, false),
-                        testing::box("wall_north", 5, 10.1, 10.4, 0.2, false),
-                        testing::box("wall_west", -0.1, 5, 0.2, 10, false),
-                        testing::box("wall_east", 10.1, 5, 0.2, 10, false), testing::box("below", 5, 0.5, 10, 1.0, false),
-                        testing::box("north_west", 2.3, 5.7, 4.6, 8.6, false),
-                        testing::box("east", 7.5, 3.5, 5, 5, false)})
-    ASSERT_TRUE(w.addObject(o).ok()) << o.id;
-  auto plan = [&](const MotionPlannerParams& p, double seconds) {
-    MotionPlanner mp(collision::RobotGeometry::box(0.66, 0.3, 0.5), p);
-    mp.setWorld(w);
-    return mp.plan(request({1.0, 1.2, 0}, {7.0, 8.0, 0}), Termination::after(seconds));
-  };
+  auto plan = [](const MotionPlannerParams& p, double seconds) { return roundTheCorner(0.66, p, seconds); };
   const MotionResult r = plan(MotionPlannerParams{}, 20.0);
   EXPECT_EQ(r.status, MotionStatus::kNoPath) << r.reason;
   EXPECT_NE(r.reason.find("with 128 yaw cells"), std::string::npos) << r.reason;

@@ -1,5 +1,5 @@
 #pragma once
-// Private: the state of a MotionPlanner, shared by motion_planner.cc, placement.cc, grasps.cc.
+// Private: the state of a MotionPlanner, shared by motion_planner.cc, planning*.cc, placement.cc, grasps.cc.
 
 #include <optional>
 #include <string>

@@ -26,6 +26,7 @@
 #include <libnetfilter_queue/libnetfilter_queue.h>
 #include <linux/netfilter.h>  // NF_ACCEPT
 #include <poll.h>
+#include <time.h>
 #include <sys/socket.h>
 
 #include <algorithm>
@@ -37,6 +38,7 @@
 #include <cstring>
 #include <deque>
 #include <filesystem>
+#include <optional>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -163,11 +165,13 @@ void releaseDue(Delayer& d, bool all) {
   }
 }
 
-/// poll() timeout until the next packet is due (-1: nothing held), rounded up to whole ms.
-int msUntilNextDue(const Delayer& d) {
-  if (d.held.empty()) return -1;
-  const double ms = Ms(d.held.front().due - Clock::now()).count();
-  return ms <= 0.0 ? 0 : static_cast<int>(ms) + 1;
+/// ppoll() timeout until the next packet is due, to the nanosecond (poll()'s whole milliseconds,
+/// rounded up, released packets up to 1 ms late); none while nothing is held.
+std::optional<timespec> untilNextDue(const Delayer& d) {
+  if (d.held.empty()) return std::nullopt;
+  const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(d.held.front().due - Clock::now()).count();
+  if (ns <= 0) return timespec{0, 0};
+  return timespec{static_cast<time_t>(ns / 1000000000), static_cast<long>(ns % 1000000000)};
 }
 
 nfq_handle* openNetlink() {
@@ -225,8 +229,9 @@ void readPackets(nfq_handle* h, Delayer& d) {
 void run(nfq_handle* h, Delayer& d) {
   pollfd p{nfq_fd(h), POLLIN, 0};
   while (!g_stop) {
-    const int r = poll(&p, 1, msUntilNextDue(d));
-    if (r < 0 && errno != EINTR) fail(kExitSocket, std::string("poll: ") + strerror(errno));
+    const std::optional<timespec> timeout = untilNextDue(d);
+    const int r = ppoll(&p, 1, timeout ? &*timeout : nullptr, nullptr);
+    if (r < 0 && errno != EINTR) fail(kExitSocket, std::string("ppoll: ") + strerror(errno));
     if (r > 0) readPackets(h, d);
     releaseDue(d, false);
   }

@@ -1464,9 +1464,8 @@ SearchResult search(const Task& task, const StateBits& init, const Goal& goal, c
                           : firstPlan(task, init, goal, options, heuristic, term);
   if (best.status != SearchStatus::kSolved || !anytime) return best;
   // Anytime phase (LAMA 2011): the lazy greedy search, then lazy weighted A* with w = 5, 3, 2, 1,
-  // 1, ..., each bounded by the
-  // best cost so far, until the budget or the caller's deadline; an exhausted iteration proves
-  // the best plan optimal.
+  // 1, ..., each bounded by the best cost so far, until the budget or the caller's deadline; an
+  // exhausted weighted A* iteration proves the best plan optimal.
   const Termination until = term.tightened(Deadline::in(options.anytime_seconds));
   // Plan neighbourhood graph search on the first plan (and on each cheaper plan it finds), the
   // neighbourhood doubled while it finds nothing cheaper.
@@ -1499,7 +1498,8 @@ SearchResult search(const Task& task, const StateBits& init, const Goal& goal, c
   static constexpr double kWeights[] = {0.0, 5.0, 3.0, 2.0, 1.0};
   for (size_t i = 0; !until() && best.cost > 0; ++i) {
     Searcher s(task, init, goal, options, heuristic, until);
-    SearchResult r = s.improve(kWeights[std::min<size_t>(i, 4)], best.cost);
+    const double w = kWeights[std::min<size_t>(i, 4)];
+    SearchResult r = s.improve(w, best.cost);
     ++best.stats.anytime_iterations;
     addRunCosts(best.stats, r.stats);
     if (r.status == SearchStatus::kSolved && r.cost < best.cost) {
@@ -1507,6 +1507,11 @@ SearchResult search(const Task& task, const StateBits& init, const Goal& goal, c
       best.plan = std::move(r.plan);
       best.cost = r.cost;
     } else if (r.status == SearchStatus::kUnsolvable) {
+      // Only weighted A* re-opens a state reached again more cheaply, so only its exhausted
+      // space holds no cheaper plan. The lazy greedy search keeps the first path to each state:
+      // its exhausted space proves nothing, and the next iteration runs (as LAMA 2011's
+      // `continue_on_fail`).
+      if (w == 0.0) continue;
       best.stats.anytime_proved_optimal = true;
       break;
     } else if (r.status != SearchStatus::kSolved) {

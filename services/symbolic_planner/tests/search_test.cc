@@ -749,6 +749,42 @@ TEST(Search, PlanNeighbourhoodSearchFindsTheCheaperWayAndProvesItOptimalOnASmall
   EXPECT_EQ(r.cost, 8);
 }
 
+TEST(Search, AnExhaustedLazyGreedyIterationDoesNotEndTheAnytimePhase) {
+  // The first plan (unit costs) is the direct edge s -> g, cost 20, the bound of the anytime
+  // iterations. The lazy greedy iteration (cost + 1) prefers a (h lower than b's), reaches x over
+  // a with g = 16, where x -> g (5) passes the bound, and keeps that first path to x: reached
+  // again over b and c with g = 3, x is not re-opened, and the open list runs out. That proves
+  // nothing; weighted A* (w = 5), which re-opens, finds s b c x g (cost 8).
+  const std::string dom = R"((define (domain trap2) (:requirements :typing :action-costs)
+    (:types node) (:predicates (at ?n - node) (edge ?a ?b - node))
+    (:functions (total-cost) - number (w ?a ?b - node) - number)
+    (:action go :parameters (?a ?b - node) :precondition (and (at ?a) (edge ?a ?b))
+      :effect (and (not (at ?a)) (at ?b) (increase (total-cost) (w ?a ?b))))))";
+  const std::string prob = R"((define (problem p) (:domain trap2) (:objects s a b c x g - node)
+    (:init (at s) (edge s g) (edge s a) (edge a x) (edge s b) (edge b c) (edge c x) (edge x g)
+      (= (w s g) 20) (= (w s a) 15) (= (w a x) 1) (= (w s b) 1) (= (w b c) 1) (= (w c x) 1)
+      (= (w x g) 5) (= (total-cost) 0))
+    (:goal (at g)) (:metric minimize (total-cost))))";
+  PlanRequest req;
+  req.domain_text = dom;
+  req.problem_text = prob;
+  req.check_plan = true;
+  req.search.anytime_seconds = 60;  // a budget: weighted A* exhausts the small space at once
+  req.search.neighbourhood_time_share = 0;  // the iterations alone
+  PlanReply r = plan(req, Termination());
+  ASSERT_EQ(r.status, PlanStatus::kSolved) << r.message;
+  EXPECT_EQ(r.cost, 8);
+  EXPECT_GE(r.stats.anytime_iterations, 2U);
+  EXPECT_EQ(r.stats.anytime_improvements, 1U);
+  // With the neighbourhood search (the default), the whole space is its neighbourhood.
+  req.search.neighbourhood_time_share = SearchOptions{}.neighbourhood_time_share;
+  r = plan(req, Termination());
+  ASSERT_EQ(r.status, PlanStatus::kSolved) << r.message;
+  EXPECT_EQ(r.cost, 8);
+  EXPECT_EQ(r.stats.neighbourhood_improvements, 1U);
+  EXPECT_EQ(r.stats.anytime_iterations, 0U);
+}
+
 TEST(Search, PlanNeighbourhoodSearchNeverReturnsADearerPlanOnIpcCostTasks) {
   // Conditional effects and negation (citycar), costs from functions of several arguments
   // (elevators, parcprinter): the plan after the neighbourhood search alone (the whole anytime

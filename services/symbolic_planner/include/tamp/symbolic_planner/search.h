@@ -241,7 +241,9 @@ struct SearchStatistics {
   uint64_t eliminated_actions{0};  ///< removed by action elimination
   uint64_t anytime_iterations{0};    ///< weighted A* iterations of the anytime phase
   uint64_t anytime_improvements{0};  ///< ... that found a cheaper plan
-  bool anytime_proved_optimal{false};  ///< an iteration exhausted its bounded space: no cheaper plan
+  /// A weighted A* iteration exhausted its bounded space, or a plan neighbourhood held every
+  /// reachable state: no cheaper plan exists.
+  bool anytime_proved_optimal{false};
   uint64_t neighbourhood_runs{0};          ///< plan neighbourhood searches of the anytime phase
   uint64_t neighbourhood_improvements{0};  ///< ... that found a cheaper plan
   uint64_t neighbourhood_states{0};        ///< states of the largest neighbourhood searched

@@ -123,6 +123,7 @@ int main(int argc, char** argv) {
   uint64_t fallback_budget = defaults.ehc_fallback_budget_per_h, fallback_min = defaults.ehc_fallback_budget_min,
            fallback_max = defaults.ehc_fallback_budget_max;
   double unit_first_share = defaults.unit_first_time_share;
+  double neighbourhood_share = defaults.neighbourhood_time_share;
   int64_t heap_reserve_mib = 64;
   double retry_share = defaults.ehc_retry_budget_share;
   uint64_t lazy_after = defaults.ehc_lazy_after, lazy_turn_ehc = defaults.ehc_lazy_turn_ehc,
@@ -186,6 +187,10 @@ int main(int argc, char** argv) {
   app.add_option("--unit-first-share", unit_first_share,
                  "the share of the time left that the unit-cost first run may use, in (0, 1]")
       ->check(CLI::Range(1e-9, 1.0));
+  app.add_option("--neighbourhood-share", neighbourhood_share,
+                 "with --anytime: the share of its time for plan neighbourhood graph search on the first plan, "
+                 "before LAMA's weighted A* iterations, in [0, 1] (0 = none)")
+      ->check(CLI::Range(0.0, 1.0));
   app.add_flag("--no-landmarks", no_landmarks, "lazy: h_FF only (no landmark-count heuristic)");
   std::string landmark_generator = defaults.landmark_generator == sp::LandmarkGenerator::kRhw ? "rhw" : "zg";
   size_t rhw_max_disjunction = defaults.rhw.max_disjunction_size;
@@ -265,6 +270,7 @@ int main(int argc, char** argv) {
   req.search.anytime_seconds = anytime;
   req.search.unit_cost_first = !no_unit_first;
   req.search.unit_first_time_share = unit_first_share;
+  req.search.neighbourhood_time_share = neighbourhood_share;
   if (heuristic == "ff") req.search.heuristic = sp::HeuristicKind::kFF;
   if (heuristic == "add") req.search.heuristic = sp::HeuristicKind::kAdd;
   if (heuristic == "max") req.search.heuristic = sp::HeuristicKind::kMax;
@@ -312,6 +318,12 @@ int main(int argc, char** argv) {
                  : reply.stats.lazy_beside_started ? "; lazy search beside ehc started"
                                                    : "",
                  reply.stats.unit_first_failed ? "; unit-cost first run failed, first plan with cost + 1" : "");
+    if (reply.stats.neighbourhood_runs > 0) {
+      std::fprintf(stderr, "; plan neighbourhood searches %llu, %llu improvements, up to %llu states",
+                   static_cast<unsigned long long>(reply.stats.neighbourhood_runs),
+                   static_cast<unsigned long long>(reply.stats.neighbourhood_improvements),
+                   static_cast<unsigned long long>(reply.stats.neighbourhood_states));
+    }
     if (reply.stats.relevance_ran) {
       const sp::RelevanceStats& r = reply.stats.relevance;
       std::fprintf(stderr, "; relevance %.4f s: facts %zu -> %zu, operators %zu -> %zu relevant -> %zu merged%s",

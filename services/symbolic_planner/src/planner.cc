@@ -345,6 +345,9 @@ PlanReply PlanningSession::solve(const Query& q, const Termination& term) {
   reply.stats.lazy_beside_won = sr.stats.lazy_beside_won;
   reply.stats.anytime_iterations = sr.stats.anytime_iterations;
   reply.stats.anytime_improvements = sr.stats.anytime_improvements;
+  reply.stats.neighbourhood_runs = sr.stats.neighbourhood_runs;
+  reply.stats.neighbourhood_improvements = sr.stats.neighbourhood_improvements;
+  reply.stats.neighbourhood_states = sr.stats.neighbourhood_states;
   reply.stats.unit_first_failed = sr.stats.unit_first_failed;
   reply.stats.landmarks = sr.stats.landmarks;
   reply.stats.landmarks_disjunctive = sr.stats.landmarks_disjunctive;

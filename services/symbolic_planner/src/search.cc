@@ -1,6 +1,7 @@
 #include "tamp/symbolic_planner/search.h"
 
 #include <deque>
+#include <queue>
 #include <limits>
 #include <map>
 #include <memory>
@@ -88,6 +89,16 @@ class StateRegistry {
     hashes_.push_back(static_cast<uint32_t>(h));
     slots_[i] = id;
     return {id, true};
+  }
+  /// The id of state `s`, or kNone when it is not registered.
+  uint32_t find(const uint64_t* s) const {
+    const uint64_t h = hash(s);
+    size_t i = h & (slots_.size() - 1);
+    while (slots_[i] != kNone) {
+      if (hashes_[slots_[i]] == static_cast<uint32_t>(h) && std::equal(s, s + w_, get(slots_[i]))) return slots_[i];
+      i = (i + 1) & (slots_.size() - 1);
+    }
+    return kNone;
   }
   const uint64_t* get(uint32_t id) const { return pool_.data() + static_cast<size_t>(id) * w_; }
   size_t size() const { return n_; }
@@ -351,6 +362,76 @@ class Searcher {
     return finished(std::move(r), sw, true);
   }
 
+  /// Plan neighbourhood graph search (Nakhost & Mueller 2010): registers the states `plan` passes
+  /// through and then, breadth-first from all of them, the states reached from them, until
+  /// `max_states` are registered; returns the cheapest path from the initial state to a goal state
+  /// through registered states only (uniform-cost). The plan's own path is among them, so the
+  /// result costs at most the plan's. `*complete`: every registered state was expanded before the
+  /// cap (the neighbourhood is the whole reachable space and the result is optimal).
+  SearchResult neighbourhood(const std::vector<OpId>& plan, size_t max_states, bool* complete) {
+    Stopwatch sw;
+    return finished(neighbourhoodSearch(plan, max_states, complete), sw, true);
+  }
+
+ private:
+  SearchResult neighbourhoodSearch(const std::vector<OpId>& plan, size_t max_states, bool* complete) {
+    *complete = false;
+    resetRegistry();
+    bool is_new = false;
+    std::copy(init_.begin(), init_.end(), buf_.begin());
+    registerState(buf_.data(), &is_new);
+    for (OpId o : plan) {
+      task_.apply(buf_.data(), o, succ_.data());
+      buf_.swap(succ_);
+      registerState(buf_.data(), &is_new);
+    }
+    // Breadth-first: the registry's order is the queue's.
+    std::vector<OpId> ops;
+    uint32_t next = 0;
+    while (next < reg_.size() && reg_.size() < max_states) {
+      if (auto st = checkLimits()) return finish(*st);
+      std::copy(reg_.get(next), reg_.get(next) + reg_.words(), buf_.begin());
+      ++next;
+      ++stats_.expanded;
+      ops.clear();
+      task_.applicableOps(buf_.data(), ops);
+      for (OpId o : ops) {
+        task_.apply(buf_.data(), o, succ_.data());
+        ++stats_.generated;
+        registerState(succ_.data(), &is_new);
+        if (reg_.size() >= max_states) break;
+      }
+    }
+    *complete = next == reg_.size();
+    // Uniform-cost search from the initial state (id 0) on the registered states.
+    constexpr Cost kInf = std::numeric_limits<Cost>::max();
+    std::fill(g_.begin(), g_.end(), kInf);
+    g_[0] = 0;
+    std::priority_queue<std::pair<Cost, uint32_t>, std::vector<std::pair<Cost, uint32_t>>, std::greater<>> open;
+    open.emplace(0, 0);
+    while (!open.empty()) {
+      if (auto st = checkLimits()) return finish(*st);
+      const auto [g, id] = open.top();
+      open.pop();
+      if (g != g_[id]) continue;
+      std::copy(reg_.get(id), reg_.get(id) + reg_.words(), buf_.begin());
+      if (task_.goalReached(buf_.data(), goal_)) return finish(SearchStatus::kSolved, path(id, kNone));
+      ops.clear();
+      task_.applicableOps(buf_.data(), ops);
+      for (OpId o : ops) {
+        task_.apply(buf_.data(), o, succ_.data());
+        const uint32_t sid = reg_.find(succ_.data());
+        if (sid == kNone || g + opCost(o) >= g_[sid]) continue;
+        g_[sid] = g + opCost(o);
+        parent_[sid] = id;
+        op_[sid] = o;
+        open.emplace(g_[sid], sid);
+      }
+    }
+    return finish(SearchStatus::kUnsolvable);  // not reached: the plan's own path ends in a goal state
+  }
+
+ public:
   /// A search's result made final: redundant actions eliminated from a solved plan (when
   /// `eliminate` and the option say so), the statistics, and the plan's cost.
   SearchResult finished(SearchResult r, const Stopwatch& sw, bool eliminate) {
@@ -1122,6 +1203,13 @@ void SearchOptions::validate() const {
     throw std::invalid_argument("SearchOptions::anytime_seconds must be a finite number >= 0, got " +
                                 std::to_string(anytime_seconds));
   }
+  if (!(neighbourhood_time_share >= 0.0 && neighbourhood_time_share <= 1.0)) {
+    throw std::invalid_argument("SearchOptions::neighbourhood_time_share must be in [0, 1], got " +
+                                std::to_string(neighbourhood_time_share));
+  }
+  if (neighbourhood_first_states == 0) {
+    throw std::invalid_argument("SearchOptions::neighbourhood_first_states must be > 0");
+  }
   if (!(unit_first_time_share > 0.0 && unit_first_time_share <= 1.0)) {
     throw std::invalid_argument("SearchOptions::unit_first_time_share must be in (0, 1], got " +
                                 std::to_string(unit_first_time_share));
@@ -1376,15 +1464,42 @@ SearchResult search(const Task& task, const StateBits& init, const Goal& goal, c
                           : firstPlan(task, init, goal, options, heuristic, term);
   if (best.status != SearchStatus::kSolved || !anytime) return best;
   // Anytime phase (LAMA 2011): the lazy greedy search, then lazy weighted A* with w = 5, 3, 2, 1,
-  // 1, ..., each bounded by the
-  // best cost so far, until the budget or the caller's deadline; an exhausted iteration proves
-  // the best plan optimal.
+  // 1, ..., each bounded by the best cost so far, until the budget or the caller's deadline; an
+  // exhausted weighted A* iteration proves the best plan optimal.
   const Termination until = term.tightened(Deadline::in(options.anytime_seconds));
+  // Plan neighbourhood graph search on the first plan (and on each cheaper plan it finds), the
+  // neighbourhood doubled while it finds nothing cheaper.
+  if (options.neighbourhood_time_share > 0) {
+    const double left = until.deadline().secondsLeft();
+    const Termination share =
+        std::isfinite(left) ? until.tightened(Deadline::in(options.neighbourhood_time_share * left)) : until;
+    for (size_t states = options.neighbourhood_first_states; !share() && best.cost > 0;) {
+      Searcher s(task, init, goal, options, heuristic, share);
+      bool complete = false;
+      SearchResult r = s.neighbourhood(best.plan, states, &complete);
+      ++best.stats.neighbourhood_runs;
+      best.stats.neighbourhood_states = std::max<uint64_t>(best.stats.neighbourhood_states, r.stats.registered_states);
+      addRunCosts(best.stats, r.stats);
+      if (r.status != SearchStatus::kSolved) break;  // out of time or memory
+      const bool cheaper = r.cost < best.cost;
+      if (cheaper) {
+        ++best.stats.neighbourhood_improvements;
+        best.plan = std::move(r.plan);
+        best.cost = r.cost;
+      }
+      if (complete) {  // the whole reachable space: the plan is optimal
+        best.stats.anytime_proved_optimal = true;
+        return best;
+      }
+      if (!cheaper) states *= 2;  // else the same size around the cheaper plan (Nakhost & Mueller)
+    }
+  }
   // 0: the lazy greedy search with landmarks (LAMA's first iteration, cost-aware heuristic).
   static constexpr double kWeights[] = {0.0, 5.0, 3.0, 2.0, 1.0};
   for (size_t i = 0; !until() && best.cost > 0; ++i) {
     Searcher s(task, init, goal, options, heuristic, until);
-    SearchResult r = s.improve(kWeights[std::min<size_t>(i, 4)], best.cost);
+    const double w = kWeights[std::min<size_t>(i, 4)];
+    SearchResult r = s.improve(w, best.cost);
     ++best.stats.anytime_iterations;
     addRunCosts(best.stats, r.stats);
     if (r.status == SearchStatus::kSolved && r.cost < best.cost) {
@@ -1392,6 +1507,11 @@ SearchResult search(const Task& task, const StateBits& init, const Goal& goal, c
       best.plan = std::move(r.plan);
       best.cost = r.cost;
     } else if (r.status == SearchStatus::kUnsolvable) {
+      // Only weighted A* re-opens a state reached again more cheaply, so only its exhausted
+      // space holds no cheaper plan. The lazy greedy search keeps the first path to each state:
+      // its exhausted space proves nothing, and the next iteration runs (as LAMA 2011's
+      // `continue_on_fail`).
+      if (w == 0.0) continue;
       best.stats.anytime_proved_optimal = true;
       break;
     } else if (r.status != SearchStatus::kSolved) {

@@ -670,6 +670,7 @@ TEST(Search, AnytimePhaseNeverReturnsADearerPlanAndEndsOptimalOnASmallTask) {
   req.problem_text = prob;
   req.check_plan = true;
   req.search.anytime_seconds = 60;  // a budget, not an expectation: the space is exhausted at once
+  req.search.neighbourhood_time_share = 0;  // LAMA 2011's iterations alone (the next test: with it)
   PlanReply r = plan(req, Termination());
   ASSERT_EQ(r.status, PlanStatus::kSolved) << r.message;
   EXPECT_EQ(r.cost, 8);
@@ -705,6 +706,111 @@ TEST(Search, AnytimePhaseNeverReturnsADearerPlanAndEndsOptimalOnASmallTask) {
   ASSERT_EQ(better.status, PlanStatus::kSolved) << better.message;
   EXPECT_GE(better.stats.anytime_iterations, 1U);
   EXPECT_LE(better.cost, first.cost);
+}
+
+TEST(Search, PlanNeighbourhoodSearchFindsTheCheaperWayAndProvesItOptimalOnASmallTask) {
+  // The cost trap again. The unit-cost first plan goes s -> m -> g (cost 11). The neighbourhood
+  // starts at 1 state and doubles: 1 and 2 hold only the plan's states {s, m, g} (registered
+  // whatever the cap), 4 adds x1 (no way round yet), 8 holds all 6 states, every one expanded:
+  // the cheapest path through them (s x1 x2 x3 g, cost 8) is optimal, and the phase ends there,
+  // before any weighted iteration.
+  const std::string dom = R"((define (domain trap) (:requirements :typing :action-costs)
+    (:types node) (:predicates (at ?n - node) (edge ?a ?b - node))
+    (:functions (total-cost) - number (w ?a ?b - node) - number)
+    (:action go :parameters (?a ?b - node) :precondition (and (at ?a) (edge ?a ?b))
+      :effect (and (not (at ?a)) (at ?b) (increase (total-cost) (w ?a ?b))))))";
+  const std::string prob = R"((define (problem p) (:domain trap) (:objects s m g x1 x2 x3 - node)
+    (:init (at s) (edge s m) (edge m g) (edge s x1) (edge x1 x2) (edge x2 x3) (edge x3 g)
+      (= (w s m) 1) (= (w m g) 10) (= (w s x1) 2) (= (w x1 x2) 2) (= (w x2 x3) 2) (= (w x3 g) 2)
+      (= (total-cost) 0))
+    (:goal (at g)) (:metric minimize (total-cost))))";
+  PlanRequest req;
+  req.domain_text = dom;
+  req.problem_text = prob;
+  req.check_plan = true;
+  req.search.anytime_seconds = 60;  // a budget: the neighbourhoods are bounded by their states
+  req.search.neighbourhood_first_states = 1;
+  PlanReply r = plan(req, Termination());
+  ASSERT_EQ(r.status, PlanStatus::kSolved) << r.message;
+  EXPECT_EQ(r.cost, 8);
+  ASSERT_EQ(r.plan.size(), 4U);
+  EXPECT_EQ(r.plan[0].toString(), "(go s x1)");
+  EXPECT_EQ(r.stats.neighbourhood_runs, 4U);
+  EXPECT_EQ(r.stats.neighbourhood_improvements, 1U);
+  EXPECT_EQ(r.stats.neighbourhood_states, 6U);
+  EXPECT_EQ(r.stats.anytime_iterations, 0U);
+
+  // With the share at 0 there is no neighbourhood search: LAMA's iterations find 8 (previous test).
+  req.search.neighbourhood_time_share = 0;
+  r = plan(req, Termination());
+  ASSERT_EQ(r.status, PlanStatus::kSolved) << r.message;
+  EXPECT_EQ(r.stats.neighbourhood_runs, 0U);
+  EXPECT_GE(r.stats.anytime_iterations, 1U);
+  EXPECT_EQ(r.cost, 8);
+}
+
+TEST(Search, AnExhaustedLazyGreedyIterationDoesNotEndTheAnytimePhase) {
+  // The first plan (unit costs) is the direct edge s -> g, cost 20, the bound of the anytime
+  // iterations. The lazy greedy iteration (cost + 1) prefers a (h lower than b's), reaches x over
+  // a with g = 16, where x -> g (5) passes the bound, and keeps that first path to x: reached
+  // again over b and c with g = 3, x is not re-opened, and the open list runs out. That proves
+  // nothing; weighted A* (w = 5), which re-opens, finds s b c x g (cost 8).
+  const std::string dom = R"((define (domain trap2) (:requirements :typing :action-costs)
+    (:types node) (:predicates (at ?n - node) (edge ?a ?b - node))
+    (:functions (total-cost) - number (w ?a ?b - node) - number)
+    (:action go :parameters (?a ?b - node) :precondition (and (at ?a) (edge ?a ?b))
+      :effect (and (not (at ?a)) (at ?b) (increase (total-cost) (w ?a ?b))))))";
+  const std::string prob = R"((define (problem p) (:domain trap2) (:objects s a b c x g - node)
+    (:init (at s) (edge s g) (edge s a) (edge a x) (edge s b) (edge b c) (edge c x) (edge x g)
+      (= (w s g) 20) (= (w s a) 15) (= (w a x) 1) (= (w s b) 1) (= (w b c) 1) (= (w c x) 1)
+      (= (w x g) 5) (= (total-cost) 0))
+    (:goal (at g)) (:metric minimize (total-cost))))";
+  PlanRequest req;
+  req.domain_text = dom;
+  req.problem_text = prob;
+  req.check_plan = true;
+  req.search.anytime_seconds = 60;  // a budget: weighted A* exhausts the small space at once
+  req.search.neighbourhood_time_share = 0;  // the iterations alone
+  PlanReply r = plan(req, Termination());
+  ASSERT_EQ(r.status, PlanStatus::kSolved) << r.message;
+  EXPECT_EQ(r.cost, 8);
+  EXPECT_GE(r.stats.anytime_iterations, 2U);
+  EXPECT_EQ(r.stats.anytime_improvements, 1U);
+  // With the neighbourhood search (the default), the whole space is its neighbourhood.
+  req.search.neighbourhood_time_share = SearchOptions{}.neighbourhood_time_share;
+  r = plan(req, Termination());
+  ASSERT_EQ(r.status, PlanStatus::kSolved) << r.message;
+  EXPECT_EQ(r.cost, 8);
+  EXPECT_EQ(r.stats.neighbourhood_improvements, 1U);
+  EXPECT_EQ(r.stats.anytime_iterations, 0U);
+}
+
+TEST(Search, PlanNeighbourhoodSearchNeverReturnsADearerPlanOnIpcCostTasks) {
+  // Conditional effects and negation (citycar), costs from functions of several arguments
+  // (elevators, parcprinter): the plan after the neighbourhood search alone (the whole anytime
+  // phase given to it) replays under the checker and costs at most the first plan. The time is
+  // a budget, not an expectation.
+  for (const auto& [dir, file] : std::vector<std::pair<std::string, std::string>>{
+           {"pddl-adl/elevators", "instance-6.pddl"},
+           {"pddl-adl/citycar", "instance-1.pddl"},
+           {"pddl-more/parcprinter/instance-18", "instance-18.pddl"}}) {
+    const auto d = test::benchmarksDir() / dir;
+    PlanRequest req;
+    req.domain_text = test::readFile(d / "domain.pddl");
+    req.problem_text = test::readFile(d / file);
+    req.check_plan = true;
+    req.timeout_seconds = 120;
+    req.search.anytime_seconds = 1e-9;  // a phase that ends at once: the unit-cost first plan
+    PlanReply first = plan(req, Termination());
+    ASSERT_EQ(first.status, PlanStatus::kSolved) << dir << ": " << first.message;
+    EXPECT_EQ(first.stats.neighbourhood_runs, 0U) << dir;
+    req.search.anytime_seconds = 0.5;
+    req.search.neighbourhood_time_share = 1;
+    PlanReply r = plan(req, Termination());
+    ASSERT_EQ(r.status, PlanStatus::kSolved) << dir << ": " << r.message;
+    EXPECT_GE(r.stats.neighbourhood_runs, 1U) << dir;
+    EXPECT_LE(r.cost, first.cost) << dir;
+  }
 }
 
 TEST(Search, UnitCostFirstRunFallsBackToCostPlusOneWhenOutOfTimeShareOrMemory) {
@@ -767,6 +873,16 @@ TEST(Search, OptionsAreValidated) {
     EXPECT_THROW(o.validate(), std::invalid_argument) << bad;
   }
   o.unit_first_time_share = 1.0;
+  EXPECT_NO_THROW(o.validate());
+  for (double bad : {-0.1, 1.5, std::nan("")}) {
+    o.neighbourhood_time_share = bad;
+    EXPECT_THROW(o.validate(), std::invalid_argument) << bad;
+  }
+  o.neighbourhood_time_share = 0;
+  EXPECT_NO_THROW(o.validate());
+  o.neighbourhood_first_states = 0;
+  EXPECT_THROW(o.validate(), std::invalid_argument);
+  o.neighbourhood_first_states = 1;
   EXPECT_NO_THROW(o.validate());
   for (double bad : {-0.1, 1.5, std::nan("")}) {
     o.ehc_retry_budget_share = bad;

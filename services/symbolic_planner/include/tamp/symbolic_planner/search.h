@@ -28,8 +28,9 @@
 ///   value) alternating over four queues, h_FF and the landmark count (landmarks.h), each with all
 ///   successors and with the preferred ones (helpful actions of h_FF and landmark achievers),
 ///   the preferred queues boosted by 1000 on every improvement of either heuristic. Complete.
-/// - Anytime phase (`anytime_seconds`, cost tasks only): LAMA 2011's restarting weighted A*
-///   iterations after the first plan, each bounded by the best cost so far.
+/// - Anytime phase (`anytime_seconds`, cost tasks only): plan neighbourhood graph search on the
+///   first plan (`neighbourhood_time_share`), then LAMA 2011's restarting weighted A*
+///   iterations, each bounded by the best cost so far.
 /// - `kWAstar` / `kAstar`: (weighted) A* with re-opening on f = g + w*h; with the admissible
 ///   h_max (the default for these) A* returns cost-optimal plans and weighted A* plans within a
 ///   factor `weight` of optimal.
@@ -179,6 +180,15 @@ struct SearchOptions {
   /// the time left; the anytime iterations always use cost + 1. false: cost + 1 at once.
   bool unit_cost_first{true};
   double unit_first_time_share{0.1};  ///< must be in (0, 1]
+  /// Anytime phase: before the weighted iterations, plan neighbourhood graph search (Nakhost and
+  /// Mueller, ICAPS 2010) on the first plan, for up to this share of the phase's time: the plan's
+  /// states and the states reached from them breadth-first, up to a number of states that
+  /// doubles from `neighbourhood_first_states` while no cheaper plan is found; the cheapest path
+  /// through those states (uniform-cost, no heuristic) replaces the plan when it is cheaper. A
+  /// neighbourhood that holds every reachable state proves its plan optimal and ends the phase.
+  /// 0 = none (LAMA 2011's iterations only); must be in [0, 1].
+  double neighbourhood_time_share{0.5};
+  size_t neighbourhood_first_states{1024};  ///< must be > 0
 
   /// @throws std::invalid_argument naming the bad field (weight < 1, ...).
   void validate() const;
@@ -231,7 +241,12 @@ struct SearchStatistics {
   uint64_t eliminated_actions{0};  ///< removed by action elimination
   uint64_t anytime_iterations{0};    ///< weighted A* iterations of the anytime phase
   uint64_t anytime_improvements{0};  ///< ... that found a cheaper plan
-  bool anytime_proved_optimal{false};  ///< an iteration exhausted its bounded space: no cheaper plan
+  /// A weighted A* iteration exhausted its bounded space, or a plan neighbourhood held every
+  /// reachable state: no cheaper plan exists.
+  bool anytime_proved_optimal{false};
+  uint64_t neighbourhood_runs{0};          ///< plan neighbourhood searches of the anytime phase
+  uint64_t neighbourhood_improvements{0};  ///< ... that found a cheaper plan
+  uint64_t neighbourhood_states{0};        ///< states of the largest neighbourhood searched
   /// `unit_cost_first`: the unit-cost run ran out of its time share or memory, or gave up, and the
   /// first plan came from the cost + 1 run; its effort is included in the counters above.
   bool unit_first_failed{false};

@@ -220,7 +220,9 @@ Outcome Planning::sample(const Stopwatch& phase, bool solved) {
     for (double c = P.proof.cell_size; c >= P.proof.min_cell_size - 1e-12; c *= 0.5) proof_cells.emplace_back(c, 1);
     if (P.proof.yaw_cells > 1) {
       proof_cells.emplace_back(P.proof.oriented_cell_size, P.proof.yaw_cells);
-      for (int k = 1; k <= P.proof.oriented_refinements; ++k) {
+      // Full mode only: there a passage the sampler cannot find is a run to the deadline; a lazy
+      // request (movables free) is answered by sampling, and finer grids only cost it time.
+      for (int k = 1; !lazy && k <= P.proof.oriented_refinements; ++k) {
         proof_cells.emplace_back(P.proof.oriented_cell_size / (1 << k), P.proof.yaw_cells << k);
       }
     }

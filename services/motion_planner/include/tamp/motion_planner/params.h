@@ -171,8 +171,8 @@ struct ProofParams {
   int yaw_cells{64};
   double oriented_cell_size{0.025};
   int oriented_max_cells{500000};
-  /// Then that many finer (x, y, yaw) grids, each with half the xy edge and twice the yaw cells
-  /// (>= 0): a passage a few centimetres too narrow for the base to turn in is proven too. A
+  /// Then (full mode) that many finer (x, y, yaw) grids, each with half the xy edge and twice the
+  /// yaw cells (>= 0): a passage a few centimetres too narrow for the base to turn in is proven. A
   /// finer grid runs only where the last one found start and goal connected with few enough
   /// cells that eight times as many (about what the finer one tests) stay within
   /// oriented_max_cells; elsewhere (large open regions) it would only run into that cap.

@@ -216,6 +216,8 @@ MissionReport GraphManager::Run::finish(MissionOutcome o, const std::string& rea
 namespace {
 /// Abstraction refinements in a row before a plan is given up (each adds at least one slot).
 constexpr int kMaxRefinements = 8;
+/// An object's bounding box that changed by more than this in any extent (m) was re-estimated.
+constexpr double kReshapedM = 0.02;
 }  // namespace
 
 bool GraphManager::Run::planBranch(std::string& why) {
@@ -702,6 +704,15 @@ bool GraphManager::Run::replan(const MissionEvent& ev, EdgeId failed, std::strin
     else
       (void)live.setObjectPose(o.id, *expected);
   }
+  // The named object's estimate grown or shrunk since the graph last took the world in (a new
+  // object seen from more sides): the world changed under the plan as much as when it moved.
+  const bool reshaped = names_object && !ev.object_id.empty() && [&] {
+    const world::Object* before = gm.abstraction_.world().findObject(ev.object_id);
+    const world::Object* after = live.findObject(ev.object_id);
+    if (!before || !after) return false;
+    const Eigen::Vector3d a = before->aabb().max - before->aabb().min, b = after->aabb().max - after->aabb().min;
+    return (a - b).cwiseAbs().maxCoeff() > kReshapedM;
+  }();
   gm.abstraction_.setWorld(live);
   gm.clearWorldCaches();
   const HeldGrasp held_before = ctx.held;
@@ -721,12 +732,12 @@ bool GraphManager::Run::replan(const MissionEvent& ev, EdgeId failed, std::strin
     if (known) gm.widenHeldMargin(held_before.object_id, ev.object_id);
   }
   rec.held_padding_m = gm.held_padding_m_;
-  // Failed or refused because of an object the graph did not know, or knew elsewhere (the world
-  // model changed since the edge was planned, e.g. a new object's estimate still growing): the
-  // world changed under the plan, the action did not fail, so it is not counted towards
-  // max_action_failures (max_replans still bounds the attempts).
-  const bool stale = ev.kind == EventKind::kActionFailed && !ev.object_id.empty() &&
-                     (std::find(fresh.begin(), fresh.end(), ev.object_id) != fresh.end() ||
+  // Failed, refused or stopped because of an object the graph did not know, or knew elsewhere or
+  // smaller (the world model changed since the edge was planned, e.g. a new object's estimate
+  // still growing onto the path): the world changed under the plan, the action did not fail, so
+  // it is not counted towards max_action_failures (max_replans still bounds the attempts).
+  const bool stale = names_object && !ev.object_id.empty() &&
+                     (reshaped || std::find(fresh.begin(), fresh.end(), ev.object_id) != fresh.end() ||
                       std::any_of(changed.begin(), changed.end(),
                                   [&](const world::Object& o) { return o.id == ev.object_id; }));
   changed.insert(changed.end(), refused.begin(), refused.end());

@@ -704,8 +704,9 @@ bool GraphManager::Run::replan(const MissionEvent& ev, EdgeId failed, std::strin
     else
       (void)live.setObjectPose(o.id, *expected);
   }
-  // The named object's estimate grown or shrunk since the graph last took the world in (a new
-  // object seen from more sides): the world changed under the plan as much as when it moved.
+  // The named object's extent changed since the graph last took the world in (an estimate grown,
+  // shrunk or turned: a new object seen from more sides): the world changed under the plan as
+  // much as when it moved.
   const bool reshaped = names_object && !ev.object_id.empty() && [&] {
     const world::Object* before = gm.abstraction_.world().findObject(ev.object_id);
     const world::Object* after = live.findObject(ev.object_id);

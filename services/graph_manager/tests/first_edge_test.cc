@@ -619,41 +619,51 @@ MissionReport corridorMission(VersionedWorld& source, DrivingExecutor& x, Script
   return gm.runMission(source, x);
 }
 
+/// A corridor mission whose first three commands end with `outcome` naming `naming`; before each,
+/// `change(o, n)` re-estimates the crate `o` (n = 0, 1, 2), when given. The crate is in the
+/// planner's world from the start when `change` is.
+MissionReport failingCorridorMission(ExecOutcome outcome, const std::string& naming,
+                                     const std::function<void(world::Object&, int)>& change,
+                                     std::vector<std::uint64_t>& versions) {
+  auto crate = [] { return corridorCrate(4.45, 5.0); };
+  ScriptedServices services;
+  VersionedWorld source;
+  DrivingExecutor x(source);
+  x.fail_first = 3;
+  x.fail_naming = naming;
+  x.fail_outcome = outcome;
+  if (change) {
+    x.before_failure = [&](int n) {
+      world::Object o = crate();
+      change(o, n);
+      ASSERT_TRUE(source.live.updateObject(o).ok());
+      ++source.at_version;
+    };
+  }
+  const MissionReport r = change ? corridorMission(source, x, services, {crate()}) : corridorMission(source, x, services);
+  versions = x.world_versions;
+  return r;
+}
+
 // A drive refused because of an object that the world model had elsewhere when the drive was
 // planned (a new object's estimate still growing) did not fail: the world changed under the
 // plan. It is planned again and not counted towards max_action_failures (2). The same refusals
 // naming an object the graph knew where it stands are counted: the mission fails at the second.
 // (An object new to the graph makes a new symbolic state, whose edges have no failures yet.)
 TEST(MissionFailureCountTest, RefusalsNamingAnObjectTheWorldModelChangedAreNotCountedAsFailures) {
-  auto crate = [] { return corridorCrate(4.45, 5.0); };
-  {
-    ScriptedServices services;
-    VersionedWorld source;
-    DrivingExecutor x(source);
-    x.fail_first = 3;
-    x.fail_naming = "crate";
-    x.before_failure = [&](int n) {
-      world::Object o = crate();
-      o.pose.translation().x() += 0.2 * (n + 1);  // seen 0.2 m further each time (tolerance 0.15 m)
-      ASSERT_TRUE(source.live.updateObject(o).ok());
-      ++source.at_version;
-    };
-    const MissionReport r = corridorMission(source, x, services, {crate()});
-    EXPECT_EQ(r.status, MissionOutcome::kSucceeded) << r.reason;
-    EXPECT_EQ(x.world_versions.size(), 4u);
-    EXPECT_EQ(x.world_versions.back(), 4u) << "the last command planned in the world of the third refusal";
-  }
-  {
-    ScriptedServices services;
-    VersionedWorld source;
-    DrivingExecutor x(source);
-    x.fail_first = 3;
-    x.fail_naming = "box";  // in the planner's world from the start, where it stands
-    const MissionReport r = corridorMission(source, x, services);
-    EXPECT_EQ(r.status, MissionOutcome::kFailed);
-    EXPECT_NE(r.reason.find("max_action_failures"), std::string::npos) << r.reason;
-    EXPECT_EQ(x.world_versions.size(), 2u);
-  }
+  std::vector<std::uint64_t> versions;
+  // Seen 0.2 m further each time (tolerance 0.15 m).
+  const MissionReport moved = failingCorridorMission(
+      ExecOutcome::kFailed, "crate", [](world::Object& o, int n) { o.pose.translation().x() += 0.2 * (n + 1); },
+      versions);
+  EXPECT_EQ(moved.status, MissionOutcome::kSucceeded) << moved.reason;
+  ASSERT_EQ(versions.size(), 4u);
+  EXPECT_EQ(versions.back(), 4u) << "the last command planned in the world of the third refusal";
+  // The box is in the planner's world from the start, where it stands.
+  const MissionReport known = failingCorridorMission(ExecOutcome::kFailed, "box", {}, versions);
+  EXPECT_EQ(known.status, MissionOutcome::kFailed);
+  EXPECT_NE(known.reason.find("max_action_failures"), std::string::npos) << known.reason;
+  EXPECT_EQ(versions.size(), 2u);
 }
 
 // The same for a drive stopped on the way (blocked: the monitor saw a new obstacle on the
@@ -661,35 +671,15 @@ TEST(MissionFailureCountTest, RefusalsNamingAnObjectTheWorldModelChangedAreNotCo
 // CI of 2026-12-06: the hidden crate seen from 0.15 m growing, two blocks, the mission failed at
 // max_action_failures): not counted. Stopped twice before the box the graph knew as it is: counted.
 TEST(MissionFailureCountTest, StopsBeforeAnObjectWhoseEstimateGrewAreNotCountedAsFailures) {
-  auto crate = [] { return corridorCrate(4.45, 5.0); };
-  {
-    ScriptedServices services;
-    VersionedWorld source;
-    DrivingExecutor x(source);
-    x.fail_first = 3;
-    x.fail_naming = "crate";
-    x.fail_outcome = ExecOutcome::kBlocked;
-    x.before_failure = [&](int n) {
-      world::Object o = crate();
-      o.shape.size.y() += 0.1 * (n + 1);  // seen from more sides: 10 cm longer each time, in place
-      ASSERT_TRUE(source.live.updateObject(o).ok());
-      ++source.at_version;
-    };
-    const MissionReport r = corridorMission(source, x, services, {crate()});
-    EXPECT_EQ(r.status, MissionOutcome::kSucceeded) << r.reason;
-    EXPECT_EQ(x.world_versions.size(), 4u);
-  }
-  {
-    ScriptedServices services;
-    VersionedWorld source;
-    DrivingExecutor x(source);
-    x.fail_first = 3;
-    x.fail_naming = "box";
-    x.fail_outcome = ExecOutcome::kBlocked;
-    const MissionReport r = corridorMission(source, x, services);
-    EXPECT_EQ(r.status, MissionOutcome::kFailed);
-    EXPECT_NE(r.reason.find("max_action_failures"), std::string::npos) << r.reason;
-  }
+  std::vector<std::uint64_t> versions;
+  // Seen from more sides: 10 cm longer each time, in place.
+  const MissionReport grown = failingCorridorMission(
+      ExecOutcome::kBlocked, "crate", [](world::Object& o, int n) { o.shape.size.y() += 0.1 * (n + 1); }, versions);
+  EXPECT_EQ(grown.status, MissionOutcome::kSucceeded) << grown.reason;
+  EXPECT_EQ(versions.size(), 4u);
+  const MissionReport known = failingCorridorMission(ExecOutcome::kBlocked, "box", {}, versions);
+  EXPECT_EQ(known.status, MissionOutcome::kFailed);
+  EXPECT_NE(known.reason.find("max_action_failures"), std::string::npos) << known.reason;
 }
 
 }  // namespace

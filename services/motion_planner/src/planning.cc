@@ -246,8 +246,7 @@ Outcome Planning::leaveStart() {
       if (!fixed.empty()) escapeFixed(fixed);
     }
     if (!escaped && P.sampling.start_escape_distance > 0.0 && P.sampling.start_escape_depth > 0.0) {
-      const std::vector<std::string> statics = touchedStaticsShallowly();
-      if (!statics.empty()) escapeStatics(statics);
+      escapeStaticsShallowly();
     }
     if (!escaped) {
       return finish(MotionStatus::kStartInCollision, "the start state touches '" + who + "'" +
@@ -315,11 +314,13 @@ void Planning::escapeFixed(const std::vector<std::string>& touched) {
   if (found) res.start_contacts.insert(res.start_contacts.end(), touched.begin(), touched.end());
 }
 
-/// The static objects (and, lazy, the ones the request fixes) that the start touches, when it is
-/// free of them `start_escape_depth` smaller and touches nothing else; empty otherwise. A robot
-/// stopped at a wall by its own safety (or localised a few millimetres off) stands there: the
-/// planner's model of the robot and the world is not the world.
-std::vector<std::string> Planning::touchedStaticsShallowly() {
+/// Out of a shallow contact with static objects (and, lazy, the ones the request fixes): when the
+/// start touches them, and is free of them `start_escape_depth` smaller and of everything else, a
+/// short straight motion going no deeper into them (checked against them that much smaller) to a
+/// free state; never through them, as a movable may be left. A robot stopped at a wall by its own
+/// safety (or localised a few millimetres off) stands there: the planner's model of the robot and
+/// the world is not the world. `escaped` stays empty otherwise.
+void Planning::escapeStaticsShallowly() {
   std::vector<std::string> touched;
   gs.placeRobot(start.get(), impl.scene);
   for (const auto& o : impl.world.objects()) {  // (lazy: the fixed objects are static for the request)
@@ -327,24 +328,14 @@ std::vector<std::string> Planning::touchedStaticsShallowly() {
     if (std::find(ignored.begin(), ignored.end(), o.id) != ignored.end()) continue;
     if (impl.scene.robotInCollision(collision::Filter::objects({o.id}))) touched.push_back(o.id);
   }
-  if (touched.empty()) return touched;
+  if (touched.empty()) return;
   collision::Scene smaller = shrunkScene(touched);
   detail::Oracle shallow(smaller, gs, ignored, oracle.movables(), oracle.reachRadius());
-  if (!(lazy ? shallow.staticFree(start.get()) : shallow.allFree(start.get()))) touched.clear();
+  const bool free = lazy ? shallow.staticFree(start.get()) : shallow.allFree(start.get());
   gs.placeRobot(start.get(), impl.scene);
-  return touched;
-}
-
-/// Out of a shallow contact with static objects `touched`: a short straight motion going no
-/// deeper into them (checked against them `start_escape_depth` smaller), to a free state. Never
-/// through them, as a movable may be left.
-void Planning::escapeStatics(const std::vector<std::string>& touched) {
-  collision::Scene smaller = shrunkScene(touched);
-  detail::Oracle escape_oracle(smaller, gs, ignored, oracle.movables(), oracle.reachRadius());
-  if (held_shape) escape_oracle.setSelfScene(&plainScene());
-  if (escapeBy(makeSi(escape_oracle, !lazy))) {
-    res.start_contacts.insert(res.start_contacts.end(), touched.begin(), touched.end());
-  }
+  if (!free) return;
+  if (held_shape) shallow.setSelfScene(&plainScene());
+  if (escapeBy(makeSi(shallow, !lazy))) res.start_contacts.insert(res.start_contacts.end(), touched.begin(), touched.end());
 }
 
 /// A copy of the request's scene with the objects `ids` `start_escape_depth` smaller.

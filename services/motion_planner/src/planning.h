@@ -163,8 +163,7 @@ struct Planning {
   bool escapeThrough(const std::vector<int>& touching);
   std::vector<std::string> touchedFixedOnly();
   void escapeFixed(const std::vector<std::string>& touched);
-  std::vector<std::string> touchedStaticsShallowly();
-  void escapeStatics(const std::vector<std::string>& touched);
+  void escapeStaticsShallowly();
   void escapeHeldMargin();
   bool checkGoal(ob::State* s, std::string& who);
   Outcome setStateGoal();

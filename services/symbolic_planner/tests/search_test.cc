@@ -652,23 +652,27 @@ TEST(Search, EhcFirstRunContinuesFromTheFirstBetterState) {
   EXPECT_LT(first.stats.evaluated, best.stats.evaluated);
 }
 
-TEST(Search, AnytimePhaseNeverReturnsADearerPlanAndEndsOptimalOnASmallTask) {
-  // The cost trap of AstarIsCostOptimalAndWastarWithinItsBound: whatever the first plan, the
-  // bounded iterations exhaust the small space and end at the optimum (cost 4).
-  const std::string dom = R"((define (domain trap) (:requirements :typing :action-costs)
+/// The cost trap: s -> m -> g is short (2 steps) but costs 11; s x1 x2 x3 g costs 8. Plans checked.
+PlanRequest costTrapRequest() {
+  PlanRequest req;
+  req.domain_text = R"((define (domain trap) (:requirements :typing :action-costs)
     (:types node) (:predicates (at ?n - node) (edge ?a ?b - node))
     (:functions (total-cost) - number (w ?a ?b - node) - number)
     (:action go :parameters (?a ?b - node) :precondition (and (at ?a) (edge ?a ?b))
       :effect (and (not (at ?a)) (at ?b) (increase (total-cost) (w ?a ?b))))))";
-  const std::string prob = R"((define (problem p) (:domain trap) (:objects s m g x1 x2 x3 - node)
+  req.problem_text = R"((define (problem p) (:domain trap) (:objects s m g x1 x2 x3 - node)
     (:init (at s) (edge s m) (edge m g) (edge s x1) (edge x1 x2) (edge x2 x3) (edge x3 g)
       (= (w s m) 1) (= (w m g) 10) (= (w s x1) 2) (= (w x1 x2) 2) (= (w x2 x3) 2) (= (w x3 g) 2)
       (= (total-cost) 0))
     (:goal (at g)) (:metric minimize (total-cost))))";
-  PlanRequest req;
-  req.domain_text = dom;
-  req.problem_text = prob;
   req.check_plan = true;
+  return req;
+}
+
+TEST(Search, AnytimePhaseNeverReturnsADearerPlanAndEndsOptimalOnASmallTask) {
+  // The cost trap of AstarIsCostOptimalAndWastarWithinItsBound: whatever the first plan, the
+  // bounded iterations exhaust the small space and end at the optimum (cost 4).
+  PlanRequest req = costTrapRequest();
   req.search.anytime_seconds = 60;  // a budget, not an expectation: the space is exhausted at once
   req.search.neighbourhood_time_share = 0;  // LAMA 2011's iterations alone (the next test: with it)
   PlanReply r = plan(req, Termination());
@@ -714,20 +718,7 @@ TEST(Search, PlanNeighbourhoodSearchFindsTheCheaperWayAndProvesItOptimalOnASmall
   // whatever the cap), 4 adds x1 (no way round yet), 8 holds all 6 states, every one expanded:
   // the cheapest path through them (s x1 x2 x3 g, cost 8) is optimal, and the phase ends there,
   // before any weighted iteration.
-  const std::string dom = R"((define (domain trap) (:requirements :typing :action-costs)
-    (:types node) (:predicates (at ?n - node) (edge ?a ?b - node))
-    (:functions (total-cost) - number (w ?a ?b - node) - number)
-    (:action go :parameters (?a ?b - node) :precondition (and (at ?a) (edge ?a ?b))
-      :effect (and (not (at ?a)) (at ?b) (increase (total-cost) (w ?a ?b))))))";
-  const std::string prob = R"((define (problem p) (:domain trap) (:objects s m g x1 x2 x3 - node)
-    (:init (at s) (edge s m) (edge m g) (edge s x1) (edge x1 x2) (edge x2 x3) (edge x3 g)
-      (= (w s m) 1) (= (w m g) 10) (= (w s x1) 2) (= (w x1 x2) 2) (= (w x2 x3) 2) (= (w x3 g) 2)
-      (= (total-cost) 0))
-    (:goal (at g)) (:metric minimize (total-cost))))";
-  PlanRequest req;
-  req.domain_text = dom;
-  req.problem_text = prob;
-  req.check_plan = true;
+  PlanRequest req = costTrapRequest();
   req.search.anytime_seconds = 60;  // a budget: the neighbourhoods are bounded by their states
   req.search.neighbourhood_first_states = 1;
   PlanReply r = plan(req, Termination());

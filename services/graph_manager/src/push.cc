@@ -79,6 +79,12 @@ MotionQuery fullBaseQuery(const Pose2D& from, const Pose2D& to, const BranchCont
   return q;
 }
 
+/// Why no push of `o` was kept, after `tried` checked pushes.
+void noPushWhy(const world::Object& o, int tried, std::string& why) {
+  why = tried == 0 ? "no push of '" + o.id + "' within push_max_m clears or opens the way"
+                   : "no straight push of '" + o.id + "' is collision-free (" + std::to_string(tried) + " tried)";
+}
+
 }  // namespace
 
 bool isPush(const Edge& e) { return !e.tokens.empty() && e.tokens[0] == "push"; }
@@ -152,7 +158,7 @@ double GraphManager::pushBackoff() const {
 std::optional<MotionAnswer> GraphManager::pushMotion(const std::string& object, const Eigen::Isometry3d& pose,
                                                      const Eigen::Isometry3d& target, const Pose2D& from,
                                                      const Pose2D& apex, const Pose2D& to, const BranchContext& ctx,
-                                                     std::string& why) {
+                                                     std::string& why, PushBlock* block) {
   char buf[160];
   std::snprintf(buf, sizeof buf, "%.3f,%.3f,%.3f>%.3f,%.3f>%.3f,%.3f|%.3f,%.3f>%.3f,%.3f@", from.x, from.y, from.theta,
                 apex.x, apex.y, to.x, to.y, pose.translation().x(), pose.translation().y(), target.translation().x(),
@@ -161,17 +167,19 @@ std::optional<MotionAnswer> GraphManager::pushMotion(const std::string& object, 
   auto it = push_cache_.find(key);
   if (it == push_cache_.end()) {
     PushCacheEntry entry;
-    entry.answer = planPushMotion(object, pose, target, from, apex, to, ctx, entry.why);
+    entry.answer = planPushMotion(object, pose, target, from, apex, to, ctx, entry.why, entry.block);
     it = push_cache_.emplace(key, std::move(entry)).first;
   }
   why = it->second.why;
+  if (block != nullptr) *block = it->second.block;
   return it->second.answer;
 }
 
 std::optional<MotionAnswer> GraphManager::planPushMotion(const std::string& object, const Eigen::Isometry3d& pose,
                                                          const Eigen::Isometry3d& target, const Pose2D& from,
                                                          const Pose2D& apex, const Pose2D& to,
-                                                         const BranchContext& ctx, std::string& why) {
+                                                         const BranchContext& ctx, std::string& why,
+                                                         PushBlock& block) {
   const MotionQuery push = pushQuery(object, pose, from, apex, ctx);
   const bool backs_off = std::hypot(apex.x - to.x, apex.y - to.y) >= 1e-6;
   // The base backs off, straight, leaving the object where it pushed it: room to turn.
@@ -191,6 +199,8 @@ std::optional<MotionAnswer> GraphManager::planPushMotion(const std::string& obje
   MotionAnswer& a = answers.front();
   if (!straightPush(a, from, apex)) {
     why = a.ok() ? "the push is not straight" : std::string(toString(a.status)) + (a.reason.empty() ? "" : ": " + a.reason);
+    // Where the base stands to push is the same for every distance along this direction.
+    block = a.status == MotionOutcome::kStartInCollision ? PushBlock::kAtStart : PushBlock::kFurtherOn;
     return std::nullopt;
   }
   if (!backs_off) return std::move(a);
@@ -200,6 +210,7 @@ std::optional<MotionAnswer> GraphManager::planPushMotion(const std::string& obje
   const MotionAnswer& b = answers.back();
   if (!straightPush(b, apex, to)) {
     why = b.ok() ? "the back-off is not straight" : "back-off: " + std::string(toString(b.status)) + (b.reason.empty() ? "" : ": " + b.reason);
+    block = PushBlock::kFurtherOn;
     return std::nullopt;
   }
   // One trajectory: the push, then the back-off (its first point is the push's last).
@@ -237,10 +248,10 @@ GraphManager::PushGeometry GraphManager::pushGeometry(const world::Object& o, co
 
 std::optional<std::string> GraphManager::addPushIfFree(const world::Object& o, const std::string& support,
                                                        const Eigen::Isometry3d& pose, const Eigen::Vector2d& n,
-                                                       double distance, const BranchContext& ctx) {
+                                                       double distance, const BranchContext& ctx, PushBlock* block) {
   const PushGeometry g = pushGeometry(o, pose, n, distance);
   std::string why_not;
-  if (!pushMotion(o.id, pose, g.target, g.from, g.apex, g.to, ctx, why_not)) {
+  if (!pushMotion(o.id, pose, g.target, g.from, g.apex, g.to, ctx, why_not, block)) {
     log::get("graph_manager")->debug("push of {} by {:.2f} m towards ({:.2f}, {:.2f}): {}", o.id, distance, n.x(), n.y(),
                                      why_not);
     return std::nullopt;
@@ -255,18 +266,18 @@ std::optional<std::string> GraphManager::addPushIfFree(const world::Object& o, c
   return slot;
 }
 
-std::optional<double> GraphManager::openingPushDistance(const world::Object& o, const Eigen::Isometry3d& pose,
-                                                        const Eigen::Vector2d& n, const Pose2D& way_end,
-                                                        const std::vector<std::string>& crossed,
-                                                        const BranchContext& ctx) {
+std::vector<double> GraphManager::openingPushDistances(const world::Object& o, const Eigen::Isometry3d& pose,
+                                                      const Eigen::Vector2d& n, double max_distance,
+                                                      const Pose2D& way_end, const std::vector<std::string>& crossed,
+                                                      const BranchContext& ctx) {
   // One lazy question per distance, asked together: from where the base ends after the push to
   // where the blocked way ends, with the object at its new place. A path that prices crossings
-  // dearly goes round the object when a way round is open; the shortest push after which it crosses neither
-  // the object nor any movable that the blocked way did not cross already wins (a way "round" it
-  // through another object is no opening).
+  // dearly goes round the object when a way round is open; a push after which it crosses neither
+  // the object nor any movable that the blocked way did not cross already opens the way (a way
+  // "round" it through another object is no opening).
   std::vector<double> distances;
   std::vector<MotionQuery> queries;
-  for (double d = params_.push_step_m; d <= params_.push_max_m + 1e-9; d += params_.push_step_m) {
+  for (double d = params_.push_step_m; d <= max_distance + 1e-9; d += params_.push_step_m) {
     const PushGeometry g = pushGeometry(o, pose, n, d);
     MotionQuery q;
     q.group = Group::kBase;
@@ -283,6 +294,7 @@ std::optional<double> GraphManager::openingPushDistance(const world::Object& o, 
     distances.push_back(d);
     queries.push_back(std::move(q));
   }
+  if (queries.empty()) return {};
   const std::vector<MotionAnswer> answers = askMotions(queries);
   auto opens = [&](std::size_t i) {
     const MotionAnswer& a = answers[i];
@@ -295,12 +307,25 @@ std::optional<double> GraphManager::openingPushDistance(const world::Object& o, 
              return c.object_id != o.id && std::find(crossed.begin(), crossed.end(), c.object_id) != crossed.end();
            });
   };
-  for (std::size_t i = 0; i < answers.size(); ++i) {
-    if (!opens(i)) continue;
-    // One step further when that is open too: the shortest opening leaves the robot a way that
-    // hugs the object, lost to the centimetres by which a push misses its slot.
-    if (i + 1 < answers.size() && opens(i + 1)) return distances[i + 1];
-    return distances[i];
+  std::vector<double> out;
+  for (std::size_t i = 0; i < answers.size(); ++i)
+    if (opens(i)) out.push_back(distances[i]);
+  // One step further first when that opens too: the shortest opening leaves the robot a way that
+  // hugs the object, lost to the centimetres by which a push misses its slot.
+  if (out.size() >= 2 && out[1] - out[0] < params_.push_step_m * 1.5) std::swap(out[0], out[1]);
+  return out;
+}
+
+std::optional<std::string> GraphManager::addOpeningPush(const world::Object& o, const std::string& support,
+                                                        const Eigen::Isometry3d& pose, const Eigen::Vector2d& n,
+                                                        double max_distance, const Pose2D& way_end,
+                                                        const std::vector<std::string>& crossed,
+                                                        const BranchContext& ctx, int& tried) {
+  for (double d : openingPushDistances(o, pose, n, max_distance, way_end, crossed, ctx)) {
+    ++tried;
+    PushBlock block = PushBlock::kNone;
+    if (auto slot = addPushIfFree(o, support, pose, n, d, ctx, &block)) return slot;
+    if (block == PushBlock::kAtStart) break;  // as blocked at any other distance
   }
   return std::nullopt;
 }
@@ -331,27 +356,39 @@ std::vector<std::string> GraphManager::spawnPushes(const world::Object& o, const
   std::sort(candidates.begin(), candidates.end(),
             [](const Candidate& a, const Candidate& b) { return a.distance < b.distance; });
   std::vector<std::string> slots;
+  auto room = [&] { return static_cast<int>(slots.size()) < params_.pushes_per_object; };
   int tried = 0;
+  std::vector<Candidate> blocked_further_on;
   for (const Candidate& k : candidates) {
-    if (static_cast<int>(slots.size()) >= params_.pushes_per_object) break;
+    if (!room()) break;
     ++tried;
-    if (auto slot = addPushIfFree(o, support, pose, k.n, k.distance, ctx)) slots.push_back(*slot);
+    PushBlock block = PushBlock::kNone;
+    if (auto slot = addPushIfFree(o, support, pose, k.n, k.distance, ctx, &block)) slots.push_back(*slot);
+    else if (block == PushBlock::kFurtherOn) blocked_further_on.push_back(k);
+  }
+  if (swept.empty()) {
+    if (slots.empty()) noPushWhy(o, tried, why);
+    return slots;
   }
   // None of those is free (a chair in a doorway, its sides against the frame or other chairs): a
   // push along the way, out of the doorway into open space, opens a way round it instead. Only
   // forwards: the base pushes from the side it comes from.
   const Eigen::Vector2d forwards = wayDirectionAt(swept, pose.translation().head<2>());
   for (const Eigen::Vector2d& n : along) {
-    if (static_cast<int>(slots.size()) >= params_.pushes_per_object || swept.empty()) break;
+    if (!room()) break;
     if (n.dot(forwards) <= 0.0) continue;
-    const std::optional<double> d = openingPushDistance(o, pose, n, swept.back(), crossed, ctx);
-    if (!d) continue;
-    ++tried;
-    if (auto slot = addPushIfFree(o, support, pose, n, *d, ctx)) slots.push_back(*slot);
+    if (auto slot = addOpeningPush(o, support, pose, n, params_.push_max_m, swept.back(), crossed, ctx, tried))
+      slots.push_back(*slot);
   }
-  if (slots.empty())
-    why = tried == 0 ? "no push of '" + o.id + "' within push_max_m clears or opens the way"
-                     : "no straight push of '" + o.id + "' is collision-free (" + std::to_string(tried) + " tried)";
+  // A push that would take the object off the way runs into something first (a wall a little
+  // beyond the way): a shorter push the same way may leave room to pass on the other side.
+  for (const Candidate& k : blocked_further_on) {
+    if (!room()) break;
+    if (auto slot = addOpeningPush(o, support, pose, k.n, k.distance - params_.push_step_m, swept.back(), crossed,
+                                   ctx, tried))
+      slots.push_back(*slot);
+  }
+  if (slots.empty()) noPushWhy(o, tried, why);
   return slots;
 }
 

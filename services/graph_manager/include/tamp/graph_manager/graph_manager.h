@@ -479,14 +479,19 @@ class GraphManager {
   /// turn away from the object it pushed with that much to spare (perception's estimate of a pushed
   /// object lags; with a fixed 0.15 m the next turn swept into it, and the monitor stopped it).
   double pushBackoff() const;
+  /// Where a push that is not free was blocked: where the base stands to push (so at every
+  /// distance along its direction), or further on (a shorter push may be free).
+  enum class PushBlock { kNone, kAtStart, kFurtherOn };
   /// Memoised per world (push_cache_): spawnPushes checks a push that evaluatePush prices later.
   std::optional<MotionAnswer> pushMotion(const std::string& object, const Eigen::Isometry3d& pose,
                                          const Eigen::Isometry3d& target, const Pose2D& from, const Pose2D& apex,
-                                         const Pose2D& to, const BranchContext& ctx, std::string& why);
+                                         const Pose2D& to, const BranchContext& ctx, std::string& why,
+                                         PushBlock* block = nullptr);
   /// pushMotion's two motion calls, uncached.
   std::optional<MotionAnswer> planPushMotion(const std::string& object, const Eigen::Isometry3d& pose,
                                              const Eigen::Isometry3d& target, const Pose2D& from, const Pose2D& apex,
-                                             const Pose2D& to, const BranchContext& ctx, std::string& why);
+                                             const Pose2D& to, const BranchContext& ctx, std::string& why,
+                                             PushBlock& block);
   /// Where a push of an object (at `pose`) along `n` by a distance starts, peaks and ends, and
   /// where it leaves the object.
   struct PushGeometry {
@@ -496,22 +501,30 @@ class GraphManager {
   PushGeometry pushGeometry(const world::Object& o, const Eigen::Isometry3d& pose, const Eigen::Vector2d& n,
                             double distance) const;
   /// The push's slot and locations, added to the abstraction when its motion is free in the
-  /// branch's world; none otherwise.
+  /// branch's world; none otherwise (and, in `block`, where it was blocked).
   std::optional<std::string> addPushIfFree(const world::Object& o, const std::string& support,
                                            const Eigen::Isometry3d& pose, const Eigen::Vector2d& n, double distance,
-                                           const BranchContext& ctx);
-  /// The shortest push of `o` along `n` (up to push_max_m) after which a lazy path pricing
-  /// crossings dearly, from the pushed base to `way_end`, goes round `o` and crosses no movable
-  /// outside `crossed` (the blocked way's): a push that does not take the object off the way but
-  /// opens a way round it; one push step further when that opens too (room to spare). None when
-  /// no distance opens a way.
-  std::optional<double> openingPushDistance(const world::Object& o, const Eigen::Isometry3d& pose,
-                                            const Eigen::Vector2d& n, const Pose2D& way_end,
-                                            const std::vector<std::string>& crossed, const BranchContext& ctx);
+                                           const BranchContext& ctx, PushBlock* block = nullptr);
+  /// The pushes of `o` along `n` (multiples of push_step_m up to `max_distance`) after which a
+  /// lazy path pricing crossings dearly, from the pushed base to `way_end`, goes round `o` and
+  /// crosses no movable outside `crossed` (the blocked way's): pushes that do not take the object
+  /// off the way but open a way round it. Shortest first, but one push step further first when
+  /// that opens too (room to spare); empty when no distance opens a way.
+  std::vector<double> openingPushDistances(const world::Object& o, const Eigen::Isometry3d& pose,
+                                           const Eigen::Vector2d& n, double max_distance, const Pose2D& way_end,
+                                           const std::vector<std::string>& crossed, const BranchContext& ctx);
+  /// The first of openingPushDistances whose push is free, added as addPushIfFree does; `tried`
+  /// counts the pushes checked.
+  std::optional<std::string> addOpeningPush(const world::Object& o, const std::string& support,
+                                            const Eigen::Isometry3d& pose, const Eigen::Vector2d& n,
+                                            double max_distance, const Pose2D& way_end,
+                                            const std::vector<std::string>& crossed, const BranchContext& ctx,
+                                            int& tried);
   /// findPossibleActions for an object the robot cannot grasp: pushes of `o` (on `support`)
-  /// that clear `swept` by `keep_clear`, each checked collision-free; when none of those is
-  /// free, pushes along the way that open a way round `o` (openingPushDistance). Their slots
-  /// (empty, and `why`, when none).
+  /// that clear `swept` by `keep_clear`, each checked collision-free; then, while fewer than
+  /// pushes_per_object are free, pushes that open a way round `o` (openingPushDistances): forwards
+  /// along the way, and shorter ones in the directions whose clearing push runs into something
+  /// beyond the way. Their slots (empty, and `why`, when none).
   std::vector<std::string> spawnPushes(const world::Object& o, const std::string& support, const BranchContext& ctx,
                                        const std::vector<Pose2D>& swept, const std::vector<std::string>& crossed,
                                        double keep_clear, std::string& why);
@@ -602,6 +615,7 @@ class GraphManager {
   struct PushCacheEntry {
     std::optional<MotionAnswer> answer;
     std::string why;
+    PushBlock block{PushBlock::kNone};
   };
   std::map<std::string, PushCacheEntry> push_cache_;
   /// Movables the robot can neither carry nor push in this world (found by spawnSubtasks): base

@@ -53,8 +53,12 @@ void Abstraction::addRegionReaches(const std::string& region_symbol, const world
 }
 
 std::string Abstraction::findLocation(const Pose2D& pose) const {
+  return findLocation(pose, params_.location_tolerance_m);
+}
+
+std::string Abstraction::findLocation(const Pose2D& pose, double within_m) const {
   std::string best;
-  double best_d = params_.location_tolerance_m;
+  double best_d = within_m;
   for (const auto& [id, p] : locations_) {
     const double d = std::hypot(p.x - pose.x, p.y - pose.y);
     if (d <= best_d && angleDiff(p.theta, pose.theta) <= params_.location_tolerance_rad) {
@@ -72,7 +76,11 @@ std::optional<Pose2D> Abstraction::locationPose(const std::string& id) const {
 }
 
 std::string Abstraction::locationFor(const Pose2D& pose, const std::string& hint) {
-  if (auto existing = findLocation(pose); !existing.empty()) return existing;
+  return locationFor(pose, hint, params_.location_tolerance_m);
+}
+
+std::string Abstraction::locationFor(const Pose2D& pose, const std::string& hint, double reuse_within_m) {
+  if (auto existing = findLocation(pose, reuse_within_m); !existing.empty()) return existing;
   std::string id = hint;
   for (int k = 2; locations_.count(id) || regions_.count(id); ++k) id = hint + "_" + std::to_string(k);
   locations_[id] = pose;

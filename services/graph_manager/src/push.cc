@@ -17,6 +17,9 @@
 namespace tamp::graph_manager {
 namespace {
 
+/// A push's stand and end reuse an existing location only this close (m).
+constexpr double kPushPoseReuseM = 0.01;
+
 /// The object's footprint in the world plane.
 world::Polygon2 worldFootprint(const world::Object& o, const Eigen::Isometry3d& pose) {
   world::Polygon2 out;
@@ -257,8 +260,10 @@ std::optional<std::string> GraphManager::addPushIfFree(const world::Object& o, c
     return std::nullopt;
   }
   const std::string slot = abstraction_.addSlot(o.id, support, g.target);
-  const std::string l_from = abstraction_.locationFor(g.from, "push_" + o.id);
-  const std::string l_to = abstraction_.locationFor(g.to, "pushed_" + o.id);
+  // Where the push was checked, to the centimetre: a stand a few centimetres off (made when the
+  // object's estimate stood elsewhere) touches the object or pushes it short of its slot.
+  const std::string l_from = abstraction_.locationFor(g.from, "push_" + o.id, kPushPoseReuseM);
+  const std::string l_to = abstraction_.locationFor(g.to, "pushed_" + o.id, kPushPoseReuseM);
   abstraction_.addPush(o.id, support, l_from, l_to, slot);
   log::get("graph_manager")->info("push of {} by {:.2f} m: from {} ({:.2f}, {:.2f}) to {}; {} at ({:.2f}, {:.2f})", o.id,
                                   distance, l_from, g.from.x, g.from.y, l_to, slot, g.target.translation().x(),

@@ -175,6 +175,21 @@ TEST(AbstractionTest, HeavyObjectsAreNotGraspable) {
   EXPECT_TRUE(has(b.staticAtoms(), "(graspable box)"));
 }
 
+TEST(AbstractionTest, ALocationIsReusedWithinItsToleranceOrWithinWhatTheCallerAsks) {
+  auto f = load("namo_corridor");
+  Abstraction a(f.sc.plannerWorld(), f.robot);
+  const std::string stand = a.locationFor(Pose2D{4.62, 0.50, M_PI / 2}, "push_box");
+  // 4 cm off: the same place for the robot (5 cm tolerance), another one to the centimetre.
+  EXPECT_EQ(a.locationFor(Pose2D{4.62, 0.54, M_PI / 2}, "push_box"), stand);
+  const std::string exact = a.locationFor(Pose2D{4.62, 0.54, M_PI / 2}, "push_box", 0.01);
+  EXPECT_NE(exact, stand);
+  ASSERT_TRUE(a.locationPose(exact).has_value());
+  EXPECT_NEAR(a.locationPose(exact)->y, 0.54, 1e-12);
+  // Asked again to the centimetre: the one just made (the nearest within 1 cm).
+  EXPECT_EQ(a.locationFor(Pose2D{4.62, 0.545, M_PI / 2}, "push_box", 0.01), exact);
+  EXPECT_EQ(a.findLocation(Pose2D{4.62, 0.515, M_PI / 2}, 0.01), "");
+}
+
 TEST(AbstractionTest, APushIsAStaticFactBetweenKnownSymbolsOnly) {
   auto f = load("namo_corridor");
   Abstraction a(f.sc.plannerWorld(), f.robot);

@@ -75,8 +75,14 @@ class Abstraction {
   /// The location symbol of `pose`: an existing one within tolerance, else a new one named
   /// `<hint>`, `<hint>_2`, ... with its `reaches` facts.
   std::string locationFor(const Pose2D& pose, const std::string& hint);
+  /// As locationFor, but an existing location is taken only within `reuse_within_m` (and the
+  /// angle tolerance): a pose that must be reached to the centimetre (where the base stands to
+  /// push) gets a symbol of its own beside a stale one a few centimetres off.
+  std::string locationFor(const Pose2D& pose, const std::string& hint, double reuse_within_m);
   /// The location within tolerance of `pose`, or empty.
   std::string findLocation(const Pose2D& pose) const;
+  /// The nearest location within `within_m` of `pose` (and the angle tolerance), or empty.
+  std::string findLocation(const Pose2D& pose, double within_m) const;
   std::optional<Pose2D> locationPose(const std::string& id) const;
   /// A new slot for `object_id` at `pose` on `parent_region` (existing one if the same pose).
   std::string addSlot(const std::string& object_id, const std::string& parent_region,

@@ -179,6 +179,35 @@ TEST_F(LaunchTest, FrozenServiceIsDetectedByHeartbeatAndRestarted) {
   EXPECT_FALSE(event("alpha", "killed"));
 }
 
+// A service whose main loop hangs while its heartbeat thread runs on (the echo node's hang file):
+// its heartbeats stop after stall_timeout_s, so it is killed and restarted like a stopped process.
+TEST_F(LaunchTest, AServiceWhoseMainLoopHangsStopsBeatingAndIsRestarted) {
+  const fs::path hang = dir_ / "hang_beta";
+  std::ofstream(dir_ / "deploy.yaml")
+      << "heartbeat_period_s: 0.2\nliveness_periods: 5\nstartup_timeout_s: 20\nstall_timeout_s: 1.0\n"
+         "restart: {max_restarts: 5, backoff_s: 0.2, backoff_max_s: 1}\nservices:\n"
+         "  - {name: alpha, executable: tamp_echo_node}\n"
+         "  - {name: beta, executable: tamp_echo_node, env: [\"TAMP_ECHO_HANG_FILE="
+      << hang.string() << "\"]}\n";
+  launch(dir_ / "deploy.yaml");
+  const pid_t stuck = pids().at("beta");
+  std::ofstream(hang) << "hang\n";  // beta's main loop hangs from its next turn on
+  ASSERT_TRUE(waitUntil([&] { return event("beta", "restarted").has_value(); }, 30.0, &sup_));
+  fs::remove(hang);
+  const auto killed = event("beta", "killed");
+  ASSERT_TRUE(killed) << "a service whose main loop hangs must be killed, not only noticed";
+  EXPECT_EQ((*killed)["pid"], stuck);
+  EXPECT_THAT(killed->value("detail", ""), HasSubstr("no heartbeat for"));
+  EXPECT_FALSE(process::processRunning(stuck));
+  EXPECT_NE((*event("beta", "restarted"))["pid"], stuck);
+  EXPECT_FALSE(event("alpha", "killed"));
+  // The stall is in the service's own log, with the limit it broke.
+  bool logged = false;
+  for (const auto& e : fs::recursive_directory_iterator(dir_))
+    if (e.is_regular_file() && readFile(e.path()).find("heartbeats withheld") != std::string::npos) logged = true;
+  EXPECT_TRUE(logged) << "no log line says the heartbeats were withheld";
+}
+
 TEST_F(LaunchTest, StatusFailsAndNamesTheMissingServices) {
   launch(deployment({"alpha", "beta"}));
   // The same run expected with two more services, one of them optional.

@@ -106,7 +106,9 @@ process::ProcessSpec Launcher::specOf(const deploy::ServiceSpec& s) const {
                "--domain",
                std::to_string(o_.domain),
                "--heartbeat-period",
-               std::to_string(d.heartbeat_period_s)};
+               std::to_string(d.heartbeat_period_s),
+               "--stall-timeout",
+               std::to_string(d.stall_timeout_s)};
   if (!o_.run_id.empty()) spec.args.insert(spec.args.end(), {"--run-id", o_.run_id});
   if (!o_.profile.empty()) spec.args.insert(spec.args.end(), {"--profile", o_.profile});
   if (o_.detach && d.orphan_timeout_s > 0) {

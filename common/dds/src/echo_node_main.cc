@@ -1,11 +1,31 @@
 // tamp_echo_node: the bare service skeleton (heartbeat + echo endpoint, nothing else). Used by the
 // multi-process tests, the round-trip benchmark, and to check a deployment's DDS connectivity.
+//
+// For the supervision tests, $TAMP_ECHO_HANG_FILE names a file while whose existence the node's
+// main loop hangs (a service stuck in its work while its heartbeat thread runs on).
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <thread>
+
 #include "tamp/dds/service_node.h"
 
 namespace {
 class EchoNode : public tamp::dds::ServiceNode {
  public:
-  explicit EchoNode(const tamp::dds::ServiceArgs& args) : ServiceNode(args) {}
+  explicit EchoNode(const tamp::dds::ServiceArgs& args) : ServiceNode(args) {
+    if (const char* f = std::getenv("TAMP_ECHO_HANG_FILE"); f != nullptr) hang_file_ = f;
+  }
+
+ protected:
+  void spinOnce() override {
+    std::error_code ec;
+    while (!hang_file_.empty() && std::filesystem::exists(hang_file_, ec))
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));  // the hang itself
+  }
+
+ private:
+  std::filesystem::path hang_file_;
 };
 }  // namespace
 

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "tamp/dds/convert.h"
 #include "tamp/dds/rpc.h"
@@ -41,7 +42,7 @@ HeartbeatPublisher::HeartbeatPublisher(std::shared_ptr<Participant> p, const std
       cv_.wait_for(lock, st, std::chrono::duration<double>(period_s_), [] { return false; });
       if (st.stop_requested()) break;
       lock.unlock();
-      publish();
+      beat();
       lock.lock();
     }
   });
@@ -73,6 +74,36 @@ void HeartbeatPublisher::setDetail(const std::string& detail) {
 void HeartbeatPublisher::setCounters(std::function<std::pair<uint64_t, uint64_t>()> served_failed) {
   std::lock_guard lock(mutex_);
   counters_ = std::move(served_failed);
+}
+
+void HeartbeatPublisher::setStallLimit(double limit_s) {
+  require(std::isfinite(limit_s) && limit_s >= 0.0,
+          "heartbeat stall limit must be finite and not negative, got " + std::to_string(limit_s));
+  kick();
+  stall_limit_ns_.store(static_cast<int64_t>(limit_s * 1e9));
+}
+
+void HeartbeatPublisher::kick() { last_kick_ns_.store(nowNs(), std::memory_order_relaxed); }
+
+double HeartbeatPublisher::stalledFor() const {
+  if (stall_limit_ns_.load() <= 0) return 0.0;
+  return static_cast<double>(nowNs() - last_kick_ns_.load(std::memory_order_relaxed)) * 1e-9;
+}
+
+void HeartbeatPublisher::beat() {
+  const int64_t limit = stall_limit_ns_.load();
+  const double stalled = stalledFor();
+  if (limit > 0 && stalled * 1e9 > static_cast<double>(limit)) {
+    if (!withheld_)
+      log::get("dds")->error("{}: its main loop has not run for {:.1f} s (stall limit {:.1f} s): heartbeats withheld, "
+                             "so that it counts as dead",
+                             service_id_, stalled, static_cast<double>(limit) * 1e-9);
+    withheld_ = true;
+    return;
+  }
+  if (withheld_) log::get("dds")->warn("{}: its main loop runs again: heartbeats resumed", service_id_);
+  withheld_ = false;
+  publish();
 }
 
 void HeartbeatPublisher::publish() {

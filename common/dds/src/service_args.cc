@@ -29,6 +29,9 @@ Result<ServiceArgs> parseServiceArgs(int argc, char** argv, const std::string& d
                  "file the supervisor touches; stop when it is older than --orphan-timeout");
   app.add_option("--orphan-timeout", a.orphan_timeout_s, "seconds without a supervisor before stopping (0: never)")
       ->check(CLI::Range(0.0, 1e6));
+  app.add_option("--stall-timeout", a.stall_timeout_s,
+                 "seconds the main loop may go without turning before heartbeats stop (0: never)")
+      ->check(CLI::Range(0.0, 1e6));
   app.add_option("--security", a.security_dir,
                  "DDS Security directory made by deploy/security/make_certs.sh (default: $TAMP_DDS_SECURITY; "
                  "'none': off)");

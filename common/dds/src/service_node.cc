@@ -37,7 +37,10 @@ msg::EchoReply echoHandler(const msg::EchoRequest& req, const RequestContext& ct
 }
 
 ServiceNode::ServiceNode(const ServiceArgs& args)
-    : name_(args.name), supervisor_lease_(args.supervisor_lease), orphan_timeout_s_(args.orphan_timeout_s) {
+    : name_(args.name),
+      supervisor_lease_(args.supervisor_lease),
+      orphan_timeout_s_(args.orphan_timeout_s),
+      stall_timeout_s_(args.stall_timeout_s) {
   ParticipantOptions po;
   po.domain_id = args.domain_id;
   if (!args.profile.empty()) po.profile = args.profile;
@@ -79,9 +82,11 @@ int ServiceNode::run() {
                             (participant_->securityIdentity().empty()
                                  ? std::string()
                                  : ", DDS Security as '" + participant_->securityIdentity() + "'"));
+  heartbeat_->setStallLimit(stall_timeout_s_);
   std::unique_lock lock(mutex_);
   while (!stop_) {
     lock.unlock();
+    heartbeat_->kick();
     if (orphaned()) {
       log::get(name_)->warn("{}: no supervisor renewed {} for {:.1f} s: stopping", name_, supervisor_lease_,
                             orphan_timeout_s_);
@@ -89,7 +94,12 @@ int ServiceNode::run() {
       break;
     }
     try {
+      const auto t0 = Clock::now();
       spinOnce();
+      const double took = std::chrono::duration<double>(Clock::now() - t0).count();
+      if (stall_timeout_s_ > 0 && took > 0.5 * stall_timeout_s_)
+        log::get(name_)->warn("{}: one turn of the main loop took {:.1f} s (stall limit {:.1f} s)", name_, took,
+                              stall_timeout_s_);
     } catch (const std::exception& e) {
       log::get(name_)->error("spinOnce failed: {}", e.what());
       heartbeat_->setState(msg::SERVICE_DEGRADED);
@@ -99,6 +109,7 @@ int ServiceNode::run() {
     cv_.wait_for(lock, std::chrono::duration<double>(spinPeriodSeconds()), [this] { return stop_; });
   }
   log::get(name_)->info("{} stopping", name_);
+  heartbeat_->setStallLimit(0.0);  // the clean stop may take longer than a turn
   heartbeat_->setState(msg::SERVICE_STOPPING);
   return 0;
 }

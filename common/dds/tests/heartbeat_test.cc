@@ -1,5 +1,9 @@
 #include "tamp/dds/heartbeat.h"
 
+#include <atomic>
+#include <limits>
+#include <thread>
+
 #include <gtest/gtest.h>
 
 #include "test_util.h"
@@ -36,6 +40,47 @@ TEST(HeartbeatTest, MonitorSeesPublisherAndItsCleanExit) {
   const Deadline d2 = Deadline::in(5.0);
   while (!d2.expired() && monitor.services()[0].alive) std::this_thread::sleep_for(std::chrono::milliseconds(20));
   EXPECT_FALSE(monitor.services()[0].alive);
+}
+
+/// Polls the monitor until `name`'s liveness is `alive` (or 10 s pass).
+bool becomes(const HeartbeatMonitor& monitor, const std::string& name, bool alive) {
+  const Deadline d = Deadline::in(10.0);
+  while (!d.expired()) {
+    for (const auto& s : monitor.services())
+      if (s.name == name && s.alive == alive) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return false;
+}
+
+TEST(HeartbeatTest, ALoopThatStopsKickingStopsTheBeatsUntilItKicksAgain) {
+  auto p = testing::makeParticipant();
+  ASSERT_TRUE(p);
+  HeartbeatMonitor monitor(p);
+  HeartbeatPublisher hb(p, "stalling_test", 0.05);
+  hb.setState(msg::SERVICE_READY);
+  ASSERT_TRUE(becomes(monitor, "stalling_test", true));
+  EXPECT_EQ(hb.stalledFor(), 0.0) << "disarmed: no stall is measured";
+  // Armed and never kicked again: the beats stop, and the monitor counts it dead (3 periods).
+  hb.setStallLimit(0.2);
+  EXPECT_TRUE(becomes(monitor, "stalling_test", false));
+  EXPECT_GT(hb.stalledFor(), 0.2);
+  // The loop turns again: the beats resume.
+  std::atomic<bool> done{false};
+  std::jthread loop([&] {
+    while (!done) {
+      hb.kick();
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+  });
+  EXPECT_TRUE(becomes(monitor, "stalling_test", true));
+  done = true;
+  loop.join();
+  // Disarmed: no kick needed.
+  hb.setStallLimit(0.0);
+  EXPECT_TRUE(becomes(monitor, "stalling_test", true));
+  EXPECT_THROW(hb.setStallLimit(-1.0), std::exception);
+  EXPECT_THROW(hb.setStallLimit(std::numeric_limits<double>::infinity()), std::exception);
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdlib>
 #include <set>
 
@@ -122,11 +123,14 @@ Result<Deployment> loadDeployment(const fs::path& file) {
   r.optional("liveness_periods", d.liveness_periods);
   r.optional("startup_timeout_s", d.startup_timeout_s);
   r.optional("orphan_timeout_s", d.orphan_timeout_s);
+  r.optional("stall_timeout_s", d.stall_timeout_s);
   r.check(d.heartbeat_period_s > 0 && d.heartbeat_period_s <= 10, "heartbeat_period_s",
           "must be in (0, 10]");
   r.check(d.liveness_periods >= 2, "liveness_periods", "must be at least 2");
   r.check(d.startup_timeout_s > 0, "startup_timeout_s", "must be positive");
   r.check(d.orphan_timeout_s >= 0, "orphan_timeout_s", "must not be negative (0: never)");
+  r.check(std::isfinite(d.stall_timeout_s) && d.stall_timeout_s >= 0, "stall_timeout_s",
+          "must be finite and not negative (0: never)");
   if (r.has("restart")) {
     auto rr = r.child("restart");
     rr.optional("max_restarts", d.restart.max_restarts);

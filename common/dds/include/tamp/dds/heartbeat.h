@@ -5,7 +5,14 @@
 /// publishes SERVICE_STOPPING and unregisters. `HeartbeatMonitor` keeps the latest heartbeat of
 /// each service; a service is alive while its last heartbeat is younger than 3 periods and its
 /// instance was not unregistered (a killed process's writer disappears with it).
+///
+/// Beats come from a thread of their own, so a process whose work is stuck would still beat. A
+/// publisher armed with a stall limit (`setStallLimit`) therefore beats only while the loop that
+/// does the service's work has called `kick()` within that limit (ServiceNode::run arms it for its
+/// main loop): a service whose main loop hangs stops beating and counts as dead, as a stopped
+/// process does, and its supervisor restarts it.
 
+#include <atomic>
 #include <condition_variable>
 #include <functional>
 #include <map>
@@ -28,9 +35,18 @@ class HeartbeatPublisher {
   void setDetail(const std::string& detail);
   /// Called at each beat to fill the request counters (e.g. from the node's RPC servers).
   void setCounters(std::function<std::pair<uint64_t, uint64_t>()> served_failed);
+  /// Beats are withheld while the last kick() is older than `limit_s`; 0 disarms (the default).
+  /// Arming counts as a kick. Throws std::invalid_argument for a negative or non-finite limit.
+  void setStallLimit(double limit_s);
+  /// The watched loop is alive. Thread-safe, wait-free.
+  void kick();
+  /// Seconds since the last kick() while armed; 0 when disarmed.
+  double stalledFor() const;
 
  private:
   void publish();
+  /// The periodic beat: published unless the watched loop stalled (logged once per stall).
+  void beat();
   std::shared_ptr<Participant> participant_;
   Writer<msg::Heartbeat> writer_;
   std::string service_id_;
@@ -39,6 +55,9 @@ class HeartbeatPublisher {
   msg::Heartbeat beat_;
   std::function<std::pair<uint64_t, uint64_t>()> counters_;
   std::condition_variable_any cv_;
+  std::atomic<int64_t> stall_limit_ns_{0};
+  std::atomic<int64_t> last_kick_ns_{0};
+  bool withheld_{false};  // the beat thread's own: whether it is withholding beats now
   std::jthread thread_;
 };
 

@@ -46,6 +46,9 @@ struct ServiceArgs {
   /// service whose supervisor was killed and not restarted does not run forever.
   std::string supervisor_lease;
   double orphan_timeout_s{0.0};  ///< > 0 with supervisor_lease; seconds
+  /// The main loop (run(): spinOnce() and its wait) may go this long without turning before the
+  /// service stops beating and counts as dead (HeartbeatPublisher::setStallLimit); 0: never.
+  double stall_timeout_s{20.0};
   /// DDS Security directory (deploy/security/make_certs.sh); empty: $TAMP_DDS_SECURITY, else none.
   std::string security_dir;
   /// The certificate/permissions to use from it; empty: the service name.
@@ -94,6 +97,7 @@ class ServiceNode {
   bool orphaned() const;
   std::string supervisor_lease_;
   double orphan_timeout_s_{0.0};
+  double stall_timeout_s_{0.0};
   std::mutex mutex_;
   std::condition_variable cv_;
   bool stop_{false};

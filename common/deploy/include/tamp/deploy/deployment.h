@@ -9,6 +9,7 @@
 ///   liveness_periods: 6       # heartbeats a service may miss before it counts as dead
 ///   startup_timeout_s: 30     # from start to first heartbeat
 ///   orphan_timeout_s: 60      # a launched service outlives a dead supervisor so long (0: always)
+///   stall_timeout_s: 20       # a service's main loop may hang so long before it stops beating (0: never)
 ///   restart: {max_restarts: 5, backoff_s: 0.5, backoff_max_s: 8, stable_after_s: 30}
 ///   discovery: {mode: multicast}  # default; or, on networks without multicast:
 ///   discovery: {mode: server, servers: ["10.0.0.1:11811"], server_host: workstation}
@@ -78,6 +79,9 @@ struct Deployment {
   int liveness_periods{6};         ///< >= 2
   double startup_timeout_s{30.0};  ///< > 0
   double orphan_timeout_s{60.0};   ///< >= 0; 0: launched services never stop by themselves
+  /// >= 0; a service whose main loop does not turn for this long stops beating (then counts as
+  /// dead after livenessTimeout() more); 0: never (ServiceArgs::stall_timeout_s).
+  double stall_timeout_s{20.0};
   RestartPolicy restart;
   DiscoverySpec discovery;
   std::vector<HostSpec> hosts;  ///< at least one ("local" when the file names none)

@@ -6,13 +6,20 @@ physically happened (the simulator's action log) and what the effort estimator s
 
 Prints one tab-separated line:
     status resumptions repeated_ids succeeded_actions stored_records restarts unlogged reason
+        [lost_records phantom_records journal_unlogged verdict]
 - repeated_ids: command ids found more than once in the simulator's action log ("none");
 - succeeded_actions: the log's succeeded actions; stored_records: distinct execution records in
   the store (-1 when it cannot be read);
 - restarts: SERVICE's "restarted" events in events.jsonl;
 - unlogged: the report's succeeded command ids missing from the action log ("none").
-Used by kill_matrix.sh and two_hosts.sh; `ok` in the last column of --verdict says whether the run
-passes: ended succeeded or failed with a reason, nothing executed twice, nothing lost.
+With --verdict, matched by id (a record's id is its command's id):
+- lost_records: commands the action log says succeeded that have no record in the store;
+- phantom_records: records in the store of commands the action log does not have;
+- journal_unlogged: commands the graph manager's journal says succeeded that the action log lacks
+  (what a restarted graph manager believes the robot did, against what it did);
+and `ok` or `bad`: the run passes when it ended succeeded or failed with a reason, no command
+was executed twice, and nothing was lost or invented on either side.
+Used by kill_matrix.sh and two_hosts.sh.
 """
 import collections
 import json
@@ -42,11 +49,29 @@ def action_log(run_dir):
     return w.get("action_log", [])
 
 
-def stored_records(store):
+def stored_ids(store):
+    """The store's record ids, or None when it cannot be read."""
+    if not Path(store).exists():
+        return None
     try:
-        return sqlite3.connect(str(store)).execute("select count(distinct record_id) from records").fetchone()[0]
+        return {r[0] for r in sqlite3.connect(str(store)).execute("select distinct record_id from records")}
     except (sqlite3.Error, OSError):
-        return -1
+        return None
+
+
+def journal_succeeded(run_dir):
+    """Command ids the graph manager's journal says succeeded ("<command id>", no mission id)."""
+    for path in [run_dir / "graph_manager.journal.json", *sorted(run_dir.glob("*/graph_manager.journal.json"))]:
+        try:
+            j = json.loads(path.read_text())
+        except (OSError, ValueError):
+            continue
+        return [a["command_id"] for a in j.get("actions", []) if a.get("outcome") == "succeeded" and a.get("command_id")]
+    return None
+
+
+def joined(ids):
+    return ",".join(sorted(ids)) if ids else "none"
 
 
 def restarts(run_dir, service):
@@ -74,24 +99,33 @@ def main(argv):
     run_dir, store, service = Path(argv[1]), Path(argv[2]), argv[3]
     status, resumptions, reason, acts = report(run_dir)
     log = action_log(run_dir)
+    records = stored_ids(store)
+    lost = phantom = journal_lost = "-"
     if log is None:
         repeated, succeeded, unlogged = "no-world", 0, "-"
     else:
         ids = [a["command_id"] if isinstance(a, dict) else a for a in log]
         rep = [i for i, n in collections.Counter(ids).items() if n > 1]
         repeated = ",".join(rep) if rep else "none"
-        succeeded = sum(1 for a in log if isinstance(a, dict) and a.get("outcome") == "succeeded")
+        done = [a["command_id"] for a in log if isinstance(a, dict) and a.get("outcome") == "succeeded"]
+        succeeded = len(done)
         # The robot's log names a command "<mission id>/<command id>", the report "<command id>".
         logged = {i.split("/")[-1] for i in ids}
-        lost = [a["command_id"] for a in acts
-                if a.get("outcome") == "succeeded" and a.get("command_id") and a["command_id"] not in logged]
-        unlogged = ",".join(lost) if lost else "none"
-    records = stored_records(store)
-    fields = [status, resumptions, repeated, succeeded, records, restarts(run_dir, service), unlogged, reason]
+        unlogged = joined([a["command_id"] for a in acts
+                           if a.get("outcome") == "succeeded" and a.get("command_id") and a["command_id"] not in logged])
+        if records is not None:
+            lost = joined(set(done) - records)
+            phantom = joined(records - set(ids))
+        journal = journal_succeeded(run_dir)
+        if journal is not None:
+            journal_lost = joined([c for c in journal if c not in logged])
+    fields = [status, resumptions, repeated, succeeded, len(records) if records is not None else -1,
+              restarts(run_dir, service), unlogged, reason]
     if len(argv) == 5:
         ok = (repeated == "none" and unlogged == "none" and status in ("succeeded", "failed")
-              and not (status == "failed" and reason == "-") and records >= succeeded)
-        fields.append("ok" if ok else "bad")
+              and not (status == "failed" and reason == "-") and lost == "none" and phantom == "none"
+              and journal_lost in ("none", "-"))
+        fields += [lost, phantom, journal_lost, "ok" if ok else "bad"]
     print("\t".join(str(f) for f in fields))
     return 0
 

@@ -18,11 +18,14 @@
 # the effort estimator's store (one per succeeded action: none lost, none twice), the service's
 # restart in events.jsonl. One line per run goes to OUT/matrix.tsv:
 #   service seed kill_at_command delay_s killed(yes/no) exit status resumptions repeated_ids
-#   succeeded_actions stored_records restarts unlogged reason
-# (unlogged: the report's succeeded command ids missing from the simulator's action log.)
-# Exit 0 when every run ended succeeded or failed with a reason, no command id was executed twice,
-# none of the report's succeeded actions is missing from the action log and no record was lost;
-# 1 otherwise (or when nothing ran); 30 on bad arguments.
+#   succeeded_actions stored_records restarts unlogged reason lost_records phantom_records
+#   journal_unlogged verdict
+# (unlogged: the report's succeeded command ids missing from the simulator's action log; records
+# and the journal matched to the action log by command id: judge_run.py.)
+# Exit 0 when every run's kill landed (the service's process was found and killed, and restarted),
+# it ended succeeded or failed with a reason, no command id was executed twice, none of the
+# report's or the journal's succeeded actions is missing from the action log and no record was
+# lost or invented; 1 otherwise (or when nothing ran); 30 on bad arguments.
 set -uo pipefail
 BUILD=${1:?usage: kill_matrix.sh BUILD_DIR [options]}; shift
 ROOT=$(cd "$(dirname "$0")/../.." && pwd)
@@ -52,7 +55,7 @@ mkdir -p "$OUT/deploy/store"
 # start from the default time models in every run).
 sed -E "s/realtime_factor: [0-9.]+/realtime_factor: $SPEED/" "$ROOT/config/services/sim.yaml" > "$OUT/deploy/sim.yaml"
 TSV=$OUT/matrix.tsv
-printf 'service\tseed\tkill_at_command\tdelay_s\tkilled\texit\tstatus\tresumptions\trepeated_ids\tsucceeded_actions\tstored_records\trestarts\tunlogged\treason\n' > "$TSV"
+printf 'service\tseed\tkill_at_command\tdelay_s\tkilled\texit\tstatus\tresumptions\trepeated_ids\tsucceeded_actions\tstored_records\trestarts\tunlogged\treason\tlost_records\tphantom_records\tjournal_unlogged\tverdict\n' > "$TSV"
 bad=0
 runs=0
 for svc in $SERVICES; do
@@ -90,12 +93,17 @@ for svc in $SERVICES; do
     dir=$OUT/$rid
     # What physically happened (the simulator's action log) against the report and the
     # estimator's store (records are de-duplicated by id: a resent one is not stored twice).
-    IFS=$'\t' read -r status resumptions repeated succeeded records restarts unlogged reason verdict < <(
+    IFS=$'\t' read -r status resumptions repeated succeeded records restarts unlogged reason lost phantom jlost verdict < <(
       python3 "$ROOT/tests/fault/judge_run.py" "$dir" "$store/effort_store.sqlite" "$svc" --verdict)
-    printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$svc" "$seed" "$k" "$delay" "$killed" "$rc" "$status" \
-      "$resumptions" "$repeated" "$succeeded" "$records" "${restarts:-0}" "$unlogged" "$reason" >> "$TSV"
+    # A run whose fault did not land tested nothing: the process was not found (the mission ended
+    # before the k-th command, or the service has another name) or was not restarted.
+    if [ "$killed" != yes ] || [ "${restarts:-0}" -lt 1 ]; then verdict="bad"; fi
+    printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$svc" "$seed" "$k" "$delay" "$killed" \
+      "$rc" "$status" "$resumptions" "$repeated" "$succeeded" "$records" "${restarts:-0}" "$unlogged" "$reason" "$lost" \
+      "$phantom" "$jlost" "$verdict" >> "$TSV"
     echo "$svc seed $seed: kill at command $k +${delay}s killed=$killed exit $rc $status repeated=$repeated" \
-      "records=$records/$succeeded restarts=${restarts:-0} unlogged=$unlogged"
+      "records=$records/$succeeded lost=$lost phantom=$phantom journal_unlogged=$jlost restarts=${restarts:-0}" \
+      "unlogged=$unlogged: $verdict"
     [ "$verdict" = ok ] || bad=$((bad + 1))
   done
 done

@@ -9,9 +9,10 @@
 #        [--kill SERVICE --kill-at S] [--delay MS [--jitter MS]]
 #
 # --kill SERVICE --kill-at S: SIGKILL to that service's process S s after the mission started,
-# on whichever host runs it (its launcher restarts it); the run is then judged by
-# tests/fault/judge_run.py (nothing executed twice, no execution record lost, ended succeeded or
-# failed with a reason), its line appended to OUT/RUN_ID/faults.log and the exit code 50 when bad.
+# on whichever host runs it (its launcher restarts it). Every run (with or without a fault) is
+# judged by tests/fault/judge_run.py (nothing executed twice, no execution record lost or
+# invented, the journal's succeeded actions in the robot's log, ended succeeded or failed with a
+# reason), its line appended to OUT/RUN_ID/faults.log and the exit code 50 when bad.
 #
 # --loss PCT / --duplicate PCT drop / duplicate that percentage of the UDP datagrams each host
 # sends on the link (nftables `numgen random` on both namespaces' output; needs `nft`, Debian
@@ -281,10 +282,11 @@ cleanup; trap - EXIT
 if [ "$RC" = 0 ] && [ ! -s "$OUT/$RUN_ID/sim_final_world.json" ]; then
   echo "two_hosts.sh: mission succeeded but the simulator wrote no final world" >&2; exit 50
 fi
-if [ -n "$KILL" ]; then
-  verdict_line=$(python3 "$ROOT/tests/fault/judge_run.py" "$RUN_DIR" "$RUN_DIR/store/effort_store.sqlite" "$KILL" --verdict)
-  echo "judge: $KILL at +${KILL_AT}s: $verdict_line" | tee -a "$RUN_DIR/faults.log"
-  if [ "${verdict_line##*$'\t'}" != ok ]; then echo 50 > "$OUT/$RUN_ID/exit_code"; exit 50; fi
-fi
+# Every run is judged, whatever its fault (a kill, loss, duplication, delay, a partition, none):
+# nothing executed twice, nothing lost or invented between the robot's log, the journal and the
+# estimator's store.
+verdict_line=$(python3 "$ROOT/tests/fault/judge_run.py" "$RUN_DIR" "$RUN_DIR/store/effort_store.sqlite" "${KILL:-none}" --verdict)
+echo "judge: ${KILL:+$KILL at +${KILL_AT}s: }$verdict_line" | tee -a "$RUN_DIR/faults.log"
+if [ "${verdict_line##*$'\t'}" != ok ]; then echo 50 > "$OUT/$RUN_ID/exit_code"; exit 50; fi
 echo "$RC" > "$OUT/$RUN_ID/exit_code"
 exit "$RC"

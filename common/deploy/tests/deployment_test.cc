@@ -91,6 +91,7 @@ services:
   EXPECT_DOUBLE_EQ(d->livenessTimeout(), 0.6);
   EXPECT_EQ(d->restart.max_restarts, 2);
   EXPECT_DOUBLE_EQ(d->restart.stable_after_s, 30.0);
+  EXPECT_DOUBLE_EQ(d->stall_timeout_s, 20.0);
   EXPECT_EQ(d->host("robot")->env, std::vector<std::string>{"A=1"});
   EXPECT_TRUE(d->services[1].optional);
   EXPECT_FALSE(d->services[1].restart);
@@ -156,6 +157,8 @@ TEST_F(DeploymentTest, BadFilesNameTheFieldAndLine) {
               HasSubstr(":1:21: field 'heartbeat_period_s': must be in (0, 10]"));
   EXPECT_THAT(errorOf("liveness_periods: 1\nservices:\n  - {name: a, executable: x}\n"),
               HasSubstr("field 'liveness_periods': must be at least 2"));
+  EXPECT_THAT(errorOf("stall_timeout_s: -1\nservices:\n  - {name: a, executable: x}\n"),
+              HasSubstr(":1:18: field 'stall_timeout_s': must be finite and not negative"));
   EXPECT_THAT(
       errorOf(
           "restart: {backoff_s: 2, backoff_max_s: 1}\nservices:\n  - {name: a, executable: x}\n"),

@@ -9,7 +9,10 @@
 # was running as failed ("robot driver restarted mid-action") instead of executing it again.
 #
 #   tests/fault/kill_matrix.sh BUILD_DIR [--scenario FILE] [--services "a b ..."] [--seeds "1 2 ..."]
-#        [--max-step K] [--out DIR] [--speed F]
+#        [--max-step K] [--out DIR] [--speed F] [--lock FILE]
+#
+# --lock FILE: each run holds flock(FILE) while it runs (a machine shared with builds and other
+# missions: runs never overlap them).
 #
 # Each run is judged from its run folder: exit code and reason (report.json), the robot's final
 # pose and the objects (sim_final_world.json), every command id at most once in the simulator's
@@ -35,6 +38,7 @@ SEEDS="1 2"
 MAX_STEP=4
 OUT=${TMPDIR:-/tmp}/tamp-kill-matrix
 SPEED=2.0
+LOCK=""
 while [ $# -gt 0 ]; do
   case $1 in
     --scenario) SCENARIO=$(realpath "$2"); shift 2;;
@@ -43,6 +47,7 @@ while [ $# -gt 0 ]; do
     --max-step) MAX_STEP=$2; shift 2;;
     --out) OUT=$2; shift 2;;
     --speed) SPEED=$2; shift 2;;
+    --lock) LOCK=$2; shift 2;;
     *) echo "kill_matrix.sh: unknown option $1" >&2; exit 30;;
   esac
 done
@@ -73,6 +78,7 @@ for svc in $SERVICES; do
       "$ROOT/config/deploy/local.yaml" > "$OUT/deploy/deploy-$rid.yaml"
     domain=$(( (seed * 13 + runs * 7) % 200 + 20 ))
     log=$OUT/$rid.out
+    if [ -n "$LOCK" ]; then exec 9> "$LOCK"; flock 9; fi
     "$BIN/tamp-run" "$SCENARIO" --out "$OUT" --run-id "$rid" --domain "$domain" --deployment "$OUT/deploy/deploy-$rid.yaml" \
       --mission-timeout 400 > "$log" 2>&1 &
     runner=$!
@@ -90,6 +96,7 @@ for svc in $SERVICES; do
     done
     wait "$runner"
     rc=$?
+    if [ -n "$LOCK" ]; then flock -u 9; exec 9>&-; fi
     dir=$OUT/$rid
     # What physically happened (the simulator's action log) against the report and the
     # estimator's store (records are de-duplicated by id: a resent one is not stored twice).

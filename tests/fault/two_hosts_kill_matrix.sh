@@ -36,7 +36,7 @@ fi
 mkdir -p "$OUT"
 OUT=$(realpath "$OUT")
 TSV=$OUT/matrix.tsv
-printf 'service\tseed\tkill_at_s\texit\tstatus\tresumptions\trepeated_ids\tsucceeded_actions\tstored_records\trestarts\tunlogged\treason\tverdict\n' > "$TSV"
+printf 'service\tseed\tkill_at_s\texit\tstatus\tresumptions\trepeated_ids\tsucceeded_actions\tstored_records\trestarts\tunlogged\treason\tlost_records\tphantom_records\tjournal_unlogged\tverdict\n' > "$TSV"
 runs=0 bad=0
 for svc in $SERVICES; do
   for seed in $SEEDS; do

@@ -34,6 +34,16 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+/// How many times a motion question is asked while the planner has not received its world.
+constexpr int kWorldLagAttempts = 3;
+
+/// Whether a reply says that the planner has not received the world version asked for yet.
+template <typename Rep>
+bool waitingForWorld(const Result<Rep>& rep) {
+  return !rep && rep.error().code == ErrorCode::kUnavailable &&
+         rep.error().message.find("world_version") != std::string::npos;
+}
+
 dds::RpcClientOptions rpcOptions() {
   dds::RpcClientOptions o;
   o.attempt_timeout_s = 2.0;
@@ -141,6 +151,13 @@ MotionAnswer DdsServiceClients::motion(const MotionQuery& q) {
   MotionAnswer a;
   const auto t0 = Clock::now();
   auto rep = checked(motion_.call(req, dds::CallOptions{q.budget_s, {}}), dds::services::kMotion.name);
+  // A planner that has not received the world version the question names answers `unavailable`
+  // after waiting for it (its world_wait_s). The world is on its way (a lossy link repairs it, a
+  // restarted planner gets it again): asked again a few times before the question counts as failed.
+  for (int attempt = 1; attempt < kWorldLagAttempts && waitingForWorld(rep); ++attempt) {
+    log::get("graph_manager")->warn("motion: {} (attempt {} of {}): asking again", rep.error().message, attempt, kWorldLagAttempts);
+    rep = checked(motion_.call(req, dds::CallOptions{q.budget_s, {}}), dds::services::kMotion.name);
+  }
   a.time_s = std::chrono::duration<double>(Clock::now() - t0).count();
   if (!rep) {
     a.status = rep.error().code == ErrorCode::kTimeout ? MotionOutcome::kTimeout : MotionOutcome::kUnavailable;

@@ -189,6 +189,18 @@ struct SearchOptions {
   /// 0 = none (LAMA 2011's iterations only); must be in [0, 1].
   double neighbourhood_time_share{0.5};
   size_t neighbourhood_first_states{1024};  ///< must be > 0
+  /// When a neighbourhood found nothing cheaper, the doubled one grows from it (its
+  /// breadth-first search goes on where it stopped) instead of being built again from the plan:
+  /// the same states, in the same order, so the same plans, for about half the breadth-first work.
+  /// false = rebuilt at each doubling (the twenty-fifth round's search; kept for the tests that
+  /// compare the two).
+  bool neighbourhood_grow{true};
+  /// With a deadline: the neighbourhood search ends, and leaves the rest of its share to the
+  /// weighted iterations, when its next search is not expected to end within the share (expected:
+  /// twice the last search's time after a doubling, the last search's time after an improvement).
+  /// A search cut by the deadline finds nothing, so that time would be lost. false = the
+  /// neighbourhood search runs until its share is out.
+  bool neighbourhood_give_back{true};
 
   /// @throws std::invalid_argument naming the bad field (weight < 1, ...).
   void validate() const;
@@ -247,6 +259,7 @@ struct SearchStatistics {
   uint64_t neighbourhood_runs{0};          ///< plan neighbourhood searches of the anytime phase
   uint64_t neighbourhood_improvements{0};  ///< ... that found a cheaper plan
   uint64_t neighbourhood_states{0};        ///< states of the largest neighbourhood searched
+  double neighbourhood_seconds{0.0};       ///< time of the plan neighbourhood searches
   /// `unit_cost_first`: the unit-cost run ran out of its time share or memory, or gave up, and the
   /// first plan came from the cost + 1 run; its effort is included in the counters above.
   bool unit_first_failed{false};

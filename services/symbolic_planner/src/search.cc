@@ -1231,10 +1231,6 @@ void SearchOptions::validate() const {
     throw std::invalid_argument("SearchOptions::neighbourhood_time_share must be in [0, 1], got " +
                                 std::to_string(neighbourhood_time_share));
   }
-  if (!(neighbourhood_trial_share > 0.0 && neighbourhood_trial_share <= 1.0)) {
-    throw std::invalid_argument("SearchOptions::neighbourhood_trial_share must be in (0, 1], got " +
-                                std::to_string(neighbourhood_trial_share));
-  }
   if (neighbourhood_first_states == 0) {
     throw std::invalid_argument("SearchOptions::neighbourhood_first_states must be > 0");
   }
@@ -1503,19 +1499,10 @@ SearchResult search(const Task& task, const StateBits& init, const Goal& goal, c
         std::isfinite(left) ? until.tightened(Deadline::in(options.neighbourhood_time_share * left)) : until;
     // One searcher while nothing cheaper is found, so that the neighbourhood grows in place
     // (`neighbourhood_grow`); a new one around each cheaper plan.
-    // Until it finds a cheaper plan, the search has only the first `neighbourhood_trial_share` of
-    // its share: where it gains nothing, the iterations get the rest.
-    const Termination trial =
-        std::isfinite(left)
-            ? until.tightened(Deadline::in(options.neighbourhood_trial_share * options.neighbourhood_time_share * left))
-            : until;
-    bool gained = false;
     std::unique_ptr<Searcher> s;
     double doubled_seconds = 0;  // the time of the last search after a doubling (0: none yet)
-    for (size_t states = options.neighbourhood_first_states; best.cost > 0;) {
-      const Termination& limit = gained ? share : trial;
-      if (limit()) break;
-      if (!s) s = std::make_unique<Searcher>(task, init, goal, options, heuristic, limit);
+    for (size_t states = options.neighbourhood_first_states; !share() && best.cost > 0;) {
+      if (!s) s = std::make_unique<Searcher>(task, init, goal, options, heuristic, share);
       bool complete = false;
       SearchResult r = s->neighbourhood(best.plan, states, options.neighbourhood_grow, &complete);
       ++best.stats.neighbourhood_runs;
@@ -1528,7 +1515,6 @@ SearchResult search(const Task& task, const StateBits& init, const Goal& goal, c
         ++best.stats.neighbourhood_improvements;
         best.plan = std::move(r.plan);
         best.cost = r.cost;
-        gained = true;
         s.reset();
       }
       if (complete) {  // the whole reachable space: the plan is optimal
@@ -1546,10 +1532,7 @@ SearchResult search(const Task& task, const StateBits& init, const Goal& goal, c
         expected *= std::clamp(growth, 2.0, 4.0);
         doubled_seconds = r.stats.seconds;
       }
-      const Termination& next_limit = gained ? share : trial;
-      if (options.neighbourhood_give_back && std::isfinite(left) && next_limit.deadline().secondsLeft() < expected) {
-        break;
-      }
+      if (options.neighbourhood_give_back && std::isfinite(left) && share.deadline().secondsLeft() < expected) break;
     }
   }
   // 0: the lazy greedy search with landmarks (LAMA's first iteration, cost-aware heuristic).

@@ -861,33 +861,6 @@ TEST(Search, PlanNeighbourhoodSearchLeavesTheTimeItCannotUseToTheIterations) {
   EXPECT_LT(back.stats.neighbourhood_seconds, 0.5);
 }
 
-TEST(Search, APlanNeighbourhoodThatGainsNothingInItsTrialLeavesTheRestToTheIterations) {
-  // citycar-2: the neighbourhood search finds nothing cheaper than the first plan up to 262 144
-  // states (2 s). Given the whole phase (1 s) without a trial, it runs until its next search is
-  // not expected to end in time; with a trial of a quarter, it ends within about 0.25 s and the
-  // iterations get the rest.
-  const auto d = test::benchmarksDir() / "pddl-adl/citycar";
-  PlanRequest req;
-  req.domain_text = test::readFile(d / "domain.pddl");
-  req.problem_text = test::readFile(d / "instance-2.pddl");
-  req.check_plan = true;
-  req.timeout_seconds = 120;
-  req.search.anytime_seconds = 1;
-  req.search.neighbourhood_time_share = 1;
-  req.search.neighbourhood_trial_share = 1;
-  PlanReply whole = plan(req, Termination());
-  ASSERT_EQ(whole.status, PlanStatus::kSolved) << whole.message;
-  ASSERT_EQ(whole.stats.neighbourhood_improvements, 0U);
-  EXPECT_GT(whole.stats.neighbourhood_seconds, 0.3);
-  req.search.neighbourhood_trial_share = 0.25;
-  PlanReply trial = plan(req, Termination());
-  ASSERT_EQ(trial.status, PlanStatus::kSolved) << trial.message;
-  ASSERT_EQ(trial.stats.neighbourhood_improvements, 0U);
-  EXPECT_LE(trial.stats.neighbourhood_seconds, 0.25);
-  EXPECT_GE(trial.stats.anytime_iterations, 1U);
-  EXPECT_LE(trial.cost, whole.cost);
-}
-
 TEST(Search, UnitCostFirstRunFallsBackToCostPlusOneWhenOutOfTimeShareOrMemory) {
   // pegsol-18 takes thousands of expansions with either cost type: a unit-cost run given 1e-9
   // of the time left runs out of it at its first time check, and the first plan comes from the
@@ -955,9 +928,6 @@ TEST(Search, OptionsAreValidated) {
   }
   o.neighbourhood_time_share = 0;
   EXPECT_NO_THROW(o.validate());
-  o.neighbourhood_trial_share = 0;
-  EXPECT_THROW(o.validate(), std::invalid_argument);
-  o.neighbourhood_trial_share = 1;
   o.neighbourhood_first_states = 0;
   EXPECT_THROW(o.validate(), std::invalid_argument);
   o.neighbourhood_first_states = 1;

@@ -202,11 +202,6 @@ struct SearchOptions {
   /// A search cut by the deadline finds nothing, so that time would be lost. false = the
   /// neighbourhood search runs until its share is out.
   bool neighbourhood_give_back{true};
-  /// Until it has found a cheaper plan, the neighbourhood search may use only this share of its
-  /// time; where it gains nothing by then (citycar: nothing up to 262 144 states, 2 s) the weighted
-  /// iterations get the rest. Once it has found one, it may use all of its share. 1 = no trial;
-  /// must be in (0, 1].
-  double neighbourhood_trial_share{0.5};
 
   /// @throws std::invalid_argument naming the bad field (weight < 1, ...).
   void validate() const;

@@ -1500,7 +1500,6 @@ SearchResult search(const Task& task, const StateBits& init, const Goal& goal, c
     // One searcher while nothing cheaper is found, so that the neighbourhood grows in place
     // (`neighbourhood_grow`); a new one around each cheaper plan.
     std::unique_ptr<Searcher> s;
-    double doubled_seconds = 0;  // the time of the last search after a doubling (0: none yet)
     for (size_t states = options.neighbourhood_first_states; !share() && best.cost > 0;) {
       if (!s) s = std::make_unique<Searcher>(task, init, goal, options, heuristic, share);
       bool complete = false;
@@ -1522,16 +1521,8 @@ SearchResult search(const Task& task, const StateBits& init, const Goal& goal, c
         return best;
       }
       if (!cheaper) states *= 2;  // else the same size around the cheaper plan (Nakhost & Mueller)
-      // A search the share's deadline cuts finds nothing: leave that time to the iterations. After
-      // a doubling, the next search is expected to take the last one's time times the growth of
-      // the last two doublings' times (each searches about all its states, and their edges grow
-      // a little faster than their number: 2.3-2.4x on citycar and parcprinter), within [2, 4].
-      double expected = r.stats.seconds;
-      if (!cheaper) {
-        const double growth = doubled_seconds > 0 ? r.stats.seconds / doubled_seconds : 2.0;
-        expected *= std::clamp(growth, 2.0, 4.0);
-        doubled_seconds = r.stats.seconds;
-      }
+      // A search the share's deadline cuts finds nothing: leave that time to the iterations.
+      const double expected = cheaper ? r.stats.seconds : 2.0 * r.stats.seconds;
       if (options.neighbourhood_give_back && std::isfinite(left) && share.deadline().secondsLeft() < expected) break;
     }
   }

@@ -197,8 +197,7 @@ struct SearchOptions {
   bool neighbourhood_grow{true};
   /// With a deadline: the neighbourhood search ends, and leaves the rest of its share to the
   /// weighted iterations, when its next search is not expected to end within the share (expected:
-  /// the last search's time after an improvement; after a doubling, that time times the growth
-  /// of the last two doublings' times, within [2, 4]).
+  /// twice the last search's time after a doubling, the last search's time after an improvement).
   /// A search cut by the deadline finds nothing, so that time would be lost. false = the
   /// neighbourhood search runs until its share is out.
   bool neighbourhood_give_back{true};

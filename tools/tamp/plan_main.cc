@@ -124,7 +124,7 @@ int main(int argc, char** argv) {
            fallback_max = defaults.ehc_fallback_budget_max;
   double unit_first_share = defaults.unit_first_time_share;
   double neighbourhood_share = defaults.neighbourhood_time_share;
-  bool neighbourhood_grow = defaults.neighbourhood_grow, neighbourhood_give_back = defaults.neighbourhood_give_back;
+  bool neighbourhood_grow = defaults.neighbourhood_grow;
   int64_t heap_reserve_mib = 64;
   double retry_share = defaults.ehc_retry_budget_share;
   uint64_t lazy_after = defaults.ehc_lazy_after, lazy_turn_ehc = defaults.ehc_lazy_turn_ehc,
@@ -195,9 +195,6 @@ int main(int argc, char** argv) {
   app.add_option("--neighbourhood-grow", neighbourhood_grow,
                  "with --neighbourhood-share: grow a neighbourhood that found nothing cheaper in place (true, "
                  "the default) or build it again from the plan at each doubling (false); the same states either way");
-  app.add_option("--neighbourhood-give-back", neighbourhood_give_back,
-                 "with --neighbourhood-share: end the neighbourhood search when its next search is not expected "
-                 "to end within its share, leaving the rest to the weighted iterations (default true)");
   app.add_flag("--no-landmarks", no_landmarks, "lazy: h_FF only (no landmark-count heuristic)");
   std::string landmark_generator = defaults.landmark_generator == sp::LandmarkGenerator::kRhw ? "rhw" : "zg";
   size_t rhw_max_disjunction = defaults.rhw.max_disjunction_size;
@@ -279,7 +276,6 @@ int main(int argc, char** argv) {
   req.search.unit_first_time_share = unit_first_share;
   req.search.neighbourhood_time_share = neighbourhood_share;
   req.search.neighbourhood_grow = neighbourhood_grow;
-  req.search.neighbourhood_give_back = neighbourhood_give_back;
   if (heuristic == "ff") req.search.heuristic = sp::HeuristicKind::kFF;
   if (heuristic == "add") req.search.heuristic = sp::HeuristicKind::kAdd;
   if (heuristic == "max") req.search.heuristic = sp::HeuristicKind::kMax;

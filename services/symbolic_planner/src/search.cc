@@ -1521,9 +1521,6 @@ SearchResult search(const Task& task, const StateBits& init, const Goal& goal, c
         return best;
       }
       if (!cheaper) states *= 2;  // else the same size around the cheaper plan (Nakhost & Mueller)
-      // A search the share's deadline cuts finds nothing: leave that time to the iterations.
-      const double expected = cheaper ? r.stats.seconds : 2.0 * r.stats.seconds;
-      if (options.neighbourhood_give_back && std::isfinite(left) && share.deadline().secondsLeft() < expected) break;
     }
   }
   // 0: the lazy greedy search with landmarks (LAMA's first iteration, cost-aware heuristic).

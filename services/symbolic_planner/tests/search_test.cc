@@ -818,7 +818,6 @@ TEST(Search, AGrownPlanNeighbourhoodHoldsTheStatesOfARebuiltOneForLessWork) {
   req.search.anytime_seconds = 600;  // a budget: the complete neighbourhood ends the phase
   req.search.neighbourhood_time_share = 1;
   req.search.neighbourhood_first_states = 64;  // more doublings than the default's
-  req.search.neighbourhood_give_back = false;
   req.search.neighbourhood_grow = false;
   PlanReply rebuilt = plan(req, Termination());
   ASSERT_EQ(rebuilt.status, PlanStatus::kSolved) << rebuilt.message;
@@ -834,31 +833,6 @@ TEST(Search, AGrownPlanNeighbourhoodHoldsTheStatesOfARebuiltOneForLessWork) {
   ASSERT_EQ(grown.plan.size(), rebuilt.plan.size());
   for (size_t i = 0; i < grown.plan.size(); ++i) EXPECT_EQ(grown.plan[i].toString(), rebuilt.plan[i].toString());
   EXPECT_LT(grown.stats.expanded, rebuilt.stats.expanded);
-}
-
-TEST(Search, PlanNeighbourhoodSearchLeavesTheTimeItCannotUseToTheIterations) {
-  // elevators-6: the reachable space is far larger than what the neighbourhood search reaches in
-  // 0.5 s. Given the whole phase, it runs to its end, and the last search, cut by the deadline,
-  // finds nothing: no weighted iteration runs. With `neighbourhood_give_back`, the search ends
-  // when its next doubling is not expected to end in time, and the iterations get the rest.
-  const auto d = test::benchmarksDir() / "pddl-adl/elevators";
-  PlanRequest req;
-  req.domain_text = test::readFile(d / "domain.pddl");
-  req.problem_text = test::readFile(d / "instance-6.pddl");
-  req.check_plan = true;
-  req.timeout_seconds = 120;
-  req.search.anytime_seconds = 0.5;
-  req.search.neighbourhood_time_share = 1;
-  req.search.neighbourhood_give_back = false;
-  PlanReply all = plan(req, Termination());
-  ASSERT_EQ(all.status, PlanStatus::kSolved) << all.message;
-  EXPECT_EQ(all.stats.anytime_iterations, 0U);
-  req.search.neighbourhood_give_back = true;
-  PlanReply back = plan(req, Termination());
-  ASSERT_EQ(back.status, PlanStatus::kSolved) << back.message;
-  EXPECT_GE(back.stats.neighbourhood_runs, 1U);
-  EXPECT_GE(back.stats.anytime_iterations, 1U);
-  EXPECT_LT(back.stats.neighbourhood_seconds, 0.5);
 }
 
 TEST(Search, UnitCostFirstRunFallsBackToCostPlusOneWhenOutOfTimeShareOrMemory) {

@@ -191,16 +191,13 @@ struct SearchOptions {
   size_t neighbourhood_first_states{1024};  ///< must be > 0
   /// When a neighbourhood found nothing cheaper, the doubled one grows from it (its
   /// breadth-first search goes on where it stopped) instead of being built again from the plan:
-  /// the same states, in the same order, so the same plans, for about half the breadth-first work.
+  /// the same states, in the same order, so the same plans. Only the breadth-first part is
+  /// saved (2-40 % of a search on citycar, parcprinter, sokoban; the uniform-cost search through
+  /// the states is the rest and is done again): 20-50 % of the neighbourhood search's time on
+  /// parcprinter-12 and pegsol-12 / -18.
   /// false = rebuilt at each doubling (the twenty-fifth round's search; kept for the tests that
   /// compare the two).
   bool neighbourhood_grow{true};
-  /// With a deadline: the neighbourhood search ends, and leaves the rest of its share to the
-  /// weighted iterations, when its next search is not expected to end within the share (expected:
-  /// twice the last search's time after a doubling, the last search's time after an improvement).
-  /// A search cut by the deadline finds nothing, so that time would be lost. false = the
-  /// neighbourhood search runs until its share is out.
-  bool neighbourhood_give_back{true};
 
   /// @throws std::invalid_argument naming the bad field (weight < 1, ...).
   void validate() const;

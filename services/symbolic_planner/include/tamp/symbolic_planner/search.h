@@ -192,7 +192,7 @@ struct SearchOptions {
   /// When a neighbourhood found nothing cheaper, the doubled one grows from it (its
   /// breadth-first search goes on where it stopped) instead of being built again from the plan:
   /// the same states, in the same order, so the same plans. Only the breadth-first part is
-  /// saved (2-40 % of a search on citycar, parcprinter, sokoban; the uniform-cost search through
+  /// saved (2-42 % of a search on citycar, parcprinter, sokoban; the uniform-cost search through
   /// the states is the rest and is done again): 20-50 % of the neighbourhood search's time on
   /// parcprinter-12 and pegsol-12 / -18.
   /// false = rebuilt at each doubling (the twenty-fifth round's search; kept for the tests that

@@ -124,6 +124,7 @@ int main(int argc, char** argv) {
            fallback_max = defaults.ehc_fallback_budget_max;
   double unit_first_share = defaults.unit_first_time_share;
   double neighbourhood_share = defaults.neighbourhood_time_share;
+  bool neighbourhood_grow = defaults.neighbourhood_grow;
   int64_t heap_reserve_mib = 64;
   double retry_share = defaults.ehc_retry_budget_share;
   uint64_t lazy_after = defaults.ehc_lazy_after, lazy_turn_ehc = defaults.ehc_lazy_turn_ehc,
@@ -191,6 +192,9 @@ int main(int argc, char** argv) {
                  "with --anytime: the share of its time for plan neighbourhood graph search on the first plan, "
                  "before LAMA's weighted A* iterations, in [0, 1] (0 = none)")
       ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--neighbourhood-grow", neighbourhood_grow,
+                 "with --neighbourhood-share: grow a neighbourhood that found nothing cheaper in place (true, "
+                 "the default) or build it again from the plan at each doubling (false); the same states either way");
   app.add_flag("--no-landmarks", no_landmarks, "lazy: h_FF only (no landmark-count heuristic)");
   std::string landmark_generator = defaults.landmark_generator == sp::LandmarkGenerator::kRhw ? "rhw" : "zg";
   size_t rhw_max_disjunction = defaults.rhw.max_disjunction_size;
@@ -271,6 +275,7 @@ int main(int argc, char** argv) {
   req.search.unit_cost_first = !no_unit_first;
   req.search.unit_first_time_share = unit_first_share;
   req.search.neighbourhood_time_share = neighbourhood_share;
+  req.search.neighbourhood_grow = neighbourhood_grow;
   if (heuristic == "ff") req.search.heuristic = sp::HeuristicKind::kFF;
   if (heuristic == "add") req.search.heuristic = sp::HeuristicKind::kAdd;
   if (heuristic == "max") req.search.heuristic = sp::HeuristicKind::kMax;
@@ -319,10 +324,11 @@ int main(int argc, char** argv) {
                                                    : "",
                  reply.stats.unit_first_failed ? "; unit-cost first run failed, first plan with cost + 1" : "");
     if (reply.stats.neighbourhood_runs > 0) {
-      std::fprintf(stderr, "; plan neighbourhood searches %llu, %llu improvements, up to %llu states",
+      std::fprintf(stderr, "; plan neighbourhood searches %llu, %llu improvements, up to %llu states, %.3f s",
                    static_cast<unsigned long long>(reply.stats.neighbourhood_runs),
                    static_cast<unsigned long long>(reply.stats.neighbourhood_improvements),
-                   static_cast<unsigned long long>(reply.stats.neighbourhood_states));
+                   static_cast<unsigned long long>(reply.stats.neighbourhood_states),
+                   reply.stats.neighbourhood_seconds);
     }
     if (reply.stats.relevance_ran) {
       const sp::RelevanceStats& r = reply.stats.relevance;

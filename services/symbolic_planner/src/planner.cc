@@ -348,6 +348,7 @@ PlanReply PlanningSession::solve(const Query& q, const Termination& term) {
   reply.stats.neighbourhood_runs = sr.stats.neighbourhood_runs;
   reply.stats.neighbourhood_improvements = sr.stats.neighbourhood_improvements;
   reply.stats.neighbourhood_states = sr.stats.neighbourhood_states;
+  reply.stats.neighbourhood_seconds = sr.stats.neighbourhood_seconds;
   reply.stats.unit_first_failed = sr.stats.unit_first_failed;
   reply.stats.landmarks = sr.stats.landmarks;
   reply.stats.landmarks_disjunctive = sr.stats.landmarks_disjunctive;

@@ -368,26 +368,39 @@ class Searcher {
   /// through registered states only (uniform-cost). The plan's own path is among them, so the
   /// result costs at most the plan's. `*complete`: every registered state was expanded before the
   /// cap (the neighbourhood is the whole reachable space and the result is optimal).
-  SearchResult neighbourhood(const std::vector<OpId>& plan, size_t max_states, bool* complete) {
+  /// `grow`: when this searcher's last call built a neighbourhood of the same plan, go on from it
+  /// (its breadth-first search resumes where the cap stopped it): the same states, in the same
+  /// order, as a neighbourhood built afresh with the larger cap. The statistics are this call's.
+  SearchResult neighbourhood(const std::vector<OpId>& plan, size_t max_states, bool grow, bool* complete) {
     Stopwatch sw;
-    return finished(neighbourhoodSearch(plan, max_states, complete), sw, true);
+    stats_ = SearchStatistics{};
+    evaluated_at_check_ = 0;
+    return finished(neighbourhoodSearch(plan, max_states, grow, complete), sw, true);
   }
 
  private:
-  SearchResult neighbourhoodSearch(const std::vector<OpId>& plan, size_t max_states, bool* complete) {
+  SearchResult neighbourhoodSearch(const std::vector<OpId>& plan, size_t max_states, bool grow, bool* complete) {
     *complete = false;
-    resetRegistry();
     bool is_new = false;
-    std::copy(init_.begin(), init_.end(), buf_.begin());
-    registerState(buf_.data(), &is_new);
-    for (OpId o : plan) {
-      task_.apply(buf_.data(), o, succ_.data());
-      buf_.swap(succ_);
+    if (!grow || !nbh_built_ || plan != nbh_plan_) {
+      resetRegistry();
+      std::copy(init_.begin(), init_.end(), buf_.begin());
       registerState(buf_.data(), &is_new);
+      for (OpId o : plan) {
+        task_.apply(buf_.data(), o, succ_.data());
+        buf_.swap(succ_);
+        registerState(buf_.data(), &is_new);
+      }
+      nbh_next_ = 0;
+      nbh_plan_ = plan;
     }
-    // Breadth-first: the registry's order is the queue's.
+    nbh_built_ = false;  // until this breadth-first search ends within its limits
+    // Breadth-first: the registry's order is the queue's. A state whose expansion the cap cut
+    // is expanded again when the neighbourhood grows (its registered successors are found, the
+    // others added in the order a fresh build would add them).
     std::vector<OpId> ops;
-    uint32_t next = 0;
+    uint32_t next = nbh_next_;
+    bool cut = false;
     while (next < reg_.size() && reg_.size() < max_states) {
       if (auto st = checkLimits()) return finish(*st);
       std::copy(reg_.get(next), reg_.get(next) + reg_.words(), buf_.begin());
@@ -395,14 +408,19 @@ class Searcher {
       ++stats_.expanded;
       ops.clear();
       task_.applicableOps(buf_.data(), ops);
-      for (OpId o : ops) {
-        task_.apply(buf_.data(), o, succ_.data());
+      for (size_t i = 0; i < ops.size(); ++i) {
+        task_.apply(buf_.data(), ops[i], succ_.data());
         ++stats_.generated;
         registerState(succ_.data(), &is_new);
-        if (reg_.size() >= max_states) break;
+        if (reg_.size() >= max_states) {
+          cut = i + 1 < ops.size();
+          break;
+        }
       }
     }
-    *complete = next == reg_.size();
+    nbh_next_ = cut ? next - 1 : next;
+    nbh_built_ = true;
+    *complete = !cut && next == reg_.size();
     // Uniform-cost search from the initial state (id 0) on the registered states.
     constexpr Cost kInf = std::numeric_limits<Cost>::max();
     std::fill(g_.begin(), g_.end(), kInf);
@@ -1102,6 +1120,12 @@ class Searcher {
   TurnTaker* turns_{nullptr};  // another search taking turns with this hill-climbing, if any
   bool in_agenda_entry_before_last_{false};  // ehc: hill-climbing to a goal-agenda entry, not the last
   bool dead_end_proven_{false};  // ehc: the state the hill-climbing stands on is a proven dead end
+  // Plan neighbourhood search: the plan the registry's neighbourhood was built around, whether it
+  // is whole (not left by a time or memory limit), and the next state its breadth-first search
+  // expands.
+  std::vector<OpId> nbh_plan_;
+  bool nbh_built_{false};
+  uint32_t nbh_next_{0};
   bool h2_commits_{opt_.ehc_h2_commits};  // ehc: test states before committing to them (h^2)
   StateBits h2_state_;
   uint64_t h2_work_{0};  // ehc: words of work of this run's h^2 tests
@@ -1473,12 +1497,16 @@ SearchResult search(const Task& task, const StateBits& init, const Goal& goal, c
     const double left = until.deadline().secondsLeft();
     const Termination share =
         std::isfinite(left) ? until.tightened(Deadline::in(options.neighbourhood_time_share * left)) : until;
+    // One searcher while nothing cheaper is found, so that the neighbourhood grows in place
+    // (`neighbourhood_grow`); a new one around each cheaper plan.
+    std::unique_ptr<Searcher> s;
     for (size_t states = options.neighbourhood_first_states; !share() && best.cost > 0;) {
-      Searcher s(task, init, goal, options, heuristic, share);
+      if (!s) s = std::make_unique<Searcher>(task, init, goal, options, heuristic, share);
       bool complete = false;
-      SearchResult r = s.neighbourhood(best.plan, states, &complete);
+      SearchResult r = s->neighbourhood(best.plan, states, options.neighbourhood_grow, &complete);
       ++best.stats.neighbourhood_runs;
       best.stats.neighbourhood_states = std::max<uint64_t>(best.stats.neighbourhood_states, r.stats.registered_states);
+      best.stats.neighbourhood_seconds += r.stats.seconds;
       addRunCosts(best.stats, r.stats);
       if (r.status != SearchStatus::kSolved) break;  // out of time or memory
       const bool cheaper = r.cost < best.cost;
@@ -1486,6 +1514,7 @@ SearchResult search(const Task& task, const StateBits& init, const Goal& goal, c
         ++best.stats.neighbourhood_improvements;
         best.plan = std::move(r.plan);
         best.cost = r.cost;
+        s.reset();
       }
       if (complete) {  // the whole reachable space: the plan is optimal
         best.stats.anytime_proved_optimal = true;

@@ -804,6 +804,37 @@ TEST(Search, PlanNeighbourhoodSearchNeverReturnsADearerPlanOnIpcCostTasks) {
   }
 }
 
+TEST(Search, AGrownPlanNeighbourhoodHoldsTheStatesOfARebuiltOneForLessWork) {
+  // parcprinter-12: the neighbourhood doubles and improves the plan until it holds every
+  // reachable state and proves its plan optimal, so the run is bounded by states, not by time.
+  // Grown in place or rebuilt at each doubling, the neighbourhoods hold the same states in the
+  // same order: the same searches, improvements, largest neighbourhood and plan; growing expands
+  // fewer states (the rebuilt one expands again what the smaller one expanded).
+  const auto d = test::benchmarksDir() / "pddl-more/parcprinter/instance-12";
+  PlanRequest req;
+  req.domain_text = test::readFile(d / "domain.pddl");
+  req.problem_text = test::readFile(d / "instance-12.pddl");
+  req.check_plan = true;
+  req.search.anytime_seconds = 600;  // a budget: the complete neighbourhood ends the phase
+  req.search.neighbourhood_time_share = 1;
+  req.search.neighbourhood_first_states = 64;  // more doublings than the default's
+  req.search.neighbourhood_grow = false;
+  PlanReply rebuilt = plan(req, Termination());
+  ASSERT_EQ(rebuilt.status, PlanStatus::kSolved) << rebuilt.message;
+  req.search.neighbourhood_grow = true;
+  PlanReply grown = plan(req, Termination());
+  ASSERT_EQ(grown.status, PlanStatus::kSolved) << grown.message;
+  EXPECT_EQ(grown.stats.anytime_iterations, 0U);  // proved optimal by the neighbourhood
+  EXPECT_GE(grown.stats.neighbourhood_runs - grown.stats.neighbourhood_improvements, 3U);  // doublings
+  EXPECT_EQ(grown.stats.neighbourhood_runs, rebuilt.stats.neighbourhood_runs);
+  EXPECT_EQ(grown.stats.neighbourhood_improvements, rebuilt.stats.neighbourhood_improvements);
+  EXPECT_EQ(grown.stats.neighbourhood_states, rebuilt.stats.neighbourhood_states);
+  EXPECT_EQ(grown.cost, rebuilt.cost);
+  ASSERT_EQ(grown.plan.size(), rebuilt.plan.size());
+  for (size_t i = 0; i < grown.plan.size(); ++i) EXPECT_EQ(grown.plan[i].toString(), rebuilt.plan[i].toString());
+  EXPECT_LT(grown.stats.expanded, rebuilt.stats.expanded);
+}
+
 TEST(Search, UnitCostFirstRunFallsBackToCostPlusOneWhenOutOfTimeShareOrMemory) {
   // pegsol-18 takes thousands of expansions with either cost type: a unit-cost run given 1e-9
   // of the time left runs out of it at its first time check, and the first plan comes from the

@@ -102,6 +102,7 @@ struct PlanStatistics {
   uint64_t neighbourhood_runs{0};          ///< plan neighbourhood searches of the anytime phase
   uint64_t neighbourhood_improvements{0};  ///< ... that found a cheaper plan
   uint64_t neighbourhood_states{0};        ///< states of the largest of them
+  double neighbourhood_seconds{0.0};       ///< ... and their time
   bool unit_first_failed{false};  ///< the unit-cost first run failed; see SearchOptions::unit_cost_first
   uint64_t landmarks{0};  ///< landmarks of the lazy search's landmark count (0: not used)
   uint64_t landmarks_disjunctive{0};  ///< ... of which disjunctive

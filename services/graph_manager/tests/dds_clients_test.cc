@@ -63,27 +63,32 @@ MotionQuery aQuestion() {
   return q;
 }
 
-TEST(DdsClientsTest, AQuestionWhoseWorldHasNotArrivedIsAskedAgain) {
+/// One motion question to a planner whose world arrives after `lagging` answers; how many
+/// questions it was asked goes to `calls`.
+MotionAnswer askALaggingPlanner(int lagging, int& calls) {
   auto gm = makeParticipant();
   auto planner = makeParticipant();
-  ASSERT_TRUE(gm && planner);
-  LaggingPlanner server(planner, 2);
+  if (!gm || !planner) throw std::runtime_error("no DDS participant");
+  LaggingPlanner server(planner, lagging);
   DdsServiceClients clients(gm, corridorRobot());
   const MotionAnswer a = clients.motion(aQuestion());
+  calls = server.calls.load();
+  return a;
+}
+
+TEST(DdsClientsTest, AQuestionWhoseWorldHasNotArrivedIsAskedAgain) {
+  int calls = 0;
+  const MotionAnswer a = askALaggingPlanner(2, calls);
   EXPECT_EQ(a.status, MotionOutcome::kNoPath) << a.reason;
-  EXPECT_EQ(server.calls.load(), 3);
+  EXPECT_EQ(calls, 3);
 }
 
 TEST(DdsClientsTest, AWorldThatNeverArrivesIsUnavailableAfterABoundedNumberOfQuestions) {
-  auto gm = makeParticipant();
-  auto planner = makeParticipant();
-  ASSERT_TRUE(gm && planner);
-  LaggingPlanner server(planner, 1000);
-  DdsServiceClients clients(gm, corridorRobot());
-  const MotionAnswer a = clients.motion(aQuestion());
+  int calls = 0;
+  const MotionAnswer a = askALaggingPlanner(1000, calls);
   EXPECT_EQ(a.status, MotionOutcome::kUnavailable);
   EXPECT_NE(a.reason.find("world_version: 7 not received"), std::string::npos) << a.reason;
-  EXPECT_EQ(server.calls.load(), 3);
+  EXPECT_EQ(calls, 3);
 }
 
 }  // namespace

@@ -114,6 +114,7 @@ const config::Schema<PerceptionParams>& schema() {
         .field("snap_distance", &T::snap_distance, positive())
         .field("explained_margin", &T::explained_margin, positive())
         .field("explained_fraction", &T::explained_fraction, inRange(0, 1, Ends::kOpenClosed))
+        .field("settle_frames", &T::settle_frames, atLeast(0))
         .field("update_distance", &T::update_distance, nonNegative())
         .field("update_angle", &T::update_angle, nonNegative())
         .field("move_event_distance", &T::move_event_distance, positive())

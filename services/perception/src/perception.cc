@@ -122,6 +122,7 @@ struct Track {
   int64_t first_seen_ns{0};
   int hits{0};
   int misses{0};
+  int settling{0};  ///< frames before a pose set outright is held against partial views
   double mass{0.0};
   bool graspable{false};
   int cylinder_votes{0};
@@ -318,6 +319,7 @@ struct Perception::Impl {
     t.pose = uprightPose(c.x(), c.y(), support + t.shape.halfHeight(), yawOf(t.pose));
     t.event_pose = t.pose;
     t.misses = 0;
+    t.settling = params.tracking.settle_frames;
     (void)world.updateObject(objectOf(t));
     char why[200];
     std::snprintf(why, sizeof(why), "%s %.2f m above its support: fell to %s", what, bottom - support,
@@ -368,6 +370,7 @@ struct Perception::Impl {
     const Eigen::Isometry3d was = held.pose;
     held.pose = seen.pose;
     held.event_pose = seen.pose;
+    held.settling = params.tracking.settle_frames;
     held.hits += seen.hits;
     held.misses = 0;
     held.last_seen_ns = stamp;
@@ -790,7 +793,8 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
     // moved: the pose stays. So too for a shape grown from what was seen, once this view no
     // longer grows it: seen close, part of a crate out of the image, the fit anchored on the
     // seen end slid the whole estimate 0.2 m a frame off the crate (namo_room_hidden).
-    if (jump > T.explained_margin && (t.size_known || t.shape == shape_before) && (t.from_prior || t.hits > 2) &&
+    if (jump > T.explained_margin && t.settling == 0 && (t.size_known || t.shape == shape_before) &&
+        (t.from_prior || t.hits > 2) &&
         explainedFraction(t, dets[i].points, T.explained_margin, sensor,
                           [&](double range) { return P.planes.noise_sigmas * P.sensor.stddev(range); }) >=
             T.explained_fraction) {
@@ -798,8 +802,10 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
       jump = 0.0;
     }
     if (jump > T.snap_distance || t.hits <= 1) {
+      if (jump > T.snap_distance) t.settling = T.settle_frames;
       t.pose = meas;
     } else {
+      t.settling = std::max(0, t.settling - 1);
       const double a = T.smoothing;
       const Eigen::Vector3d pos = t.pose.translation() + a * (meas.translation() - t.pose.translation());
       double yaw_t = yawOf(t.pose), yaw_m = yawOf(meas);

@@ -871,6 +871,9 @@ struct Simulator::Impl {
       }
       stopRiding(c.object_id);
       world::Object o = world.object(c.object_id);
+      if (c.object_pose)
+        logger()->info("pick '{}': '{}' {:.4f} m from where the command says", c.command_id, o.id,
+                       (o.pose.translation() - c.object_pose->translation()).norm());
       o.region.clear();
       o.pose = squeezed(o, robot.toolPoseInWorld(toState(q)));
       (void)world.updateObject(o);

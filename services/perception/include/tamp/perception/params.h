@@ -105,6 +105,10 @@ struct TrackingParams {
   /// it stands (a partial view is no motion).
   double explained_margin{0.02};   ///< m, > 0
   double explained_fraction{0.9};  ///< in (0, 1]
+  /// A pose set outright from one frame (a snap, a fall, the gripper's) is not yet held this way:
+  /// it follows the next `settle_frames` measurements first (a frame taken while the robot moves
+  /// can be centimetres off), >= 0.
+  int settle_frames{3};
   double update_distance{0.01};    ///< m, world pose updated when the track moved this much
   double update_angle{0.05};       ///< rad
   double move_event_distance{0.10};  ///< m, a MOVED event when the object moved this much

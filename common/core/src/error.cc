@@ -13,6 +13,7 @@ std::string_view toString(ErrorCode code) {
     case ErrorCode::kCancelled: return "cancelled";
     case ErrorCode::kUnavailable: return "unavailable";
     case ErrorCode::kInfeasible: return "infeasible";
+    case ErrorCode::kNotReady: return "not ready";
     case ErrorCode::kInternal: return "internal error";
   }
   return "unknown error";

@@ -23,6 +23,7 @@ msg::StatusCode toMsg(ErrorCode code) {
     case ErrorCode::kUnavailable: return msg::STATUS_UNAVAILABLE;
     case ErrorCode::kInfeasible: return msg::STATUS_INFEASIBLE;
     case ErrorCode::kInternal: return msg::STATUS_INTERNAL;
+    case ErrorCode::kNotReady: return msg::STATUS_NOT_READY;
   }
   return msg::STATUS_INTERNAL;
 }
@@ -40,6 +41,7 @@ ErrorCode fromMsg(msg::StatusCode code) {
     case msg::STATUS_UNAVAILABLE: return ErrorCode::kUnavailable;
     case msg::STATUS_INFEASIBLE: return ErrorCode::kInfeasible;
     case msg::STATUS_INTERNAL: return ErrorCode::kInternal;
+    case msg::STATUS_NOT_READY: return ErrorCode::kNotReady;
   }
   return ErrorCode::kInternal;
 }

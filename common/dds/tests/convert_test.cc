@@ -11,7 +11,7 @@ using ::testing::HasSubstr;
 TEST(ConvertTest, StatusCodesRoundTrip) {
   for (ErrorCode c : {ErrorCode::kInvalidArgument, ErrorCode::kParseError, ErrorCode::kUnsupported,
                       ErrorCode::kNotFound, ErrorCode::kIo, ErrorCode::kTimeout, ErrorCode::kCancelled,
-                      ErrorCode::kUnavailable, ErrorCode::kInfeasible, ErrorCode::kInternal}) {
+                      ErrorCode::kUnavailable, ErrorCode::kInfeasible, ErrorCode::kInternal, ErrorCode::kNotReady}) {
     EXPECT_EQ(fromMsg(toMsg(c)), c);
   }
 }

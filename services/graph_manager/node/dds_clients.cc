@@ -40,8 +40,7 @@ constexpr int kWorldLagAttempts = 3;
 /// Whether a reply says that the planner has not received the world version asked for yet.
 template <typename Rep>
 bool waitingForWorld(const Result<Rep>& rep) {
-  return !rep && rep.error().code == ErrorCode::kUnavailable &&
-         rep.error().message.find("world_version") != std::string::npos;
+  return !rep && rep.error().code == ErrorCode::kNotReady;
 }
 
 dds::RpcClientOptions rpcOptions() {

@@ -29,17 +29,20 @@ robot::RobotModel corridorRobot() {
 
 /// A motion server whose world arrives after `lagging_answers` questions: until then it answers
 /// as the motion planner does for a version it has not received; then `no path`.
+/// `code` is what it answers meanwhile (the motion planner's: STATUS_NOT_READY).
 struct LaggingPlanner {
   int lagging_answers{0};
+  msg::StatusCode code{msg::STATUS_NOT_READY};
   std::atomic<int> calls{0};
   std::unique_ptr<dds::RpcServer<msg::MotionRequest, msg::MotionReply>> server;
 
-  explicit LaggingPlanner(std::shared_ptr<dds::Participant> p, int lagging) : lagging_answers(lagging) {
+  LaggingPlanner(std::shared_ptr<dds::Participant> p, int lagging, msg::StatusCode answer)
+      : lagging_answers(lagging), code(answer) {
     server = std::make_unique<dds::RpcServer<msg::MotionRequest, msg::MotionReply>>(
         p, dds::services::kMotion, [this](const msg::MotionRequest& req, const dds::RequestContext&) {
           msg::MotionReply rep;
           if (calls++ < lagging_answers) {
-            rep.header().code(msg::STATUS_UNAVAILABLE);
+            rep.header().code(code);
             rep.header().message("world_version: " + std::to_string(req.world_version()) + " not received (latest 0)");
             return rep;
           }
@@ -65,11 +68,11 @@ MotionQuery aQuestion() {
 
 /// One motion question to a planner whose world arrives after `lagging` answers; how many
 /// questions it was asked goes to `calls`.
-MotionAnswer askALaggingPlanner(int lagging, int& calls) {
+MotionAnswer askALaggingPlanner(int lagging, int& calls, msg::StatusCode answer = msg::STATUS_NOT_READY) {
   auto gm = makeParticipant();
   auto planner = makeParticipant();
   if (!gm || !planner) throw std::runtime_error("no DDS participant");
-  LaggingPlanner server(planner, lagging);
+  LaggingPlanner server(planner, lagging, answer);
   DdsServiceClients clients(gm, corridorRobot());
   const MotionAnswer a = clients.motion(aQuestion());
   calls = server.calls.load();
@@ -89,6 +92,15 @@ TEST(DdsClientsTest, AWorldThatNeverArrivesIsUnavailableAfterABoundedNumberOfQue
   EXPECT_EQ(a.status, MotionOutcome::kUnavailable);
   EXPECT_NE(a.reason.find("world_version: 7 not received"), std::string::npos) << a.reason;
   EXPECT_EQ(calls, 3);
+}
+
+// Only the status says that the world has not arrived: an unavailable planner is not asked
+// again by the client, whatever its message reads (the RPC layer's own retries aside).
+TEST(DdsClientsTest, AnUnavailablePlannerIsNotAskedAgainWhateverItsMessageSays) {
+  int calls = 0;
+  const MotionAnswer a = askALaggingPlanner(1000, calls, msg::STATUS_UNAVAILABLE);
+  EXPECT_EQ(a.status, MotionOutcome::kUnavailable);
+  EXPECT_EQ(calls, 1);
 }
 
 }  // namespace

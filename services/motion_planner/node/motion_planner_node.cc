@@ -317,7 +317,7 @@ Result<Termination> MotionPlannerNode::termination(uint64_t world_version, const
   if (world_version > 0 && mirror_->publishedVersion() < world_version) {
     const Termination wait = term.tightened(Deadline::in(config_.world_wait_s));
     if (!mirror_->waitForPublishedVersion(world_version, wait)) {
-      return Error(ErrorCode::kUnavailable, "world_version: " + std::to_string(world_version) +
+      return Error(ErrorCode::kNotReady, "world_version: " + std::to_string(world_version) +
                                                 " not received (latest " + std::to_string(mirror_->publishedVersion()) +
                                                 ")");
     }

@@ -195,7 +195,7 @@ TEST_F(NodeTest, PlacementAndGraspRequests) {
   pr.region_id("floor");
   auto early = placement.call(pr, dds::CallOptions{30.0, {}});
   ASSERT_FALSE(early.ok());
-  EXPECT_EQ(early.error().code, ErrorCode::kUnavailable) << early.error().toString();
+  EXPECT_EQ(early.error().code, ErrorCode::kNotReady) << early.error().toString();
   EXPECT_NE(early.error().message.find("world_version"), std::string::npos) << early.error().toString();
   dds::RpcClient<msg::GraspRequest, msg::GraspReply> grasp_early(client_, dds::services::kGrasp);
   msg::GraspRequest ge;
@@ -203,7 +203,7 @@ TEST_F(NodeTest, PlacementAndGraspRequests) {
   ge.world_version(publisher_->publishedVersion() + 1000);
   auto g_early = grasp_early.call(ge, dds::CallOptions{30.0, {}});
   ASSERT_FALSE(g_early.ok());
-  EXPECT_EQ(g_early.error().code, ErrorCode::kUnavailable) << g_early.error().toString();
+  EXPECT_EQ(g_early.error().code, ErrorCode::kNotReady) << g_early.error().toString();
   // In the version published (the request waits for the world to be there).
   pr = msg::PlacementRequest();
   pr.world_version(publisher_->publishedVersion());

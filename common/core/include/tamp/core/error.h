@@ -30,6 +30,8 @@ enum class ErrorCode {
   kUnavailable,      ///< a peer (service) is absent or not answering
   kInfeasible,       ///< the request is well-formed but has no solution
   kInternal,         ///< a bug or an unexpected library failure
+  kNotReady,         ///< the peer has not yet received the state the request names (a world
+                     ///< version): well-formed, worth asking again shortly
 };
 
 std::string_view toString(ErrorCode code);

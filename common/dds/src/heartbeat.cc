@@ -90,18 +90,50 @@ double HeartbeatPublisher::stalledFor() const {
   return static_cast<double>(nowNs() - last_kick_ns_.load(std::memory_order_relaxed)) * 1e-9;
 }
 
+void WorkWatch::busy() {
+  last_kick_ns_.store(nowNs(), std::memory_order_relaxed);
+  busy_.store(true);
+}
+
+void WorkWatch::kick() { last_kick_ns_.store(nowNs(), std::memory_order_relaxed); }
+
+void WorkWatch::idle() { busy_.store(false); }
+
+double WorkWatch::stalledFor() const {
+  if (!busy_.load()) return 0.0;
+  return static_cast<double>(nowNs() - last_kick_ns_.load(std::memory_order_relaxed)) * 1e-9;
+}
+
+std::shared_ptr<WorkWatch> HeartbeatPublisher::watchWorker(const std::string& name) {
+  require(!name.empty(), "a watched worker needs a name");
+  auto w = std::make_shared<WorkWatch>(name);
+  std::lock_guard lock(mutex_);
+  workers_.push_back(w);
+  return w;
+}
+
+std::pair<std::string, double> HeartbeatPublisher::stalled(int64_t limit_ns) const {
+  const double limit_s = static_cast<double>(limit_ns) * 1e-9;
+  if (const double s = stalledFor(); s > limit_s) return {"its main loop has not run", s};
+  std::lock_guard lock(mutex_);
+  for (const auto& w : workers_)
+    if (const double s = w->stalledFor(); s > limit_s) return {"its worker '" + w->name() + "' has not moved on", s};
+  return {};
+}
+
 void HeartbeatPublisher::beat() {
   const int64_t limit = stall_limit_ns_.load();
-  const double stalled = stalledFor();
-  if (limit > 0 && stalled * 1e9 > static_cast<double>(limit)) {
-    if (!withheld_)
-      log::get("dds")->error("{}: its main loop has not run for {:.1f} s (stall limit {:.1f} s): heartbeats withheld, "
-                             "so that it counts as dead",
-                             service_id_, stalled, static_cast<double>(limit) * 1e-9);
-    withheld_ = true;
-    return;
+  if (limit > 0) {
+    if (const auto [what, for_s] = stalled(limit); !what.empty()) {
+      if (!withheld_)
+        log::get("dds")->error("{}: {} for {:.1f} s (stall limit {:.1f} s): heartbeats withheld, so that it counts as "
+                               "dead",
+                               service_id_, what, for_s, static_cast<double>(limit) * 1e-9);
+      withheld_ = true;
+      return;
+    }
   }
-  if (withheld_) log::get("dds")->warn("{}: its main loop runs again: heartbeats resumed", service_id_);
+  if (withheld_) log::get("dds")->warn("{}: its work goes on again: heartbeats resumed", service_id_);
   withheld_ = false;
   publish();
 }

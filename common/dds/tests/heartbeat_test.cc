@@ -83,5 +83,50 @@ TEST(HeartbeatTest, ALoopThatStopsKickingStopsTheBeatsUntilItKicksAgain) {
   EXPECT_THROW(hb.setStallLimit(std::numeric_limits<double>::infinity()), std::exception);
 }
 
+// A worker (a mission, a frame) is watched while it works: idle, it needs no kick; busy and not
+// kicked, the beats stop though the main loop turns; kicked or idle again, they resume.
+TEST(HeartbeatTest, ABusyWorkerThatStopsKickingStopsTheBeatsAnIdleOneDoesNot) {
+  auto p = testing::makeParticipant();
+  ASSERT_TRUE(p);
+  HeartbeatMonitor monitor(p);
+  HeartbeatPublisher hb(p, "worker_test", 0.05);
+  hb.setState(msg::SERVICE_READY);
+  std::shared_ptr<WorkWatch> worker = hb.watchWorker("mission");
+  std::atomic<bool> done{false};
+  std::jthread main_loop([&] {
+    while (!done) {
+      hb.kick();
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+  });
+  hb.setStallLimit(0.2);
+  ASSERT_TRUE(becomes(monitor, "worker_test", true));
+  // Idle for three times the limit (the time passing is what is tested): still beating.
+  std::this_thread::sleep_for(std::chrono::milliseconds(600));
+  EXPECT_EQ(worker->stalledFor(), 0.0);
+  EXPECT_TRUE(becomes(monitor, "worker_test", true));
+  // Busy, never kicked: dead, though the main loop turns.
+  {
+    WorkWatch::Scope busy(worker.get());
+    EXPECT_TRUE(becomes(monitor, "worker_test", false));
+    EXPECT_GT(worker->stalledFor(), 0.2);
+    // It moves on again: alive.
+    std::atomic<bool> working{true};
+    std::jthread work([&] {
+      while (working) {
+        worker->kick();
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      }
+    });
+    EXPECT_TRUE(becomes(monitor, "worker_test", true));
+    working = false;
+  }
+  // Idle again (the scope ended): no kick needed.
+  EXPECT_EQ(worker->stalledFor(), 0.0);
+  EXPECT_TRUE(becomes(monitor, "worker_test", true));
+  done = true;
+  EXPECT_THROW((void)hb.watchWorker(""), std::exception);
+}
+
 }  // namespace
 }  // namespace tamp::dds

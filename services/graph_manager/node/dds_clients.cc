@@ -43,6 +43,16 @@ bool waitingForWorld(const Result<Rep>& rep) {
   return !rep && rep.error().code == ErrorCode::kNotReady;
 }
 
+}  // namespace
+
+template <typename Rep>
+Result<Rep> DdsServiceClients::answered(Result<Rep> rep, const char* service) const {
+  alive();
+  return checked(std::move(rep), service);
+}
+
+namespace {
+
 dds::RpcClientOptions rpcOptions() {
   dds::RpcClientOptions o;
   o.attempt_timeout_s = 2.0;
@@ -99,7 +109,7 @@ TaskPlan DdsServiceClients::plan(const TaskQuery& q) {
   req.search(msg::SearchKind::SEARCH_DEFAULT);
   req.use_costs(true);
   TaskPlan out;
-  auto rep = checked(plan_.call(req, dds::CallOptions{q.budget_s, {}}), dds::services::kPlan.name);
+  auto rep = answered(plan_.call(req, dds::CallOptions{q.budget_s, {}}), dds::services::kPlan.name);
   out.time_s = std::chrono::duration<double>(Clock::now() - t0).count();
   if (!rep) {
     out.status = rep.error().code == ErrorCode::kTimeout ? TaskStatus::kTimeout : TaskStatus::kUnavailable;
@@ -149,13 +159,13 @@ MotionAnswer DdsServiceClients::motion(const MotionQuery& q) {
   req.straight_only(q.straight_only);
   MotionAnswer a;
   const auto t0 = Clock::now();
-  auto rep = checked(motion_.call(req, dds::CallOptions{q.budget_s, {}}), dds::services::kMotion.name);
+  auto rep = answered(motion_.call(req, dds::CallOptions{q.budget_s, {}}), dds::services::kMotion.name);
   // A planner that has not received the world version the question names answers `unavailable`
   // after waiting for it (its world_wait_s). The world is on its way (a lossy link repairs it, a
   // restarted planner gets it again): asked again a few times before the question counts as failed.
   for (int attempt = 1; attempt < kWorldLagAttempts && waitingForWorld(rep); ++attempt) {
     log::get("graph_manager")->warn("motion: {} (attempt {} of {}): asking again", rep.error().message, attempt, kWorldLagAttempts);
-    rep = checked(motion_.call(req, dds::CallOptions{q.budget_s, {}}), dds::services::kMotion.name);
+    rep = answered(motion_.call(req, dds::CallOptions{q.budget_s, {}}), dds::services::kMotion.name);
   }
   a.time_s = std::chrono::duration<double>(Clock::now() - t0).count();
   if (!rep) {
@@ -226,7 +236,7 @@ Result<std::vector<PlacementOption>> DdsServiceClients::placements(const Placeme
   for (const auto& o : q.overrides) req.object_overrides().push_back(toMsg(o));
   for (const auto& o : q.added) req.added_objects().push_back(dds::toMsg(o, 0));
   req.world_version(q.world_version);
-  auto rep = checked(placement_.call(req, dds::CallOptions{q.budget_s, {}}), dds::services::kPlacement.name);
+  auto rep = answered(placement_.call(req, dds::CallOptions{q.budget_s, {}}), dds::services::kPlacement.name);
   if (!rep) return rep.error();
   if (rep->header().code() != msg::StatusCode::STATUS_OK)
     return Error(dds::fromMsg(rep->header().code()), rep->header().message());
@@ -254,7 +264,7 @@ Result<std::vector<GraspOption>> DdsServiceClients::grasps(const GraspQuery& q) 
   for (const auto& o : q.overrides) req.object_overrides().push_back(toMsg(o));
   for (const auto& o : q.added) req.added_objects().push_back(dds::toMsg(o, 0));
   req.world_version(q.world_version);
-  auto rep = checked(grasp_.call(req, dds::CallOptions{q.budget_s, {}}), dds::services::kGrasp.name);
+  auto rep = answered(grasp_.call(req, dds::CallOptions{q.budget_s, {}}), dds::services::kGrasp.name);
   if (!rep) return rep.error();
   if (rep->header().code() != msg::StatusCode::STATUS_OK)
     return Error(dds::fromMsg(rep->header().code()), rep->header().message());
@@ -277,7 +287,7 @@ std::vector<EffortAnswer> DdsServiceClients::effort(const std::vector<EffortQuer
   msg::EffortRequest req;
   for (const auto& q : qs) req.queries().push_back(toEffortMsg(q));
   std::vector<EffortAnswer> out(qs.size());
-  auto rep = checked(effort_.call(req, dds::CallOptions{5.0, {}}), dds::services::kEffort.name);
+  auto rep = answered(effort_.call(req, dds::CallOptions{5.0, {}}), dds::services::kEffort.name);
   if (!rep) {
     for (auto& a : out) a.message = rep.error().message;
     return out;
@@ -288,7 +298,7 @@ std::vector<EffortAnswer> DdsServiceClients::effort(const std::vector<EffortQuer
 
 std::optional<std::uint64_t> DdsServiceClients::effortModelVersion() {
   // An empty batch: the reply carries the version of the snapshot it would have used.
-  auto rep = checked(effort_.call(msg::EffortRequest{}, dds::CallOptions{2.0, {}}), dds::services::kEffort.name);
+  auto rep = answered(effort_.call(msg::EffortRequest{}, dds::CallOptions{2.0, {}}), dds::services::kEffort.name);
   if (!rep) return std::nullopt;
   return rep->model_version();
 }
@@ -369,7 +379,9 @@ ExecutionReport DdsExecutor::finalOf(std::unique_lock<std::mutex>& lock, const s
   const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(budget_s));
   const auto done = [&] { return final_.count(wire) > 0; };
   while (!done()) {
-    const auto slice = resend ? std::min(deadline, Clock::now() + std::chrono::milliseconds(250)) : deadline;
+    // In slices, so that the worker tells the heartbeat it is waiting, not stuck.
+    const auto slice = std::min(deadline, Clock::now() + (resend ? std::chrono::milliseconds(250) : std::chrono::milliseconds(1000)));
+    alive();
     if (cv_.wait_until(lock, slice, done)) break;
     if (Clock::now() >= deadline) {
       r.outcome = ExecOutcome::kTimeout;
@@ -414,6 +426,7 @@ DdsWorldSource::DdsWorldSource(std::shared_ptr<dds::Participant> p, robot::Robot
       }) {}
 
 Observation DdsWorldSource::robot() {
+  alive();
   Observation o;
   std::optional<msg::RobotState> s;
   {
@@ -442,6 +455,7 @@ Status DdsWorldSource::waitReady(const Termination& until) {
     }
     world = mirror_.publishedVersion() > 0;
     if (state && world) return Status::Ok();
+    alive();
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   std::string missing;

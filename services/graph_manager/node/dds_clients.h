@@ -11,6 +11,7 @@
 #include <mutex>
 #include <optional>
 
+#include "tamp/dds/heartbeat.h"
 #include "tamp/dds/participant.h"
 #include "tamp/dds/rpc.h"
 #include "tamp/dds/topics.h"
@@ -19,7 +20,22 @@
 
 namespace tamp::graph_manager {
 
-class DdsServiceClients : public ServiceClients {
+/// An adapter whose calls and waits tell the heartbeat that the mission's worker moves on
+/// (dds::WorkWatch): a worker stuck elsewhere stops the beats, and the supervisor restarts it.
+class Watched {
+ public:
+  void watchedBy(dds::WorkWatch* watch) { watch_ = watch; }
+
+ protected:
+  void alive() const {
+    if (watch_) watch_->kick();
+  }
+
+ private:
+  dds::WorkWatch* watch_{nullptr};
+};
+
+class DdsServiceClients : public ServiceClients, public Watched {
  public:
   DdsServiceClients(std::shared_ptr<dds::Participant> p, robot::RobotModel robot);
   /// The mission's robot (joint names of motion requests). Not concurrent with the calls below.
@@ -35,6 +51,9 @@ class DdsServiceClients : public ServiceClients {
   std::optional<std::uint64_t> effortModelVersion() override;
 
  private:
+  /// `rep` screened (checked), the worker kicked: a call came back.
+  template <typename Rep>
+  Result<Rep> answered(Result<Rep> rep, const char* service) const;
   robot::RobotModel robot_;
   dds::RpcClient<msg::PlanRequest, msg::PlanReply> plan_;
   dds::RpcClient<msg::MotionRequest, msg::MotionReply> motion_;
@@ -45,7 +64,7 @@ class DdsServiceClients : public ServiceClients {
 
 /// Commands go out as "<mission id>/<command id>": the monitor and the robot are idempotent on
 /// command ids, and a deployment runs many missions whose steps are numbered alike.
-class DdsExecutor : public Executor {
+class DdsExecutor : public Executor, public Watched {
  public:
   DdsExecutor(std::shared_ptr<dds::Participant> p, std::string mission_id);
   ExecutionReport execute(const EdgeCommand& command, double budget_s) override;
@@ -72,7 +91,7 @@ class DdsExecutor : public Executor {
   dds::Reader<msg::ExecuteStatus> reader_;
 };
 
-class DdsWorldSource : public WorldSource {
+class DdsWorldSource : public WorldSource, public Watched {
  public:
   DdsWorldSource(std::shared_ptr<dds::Participant> p, robot::RobotModel robot);
   /// The mission's robot (joint values of robot states). Not concurrent with `robot()`.

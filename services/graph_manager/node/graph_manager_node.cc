@@ -74,6 +74,10 @@ GraphManagerNode::GraphManagerNode(const dds::ServiceArgs& args, GraphManagerPar
       executor_(participant(), ""),
       source_(participant(), robot) {
   openJournal();
+  mission_watch_ = heartbeat().watchWorker("mission");
+  clients_.watchedBy(mission_watch_.get());
+  executor_.watchedBy(mission_watch_.get());
+  source_.watchedBy(mission_watch_.get());
   thread_ = std::jthread([this](std::stop_token st) { worker(st); });
   commands_ = std::make_unique<dds::Reader<msg::MissionCommand>>(
       participant(), dds::topics::kMissionCommand,
@@ -194,6 +198,7 @@ void GraphManagerNode::runGuarded(const msg::MissionCommand& c, const MissionRec
     running_ = c.mission_id();
     abort_ = false;
   }
+  const dds::WorkWatch::Scope busy(mission_watch_.get());
   try {
     runOne(c, resumed);
   } catch (const std::exception& e) {

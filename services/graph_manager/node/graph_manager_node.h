@@ -65,6 +65,7 @@ class GraphManagerNode : public dds::ServiceNode {
   OracleServiceClients oracle_clients_;  // policy oracle: efforts and truth from the simulator
   DdsExecutor executor_;
   DdsWorldSource source_;
+  std::shared_ptr<dds::WorkWatch> mission_watch_;  // the worker, watched while a mission runs
   std::jthread thread_;
   std::unique_ptr<dds::Reader<msg::MissionCommand>> commands_;
 };

@@ -68,6 +68,7 @@ PerceptionNode::PerceptionNode(const dds::ServiceArgs& args, PerceptionNodeOptio
   if (Status s = world_pub_.publish(snapshot_); !s.ok()) {
     throw std::runtime_error("publishing the prior world: " + s.error().toString());
   }
+  frame_watch_ = heartbeat().watchWorker("frames");
   worker_ = std::jthread([this](std::stop_token st) { work(st); });
   if (options_.robot) {
     robot_states_ = std::make_unique<dds::Reader<msg::RobotState>>(
@@ -243,6 +244,7 @@ void PerceptionNode::work(std::stop_token stop) {
       frame = std::move(pending_);
       pending_.reset();
     }
+    const dds::WorkWatch::Scope busy(frame_watch_.get());
     try {
       process(*frame, stop);
     } catch (const std::exception& e) {

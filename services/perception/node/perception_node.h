@@ -116,6 +116,7 @@ class PerceptionNode : public dds::ServiceNode {
   std::optional<Clock::time_point> last_map_;
   std::optional<Perception::HeldGrasp> checkpointed_grasp_;  // worker thread only
   bool checkpoint_failed_{false};                            // logged once
+  std::shared_ptr<dds::WorkWatch> frame_watch_;  // the worker, watched while it processes a frame
   std::jthread worker_;
   std::unique_ptr<dds::Reader<msg::RobotState>> robot_states_;
   std::unique_ptr<dds::Reader<msg::PointCloudFrame>> clouds_;  // last: callbacks need the rest

@@ -871,9 +871,11 @@ struct Simulator::Impl {
       }
       stopRiding(c.object_id);
       world::Object o = world.object(c.object_id);
-      if (c.object_pose)
-        logger()->info("pick '{}': '{}' {:.4f} m from where the command says", c.command_id, o.id,
-                       (o.pose.translation() - c.object_pose->translation()).norm());
+      if (c.object_pose) {
+        const Eigen::Vector3d off = o.pose.translation() - c.object_pose->translation();
+        logger()->info("pick '{}': '{}' {:.4f} m from where the command says ({:+.4f}, {:+.4f}, {:+.4f})", c.command_id,
+                       o.id, off.norm(), off.x(), off.y(), off.z());
+      }
       o.region.clear();
       o.pose = squeezed(o, robot.toolPoseInWorld(toState(q)));
       (void)world.updateObject(o);

@@ -10,7 +10,9 @@
 /// publisher armed with a stall limit (`setStallLimit`) therefore beats only while the loop that
 /// does the service's work has called `kick()` within that limit (ServiceNode::run arms it for its
 /// main loop): a service whose main loop hangs stops beating and counts as dead, as a stopped
-/// process does, and its supervisor restarts it.
+/// process does, and its supervisor restarts it. Worker threads (a mission, a frame) are watched
+/// the same way while they work (`watchWorker`): busy and not kicked within the limit withholds
+/// the beats too; a worker waiting for work is not watched.
 
 #include <atomic>
 #include <condition_variable>
@@ -24,6 +26,43 @@
 #include "tamp/dds/topics.h"
 
 namespace tamp::dds {
+
+/// A worker thread's liveness: while it is busy (between `busy()` and `idle()`) it must `kick()`
+/// within the heartbeat's stall limit. Thread-safe, wait-free.
+class WorkWatch {
+ public:
+  explicit WorkWatch(std::string name) : name_(std::move(name)) {}
+  const std::string& name() const { return name_; }
+  /// Work starts (counts as a kick).
+  void busy();
+  /// The work goes on; ignored while idle.
+  void kick();
+  /// Waiting for work: not watched.
+  void idle();
+  /// Seconds since the last kick while busy; 0 while idle.
+  double stalledFor() const;
+
+  /// busy() for a scope, idle() at its end.
+  class Scope {
+   public:
+    explicit Scope(WorkWatch* w) : w_(w) {
+      if (w_) w_->busy();
+    }
+    ~Scope() {
+      if (w_) w_->idle();
+    }
+    Scope(const Scope&) = delete;
+    Scope& operator=(const Scope&) = delete;
+
+   private:
+    WorkWatch* w_;
+  };
+
+ private:
+  std::string name_;
+  std::atomic<bool> busy_{false};
+  std::atomic<int64_t> last_kick_ns_{0};
+};
 
 class HeartbeatPublisher {
  public:
@@ -42,21 +81,28 @@ class HeartbeatPublisher {
   void kick();
   /// Seconds since the last kick() while armed; 0 when disarmed.
   double stalledFor() const;
+  /// A worker thread watched under the same stall limit (while it is armed). The publisher keeps
+  /// it; the node owns the thread.
+  std::shared_ptr<WorkWatch> watchWorker(const std::string& name);
 
  private:
   void publish();
-  /// The periodic beat: published unless the watched loop stalled (logged once per stall).
+  /// The periodic beat: published unless the watched loop or a busy worker stalled (logged once
+  /// per stall).
   void beat();
+  /// What stalled beyond `limit_ns` ("its main loop", "its worker 'mission'") and for how long; empty when none.
+  std::pair<std::string, double> stalled(int64_t limit_ns) const;
   std::shared_ptr<Participant> participant_;
   Writer<msg::Heartbeat> writer_;
   std::string service_id_;
   double period_s_;
-  std::mutex mutex_;
+  mutable std::mutex mutex_;
   msg::Heartbeat beat_;
   std::function<std::pair<uint64_t, uint64_t>()> counters_;
   std::condition_variable_any cv_;
   std::atomic<int64_t> stall_limit_ns_{0};
   std::atomic<int64_t> last_kick_ns_{0};
+  std::vector<std::shared_ptr<WorkWatch>> workers_;  // guarded by mutex_
   bool withheld_{false};  // the beat thread's own: whether it is withholding beats now
   std::jthread thread_;
 };

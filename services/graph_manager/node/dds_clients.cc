@@ -391,7 +391,7 @@ ExecutionReport DdsExecutor::finalOf(std::unique_lock<std::mutex>& lock, const s
     // Commands are volatile: a monitor restarted while this one was out never received it. Sent
     // again, it is answered from the monitor's journal or the robot's own results, never executed
     // twice (the monitor and the robot are idempotent on command ids).
-    if (const int now = writer_.readersEverMatched(); now > matches) {
+    if (const int now = writer_.readersEverMatched(); resend != nullptr && now > matches) {
       matches = now;
       lock.unlock();
       const Status s = writer_.write(*resend);

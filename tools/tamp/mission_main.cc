@@ -71,9 +71,12 @@ int main(int argc, char** argv) {
   const tamp::Termination startup = tamp::Termination::after(deployment->startup_timeout_s);
   for (const auto& s : deployment->services) {
     if (s.optional) continue;
-    if (!monitor.waitFor(s.name, 1, startup)) {
-      std::fprintf(stderr, "tamp mission: no heartbeat of service '%s' in run %s within %.0f s (tamp status)\n",
-                   s.name.c_str(), rid->c_str(), deployment->startup_timeout_s);
+    if (!monitor.waitFor(s.name, 1, startup, /*ready=*/true)) {
+      std::string why = "no heartbeat";
+      for (const auto& info : monitor.services())
+        if (info.alive && info.name == s.name) why = "alive but not ready (" + info.detail + ")";
+      std::fprintf(stderr, "tamp mission: service '%s' in run %s: %s within %.0f s (tamp status)\n", s.name.c_str(),
+                   rid->c_str(), why.c_str(), deployment->startup_timeout_s);
       return tamp::cli::kExitServiceError;
     }
   }

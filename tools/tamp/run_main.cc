@@ -175,7 +175,7 @@ int main(int argc, char** argv) {
   const tamp::Termination startup = tamp::Termination::after(deployment->startup_timeout_s);
   std::vector<std::string> not_alive;
   for (const auto& name : started) {
-    while (!monitor.waitFor(name, 1, startup.tightened(tamp::Deadline::in(0.1)))) {
+    while (!monitor.waitFor(name, 1, startup.tightened(tamp::Deadline::in(0.1)), /*ready=*/true)) {
       launcher.poll();
       auto st = sup.status(name);
       if (startup() || tamp::cli::stopRequested() || (st && st->phase != tamp::process::ProcessPhase::kRunning &&
@@ -193,8 +193,11 @@ int main(int argc, char** argv) {
     const bool alive = std::find(not_alive.begin(), not_alive.end(), name) == not_alive.end();
     const bool optional = std::find(optional_names.begin(), optional_names.end(), name) != optional_names.end();
     if (!alive) {
-      std::printf("%-20s %8s %10s  NOT ALIVE (%s; see %s)%s\n", name.c_str(), "-", "-",
-                  st ? (st->last_exit.empty() ? "no heartbeat" : st->last_exit.c_str()) : "?",
+      std::string why = st ? (st->last_exit.empty() ? "no heartbeat" : st->last_exit) : "?";
+      const char* label = "NOT ALIVE";
+      for (const auto& info : monitor.services())
+        if (info.alive && info.name == name) why = info.detail, label = "NOT READY";
+      std::printf("%-20s %8s %10s  %s (%s; see %s)%s\n", name.c_str(), "-", "-", label, why.c_str(),
                   (run_dir / (name + ".log")).c_str(), optional ? " -- optional, going on" : "");
       if (!optional) rc = tamp::cli::kExitServiceError;
       continue;

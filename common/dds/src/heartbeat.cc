@@ -193,10 +193,11 @@ std::vector<ServiceInfo> HeartbeatMonitor::services() const {
   return out;
 }
 
-bool HeartbeatMonitor::waitFor(const std::string& name, int count, const Termination& until) const {
+bool HeartbeatMonitor::waitFor(const std::string& name, int count, const Termination& until, bool ready) const {
   while (true) {
     int n = 0;
-    for (const auto& s : services()) n += (s.alive && s.name == name) ? 1 : 0;
+    for (const auto& s : services())
+      n += (s.alive && s.name == name && (!ready || s.state != msg::SERVICE_STARTING)) ? 1 : 0;
     if (n >= count) return true;
     if (until()) return false;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));

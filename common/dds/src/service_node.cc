@@ -75,7 +75,9 @@ bool ServiceNode::orphaned() const {
 }
 
 int ServiceNode::run() {
-  heartbeat_->setState(msg::SERVICE_READY);
+  std::string waiting = notReadyBecause();
+  heartbeat_->setDetail(waiting);
+  heartbeat_->setState(waiting.empty() ? msg::SERVICE_READY : msg::SERVICE_STARTING);
   log::get(name_)->info("{} ready on DDS domain {} (profile {}{})", name_, participant_->domainId(),
                         participant_->profile(),
                         (runId().empty() ? std::string() : ", run " + runId()) +
@@ -87,6 +89,7 @@ int ServiceNode::run() {
   while (!stop_) {
     lock.unlock();
     heartbeat_->kick();
+    if (!waiting.empty()) waiting = awaitInputs(waiting);
     if (orphaned()) {
       log::get(name_)->warn("{}: no supervisor renewed {} for {:.1f} s: stopping", name_, supervisor_lease_,
                             orphan_timeout_s_);
@@ -112,6 +115,16 @@ int ServiceNode::run() {
   heartbeat_->setStallLimit(0.0);  // the clean stop may take longer than a turn
   heartbeat_->setState(msg::SERVICE_STOPPING);
   return 0;
+}
+
+std::string ServiceNode::awaitInputs(const std::string& was) {
+  std::string now = notReadyBecause();
+  heartbeat_->setDetail(now);
+  if (now.empty()) {
+    heartbeat_->setState(msg::SERVICE_READY);
+    log::get(name_)->info("{}: its inputs arrived (it waited for: {}): ready", name_, was);
+  }
+  return now;
 }
 
 void ServiceNode::stop() {

@@ -1,4 +1,5 @@
 #include "tamp/dds/heartbeat.h"
+#include "tamp/dds/service_node.h"
 
 #include <atomic>
 #include <limits>
@@ -126,6 +127,55 @@ TEST(HeartbeatTest, ABusyWorkerThatStopsKickingStopsTheBeatsAnIdleOneDoesNot) {
   EXPECT_TRUE(becomes(monitor, "worker_test", true));
   done = true;
   EXPECT_THROW((void)hb.watchWorker(""), std::exception);
+}
+
+/// A service that waits for an input before it can work (as the execution monitor waits for the
+/// robot state).
+class WaitingNode : public ServiceNode {
+ public:
+  explicit WaitingNode(const ServiceArgs& a) : ServiceNode(a) {}
+  std::atomic<bool> input{false};
+
+ protected:
+  std::string notReadyBecause() const override { return input ? "" : "no test input yet"; }
+  double spinPeriodSeconds() const override { return 0.02; }
+};
+
+/// The state and detail of the alive service `name`, once it says `state` (or nullopt after 10 s).
+std::optional<ServiceInfo> once(const HeartbeatMonitor& monitor, const std::string& name, msg::ServiceState state) {
+  const Deadline d = Deadline::in(10.0);
+  while (!d.expired()) {
+    for (const auto& s : monitor.services())
+      if (s.name == name && s.alive && s.state == state) return s;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return std::nullopt;
+}
+
+// A service is alive before it is ready: STARTING, saying what it waits for, until its input
+// arrives; `waitFor(..., ready)` (what tamp run and tamp mission wait on) holds until then.
+TEST(HeartbeatTest, AServiceWaitingForItsInputIsAliveButNotReadyUntilItArrives) {
+  const int domain = testing::isolatedDomain();
+  auto p = testing::makeParticipant(domain);
+  ASSERT_TRUE(p);
+  HeartbeatMonitor monitor(p);
+  ServiceArgs args;
+  args.name = "waiting_test";
+  args.domain_id = domain;
+  args.heartbeat_period_s = 0.05;
+  WaitingNode node(args);
+  std::jthread runner([&] { (void)node.run(); });
+  const auto starting = once(monitor, "waiting_test", msg::SERVICE_STARTING);
+  ASSERT_TRUE(starting.has_value());
+  EXPECT_EQ(starting->detail, "no test input yet");
+  EXPECT_TRUE(monitor.waitFor("waiting_test", 1, Termination::after(5.0)));
+  EXPECT_FALSE(monitor.waitFor("waiting_test", 1, Termination::after(0.5), /*ready=*/true));
+  node.input = true;
+  EXPECT_TRUE(monitor.waitFor("waiting_test", 1, Termination::after(10.0), /*ready=*/true));
+  const auto ready = once(monitor, "waiting_test", msg::SERVICE_READY);
+  ASSERT_TRUE(ready.has_value());
+  EXPECT_EQ(ready->detail, "");
+  node.stop();
 }
 
 }  // namespace

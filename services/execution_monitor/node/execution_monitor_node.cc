@@ -362,6 +362,11 @@ void ExecutionMonitorNode::onCommand(const msg::ExecuteCommand& m) {
   }
 }
 
+std::string ExecutionMonitorNode::notReadyBecause() const {
+  if (have_state_) return {};
+  return std::string("no robot state yet (") + dds::topics::kRobotState.name + ")";
+}
+
 void ExecutionMonitorNode::onState(const msg::RobotState& m, const dds::SampleMeta& meta) {
   try {
     if (!msgv::accept(m, dds::topics::kRobotState.name, rejects_)) return;
@@ -372,6 +377,7 @@ void ExecutionMonitorNode::onState(const msg::RobotState& m, const dds::SampleMe
       return;
     }
     publish(monitor_->onRobotState(*o, now()));
+    have_state_ = true;
   } catch (const std::exception& e) {
     logger()->error("robot state: {}", e.what());
   }

@@ -62,6 +62,8 @@ class ExecutionMonitorNode : public dds::ServiceNode {
 
  protected:
   void spinOnce() override;
+  /// Not ready until a robot state arrived: a command before it would fail its precondition.
+  std::string notReadyBecause() const override;
   double spinPeriodSeconds() const override { return 0.05; }
 
  private:
@@ -101,6 +103,7 @@ class ExecutionMonitorNode : public dds::ServiceNode {
   std::unique_ptr<dds::Reader<msg::ExecutionRecord>> record_reader_;
   std::unique_ptr<dds::Reader<msg::RecordAck>> ack_reader_;
   std::atomic<bool> world_dirty_{true};
+  std::atomic<bool> have_state_{false};  // a robot state was accepted (notReadyBecause)
   std::uint64_t failure_seq_{0};
   std::vector<RobotRequest> unsent_;  // robot requests waiting for the robot driver's match, in order
   bool waiting_for_robot_{false};

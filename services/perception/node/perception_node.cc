@@ -218,6 +218,11 @@ void PerceptionNode::onState(const msg::RobotState& m) {
   state_cv_.notify_all();
 }
 
+std::string PerceptionNode::notReadyBecause() const {
+  if (!options_.robot || states_.load() > 0) return {};
+  return std::string("no robot state yet (") + dds::topics::kRobotState.name + ")";
+}
+
 std::optional<RobotBody> PerceptionNode::bodyAt(std::int64_t stamp_ns, std::stop_token stop) const {
   if (!options_.robot) return std::nullopt;
   std::optional<StampedRobotState> at;

@@ -85,6 +85,8 @@ class PerceptionNode : public dds::ServiceNode {
 
  protected:
   std::pair<uint64_t, uint64_t> requestCounters() const override;
+  /// Not ready until a robot state arrived (frames cannot be placed without the robot's body).
+  std::string notReadyBecause() const override;
 
  private:
   msgv::RejectLog rejects_{"perception"};  // malformed input: logged once per kind, rate-limited

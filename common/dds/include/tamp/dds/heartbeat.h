@@ -130,8 +130,9 @@ class HeartbeatMonitor {
   explicit HeartbeatMonitor(std::shared_ptr<Participant> p);
   /// Every service heard of, alive ones first, by name.
   std::vector<ServiceInfo> services() const;
-  /// Waits until `count` alive services called `name` are seen (or the termination fires).
-  bool waitFor(const std::string& name, int count, const Termination& until) const;
+  /// Waits until `count` alive services called `name` are seen (or the termination fires); with
+  /// `ready`, only those past SERVICE_STARTING (their inputs arrived: ServiceNode::notReadyBecause).
+  bool waitFor(const std::string& name, int count, const Termination& until, bool ready = false) const;
 
  private:
   struct Entry {

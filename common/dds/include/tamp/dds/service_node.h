@@ -87,6 +87,11 @@ class ServiceNode {
   virtual double spinPeriodSeconds() const { return 0.1; }
   /// Sum of requests served/failed by the node's servers, for the heartbeat (default: echo only).
   virtual std::pair<uint64_t, uint64_t> requestCounters() const;
+  /// What the service still waits for before it can do its work (e.g. "no robot state yet");
+  /// empty: ready (the default). Until it is empty the heartbeat says SERVICE_STARTING with this
+  /// as its detail, and `tamp run` / `tamp mission` do not start a mission. Polled by run() at
+  /// every turn of the main loop; once ready, a service stays ready. Thread-safe.
+  virtual std::string notReadyBecause() const { return {}; }
 
  private:
   std::string name_;
@@ -95,6 +100,9 @@ class ServiceNode {
   std::unique_ptr<RpcServer<msg::EchoRequest, msg::EchoReply>> echo_;
   /// True when the supervisor's lease (ServiceArgs::supervisor_lease) expired.
   bool orphaned() const;
+  /// One poll of notReadyBecause() while starting: the heartbeat's detail, READY once it is
+  /// empty. Returns what it still waits for.
+  std::string awaitInputs(const std::string& was);
   std::string supervisor_lease_;
   double orphan_timeout_s_{0.0};
   double stall_timeout_s_{0.0};

@@ -6,7 +6,7 @@
 #   tests/fault/two_hosts.sh BUILD_DIR [--discovery server|multicast] [--scenario FILE]
 #        [--netem "loss 10%"|"delay 50ms"|"duplicate 10%"|...] [--partition-at S --partition-for S]
 #        [--seed N] [--out DIR] [--run-id ID] [--one-host] [--ping N] [--loss PCT] [--duplicate PCT]
-#        [--kill SERVICE --kill-at S] [--delay MS [--jitter MS]]
+#        [--kill SERVICE --kill-at S] [--delay MS [--jitter MS]] [--security DIR]
 #
 # --kill SERVICE --kill-at S: SIGKILL to that service's process S s after the mission started,
 # on whichever host runs it (its launcher restarts it). Every run (with or without a fault) is
@@ -28,6 +28,7 @@
 # `iptables` (Debian package iptables). UDP round trips across the link (tests/fault/udp_rtt.py)
 # before and after the delay is on, the delayed packets and the kernel queue's drops go to faults.log.
 #
+# --security DIR (from deploy/security/make_certs.sh): every participant on both hosts secured.
 # --one-host runs both launchers in the workstation namespace (same deployment, discovery and
 # UDP profile; traffic stays on the host), the baseline of the two-host benchmark. --ping N: after
 # the mission, N round trips of `tamp ping` from the workstation namespace to the simulator (on
@@ -50,7 +51,7 @@ BUILD=${1:?usage: two_hosts.sh BUILD_DIR [options]}; shift
 ROOT=$(cd "$(dirname "$0")/../.." && pwd)
 DISCOVERY=server SCENARIO=$ROOT/config/scenarios/namo_corridor_short.yaml NETEM="" SEED=1
 PART_AT="" PART_FOR=5 OUT=${TMPDIR:-/tmp}/tamp-two-hosts RUN_ID="" ONE_HOST=0 PING=0 LOSS=0 DUP=0
-KILL="" KILL_AT="" DELAY="" JITTER=0
+KILL="" KILL_AT="" DELAY="" JITTER=0 SECURITY=""
 QUEUE_NUM=13  # the nfqueue of --delay, one per namespace
 while [ $# -gt 0 ]; do
   case $1 in
@@ -70,6 +71,7 @@ while [ $# -gt 0 ]; do
     --kill-at) KILL_AT=$2; shift 2;;
     --delay) DELAY=$2; shift 2;;
     --jitter) JITTER=$2; shift 2;;
+    --security) SECURITY=$(realpath "$2"); shift 2;;
     *) echo "two_hosts.sh: unknown option $1" >&2; exit 30;;
   esac
 done
@@ -84,6 +86,14 @@ for pct in "$LOSS" "$DUP"; do
 done
 if { [ "$LOSS" -gt 0 ] || [ "$DUP" -gt 0 ]; } && ! command -v nft > /dev/null; then
   echo "two_hosts.sh: --loss/--duplicate need nft (Debian package nftables)" >&2; exit 30
+fi
+if [ -n "$SECURITY" ]; then
+  for f in ca.pem governance.p7s; do
+    [ -s "$SECURITY/$f" ] || { echo "two_hosts.sh: --security $SECURITY: no $f (make it with deploy/security/make_certs.sh DIR)" >&2; exit 30; }
+  done
+  # Every participant of both hosts (services, launchers, tamp mission) is secured with its own
+  # identity from DIR (tamp::dds::Participant reads $TAMP_DDS_SECURITY).
+  export TAMP_DDS_SECURITY=$SECURITY
 fi
 BIN=$(realpath "$BUILD")/bin
 DELAYER=${TAMP_LINK_DELAY:-$BIN/tamp_link_delay}
@@ -276,7 +286,7 @@ if [ "$LOSS" -gt 0 ] || [ "$DUP" -gt 0 ]; then
   for ns in "$NS_R" "$NS_W"; do ip netns exec "$ns" nft list table ip tamp_fault | grep counter >> "$RUN_DIR/faults.log"; done
 fi
 cat "$OUT/$RUN_ID/mission.out"
-echo "two_hosts.sh: run $RUN_ID discovery=$DISCOVERY one_host=$ONE_HOST netem='${NETEM}' loss=$LOSS% duplicate=$DUP% partition_at='${PART_AT}' delay='${DELAY}' jitter=$JITTER seed=$SEED exit=$RC mission_s=$(awk "BEGIN{print $END - $START}")"
+echo "two_hosts.sh: run $RUN_ID discovery=$DISCOVERY security=${SECURITY:+on} one_host=$ONE_HOST netem='${NETEM}' loss=$LOSS% duplicate=$DUP% partition_at='${PART_AT}' delay='${DELAY}' jitter=$JITTER seed=$SEED exit=$RC mission_s=$(awk "BEGIN{print $END - $START}")"
 cleanup; trap - EXIT
 # The simulator writes its final world on a clean stop (cleanup sends SIGTERM to the launchers).
 if [ "$RC" = 0 ] && [ ! -s "$OUT/$RUN_ID/sim_final_world.json" ]; then

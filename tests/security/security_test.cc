@@ -15,6 +15,7 @@
 #include <fstream>
 #include <thread>
 
+#include <fastrtps/config.h>
 #include <gtest/gtest.h>
 
 #include "../integration/integration_util.h"
@@ -305,6 +306,26 @@ TEST_F(SecurityTest, MissingCredentialsAreAClearErrorNamingTheFile) {
   ASSERT_FALSE(p);
   EXPECT_EQ(p.error().code, ErrorCode::kNotFound);
   EXPECT_NE(p.error().toString().find("no_such_service/cert.pem"), std::string::npos) << p.error().toString();
+}
+
+// Fast DDS 2.9 has no secure discovery server: a secured client of one never authenticates it
+// (the `tamp mission` tool aborted on an assertion inside Fast DDS in a secured two-host run).
+// Refused by name instead, with what works (multicast discovery); from 2.10 on it is allowed.
+TEST_F(SecurityTest, ASecuredParticipantWithADiscoveryServerIsRefusedWhereFastDdsCannotSecureIt) {
+  auto p = dds::Participant::create([] {
+    auto o = secured(genuineDir(), "sim");
+    o.domain_id = domain_;
+    o.discovery_servers = {"127.0.0.1:11811"};
+    return o;
+  }());
+#if FASTRTPS_VERSION_MAJOR == 2 && FASTRTPS_VERSION_MINOR < 10
+  ASSERT_FALSE(p);
+  EXPECT_EQ(p.error().code, ErrorCode::kUnsupported);
+  EXPECT_NE(p.error().message.find("discovery server"), std::string::npos) << p.error().toString();
+  EXPECT_NE(p.error().message.find("multicast"), std::string::npos) << p.error().toString();
+#else
+  EXPECT_TRUE(p) << p.error().toString();
+#endif
 }
 
 TEST_F(SecurityTest, MakeCertsIsIdempotent) {

@@ -17,6 +17,7 @@
 #include <fastdds/dds/topic/TypeSupport.hpp>
 
 #include <fastdds/rtps/attributes/ServerAttributes.h>
+#include <fastrtps/config.h>
 #include <fastrtps/utils/IPLocator.h>
 
 #include "tamp/core/log.h"
@@ -84,6 +85,21 @@ Result<std::optional<ParticipantOptions::SecurityFiles>> resolveSecurity(const P
     }
   }
   return files;
+}
+
+/// Fast DDS has a secure discovery server from 2.10 on. Before, a secured client of a (plain)
+/// server never authenticates it, and Debian's 2.9.1 aborts on an assertion in
+/// SecurityManager::encode_rtps_message (a secured two-host run, session 24): refused here, by name.
+Status secureDiscoverySupported(bool secured, const std::vector<DiscoveryServerAddress>& servers) {
+  constexpr bool kHasSecureServer =
+      FASTRTPS_VERSION_MAJOR > 2 || (FASTRTPS_VERSION_MAJOR == 2 && FASTRTPS_VERSION_MINOR >= 10);
+  if (!secured || servers.empty() || kHasSecureServer) return Status::Ok();
+  return Error(ErrorCode::kUnsupported,
+               "DDS Security with a discovery server ($TAMP_DDS_DISCOVERY_SERVERS or the deployment's discovery: "
+               "{mode: server}) needs Fast DDS 2.10 or later (its secure discovery server); this build has " +
+                   std::to_string(FASTRTPS_VERSION_MAJOR) + "." + std::to_string(FASTRTPS_VERSION_MINOR) + "." +
+                   std::to_string(FASTRTPS_VERSION_MICRO) +
+                   ": use multicast discovery (discovery: {mode: multicast}) with security, or no security");
 }
 
 /// Makes the participant a CLIENT of each server (server i has the default GUID prefix of id i).
@@ -214,6 +230,7 @@ Result<std::shared_ptr<Participant>> Participant::create(const ParticipantOption
   qos.name(options.name.empty() ? "tamp" : options.name);
   auto servers = resolveDiscoveryServers(options.discovery_servers);
   if (!servers) return servers.error();
+  if (Status s = secureDiscoverySupported(security->has_value(), *servers); !s.ok()) return s.error();
   if (!servers->empty()) useDiscoveryServers(qos, *servers);
 
   if (*security) {

@@ -142,6 +142,16 @@ struct SearchOptions {
   /// ehc: test committed states with h^2 from the start of every hill-climbing run (the
   /// restart's mode; set for the default run by `search()` after a first run that restarted).
   bool ehc_h2_commits{false};
+  /// ehc, while testing with h^2: 0 tests every state before committing to it (the twenty-first
+  /// round's test). n > 0: the gap starts at 1 (every state tested before it is taken) and
+  /// doubles after each test that finds no dead end, up to n, and falls back to 1 after one; at
+  /// a gap above 1 states are taken untested, and the last one is tested once the states taken
+  /// since the last one found alive reach the gap, when a plateau is met (helpful actions find
+  /// no better state) and before the goal of a goal-agenda entry is taken. h^2 dead ends are monotone along a path (what is reachable from a state is reachable
+  /// from its predecessors, so h^2 from it reaches a subset of what it reaches from them): when
+  /// the last state is dead, bisection over the untested states finds the first dead one, and
+  /// the run goes back to the state before it, with it and the states after it marked dead.
+  uint32_t ehc_h2_test_gap_max{16};
   /// The bounds of one h^2 test of a committed state (over them: not a dead end).
   H2MutexOptions ehc_h2_mutexes{20'000, 200'000'000};
   /// The h^2 tests of one hill-climbing run stop (states are committed to untested) once they

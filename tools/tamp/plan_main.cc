@@ -203,6 +203,7 @@ int main(int argc, char** argv) {
   bool h2_restart = defaults.ehc_h2_restart;
   bool prune_irrelevant = sp::PlanRequest{}.prune_irrelevant;
   uint32_t h2_test_gap_max = defaults.ehc_h2_test_gap_max;
+  bool ff_first_h2_restart = defaults.ehc_ff_first_h2_restart;
   app.add_option("--landmarks", landmark_generator,
                  "lazy: the landmarks counted: rhw (Richter-Helmert-Westphal: disjunctive landmarks, greedy-necessary "
                  "orders, landmarks required again) or zg (Zhu-Givan fact landmarks)")
@@ -223,6 +224,8 @@ int main(int argc, char** argv) {
                  "ehc, testing with h^2: 0 tests every state before committing to it; n > 0 tests the last "
                  "state committed at a gap doubling up to n (and on a plateau), finding the first dead one by "
                  "bisection");
+  app.add_option("--ehc-ff-first-h2-restart", ff_first_h2_restart,
+                 "ehc: --ehc-h2-restart for the first run (FF-v2.3's variant) too: true or false");
   app.add_option("--prune-irrelevant", prune_irrelevant,
                  "search a task pruned to the facts and operators relevant to the goal (backward relevance, "
                  "operators the same on them merged): true or false");
@@ -274,6 +277,7 @@ int main(int argc, char** argv) {
   req.search.ehc_lazy_beside = !no_lazy_beside;
   req.search.ehc_h2_restart = h2_restart;
   req.search.ehc_h2_test_gap_max = h2_test_gap_max;
+  req.search.ehc_ff_first_h2_restart = ff_first_h2_restart;
   req.search.ehc_lazy_after = lazy_after;
   req.search.ehc_lazy_turn_ehc = lazy_turn_ehc;
   req.search.ehc_lazy_turn_lazy = lazy_turn_lazy;

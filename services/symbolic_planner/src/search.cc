@@ -1327,6 +1327,7 @@ SearchResult configuredSearch(const Task& task, const StateBits& init, const Goa
     SearchOptions first = options;
     first.ehc_fallback = false;
     first.ehc_eval_budget_per_h = options.ehc_ff_budget_per_h;
+    first.ehc_h2_restart = options.ehc_h2_restart && options.ehc_ff_first_h2_restart;
     if (options.ehc_ff_first_improvement) first.ehc_best_sibling = false;
     SearchResult r1;
     try {

@@ -604,9 +604,19 @@ TEST(Search, EhcStartsAgainTestingWithH2AfterCommittingToADeadEnd) {
     const PlanReply with = plan(req, Termination());
     ASSERT_EQ(with.status, PlanStatus::kSolved) << with.message;  // replayed by the checker
     EXPECT_EQ(with.plan.size(), 4U);
-    // Each run restarts once: the default run alone; with the first run, that one and, its plan
-    // being long for its initial h, the default run beside it (`ehc_second_budget_per_step`).
-    EXPECT_EQ(with.stats.ehc_h2_restarts, ff_first ? 2U : 1U);
+    // The default run restarts once; the first run (FF-v2.3's variant) ends at its dead end
+    // (`ehc_ff_first_h2_restart` false) and leaves the task to the default run.
+    EXPECT_EQ(with.stats.ehc_h2_restarts, 1U);
+    if (ff_first) {
+      // Restarting it too: that run and, its plan being long for its initial h, the default run
+      // beside it (`ehc_second_budget_per_step`), the same plan.
+      req.search.ehc_ff_first_h2_restart = true;
+      const PlanReply both = plan(req, Termination());
+      ASSERT_EQ(both.status, PlanStatus::kSolved) << both.message;
+      EXPECT_EQ(both.stats.ehc_h2_restarts, 2U);
+      EXPECT_EQ(both.plan, with.plan);
+      req.search.ehc_ff_first_h2_restart = false;
+    }
     EXPECT_GE(with.stats.ehc_h2_dead_ends, 1U);
     EXPECT_GT(with.stats.ehc_h2_tests, with.stats.ehc_h2_dead_ends);  // d's and e's successors pass
     // Testing from the start needs no restart.

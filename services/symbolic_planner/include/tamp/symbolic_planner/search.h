@@ -142,6 +142,8 @@ struct SearchOptions {
   /// ehc: test committed states with h^2 from the start of every hill-climbing run (the
   /// restart's mode; set for the default run by `search()` after a first run that restarted).
   bool ehc_h2_commits{false};
+  /// ehc_h2_restart for the first run (FF-v2.3's variant) too; false: its proven dead end ends it.
+  bool ehc_ff_first_h2_restart{false};
   /// ehc, while testing with h^2: 0 tests every state before committing to it (the twenty-first
   /// round's test). n > 0: the gap starts at 1 (every state tested before it is taken) and
   /// doubles after each test that finds no dead end, up to n, and falls back to 1 after one; at

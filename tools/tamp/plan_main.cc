@@ -202,6 +202,8 @@ int main(int argc, char** argv) {
   bool rhw_reasonable = defaults.rhw.reasonable_orders;
   bool h2_restart = defaults.ehc_h2_restart;
   bool prune_irrelevant = sp::PlanRequest{}.prune_irrelevant;
+  uint32_t h2_test_gap_max = defaults.ehc_h2_test_gap_max;
+  bool ff_first_h2_restart = defaults.ehc_ff_first_h2_restart;
   app.add_option("--landmarks", landmark_generator,
                  "lazy: the landmarks counted: rhw (Richter-Helmert-Westphal: disjunctive landmarks, greedy-necessary "
                  "orders, landmarks required again) or zg (Zhu-Givan fact landmarks)")
@@ -218,6 +220,12 @@ int main(int argc, char** argv) {
   app.add_option("--ehc-h2-restart", h2_restart,
                  "ehc: after a hill-climbing run proves a state it committed to a dead end, run it again "
                  "from the start, testing every state it commits to with h^2 from that state: true or false");
+  app.add_option("--ehc-h2-test-gap-max", h2_test_gap_max,
+                 "ehc, testing with h^2: 0 tests every state before committing to it; n > 0 tests the last "
+                 "state committed at a gap doubling up to n (and on a plateau), finding the first dead one by "
+                 "bisection");
+  app.add_option("--ehc-ff-first-h2-restart", ff_first_h2_restart,
+                 "ehc: --ehc-h2-restart for the first run (FF-v2.3's variant) too: true or false");
   app.add_option("--prune-irrelevant", prune_irrelevant,
                  "search a task pruned to the facts and operators relevant to the goal (backward relevance, "
                  "operators the same on them merged): true or false");
@@ -268,6 +276,8 @@ int main(int argc, char** argv) {
   req.search.rhw.reasonable_orders = rhw_reasonable;
   req.search.ehc_lazy_beside = !no_lazy_beside;
   req.search.ehc_h2_restart = h2_restart;
+  req.search.ehc_h2_test_gap_max = h2_test_gap_max;
+  req.search.ehc_ff_first_h2_restart = ff_first_h2_restart;
   req.search.ehc_lazy_after = lazy_after;
   req.search.ehc_lazy_turn_ehc = lazy_turn_ehc;
   req.search.ehc_lazy_turn_lazy = lazy_turn_lazy;

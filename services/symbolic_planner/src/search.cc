@@ -613,6 +613,43 @@ class Searcher {
     std::vector<uint32_t> queue;
     std::vector<OpId> all_ops;
     bool helpful_only = true;
+    // ehc_h2_test_gap_max > 0: the states committed to since `alive` (the last state h^2 found
+    // alive, or where this climb started), untested, each with the plan's length before it. At a
+    // gap of 1 (at the start and after a dead end) states are tested before they are taken, as
+    // without test_later, so that where dead ends are dense no bisection or search again is paid.
+    const bool test_later = opt_.ehc_h2_test_gap_max > 0;
+    std::vector<std::pair<uint32_t, size_t>> untested;
+    uint32_t alive = cur;
+    uint32_t gap = 1;
+    // Tests the last untested state; when h^2 finds it a dead end, finds the first dead one by
+    // bisection (dead ends are monotone along the path), marks it and those after it dead and
+    // goes back to the state before it. Returns whether it went back.
+    const auto goBackFromDeadEnd = [&]() -> bool {
+      if (untested.empty() || term_()) return false;
+      if (!h2DeadEnd(reg_.get(untested.back().first))) {
+        alive = untested.back().first;
+        untested.clear();
+        gap = std::min<uint32_t>(gap * 2, opt_.ehc_h2_test_gap_max);
+        return false;
+      }
+      size_t lo = 0, hi = untested.size() - 1;
+      while (lo < hi) {
+        const size_t mid = lo + (hi - lo) / 2;
+        if (h2DeadEnd(reg_.get(untested[mid].first))) {
+          hi = mid;
+        } else {
+          lo = mid + 1;
+        }
+      }
+      for (size_t k = lo; k < untested.size(); ++k) h_cache_[untested[k].first] = Heuristic::kDeadEnd;
+      plan.resize(untested[lo].second);
+      cur = lo == 0 ? alive : untested[lo - 1].first;
+      hcur = h_cache_[cur];
+      alive = cur;
+      untested.clear();
+      gap = 1;
+      return true;
+    };
     // Evaluations a plateau searched again without pruning may use (0 = unbounded).
     const uint64_t retry_budget =
         opt_.ehc_retry_budget_share > 0 && fallback_budget_ > 0
@@ -667,7 +704,7 @@ class Searcher {
           if (auto st = checkLimits()) return finish(*st);
           if (h == Heuristic::kDeadEnd) continue;
           if (h < hcur && (found == kNone || h < h_cache_[found])) {
-            if (h2_commits_ && !term_() && h2DeadEnd(succ_.data())) {
+            if (h2_commits_ && (!test_later || gap == 1) && !term_() && h2DeadEnd(succ_.data())) {
               h_cache_[sid] = Heuristic::kDeadEnd;
               continue;
             }
@@ -681,6 +718,11 @@ class Searcher {
         }
       }
       if (found == kNone) {
+        // A plateau: first make sure the state is not one of h^2's dead ends.
+        if (h2_commits_ && test_later && goBackFromDeadEnd()) {
+          helpful_only = true;
+          continue;
+        }
         // The helpful actions may have pruned the way out of this plateau: search it once more
         // with every applicable action before giving up on hill-climbing.
         if (helpful_only && opt_.ehc_full_retry) {
@@ -694,11 +736,27 @@ class Searcher {
       }
       helpful_only = true;
       std::vector<OpId> seg = path(found, cur);
+      const size_t plan_before = plan.size();
       plan.insert(plan.end(), seg.begin(), seg.end());
       cur = found;
       parent_[cur] = kNone;
-      if (task_.goalReached(reg_.get(cur), goal)) return finish(SearchStatus::kSolved, plan);
+      if (task_.goalReached(reg_.get(cur), goal)) {
+        // The goal of an agenda entry is where the next entry starts: not from a dead end. (A
+        // goal state itself is not tested, as without test_later.)
+        if (h2_commits_ && test_later && &goal != &goal_ && goBackFromDeadEnd()) continue;
+        return finish(SearchStatus::kSolved, plan);
+      }
       hcur = h_cache_[cur];
+      if (h2_commits_ && test_later) {
+        if (gap == 1) {
+          // Tested before it was taken, as without test_later.
+          alive = cur;
+          gap = std::min<uint32_t>(2, opt_.ehc_h2_test_gap_max);
+        } else {
+          untested.emplace_back(cur, plan_before);
+          if (untested.size() >= gap) goBackFromDeadEnd();
+        }
+      }
     }
   }
 
@@ -1269,6 +1327,7 @@ SearchResult configuredSearch(const Task& task, const StateBits& init, const Goa
     SearchOptions first = options;
     first.ehc_fallback = false;
     first.ehc_eval_budget_per_h = options.ehc_ff_budget_per_h;
+    first.ehc_h2_restart = options.ehc_h2_restart && options.ehc_ff_first_h2_restart;
     if (options.ehc_ff_first_improvement) first.ehc_best_sibling = false;
     SearchResult r1;
     try {

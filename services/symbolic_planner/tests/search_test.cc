@@ -604,9 +604,19 @@ TEST(Search, EhcStartsAgainTestingWithH2AfterCommittingToADeadEnd) {
     const PlanReply with = plan(req, Termination());
     ASSERT_EQ(with.status, PlanStatus::kSolved) << with.message;  // replayed by the checker
     EXPECT_EQ(with.plan.size(), 4U);
-    // Each run restarts once: the default run alone; with the first run, that one and, its plan
-    // being long for its initial h, the default run beside it (`ehc_second_budget_per_step`).
-    EXPECT_EQ(with.stats.ehc_h2_restarts, ff_first ? 2U : 1U);
+    // The default run restarts once; the first run (FF-v2.3's variant) ends at its dead end
+    // (`ehc_ff_first_h2_restart` false) and leaves the task to the default run.
+    EXPECT_EQ(with.stats.ehc_h2_restarts, 1U);
+    if (ff_first) {
+      // Restarting it too: that run and, its plan being long for its initial h, the default run
+      // beside it (`ehc_second_budget_per_step`), the same plan.
+      req.search.ehc_ff_first_h2_restart = true;
+      const PlanReply both = plan(req, Termination());
+      ASSERT_EQ(both.status, PlanStatus::kSolved) << both.message;
+      EXPECT_EQ(both.stats.ehc_h2_restarts, 2U);
+      EXPECT_EQ(both.plan, with.plan);
+      req.search.ehc_ff_first_h2_restart = false;
+    }
     EXPECT_GE(with.stats.ehc_h2_dead_ends, 1U);
     EXPECT_GT(with.stats.ehc_h2_tests, with.stats.ehc_h2_dead_ends);  // d's and e's successors pass
     // Testing from the start needs no restart.
@@ -618,6 +628,51 @@ TEST(Search, EhcStartsAgainTestingWithH2AfterCommittingToADeadEnd) {
     EXPECT_LT(from_start.stats.evaluated, with.stats.evaluated);
     req.search.ehc_h2_commits = false;
   }
+}
+
+// One-way roads with the trap after a stretch of good road: a -> p1 -> .. -> p4, then either
+// the trap p4 -> b1 -> .. -> b4 -> c (h_FF falls all the way to b4, as b4 -> g looks open facing
+// south) or the way p4 -> d1 -> .. -> d6 -> g. Testing every state tests each of the 11 states
+// committed to but g; testing later commits to p1 .. p4 and b1 .. b3 on tests of p1 and p3 only,
+// finds b3 dead, and bisection finds b1, the first dead state, and goes back to p4.
+TEST(Search, EhcTestingWithH2LaterFindsTheFirstDeadStateByBisectionInFewerTests) {
+  PlanRequest req;
+  req.domain_text = test::kOneWayDomain;
+  req.problem_text = R"((define (problem long-trap) (:domain oneway)
+    (:objects a p1 p2 p3 p4 b1 b2 b3 b4 c d1 d2 d3 d4 d5 d6 g north south)
+    (:init (at a) (facing north)
+           (road a p1 north north) (road p1 p2 north north) (road p2 p3 north north)
+           (road p3 p4 north north)
+           (road p4 b1 north north) (road b1 b2 north north) (road b2 b3 north north)
+           (road b3 b4 north north) (road b4 c north south) (road b4 g south south)
+           (road p4 d1 north north) (road d1 d2 north north) (road d2 d3 north north)
+           (road d3 d4 north north) (road d4 d5 north north) (road d5 d6 north north)
+           (road d6 g north north))
+    (:goal (at g))))";
+  req.timeout_seconds = 60;
+  req.check_plan = true;
+  req.search.ehc_fallback = false;  // the hill-climbing alone
+  req.search.ehc_lazy_beside = false;
+  req.search.ehc_ff_first = false;
+  req.search.ehc_h2_test_gap_max = 0;
+  const PlanReply every = plan(req, Termination());
+  ASSERT_EQ(every.status, PlanStatus::kSolved) << every.message;  // replayed by the checker
+  EXPECT_EQ(every.plan.size(), 11U);                                // a p1..p4 d1..d6 g
+  EXPECT_EQ(every.stats.ehc_h2_restarts, 1U);
+  EXPECT_EQ(every.stats.ehc_h2_dead_ends, 1U);  // b1, tested before the run takes it
+  EXPECT_EQ(every.stats.ehc_h2_tests, 9U);      // p1 .. p4, b1, d3 .. d6 (d1, d2 no better than p4)
+  req.search.ehc_h2_test_gap_max = 16;
+  const PlanReply later = plan(req, Termination());
+  ASSERT_EQ(later.status, PlanStatus::kSolved) << later.message;
+  EXPECT_EQ(later.plan, every.plan);  // back to p4, not to p3 nor past b1
+  EXPECT_EQ(later.stats.ehc_h2_restarts, 1U);
+  EXPECT_EQ(later.stats.ehc_h2_dead_ends, 2U);  // b3, then b1 in the bisection
+  // p1, p3 (gap 2), b3 (gap 4: p4 b1 b2 b3), then b1 and p4 in the bisection; from p4 again (gap
+  // 1): d3, d5 (gap 2).
+  EXPECT_EQ(later.stats.ehc_h2_tests, 7U);
+  // The restarted run expands b1 and b2 on its way into the trap and p4 once more after going
+  // back; going back further (to p3, the last state tested before the trap) would expand p3 too.
+  EXPECT_EQ(later.stats.expanded, every.stats.expanded + 3);
 }
 
 TEST(Search, EhcWithoutADeadEndNeverTestsWithH2) {

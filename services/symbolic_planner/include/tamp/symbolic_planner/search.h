@@ -15,11 +15,12 @@
 ///   FF-v2.3's variant (`Heuristic::setFFStyle`), a first hill-climbing run uses that variant
 ///   within a budget of evaluations (it tends to give shorter plans); when it fails or runs
 ///   out of budget, the search starts again from the initial state with the default heuristic,
-///   exactly as without the first run. A run that proves a state it committed to a dead end
-///   (`ehc_h2_restart`) starts again once from the initial state, testing every state it would
-///   commit to with h^2 from that state, which sees dead ends the delete relaxation does not
-///   (Haslum & Geffner 2000; an irreversible move, as in airport, where FF's own path avoids one
-///   by its tie-breaking).
+///   exactly as without the first run. A run other than the first that proves a state it
+///   committed to a dead end (`ehc_h2_restart`) starts again once from the initial state,
+///   testing the states it commits to with h^2 from them (`ehc_h2_test_gap_max`), which sees
+///   dead ends the delete relaxation does not (Haslum & Geffner 2000; an irreversible move, as
+///   in airport, where FF's own path avoids one by its tie-breaking); the first run ends there
+///   (`ehc_ff_first_h2_restart`).
 /// - `kGbfs`: eager greedy best-first search on h_FF with a second open list for successors through
 ///   helpful (preferred) operators, alternating with a boost on progress (as Fast Downward's
 ///   `eager_greedy([ff], preferred=[ff])`). Complete: it proves unsolvability by exhaustion.
@@ -131,10 +132,11 @@ struct SearchOptions {
   /// evaluations (a TAMP query: about 30) never meets the lazy search. false: the lazy search
   /// only after the hill-climbing has failed (FF's order).
   bool ehc_lazy_beside{true};
-  /// ehc: when a hill-climbing run proves that a state it committed to is a dead end (h_FF finds
-  /// the goal unreachable from it, or its plateau searched again without pruning holds
-  /// everything reachable from it), the run starts again from the initial state, once, and from
-  /// then on tests every state it would commit to with h^2 from that state (mutexes.h): a state
+  /// ehc: when a hill-climbing run (not the first, see `ehc_ff_first_h2_restart`) proves that a
+  /// state it committed to is a dead end (h_FF finds the goal unreachable from it, or its plateau
+  /// searched again without pruning holds everything reachable from it), the run starts again
+  /// from the initial state, once, and from then on tests the states it commits to with h^2 from
+  /// them (mutexes.h; when, `ehc_h2_test_gap_max`): a state
   /// from which h^2 finds a goal fact or pair unreachable is a dead end the delete relaxation
   /// does not see (airport: an aircraft that cannot turn round), skipped as h_FF's dead ends are.
   /// The restarted run shares the run's budgets. false: a proven dead end ends the run (FF).
@@ -142,6 +144,20 @@ struct SearchOptions {
   /// ehc: test committed states with h^2 from the start of every hill-climbing run (the
   /// restart's mode; set for the default run by `search()` after a first run that restarted).
   bool ehc_h2_commits{false};
+  /// ehc_h2_restart for the first run (FF-v2.3's variant) too; false: its proven dead end ends it
+  /// and the default run takes over (on airport-30 the first run's restart found about 80 dead
+  /// ends with h^2 and failed all the same).
+  bool ehc_ff_first_h2_restart{false};
+  /// ehc, while testing with h^2: 0 tests every state before committing to it (the twenty-first
+  /// round's test). n > 0: the gap starts at 1 (every state tested before it is taken) and
+  /// doubles after each test that finds no dead end, up to n, and falls back to 1 after one; at
+  /// a gap above 1 states are taken untested, and the last one is tested once the states taken
+  /// since the last one found alive reach the gap, when a plateau is met (helpful actions find
+  /// no better state) and before the goal of a goal-agenda entry is taken. h^2 dead ends are monotone along a path (what is reachable from a state is reachable
+  /// from its predecessors, so h^2 from it reaches a subset of what it reaches from them): when
+  /// the last state is dead, bisection over the untested states finds the first dead one, and
+  /// the run goes back to the state before it, with it and the states after it marked dead.
+  uint32_t ehc_h2_test_gap_max{16};
   /// The bounds of one h^2 test of a committed state (over them: not a dead end).
   H2MutexOptions ehc_h2_mutexes{20'000, 200'000'000};
   /// The h^2 tests of one hill-climbing run stop (states are committed to untested) once they

@@ -208,6 +208,57 @@ TEST_F(LaunchTest, AServiceWhoseMainLoopHangsStopsBeatingAndIsRestarted) {
   EXPECT_TRUE(logged) << "no log line says the heartbeats were withheld";
 }
 
+// A service alive but not ready (an input that never arrives: the echo node's not-ready file) is
+// restarted after ready_timeout_s, at most ready_restarts times, then left running; once its
+// input comes it is ready.
+TEST_F(LaunchTest, AServiceThatStaysNotReadyIsRestartedABoundedNumberOfTimes) {
+  const fs::path gate = dir_ / "beta_not_ready";
+  std::ofstream(gate) << "not yet\n";
+  std::ofstream(dir_ / "deploy.yaml")
+      << "heartbeat_period_s: 0.2\nliveness_periods: 5\nstartup_timeout_s: 20\nready_timeout_s: 1.5\n"
+         "ready_restarts: 1\nrestart: {max_restarts: 5, backoff_s: 0.2, backoff_max_s: 1}\nservices:\n"
+         "  - {name: alpha, executable: tamp_echo_node}\n"
+         "  - {name: beta, executable: tamp_echo_node, env: [\"TAMP_ECHO_NOT_READY_FILE="
+      << gate.string() << "\"]}\n";
+  launch(dir_ / "deploy.yaml");
+  const pid_t first = pids().at("beta");
+  ASSERT_TRUE(waitUntil([&] { return event("beta", "restarted").has_value(); }, 30.0, &sup_));
+  const auto killed = event("beta", "killed");
+  ASSERT_TRUE(killed);
+  EXPECT_EQ((*killed)["pid"], first);
+  EXPECT_THAT(killed->value("detail", ""), HasSubstr("not ready within ready_timeout_s (1.5 s)"));
+  EXPECT_THAT(killed->value("detail", ""), HasSubstr("no test input while"));
+  EXPECT_THAT(killed->value("detail", ""), HasSubstr("1 of 1"));
+  const pid_t second = (*event("beta", "restarted"))["pid"].get<pid_t>();
+  // The one restart used: the new process, not ready for twice the timeout, is left running.
+  auto beta = [&]() -> nlohmann::json {
+    auto [rc, out] = status(dir_ / "deploy.yaml", run_id_, 1.0);
+    const auto brace = out.find('{');
+    if (brace == std::string::npos) return {};
+    auto j = nlohmann::json::parse(out.substr(brace), nullptr, false);
+    if (!j.is_object()) return {};
+    for (const auto& s : j["services"])
+      if (s["name"] == "beta" && s["pid"].get<pid_t>() == second && s["alive"].get<bool>()) return s;
+    return {};
+  };
+  auto field = [&](const char* key) {
+    const auto b = beta();
+    return b.is_object() && b.contains(key) ? b[key] : nlohmann::json();
+  };
+  ASSERT_TRUE(waitUntil([&] { const auto up = field("uptime_s"); return up.is_number() && up.get<double>() > 3.0; },
+                        30.0, &sup_));
+  EXPECT_EQ(pids().at("beta"), second);
+  EXPECT_EQ(field("state"), "starting");
+  std::size_t kills = 0;
+  for (const auto& e : readEvents(runDir() / "events.jsonl"))
+    kills += (e.value("service", "") == "beta" && e.value("event", "") == "killed") ? 1 : 0;
+  EXPECT_EQ(kills, 1u);
+  EXPECT_FALSE(event("alpha", "killed"));
+  // Its input comes: ready, the same process.
+  fs::remove(gate);
+  EXPECT_TRUE(waitUntil([&] { return field("state") == "ready"; }, 30.0, &sup_));
+}
+
 TEST_F(LaunchTest, StatusFailsAndNamesTheMissingServices) {
   launch(deployment({"alpha", "beta"}));
   // The same run expected with two more services, one of them optional.

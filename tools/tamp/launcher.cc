@@ -276,6 +276,7 @@ Status Launcher::startOneByOne() {
 void Launcher::poll() {
   sup_.poll();
   if (o_.restart && o_.liveness) checkLiveness();
+  if (o_.restart) checkReadiness();
   touchLease();
   if (pids_dirty_) writePidFile();
 }
@@ -309,6 +310,56 @@ void Launcher::checkLiveness() {
       (void)sup_.declareDead(st.name, why);
     }
   }
+}
+
+namespace {
+
+/// The heartbeat of `st`'s current process on `host`, if heard.
+const dds::ServiceInfo* heardFrom(const std::vector<dds::ServiceInfo>& services, const process::ProcessStatus& st,
+                                  const std::string& host) {
+  for (const auto& s : services)
+    if (s.alive && s.name == st.name && s.pid == static_cast<uint32_t>(st.pid) && s.host == host) return &s;
+  return nullptr;
+}
+
+double secondsSince(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+}  // namespace
+
+// A new process is a new participant, which authenticates and matches with every other one
+// anew: what cures a pair that never matched (Fast DDS 2.9.1, secured: docs/reliability.md).
+void Launcher::checkReadiness() {
+  const auto services = monitor_->services();
+  const std::string host = thisHost();
+  const int limit = o_.deployment.ready_restarts;
+  for (const auto& st : sup_.status()) {
+    if (st.phase != process::ProcessPhase::kRunning || st.pid <= 0) continue;
+    const process::ProcessSpec* spec = sup_.spec(st.name);
+    if (spec == nullptr || !spec->restart || ready_restarts_[st.name] >= limit) continue;
+    const dds::ServiceInfo* seen = heardFrom(services, st, host);
+    if (seen == nullptr || seen->state != msg::SERVICE_STARTING) continue;
+    if (secondsSince(st.started) <= o_.deployment.ready_timeout_s) continue;
+    const int n = ++ready_restarts_[st.name];
+    char why[512];
+    std::snprintf(why, sizeof(why), "not ready within ready_timeout_s (%.1f s) of its start (%s): restarted, %d of %d",
+                  o_.deployment.ready_timeout_s, seen->detail.c_str(), n, limit);
+    (void)sup_.declareDead(st.name, why);
+  }
+}
+
+bool Launcher::readinessGivenUp(const std::string& name) const {
+  const auto st = sup_.status(name);
+  if (!st || st->phase != process::ProcessPhase::kRunning) return false;
+  const process::ProcessSpec* spec = sup_.spec(name);
+  const auto used = ready_restarts_.find(name);
+  const bool more = spec != nullptr && spec->restart && o_.restart &&
+                    (used == ready_restarts_.end() ? 0 : used->second) < o_.deployment.ready_restarts;
+  if (more) return false;
+  const dds::ServiceInfo* seen = heardFrom(monitor_->services(), *st, thisHost());
+  return seen != nullptr && seen->state == msg::SERVICE_STARTING &&
+         secondsSince(st->started) > o_.deployment.ready_timeout_s;
 }
 
 void Launcher::stop(double grace_s) {

@@ -18,10 +18,15 @@
 /// `startup_timeout_s` of its start, or when its last heartbeat (from its own pid) is older than
 /// `liveness_periods` heartbeat periods (a frozen process: SIGSTOP, a deadlocked heartbeat). A
 /// dead service is killed (SIGKILL to its process group) and restarted with exponential back-off.
+///
+/// Readiness: a service alive but not ready (its heartbeat says STARTING: an input it cannot work
+/// without never arrived) `ready_timeout_s` after its start is restarted the same way, at most
+/// `ready_restarts` times per launch, then left running, not ready.
 
 #include <sys/types.h>
 
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -92,6 +97,10 @@ class Launcher {
   /// The participant watching heartbeats (in the run's partition).
   const std::shared_ptr<dds::Participant>& participant() const { return participant_; }
   const dds::HeartbeatMonitor& monitor() const { return *monitor_; }
+  /// True when `name`'s current process has been alive but not ready for the deployment's
+  /// ready_timeout_s and will not be restarted for it any more (ready_restarts used, or a
+  /// service that is not restarted): whoever waits for it to be ready may stop waiting.
+  bool readinessGivenUp(const std::string& name) const;
   /// Appends a supervisor-level event (service "") to events.jsonl.
   void note(const std::string& event, const std::string& detail);
 
@@ -104,6 +113,8 @@ class Launcher {
   void writePidFile();
   void touchLease();
   void checkLiveness();
+  /// Restarts a service alive but not ready for ready_timeout_s (at most ready_restarts times).
+  void checkReadiness();
   Status startOneByOne();
 
   LaunchOptions o_;
@@ -112,6 +123,7 @@ class Launcher {
   std::shared_ptr<dds::Participant> participant_;
   std::unique_ptr<dds::HeartbeatMonitor> monitor_;
   std::vector<std::string> adopted_;
+  std::map<std::string, int> ready_restarts_;  ///< readiness restarts made, by service
   int lock_fd_{-1};
   bool owns_run_dir_{false};  ///< holds launch.lock
   bool pids_dirty_{true};

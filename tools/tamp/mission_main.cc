@@ -68,7 +68,8 @@ int main(int argc, char** argv) {
   }
   tamp::cli::stopOnSignals({SIGINT, SIGTERM}, /*restart=*/true);
   tamp::dds::HeartbeatMonitor monitor(*participant);
-  const tamp::Termination startup = tamp::Termination::after(deployment->startup_timeout_s);
+  // The services' supervisors (tamp launch) restart one that stays not ready: wait that long.
+  const tamp::Termination startup = tamp::Termination::after(deployment->readyWait());
   for (const auto& s : deployment->services) {
     if (s.optional) continue;
     if (!monitor.waitFor(s.name, 1, startup, /*ready=*/true)) {
@@ -76,7 +77,7 @@ int main(int argc, char** argv) {
       for (const auto& info : monitor.services())
         if (info.alive && info.name == s.name) why = "alive but not ready (" + info.detail + ")";
       std::fprintf(stderr, "tamp mission: service '%s' in run %s: %s within %.0f s (tamp status)\n", s.name.c_str(),
-                   rid->c_str(), why.c_str(), deployment->startup_timeout_s);
+                   rid->c_str(), why.c_str(), deployment->readyWait());
       return tamp::cli::kExitServiceError;
     }
   }

@@ -12,7 +12,9 @@
 // talks only to services of the same run, so two `tamp run`s on one DDS domain do not mix. A
 // service that dies is restarted with back-off (events.jsonl in the run folder); a restarted graph
 // manager takes the mission up from its journal (graph_manager.journal.json in the run folder).
-// With --keep-running a service that freezes (no heartbeat) is killed and restarted too.
+// A service that freezes (no heartbeat: a stopped process, a hung main loop, or a busy worker that
+// stopped making progress, dds::WorkWatch) is killed and restarted too, as is one that stays not
+// ready (an input it cannot work without never arrived; the deployment's ready_timeout_s).
 #include <signal.h>
 #include <unistd.h>
 
@@ -127,8 +129,8 @@ int main(int argc, char** argv) {
   tamp::cli::stopOnSignals({SIGINT, SIGTERM}, /*restart=*/true);
 
   // Every service of every host of the deployment, on this machine, attached to this process
-  // (they die with it); restarted when they die, and on a freeze when they are to keep running
-  // (a mission's services may be busy: motion planning, a Traverse, are not frozen).
+  // (they die with it); restarted when they die or freeze. A busy service is not frozen: its
+  // heartbeat thread beats on while its worker makes progress (dds::WorkWatch).
   tamp::deploy::Deployment local = *deployment;
   std::vector<std::string> started, optional_names;
   for (auto& s : local.services) {
@@ -154,7 +156,7 @@ int main(int argc, char** argv) {
   lo.config_dir = tamp::configDir();
   lo.detach = false;
   lo.restart = true;
-  lo.liveness = keep;
+  lo.liveness = true;
   lo.adopt = false;
   tamp::launch::Launcher launcher(lo);
   tamp::process::Supervisor& sup = launcher.supervisor();
@@ -166,20 +168,27 @@ int main(int argc, char** argv) {
     return tamp::cli::kExitServiceError;
   }
 
-  auto participant = tamp::dds::Participant::create({*dom, tamp::dds::kProfileDefault, "tamp/run", {}}, run_id);
-  if (!participant) {
-    std::cerr << "tamp run: " << participant.error().toString() << "\n";
-    return tamp::cli::kExitServiceError;
-  }
-  tamp::dds::HeartbeatMonitor monitor(*participant);
-  const tamp::Termination startup = tamp::Termination::after(deployment->startup_timeout_s);
+  // The launcher's participant, which has heard the services start, serves the mission too: a
+  // second one would have to match every service anew (under DDS Security on Fast DDS 2.9.1, one
+  // such pair in about twenty-five never matched: a service "not alive" that was; docs/reliability.md).
+  const std::shared_ptr<tamp::dds::Participant> participant = launcher.participant();
+  const tamp::dds::HeartbeatMonitor& monitor = launcher.monitor();
+  // Alive within startup_timeout_s of its (re)start; ready as long as the launcher may still
+  // restart a service that stays not ready (ready_timeout_s, ready_restarts).
+  const tamp::Termination ready_wait = tamp::Termination::after(deployment->readyWait());
   std::vector<std::string> not_alive;
   for (const auto& name : started) {
-    while (!monitor.waitFor(name, 1, startup.tightened(tamp::Deadline::in(0.1)), /*ready=*/true)) {
+    while (!monitor.waitFor(name, 1, ready_wait.tightened(tamp::Deadline::in(0.1)), /*ready=*/true)) {
       launcher.poll();
       auto st = sup.status(name);
-      if (startup() || tamp::cli::stopRequested() || (st && st->phase != tamp::process::ProcessPhase::kRunning &&
-                                   st->phase != tamp::process::ProcessPhase::kBackoff)) {
+      bool heard = false;
+      for (const auto& info : monitor.services()) heard = heard || (info.alive && info.name == name);
+      const bool ended = st && st->phase != tamp::process::ProcessPhase::kRunning &&
+                         st->phase != tamp::process::ProcessPhase::kBackoff;
+      const bool silent =
+          !heard && st && st->phase == tamp::process::ProcessPhase::kRunning &&
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - st->started).count() > deployment->startup_timeout_s;
+      if (ready_wait() || silent || launcher.readinessGivenUp(name) || tamp::cli::stopRequested() || ended) {
         not_alive.push_back(name);
         break;
       }
@@ -202,7 +211,7 @@ int main(int argc, char** argv) {
       if (!optional) rc = tamp::cli::kExitServiceError;
       continue;
     }
-    tamp::dds::RpcClient<tamp::msg::EchoRequest, tamp::msg::EchoReply> echo(*participant,
+    tamp::dds::RpcClient<tamp::msg::EchoRequest, tamp::msg::EchoReply> echo(participant,
                                                                              tamp::dds::echoService(name));
     tamp::msg::EchoRequest req;
     req.payload({1, 2, 3, 4});
@@ -241,7 +250,7 @@ int main(int argc, char** argv) {
     mo.seed = seed;
     mo.timeout_s = mission_timeout;
     mo.out_dir = run_dir;
-    rc = tamp::runner::runMission(*participant, mo, [&] {
+    rc = tamp::runner::runMission(participant, mo, [&] {
       launcher.poll();
       return tamp::cli::stopRequested();
     });

@@ -2,10 +2,13 @@
 // multi-process tests, the round-trip benchmark, and to check a deployment's DDS connectivity.
 //
 // For the supervision tests, $TAMP_ECHO_HANG_FILE names a file while whose existence the node's
-// main loop hangs (a service stuck in its work while its heartbeat thread runs on).
+// main loop hangs (a service stuck in its work while its heartbeat thread runs on), and
+// $TAMP_ECHO_NOT_READY_FILE one while whose existence it is alive but not ready (an input that
+// never arrives).
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
+#include <string>
 #include <thread>
 
 #include "tamp/dds/service_node.h"
@@ -15,6 +18,12 @@ class EchoNode : public tamp::dds::ServiceNode {
  public:
   explicit EchoNode(const tamp::dds::ServiceArgs& args) : ServiceNode(args) {
     if (const char* f = std::getenv("TAMP_ECHO_HANG_FILE"); f != nullptr) hang_file_ = f;
+    if (const char* f = std::getenv("TAMP_ECHO_NOT_READY_FILE"); f != nullptr) not_ready_file_ = f;
+  }
+  std::string notReadyBecause() const override {
+    std::error_code ec;
+    if (not_ready_file_.empty() || !std::filesystem::exists(not_ready_file_, ec)) return {};
+    return "no test input while " + not_ready_file_.string() + " exists";
   }
 
  protected:
@@ -26,6 +35,7 @@ class EchoNode : public tamp::dds::ServiceNode {
 
  private:
   std::filesystem::path hang_file_;
+  std::filesystem::path not_ready_file_;
 };
 }  // namespace
 

@@ -124,6 +124,8 @@ Result<Deployment> loadDeployment(const fs::path& file) {
   r.optional("startup_timeout_s", d.startup_timeout_s);
   r.optional("orphan_timeout_s", d.orphan_timeout_s);
   r.optional("stall_timeout_s", d.stall_timeout_s);
+  r.optional("ready_timeout_s", d.ready_timeout_s);
+  r.optional("ready_restarts", d.ready_restarts);
   r.check(d.heartbeat_period_s > 0 && d.heartbeat_period_s <= 10, "heartbeat_period_s",
           "must be in (0, 10]");
   r.check(d.liveness_periods >= 2, "liveness_periods", "must be at least 2");
@@ -131,6 +133,8 @@ Result<Deployment> loadDeployment(const fs::path& file) {
   r.check(d.orphan_timeout_s >= 0, "orphan_timeout_s", "must not be negative (0: never)");
   r.check(std::isfinite(d.stall_timeout_s) && d.stall_timeout_s >= 0, "stall_timeout_s",
           "must be finite and not negative (0: never)");
+  r.check(std::isfinite(d.ready_timeout_s) && d.ready_timeout_s > 0, "ready_timeout_s", "must be finite and positive");
+  r.check(d.ready_restarts >= 0, "ready_restarts", "must not be negative (0: never)");
   if (r.has("restart")) {
     auto rr = r.child("restart");
     rr.optional("max_restarts", d.restart.max_restarts);

@@ -92,6 +92,11 @@ services:
   EXPECT_EQ(d->restart.max_restarts, 2);
   EXPECT_DOUBLE_EQ(d->restart.stable_after_s, 30.0);
   EXPECT_DOUBLE_EQ(d->stall_timeout_s, 20.0);
+  EXPECT_DOUBLE_EQ(d->ready_timeout_s, 20.0);
+  EXPECT_EQ(d->ready_restarts, 2);
+  // The first heartbeat, then two readiness restarts (each after 20 s and at most the 8 s
+  // back-off cap), then 20 s for the last process: 30 + 2 * 28 + 20.
+  EXPECT_DOUBLE_EQ(d->readyWait(), 30.0 + 2 * (20.0 + d->restart.backoff_max_s) + 20.0);
   EXPECT_EQ(d->host("robot")->env, std::vector<std::string>{"A=1"});
   EXPECT_TRUE(d->services[1].optional);
   EXPECT_FALSE(d->services[1].restart);
@@ -159,6 +164,10 @@ TEST_F(DeploymentTest, BadFilesNameTheFieldAndLine) {
               HasSubstr("field 'liveness_periods': must be at least 2"));
   EXPECT_THAT(errorOf("stall_timeout_s: -1\nservices:\n  - {name: a, executable: x}\n"),
               HasSubstr(":1:18: field 'stall_timeout_s': must be finite and not negative"));
+  EXPECT_THAT(errorOf("ready_timeout_s: 0\nservices:\n  - {name: a, executable: x}\n"),
+              HasSubstr(":1:18: field 'ready_timeout_s': must be finite and positive"));
+  EXPECT_THAT(errorOf("ready_restarts: -1\nservices:\n  - {name: a, executable: x}\n"),
+              HasSubstr(":1:17: field 'ready_restarts': must not be negative"));
   EXPECT_THAT(
       errorOf(
           "restart: {backoff_s: 2, backoff_max_s: 1}\nservices:\n  - {name: a, executable: x}\n"),

@@ -362,9 +362,15 @@ void ExecutionMonitorNode::onCommand(const msg::ExecuteCommand& m) {
   }
 }
 
+// Both inputs every command is validated against (a command without them fails before it starts).
 std::string ExecutionMonitorNode::notReadyBecause() const {
-  if (have_state_) return {};
-  return std::string("no robot state yet (") + dds::topics::kRobotState.name + ")";
+  std::string missing;
+  if (!have_state_) missing = std::string("no robot state yet (") + dds::topics::kRobotState.name + ")";
+  if (mirror_ == nullptr || mirror_->publishedVersion() == 0) {
+    missing += missing.empty() ? "" : ", ";
+    missing += std::string("no world model yet (") + dds::topics::kWorldMeta.name + " and its objects)";
+  }
+  return missing;
 }
 
 void ExecutionMonitorNode::onState(const msg::RobotState& m, const dds::SampleMeta& meta) {

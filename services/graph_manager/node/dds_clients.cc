@@ -99,6 +99,21 @@ DdsServiceClients::DdsServiceClients(std::shared_ptr<dds::Participant> p, robot:
       grasp_(p, dds::services::kGrasp, rpcOptions()),
       effort_(p, dds::services::kEffort, rpcOptions()) {}
 
+std::string DdsServiceClients::missingServers() const {
+  std::string missing;
+  auto check = [&missing](bool present, const char* service) {
+    if (present) return;
+    missing += missing.empty() ? "no server matched for " : ", ";
+    missing += service;
+  };
+  check(plan_.serverPresent(), dds::services::kPlan.name);
+  check(motion_.serverPresent(), dds::services::kMotion.name);
+  check(placement_.serverPresent(), dds::services::kPlacement.name);
+  check(grasp_.serverPresent(), dds::services::kGrasp.name);
+  check(effort_.serverPresent(), dds::services::kEffort.name);
+  return missing;
+}
+
 TaskPlan DdsServiceClients::plan(const TaskQuery& q) {
   const auto t0 = Clock::now();
   msg::PlanRequest req;
@@ -446,25 +461,30 @@ Observation DdsWorldSource::robot() {
 }
 
 Status DdsWorldSource::waitReady(const Termination& until) {
-  bool state = false;
-  bool world = false;
-  while (!until()) {
-    {
-      std::lock_guard g(mutex_);
-      state = last_.has_value();
-    }
-    world = mirror_.publishedVersion() > 0;
-    if (state && world) return Status::Ok();
+  std::string missing = missingInputs();
+  while (!missing.empty() && !until()) {
     alive();
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    missing = missingInputs();
   }
+  if (missing.empty()) return Status::Ok();
+  return Error(ErrorCode::kUnavailable, missing);
+}
+
+std::string DdsWorldSource::missingInputs() const {
+  bool state = false;
+  {
+    std::lock_guard g(mutex_);
+    state = last_.has_value();
+  }
+  const bool world = mirror_.publishedVersion() > 0;
   std::string missing;
   if (!world) missing = "no complete world model (" + std::string(dds::topics::kWorldMeta.name) + " and its objects, from perception)";
   if (!state) {
     if (!missing.empty()) missing += " and ";
     missing += "no robot state (" + std::string(dds::topics::kRobotState.name) + " from the robot)";
   }
-  return Error(ErrorCode::kUnavailable, missing);
+  return missing;
 }
 
 }  // namespace tamp::graph_manager

@@ -49,6 +49,8 @@ class DdsServiceClients : public ServiceClients, public Watched {
   Result<std::vector<GraspOption>> grasps(const GraspQuery& q) override;
   std::vector<EffortAnswer> effort(const std::vector<EffortQuery>& q) override;
   std::optional<std::uint64_t> effortModelVersion() override;
+  /// The services none of whose servers is matched yet ("" once every one is). Thread-safe.
+  std::string missingServers() const;
 
  private:
   /// `rep` screened (checked), the worker kicked: a call came back.
@@ -75,6 +77,8 @@ class DdsExecutor : public Executor, public Watched {
   void setMission(const std::string& id) { mission_id_ = id; }
   /// The id a command of the current mission has on the wire.
   std::string wireId(const std::string& command_id) const { return mission_id_ + "/" + command_id; }
+  /// True once an execution monitor's command reader and status writer are matched.
+  bool monitorPresent() const { return writer_.matchedReaders() > 0 && reader_.matchedWriters() > 0; }
 
  private:
   void onStatus(const msg::ExecuteStatus& s);
@@ -101,11 +105,13 @@ class DdsWorldSource : public WorldSource, public Watched {
   Observation robot() override;
   /// Waits until a robot state and a world model have arrived. On a timeout, says which did not.
   Status waitReady(const Termination& until);
+  /// Which of the two has not arrived yet ("" once both have). Thread-safe.
+  std::string missingInputs() const;
 
  private:
   robot::RobotModel robot_;
   dds::WorldMirror mirror_;
-  std::mutex mutex_;
+  mutable std::mutex mutex_;
   std::optional<msg::RobotState> last_;
   dds::Reader<msg::RobotState> state_;
 };

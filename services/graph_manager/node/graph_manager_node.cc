@@ -84,6 +84,19 @@ GraphManagerNode::GraphManagerNode(const dds::ServiceArgs& args, GraphManagerPar
       [this](const msg::MissionCommand& c, const dds::SampleMeta&) { onCommand(c); });
 }
 
+std::string GraphManagerNode::notReadyBecause() const {
+  std::string missing = source_.missingInputs();
+  auto add = [&missing](const std::string& what) {
+    if (what.empty()) return;
+    missing += missing.empty() ? "" : "; ";
+    missing += what;
+  };
+  add(clients_.missingServers());
+  add(executor_.monitorPresent() ? std::string()
+                                 : std::string("no execution monitor matched (") + dds::topics::kExecuteCommand.name + ")");
+  return missing;
+}
+
 GraphManagerNode::~GraphManagerNode() {
   commands_.reset();
   abort_ = true;

@@ -29,6 +29,9 @@ class GraphManagerNode : public dds::ServiceNode {
   static Result<std::unique_ptr<dds::ServiceNode>> create(const dds::ServiceArgs& args);
   GraphManagerNode(const dds::ServiceArgs& args, GraphManagerParams params, const robot::RobotModel& robot);
   ~GraphManagerNode() override;
+  /// A robot state, a world model, and every service it calls matched (an execution monitor
+  /// included): what a mission starts from.
+  std::string notReadyBecause() const override;
 
  private:
   msgv::RejectLog rejects_{"graph_manager"};  // malformed input: logged once per kind, rate-limited

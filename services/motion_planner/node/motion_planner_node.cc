@@ -152,6 +152,11 @@ MotionPlannerNode::~MotionPlannerNode() {
   mirror_.reset();
 }
 
+std::string MotionPlannerNode::notReadyBecause() const {
+  if (mirror_ != nullptr && mirror_->publishedVersion() > 0) return {};
+  return std::string("no world model yet (") + dds::topics::kWorldMeta.name + " and its objects)";
+}
+
 std::pair<uint64_t, uint64_t> MotionPlannerNode::requestCounters() const {
   auto [served, failed] = ServiceNode::requestCounters();
   if (motion_) {

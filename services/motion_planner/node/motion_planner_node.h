@@ -87,6 +87,8 @@ class MotionPlannerNode : public dds::ServiceNode {
 
  protected:
   std::pair<uint64_t, uint64_t> requestCounters() const override;
+  /// A world model (requests are planned in it; before it, they are answered NOT_READY).
+  std::string notReadyBecause() const override;
   void spinOnce() override;
 
  private:

@@ -10,6 +10,8 @@
 ///   startup_timeout_s: 30     # from start to first heartbeat
 ///   orphan_timeout_s: 60      # a launched service outlives a dead supervisor so long (0: always)
 ///   stall_timeout_s: 20       # a service's main loop may hang so long before it stops beating (0: never)
+///   ready_timeout_s: 20       # alive but not ready (an input never arrived) so long after its start:
+///   ready_restarts: 2         #   restarted, at most this many times per launch (0: never)
 ///   restart: {max_restarts: 5, backoff_s: 0.5, backoff_max_s: 8, stable_after_s: 30}
 ///   discovery: {mode: multicast}  # default; or, on networks without multicast:
 ///   discovery: {mode: server, servers: ["10.0.0.1:11811"], server_host: workstation}
@@ -82,6 +84,13 @@ struct Deployment {
   /// >= 0; a service whose main loop does not turn for this long stops beating (then counts as
   /// dead after livenessTimeout() more); 0: never (ServiceArgs::stall_timeout_s).
   double stall_timeout_s{20.0};
+  /// > 0; a service alive but not ready (ServiceNode::notReadyBecause: an input it cannot work
+  /// without never arrived) this long after its start is restarted, at most `ready_restarts`
+  /// times (>= 0) per launch: a new participant matches every other one anew (on Fast DDS 2.9.1,
+  /// secured, a pair of participants sometimes never matched; docs/reliability.md). After that it
+  /// is left running, not ready (a robot driver that is off is not cured by restarts).
+  double ready_timeout_s{20.0};
+  int ready_restarts{2};
   RestartPolicy restart;
   DiscoverySpec discovery;
   std::vector<HostSpec> hosts;  ///< at least one ("local" when the file names none)
@@ -92,6 +101,11 @@ struct Deployment {
   std::vector<const ServiceSpec*> servicesOn(const std::string& host) const;
   /// Seconds without a heartbeat after which a running service counts as dead.
   double livenessTimeout() const { return heartbeat_period_s * liveness_periods; }
+  /// How long a tool waits for every service to be ready: the first heartbeat, then every
+  /// readiness restart the supervisor may make, each after ready_timeout_s and a back-off.
+  double readyWait() const {
+    return startup_timeout_s + ready_restarts * (ready_timeout_s + restart.backoff_max_s) + ready_timeout_s;
+  }
 };
 
 /// The implicit host of a file without `hosts`.

@@ -9,6 +9,7 @@
 
 #include "tamp/core/log.h"
 #include "tamp/graph_manager/graph_manager.h"
+#include "tamp/graph_manager/drop_settle.h"
 #include "state_atoms.h"
 
 namespace tamp::graph_manager {
@@ -632,24 +633,19 @@ void GraphManager::Run::awaitRefit() {
 }
 
 void GraphManager::Run::awaitSettled(const std::string& object) {
-  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                           std::chrono::duration<double>(gm.params_.drop_settle_timeout_s));
   const auto t0 = Clock::now();
+  DropSettleWatch watch(object, gm.params_.drop_confirm_s);
   while (true) {
-    const world::World w = source.world();
-    if (const world::Object* o = w.findObject(object)) {
-      const double half = o->shape.halfHeight();
-      const Eigen::Vector3d bottom = o->pose.translation() - Eigen::Vector3d(0, 0, half);
-      const world::Region* below = w.regionBelow(bottom, 0.05);
-      const double support = below ? below->height : 0.0;
-      if (std::abs(bottom.z() - support) <= 0.05) {
-        log::get("graph_manager")->info("'{}' rests at ({:.2f}, {:.2f}, {:.2f}) {:.3f} s after the drop", object,
-                                        o->pose.translation().x(), o->pose.translation().y(), o->pose.translation().z(),
-                                        since(t0));
-        return;
-      }
+    if (watch.settled(source.world(), since(t0))) {
+      const Eigen::Vector3d& p = *watch.restingAt();
+      log::get("graph_manager")->info("'{}' rests at ({:.2f}, {:.2f}, {:.2f}) {:.3f} s after the drop{}", object, p.x(), p.y(),
+                                      p.z(), since(t0),
+                                      watch.restarts() > 0 ? " (its estimate vanished or moved " +
+                                                                 std::to_string(watch.restarts()) + " time(s) first)"
+                                                           : std::string());
+      return;
     }
-    if (Clock::now() >= deadline) {
+    if (since(t0) >= gm.params_.drop_settle_timeout_s) {
       log::get("graph_manager")->warn("'{}' not seen resting on a support {:.1f} s after the drop: planning from the world model as it is",
                                       object, gm.params_.drop_settle_timeout_s);
       return;

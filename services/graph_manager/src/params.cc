@@ -72,7 +72,8 @@ const config::Schema<GraphManagerParams>& schema() {
         .field("held_object_wait_s", &P::held_object_wait_s, positive())
         .field("max_action_failures", &P::max_action_failures, atLeast(1))
         .field("moved_object_tolerance_m", &P::moved_object_tolerance_m, positive())
-        .field("drop_settle_timeout_s", &P::drop_settle_timeout_s, atLeast(0.0));
+        .field("drop_settle_timeout_s", &P::drop_settle_timeout_s, atLeast(0.0))
+        .field("drop_confirm_s", &P::drop_confirm_s, atLeast(0.0));
     return s;
   }();
   return kSchema;

@@ -125,6 +125,10 @@ struct GraphManagerParams {
   /// robot reports the empty hand before perception has seen where the object fell: a re-pick
   /// planned on the estimate of a falling object sends the gripper into it.
   double drop_settle_timeout_s{2.0};
+  /// After a drop, the object must rest unchanged in the world model this long (s, >= 0) before
+  /// a re-pick is planned from it (DropSettleWatch): the first frames after a drop may move the
+  /// fall estimate, or call it gone before perception sees where the object really fell.
+  double drop_confirm_s{0.3};
   /// A restarted graph manager takes up an unfinished mission of its journal only when the
   /// journal was written at most this long ago (s, > 0): a deployment started again hours later
   /// must not set the robot moving on an old mission. An older one is closed as aborted.

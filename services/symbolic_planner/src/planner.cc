@@ -478,7 +478,8 @@ PlanReply Planner::solve(const PlanRequest& req, const Termination& caller_term)
     reply.stats.parse_seconds = parse_s;
     if (reply.status == PlanStatus::kSolved && req.check_plan) {
       Stopwatch check_sw;
-      ValidationResult v = validatePlan(*domain, problem, reply.plan, std::nullopt, std::nullopt, req.return_states);
+      ValidationResult v =
+          validatePlan(*domain, problem, reply.plan, std::nullopt, std::nullopt, req.return_states);
       reply.stats.check_seconds = check_sw.seconds();
       if (!v.valid) {
         reply.status = PlanStatus::kInternalError;

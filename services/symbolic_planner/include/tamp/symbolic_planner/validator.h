@@ -47,9 +47,9 @@ struct ValidationResult {
 /// problem's goal) at the end. With `record_states` false, `states` stays empty and the verdict,
 /// step, message and cost are the same: the states are a copy of every true atom per step (static
 /// ones included), sorted, which on a long plan over many atoms costs far more than the replay
-/// itself (issue 14, twenty-eighth round: miconic-120, 78 steps over about 1 200 true atoms, a run of
-/// 15.9 ms CPU without them 7.9 ms, the replay 0.3 ms), so callers that only want the verdict
-/// leave them out.
+/// itself (issue 14, twenty-eighth round: miconic-120, 78 steps over about 1 200 true atoms, a
+/// run of 15.9 ms CPU, 7.9 ms without them, the replay 0.3 ms), so callers that only want the
+/// verdict leave them out.
 ValidationResult validatePlan(const pddl::Domain& domain, const pddl::Problem& problem,
                               const std::vector<PlanStep>& plan,
                               const std::optional<std::vector<pddl::Atom>>& init = std::nullopt,

@@ -1,4 +1,4 @@
-# Issue 14, twenty-eighth round: the alternations (rounds 0-3; per round and domain one driver
+# Issue 14, twenty-eighth round: the alternations (rounds 0-4; per round and domain one driver
 # call of main, then one of the new binary, the lock per instance): per domain and round, the
 # median wall and CPU time of each over the instances FF 2.3 solves, against FF's median.
 import csv, sys, statistics as st

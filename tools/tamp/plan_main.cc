@@ -295,6 +295,7 @@ int main(int argc, char** argv) {
   if (cost_type == "plusone") req.search.cost_type = sp::CostType::kPlusOne;
   req.timeout_seconds = timeout;
   req.check_plan = !no_check;
+  req.return_states = false;  // only the plan is printed
   req.prune_irrelevant = prune_irrelevant;
   // The planner (and the grounding its cache keeps) is deliberately never destroyed: freeing the
   // grounding piece by piece at exit costs 0.2-0.3 ms per run, which is what a process-per-instance
@@ -303,12 +304,12 @@ int main(int argc, char** argv) {
   const sp::PlanReply reply = planner->solve(req, tamp::Termination());
   if (stats) {
     std::fprintf(stderr,
-                 "; status %s; parse %.4f s, ground %.4f s, search %.4f s; facts %zu, operators %zu; "
+                 "; status %s; parse %.4f s, ground %.4f s, search %.4f s, check %.4f s; facts %zu, operators %zu; "
                  "expanded %llu, evaluated %llu, initial h %lld; ehc plateau retries %llu (%llu abandoned); ehc fallbacks "
                  "%llu (%llu in a goal-agenda entry before the last); anytime %llu "
                  "iterations, %llu improvements; landmarks %llu (%llu disjunctive, %llu greedy-necessary, %llu reasonable orders); ehc h^2 restarts %llu (%llu tests, %llu dead ends)%s%s%s%s%s",
                  sp::toString(reply.status).c_str(), reply.stats.parse_seconds, reply.stats.ground_seconds,
-                 reply.stats.search_seconds, reply.stats.facts, reply.stats.operators,
+                 reply.stats.search_seconds, reply.stats.check_seconds, reply.stats.facts, reply.stats.operators,
                  static_cast<unsigned long long>(reply.stats.expanded),
                  static_cast<unsigned long long>(reply.stats.evaluated), static_cast<long long>(reply.stats.initial_h),
                  static_cast<unsigned long long>(reply.stats.ehc_retries),

@@ -379,7 +379,8 @@ int main(int argc, char** argv) {
       if (plan && ptext) {
         auto prob = sp::pddl::parseProblem(*ptext, *dom, p.string());
         if (prob) {
-          const sp::ValidationResult v = sp::validatePlan(*dom, *prob, *plan);
+          const sp::ValidationResult v =
+              sp::validatePlan(*dom, *prob, *plan, std::nullopt, std::nullopt, /*record_states=*/false);
           row.solved = v.valid;
           row.plan_length = static_cast<long>(plan->size());
           row.plan_cost = v.cost;

@@ -477,7 +477,10 @@ PlanReply Planner::solve(const PlanRequest& req, const Termination& caller_term)
     PlanReply reply = session->solve(q, term);
     reply.stats.parse_seconds = parse_s;
     if (reply.status == PlanStatus::kSolved && req.check_plan) {
-      ValidationResult v = validatePlan(*domain, problem, reply.plan);
+      Stopwatch check_sw;
+      ValidationResult v =
+          validatePlan(*domain, problem, reply.plan, std::nullopt, std::nullopt, req.return_states);
+      reply.stats.check_seconds = check_sw.seconds();
       if (!v.valid) {
         reply.status = PlanStatus::kInternalError;
         reply.message = "plan checker rejected the plan: " + v.message;

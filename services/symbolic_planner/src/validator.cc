@@ -227,13 +227,13 @@ std::vector<std::string> atomList(const std::set<std::string>& state) {
 
 ValidationResult validatePlan(const pddl::Domain& domain, const pddl::Problem& problem,
                               const std::vector<PlanStep>& plan, const std::optional<std::vector<pddl::Atom>>& init,
-                              const std::optional<pddl::Formula>& goal) {
+                              const std::optional<pddl::Formula>& goal, bool record_states) {
   Checker ck(domain, problem);
   ValidationResult r;
   std::set<std::string> state;
   Binding empty;
   for (const auto& a : init ? *init : problem.init) state.insert(ck.groundAtom(a, empty));
-  r.states.push_back(atomList(state));
+  if (record_states) r.states.push_back(atomList(state));
   for (size_t i = 0; i < plan.size(); ++i) {
     const PlanStep& st = plan[i];
     const std::string where = "step " + std::to_string(i + 1) + " " + st.toString() + ": ";
@@ -272,7 +272,7 @@ ValidationResult validatePlan(const pddl::Domain& domain, const pddl::Problem& p
     ck.effects(*act, state, b, adds, dels);
     for (const auto& d : dels) state.erase(d);
     for (const auto& a : adds) state.insert(a);
-    r.states.push_back(atomList(state));
+    if (record_states) r.states.push_back(atomList(state));
   }
   r.failed_step = -1;
   Binding b;

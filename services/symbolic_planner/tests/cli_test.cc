@@ -205,6 +205,20 @@ TEST_F(Cli, ReasonableOrdersAreCountedInTheStatsWhenAskedFor) {
   EXPECT_EQ(bad.code, 30) << bad.out;
 }
 
+// Issue 14, twenty-eighth round: the plan's replay by the independent checker is timed in --stats,
+// and not run with --no-check.
+TEST_F(Cli, TheChecksTimeIsInTheStats) {
+  const auto miconic = test::benchmarksDir() / "pddl/miconic";  // 99 steps: a replay of >= 0.1 ms
+  const std::string task = (miconic / "domain.pddl").string() + " " + (miconic / "instance-150.pddl").string();
+  CliRun on = runCli(task + " --stats");
+  ASSERT_EQ(on.code, 0) << on.out;
+  ASSERT_NE(on.out.find(", check "), std::string::npos) << on.out;
+  EXPECT_EQ(on.out.find(", check 0.0000 s"), std::string::npos) << on.out;  // it ran (>= 50 us)
+  CliRun off = runCli(task + " --stats --no-check");
+  ASSERT_EQ(off.code, 0) << off.out;
+  EXPECT_NE(off.out.find(", check 0.0000 s"), std::string::npos) << off.out;
+}
+
 TEST_F(Cli, ExitCodes) {
   // 30: input error, with file:line:column.
   const std::string broken = tmpFile("broken.pddl", "(define (problem x)\n  (:domain mobile-manipulation)\n  (:init (robot-at nowhere))\n  (:goal (hand-empty)))\n");

@@ -181,5 +181,37 @@ TEST(Planner, CachesSessionsAcrossSelfContainedRequests) {
   EXPECT_NE(d.message.find("/nonexistent/domain.pddl"), std::string::npos) << d.message;
 }
 
+// Issue 14, twenty-eighth round: the replay's states are returned only when asked for; the plan
+// is checked either way, and the check's time is counted when it runs.
+TEST(Planner, ReturnsTheReplayedStatesOnlyWhenAskedAndTimesTheCheck) {
+  const auto dir = test::sourceDir() / "config/pddl";
+  Planner planner(0);
+  PlanRequest req;
+  req.domain_path = (dir / "mobile_manipulation.pddl").string();
+  req.objects = {{"start", "location"}, {"near_table", "location"}, {"table", "region"},
+                 {"over_table", "armconf"}, {"can", "item"}};
+  req.init = {{"robot-at", {"start"}}, {"arm-at", {"stow"}}, {"hand-empty", {}}, {"on", {"can", "table"}},
+              {"graspable", {"can"}}, {"reaches", {"start", "stow"}}, {"reaches", {"near_table", "stow"}},
+              {"reaches", {"near_table", "over_table"}}, {"conf-over", {"over_table", "table"}}};
+  req.goal = "(holding can)";
+  PlanReply with = planner.solve(req, Termination());
+  ASSERT_EQ(with.status, PlanStatus::kSolved) << with.message;
+  EXPECT_EQ(with.states.size(), with.plan.size() + 1);
+  EXPECT_GT(with.stats.check_seconds, 0.0);
+  req.return_states = false;
+  PlanReply without = planner.solve(req, Termination());
+  ASSERT_EQ(without.status, PlanStatus::kSolved) << without.message;
+  EXPECT_TRUE(without.states.empty());
+  EXPECT_EQ(without.plan, with.plan);
+  EXPECT_EQ(without.cost, with.cost);
+  EXPECT_GT(without.stats.check_seconds, 0.0);  // checked all the same
+  req.check_plan = false;
+  req.return_states = true;
+  PlanReply unchecked = planner.solve(req, Termination());
+  ASSERT_EQ(unchecked.status, PlanStatus::kSolved) << unchecked.message;
+  EXPECT_TRUE(unchecked.states.empty());
+  EXPECT_EQ(unchecked.stats.check_seconds, 0.0);
+}
+
 }  // namespace
 }  // namespace tamp::symbolic_planner

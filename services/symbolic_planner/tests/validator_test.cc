@@ -61,6 +61,28 @@ TEST_F(Validator, ReportsTheStatesAlongThePlan) {
   for (const auto& s : v.states) EXPECT_TRUE(std::is_sorted(s.begin(), s.end()));
 }
 
+// Issue 14, twenty-eighth round: a caller that wants only the verdict leaves the states out and
+// gets the same verdict, cost, step and message, valid plan or not.
+TEST_F(Validator, LeavesTheStatesOutWhenNotAskedAndGivesTheSameVerdict) {
+  auto plan = steps(kGoodPlan);
+  ValidationResult with = validatePlan(domain_, problem_, plan);
+  ValidationResult without = validatePlan(domain_, problem_, plan, std::nullopt, std::nullopt, false);
+  ASSERT_TRUE(with.valid) << with.message;
+  EXPECT_EQ(with.states.size(), plan.size() + 1);
+  EXPECT_TRUE(without.valid) << without.message;
+  EXPECT_TRUE(without.states.empty());
+  EXPECT_DOUBLE_EQ(without.cost, with.cost);
+  EXPECT_EQ(without.failed_step, -1);
+  plan.erase(plan.begin() + 6);  // unlock while holding b1: step 7 fails
+  with = validatePlan(domain_, problem_, plan);
+  without = validatePlan(domain_, problem_, plan, std::nullopt, std::nullopt, false);
+  EXPECT_FALSE(without.valid);
+  EXPECT_EQ(without.failed_step, with.failed_step);
+  EXPECT_EQ(without.message, with.message);
+  EXPECT_EQ(with.states.size(), 7U);  // up to the failed step
+  EXPECT_TRUE(without.states.empty());
+}
+
 TEST_F(Validator, NamesTheFirstInapplicableStep) {
   auto p = steps(kGoodPlan);
   p.erase(p.begin() + 6);  // keep holding b1: unlock's forall (not (holding ?i)) fails

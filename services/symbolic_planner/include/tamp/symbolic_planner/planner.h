@@ -77,6 +77,7 @@ struct PlanStatistics {
   double parse_seconds{0.0};
   double ground_seconds{0.0};   ///< exploration + task construction (0 when cached)
   double search_seconds{0.0};
+  double check_seconds{0.0};    ///< the independent replay of the plan (PlanRequest::check_plan)
   bool grounding_reused{false};
   size_t facts{0};
   size_t operators{0};
@@ -130,6 +131,9 @@ struct PlanRequest {
   SearchOptions search;
   double timeout_seconds{60.0};  ///< on top of the caller's Termination; <= 0: none
   bool check_plan{true};     ///< replay the plan with the independent checker before replying
+  /// With `check_plan`: fill PlanReply::states from the replay. A caller that wants only the
+  /// plan (`tamp plan`) sets it false and saves a copy of every true atom per step.
+  bool return_states{true};
   bool prune_irrelevant{true};  ///< see Query::prune_irrelevant
 };
 
@@ -140,8 +144,9 @@ struct PlanReply {
   Cost cost{0};          ///< total-cost of the plan (its length without a metric)
   std::string message;   ///< for errors: what and where; empty on success
   PlanStatistics stats;
-  /// When solved and checked (`check_plan`): every true ground atom of each state along the
-  /// plan, from the independent replay (states[0] the initial state, states[i + 1] after step i).
+  /// When solved, checked (`check_plan`) and asked for (`return_states`): every true ground atom
+  /// of each state along the plan, from the independent replay (states[0] the initial state,
+  /// states[i + 1] after step i).
   std::vector<std::vector<std::string>> states;
 };
 

@@ -223,9 +223,26 @@ std::string PerceptionNode::notReadyBecause() const {
   return std::string("no robot state yet (") + dds::topics::kRobotState.name + ")";
 }
 
+namespace {
+
+/// The latest change, at or before `stamp_ns`, from a state holding an object to one with the
+/// gripper empty: that first empty state and the object let go; nullopt without one.
+std::optional<std::pair<StampedRobotState, std::string>> lastRelease(const std::deque<StampedRobotState>& states,
+                                                                     std::int64_t stamp_ns) {
+  for (std::size_t i = states.size(); i-- > 1;) {
+    const StampedRobotState& s = states[i];
+    if (s.stamp_ns > stamp_ns) continue;
+    if (s.held_object_id.empty() && !states[i - 1].held_object_id.empty()) return std::pair{s, states[i - 1].held_object_id};
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
 std::optional<RobotBody> PerceptionNode::bodyAt(std::int64_t stamp_ns, std::stop_token stop) const {
   if (!options_.robot) return std::nullopt;
   std::optional<StampedRobotState> at;
+  std::optional<std::pair<StampedRobotState, std::string>> release;  // first empty state, object let go
   {
     std::unique_lock lock(state_mutex_);
     // The state of the frame's instant may still be on its way (another topic, another thread):
@@ -234,9 +251,15 @@ std::optional<RobotBody> PerceptionNode::bodyAt(std::int64_t stamp_ns, std::stop
     state_cv_.wait_for(lock, stop, wait,
                        [&] { return !states_seen_.empty() && states_seen_.back().stamp_ns >= stamp_ns; });
     at = robotStateAt(states_seen_, stamp_ns, options_.robot_state_max_age_s);
+    if (at) release = lastRelease(states_seen_, stamp_ns);
   }
   if (!at) return std::nullopt;
-  return robotBodyAt(*options_.robot, at->state, at->held_object_id, at->stamp_ns);
+  RobotBody body = robotBodyAt(*options_.robot, at->state, at->held_object_id, at->stamp_ns);
+  if (release && at->held_object_id.empty()) {
+    body.released_object_id = release->second;
+    body.world_T_tool_at_release = robotBodyAt(*options_.robot, release->first.state, {}, release->first.stamp_ns).world_T_tool;
+  }
+  return body;
 }
 
 void PerceptionNode::work(std::stop_token stop) {

@@ -554,6 +554,50 @@ TEST(SelfFilterTest, ADroppedObjectFallsOntoTheSupportBelowIt) {
   EXPECT_GE(count(run.events, EventType::kMoved), 1);
 }
 
+// Carried, seen held for the last time, carried on, then dropped between two frames: the robot's
+// states say where the gripper was when it first reported itself empty (RobotBody::
+// world_T_tool_at_release), and the fall estimate starts there, not where the last frame saw it
+// held (half a second of driving earlier: 19 cm short in transport_drop, and seen empty there,
+// the parcel was called gone).
+TEST(SelfFilterTest, ADroppedObjectFallsFromWhereTheGripperLetItGo) {
+  const robot::RobotState ready = armReady();
+  const Eigen::Isometry3d tool = robotModel().toolPoseInWorld(ready);
+  const auto [prior, parcel] = parcelOnStand(tool.translation());
+  world::World truth = prior;
+  sim::DepthSensor camera = robotCamera();
+  Perception p(prior, PerceptionParams{});
+  int64_t stamp = kSecond;
+  (void)look(p, truth, ready, 2, true, stamp, camera);
+  const Eigen::Isometry3d tool_T_parcel = tool.inverse() * parcel.pose;
+  (void)look(p, truth, ready, 1, true, stamp, camera, "parcel");  // grasped where it stands
+  const robot::RobotState carried_at = armReady(0.5);
+  world::Object carried = parcel;
+  carried.pose = robotModel().toolPoseInWorld(carried_at) * tool_T_parcel;
+  ASSERT_TRUE(truth.updateObject(carried).ok());
+  (void)look(p, truth, carried_at, 1, true, stamp, camera, "parcel");  // the last frame that sees it held
+  ASSERT_EQ(p.heldObject(), "parcel");
+  // Carried on to 0.9 rad, dropped there (between frames); the next frame comes at 1.0 rad.
+  const robot::RobotState let_go = armReady(0.9), now = armReady(1.0);
+  const Eigen::Isometry3d release_tool = robotModel().toolPoseInWorld(let_go);
+  world::Object fallen = parcel;
+  const Eigen::Vector3d at = (release_tool * tool_T_parcel).translation();
+  fallen.pose = testing::box("x", 0.05, 0.05, parcel.shape.size.z(), at.x(), at.y(), 0.0).pose;
+  ASSERT_TRUE(truth.updateObject(fallen).ok());
+  const PointCloudFrame f = camera.capture(truth, robotModel(), now, stamp);
+  RobotBody body = robotBodyAt(robotModel(), now, {}, stamp);
+  body.world_T_tool_at_release = release_tool;
+  body.released_object_id = "parcel";
+  auto r = p.processFrame(f, Termination(), &body);
+  ASSERT_TRUE(r.ok()) << r.error().toString();
+  EXPECT_EQ(p.heldObject(), "");
+  ASSERT_NE(p.world().findObject("parcel"), nullptr);
+  const Eigen::Vector3d estimate = p.world().object("parcel").pose.translation();
+  const Eigen::Vector3d last_held = carried.pose.translation();
+  EXPECT_LT((estimate - fallen.pose.translation()).head<2>().norm(), 0.03) << "at " << estimate.transpose();
+  // The point of the test: the carried-on distance is far beyond the tolerance.
+  EXPECT_GT((last_held - fallen.pose.translation()).head<2>().norm(), 0.1);
+}
+
 // Dropped before perception ever saw it held (the drop came right after start-up): the prior has it
 // in the air, its place is seen empty. It fell: the world model puts it on the floor below, not gone.
 TEST(SelfFilterTest, AnObjectSeenEmptyInTheAirFellOntoTheSupportBelow) {

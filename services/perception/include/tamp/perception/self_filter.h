@@ -45,6 +45,12 @@ struct RobotBody {
   Eigen::Isometry3d world_T_tool{Eigen::Isometry3d::Identity()};  ///< the tool link (held object)
   std::int64_t stamp_ns{0};  ///< of the robot state it was computed from
   std::string base_link;     ///< owner of the parts that drive on the floor (objects cannot be inside them)
+  /// The tool where the robot's state first reported the gripper empty after holding
+  /// `released_object_id` (the latest such change up to this instant), if known: where a dropped
+  /// object left the gripper. A frame's own instant may be long after (states come every 50 ms,
+  /// frames every 0.5 s), and the last frame that saw it held longer before.
+  std::optional<Eigen::Isometry3d> world_T_tool_at_release;
+  std::string released_object_id;
 };
 
 /// What the robot reported at one instant: its state and the object in its gripper.

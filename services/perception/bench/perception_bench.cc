@@ -322,6 +322,10 @@ Tally runScene(const Scene& scene, bool with_classes, int frames_per_view) {
     const tp::PoseError e = tp::poseError(gt[i]->shape, gt[i]->pose, f.pose);
     t.xy.push_back(e.xy);
     t.z.push_back(e.z);
+    if (std::getenv("TAMP_BENCH_VERBOSE") != nullptr)
+      std::fprintf(stderr, "%s %s: truth (%.3f, %.3f) perceived %s (%.3f, %.3f) size %.2f x %.2f: xy error %.3f m\n",
+                   scene.name.c_str(), gt[i]->id.c_str(), gt[i]->pose.translation().x(), gt[i]->pose.translation().y(),
+                   f.id.c_str(), f.pose.translation().x(), f.pose.translation().y(), f.shape.size.x(), f.shape.size.y(), e.xy);
     if (tp::yawSymmetry(gt[i]->shape) > 0) t.yaw.push_back(e.yaw);
   }
   t.false_pos = t.perceived - t.found;

@@ -784,7 +784,9 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
     if (!t.size_known) {
       I.growShape(t, dets[i]);
       // Refit the grown shape (anchored on the seen faces) for the pose.
-      meas = fitShape(dets[i], t.shape, sensor, T, yawOf(t.pose), t.pose.translation().head<2>(), seenFree).pose;
+      meas = fitShape(dets[i], t.shape, sensor, T, yawOf(t.pose), t.pose.translation().head<2>(), seenFree,
+                      /*known_size=*/false)
+                 .pose;
       log::get("perception")->debug("{} grown to {:.2f} x {:.2f}: detection rect {:.2f} x {:.2f} yaw {:.2f} at ({:.2f}, {:.2f}); fit ({:.2f}, {:.2f}) yaw {:.2f}, track ({:.2f}, {:.2f})",
                                     t.id, t.shape.size.x(), t.shape.size.y(), dets[i].rect.extents.x(), dets[i].rect.extents.y(),
                                     dets[i].rect.yaw, dets[i].pose.translation().x(), dets[i].pose.translation().y(),

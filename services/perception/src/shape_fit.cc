@@ -379,9 +379,36 @@ Detection describeCluster(std::vector<Eigen::Vector3d> points, double support_z,
 
 // ---- known shapes -------------------------------------------------------------------------------
 
+namespace {
+
+/// Where, along `along` from the detection's rectangle centre, the face across `along` that the
+/// sensor sees stands: the median of the points below the top (not the top face) and inside the
+/// rectangle's width `width` along `across`, `margin` clear of its ends (not the side faces). On a
+/// box seen from outside these are that face's points alone. nullopt: too few to tell.
+std::optional<double> nearFace(const Detection& det, const Eigen::Vector2d& along, const Eigen::Vector2d& across,
+                               double width, double margin) {
+  constexpr std::size_t kMinPoints = 12;
+  const double half = width / 2 - margin;
+  if (half < 0.02) return std::nullopt;
+  const double below_top = det.top_z - std::max(0.01, 0.2 * det.height);
+  std::vector<double> at;
+  for (const auto& p : det.points) {
+    if (p.z() > below_top) continue;
+    const Eigen::Vector2d q = p.head<2>() - det.rect.centre;
+    if (std::abs(q.dot(across)) > half) continue;
+    at.push_back(q.dot(along));
+  }
+  if (at.size() < kMinPoints) return std::nullopt;
+  auto mid = at.begin() + static_cast<std::ptrdiff_t>(at.size() / 2);
+  std::nth_element(at.begin(), mid, at.end());
+  return *mid;
+}
+
+}  // namespace
+
 ShapeFit fitShape(const Detection& det, const world::Shape& shape, const Eigen::Vector3d& sensor,
                   const TrackingParams& params, double yaw_hint, const std::optional<Eigen::Vector2d>& origin_hint,
-                  const std::function<bool(const Eigen::Vector3d&)>& seen_free) {
+                  const std::function<bool(const Eigen::Vector3d&)>& seen_free, bool known_size) {
   ShapeFit fit;
   const bool hinted = std::isfinite(yaw_hint);  // a track's yaw; NaN: a first sighting
   const double hint = hinted ? yaw_hint : 0.0;
@@ -466,6 +493,21 @@ ShapeFit fitShape(const Detection& det, const world::Shape& shape, const Eigen::
         const double slack = (L(i) - e(i)) / 2;
         c[i] = std::clamp((*centre_hint - det.rect.centre).dot(i == 0 ? a0 : a1), -slack, slack);
       }
+    }
+    // An axis seen end to end whose near end is the face the sensor looks at most directly:
+    // that end is the trimmed extreme of a face smeared by range noise along the rays, towards
+    // the sensor as much as away (the fit sat 1-2 cm towards the camera: transport_drop's
+    // re-picks). The face's own points place it: their median, the box's length behind it. A
+    // face seen at a grazing angle is not used: the other face's points, smeared along the rays,
+    // reach into it.
+    for (int i = 0; known_size && i < 2; ++i) {
+      if (std::abs(su[i]) < std::abs(su[1 - i])) continue;
+      // Seen end to end, and no longer than the box by more than the noise (a detection longer
+      // than the shape it is fitted to, e.g. a shape still growing from views, stays centred).
+      if (e(i) < L(i) - anchor_tol || e(i) > L(i) + params.size_tolerance || std::abs(su[i]) <= e(i) / 2) continue;
+      const double sign = su[i] < 0 ? -1.0 : 1.0;
+      if (auto face = nearFace(det, i == 0 ? a0 : a1, i == 0 ? a1 : a0, e(i == 0 ? 1 : 0), params.size_tolerance))
+        c[i] = *face - sign * L(i) / 2;
     }
     const Eigen::Vector2d centre = det.rect.centre + c[0] * a0 + c[1] * a1;
     double yaw = det.rect.yaw + (swapped ? kPi / 2 : 0.0);

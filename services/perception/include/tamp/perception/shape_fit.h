@@ -102,10 +102,14 @@ struct ShapeFit {
 /// the one nearest the track's is taken. Without a hint (a first sighting): the near end is a
 /// face, and abreast the seen part's centre is taken. A crate driven past close, its near end
 /// below the image, was anchored on that cut 0.9 m off, and taken for a new crate (namo_doorway).
+/// A box seen end to end along an axis whose near end is a face towards the sensor, with
+/// `known_size`: placed by that face's points (their median), the box's length behind it, not by
+/// the trimmed extent, which range noise pulls towards the sensor (1-2 cm: a re-pick missed). A
+/// shape still growing from views (`known_size` false) is not a length to measure from.
 ShapeFit fitShape(const Detection& detection, const world::Shape& shape, const Eigen::Vector3d& sensor,
                   const TrackingParams& params, double yaw_hint = std::numeric_limits<double>::quiet_NaN(),
                   const std::optional<Eigen::Vector2d>& origin_hint = std::nullopt,
-                  const std::function<bool(const Eigen::Vector3d&)>& seen_free = {});
+                  const std::function<bool(const Eigen::Vector3d&)>& seen_free = {}, bool known_size = true);
 
 /// Yaw of an upright pose (rotation about world z), in [-pi, pi).
 double yawOf(const Eigen::Isometry3d& pose);

@@ -51,6 +51,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[2]
+# The configuration the services read: $TAMP_CONFIG_DIR when set (a frozen build evaluated with
+# its own configuration), else the repository's. The runs' deployment and simulator and estimator
+# settings are made from it, so that they match what the binaries accept.
+CONFIG = Path(os.environ.get("TAMP_CONFIG_DIR") or REPO / "config")
 DEBIAN_PYTHON = "/usr/bin/python3"  # apt's python3-matplotlib is importable from this one only
 PLOT_PACKAGE = "python3-matplotlib"
 SCENARIO_SUFFIXES = {".yaml", ".yml"}
@@ -161,16 +165,16 @@ class Setup:
 
 
 def make_setup(work, realtime_factor):
-    sim = (REPO / "config/services/sim.yaml").read_text()
+    sim = (CONFIG / "services/sim.yaml").read_text()
     sim, n = re.subn(r"(?m)^realtime_factor: [0-9.]+", f"realtime_factor: {realtime_factor}", sim)
     if n != 1:
         raise InputError("config/services/sim.yaml: no `realtime_factor:` line to set")
     (work / "sim.yaml").write_text(sim)
-    deploy = (REPO / "config/deploy/local.yaml").read_text()
+    deploy = (CONFIG / "deploy/local.yaml").read_text()
     deploy = deploy.replace("{config}/services/sim.yaml", str(work / "sim.yaml"))
     deploy = deploy.replace("{config}/services/effort_estimator.yaml", str(work / "effort_estimator.yaml"))
     (work / "deploy.yaml").write_text(deploy)
-    estimator = (REPO / "config/services/effort_estimator.yaml").read_text()
+    estimator = (CONFIG / "services/effort_estimator.yaml").read_text()
     if not re.search(r"(?m)^store_directory: ", estimator):
         raise InputError("config/services/effort_estimator.yaml: no `store_directory:` line to set")
     return Setup(work, work / "deploy.yaml", estimator)

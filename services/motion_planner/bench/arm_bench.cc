@@ -11,13 +11,17 @@
 // between two states the planner checked, which a robot that sweeps its commanded motion at 1 cm
 // (the simulator) stops before.
 //
-// Usage: tamp_motion_planner_arm_bench [--targets 12] [--seed 1] [SCENARIO.yaml ...]
+// Usage: tamp_motion_planner_arm_bench [--targets 12] [--seed 1] [--planners] [SCENARIO.yaml ...]
+//   --planners: one row per arm planner (sampling.arm_planner and arm_full_planner both) at the
+//   default swept step
 //   default scenarios: config/scenarios/{namo_corridor_slippery,occluded_can,holding_start}.yaml
 // Exits 2 on bad arguments, 1 when nothing was planned.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <numeric>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -35,7 +39,7 @@ using namespace tamp;
 namespace {
 
 struct Tally {
-  std::vector<double> full_ms, lazy_ms;
+  std::vector<double> full_ms, lazy_ms, duration_s, length_rad;
   int requests = 0, solved = 0, clipped = 0, repaired = 0;
   std::string first_clip;
 };
@@ -74,7 +78,8 @@ double ms(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-void runScenario(const world::Scenario& sc, double swept_step, int targets, unsigned seed, Tally& t) {
+void runScenario(const world::Scenario& sc, double swept_step, std::optional<mp::PlannerKind> arm_planner, int targets,
+                 unsigned seed, Tally& t) {
   auto model = robot::RobotModel::loadDescription(sc.robot.description);
   if (!model.ok()) {
     std::fprintf(stderr, "%s: %s\n", sc.file.c_str(), model.error().toString().c_str());
@@ -82,6 +87,7 @@ void runScenario(const world::Scenario& sc, double swept_step, int targets, unsi
   }
   mp::MotionPlannerParams params;
   params.sampling.arm_swept_step = swept_step;
+  if (arm_planner) params.sampling.arm_planner = params.sampling.arm_full_planner = *arm_planner;
   mp::MotionPlanner planner(*model, params);
   const world::World view = sc.plannerWorld();
   planner.setWorld(view);
@@ -130,6 +136,8 @@ void runScenario(const world::Scenario& sc, double swept_step, int targets, unsi
         ++t.solved;
         if (r.stats.swept_repairs > 0) ++t.repaired;
         t.full_ms.push_back(took);
+        t.duration_s.push_back(r.trajectory.duration());
+        t.length_rad.push_back(r.path_length);
         const std::string hit = denseContact(check, *model, req.start, r.path);
         if (!hit.empty() && ++t.clipped == 1)
           t.first_clip = sc.name + " '" + o.id + "' target " + std::to_string(i) + (leg ? " back" : " out") + ": " + hit;
@@ -148,10 +156,13 @@ void runScenario(const world::Scenario& sc, double swept_step, int targets, unsi
 int main(int argc, char** argv) {
   int targets = 12;
   unsigned seed = 1;
+  bool planners = false;
   std::vector<std::string> files;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if ((a == "--targets" || a == "--seed") && i + 1 < argc) {
+    if (a == "--planners") {
+      planners = true;
+    } else if ((a == "--targets" || a == "--seed") && i + 1 < argc) {
       const int v = std::atoi(argv[++i]);
       if (v < 1) {
         std::fprintf(stderr, "%s must be a positive integer\n", a.c_str());
@@ -160,7 +171,7 @@ int main(int argc, char** argv) {
       if (a == "--targets") targets = v;
       else seed = static_cast<unsigned>(v);
     } else if (!a.empty() && a[0] == '-') {
-      std::fprintf(stderr, "unknown option %s\nusage: %s [--targets N] [--seed S] [SCENARIO.yaml ...]\n", a.c_str(), argv[0]);
+      std::fprintf(stderr, "unknown option %s\nusage: %s [--targets N] [--seed S] [--planners] [SCENARIO.yaml ...]\n", a.c_str(), argv[0]);
       return 2;
     } else {
       files.push_back(a);
@@ -179,18 +190,40 @@ int main(int argc, char** argv) {
     }
     scenarios.push_back(std::move(*sc));
   }
-  std::printf("| arm_swept_step | full requests | solved | re-planned segments in | clipped | full median ms | full p95 ms | lazy median ms | lazy p95 ms |\n");
-  std::printf("|---|---|---|---|---|---|---|---|---|\n");
+  // The rows: the swept check off and on (default), or with --planners each arm planner at the
+  // default swept step.
+  struct Row {
+    std::string label;
+    double step;
+    std::optional<mp::PlannerKind> planner;  // both modes; none: the defaults
+  };
+  const mp::SamplingParams defaults;
+  std::vector<Row> rows;
+  if (planners) {
+    // Not LBKPIECE1: in joint space its trees grow deep, and OMPL 1.5's recursive
+    // LBKPIECE1::removeMotion overflowed the stack here (namo_corridor_slippery, 20 targets).
+    for (auto k : {mp::PlannerKind::kKpiece, mp::PlannerKind::kRrtConnect})
+      rows.push_back({std::string(mp::toString(k)), defaults.arm_swept_step, k});
+    rows.push_back({"defaults: lazy " + std::string(mp::toString(defaults.arm_planner)) + ", full " +
+                        std::string(mp::toString(defaults.arm_full_planner)),
+                    defaults.arm_swept_step, std::nullopt});
+  } else {
+    rows = {{"off", 0.0, std::nullopt}, {"0.01 m", 0.01, std::nullopt}, {"0.0025 m", 0.0025, std::nullopt}};
+  }
+  std::printf("| %s | full requests | solved | re-planned segments in | clipped | full median ms | full p95 ms | full max ms | lazy median ms | lazy p95 ms | trajectory median / total s | path median / total rad |\n",
+              planners ? "arm_planner" : "arm_swept_step");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   int solved = 0;
-  for (double step : {0.0, 0.01, 0.0025}) {
+  for (const Row& row : rows) {
     Tally t;
-    for (const auto& sc : scenarios) runScenario(sc, step, targets, seed, t);
+    for (const auto& sc : scenarios) runScenario(sc, row.step, row.planner, targets, seed, t);
     solved += t.solved;
-    std::printf("| %s | %d | %d | %d | %d | %.1f | %.1f | %.1f | %.1f |\n", step > 0 ? (step > 0.005 ? "0.01 m" : "0.0025 m") : "off", t.requests,
-                t.solved, t.repaired, t.clipped, t.full_ms.empty() ? 0.0 : interpolatedPercentile(t.full_ms, 0.5),
-                t.full_ms.empty() ? 0.0 : interpolatedPercentile(t.full_ms, 0.95),
-                t.lazy_ms.empty() ? 0.0 : interpolatedPercentile(t.lazy_ms, 0.5),
-                t.lazy_ms.empty() ? 0.0 : interpolatedPercentile(t.lazy_ms, 0.95));
+    auto pct = [](const std::vector<double>& v, double q) { return v.empty() ? 0.0 : interpolatedPercentile(v, q); };
+    auto sum = [](const std::vector<double>& v) { return std::accumulate(v.begin(), v.end(), 0.0); };
+    std::printf("| %s | %d | %d | %d | %d | %.1f | %.1f | %.1f | %.1f | %.1f | %.2f / %.1f | %.2f / %.1f |\n", row.label.c_str(),
+                t.requests, t.solved, t.repaired, t.clipped, pct(t.full_ms, 0.5), pct(t.full_ms, 0.95), pct(t.full_ms, 1.0),
+                pct(t.lazy_ms, 0.5), pct(t.lazy_ms, 0.95), pct(t.duration_s, 0.5), sum(t.duration_s), pct(t.length_rad, 0.5),
+                sum(t.length_rad));
     if (!t.first_clip.empty()) std::printf("  first clipped path: %s\n", t.first_clip.c_str());
   }
   if (solved == 0) {

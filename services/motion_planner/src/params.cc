@@ -53,7 +53,8 @@ const config::Schema<MotionPlannerParams>& schema() {
         .field("clearance_grid_resolution", &S::clearance_grid_resolution, nonNegative())
         .convert<std::string>("lazy_planner", &S::lazy_planner, planner)
         .convert<std::string>("full_planner", &S::full_planner, planner)
-        .convert<std::string>("arm_planner", &S::arm_planner, planner);
+        .convert<std::string>("arm_planner", &S::arm_planner, planner)
+        .convert<std::string>("arm_full_planner", &S::arm_full_planner, planner);
     using L = LazyParams;
     s.section("lazy", &P::lazy)
         .field("optimize", &L::optimize)

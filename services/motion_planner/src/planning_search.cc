@@ -121,7 +121,7 @@ void Planning::densify(og::PathGeometric& path, int s, const std::vector<int>& g
 Outcome Planning::search() {
   if (req.straight_only) return straightOnly();
   Stopwatch phase;
-  const PlannerKind kind = req.group != PlanningGroup::kBase ? P.sampling.arm_planner
+  const PlannerKind kind = req.group != PlanningGroup::kBase ? (lazy ? P.sampling.arm_planner : P.sampling.arm_full_planner)
                            : lazy                            ? P.sampling.lazy_planner
                                                              : P.sampling.full_planner;
   planner = makePlanner(kind, si, P.sampling.range);
@@ -409,7 +409,7 @@ Outcome Planning::repairSwept(og::PathGeometric& path) {
   fine_si->setMotionValidator(
       std::make_shared<detail::SweptArmMotionValidator>(fine_si, gs, sweep_radii, P.sampling.arm_swept_step));
   fine_si->setup();
-  const PlannerKind arm_kind = P.sampling.arm_planner;
+  const PlannerKind arm_kind = P.sampling.arm_full_planner;  // full mode only
   res.stats.swept_repairs = detail::repairSegments(
       fine_si, path, [&](const ob::SpaceInformationPtr& s) { return makePlanner(arm_kind, s, P.sampling.range); },
       termination);

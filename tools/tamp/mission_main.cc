@@ -1,8 +1,8 @@
 // `tamp mission SCENARIO --run-id ID [--deployment FILE]`: sends the scenario's mission to the
 // services of a running deployment (started by `tamp launch` on each host, or `tamp run
 // --keep-running`) and follows it as `tamp run` does: waits (up to the deployment's
-// startup_timeout_s) for a heartbeat of every service of the deployment in run ID, then the
-// mission; writes report.json etc. into OUT/RUN_ID/mission. Discovery is the deployment's
+// readyWait()) until every service of the deployment in run ID is heard ready (join_run.h), then
+// the mission; writes report.json etc. into OUT/RUN_ID/mission. Discovery is the deployment's
 // (multicast, or as a client of its discovery servers). Exit codes as `tamp run`: 0 succeeded,
 // 10 mission failed, 20 out of time, 30 bad input, 40 a service unavailable.
 #include <csignal>
@@ -14,11 +14,11 @@
 #include <CLI/CLI.hpp>
 
 #include "cli_common.h"
+#include "join_run.h"
 #include "mission_run.h"
 #include "tamp/core/paths.h"
 #include "tamp/core/termination.h"
 #include "tamp/deploy/deployment.h"
-#include "tamp/dds/heartbeat.h"
 #include "tamp/dds/participant.h"
 
 namespace fs = std::filesystem;
@@ -60,29 +60,15 @@ int main(int argc, char** argv) {
     return tamp::cli::kExitInputError;
   }
   setenv("TAMP_DDS_DISCOVERY_SERVERS", deployment->discovery.serversEnv().c_str(), 1);
-  auto participant =
-      tamp::dds::Participant::create({*dom, tamp::dds::kProfileDefault, "tamp/mission", {}}, *rid);
-  if (!participant) {
-    std::cerr << "tamp mission: " << participant.error().toString() << "\n";
-    return tamp::cli::kExitServiceError;
-  }
   tamp::cli::stopOnSignals({SIGINT, SIGTERM}, /*restart=*/true);
-  tamp::dds::HeartbeatMonitor monitor(*participant);
-  // The services' supervisors (tamp launch) restart one that stays not ready: wait that long.
-  const tamp::Termination startup = tamp::Termination::after(deployment->readyWait());
-  for (const auto& s : deployment->services) {
-    if (s.optional) continue;
-    if (!monitor.waitFor(s.name, 1, startup, /*ready=*/true)) {
-      std::string why = "no heartbeat";
-      for (const auto& info : monitor.services())
-        if (info.alive && info.name == s.name) why = "alive but not ready (" + info.detail + ")";
-      std::fprintf(stderr, "tamp mission: service '%s' in run %s: %s within %.0f s (tamp status)\n", s.name.c_str(),
-                   rid->c_str(), why.c_str(), deployment->readyWait());
-      return tamp::cli::kExitServiceError;
-    }
+  const tamp::runner::JoinedRun joined = tamp::runner::joinRun(*deployment, *dom, *rid);
+  if (!joined.participant) {
+    std::fprintf(stderr, "tamp mission: run %s: %s\n", rid->c_str(), joined.error.c_str());
+    return joined.exit_code;
   }
+  const auto& participant = joined.participant;
   std::printf("tamp mission: run %s, DDS domain %d, %zu services alive%s\n", rid->c_str(), *dom,
-              deployment->services.size(), (*participant)->usesDiscoveryServer() ? " (discovery server)" : "");
+              deployment->services.size(), participant->usesDiscoveryServer() ? " (discovery server)" : "");
   std::fflush(stdout);
   tamp::runner::MissionOptions mo;
   mo.scenario = fs::absolute(scenario).string();
@@ -92,7 +78,7 @@ int main(int argc, char** argv) {
   mo.out_dir = fs::absolute(fs::path(out_dir) / *rid / "mission");
   fs::create_directories(mo.out_dir);
   const tamp::Stopwatch wall;
-  const int rc = tamp::runner::runMission(*participant, mo, [] { return tamp::cli::stopRequested(); });
+  const int rc = tamp::runner::runMission(participant, mo, [] { return tamp::cli::stopRequested(); });
   // From the mission sent to its end (services already alive): what benchmarks compare.
   std::printf("tamp mission: wall time %.2f s\n", wall.seconds());
   return rc;

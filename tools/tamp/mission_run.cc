@@ -33,7 +33,7 @@ std::string bar(double fraction, int width = 30) {
   return "[" + std::string(static_cast<std::size_t>(n), '#') + std::string(static_cast<std::size_t>(width - n), '.') + "]";
 }
 
-/// Executed base paths and moved objects over the scenario's world.
+/// Executed base paths, moved objects and what perception found over the scenario's world.
 void writeWorldPictures(const world::Scenario& sc, const nlohmann::json& report, const fs::path& dir) {
   render::Drawing d;
   d.world = sc.world;
@@ -70,6 +70,22 @@ void writeWorldPictures(const world::Scenario& sc, const nlohmann::json& report,
     to.translation() = Eigen::Vector3d(m["to"]["x"].get<double>(), m["to"]["y"].get<double>(), m["to"]["z"].get<double>());
     to.linear() = Eigen::AngleAxisd(m["to"]["yaw"].get<double>(), Eigen::Vector3d::UnitZ()).toRotationMatrix();
     (void)d.world.setObjectPose(id, to);
+  }
+  // What perception found that the scenario did not list, where it estimated it (dashed).
+  for (const auto& o : report.value("perceived", nlohmann::json::array())) {
+    if (!o.contains("pose")) continue;
+    render::Footprint seen;
+    seen.pose = Pose2D{o["pose"]["x"].get<double>(), o["pose"]["y"].get<double>(), o["pose"]["yaw"].get<double>()};
+    // The outline's world corners into the object's frame (a footprint is drawn at its pose).
+    const Eigen::Rotation2Dd to_object(-seen.pose.theta);
+    for (const auto& xy : o.value("footprint", nlohmann::json::array()))
+      seen.polygon.push_back(to_object * (Eigen::Vector2d(xy[0].get<double>(), xy[1].get<double>()) -
+                                          Eigen::Vector2d(seen.pose.x, seen.pose.y)));
+    if (seen.polygon.size() < 3) continue;
+    seen.colour = render::Rgba{0.55, 0.15, 0.65, 1.0};
+    seen.dashed = true;
+    seen.label = o.value("id", "") + " (perceived)";
+    d.robots.push_back(std::move(seen));
   }
   render::Footprint start;
   start.polygon = footprint;

@@ -314,7 +314,10 @@ void GraphManagerNode::runOne(const msg::MissionCommand& c, const MissionRecord*
   // in it). The robot's own report of the hand selects the conditional branch.
   // A resumed mission believes what the robot reports.
   const world::World told = sc->world.plannerView();
-  if (!resumed) gm.setBelief(Belief{told.held() ? told.held()->object_id : std::string()});
+  std::set<std::string> told_ids;
+  for (const auto& o : told.objects()) told_ids.insert(o.id);
+  if (!resumed) gm.setBelief(Belief{told.held() ? told.held()->object_id : std::string(), told_ids});
+  else gm.setBelief(Belief{std::nullopt, told_ids});
   logger()->info("mission {}: scenario {}, policy {}, goal {} atoms", id, sc->name, toString(p.policy), goal->atoms.size());
 
   MissionObserver obs;

@@ -106,7 +106,9 @@ class SeenWorld final : public WorldSource {
 /// One mission: the state of the loop and its steps.
 struct GraphManager::Run {
   Run(GraphManager& g, WorldSource& s, Executor& x, const MissionObserver& o)
-      : gm(g), seen(s, g.world_version_), executor(x), observer(o), start_calls(g.logged_.mark()) {}
+      : gm(g), seen(s, g.world_version_), executor(x), observer(o), start_calls(g.logged_.mark()) {
+    for (const auto& obj : g.abstraction_.world().objects()) scenario_ids.insert(obj.id);
+  }
 
   GraphManager& gm;
   SeenWorld seen;
@@ -114,6 +116,7 @@ struct GraphManager::Run {
   Executor& executor;
   const MissionObserver& observer;
   std::size_t start_calls{0};  ///< the call log's mark at the mission's start
+  std::set<std::string> scenario_ids;  ///< the objects of the world at the start (Belief::told_objects unset)
   MissionReport report;
   NodeId current{-1};
   BranchContext ctx;
@@ -158,6 +161,7 @@ struct GraphManager::Run {
     if (observer.on_state) observer.on_state(s, msg);
   }
   MissionReport finish(MissionOutcome o, const std::string& reason);
+  void recordPerceived();
   bool planBranch(std::string& why);
   /// Plans the manipulation (and the arm motion into it) in the world as it is now; false when
   /// it cannot be (an event, handled).
@@ -203,9 +207,18 @@ struct GraphManager::Run {
   }
 };
 
+void GraphManager::Run::recordPerceived() {
+  report.perceived.clear();
+  const std::set<std::string>& told = gm.belief_.told_objects ? *gm.belief_.told_objects : scenario_ids;
+  const world::World live = source.world();
+  for (const auto& o : live.objects())
+    if (!told.count(o.id)) report.perceived.push_back(o);
+}
+
 MissionReport GraphManager::Run::finish(MissionOutcome o, const std::string& reason) {
   report.status = o;
   report.reason = reason;
+  recordPerceived();
   report.counters = gm.counters_;
   report.decisions = gm.decisions_;
   report.planning_time_s = gm.planning_s_;
@@ -865,6 +878,7 @@ MissionReport GraphManager::Run::run() {
     if (!replan(ev, id, why)) return finish(MissionOutcome::kFailed, why);
   }
   report.status = MissionOutcome::kSucceeded;
+  recordPerceived();
   report.counters = gm.counters_;
   report.decisions = gm.decisions_;
   report.planning_time_s = gm.planning_s_;

@@ -70,6 +70,18 @@ std::string reportJson(const MissionReport& r, const std::string& scenario, cons
     moved.push_back(m);
   }
   j["moves"] = moved;
+  nlohmann::json perceived = nlohmann::json::array();
+  for (const auto& o : r.perceived) {
+    // The footprint in world coordinates (x, y), as the world model estimated it.
+    const Eigen::Isometry3d& p = o.pose;
+    nlohmann::json fp = nlohmann::json::array();
+    for (const auto& v : o.shape.footprint(16)) {
+      const Eigen::Vector3d w = p * Eigen::Vector3d(v.x(), v.y(), 0.0);
+      fp.push_back({w.x(), w.y()});
+    }
+    perceived.push_back({{"id", o.id}, {"kind", std::string(world::toString(o.kind))}, {"pose", pose(p)}, {"footprint", fp}});
+  }
+  j["perceived"] = perceived;
   nlohmann::json decisions = nlohmann::json::array();
   for (const auto& d : r.decisions) {
     nlohmann::json alts = nlohmann::json::array();

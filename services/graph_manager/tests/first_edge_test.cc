@@ -12,7 +12,10 @@
 #include <gtest/gtest.h>
 
 #include "tamp/core/paths.h"
+#include <nlohmann/json.hpp>
+
 #include "tamp/graph_manager/graph_manager.h"
+#include "tamp/graph_manager/report.h"
 #include "tamp/world/scenario.h"
 
 namespace tamp::graph_manager {
@@ -596,7 +599,7 @@ TEST(MissionWorldVersionTest, MotionQuestionsAndCommandsCarryTheWorldVersionTheG
 /// A mission on namo_corridor from start to goal over scripted services (straight drives),
 /// executed by `x` in `source`.
 MissionReport corridorMission(VersionedWorld& source, DrivingExecutor& x, ScriptedServices& services,
-                              const std::vector<world::Object>& more = {}) {
+                              const std::vector<world::Object>& more = {}, const Belief& belief = {}) {
   auto sc = world::loadScenario(configDir() / "scenarios" / "namo_corridor.yaml");
   EXPECT_TRUE(sc.ok());
   auto robot = robot::RobotModel::loadDescription(sc->robot.description);
@@ -610,6 +613,7 @@ MissionReport corridorMission(VersionedWorld& source, DrivingExecutor& x, Script
   params.concurrent_motions = false;
   params.max_replans = 6;
   GraphManager gm(std::move(a), "", MissionGoal{{"(robot-at goal)"}}, services, params);
+  gm.setBelief(belief);
   source.live = sc->plannerWorld();
   for (const auto& o : more) EXPECT_TRUE(source.live.addObject(o).ok());
   source.at_version = 1;
@@ -680,6 +684,60 @@ TEST(MissionFailureCountTest, StopsBeforeAnObjectWhoseEstimateGrewAreNotCountedA
   const MissionReport known = failingCorridorMission(ExecOutcome::kBlocked, "box", {}, versions);
   EXPECT_EQ(known.status, MissionOutcome::kFailed);
   EXPECT_NE(known.reason.find("max_action_failures"), std::string::npos) << known.reason;
+}
+
+
+// What perception found that the scenario did not list is in the report, where the world model
+// has it at the mission's end, with its outline in the world (tamp run draws it in world.png, so
+// that a user sees what stopped a drive); the scenario's own objects are not.
+TEST(MissionReportTest, AnObjectFoundOnTheWayIsReportedWithItsOutline) {
+  ScriptedServices services;
+  VersionedWorld source;
+  DrivingExecutor x(source);
+  x.fail_first = 1;
+  x.fail_naming = "crate";
+  x.fail_outcome = ExecOutcome::kBlocked;
+  x.before_failure = [&](int) {
+    ASSERT_TRUE(source.live.addObject(corridorCrate(4.45, 5.0)).ok());
+    ++source.at_version;
+  };
+  const MissionReport r = corridorMission(source, x, services);
+  ASSERT_EQ(r.perceived.size(), 1u) << r.reason;
+  EXPECT_EQ(r.perceived.front().id, "crate");
+  const auto j = nlohmann::json::parse(reportJson(r, "namo_corridor", "effort", 1));
+  ASSERT_EQ(j["perceived"].size(), 1u);
+  const auto& crate = j["perceived"][0];
+  EXPECT_EQ(crate["id"], "crate");
+  EXPECT_EQ(crate["kind"], "movable");
+  EXPECT_NEAR(crate["pose"]["x"].get<double>(), 4.45, 1e-9);
+  // The 0.2 m box's outline: its corners 0.1 m from its centre in x and y, in the world.
+  ASSERT_GE(crate["footprint"].size(), 4u);
+  for (const auto& c : crate["footprint"]) {
+    EXPECT_NEAR(std::abs(c[0].get<double>() - 4.45), 0.1, 1e-6);
+    EXPECT_NEAR(std::abs(c[1].get<double>() - 1.2), 0.1, 1e-6);
+  }
+}
+
+// Perceived is against what the scenario told the planner (Belief::told_objects), not against
+// the world model at the start: a crate perception found before the mission began is listed too.
+TEST(MissionReportTest, AnObjectPerceivedBeforeTheMissionStartedIsReportedToo) {
+  auto sc = world::loadScenario(configDir() / "scenarios" / "namo_corridor.yaml");
+  ASSERT_TRUE(sc.ok());
+  Belief told;
+  told.told_objects.emplace();
+  const world::World view = sc->plannerWorld();
+  for (const auto& o : view.objects()) told.told_objects->insert(o.id);
+  ScriptedServices services;
+  VersionedWorld source;
+  DrivingExecutor x(source);
+  const MissionReport r = corridorMission(source, x, services, {corridorCrate(6.5, 5.0)}, told);
+  ASSERT_EQ(r.perceived.size(), 1u) << r.reason;
+  EXPECT_EQ(r.perceived.front().id, "crate");
+  // Without it, the world at the start is what was known.
+  ScriptedServices services2;
+  VersionedWorld source2;
+  DrivingExecutor x2(source2);
+  EXPECT_TRUE(corridorMission(source2, x2, services2, {corridorCrate(6.5, 5.0)}).perceived.empty());
 }
 
 }  // namespace

@@ -182,6 +182,9 @@ struct Belief {
   /// changes the start: the plan assumes the hand empty, and a robot that reports an object in
   /// it takes the conditional branch. A believed object the robot does not report is not held.
   std::optional<std::string> held_object_id;
+  /// The objects the scenario told of; unset: those of the world at the mission's start. The
+  /// report's `perceived` lists the world model's other objects at the end.
+  std::optional<std::set<std::string>> told_objects;
 };
 
 /// A contingency known in advance (the paper's "Conditional Planning"): at node `at`, the
@@ -239,6 +242,10 @@ struct MissionReport {
   std::vector<ExecutedAction> actions;
   std::vector<std::pair<std::string, Eigen::Isometry3d>> moved_from;  ///< object, pose before
   std::vector<std::pair<std::string, Eigen::Isometry3d>> moved_to;
+  /// The objects of the world model at the mission's end that the scenario's view did not have:
+  /// what perception found (a crate that blocked a drive, an object that appeared), as it
+  /// estimated them, so that a user sees what the decisions were about (tamp run's world.png).
+  std::vector<world::Object> perceived;
   std::string graph_dot;
 };
 

@@ -126,9 +126,12 @@ struct GraphManagerParams {
   /// planned on the estimate of a falling object sends the gripper into it.
   double drop_settle_timeout_s{2.0};
   /// After a drop, the object must rest unchanged in the world model this long (s, >= 0) before
-  /// a re-pick is planned from it (DropSettleWatch): the first frames after a drop may move the
-  /// fall estimate, or call it gone before perception sees where the object really fell.
-  double drop_confirm_s{0.3};
+  /// a re-pick is planned from it (DropSettleWatch): the first frames after a drop could move the
+  /// fall estimate, or call it gone before perception sees where the object really fell. 0 since
+  /// session 26: perception's fall estimate starts where the gripper let go (session 25), and in
+  /// 10 transport_drop runs it never moved within the 0.3 s window that was the default, which
+  /// was then most of the drop's replanning latency (docs/benchmarks.md).
+  double drop_confirm_s{0.0};
   /// A restarted graph manager takes up an unfinished mission of its journal only when the
   /// journal was written at most this long ago (s, > 0): a deployment started again hours later
   /// must not set the robot moving on an old mission. An older one is closed as aborted.

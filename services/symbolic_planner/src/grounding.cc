@@ -170,7 +170,22 @@ struct Grounder::Impl {
   size_t queue_head{0};
   std::vector<std::vector<AtomId>> by_pred;  // processed atoms
   ArgIndex by_arg;  // (pred, position, object) -> processed atoms, in processing order
-  std::vector<std::vector<std::pair<uint32_t, uint32_t>>> triggers;  // pred -> (schema, variant)
+  /// A positive precondition `pi` of variant `vi` of schema `si`: an atom of its predicate may
+  /// extend the variant's bindings there.
+  struct Trigger {
+    uint32_t si, vi, pi;
+  };
+  /// pred -> its triggers in the order of processing (schema, variant, precondition).
+  std::vector<std::vector<Trigger>> triggers;
+  /// Triggers by a constant argument (pred, position, object) -> indexes into triggers[pred]
+  /// (each trigger under the one of its constant positions whose list is shortest), and per pred
+  /// the triggers without a constant: an atom is matched against only the triggers whose
+  /// constants it could match, in the order of `triggers` (the same joins in the same order as
+  /// against all of them; airport's per-instance domains: ~1 000 schemas of a dozen preconditions
+  /// over the same predicates, constants in every one).
+  ArgIndex trigger_by_const;
+  std::vector<std::vector<uint32_t>> trigger_free;
+  std::vector<uint32_t> trigger_buf_;  // scratch of explore(): an atom's candidate triggers
   bool initialized{false};
   SeqTable bindings;
   uint64_t work{0};
@@ -465,10 +480,46 @@ struct Grounder::Impl {
     for (uint32_t si = 0; si < schemas.size(); ++si) {
       for (uint32_t vi = 0; vi < schemas[si].variants.size(); ++vi) {
         std::vector<uint32_t> seen;
-        for (const auto& a : schemas[si].variants[vi].pos) {
+        const auto& pos = schemas[si].variants[vi].pos;
+        for (const auto& a : pos) {
           if (std::find(seen.begin(), seen.end(), a.pred) != seen.end()) continue;
           seen.push_back(a.pred);
-          triggers[a.pred].push_back({si, vi});
+          for (uint32_t pi = 0; pi < pos.size(); ++pi) {
+            if (pos[pi].pred == a.pred) triggers[a.pred].push_back({si, vi, pi});
+          }
+        }
+      }
+    }
+    // Index the triggers by a constant: count the triggers per (pred, position, object), then
+    // put each under its constant position with the fewest.
+    ArgIndex counts(pred_arity);
+    auto constants = [&](const Trigger& tr, auto&& fn) {
+      const LAtom& la = schemas[tr.si].variants[tr.vi].pos[tr.pi];
+      for (uint32_t i = 0; i < la.args.size(); ++i) {
+        if (!isVar(la.args[i])) fn(i, objOf(la.args[i]));
+      }
+    };
+    for (uint32_t p = 0; p < triggers.size(); ++p) {
+      for (const Trigger& tr : triggers[p]) constants(tr, [&](uint32_t i, uint32_t o) { counts.add(p, i, o, 0); });
+    }
+    trigger_by_const = ArgIndex(pred_arity);
+    trigger_free.assign(triggers.size(), {});
+    for (uint32_t p = 0; p < triggers.size(); ++p) {
+      for (uint32_t t = 0; t < triggers[p].size(); ++t) {
+        uint32_t best_pos = UINT32_MAX, best_obj = 0;
+        size_t best_n = SIZE_MAX;
+        constants(triggers[p][t], [&](uint32_t i, uint32_t o) {
+          const size_t n = counts.get(p, i, o).size();
+          if (n < best_n) {
+            best_n = n;
+            best_pos = i;
+            best_obj = o;
+          }
+        });
+        if (best_pos == UINT32_MAX) {
+          trigger_free[p].push_back(t);
+        } else {
+          trigger_by_const.add(p, best_pos, best_obj, t);
         }
       }
     }
@@ -750,21 +801,28 @@ struct Grounder::Impl {
         for (uint32_t i = 1; i < atoms.length(a); ++i) by_arg.add(pred, i - 1, k[i], a);
         pending_index_ = a;
       }
-      for (auto [si, vi] : triggers[pred]) {
+      // The triggers whose constants the atom's arguments equal, in processing order.
+      std::vector<uint32_t>& cand = trigger_buf_;
+      cand.assign(trigger_free[pred].begin(), trigger_free[pred].end());
+      for (uint32_t i = 1; i < atoms.length(a); ++i) {
+        const std::vector<uint32_t>& with = trigger_by_const.get(pred, i - 1, k[i]);
+        cand.insert(cand.end(), with.begin(), with.end());
+      }
+      std::sort(cand.begin(), cand.end());
+      for (size_t c = 0; c < cand.size(); ++c) {
+        const auto [si, vi, pi] = triggers[pred][cand[c]];
         const Variant& v = schemas[si].variants[vi];
         cur_var_type = &schemas[si].var_type;
-        for (size_t pi = 0; pi < v.pos.size(); ++pi) {
-          if (v.pos[pi].pred != pred) continue;
-          bind.assign(schemas[si].var_type.size(), -1);
-          std::vector<char>& used = used_buf_;
-          used.assign(v.pos.size(), 0);
-          trail_.clear();
-          if (!matchAtom(v.pos[pi], a, bind, trail_)) continue;
-          trail_.clear();  // the trigger's own bindings stay for this join
-          used[pi] = 1;
-          // Resuming after an interruption re-runs this atom's joins; bindings are deduplicated.
-          if (Status s = join(si, vi, bind, used, v.pos.size() - 1, term); !s.ok()) return s;
-        }
+        bind.assign(schemas[si].var_type.size(), -1);
+        std::vector<char>& used = used_buf_;
+        used.assign(v.pos.size(), 0);
+        trail_.clear();
+        if (!matchAtom(v.pos[pi], a, bind, trail_)) continue;
+        trail_.clear();  // the trigger's own bindings stay for this join
+        used[pi] = 1;
+        // Resuming after an interruption re-runs this atom's joins; bindings are deduplicated.
+        // (A join may intern atoms and so move `atoms`' storage: `k` is not used past here.)
+        if (Status s = join(si, vi, bind, used, v.pos.size() - 1, term); !s.ok()) return s;
       }
       ++queue_head;
     }

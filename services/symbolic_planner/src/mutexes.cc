@@ -89,17 +89,25 @@ void MutexTable::compute(const Task& task, const StateBits& init, const H2MutexO
   ChangeClock clock;
   clock.row_tick.assign(n, 1);
   clock.op_tick.assign(task.ops.size(), 0);
+  // markPairs stamps the rows it changes with the tick after the operator's; only an operator
+  // without precondition reads which facts they were (the reached ones make it stale).
+  row_tick_ = clock.row_tick.data();
+  struct Unset {
+    uint64_t*& p;
+    ~Unset() { p = nullptr; }
+  } unset{row_tick_};  // the clock is compute()'s own
+  track_new_ = std::any_of(task.ops.begin(), task.ops.end(), [](const Operator& op) { return op.pre.empty(); });
   for (bool changed = true; changed;) {
     changed = false;
     for (OpId o = 0; o < task.ops.size(); ++o) {
       if (!clock.stale(task.ops[o], o)) continue;
       clock.op_tick[o] = ++clock.now;
+      tick_ = clock.now + 1;
       new_bits_.clear();
       if (!processOperator(task, o)) continue;
       changed = true;
       ++clock.now;
       for (FactId f : new_bits_) {
-        clock.row_tick[f] = clock.now;
         if (pairReachable(f, f)) clock.reached_tick = clock.now;
       }
       if (work_ > options.max_work) {
@@ -164,7 +172,8 @@ bool MutexTable::processOperator(const Task& task, OpId o) {
   return changed;
 }
 
-/// Marks {p, q} reachable for every q set in `with` (both rows). Returns whether one was new.
+/// Marks {p, q} reachable for every q set in `with` (both rows), stamping the changed rows with
+/// `tick_` (and listing them in `new_bits_` when `track_new_`). Returns whether one was new.
 bool MutexTable::markPairs(FactId p, const uint64_t* with) {
   uint64_t* rp = row(p);
   bool changed = false;
@@ -173,13 +182,15 @@ bool MutexTable::markPairs(FactId p, const uint64_t* with) {
     if (fresh == 0) continue;
     changed = true;
     rp[w] |= fresh;
-    new_bits_.push_back(p);
+    row_tick_[p] = tick_;
+    if (track_new_) new_bits_.push_back(p);
     while (fresh != 0) {
       const auto q = static_cast<FactId>(w * 64 + static_cast<size_t>(std::countr_zero(fresh)));
       fresh &= fresh - 1;
       if (stop_left_ > 0 && stop_flag_[p] != 0 && stop_flag_[q] != 0) --stop_left_;
       setBit(row(q), p);
-      new_bits_.push_back(q);
+      row_tick_[q] = tick_;
+      if (track_new_) new_bits_.push_back(q);
     }
   }
   return changed;

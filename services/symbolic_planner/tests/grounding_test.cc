@@ -74,6 +74,40 @@ TEST(Grounding, RelaxedReachabilityStaticsAndEquality) {
   EXPECT_FALSE(t.unit_cost);
 }
 
+TEST(Grounding, AtomsJoinTheSchemasWhoseConstantsTheyMatchAtAnyPosition) {
+  // An atom is joined only with the preconditions whose constants it matches (twenty-ninth
+  // round: triggers indexed by one constant each): constants in either position, several in one
+  // precondition, none (a repeated variable), a schema without parameters; fluent atoms reached
+  // late (at c) and static ones (link).
+  const std::string dom = R"(
+(define (domain consts)
+  (:requirements :strips :typing)
+  (:types node)
+  (:constants a b c - node)
+  (:predicates (link ?x ?y - node) (at ?x - node) (seen ?x ?y - node))
+  (:action from-a :parameters (?y - node)
+    :precondition (and (at a) (link a ?y)) :effect (at ?y))
+  (:action into-c :parameters (?x - node)
+    :precondition (and (at ?x) (link ?x c)) :effect (and (at c) (seen ?x c)))
+  (:action loop :parameters (?x - node)
+    :precondition (and (at ?x) (link ?x ?x)) :effect (seen ?x ?x))
+  (:action both :parameters ()
+    :precondition (and (at b) (link b c) (seen b c)) :effect (seen b b))
+  (:action never :parameters (?x - node)
+    :precondition (and (at ?x) (link c ?x) (link ?x a)) :effect (seen c a)))
+)";
+  const std::string prob = R"(
+(define (problem p) (:domain consts) (:objects d - node)
+  (:init (at a) (link a b) (link b c) (link c c) (link a d))
+  (:goal (seen b b)))
+)";
+  auto g = ground(dom, prob, false);
+  auto names = opNames(*g.task);
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(names, (std::vector<std::string>{"(both)", "(from-a b)", "(from-a d)", "(into-c b)",
+                                             "(into-c c)", "(loop c)"}));
+}
+
 TEST(Grounding, NegationBecomesComplementFactsKeptConsistent) {
   auto g = ground(test::kAdlDomain, test::kAdlProblem, true);
   const Task& t = *g.task;

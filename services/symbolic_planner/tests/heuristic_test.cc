@@ -344,6 +344,64 @@ TEST(Heuristic, SharedPreconditionNodesChangeNoValueNorHelpfulActionOnRandomWalk
   }
 }
 
+TEST(Heuristic, LayerZeroCountedFromThePreviousStateChangesNoValueNorHelpfulAction) {
+  // h_FF's layered graph counts layer 0 by moving its base state from the last state evaluated
+  // to the new one (twenty-ninth round). Reference: the same goal written as two equal
+  // conjuncts, which counts layer 0 in full from every state (the same value and helpful
+  // actions). The states of random walks (fixed seed) are evaluated in walk order (neighbours,
+  // a few facts apart) and in a shuffled order (far apart), with both orders of the helpful
+  // actions; a third object switches between the goals before every evaluation (the base
+  // emptied and filled again). openstacks: merged operators and shared-precondition nodes;
+  // airport: many preconditions true in every state; hiking; gripper.
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"pddl-more/openstacks/domain.pddl", "pddl-more/openstacks/instance-6.pddl"},
+      {"pddl-more/airport/instance-10/domain.pddl", "pddl-more/airport/instance-10/instance-10.pddl"},
+      {"pddl-more/hiking/domain.pddl", "pddl-more/hiking/instance-4.pddl"},
+      {"pddl/gripper/domain.pddl", "pddl/gripper/instance-4.pddl"},
+  };
+  for (const auto& [dom, prob] : cases) {
+    SCOPED_TRACE(prob);
+    SolvedInstance in;
+    ASSERT_NO_FATAL_FAILURE(loadSolvedInstance(dom, prob, in));
+    const Task& t = in.task();
+    Goal twice = in.goal;
+    twice.conjuncts.push_back(in.goal.conjuncts[0]);
+    std::vector<StateBits> states;
+    forEachRandomWalkState(t, in.init, /*seed=*/11, /*walks=*/12, /*steps=*/60,
+                           [&](const StateBits& cur, int, int) { states.push_back(cur); });
+    std::vector<StateBits> shuffled = states;
+    std::mt19937 rng(5);
+    std::shuffle(shuffled.begin(), shuffled.end(), rng);
+    states.insert(states.end(), shuffled.begin(), shuffled.end());
+    auto incremental = makeHeuristic(HeuristicKind::kFF, t, CostType::kUnit);
+    auto full = makeHeuristic(HeuristicKind::kFF, t, CostType::kUnit);
+    auto switching = makeHeuristic(HeuristicKind::kFF, t, CostType::kUnit);
+    incremental->setGoal(in.goal);
+    full->setGoal(twice);
+    size_t positive = 0;
+    for (size_t i = 0; i < states.size(); ++i) {
+      for (bool ff_style : {false, true}) {
+        incremental->setFFStyle(ff_style);
+        full->setFFStyle(ff_style);
+        switching->setFFStyle(ff_style);
+        const Cost want = full->evaluate(states[i].data());
+        ASSERT_EQ(incremental->evaluate(states[i].data()), want) << "state " << i;
+        ASSERT_EQ(incremental->preferred(), full->preferred()) << "state " << i;
+        switching->setGoal(twice);
+        ASSERT_EQ(switching->evaluate(states[(i * 7) % states.size()].data()),
+                  full->evaluate(states[(i * 7) % states.size()].data()))
+            << "state " << i;
+        switching->setGoal(in.goal);
+        ASSERT_EQ(switching->evaluate(states[i].data()), want) << "state " << i;
+        ASSERT_EQ(switching->preferred(), incremental->preferred()) << "state " << i;
+        positive += want > 0 && want != Heuristic::kDeadEnd ? 1 : 0;
+      }
+    }
+    EXPECT_GT(states.size(), 400U);  // airport's walks end early in states without applicable operators
+    EXPECT_GT(positive, states.size());  // most states are neither goal states nor dead ends
+  }
+}
+
 TEST(Heuristic, HelpfulActionsAreTheApplicableAddersOfTheFirstLayerSubGoalsOnRandomWalks) {
   // The helpful actions (the default order) are taken from the sub-goals' adders at layer 0
   // rather than by testing every achiever for applicability: in every state of random walks

@@ -90,6 +90,11 @@ class MutexTable {
   // Scratch of processOperator.
   std::vector<uint64_t> compat_, adds_;
   std::vector<FactId> add_list_, new_bits_;
+  // compute()'s change clock as markPairs sees it: fact -> tick of its row's last change, the
+  // tick of the operator in progress, and whether the rows changed are listed in new_bits_.
+  uint64_t* row_tick_{nullptr};
+  uint64_t tick_{0};
+  bool track_new_{false};
   // reachesTogether(): per fact 1 if it is one of the facts, and the pairs of them (a fact with
   // itself included) not reached yet; the fixpoint stops when that count is 0.
   std::vector<uint8_t> stop_flag_;

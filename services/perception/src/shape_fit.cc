@@ -404,6 +404,24 @@ std::optional<double> nearFace(const Detection& det, const Eigen::Vector2d& alon
   return *mid;
 }
 
+/// The rectangle a box-like shape is fitted by, in the shape's own frame.
+struct BoxInFrame {
+  Eigen::Vector2d dims;    ///< full extents, along `turn` and across
+  Eigen::Vector2d offset;  ///< its centre
+  double turn{0.0};        ///< its first axis' angle, rad
+};
+
+BoxInFrame boxInFrame(const world::Shape& shape, const Aabb& local) {
+  if (shape.kind == world::ShapeKind::kPrism && shape.polygon.size() >= 3) {
+    const Rect2 r = minAreaRect(convexHull(shape.polygon));
+    // An axis-aligned polygon's rectangle is its bounding box (turn 0, as before).
+    if (r.extents.x() * r.extents.y() < (local.max.x() - local.min.x()) * (local.max.y() - local.min.y()) - 1e-9)
+      return {r.extents, r.centre, r.yaw};
+  }
+  return {Eigen::Vector2d(local.max.x() - local.min.x(), local.max.y() - local.min.y()),
+          0.5 * Eigen::Vector2d(local.max.x() + local.min.x(), local.max.y() + local.min.y()), 0.0};
+}
+
 }  // namespace
 
 ShapeFit fitShape(const Detection& det, const world::Shape& shape, const Eigen::Vector3d& sensor,
@@ -439,9 +457,15 @@ ShapeFit fitShape(const Detection& det, const world::Shape& shape, const Eigen::
     fit.excess = std::max(0.0, det.majorExtent() - 2 * r);
     fit.deficit = std::max(0.0, 2 * r - det.rect.extents.x()) + std::max(0.0, 2 * r - det.rect.extents.y());
   } else {
-    // Box (a prism by its bounding box, whose centre may be off the prism's frame origin).
-    const Eigen::Vector2d dims(local.max.x() - local.min.x(), local.max.y() - local.min.y());
-    const Eigen::Vector2d offset = 0.5 * Eigen::Vector2d(local.max.x() + local.min.x(), local.max.y() + local.min.y());
+    // A box, or a prism by its minimum-area rectangle in its own frame: turned by `turn` there,
+    // centred at `offset` (a NAMO world's rotated box is a prism whose corners are turned in a
+    // frame of yaw 0; by its bounding box the fit turned it a second time, by the rectangle's
+    // own angle, and planned drives through its corners: moghaddam world 16). The fit places
+    // the rectangle; the object's frame is the rectangle's turned back by `turn`.
+    const BoxInFrame box = boxInFrame(shape, local);
+    const Eigen::Vector2d dims = box.dims, offset = box.offset;
+    const double turn = box.turn;
+    const double rect_hint = hint + turn;  // the rectangle's yaw where the track has the object
     const Eigen::Vector2d e = det.rect.extents;
     // By the worst axis, as a cylinder's (its major extent against the diameter). The sum over
     // both axes counted the range noise twice: a far view of occluded_can's 5 x 7 cm box exceeded
@@ -459,8 +483,8 @@ ShapeFit fitShape(const Detection& det, const world::Shape& shape, const Eigen::
     bool swapped = xb < xa - 1e-9 || (std::abs(xb - xa) <= 1e-9 && deficitOf(Lb) < deficitOf(La) - 1e-9);
     if (std::abs(xb - xa) <= 1e-9 && std::abs(deficitOf(Lb) - deficitOf(La)) <= params.size_tolerance &&
         hinted) {
-      const double off_a = std::abs(std::remainder(det.rect.yaw - yaw_hint, kPi));
-      const double off_b = std::abs(std::remainder(det.rect.yaw + kPi / 2 - yaw_hint, kPi));
+      const double off_a = std::abs(std::remainder(det.rect.yaw - rect_hint, kPi));
+      const double off_b = std::abs(std::remainder(det.rect.yaw + kPi / 2 - rect_hint, kPi));
       swapped = off_b < off_a;
     }
     const Eigen::Vector2d L = swapped ? Lb : La;
@@ -513,8 +537,8 @@ ShapeFit fitShape(const Detection& det, const world::Shape& shape, const Eigen::
     double yaw = det.rect.yaw + (swapped ? kPi / 2 : 0.0);
     // The symmetric equivalent closest to the hint.
     const double sym = yawSymmetry(world::Shape::box(dims.x(), dims.y(), 1.0));
-    yaw = hint + wrapAngle(yaw - hint);
-    yaw -= sym * std::round((yaw - hint) / sym);
+    yaw = rect_hint + wrapAngle(yaw - rect_hint);
+    yaw -= sym * std::round((yaw - rect_hint) / sym);
     yaw = wrapAngle(yaw);
     // Residual: boundary points against the fitted rectangle.
     const Eigen::Vector2d b0 = axis(yaw), b1 = axis(yaw + kPi / 2);
@@ -525,9 +549,11 @@ ShapeFit fitShape(const Detection& det, const world::Shape& shape, const Eigen::
       sum += dist * dist;
     }
     fit.residual = rms(sum, det.boundary.size());
-    // The object's frame origin is the box centre minus the (rotated) bounding-box offset.
-    const Eigen::Vector2d origin = centre - (offset.x() * b0 + offset.y() * b1);
-    fit.pose = uprightPose(origin.x(), origin.y(), z, yaw);
+    // The object's frame: the rectangle's yaw turned back; its origin the rectangle's centre
+    // minus the offset, turned by the object's yaw.
+    const double object_yaw = wrapAngle(yaw - turn);
+    const Eigen::Vector2d origin = centre - (offset.x() * axis(object_yaw) + offset.y() * axis(object_yaw + kPi / 2));
+    fit.pose = uprightPose(origin.x(), origin.y(), z, object_yaw);
   }
   const double height_tol = std::max(params.height_tolerance, 0.1 * shape_height);
   fit.compatible = fit.excess <= params.size_tolerance && std::abs(fit.height_error) <= height_tol;

@@ -700,6 +700,7 @@ BranchContext GraphManager::advance(EdgeId id, EdgeId next, const BranchContext&
   BranchContext c = ctx;
   switch (e.kind) {
     case ActionKind::kMoveBase:
+      c.came_from = ctx.state.base;
       if (isPush(e)) {
         // (push ?o ?r ?from ?to ?s): the base ends at ?to, the object on slot ?s.
         if (auto to = abstraction_.locationPose(e.tokens.size() == 6 ? e.tokens[4] : "")) c.state.base = *to;

@@ -19,8 +19,9 @@ bool GraphManager::refineSupport(const std::string& object, const std::string& r
                                   object, region, s);
   if (!abstraction_.isReached(Abstraction::armconfOver(s))) {
     // No known base pose reaches it (an object dropped where no location was foreseen): a stand
-    // beside it, as for a blocking object.
-    if (auto g = standBeside(*o, ctx.state.base, ctx)) {
+    // beside it, as for a blocking object, on the side the branch's robot drove in from (not the
+    // side of where the refuted plan stood: that may be the far side of the object).
+    if (auto g = standBeside(*o, ctx.came_from.value_or(ctx.state.base), ctx)) {
       const std::string near = abstraction_.locationFor(g->base_pose, "near_" + object);
       abstraction_.addReach(near, Abstraction::armconfOver(s));
       log::get("graph_manager")->info("{} is reached from {} ({:.2f}, {:.2f})", s, near, g->base_pose.x, g->base_pose.y);

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "object_geometry.h"
+#include "tamp/core/log.h"
 #include "tamp/graph_manager/graph_manager.h"
 
 namespace tamp::graph_manager {
@@ -76,6 +77,8 @@ std::optional<GraspOption> GraphManager::standBeside(const world::Object& o, con
     gq.base = base;
     gq.overrides = overridesOf(ctx, o.id);
     auto g = askGrasps(gq);
+    log::get("graph_manager")->debug("stand beside {} at ({:.2f}, {:.2f}, {:.2f}): {}", o.id, base.x, base.y, base.theta,
+                                     g ? std::to_string(g->size()) + " grasps" : g.error().message);
     if (g && !g->empty()) {
       GraspOption chosen = g->front();
       chosen.base_pose = base;

@@ -131,5 +131,41 @@ TEST(StandTest, AnObjectOutOfTheArmsReachIsLeftToTheServicesSamples) {
   EXPECT_FALSE(services.asked.front().base.has_value());
 }
 
+
+// hall_transport: the parcel at (2.8, 2.0) on one large floor region. A plan that meant to pick it
+// from near_dock (5.45, 2.0), east of it, after driving from start (1.0, 2.0), west of it, is
+// refuted; the refinement's stand is sought on the side the robot drives in from, not on the far
+// side of where the refuted plan stood (a drive round the parcel and a half turn, 55 s against
+// 37.5 s executed).
+TEST(StandTest, ARefinedSlotIsReachedFromTheSideTheRobotDroveInFrom) {
+  auto sc = world::loadScenario(configDir() / "scenarios" / "hall_transport.yaml");
+  ASSERT_TRUE(sc) << sc.error().toString();
+  auto robot = robot::RobotModel::loadDescription(sc->robot.description);
+  ASSERT_TRUE(robot) << robot.error().toString();
+  GraspOnly services;
+  GraphManager gm(Abstraction(sc->plannerWorld(), *robot), "(define (domain scripted))",
+                  MissionGoal{{"(on box dock)"}}, services, GraphManagerParams{});
+  BranchContext ctx;
+  ctx.state.base = Pose2D{5.45, 2.0, 0.0};  // where the refuted plan stood
+  ctx.came_from = Pose2D{1.0, 2.0, 0.0};    // where its drive there started
+  ASSERT_TRUE(gm.refineSupport("box", "hall", ctx));
+  ASSERT_FALSE(services.asked.empty());
+  ASSERT_TRUE(services.asked.front().base.has_value());
+  const Pose2D& b = *services.asked.front().base;
+  EXPECT_LT(b.x, 2.8) << "west of the parcel, facing it";
+  EXPECT_NEAR(b.y, 2.0, 1e-6);
+  EXPECT_NEAR(std::remainder(b.theta, 2 * M_PI), 0.0, 1e-6);
+
+  // Without a drive in the branch, the side of where the branch stands.
+  GraspOnly other;
+  GraphManager gm2(Abstraction(sc->plannerWorld(), *robot), "(define (domain scripted))",
+                   MissionGoal{{"(on box dock)"}}, other, GraphManagerParams{});
+  ctx.came_from.reset();
+  ASSERT_TRUE(gm2.refineSupport("box", "hall", ctx));
+  ASSERT_FALSE(other.asked.empty());
+  ASSERT_TRUE(other.asked.front().base.has_value());
+  EXPECT_GT(other.asked.front().base->x, 2.8);
+}
+
 }  // namespace
 }  // namespace tamp::graph_manager

@@ -69,6 +69,9 @@ struct BranchContext {
   std::map<std::string, Eigen::Isometry3d> object_poses;  ///< objects moved by the branch
   std::optional<GraspOption> pending_grasp;   ///< chosen by the move_arm before a pick
   std::optional<Eigen::Isometry3d> pending_place;  ///< object pose chosen before a place
+  /// Where the branch's last base motion started: the side the robot comes from to what it does
+  /// here (a stand beside an object is sought on that side). None before the branch's first drive.
+  std::optional<Pose2D> came_from;
 };
 
 /// One alternative at a decision point, with its predicted effort.

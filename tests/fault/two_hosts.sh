@@ -3,10 +3,11 @@
 # 10.0.0.1) joined by a veth link, each running `tamp launch config/deploy/two_hosts.yaml --host
 # ...`, the mission sent from the workstation with `tamp mission`. Needs root (ip netns).
 #
-#   tests/fault/two_hosts.sh BUILD_DIR [--discovery server|multicast] [--scenario FILE]
+#   tests/fault/two_hosts.sh BUILD_DIR [--discovery server|servers|multicast] [--scenario FILE]
 #        [--netem "loss 10%"|"delay 50ms"|"duplicate 10%"|...] [--partition-at S --partition-for S]
 #        [--seed N] [--out DIR] [--run-id ID] [--one-host] [--ping N] [--loss PCT] [--duplicate PCT]
-#        [--kill SERVICE --kill-at S] [--delay MS [--jitter MS]] [--security DIR]
+#        [--kill SERVICE --kill-at S] [--kill-launcher HOST --kill-launcher-at S]
+#        [--delay MS [--jitter MS]] [--security DIR]
 #
 # --kill SERVICE --kill-at S: SIGKILL to that service's process S s after the mission started,
 # on whichever host runs it (its launcher restarts it). Every run (with or without a fault) is
@@ -28,6 +29,12 @@
 # `iptables` (Debian package iptables). UDP round trips across the link (tests/fault/udp_rtt.py)
 # before and after the delay is on, the delayed packets and the kernel queue's drops go to faults.log.
 #
+# --kill-launcher HOST --kill-launcher-at S|ready: SIGKILL to that host's `tamp launch` (the
+# supervisor, and with it the discovery servers it runs) S s after the mission started, or with
+# `ready` before `tamp mission` starts, once every service is ready (`tamp status --json` from
+# the workstation): the mission tool is then a participant that must be discovered without that
+# host's servers. The host's services go on as orphans (orphan_timeout_s); nothing restarts them.
+#
 # --security DIR (from deploy/security/make_certs.sh): every participant on both hosts secured.
 # --one-host runs both launchers in the workstation namespace (same deployment, discovery and
 # UDP profile; traffic stays on the host), the baseline of the two-host benchmark. --ping N: after
@@ -38,7 +45,9 @@
 # --discovery server (default): the deployment gets `discovery: {mode: server, servers:
 # ["10.0.0.1:11811"], server_host: workstation}` and multicast is removed from the link (the veth
 # interfaces lose the MULTICAST flag and have no multicast route), so only the server path can
-# discover. --netem applies `tc qdisc ... netem ARGS` (with the seed) on both ends of the link;
+# discover. --discovery servers: the same without multicast, but a server on each host
+# (`servers: ["10.0.0.1:11811", "10.0.0.2:11811"], server_hosts: [workstation, robot]`), every
+# participant a client of both. --netem applies `tc qdisc ... netem ARGS` (with the seed) on both ends of the link;
 # --partition-at/--partition-for take the link down for that long, that far into the mission.
 # Exit code: `tamp mission`'s (0 succeeded, 10 failed, 20 timeout, 30 input, 40 services), and 50
 # when the run's checks fail (the simulator's final world is missing), 77 when the network
@@ -51,7 +60,7 @@ BUILD=${1:?usage: two_hosts.sh BUILD_DIR [options]}; shift
 ROOT=$(cd "$(dirname "$0")/../.." && pwd)
 DISCOVERY=server SCENARIO=$ROOT/config/scenarios/namo_corridor_short.yaml NETEM="" SEED=1
 PART_AT="" PART_FOR=5 OUT=${TMPDIR:-/tmp}/tamp-two-hosts RUN_ID="" ONE_HOST=0 PING=0 LOSS=0 DUP=0
-KILL="" KILL_AT="" DELAY="" JITTER=0 SECURITY=""
+KILL="" KILL_AT="" KILL_LAUNCHER="" KILL_LAUNCHER_AT="" DELAY="" JITTER=0 SECURITY=""
 QUEUE_NUM=13  # the nfqueue of --delay, one per namespace
 while [ $# -gt 0 ]; do
   case $1 in
@@ -69,13 +78,22 @@ while [ $# -gt 0 ]; do
     --duplicate) DUP=$2; shift 2;;
     --kill) KILL=$2; shift 2;;
     --kill-at) KILL_AT=$2; shift 2;;
+    --kill-launcher) KILL_LAUNCHER=$2; shift 2;;
+    --kill-launcher-at) KILL_LAUNCHER_AT=$2; shift 2;;
     --delay) DELAY=$2; shift 2;;
     --jitter) JITTER=$2; shift 2;;
     --security) SECURITY=$(realpath "$2"); shift 2;;
     *) echo "two_hosts.sh: unknown option $1" >&2; exit 30;;
   esac
 done
-case $DISCOVERY in server|multicast) ;; *) echo "two_hosts.sh: --discovery server|multicast, got '$DISCOVERY'" >&2; exit 30;; esac
+case $DISCOVERY in server|servers|multicast) ;; *) echo "two_hosts.sh: --discovery server|servers|multicast, got '$DISCOVERY'" >&2; exit 30;; esac
+if [ "$DISCOVERY" = servers ] && [ "$ONE_HOST" = 1 ]; then
+  echo "two_hosts.sh: --discovery servers puts a server on each host; not with --one-host" >&2; exit 30
+fi
+if [ -n "$KILL_LAUNCHER" ]; then
+  case $KILL_LAUNCHER in robot|workstation) ;; *) echo "two_hosts.sh: --kill-launcher robot|workstation, got '$KILL_LAUNCHER'" >&2; exit 30;; esac
+  [[ $KILL_LAUNCHER_AT =~ ^([0-9]+(\.[0-9]+)?|ready)$ ]] || { echo "two_hosts.sh: --kill-launcher needs --kill-launcher-at SECONDS|ready, got '$KILL_LAUNCHER_AT'" >&2; exit 30; }
+fi
 SERVICES_ALL="sim perception execution_monitor graph_manager symbolic_planner motion_planner effort_estimator"
 if [ -n "$KILL" ]; then
   [[ " $SERVICES_ALL " == *" $KILL "* ]] || { echo "two_hosts.sh: --kill takes one of: $SERVICES_ALL; got '$KILL'" >&2; exit 30; }
@@ -120,6 +138,8 @@ sed -E "s#\{config\}/services/effort_estimator.yaml#$RUN_DIR/effort_estimator.ya
   "$ROOT/config/deploy/two_hosts.yaml" > "$DEPLOY"
 if [ "$DISCOVERY" = server ]; then
   printf 'discovery: {mode: server, servers: ["10.0.0.1:11811"], server_host: workstation}\n' >> "$DEPLOY"
+elif [ "$DISCOVERY" = servers ]; then
+  printf 'discovery: {mode: server, servers: ["10.0.0.1:11811", "10.0.0.2:11811"], server_hosts: [workstation, robot]}\n' >> "$DEPLOY"
 else
   printf 'discovery: {mode: multicast}\n' >> "$DEPLOY"
 fi
@@ -129,6 +149,12 @@ PIDS=()
 cleanup() {
   for p in "${PIDS[@]}"; do kill -TERM "$p" 2>/dev/null || true; done
   for p in "${PIDS[@]}"; do wait "$p" 2>/dev/null || true; done
+  # Services whose launcher was killed (--kill-launcher) are orphans: stopped here, as the launcher
+  # would have (the simulator writes its final world on it), waited for at most 10 s.
+  local orphans="tamp_[a-z_]*_service --name .*--run-id $RUN_ID"
+  if pkill -TERM -f -- "$orphans" 2>/dev/null; then
+    for _ in $(seq 50); do pgrep -f -- "$orphans" > /dev/null || break; sleep 0.2; done
+  fi
   ip netns del "$NS_R" 2>/dev/null || true
   ip netns del "$NS_W" 2>/dev/null || true
 }
@@ -146,7 +172,7 @@ ip -n "$NS_W" addr add 10.0.0.1/24 dev veth-w-$TAG
 for ns in "$NS_R" "$NS_W"; do ip -n "$ns" link set lo up; done
 ip -n "$NS_R" link set veth-r-$TAG up
 ip -n "$NS_W" link set veth-w-$TAG up
-if [ "$DISCOVERY" = server ]; then
+if [ "$DISCOVERY" != multicast ]; then
   ip -n "$NS_R" link set veth-r-$TAG multicast off
   ip -n "$NS_W" link set veth-w-$TAG multicast off
   ip -n "$NS_R" link set lo multicast off
@@ -268,6 +294,35 @@ if [ -n "$KILL" ]; then
   PIDS+=($!)
 fi
 
+# SIGKILL to one host's supervisor (and the discovery servers it runs); nothing restarts it.
+kill_launcher() {
+  local pid
+  pid=$(pgrep -f -- "tamp launch $DEPLOY --host $KILL_LAUNCHER --run-id $RUN_ID" | head -1)
+  if [ -n "$pid" ] && kill -9 "$pid" 2>/dev/null; then
+    echo "kill: SIGKILL to the $KILL_LAUNCHER launcher (pid $pid) at $(date -u +%T.%N)" >> "$OUT/$RUN_ID/faults.log"
+  else
+    echo "kill: no running $KILL_LAUNCHER launcher to kill at $(date -u +%T.%N)" >> "$OUT/$RUN_ID/faults.log"
+  fi
+}
+# True once every service of the deployment says it is ready (bounded by the caller).
+all_ready() {
+  ip netns exec "$NS_W" "$BIN/tamp" status --deployment "$DEPLOY" --run-id "$RUN_ID" --json --wait 2 2>/dev/null |
+    python3 -c 'import json,sys; j=json.load(sys.stdin); s=j["services"]; sys.exit(0 if s and not j["missing"] and all(x.get("state")=="ready" for x in s) else 1)'
+}
+if [ "$KILL_LAUNCHER_AT" = ready ]; then
+  ready_from=$(date +%s.%N)
+  for _ in $(seq 60); do all_ready && break; done
+  echo "ready: every service after $(awk "BEGIN{print $(date +%s.%N) - $ready_from}") s" >> "$OUT/$RUN_ID/faults.log"
+  kill_launcher
+elif [ -n "$KILL_LAUNCHER" ]; then
+  (
+    until grep -q "tamp mission: run" "$OUT/$RUN_ID/mission.out" 2>/dev/null; do sleep 0.2; done
+    sleep "$KILL_LAUNCHER_AT"
+    kill_launcher
+  ) &
+  PIDS+=($!)
+fi
+
 START=$(date +%s.%N)
 set +e
 ip netns exec "$NS_W" "$BIN/tamp" mission "$SCENARIO" --deployment "$DEPLOY" --run-id "$RUN_ID" --seed "$SEED" \
@@ -277,6 +332,7 @@ END=$(date +%s.%N)
 if [ "$PING" -gt 0 ]; then
   SERVERS=""
   [ "$DISCOVERY" = server ] && SERVERS=10.0.0.1:11811
+  [ "$DISCOVERY" = servers ] && SERVERS="10.0.0.1:11811;10.0.0.2:11811"
   ip netns exec "$NS_W" env TAMP_DDS_DISCOVERY_SERVERS=$SERVERS "$BIN/tamp" ping sim --run-id "$RUN_ID" -c "$PING" > "$RUN_DIR/ping.out" 2>&1
   tail -1 "$RUN_DIR/ping.out"
 fi

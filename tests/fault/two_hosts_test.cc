@@ -77,6 +77,22 @@ TEST(TwoHostsTest, MissionThroughADiscoveryServerWithoutMulticastReachesTheGoal)
   EXPECT_NE(r.output.find("(discovery server)"), std::string::npos) << r.output;
 }
 
+// A discovery server on each host (`server_hosts: [workstation, robot]`): the workstation's
+// supervisor, and the server it runs, is killed once every service is ready; the mission tool
+// started after it, and perception restarted mid-mission, are new participants that only the
+// robot's server can introduce. With one server on the workstation the same run ends "service
+// 'sim': no heartbeat" (exit 40; checked by hand, docs/reliability.md).
+TEST(TwoHostsTest, AMissionIsDiscoveredThroughTheRobotsServerWhenTheWorkstationsServerIsGone) {
+  const TwoHostRun r = runTwoHosts("ctest-two-hosts-servers",
+                                   {"--discovery", "servers", "--kill-launcher", "workstation", "--kill-launcher-at",
+                                    "ready", "--kill", "perception", "--kill-at", "4"});
+  expectMissionAtGoal(r);
+  if (HasFatalFailure() || IsSkipped()) return;
+  EXPECT_NE(r.faults.find("kill: SIGKILL to the workstation launcher"), std::string::npos) << r.faults;
+  EXPECT_NE(r.faults.find("kill: SIGKILL to perception"), std::string::npos) << r.faults;
+  EXPECT_NE(r.output.find("(discovery server)"), std::string::npos) << r.output;
+}
+
 TEST(TwoHostsTest, MissionOverMulticastReachesTheGoal) {
   expectMissionAtGoal(runTwoHosts("ctest-two-hosts-multicast", {"--discovery", "multicast"}));
 }

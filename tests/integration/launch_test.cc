@@ -3,8 +3,10 @@
 // supervised by the real `tamp-launch`. Every wait is on a condition (an event line, a pid file,
 // an exit) with a deadline; nothing sleeps to synchronise.
 #include <signal.h>
+#include <unistd.h>
 #include <sys/wait.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -284,6 +286,22 @@ TEST_F(LaunchTest, StatusFailsAndNamesTheMissingServices) {
   auto [rc_other, other] = status(dir_ / "deploy.yaml", run_id_ + "-other", 2.0);
   EXPECT_EQ(rc_other, 40) << other;
   EXPECT_EQ(nlohmann::json::parse(other.substr(other.find('{')))["services"].size(), 0u) << other;
+}
+
+// A deployment with a discovery server: `tamp status --deployment` discovers as its services do
+// (a client of the server), from a shell without $TAMP_DDS_DISCOVERY_SERVERS; before, it listened
+// by multicast, heard none of them and said every service was missing.
+TEST_F(LaunchTest, StatusDiscoversThroughTheDeploymentsServer) {
+  ASSERT_EQ(std::getenv("TAMP_DDS_DISCOVERY_SERVERS"), nullptr);
+  const std::string server = "127.0.0.1:" + std::to_string(30000 + ::getpid() % 20000 + 7);
+  const fs::path file =
+      deployment({"alpha", "beta"}, "discovery: {mode: server, servers: [\"" + server + "\"], server_host: local}\n");
+  launch(file);
+  auto [rc, out] = status(file, run_id_, 20.0);
+  EXPECT_EQ(rc, 0) << out;
+  auto j = nlohmann::json::parse(out.substr(out.find('{')));
+  EXPECT_EQ(j["services"].size(), 2u) << out;
+  EXPECT_TRUE(j["missing"].empty()) << out;
 }
 
 TEST_F(LaunchTest, SignalStopsEveryServiceCleanly) {

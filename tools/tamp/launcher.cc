@@ -146,8 +146,7 @@ process::ProcessSpec Launcher::specOf(const deploy::ServiceSpec& s) const {
 
 Status Launcher::startDiscoveryServers() {
   const auto& dc = o_.deployment.discovery;
-  if (dc.mode != deploy::DiscoverySpec::Mode::kServer || dc.server_host != o_.host) return Status::Ok();
-  for (std::size_t i = 0; i < dc.servers.size(); ++i) {
+  for (std::size_t i : dc.serversOn(o_.host)) {
     auto address = dds::parseDiscoveryServer(dc.servers[i]);
     if (!address) return address.error();
     auto server = dds::DiscoveryServer::start(*address, static_cast<int>(i));

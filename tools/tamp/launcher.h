@@ -69,9 +69,10 @@ class Launcher {
   Launcher(const Launcher&) = delete;
   Launcher& operator=(const Launcher&) = delete;
 
-  /// With `discovery: {mode: server}` and this host the deployment's `server_host`, first starts
-  /// the discovery servers (in this process: they live as long as the supervisor; clients keep
-  /// what they discovered when it dies, and a new supervisor serves them again). Sets
+  /// With `discovery: {mode: server}`, first starts the discovery servers the deployment puts on
+  /// this host (in this process: they live as long as the supervisor; clients keep what they
+  /// discovered when it dies, the servers of other hosts go on serving them, and a new
+  /// supervisor serves them again). Sets
   /// $TAMP_DDS_DISCOVERY_SERVERS of this process to the deployment's servers ("" for multicast),
   /// and of every service.
   /// Takes the run folder's lock, creates the DDS participant for liveness, adopts the services

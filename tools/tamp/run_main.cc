@@ -144,7 +144,7 @@ int main(int argc, char** argv) {
   }
   local.hosts = {tamp::deploy::HostSpec{tamp::deploy::kLocalHost, "this machine", {}}};
   // Every host is this one: so is the one that runs the discovery servers (mode server).
-  if (local.discovery.mode == tamp::deploy::DiscoverySpec::Mode::kServer) local.discovery.server_host = tamp::deploy::kLocalHost;
+  local.discovery.runAllOn(tamp::deploy::kLocalHost);
   tamp::launch::LaunchOptions lo;
   lo.deployment = local;
   lo.host = tamp::deploy::kLocalHost;

@@ -1,9 +1,10 @@
 // `tamp status [--deployment FILE [--host NAME]] [--run-id ID]`: the live services of a DDS domain
-// and run, from their heartbeats. With a deployment (or --expect), every expected service that is
+// and run, from their heartbeats (discovered as the deployment's services discover). With a deployment (or --expect), every expected service that is
 // not alive is listed as MISSING and the exit code is 40; optional services of the deployment are
 // listed as missing too but do not fail the check.
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
 
 #include <CLI/CLI.hpp>
@@ -60,6 +61,10 @@ int main(int argc, char** argv) {
       expect.push_back(s->name);
       if (s->optional) optional_names.push_back(s->name);
     }
+    // Discover as the deployment's services do (multicast, or its discovery servers), as `tamp
+    // mission --deployment` does: without it a shell without $TAMP_DDS_DISCOVERY_SERVERS saw no
+    // service of a server-discovery deployment.
+    setenv("TAMP_DDS_DISCOVERY_SERVERS", d->discovery.serversEnv().c_str(), 1);
     // Discovery of every service takes a few heartbeat periods: listen at least that long.
     if (app.count("--wait") == 0) wait_s = std::max(wait_s, 4.0 * d->heartbeat_period_s);
   } else if (!host.empty()) {

@@ -84,6 +84,44 @@ TEST(DiscoveryServerTest, ClientsOfAServerExchangeSamples) {
   EXPECT_TRUE(inbox.waitFor([](const std::string& id) { return id == "box_1"; }, 10.0).has_value());
 }
 
+// Two servers, every client a client of both (a deployment with a server on each host): when
+// one server is gone, a participant that starts afterwards still finds the others through the
+// other server, and samples flow.
+TEST(DiscoveryServerTest, WithTwoServersANewParticipantIsFoundWhenOneServerIsGone) {
+  const uint16_t port = static_cast<uint16_t>(30000 + ::getpid() % 20000 + 2);
+  const DiscoveryServerAddress first{"127.0.0.1", port};
+  const DiscoveryServerAddress second{"127.0.0.1", static_cast<uint16_t>(port + 1)};
+  auto server0 = DiscoveryServer::start(first, 0);
+  ASSERT_TRUE(server0.ok()) << server0.error().toString();
+  auto server1 = DiscoveryServer::start(second, 1);
+  ASSERT_TRUE(server1.ok()) << server1.error().toString();
+  auto client = [&](const std::string& name) {
+    ParticipantOptions o{testing::isolatedDomain(), kProfileUdp, name, {}};
+    o.discovery_servers = {first.toString(), second.toString()};
+    auto p = Participant::create(o);
+    if (!p) ADD_FAILURE() << p.error().toString();
+    return p ? *p : nullptr;
+  };
+  auto a = client("client_a");
+  ASSERT_TRUE(a);
+  Writer<msg::WorldObject> writer(a, topics::kWorldObjects);
+  server0->reset();  // the first host's server goes (its launcher died)
+  auto b = client("client_b");
+  ASSERT_TRUE(b);
+  testing::Inbox<std::string> inbox;
+  Reader<msg::WorldObject> reader(b, topics::kWorldObjects,
+                                  [&](const msg::WorldObject& o, const SampleMeta& meta) {
+                                    if (meta.alive) inbox.push(o.id());
+                                  });
+  ASSERT_TRUE(writer.waitForReaders(Termination::after(20.0), 1)) << "not found through the second server";
+  msg::WorldObject o;
+  o.id("box_2");
+  o.kind(msg::OBJECT_MOVABLE);
+  o.pose().orientation().w(1.0);
+  ASSERT_TRUE(writer.write(o).ok());
+  EXPECT_TRUE(inbox.waitFor([](const std::string& id) { return id == "box_2"; }, 10.0).has_value());
+}
+
 TEST(DiscoveryServerTest, RefusesAnAddressThatIsNotLocalOrABadId) {
   EXPECT_EQ(DiscoveryServer::start({"127.0.0.1", 11811}, 300).error().code,
             ErrorCode::kInvalidArgument);

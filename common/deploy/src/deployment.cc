@@ -52,13 +52,38 @@ std::string badServerAddress(const std::string& text) {
   return {};
 }
 
-/// The `discovery` mapping (after `hosts`: server_host must name one).
+/// `server_host` (every server) or `server_hosts` (one per server), each a declared host.
+void readServerHosts(config::FieldReader& dr, Deployment& d) {
+  std::string one;
+  std::vector<std::string> each;
+  dr.optional("server_host", one);
+  dr.optional("server_hosts", each);
+  const std::string hosts = listOf(d.hosts);
+  if (!dr.check(one.empty() != each.empty(), one.empty() ? "server_host" : "server_hosts",
+                "give either server_host (the host of every server) or server_hosts (one per server)"))
+    return;
+  if (!one.empty()) {
+    dr.check(d.host(one) != nullptr, "server_host",
+             "must name a declared host that runs the discovery servers (hosts: " + hosts + "), got '" + one + "'");
+    d.discovery.server_hosts.assign(d.discovery.servers.size(), one);
+    return;
+  }
+  if (!dr.check(each.size() == d.discovery.servers.size(), "server_hosts",
+                "one host per server: " + std::to_string(d.discovery.servers.size()) + " servers, " +
+                    std::to_string(each.size()) + " hosts"))
+    return;
+  for (std::size_t i = 0; i < each.size(); ++i)
+    dr.check(d.host(each[i]) != nullptr, "server_hosts",
+             "entry " + std::to_string(i) + ": must name a declared host (hosts: " + hosts + "), got '" + each[i] + "'");
+  d.discovery.server_hosts = std::move(each);
+}
+
+/// The `discovery` mapping (after `hosts`: the server hosts must name them).
 void readDiscovery(config::FieldReader& r, Deployment& d) {
   auto dr = r.child("discovery");
   std::string mode = "multicast";
   dr.required("mode", mode);
   dr.optional("servers", d.discovery.servers);
-  dr.optional("server_host", d.discovery.server_host);
   if (mode == "server") {
     d.discovery.mode = DiscoverySpec::Mode::kServer;
     dr.check(!d.discovery.servers.empty(), "servers", "mode 'server' needs at least one server (\"IPv4:PORT\")");
@@ -66,15 +91,16 @@ void readDiscovery(config::FieldReader& r, Deployment& d) {
       const std::string bad = badServerAddress(d.discovery.servers[i]);
       dr.check(bad.empty(), "servers", "entry " + std::to_string(i) + ": " + bad);
     }
-    {
-      dr.check(d.host(d.discovery.server_host) != nullptr, "server_host",
-               "must name a declared host that runs the discovery servers (hosts: " + listOf(d.hosts) + "), got '" +
-                   d.discovery.server_host + "'");
-    }
+    readServerHosts(dr, d);
   } else {
+    std::string one;
+    std::vector<std::string> each;
+    dr.optional("server_host", one);
+    dr.optional("server_hosts", each);
     dr.check(mode == "multicast", "mode", "must be 'multicast' or 'server', got '" + mode + "'");
     dr.check(d.discovery.servers.empty(), "servers", "only with mode 'server'");
-    dr.check(d.discovery.server_host.empty(), "server_host", "only with mode 'server'");
+    dr.check(one.empty(), "server_host", "only with mode 'server'");
+    dr.check(each.empty(), "server_hosts", "only with mode 'server'");
   }
   dr.refuseUnknownKeys();
 }
@@ -85,6 +111,14 @@ std::string DiscoverySpec::serversEnv() const {
   if (mode != Mode::kServer) return {};
   std::string out;
   for (const auto& s : servers) out += (out.empty() ? "" : ";") + s;
+  return out;
+}
+
+std::vector<std::size_t> DiscoverySpec::serversOn(const std::string& host) const {
+  std::vector<std::size_t> out;
+  if (mode != Mode::kServer) return out;
+  for (std::size_t i = 0; i < servers.size() && i < server_hosts.size(); ++i)
+    if (server_hosts[i] == host) out.push_back(i);
   return out;
 }
 

@@ -203,8 +203,24 @@ services:
 )"));
   ASSERT_TRUE(d.ok()) << d.error().toString();
   EXPECT_EQ(d->discovery.mode, DiscoverySpec::Mode::kServer);
-  EXPECT_EQ(d->discovery.server_host, "desk");
+  EXPECT_EQ(d->discovery.server_hosts, (std::vector<std::string>{"desk", "desk"}));
+  EXPECT_EQ(d->discovery.serversOn("desk"), (std::vector<std::size_t>{0, 1}));
+  EXPECT_TRUE(d->discovery.serversOn("robot").empty());
   EXPECT_EQ(d->discovery.serversEnv(), "10.0.0.1:11811;10.0.0.3:11900");
+}
+
+// One server per host: either host's launcher runs its own, every client lists both, so no host
+// is the only one that makes new participants discoverable.
+TEST_F(DeploymentTest, EachDiscoveryServerMayRunOnAHostOfItsOwn) {
+  auto d = loadDeployment(write(R"(hosts: {robot: , desk: }
+discovery: {mode: server, servers: ["10.0.0.1:11811", "10.0.0.2:11811"], server_hosts: [desk, robot]}
+services:
+  - {name: a, host: robot, executable: svc_a}
+)"));
+  ASSERT_TRUE(d.ok()) << d.error().toString();
+  EXPECT_EQ(d->discovery.serversOn("desk"), (std::vector<std::size_t>{0}));
+  EXPECT_EQ(d->discovery.serversOn("robot"), (std::vector<std::size_t>{1}));
+  EXPECT_EQ(d->discovery.serversEnv(), "10.0.0.1:11811;10.0.0.2:11811");
 }
 
 TEST_F(DeploymentTest, BadDiscoveryNamesTheField) {
@@ -231,9 +247,26 @@ TEST_F(DeploymentTest, BadDiscoveryNamesTheField) {
               services),
       HasSubstr("field 'discovery.server_host': must name a declared host that runs the discovery "
                 "servers (hosts: robot, desk), got 'lab'"));
+  EXPECT_THAT(errorOf(hosts + "discovery: {mode: server, servers: [\"10.0.0.1:11811\"]}\n" + services),
+              HasSubstr("field 'discovery.server_host': give either server_host"));
+  EXPECT_THAT(errorOf(hosts +
+                      "discovery: {mode: server, servers: [\"10.0.0.1:11811\"], server_host: desk, "
+                      "server_hosts: [desk]}\n" + services),
+              HasSubstr("field 'discovery.server_hosts': give either server_host"));
+  EXPECT_THAT(errorOf(hosts +
+                      "discovery: {mode: server, servers: [\"10.0.0.1:11811\", \"10.0.0.2:11811\"], "
+                      "server_hosts: [desk]}\n" + services),
+              HasSubstr("field 'discovery.server_hosts': one host per server: 2 servers, 1 hosts"));
+  EXPECT_THAT(errorOf(hosts +
+                      "discovery: {mode: server, servers: [\"10.0.0.1:11811\", \"10.0.0.2:11811\"], "
+                      "server_hosts: [desk, lab]}\n" + services),
+              HasSubstr("field 'discovery.server_hosts': entry 1: must name a declared host (hosts: robot, "
+                        "desk), got 'lab'"));
   EXPECT_THAT(errorOf(hosts + "discovery: {mode: multicast, servers: [\"10.0.0.1:11811\"]}\n" +
                       services),
               HasSubstr("field 'discovery.servers': only with mode 'server'"));
+  EXPECT_THAT(errorOf(hosts + "discovery: {mode: multicast, server_hosts: [desk]}\n" + services),
+              HasSubstr("field 'discovery.server_hosts': only with mode 'server'"));
   EXPECT_THAT(errorOf(hosts + "discovery: {mode: multicast, port: 3}\n" + services),
               HasSubstr("field 'discovery.port': unknown key 'port'"));
 }

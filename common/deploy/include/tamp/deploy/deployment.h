@@ -16,7 +16,10 @@
 ///   discovery: {mode: multicast}  # default; or, on networks without multicast:
 ///   discovery: {mode: server, servers: ["10.0.0.1:11811"], server_host: workstation}
 ///                             # every participant is a client of the servers; `tamp launch
-///                             # --host <server_host>` runs them (an IPv4 of that host each)
+///                             # --host <server_host>` runs them (an IPv4 of that host each);
+///                             # or one host per server, so that no host is the only one:
+///                             # servers: ["10.0.0.1:11811", "10.0.0.2:11811"],
+///                             # server_hosts: [workstation, robot]
 ///   hosts:                    # optional; without it every service is on host "local"
 ///     robot: {env: ["KEY=value"], description: "..."}
 ///     workstation: {}
@@ -70,7 +73,13 @@ struct DiscoverySpec {
   enum class Mode { kMulticast, kServer };
   Mode mode{Mode::kMulticast};
   std::vector<std::string> servers;  ///< "IPv4:PORT", server i has GUID prefix id i; kServer only
-  std::string server_host;           ///< host whose `tamp launch` runs the servers; kServer only
+  /// Host whose `tamp launch` runs server i (as long as `servers`); kServer only. The file gives
+  /// either `server_host` (one host for every server) or `server_hosts` (one per server).
+  std::vector<std::string> server_hosts;
+  /// The indices into `servers` of the servers `host` runs.
+  std::vector<std::size_t> serversOn(const std::string& host) const;
+  /// Every server runs on `host` (tamp run on one machine).
+  void runAllOn(const std::string& host) { server_hosts.assign(servers.size(), host); }
   /// "IP:PORT;IP:PORT" ($TAMP_DDS_DISCOVERY_SERVERS) or "" for multicast.
   std::string serversEnv() const;
 };

@@ -323,6 +323,10 @@ class Searcher {
   /// Hill-climbing runs: take turns with another search (see `TurnTaker`).
   void takeTurns(TurnTaker* turns) { turns_ = turns; }
 
+  /// The lazy search prefers only its heuristic's preferred operators, none of the landmark
+  /// count's (Fast Downward's `lama-first`: `lmcount(pref=false)`).
+  void preferNoLandmarkAchievers() { landmark_preferred_ = false; }
+
   /// The lazy search (`kLazy`) from the start, suspended after every `turn` evaluations (> 0).
   SearchCoroutine lazyInTurns(uint64_t turn) {
     Stopwatch sw;
@@ -879,7 +883,7 @@ class Searcher {
       for (uint32_t i = 0; i < pref_count_[id]; ++i) pref_mark[pref_pool_[pref_begin_[id] + i]] = mark;
       ops.clear();
       task_.applicableOps(reg_.get(id), ops);
-      if (lm && use_pref) {
+      if (lm && use_pref && landmark_preferred_) {
         lm_pref.clear();
         lm->preferredAmong(reg_.get(id), accepted.data() + static_cast<size_t>(id) * lw, ops, lm_pref);
         for (OpId o : lm_pref) pref_mark[o] = mark;
@@ -1176,6 +1180,7 @@ class Searcher {
   uint64_t fallback_budget_{0};  // ehc: fall back after this many evaluations (0 = unlimited)
   uint32_t iter_{0};
   TurnTaker* turns_{nullptr};  // another search taking turns with this hill-climbing, if any
+  bool landmark_preferred_{true};  // lazy: the landmark count's preferred operators too
   bool in_agenda_entry_before_last_{false};  // ehc: hill-climbing to a goal-agenda entry, not the last
   bool dead_end_proven_{false};  // ehc: the state the hill-climbing stands on is a proven dead end
   // Plan neighbourhood search: the plan the registry's neighbourhood was built around, whether it
@@ -1422,6 +1427,9 @@ class LazyBeside : public TurnTaker {
     if (steps_) return;
     heuristic_ = makeHeuristic(defaultHeuristic(options_), task_, defaultCostType(options_, task_));
     searcher_ = std::make_unique<Searcher>(task_, init_, goal_, options_, *heuristic_, term_);
+    if (options_.lazy_plan_preferred && heuristic_->setRelaxedPlanPreferred(true)) {
+      searcher_->preferNoLandmarkAchievers();
+    }
     steps_.emplace(searcher_->lazyInTurns(options_.ehc_lazy_turn_lazy));
   }
 

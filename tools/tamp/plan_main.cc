@@ -235,7 +235,7 @@ int main(int argc, char** argv) {
   app.add_option("--lazy-plan-preferred", lazy_plan_preferred,
                  "ehc: the lazy search beside the hill-climbing prefers the relaxed plan's applicable operators "
                  "and none of the landmark count's (LAMA-first's), not FF's helpful actions and the landmarks' "
-                 "achievers: true or false");
+                 "achievers: true or false (default false)");
   app.add_option("--ehc-lazy-after", lazy_after,
                  "ehc: the lazy search starts beside the hill-climbing after this many evaluations (> 0)")
       ->check(CLI::Range(uint64_t{1}, UINT64_MAX));

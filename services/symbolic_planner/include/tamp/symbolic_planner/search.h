@@ -175,6 +175,11 @@ struct SearchOptions {
   /// plan's a few), but loses depots-6 and -20 (0.3 / 0.4 s with the default; out of time at
   /// 60 s; LAMA-first itself needs 41 s on depots-6).
   bool lazy_plan_preferred{false};
+  /// ehc_lazy_beside with `lazy_plan_preferred` off: a second lazy search beside the hill-climbing,
+  /// with LAMA-first's preferred operators; after each turn of the hill-climbing both lazy
+  /// searches take one (each a third of the evaluations; a half each once the hill-climbing gives
+  /// up), and the first final answer of either is the answer.
+  bool lazy_beside_both{false};
   uint64_t ehc_lazy_after{4000};
   uint64_t ehc_lazy_turn_ehc{100};
   uint64_t ehc_lazy_turn_lazy{100};

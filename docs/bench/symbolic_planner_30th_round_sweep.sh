@@ -42,3 +42,19 @@ for d in "$@"; do
     > /tmp/r30/out/${tag}_${b}_${d}.md 2>/tmp/r30/out/${tag}_${b}_${d}.err
   echo "== $set $d $b end $(date -u +%T) load $(cut -d" " -f1-3 /proc/loadavg)"
 done' sweep "$set" "$limit" "$tag" "$b" "$@"
+
+# --- from 06:01 UTC: sweep4.sh (lazy_beside_both on) ---
+#!/bin/bash
+# Issue 14, thirtieth round (as run from 06:01 UTC): sweep4.sh, sweep3.sh with --lazy-beside-both true; SET LIMIT TAG BIN DOMAIN... : one hold
+# of the lock for all the domains given (one sweep), one driver call per domain inside it.
+cd /work/planner-r30
+set=$1; limit=$2; tag=$3; b=$4; shift 4
+flock /tmp/tamp-build.lock bash -c '
+set=$1; limit=$2; tag=$3; b=$4; shift 4
+for d in "$@"; do
+  echo "== $set $d $b start $(date -u +%T) load $(cut -d" " -f1-3 /proc/loadavg)"
+  /tmp/r30/tamp_symbolic_planner_ipc_bench --planner /tmp/r30/tamp-plan-$b --set tests/data/benchmarks/$set --domain $d \
+    --out /tmp/r30/out/${tag}_${b}_${d}.csv --label $b --timeout $limit -- --timeout $((limit-1)) --stats --lazy-beside-both true \
+    > /tmp/r30/out/${tag}_${b}_${d}.md 2>/tmp/r30/out/${tag}_${b}_${d}.err
+  echo "== $set $d $b end $(date -u +%T) load $(cut -d" " -f1-3 /proc/loadavg)"
+done' sweep "$set" "$limit" "$tag" "$b" "$@"

@@ -231,6 +231,15 @@ int main(int argc, char** argv) {
                  "operators the same on them merged): true or false");
   app.add_flag("--no-ehc-lazy-beside", no_lazy_beside,
                "ehc: the lazy search only after the hill-climbing fails (FF's order), not beside it");
+  bool lazy_plan_preferred = defaults.lazy_plan_preferred;
+  app.add_option("--lazy-plan-preferred", lazy_plan_preferred,
+                 "ehc: the lazy search beside the hill-climbing prefers the relaxed plan's applicable operators "
+                 "and none of the landmark count's (LAMA-first's), not FF's helpful actions and the landmarks' "
+                 "achievers: true or false (default false)");
+  bool lazy_beside_both = defaults.lazy_beside_both;
+  app.add_option("--lazy-beside-both", lazy_beside_both,
+                 "ehc: two lazy searches beside the hill-climbing in turns, one with the default preferred "
+                 "operators, one with LAMA-first's: true or false (default false)");
   app.add_option("--ehc-lazy-after", lazy_after,
                  "ehc: the lazy search starts beside the hill-climbing after this many evaluations (> 0)")
       ->check(CLI::Range(uint64_t{1}, UINT64_MAX));
@@ -275,6 +284,8 @@ int main(int argc, char** argv) {
   req.search.rhw.skip_one_action_disjunctions = !rhw_keep_one_action;
   req.search.rhw.reasonable_orders = rhw_reasonable;
   req.search.ehc_lazy_beside = !no_lazy_beside;
+  req.search.lazy_plan_preferred = lazy_plan_preferred;
+  req.search.lazy_beside_both = lazy_beside_both;
   req.search.ehc_h2_restart = h2_restart;
   req.search.ehc_h2_test_gap_max = h2_test_gap_max;
   req.search.ehc_ff_first_h2_restart = ff_first_h2_restart;

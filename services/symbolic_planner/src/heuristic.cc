@@ -491,6 +491,10 @@ class LayeredFF : public Heuristic {
     ff_style_ = on;
     return true;
   }
+  bool setRelaxedPlanPreferred(bool on) override {
+    plan_preferred_ = on;
+    return true;
+  }
 
   Cost evaluate(const uint64_t* s) override {
     preferred_.clear();
@@ -808,16 +812,17 @@ class LayeredFF : public Heuristic {
   }
 
   /// Helpful actions: first the relaxed plan's own layer-1 operators that are applicable (EHC
-  /// tries helpful actions in order), then every applicable operator that adds a layer-1
-  /// sub-goal (for a conditional effect: with its condition true).
+  /// tries helpful actions in order), then (unless `plan_preferred_`) every applicable operator
+  /// that adds a layer-1 sub-goal (for a conditional effect: with its condition true).
   void collectHelpful(const uint64_t* s) {
     if (goals_at_.size() < 2) return;
-    if (ff_style_) return collectHelpfulFF(s);
+    if (ff_style_ && !plan_preferred_) return collectHelpfulFF(s);
     for (OpId o : plan_first_) {
       if (op_mark_[o] == epoch_ || !task_.applicable(s, o)) continue;
       op_mark_[o] = epoch_;
       preferred_.push_back(o);
     }
+    if (plan_preferred_) return;
     // The operators applicable in s that add g are those of g's adders at layer 0 (a merged
     // rop: its members whose own fact is true), taken in operator order as from
     // `task_.achievers[g]`, without testing each achiever's preconditions against s (hiking-16:
@@ -917,6 +922,7 @@ class LayeredFF : public Heuristic {
   std::vector<uint32_t> goal_mark_, op_mark_, op_used_;
   std::vector<std::pair<uint32_t, OpId>> cand_;
   bool ff_style_{false};
+  bool plan_preferred_{false};  ///< setRelaxedPlanPreferred
   std::vector<OpId> plan_first_;
   std::vector<OpId> layer0_;       ///< collectHelpful(): a sub-goal's adders applicable in the state
   bool several_conjuncts_{false};  ///< the goal is a disjunction of conjuncts
@@ -976,6 +982,11 @@ class RelaxationHeuristic : public Heuristic {
   }
 
   bool computesPreferred() const override { return mode_ == Mode::kFF; }
+  bool setRelaxedPlanPreferred(bool on) override {
+    if (mode_ != Mode::kFF) return false;
+    plan_preferred_ = on;
+    return true;
+  }
   const std::vector<OpId>& preferred() const override { return preferred_; }
 
   Cost evaluate(const uint64_t* s) override {
@@ -1101,6 +1112,7 @@ class RelaxationHeuristic : public Heuristic {
       pref_stamp_.assign(task_.ops.size(), 0);
       pref_mark_ = 1;
     }
+    if (plan_preferred_) return collectPlanOperators();
     for (FactId g : g1_) {
       for (OpId o : task_.achievers[g]) {
         if (pref_stamp_[o] == pref_mark_) continue;
@@ -1108,6 +1120,17 @@ class RelaxationHeuristic : public Heuristic {
         pref_stamp_[o] = pref_mark_;
         preferred_.push_back(o);
       }
+    }
+  }
+
+  /// The relaxed plan's first-layer operators: the best supporters of the first-layer sub-goals
+  /// (their preconditions, a conditional effect's condition included, hold in the state).
+  void collectPlanOperators() {
+    for (FactId g : g1_) {
+      const OpId o = R_.op[supporter_[g]];
+      if (pref_stamp_[o] == pref_mark_) continue;
+      pref_stamp_[o] = pref_mark_;
+      preferred_.push_back(o);
     }
   }
 
@@ -1140,6 +1163,7 @@ class RelaxationHeuristic : public Heuristic {
   uint32_t mark_{0}, pref_mark_{0};
   std::vector<FactId> stack_, g1_;
   std::vector<OpId> preferred_;
+  bool plan_preferred_{false};  ///< setRelaxedPlanPreferred
 };
 
 class BlindHeuristic : public Heuristic {

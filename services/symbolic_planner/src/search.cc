@@ -323,6 +323,10 @@ class Searcher {
   /// Hill-climbing runs: take turns with another search (see `TurnTaker`).
   void takeTurns(TurnTaker* turns) { turns_ = turns; }
 
+  /// The lazy search prefers only its heuristic's preferred operators, none of the landmark
+  /// count's (Fast Downward's `lama-first`: `lmcount(pref=false)`).
+  void preferNoLandmarkAchievers() { landmark_preferred_ = false; }
+
   /// The lazy search (`kLazy`) from the start, suspended after every `turn` evaluations (> 0).
   SearchCoroutine lazyInTurns(uint64_t turn) {
     Stopwatch sw;
@@ -879,7 +883,7 @@ class Searcher {
       for (uint32_t i = 0; i < pref_count_[id]; ++i) pref_mark[pref_pool_[pref_begin_[id] + i]] = mark;
       ops.clear();
       task_.applicableOps(reg_.get(id), ops);
-      if (lm && use_pref) {
+      if (lm && use_pref && landmark_preferred_) {
         lm_pref.clear();
         lm->preferredAmong(reg_.get(id), accepted.data() + static_cast<size_t>(id) * lw, ops, lm_pref);
         for (OpId o : lm_pref) pref_mark[o] = mark;
@@ -1176,6 +1180,7 @@ class Searcher {
   uint64_t fallback_budget_{0};  // ehc: fall back after this many evaluations (0 = unlimited)
   uint32_t iter_{0};
   TurnTaker* turns_{nullptr};  // another search taking turns with this hill-climbing, if any
+  bool landmark_preferred_{true};  // lazy: the landmark count's preferred operators too
   bool in_agenda_entry_before_last_{false};  // ehc: hill-climbing to a goal-agenda entry, not the last
   bool dead_end_proven_{false};  // ehc: the state the hill-climbing stands on is a proven dead end
   // Plan neighbourhood search: the plan the registry's neighbourhood was built around, whether it
@@ -1383,7 +1388,10 @@ SearchResult configuredSearch(const Task& task, const StateBits& init, const Goa
 /// SearchOptions::ehc_lazy_beside: the lazy search, started once the hill-climbing has used
 /// `ehc_lazy_after` evaluations, then run for `ehc_lazy_turn_lazy` evaluations after every
 /// `ehc_lazy_turn_ehc` of the hill-climbing's, inside the hill-climbing's own call (one thread:
-/// a turn costs a function call). It has a searcher (states) and a heuristic of its own.
+/// a turn costs a function call). It has a searcher (states) and a heuristic of its own. With
+/// `lazy_beside_both`, two lazy searches take their turns one after the other (the one with the
+/// default preferred operators first, then the one with LAMA-first's); the first final answer of
+/// either is the answer.
 class LazyBeside : public TurnTaker {
  public:
   LazyBeside(const Task& task, const StateBits& init, const Goal& goal, const SearchOptions& options,
@@ -1396,33 +1404,65 @@ class LazyBeside : public TurnTaker {
     if (finished_ || --left_ > 0) return;
     left_ = options_.ehc_lazy_turn_ehc;
     start();
-    steps_->resume();
-    finished_ = steps_->done();
+    for (size_t i = 0; i < lanes_.size() && !finished_; ++i) turn(i);
   }
   /// The lazy search has given a final answer (a plan or a proof): the hill-climbing stops.
-  bool stopped() const override {
-    if (!finished_) return false;
-    const SearchStatus st = steps_->result().status;
-    return st == SearchStatus::kSolved || st == SearchStatus::kUnsolvable;
+  bool stopped() const override { return finished_ && isFinal(lanes_[winner_]); }
+  bool started() const { return !lanes_.empty(); }
+  /// The lazy searches' counters so far (they must have started).
+  const SearchStatistics& statistics() {
+    sum_ = lanes_[0].searcher->statistics();
+    for (size_t i = 1; i < lanes_.size(); ++i) addRunCosts(sum_, lanes_[i].searcher->statistics());
+    return sum_;
   }
-  bool started() const { return steps_.has_value(); }
-  /// The lazy search's counters so far (it must have started).
-  const SearchStatistics& statistics() const { return searcher_->statistics(); }
   bool finished() const { return finished_; }
-  /// Runs the lazy search to its end (starting it if it has not started).
+  /// Runs the lazy searches in turns to the first final answer, or until all have ended (starting
+  /// them if they have not started); the answer's counters include the others'.
   SearchResult& runToEnd() {
     start();
-    steps_->runToEnd();
-    finished_ = true;
-    return steps_->result();
+    for (size_t i = 0; !finished_; i = (i + 1) % lanes_.size()) turn(i);
+    SearchResult& r = lanes_[winner_].steps->result();
+    for (size_t i = 0; i < lanes_.size(); ++i) {
+      if (i != winner_) addRunCosts(r.stats, lanes_[i].searcher->statistics());
+    }
+    return r;
   }
 
  private:
+  struct Lane {
+    std::unique_ptr<Heuristic> heuristic;
+    std::unique_ptr<Searcher> searcher;
+    std::optional<SearchCoroutine> steps;
+  };
+  static bool isFinal(const Lane& l) {
+    if (!l.steps->done()) return false;
+    const SearchStatus st = l.steps->result().status;
+    return st == SearchStatus::kSolved || st == SearchStatus::kUnsolvable;
+  }
+  /// One turn of lane i (none if it has ended); records the winner once a lane answers or all end.
+  void turn(size_t i) {
+    Lane& l = lanes_[i];
+    if (l.steps->done()) return;
+    l.steps->resume();
+    if (!l.steps->done()) return;
+    bool all_done = true;
+    for (const Lane& x : lanes_) all_done = all_done && x.steps->done();
+    if (isFinal(l) || all_done) {
+      finished_ = true;
+      winner_ = i;
+    }
+  }
   void start() {
-    if (steps_) return;
-    heuristic_ = makeHeuristic(defaultHeuristic(options_), task_, defaultCostType(options_, task_));
-    searcher_ = std::make_unique<Searcher>(task_, init_, goal_, options_, *heuristic_, term_);
-    steps_.emplace(searcher_->lazyInTurns(options_.ehc_lazy_turn_lazy));
+    if (!lanes_.empty()) return;
+    addLane(options_.lazy_plan_preferred);
+    if (options_.lazy_beside_both && !options_.lazy_plan_preferred) addLane(true);
+  }
+  void addLane(bool plan_preferred) {
+    Lane& l = lanes_.emplace_back();
+    l.heuristic = makeHeuristic(defaultHeuristic(options_), task_, defaultCostType(options_, task_));
+    l.searcher = std::make_unique<Searcher>(task_, init_, goal_, options_, *l.heuristic, term_);
+    if (plan_preferred && l.heuristic->setRelaxedPlanPreferred(true)) l.searcher->preferNoLandmarkAchievers();
+    l.steps.emplace(l.searcher->lazyInTurns(options_.ehc_lazy_turn_lazy));
   }
 
   const Task& task_;
@@ -1430,10 +1470,10 @@ class LazyBeside : public TurnTaker {
   const Goal& goal_;
   SearchOptions options_;
   const Termination& term_;
-  uint64_t left_;  // hill-climbing evaluations before the lazy search's next turn
-  std::unique_ptr<Heuristic> heuristic_;
-  std::unique_ptr<Searcher> searcher_;
-  std::optional<SearchCoroutine> steps_;
+  uint64_t left_;  // hill-climbing evaluations before the lazy searches' next turns
+  std::vector<Lane> lanes_;
+  size_t winner_{0};  // with finished_: the lane that answered (or ended last)
+  SearchStatistics sum_;
   bool finished_{false};
 };
 

@@ -447,6 +447,79 @@ TEST(Heuristic, HelpfulActionsAreTheApplicableAddersOfTheFirstLayerSubGoalsOnRan
   }
 }
 
+TEST(Heuristic, RelaxedPlanPreferredAreTheRelaxedPlansOwnApplicableOperatorsAmongTheHelpfulActions) {
+  // setRelaxedPlanPreferred (LAMA-first's preferred operators; the lazy search beside the
+  // hill-climbing uses them): in every state of random walks (fixed seed) the value is the same;
+  // the preferred operators are distinct, applicable, at most h of them (every relaxed-plan
+  // action costs at least 1), some wherever 0 < h < dead end, and all among FF's helpful actions;
+  // for the layered graph they are the helpful actions' first ones (the relaxed plan's own come
+  // first there), also with FF-v2.3's order set (the switch takes precedence). On hiking-4
+  // (sub-goals with hundreds of applicable adders) they are strictly fewer in most states.
+  // transport-6 with cost + 1: the cost-based relaxed plan (h_add's best supporters).
+  struct Case {
+    std::string dom, prob;
+    CostType cost_type;
+    bool layered;
+  };
+  const std::vector<Case> cases = {
+      {"pddl-more/hiking/domain.pddl", "pddl-more/hiking/instance-4.pddl", CostType::kUnit, true},
+      {"pddl/gripper/domain.pddl", "pddl/gripper/instance-4.pddl", CostType::kUnit, true},
+      {"pddl-more/transport/domain.pddl", "pddl-more/transport/instance-6.pddl", CostType::kPlusOne, false},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.prob);
+    SolvedInstance in;
+    ASSERT_NO_FATAL_FAILURE(loadSolvedInstance(c.dom, c.prob, in));
+    const Task& t = in.task();
+    auto h = makeHeuristic(HeuristicKind::kFF, t, c.cost_type);
+    h->setGoal(in.goal);
+    size_t states = 0, positive = 0, fewer = 0;
+    const auto visit = [&](const StateBits& cur, int walk, int step) {
+      ASSERT_TRUE(h->setRelaxedPlanPreferred(false));
+      const Cost v = h->evaluate(cur.data());
+      const std::vector<OpId> helpful = h->preferred();
+      ASSERT_TRUE(h->setRelaxedPlanPreferred(true));
+      ASSERT_EQ(h->evaluate(cur.data()), v);
+      const std::vector<OpId> plan_ops = h->preferred();
+      ++states;
+      if (v == 0 || v == Heuristic::kDeadEnd) {
+        ASSERT_TRUE(plan_ops.empty()) << "walk " << walk << " step " << step;
+        return;
+      }
+      ++positive;
+      ASSERT_FALSE(plan_ops.empty()) << "walk " << walk << " step " << step;
+      ASSERT_LE(static_cast<Cost>(plan_ops.size()), v);
+      std::vector<OpId> sorted = plan_ops;
+      std::sort(sorted.begin(), sorted.end());
+      ASSERT_EQ(std::adjacent_find(sorted.begin(), sorted.end()), sorted.end());
+      for (OpId o : plan_ops) {
+        ASSERT_TRUE(t.applicable(cur.data(), o)) << t.ops[o].name;
+        ASSERT_NE(std::find(helpful.begin(), helpful.end(), o), helpful.end()) << t.ops[o].name;
+      }
+      fewer += plan_ops.size() < helpful.size() ? 1 : 0;
+      if (!c.layered) return;
+      ASSERT_TRUE(std::equal(plan_ops.begin(), plan_ops.end(), helpful.begin()));
+      ASSERT_TRUE(h->setFFStyle(true));
+      ASSERT_EQ(h->evaluate(cur.data()), v);
+      ASSERT_EQ(h->preferred(), plan_ops);
+      ASSERT_TRUE(h->setFFStyle(false));
+    };
+    forEachRandomWalkState(t, in.init, /*seed=*/7, /*walks=*/10, /*steps=*/60, visit);
+    if (HasFatalFailure()) return;
+    EXPECT_GT(states, 200U);
+    EXPECT_GT(positive * 2, states);
+    if (c.prob.find("hiking") != std::string::npos) {
+      EXPECT_GT(fewer * 2, positive);
+    }
+  }
+  // The heuristics that compute no helpful actions have no such switch.
+  SolvedInstance in;
+  ASSERT_NO_FATAL_FAILURE(loadSolvedInstance("pddl/gripper/domain.pddl", "pddl/gripper/instance-4.pddl", in));
+  for (HeuristicKind k : {HeuristicKind::kAdd, HeuristicKind::kBlind}) {
+    EXPECT_FALSE(makeHeuristic(k, in.task(), CostType::kUnit)->setRelaxedPlanPreferred(true));
+  }
+}
+
 TEST(Landmarks, PreferredAmongTheApplicableOperatorsIsThePreferredSet) {
   // preferredAmong (what the lazy search calls, with the applicable operators it generates
   // anyway) gives the same operators as preferred (every adder of the landmarks in question

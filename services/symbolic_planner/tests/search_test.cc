@@ -543,6 +543,77 @@ TEST(Search, LazySearchBesideNotStartedChangesNothing) {
   }
 }
 
+TEST(Search, LazySearchBesidePrefersTheRelaxedPlansOperatorsAndNoneOfTheLandmarkCounts) {
+  // hiking-4: both hill-climbing runs give up and the lazy search beside them gives the plan.
+  // With LAMA-first's preferred operators (`lazy_plan_preferred`, off by default) it needs fewer
+  // evaluations than with FF's helpful actions and the landmarks' achievers (20 833 against
+  // 36 497 when written); the same plan and count in a second run; both plans checked.
+  PlanRequest req = benchmarkRequest("pddl-more/hiking", "instance-4.pddl");
+  req.timeout_seconds = 120;
+  ASSERT_FALSE(req.search.lazy_plan_preferred);  // the default
+  req.search.lazy_plan_preferred = true;
+  PlanReply lama = plan(req, Termination());
+  ASSERT_EQ(lama.status, PlanStatus::kSolved) << lama.message;  // replayed by the checker
+  EXPECT_TRUE(lama.stats.lazy_beside_won);
+  PlanReply again = plan(req, Termination());
+  ASSERT_EQ(again.status, PlanStatus::kSolved) << again.message;
+  EXPECT_EQ(again.stats.evaluated, lama.stats.evaluated);
+  EXPECT_EQ(again.plan, lama.plan);
+  req.search.lazy_plan_preferred = false;
+  PlanReply ff = plan(req, Termination());
+  ASSERT_EQ(ff.status, PlanStatus::kSolved) << ff.message;
+  EXPECT_TRUE(ff.stats.lazy_beside_won);
+  EXPECT_LT(lama.stats.evaluated * 3, ff.stats.evaluated * 2);
+  // openstacks-6: the hill-climbing needs fewer evaluations than `ehc_lazy_after`, so the lazy
+  // search never starts and the option changes nothing (the hill-climbing keeps FF's helpful
+  // actions).
+  PlanRequest os = benchmarkRequest("pddl-more/openstacks", "instance-6.pddl");
+  os.timeout_seconds = 120;
+  os.search.lazy_plan_preferred = true;
+  PlanReply on = plan(os, Termination());
+  os.search.lazy_plan_preferred = false;
+  PlanReply off = plan(os, Termination());
+  ASSERT_EQ(on.status, PlanStatus::kSolved) << on.message;
+  ASSERT_EQ(off.status, PlanStatus::kSolved) << off.message;
+  EXPECT_FALSE(on.stats.lazy_beside_started);
+  EXPECT_EQ(on.stats.evaluated, off.stats.evaluated);
+  EXPECT_EQ(on.plan, off.plan);
+}
+
+TEST(Search, TwoLazySearchesBesideTheHillClimbingGiveTheFirstAnswerOfEither) {
+  // `lazy_beside_both`: the default lazy search and one with LAMA-first's preferred operators take
+  // turns beside the hill-climbing. Each searches as it would alone (its own states, heuristic
+  // and turns counted in its own evaluations), so the answer is the plan of whichever finds one
+  // first: on hiking-4 LAMA-first's (the plan of the `lazy_plan_preferred` run), on depots-6 the
+  // default one's (main's plan; LAMA-first's alone does not finish in 60 s). Both checked, with
+  // more evaluations than that search's run (the other's are counted), the same in a second run.
+  struct Case {
+    std::string folder, instance;
+    bool lama_first_wins;
+  };
+  const std::vector<Case> cases = {{"pddl-more/hiking", "instance-4.pddl", true},
+                                   {"pddl/depots", "instance-6.pddl", false}};
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.folder);
+    PlanRequest req = benchmarkRequest(c.folder, c.instance);
+    req.timeout_seconds = 120;
+    req.search.lazy_plan_preferred = c.lama_first_wins;
+    PlanReply alone = plan(req, Termination());
+    req.search.lazy_plan_preferred = false;
+    ASSERT_FALSE(req.search.lazy_beside_both);  // the default
+    req.search.lazy_beside_both = true;
+    PlanReply both = plan(req, Termination());
+    PlanReply again = plan(req, Termination());
+    ASSERT_EQ(alone.status, PlanStatus::kSolved) << alone.message;
+    ASSERT_EQ(both.status, PlanStatus::kSolved) << both.message;  // replayed by the checker
+    EXPECT_TRUE(both.stats.lazy_beside_won);
+    EXPECT_EQ(both.plan, alone.plan);
+    EXPECT_GT(both.stats.evaluated, alone.stats.evaluated);
+    EXPECT_EQ(again.plan, both.plan);
+    EXPECT_EQ(again.stats.evaluated, both.stats.evaluated);
+  }
+}
+
 TEST(Search, LazySearchBesideProvesUnsolvabilityAndGoesOnAloneWhenTheHillClimbingGivesUp) {
   // Turns of one evaluation from the first one on. (1) The swap task (relaxed solvable, really
   // unsolvable): the answer is the proof. (2) logistics-12 with a hill-climbing that gives up

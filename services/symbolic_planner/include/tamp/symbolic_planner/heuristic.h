@@ -55,6 +55,16 @@ class Heuristic {
     (void)on;
     return false;
   }
+  /// Switches `preferred()` to the relaxed plan's own first-layer operators (those applicable in
+  /// the state, each once: Fast Downward's preferred operators of h_FF, and so LAMA-first's) or
+  /// back to FF's helpful actions (every applicable operator that adds a first-layer sub-goal, a
+  /// superset: on hiking hundreds where the relaxed plan has a few). Takes precedence over
+  /// `setFFStyle`; values are unchanged. Returns false (and changes nothing) when the heuristic
+  /// computes no helpful actions.
+  virtual bool setRelaxedPlanPreferred(bool on) {
+    (void)on;
+    return false;
+  }
 
  protected:
   std::vector<OpId> no_ops_;

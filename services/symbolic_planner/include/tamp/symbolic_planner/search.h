@@ -11,7 +11,8 @@
 ///   first, then best-first). With `ehc_lazy_beside` (the default) that lazy search starts beside
 ///   a hill-climbing that has used `ehc_lazy_after` evaluations and the two take turns in one
 ///   thread; the first plan or proof wins, and a failed hill-climbing leaves the lazy search to go
-///   on from where it is. With `ehc_ff_first` (the default) and a heuristic that has
+///   on from where it is (`lazy_plan_preferred`: with LAMA-first's preferred operators). With
+///   `ehc_ff_first` (the default) and a heuristic that has
 ///   FF-v2.3's variant (`Heuristic::setFFStyle`), a first hill-climbing run uses that variant
 ///   within a budget of evaluations (it tends to give shorter plans); when it fails or runs
 ///   out of budget, the search starts again from the initial state with the default heuristic,
@@ -164,6 +165,21 @@ struct SearchOptions {
   /// have done this many words of work in all (about 3 x 10^8 a second here); 0 = unbounded.
   /// airport-30's restart: 500 tests, 3.1 x 10^9 words, 10 s.
   uint64_t ehc_h2_work_budget{4'000'000'000};
+  /// ehc_lazy_beside: its lazy search (beside the hill-climbing, and alone once it gives up) prefers
+  /// LAMA-first's operators: the relaxed plan's own applicable first-layer operators
+  /// (`Heuristic::setRelaxedPlanPreferred`) and none of the landmark count's, in a heuristic of
+  /// its own; the hill-climbing, `kLazy` and the anytime phase keep theirs (FF's helpful actions
+  /// and the achievers of the landmarks still needed). Off by default (docs/benchmarks.md, issue
+  /// 14, thirtieth round): on it solves hiking-16 / -20, transport-18, trucks-18 and
+  /// scanalyzer-30 in 30 s (FF's helpful actions on hiking are hundreds of drives, the relaxed
+  /// plan's a few), but loses depots-6 and -20 (0.3 / 0.4 s with the default; out of time at
+  /// 60 s; LAMA-first itself needs 41 s on depots-6).
+  bool lazy_plan_preferred{false};
+  /// ehc_lazy_beside with `lazy_plan_preferred` off: a second lazy search beside the hill-climbing,
+  /// with LAMA-first's preferred operators; after each turn of the hill-climbing both lazy
+  /// searches take one (each a third of the evaluations; a half each once the hill-climbing gives
+  /// up), and the first final answer of either is the answer.
+  bool lazy_beside_both{false};
   uint64_t ehc_lazy_after{4000};
   uint64_t ehc_lazy_turn_ehc{100};
   uint64_t ehc_lazy_turn_lazy{100};

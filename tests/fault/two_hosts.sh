@@ -125,6 +125,13 @@ elif [ "$JITTER" != 0 ]; then
 fi
 TAG=t$$
 RUN_ID=${RUN_ID:-twohost-$DISCOVERY-$TAG}
+# One two-host run at a time on this machine: ctest starts the TwoHostsTest cases side by side
+# (gtest_discover_tests' PRE_TEST discovery leaves RUN_SERIAL unknown when ctest schedules), and
+# six deployments on two cores starved one run's execution record past its mission's end (CI of
+# session 27). Not /tmp/tamp-build.lock: the CI holds that one around the whole test run.
+LOCK=${TAMP_TWO_HOSTS_LOCK:-/tmp/tamp-two-hosts.lock}
+exec 9> "$LOCK"
+if ! flock -w 420 9; then echo "two_hosts.sh: another two-host run held $LOCK for 420 s" >&2; exit 75; fi
 NS_R=tamp-robot-$TAG NS_W=tamp-ws-$TAG
 mkdir -p "$OUT/$RUN_ID"
 OUT=$(realpath "$OUT")
@@ -151,7 +158,7 @@ cleanup() {
   for p in "${PIDS[@]}"; do wait "$p" 2>/dev/null || true; done
   # Services whose launcher was killed (--kill-launcher) are orphans: stopped here, as the launcher
   # would have (the simulator writes its final world on it), waited for at most 10 s.
-  local orphans="tamp_[a-z_]*_service --name .*--run-id $RUN_ID"
+  local orphans="tamp_[a-z_]*_service --name .*--run-id $RUN_ID( |\$)"
   if pkill -TERM -f -- "$orphans" 2>/dev/null; then
     for _ in $(seq 50); do pgrep -f -- "$orphans" > /dev/null || break; sleep 0.2; done
   fi
@@ -220,7 +227,7 @@ udp_rtt() {  # LABEL
 # The delay of every UDP datagram NS sends on DEV: tamp_link_delay on the queue, then the rule.
 link_delay() {  # NS DEV HOST
   local log=$RUN_DIR/delay-$3.out
-  ip netns exec "$1" "$DELAYER" --queue $QUEUE_NUM --delay-ms "$DELAY" --jitter-ms "$JITTER" --seed "$SEED" > "$log" 2>&1 &
+  ip netns exec "$1" "$DELAYER" --queue $QUEUE_NUM --delay-ms "$DELAY" --jitter-ms "$JITTER" --seed "$SEED" > "$log" 2>&1 9>&- &
   PIDS+=($!) DELAY_PIDS+=($!)
   local pid=$! rc=0
   for _ in $(seq 50); do grep -q '^ready' "$log" && break; kill -0 $pid 2>/dev/null || break; sleep 0.1; done
@@ -259,10 +266,10 @@ NS_ROBOT_SIDE=$NS_R
 [ "$ONE_HOST" = 1 ] && NS_ROBOT_SIDE=$NS_W
 ip netns exec "$NS_ROBOT_SIDE" env TAMP_SIM_FINAL_WORLD="$OUT/$RUN_ID/sim_final_world.json" \
   "$BIN/tamp" launch "$DEPLOY" --host robot --run-id "$RUN_ID" --scenario "$SCENARIO" --out "$OUT" \
-  > "$OUT/$RUN_ID/launch-robot.out" 2>&1 &
+  > "$OUT/$RUN_ID/launch-robot.out" 2>&1 9>&- &
 PIDS+=($!)
 ip netns exec "$NS_W" "$BIN/tamp" launch "$DEPLOY" --host workstation --run-id "$RUN_ID" --scenario "$SCENARIO" \
-  --out "$OUT" > "$OUT/$RUN_ID/launch-workstation.out" 2>&1 &
+  --out "$OUT" > "$OUT/$RUN_ID/launch-workstation.out" 2>&1 9>&- &
 PIDS+=($!)
 
 if [ -n "$PART_AT" ]; then
@@ -284,7 +291,7 @@ if [ -n "$KILL" ]; then
     # SIGKILL KILL_AT s after the mission started; the service's launcher restarts it.
     until grep -q "tamp mission: run" "$OUT/$RUN_ID/mission.out" 2>/dev/null; do sleep 0.2; done
     sleep "$KILL_AT"
-    pid=$(pgrep -f -- "tamp_${KILL}_service --name $KILL .*--run-id $RUN_ID" | head -1)
+    pid=$(pgrep -f -- "tamp_${KILL}_service --name $KILL .*--run-id $RUN_ID( |\$)" | head -1)
     if [ -n "$pid" ] && kill -9 "$pid" 2>/dev/null; then
       echo "kill: SIGKILL to $KILL (pid $pid) at $(date -u +%T.%N)" >> "$OUT/$RUN_ID/faults.log"
     else

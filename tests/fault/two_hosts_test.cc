@@ -36,7 +36,7 @@ TwoHostRun runTwoHosts(const std::string& run_id, const std::vector<std::string>
   args.insert(args.end(), options.begin(), options.end());
   TwoHostRun r;
   std::tie(r.exit_code, r.output) =
-      runCommand(fs::path(TAMP_SOURCE_DIR) / "tests" / "fault" / "two_hosts.sh", args, 300.0);
+      runCommand(fs::path(TAMP_SOURCE_DIR) / "tests" / "fault" / "two_hosts.sh", args, 580.0);
   const fs::path truth = out / run_id / "sim_final_world.json";
   if (fs::exists(truth)) r.truth = nlohmann::json::parse(readFile(truth), nullptr, false);
   if (fs::exists(out / run_id / "faults.log")) r.faults = readFile(out / run_id / "faults.log");

@@ -62,9 +62,13 @@ function(tamp_add_test name)
   if(T_SERIAL)
     set(serial TRUE)
   endif()
+  # LABELS last: PROPERTIES is a flat key/value list, so a label list ("fault;integration") would
+  # shift every pair after it (RUN_SERIAL was lost on the two-host tests, and the tests without
+  # labels got one named RUN_SERIAL). Only the first label survives the discovery script's
+  # expansion (an escaped ';' does not either): give the one that selects the test first.
   gtest_discover_tests(${name}
     DISCOVERY_MODE PRE_TEST
-    PROPERTIES ENVIRONMENT "SKIP_DEFAULT_XML_FILE=1" TIMEOUT ${T_TIMEOUT} LABELS "${T_LABELS}" RUN_SERIAL ${serial})
+    PROPERTIES ENVIRONMENT "SKIP_DEFAULT_XML_FILE=1" TIMEOUT ${T_TIMEOUT} RUN_SERIAL ${serial} LABELS "${T_LABELS}")
 endfunction()
 
 function(tamp_add_benchmark name)

@@ -1,17 +1,23 @@
 #!/usr/bin/env bash
 # The main job: installs the dependencies, builds (Release), and runs a scenario end to end with
-# every service as its own process on this machine. Usage: deploy/run.sh [SCENARIO] [tamp run options]
+# every service as its own process on this machine.
+# Usage: deploy/run.sh [SCENARIO] [tamp run options]
+# The simulated robot runs at 4x real time unless a --realtime-factor is given (1 = real time);
+# executed and predicted times are simulated seconds either way.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./deploy/install_deps.sh
 ./deploy/build.sh release
 default_scenario=config/scenarios/namo_corridor.yaml
+scenario=()
 if [ $# -gt 0 ] && [[ "$1" != -* ]]; then
-  scenario="$1"; shift
-  [ -f "$scenario" ] || { echo "deploy/run.sh: no scenario file $scenario" >&2; exit 30; }
-  exec ./build/release/bin/tamp run "$scenario" "$@"
+  [ -f "$1" ] || { echo "deploy/run.sh: no scenario file $1" >&2; exit 30; }
+  scenario=("$1"); shift
 elif [ -f "$default_scenario" ]; then
-  exec ./build/release/bin/tamp run "$default_scenario" "$@"
-else
-  exec ./build/release/bin/tamp run "$@"
+  scenario=("$default_scenario")
 fi
+speed=(--realtime-factor 4)
+for a in "$@"; do
+  case "$a" in --realtime-factor|--realtime-factor=*) speed=() ;; esac
+done
+exec ./build/release/bin/tamp run "${scenario[@]}" "${speed[@]}" "$@"

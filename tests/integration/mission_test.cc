@@ -236,11 +236,16 @@ TEST(MissionTest, DISABLED_AWayRoundWhatTheRobotCannotMoveIsOpenedByPushingOther
     if (a["action"].get<std::string>().rfind("(pick ", 0) == 0) ADD_FAILURE() << "a box wider than the gripper was picked";
 }
 
+// Also run with `--realtime-factor 5`, which overrides the deployment's simulator parameters
+// (2x here) for this run: the simulator says so in its log.
 TEST(MissionTest, CorridorShortDetourIsTakenInsteadOfMovingTheBox) {
-  const Mission m = run("namo_corridor_short.yaml");
+  const Mission m = run("namo_corridor_short.yaml", {"--realtime-factor", "5"});
   ASSERT_EQ(m.exit_code, 0) << m.output;
   expectAtTheCorridorGoal(m);
   expectTheBoxUntouched(m);
+  EXPECT_NE(m.output.find("runs at 5x real time"), std::string::npos) << m.output;
+  const std::string sim_log = readFile(m.run_dir / "sim.log");
+  EXPECT_NE(sim_log.find("simulated time runs at 5x real time"), std::string::npos) << sim_log;
 }
 
 // Every pick of the corridor box misses (scripted). The pick is tried max_action_failures (2)

@@ -1,4 +1,5 @@
-// `tamp run [SCENARIO] [--policy effort|infeasible|oracle] [--out DIR] [--seed N]`: the main job. Starts
+// `tamp run [SCENARIO] [--policy effort|infeasible|oracle] [--out DIR] [--seed N] [--realtime-factor F]`:
+// the main job. Starts
 // every service of a deployment (config/deploy/local.yaml by default) as supervised processes on
 // one DDS domain, waits until each is alive (heartbeats) and answers a request (echo), then sends
 // the scenario's mission to the graph manager and follows it: one line per executed action
@@ -71,6 +72,12 @@ int main(int argc, char** argv) {
                  "DDS Security directory (deploy/security/make_certs.sh): every service and this tool run secured, "
                  "each with its own identity (default: $TAMP_DDS_SECURITY)")
       ->check(CLI::ExistingDirectory);
+  double realtime_factor = -1.0;
+  app.add_option("--realtime-factor", realtime_factor,
+                 "simulated seconds per wall-clock second of the simulated robot for this run (default: "
+                 "config/services/sim.yaml's, 1 = real time; 0 = as fast as possible); reports and time models "
+                 "stay in simulated seconds")
+      ->check(CLI::NonNegativeNumber);
   CLI11_PARSE(app, argc, argv);
 
   auto deployment = tamp::deploy::loadDeployment(deployment_file);
@@ -124,6 +131,11 @@ int main(int argc, char** argv) {
   // faults) to the graph manager for this run only; a normal run does not expose it.
   if (policy == "oracle") setenv("TAMP_ORACLE", "1", 1);
   else unsetenv("TAMP_ORACLE");
+  if (realtime_factor >= 0) {
+    setenv("TAMP_SIM_REALTIME_FACTOR", std::to_string(realtime_factor).c_str(), 1);
+    if (realtime_factor == 0) std::printf("tamp run: the simulated robot runs as fast as it can\n");
+    else std::printf("tamp run: the simulated robot runs at %gx real time (times are simulated seconds)\n", realtime_factor);
+  }
   // The services inherit the security directory; each picks its identity by its --name.
   if (!security.empty()) setenv("TAMP_DDS_SECURITY", fs::absolute(security).c_str(), 1);
   tamp::cli::stopOnSignals({SIGINT, SIGTERM}, /*restart=*/true);

@@ -135,6 +135,23 @@ msg::RobotState toMsg(const RobotStateSample& s, const std::vector<std::string>&
   return m;
 }
 
+namespace {
+/// `tamp run --realtime-factor F` reaches the simulator as $TAMP_SIM_REALTIME_FACTOR: it overrides
+/// the parameter file's realtime_factor for this run (0 = as fast as possible).
+Status applyRealtimeFactorFromEnv(SimParams& params) {
+  const char* v = std::getenv("TAMP_SIM_REALTIME_FACTOR");
+  if (v == nullptr || *v == '\0') return Status::Ok();
+  char* end = nullptr;
+  const double f = std::strtod(v, &end);
+  if (end == v || *end != '\0' || !std::isfinite(f) || f < 0) {
+    return Error(ErrorCode::kInvalidArgument,
+                 std::string("TAMP_SIM_REALTIME_FACTOR: expected a number >= 0 (0 = as fast as possible), got '") + v + "'");
+  }
+  params.realtime_factor = f;
+  return Status::Ok();
+}
+}  // namespace
+
 Result<std::unique_ptr<dds::ServiceNode>> SimNode::create(const dds::ServiceArgs& args) {
   std::filesystem::path file = args.config_file;
   if (file.empty() && std::filesystem::exists(configDir() / "services" / "sim.yaml")) {
@@ -143,6 +160,9 @@ Result<std::unique_ptr<dds::ServiceNode>> SimNode::create(const dds::ServiceArgs
   auto params = file.empty() ? Result<SimParams>(SimParams{}) : loadSimParams(file);
   if (!params) return params.error();
   if (!args.scenario_file.empty()) params->scenario = std::filesystem::absolute(args.scenario_file).string();
+  if (Status s = applyRealtimeFactorFromEnv(*params); !s) return s.error();
+  if (params->realtime_factor > 0) logger()->info("simulated time runs at {}x real time", params->realtime_factor);
+  else logger()->info("simulated time runs as fast as the simulator can");
   auto setup = loadSetup(*params);
   if (!setup) return setup.error();
   // A restart within the run: the physical world stood where the checkpoint has it.

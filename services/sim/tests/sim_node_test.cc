@@ -189,6 +189,22 @@ struct OracleEnv {
 // nominalDuration of the same command (another code path: the command's planned timeline) and,
 // with noise and stalls off, to what the robot then takes. It also reveals the hidden objects
 // (with their true kind) and the scripted faults.
+// `tamp run --realtime-factor` reaches the simulator as $TAMP_SIM_REALTIME_FACTOR; a value that is
+// not a number >= 0 stops the node from starting, with the variable named.
+TEST(SimNodeTest, ABadRealtimeFactorFromTheEnvironmentIsRefused) {
+  for (const char* bad : {"abc", "-1", "2x", "nan"}) {
+    setenv("TAMP_SIM_REALTIME_FACTOR", bad, 1);
+    dds::ServiceArgs args;
+    args.name = "sim_rt_test";
+    args.domain_id = dds::testing::isolatedDomain();
+    auto node = SimNode::create(args);
+    unsetenv("TAMP_SIM_REALTIME_FACTOR");
+    ASSERT_FALSE(node) << bad;
+    EXPECT_NE(node.error().message.find("TAMP_SIM_REALTIME_FACTOR"), std::string::npos) << node.error().message;
+    EXPECT_NE(node.error().message.find(bad), std::string::npos) << node.error().message;
+  }
+}
+
 TEST(SimNodeOracleTest, DurationsAreTheSimulatorsNominalOnesAndTheTruthIsRevealed) {
   const OracleEnv env(true);
   const int domain = dds::testing::isolatedDomain();

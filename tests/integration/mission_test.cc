@@ -393,6 +393,21 @@ TEST(MissionTest, FreshStartsFromTheDefaultModelsAndLeavesTheLearnedStoreAlone) 
   expectAtTheCorridorGoal(fresh);
 }
 
+// A mission out of time (`--mission-timeout`) is aborted, and its report is still written: the
+// actions done, the decisions taken, the status "aborted". Before, tamp run exited 20 leaving no
+// report, and the graph manager, still in its Traverse, was killed when the services stopped.
+TEST(MissionTest, AMissionOutOfTimeIsAbortedAndStillLeavesItsReport) {
+  const Mission m = run("namo_corridor.yaml", {"--mission-timeout", "4"});
+  EXPECT_EQ(m.exit_code, 20) << m.output;
+  ASSERT_TRUE(m.report.is_object()) << "no report.json: " << m.output;
+  EXPECT_EQ(m.report["status"], "aborted") << m.report.dump(1);
+  EXPECT_FALSE(m.report["decisions"].empty()) << m.report.dump(1);
+  ASSERT_TRUE(m.truth.is_object()) << m.output;
+  // At twice real time four seconds are not enough to reach the goal (8.5, 1.2) from (1.5, 1.2).
+  EXPECT_GT(distance(m.truth["robot"], 8.5, 1.2), 1.0) << m.truth.dump();
+  EXPECT_EQ(m.output.find("ended with signal 9"), std::string::npos) << "a service had to be killed: " << m.output;
+}
+
 TEST(MissionTest, ABadScenarioIsAnInputErrorBeforeAnyServiceStarts) {
   const fs::path bad = tempFile("tamp_bad_scenario", ".yaml");
   std::ofstream(bad) << "name: bad\npddl:\n  domain: nowhere.pddl\nrobot: {start: start}\n";

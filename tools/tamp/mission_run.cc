@@ -224,29 +224,35 @@ int runMission(const std::shared_ptr<dds::Participant>& p, const MissionOptions&
     return cli::kExitServiceError;
   }
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(o.timeout_s);
+  // Out of time or stopped: the mission is aborted, and its report (what was done, what was
+  // planned) is still written when the graph manager answers within kAbortWait.
+  constexpr auto kAbortWait = std::chrono::seconds(30);
+  bool timed_out = false;
   std::unique_lock lock(m);
+  auto abortAndWait = [&] {
+    lock.unlock();
+    msg::MissionCommand abort = c;
+    abort.abort(true);
+    (void)writer.write(abort);
+    lock.lock();
+    return cv.wait_for(lock, kAbortWait, [&] { return last && isFinal(last->state()); });
+  };
   while (!(last && isFinal(last->state()))) {
     if (std::chrono::steady_clock::now() > deadline) {
-      lock.unlock();
-      msg::MissionCommand abort = c;
-      abort.abort(true);
-      (void)writer.write(abort);
-      std::fprintf(stderr, "tamp run: the mission did not end within %.0f s\n", o.timeout_s);
-      return cli::kExitTimeout;
+      std::fprintf(stderr, "tamp run: the mission did not end within %.0f s: aborting it (its report follows)\n",
+                   o.timeout_s);
+      timed_out = true;
+      if (!abortAndWait()) {
+        std::fprintf(stderr, "tamp run: no report: the graph manager did not answer the abort\n");
+        return cli::kExitTimeout;
+      }
+      break;
     }
     cv.wait_for(lock, std::chrono::milliseconds(100));
     lock.unlock();
     const bool stop = poll();
     lock.lock();
-    if (stop) {
-      lock.unlock();
-      msg::MissionCommand abort = c;
-      abort.abort(true);
-      (void)writer.write(abort);
-      lock.lock();
-      cv.wait_for(lock, std::chrono::seconds(5), [&] { return last && isFinal(last->state()); });
-      if (!(last && isFinal(last->state()))) return cli::kExitServiceError;
-    }
+    if (stop && !abortAndWait()) return cli::kExitServiceError;
   }
   const msg::MissionStatus final_status = *last;
   lock.unlock();
@@ -254,7 +260,7 @@ int runMission(const std::shared_ptr<dds::Participant>& p, const MissionOptions&
   const auto report = nlohmann::json::parse(final_status.report_json(), nullptr, false);
   printSummary(report);
   std::printf("tamp run: report, graph and pictures in %s\n", o.out_dir.c_str());
-  return exitCodeOf(report, final_status.state());
+  return timed_out ? cli::kExitTimeout : exitCodeOf(report, final_status.state());
 }
 
 }  // namespace tamp::runner

@@ -13,12 +13,23 @@ MotionQuery GraphManager::withHeldMargin(MotionQuery q) const {
   return q;
 }
 
+namespace {
+/// The mission is being aborted: nothing more is asked (the Traverse asking is discarded).
+MotionAnswer notAskedWhileAborting() {
+  MotionAnswer a;
+  a.status = MotionOutcome::kUnavailable;
+  a.reason = "not asked: the mission is being aborted";
+  return a;
+}
+}  // namespace
+
 MotionAnswer GraphManager::askMotion(const MotionQuery& query) {
   const MotionQuery q = withHeldMargin(query);
   if (const MotionAnswer* kept = params_.memoise_answers ? memo_.motion(q) : nullptr) {
     ++counters_.memo_hits;
     return *kept;
   }
+  if (interrupted_ && interrupted_()) return notAskedWhileAborting();
   ++counters_.motion_calls;
   MotionAnswer a = services_.motion(q);
   if (params_.memoise_answers) memo_.keep(q, a);
@@ -41,6 +52,10 @@ std::vector<MotionAnswer> GraphManager::askMotions(const std::vector<MotionQuery
     }
   }
   if (ask.empty()) return out;
+  if (interrupted_ && interrupted_()) {
+    for (std::size_t i : where) out[i] = notAskedWhileAborting();
+    return out;
+  }
   counters_.motion_calls += static_cast<int>(ask.size());
   std::vector<MotionAnswer> answers = ask.size() == 1 ? std::vector<MotionAnswer>{services_.motion(ask[0])}
                                                       : services_.motions(ask);

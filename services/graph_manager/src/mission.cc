@@ -108,7 +108,13 @@ struct GraphManager::Run {
   Run(GraphManager& g, WorldSource& s, Executor& x, const MissionObserver& o)
       : gm(g), seen(s, g.world_version_), executor(x), observer(o), start_calls(g.logged_.mark()) {
     for (const auto& obj : g.abstraction_.world().objects()) scenario_ids.insert(obj.id);
+    gm.interrupted_ = o.abort_requested;  // an abort stops a Traverse too, not only the loop
   }
+  ~Run() { gm.interrupted_ = nullptr; }
+  Run(const Run&) = delete;
+  Run& operator=(const Run&) = delete;
+
+  bool abortRequested() const { return observer.abort_requested && observer.abort_requested(); }
 
   GraphManager& gm;
   SeenWorld seen;
@@ -242,6 +248,10 @@ bool GraphManager::Run::planBranch(std::string& why) {
   continuation.reset();
   auto search = [&] { return event_at && gm.params_.replan_first_edge ? gm.traverseFirstEdge(current, ctx) : gm.traverse(current, ctx); };
   TraverseResult t = search();
+  if (abortRequested()) {
+    why = t.reason;
+    return false;
+  }
   // The geometry refuted a region-level reach (a pick from too far on a large region): plan again
   // from the refined state, where those objects are on slots of their own. Each round adds at
   // least one slot, so this ends; the bound keeps it short.
@@ -420,7 +430,7 @@ void GraphManager::Run::learnHeldObject(const std::string& object) {
   const auto deadline = Clock::now() + std::chrono::duration<double>(gm.params_.held_object_wait_s);
   world::World live = source.world();
   while (live.findObject(object) == nullptr && Clock::now() < deadline &&
-         !(observer.abort_requested && observer.abort_requested())) {
+         !abortRequested()) {
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
     live = source.world();
   }
@@ -832,7 +842,7 @@ MissionReport GraphManager::Run::run() {
   current = gm.root_;
   ctx = gm.contextOf(believed);
   while (true) {
-    if (observer.abort_requested && observer.abort_requested()) return finish(MissionOutcome::kAborted, "aborted by the user");
+    if (abortRequested()) return finish(MissionOutcome::kAborted, "aborted by the user");
     if (gm.isGoal(current)) break;
     std::string why;
     // The hand before the first action (before any motion is planned) and before each pick.
@@ -843,7 +853,10 @@ MissionReport GraphManager::Run::run() {
       if (h == Hand::kGaveUp) return finish(MissionOutcome::kFailed, why);
       if (h == Hand::kSwitched) continue;
     }
-    if (branch.empty() && !planBranch(why)) return finish(MissionOutcome::kFailed, why);
+    if (branch.empty() && !planBranch(why)) {
+      if (abortRequested()) return finish(MissionOutcome::kAborted, "aborted by the user");
+      return finish(MissionOutcome::kFailed, why);
+    }
     const EdgeId id = branch.front();
     const EdgeId next = branch.size() > 1 ? branch[1] : -1;
     const Prepared p = prepare(id, next);

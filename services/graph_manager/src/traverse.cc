@@ -208,6 +208,7 @@ struct GraphManager::Search {
   int evaluations{0};
   int completions{0};  ///< complete branches found (however costly)
   bool exhausted{false};
+  bool interrupted{false};  ///< stopped by GraphManager::interrupted_ (an abort)
   std::vector<EdgeId> branch;
   std::vector<double> branch_sd2;
   /// traverseFirstEdge: below the first edge (with the manipulation an arm motion prepares) of
@@ -230,6 +231,10 @@ struct GraphManager::Search {
   bool outOfBudget() {
     if (evaluations >= gm.params_.max_evaluations || since(t0) > gm.params_.traverse_budget_s) {
       exhausted = true;
+      return true;
+    }
+    if (gm.interrupted_ && gm.interrupted_()) {
+      exhausted = interrupted = true;
       return true;
     }
     return false;
@@ -426,6 +431,10 @@ TraverseResult GraphManager::search(NodeId from, const BranchContext& context, b
   r.evaluations = s.evaluations;
   r.time_s = since(t0);
   planning_s_ += r.time_s;
+  if (s.interrupted) {  // an abort: whatever was found is not to be executed
+    r.reason = "interrupted: the mission is being aborted";
+    return r;
+  }
   if (s.best_branch.empty() && !isGoal(from)) {
     std::string why;
     for (const Edge& e : graph_.edges())

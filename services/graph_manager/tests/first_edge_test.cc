@@ -596,6 +596,55 @@ TEST(MissionWorldVersionTest, MotionQuestionsAndCommandsCarryTheWorldVersionTheG
   for (std::uint64_t v : services.grasp_versions) EXPECT_EQ(v, 7u);
 }
 
+// An abort (`tamp run` out of time, Ctrl-C) stops a Traverse at its next step, not only the
+// mission loop between actions: the mission ends aborted before its first command, and no motion
+// is asked for after the abort. Before, the graph manager answered an abort only once
+// the Traverse had ended (namo_moghaddam_07: 12-30 s), after `tamp run` had stopped waiting, so a
+// mission out of time left no report.
+TEST(MissionAbortTest, AnAbortStopsTheTraverseBeforeItsEnd) {
+  struct Outcome {
+    MissionReport report;
+    int motion_calls{0};
+    std::size_t commands{0};
+  };
+  auto run = [](bool abort) {
+    auto sc = world::loadScenario(configDir() / "scenarios" / "namo_corridor.yaml");
+    EXPECT_TRUE(sc.ok());
+    auto robot = robot::RobotModel::loadDescription(sc->robot.description);
+    EXPECT_TRUE(robot.ok());
+    ScriptedServices services;
+    services.plans = {{"(move_base start goal)"}};
+    services.box_immovable = true;  // the box is crossed: sub-tasks, placements, pushes are asked for
+    GraphManagerParams params;
+    params.max_contingencies = 0;
+    params.concurrent_motions = false;
+    GraphManager gm(Abstraction(sc->plannerWorld(), *robot), "", MissionGoal{{"(robot-at goal)"}}, services, params);
+    VersionedWorld source;
+    source.live = sc->plannerWorld();
+    source.at_version = 1;
+    source.robot_now.valid = true;
+    source.robot_now.robot.base = sc->robot.start;
+    source.robot_now.robot.arm = *robot->namedConfiguration("stow");
+    DrivingExecutor robot_x(source);
+    MissionObserver observer;
+    observer.abort_requested = [&] { return abort && services.motion_calls >= 1; };
+    Outcome o;
+    o.report = gm.runMission(source, robot_x, observer);
+    o.motion_calls = services.motion_calls;
+    o.commands = robot_x.world_versions.size();
+    return o;
+  };
+  const Outcome whole = run(false);
+  ASSERT_EQ(whole.report.status, MissionOutcome::kSucceeded) << whole.report.reason;
+  ASSERT_GE(whole.motion_calls, 4) << "the Traverse asks more than the abort lets it here";
+  ASSERT_GE(whole.commands, 1u);
+  const Outcome aborted = run(true);
+  EXPECT_EQ(aborted.report.status, MissionOutcome::kAborted) << aborted.report.reason;
+  EXPECT_EQ(aborted.report.reason, "aborted by the user");
+  EXPECT_EQ(aborted.commands, 0u) << "a command was sent after the abort";
+  EXPECT_EQ(aborted.motion_calls, 1) << "a motion was asked for after the abort";
+}
+
 /// A mission on namo_corridor from start to goal over scripted services (straight drives),
 /// executed by `x` in `source`.
 MissionReport corridorMission(VersionedWorld& source, DrivingExecutor& x, ScriptedServices& services,

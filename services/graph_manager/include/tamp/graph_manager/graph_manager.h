@@ -603,6 +603,9 @@ class GraphManager {
   Counters counters_;
   std::vector<Decision> decisions_;
   int traverse_count_{0};
+  /// Set by a running mission (its observer's abort_requested): a Traverse stops at its next
+  /// step when it answers true, as when its budget runs out.
+  std::function<bool()> interrupted_;
   double planning_s_{0.0};
   /// The margin a held object is planned with (params_.held_padding_step_m per static contact
   /// the robot was stopped before while holding; see Run::replan).

@@ -393,8 +393,8 @@ TEST(MissionTest, FreshStartsFromTheDefaultModelsAndLeavesTheLearnedStoreAlone) 
   expectAtTheCorridorGoal(fresh);
 }
 
-// A mission out of time (`--mission-timeout`) is aborted, and its report is still written: the
-// actions done, the decisions taken, the status "aborted". Before, tamp run exited 20 leaving no
+// A mission out of time (`--mission-timeout`) is aborted, the action under way cancelled, and its
+// report is still written: the actions done, the decisions taken, the status "aborted". Before, tamp run exited 20 leaving no
 // report, and the graph manager, still in its Traverse, was killed when the services stopped.
 TEST(MissionTest, AMissionOutOfTimeIsAbortedAndStillLeavesItsReport) {
   const Mission m = run("namo_corridor.yaml", {"--mission-timeout", "4"});
@@ -402,6 +402,10 @@ TEST(MissionTest, AMissionOutOfTimeIsAbortedAndStillLeavesItsReport) {
   ASSERT_TRUE(m.report.is_object()) << "no report.json: " << m.output;
   EXPECT_EQ(m.report["status"], "aborted") << m.report.dump(1);
   EXPECT_FALSE(m.report["decisions"].empty()) << m.report.dump(1);
+  // The first drive (about 14 simulated seconds) was under way: it was cancelled, the robot
+  // stopped where it was rather than finish it.
+  ASSERT_FALSE(m.report["actions"].empty()) << m.report.dump(1);
+  EXPECT_EQ(m.report["actions"].back()["outcome"], "cancelled") << m.report["actions"].dump(1);
   ASSERT_TRUE(m.truth.is_object()) << m.output;
   // At twice real time four seconds are not enough to reach the goal (8.5, 1.2) from (1.5, 1.2).
   EXPECT_GT(distance(m.truth["robot"], 8.5, 1.2), 1.0) << m.truth.dump();

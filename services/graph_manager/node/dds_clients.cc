@@ -373,7 +373,9 @@ ExecutionReport DdsExecutor::execute(const EdgeCommand& c, double budget_s) {
     return r;
   }
   std::unique_lock lock(mutex_);
+  in_flight_ = m;
   r = finalOf(lock, wire, budget_s, &m, matches);
+  in_flight_.reset();
   if (r.outcome == ExecOutcome::kTimeout) {
     lock.unlock();
     msg::ExecuteCommand cancel = m;
@@ -381,6 +383,19 @@ ExecutionReport DdsExecutor::execute(const EdgeCommand& c, double budget_s) {
     (void)writer_.write(cancel);
   }
   return r;
+}
+
+void DdsExecutor::cancelInFlight() {
+  std::optional<msg::ExecuteCommand> cancel;
+  {
+    std::lock_guard g(mutex_);
+    cancel = in_flight_;
+  }
+  if (!cancel) return;
+  cancel->cancel(true);
+  const Status s = writer_.write(*cancel);
+  log::get("graph_manager")->info("'{}' cancelled (the mission is aborted){}", cancel->command_id(),
+                                  s ? "" : ": " + s.error().message);
 }
 
 ExecutionReport DdsExecutor::await(const std::string& command_id, double budget_s) {

@@ -79,6 +79,10 @@ class DdsExecutor : public Executor, public Watched {
   std::string wireId(const std::string& command_id) const { return mission_id_ + "/" + command_id; }
   /// True once an execution monitor's command reader and status writer are matched.
   bool monitorPresent() const { return writer_.matchedReaders() > 0 && reader_.matchedWriters() > 0; }
+  /// Thread-safe: asks the execution monitor to stop the command execute() is waiting for, if
+  /// any (a mission aborted mid-action: the robot stops instead of finishing the action). The
+  /// monitor's final status (cancelled, or what it was already) ends the wait as usual.
+  void cancelInFlight();
 
  private:
   void onStatus(const msg::ExecuteStatus& s);
@@ -92,6 +96,7 @@ class DdsExecutor : public Executor, public Watched {
   std::mutex mutex_;
   std::condition_variable cv_;
   std::map<std::string, msg::ExecuteStatus> final_;
+  std::optional<msg::ExecuteCommand> in_flight_;  ///< the command execute() waits for (mutex_)
   dds::Reader<msg::ExecuteStatus> reader_;
 };
 

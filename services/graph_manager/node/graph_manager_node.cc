@@ -118,9 +118,12 @@ void GraphManagerNode::onCommand(const msg::MissionCommand& c) {
     }
     return;
   }
-  std::lock_guard g(mutex_);
+  std::unique_lock g(mutex_);
   if (c.abort()) {
-    if (c.mission_id() == running_) abort_ = true;
+    if (c.mission_id() != running_) return;
+    abort_ = true;
+    g.unlock();
+    executor_.cancelInFlight();  // the robot stops now, not at the end of its action
     return;
   }
   if (c.mission_id().empty() || seen_.count(c.mission_id())) return;  // idempotent on mission id

@@ -884,6 +884,7 @@ MissionReport GraphManager::Run::run() {
       continue;
     }
     if (rep.outcome == ExecOutcome::kUnavailable) return finish(MissionOutcome::kUnavailable, rep.reason);
+    if (abortRequested()) return finish(MissionOutcome::kAborted, "aborted by the user");  // stopped mid-action
     e.state = EdgeState::kFailed;
     e.reason = std::string(toString(rep.outcome)) + ": " + rep.reason;
     if (observer.on_action) observer.on_action(a, done_effort, branch_total);

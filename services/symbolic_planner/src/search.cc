@@ -1453,9 +1453,10 @@ class LazyBeside : public TurnTaker {
     const SearchStatus st = l.steps->result().status;
     return st == SearchStatus::kSolved || st == SearchStatus::kUnsolvable;
   }
-  bool secondPending() const {
-    return options_.lazy_beside_both && !options_.lazy_plan_preferred && lanes_.size() == 1;
-  }
+  /// Whether a second lane (LAMA-first's preferred operators) is to join the first.
+  bool twoLanes() const { return options_.lazy_beside_both && !options_.lazy_plan_preferred; }
+  /// A second lane is to join and has not yet.
+  bool secondPending() const { return twoLanes() && lanes_.size() == 1; }
   /// One turn of lane i (none if it has ended); records the winner once a lane answers or all end
   /// (a second lane still to join joins then instead).
   void turn(size_t i) {
@@ -1479,14 +1480,12 @@ class LazyBeside : public TurnTaker {
   }
   void start() {
     if (!lanes_.empty()) return;
-    if (options_.landmarks && options_.landmark_generator == LandmarkGenerator::kRhw && secondPending0()) {
+    if (options_.landmarks && options_.landmark_generator == LandmarkGenerator::kRhw && twoLanes()) {
       landmarks_.emplace(rhwLandmarks(task_, init_, goal_, options_.rhw));
     }
     addLane(options_.lazy_plan_preferred);
     maybeAddSecond();
   }
-  /// Before the first lane: whether a second one may join.
-  bool secondPending0() const { return options_.lazy_beside_both && !options_.lazy_plan_preferred; }
   /// The second lane joins once the hill-climbing and the first lane have used
   /// `lazy_second_after` evaluations since the first started.
   void maybeAddSecond() {

@@ -243,7 +243,7 @@ int main(int argc, char** argv) {
   uint64_t lazy_second_after = defaults.lazy_second_after;
   app.add_option("--lazy-second-after", lazy_second_after,
                  "ehc, --lazy-beside-both: the second lazy search joins after this many evaluations of the "
-                 "hill-climbing and the first lazy search since the first started (0: with the first; default 16000)");
+                 "hill-climbing and the first lazy search since the first started (0: with the first; default 32000)");
   app.add_option("--ehc-lazy-after", lazy_after,
                  "ehc: the lazy search starts beside the hill-climbing after this many evaluations (> 0)")
       ->check(CLI::Range(uint64_t{1}, UINT64_MAX));

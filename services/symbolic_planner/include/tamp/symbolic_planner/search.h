@@ -190,8 +190,8 @@ struct SearchOptions {
   /// lazy_beside_both: the second lazy search joins once the hill-climbing and the first lazy
   /// search have used this many evaluations since the first started (or once the first ends
   /// without an answer); 0: both start together. A search that ends sooner (airport-30: about
-  /// 3 400 after the first started; transport-30's first plan: about 40 000 in all) pays nothing
-  /// or little for the second; one that needs hundreds of thousands (hiking-16) loses a few
+  /// 3 400 after the first started; transport-30: about 44 000 in all) pays nothing or little
+  /// for the second; one that needs hundreds of thousands (hiking-16) loses a few
   /// seconds (docs/benchmarks.md, issue 14, thirty-first round: 8 000, 16 000 and 32 000).
   uint64_t lazy_second_after{32'000};
   uint64_t ehc_lazy_after{4000};

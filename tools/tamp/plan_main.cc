@@ -239,7 +239,11 @@ int main(int argc, char** argv) {
   bool lazy_beside_both = defaults.lazy_beside_both;
   app.add_option("--lazy-beside-both", lazy_beside_both,
                  "ehc: two lazy searches beside the hill-climbing in turns, one with the default preferred "
-                 "operators, one with LAMA-first's: true or false (default false)");
+                 "operators, one with LAMA-first's (joining after --lazy-second-after): true or false (default true)");
+  uint64_t lazy_second_after = defaults.lazy_second_after;
+  app.add_option("--lazy-second-after", lazy_second_after,
+                 "ehc, --lazy-beside-both: the second lazy search joins after this many evaluations of the "
+                 "hill-climbing and the first lazy search since the first started (0: with the first; default 32000)");
   app.add_option("--ehc-lazy-after", lazy_after,
                  "ehc: the lazy search starts beside the hill-climbing after this many evaluations (> 0)")
       ->check(CLI::Range(uint64_t{1}, UINT64_MAX));
@@ -286,6 +290,7 @@ int main(int argc, char** argv) {
   req.search.ehc_lazy_beside = !no_lazy_beside;
   req.search.lazy_plan_preferred = lazy_plan_preferred;
   req.search.lazy_beside_both = lazy_beside_both;
+  req.search.lazy_second_after = lazy_second_after;
   req.search.ehc_h2_restart = h2_restart;
   req.search.ehc_h2_test_gap_max = h2_test_gap_max;
   req.search.ehc_ff_first_h2_restart = ff_first_h2_restart;

@@ -327,6 +327,11 @@ class Searcher {
   /// count's (Fast Downward's `lama-first`: `lmcount(pref=false)`).
   void preferNoLandmarkAchievers() { landmark_preferred_ = false; }
 
+  /// The lazy search counts the landmarks of `graph` (which must outlive the search and be the
+  /// graph `makeLandmarkCounter` would build: the same task, initial state, goal and options)
+  /// instead of building its own: two lazy searches beside one hill-climbing build it once.
+  void shareLandmarkGraph(const LandmarkGraph* graph) { shared_landmarks_ = graph; }
+
   /// The lazy search (`kLazy`) from the start, suspended after every `turn` evaluations (> 0).
   SearchCoroutine lazyInTurns(uint64_t turn) {
     Stopwatch sw;
@@ -957,8 +962,9 @@ class Searcher {
 
   std::unique_ptr<LandmarkCounter> makeLandmarkCounter() const {
     if (opt_.landmark_generator == LandmarkGenerator::kRhw) {
-      return std::make_unique<LandmarkCounter>(task_, rhwLandmarks(task_, init_, goal_, opt_.rhw),
-                                               LandmarkProgression::kPastAndFuture);
+      return std::make_unique<LandmarkCounter>(
+          task_, shared_landmarks_ != nullptr ? *shared_landmarks_ : rhwLandmarks(task_, init_, goal_, opt_.rhw),
+          LandmarkProgression::kPastAndFuture);
     }
     return std::make_unique<LandmarkCounter>(task_, init_, goal_);
   }
@@ -1181,6 +1187,7 @@ class Searcher {
   uint32_t iter_{0};
   TurnTaker* turns_{nullptr};  // another search taking turns with this hill-climbing, if any
   bool landmark_preferred_{true};  // lazy: the landmark count's preferred operators too
+  const LandmarkGraph* shared_landmarks_{nullptr};  // lazy, kRhw: the graph to count, if built before
   bool in_agenda_entry_before_last_{false};  // ehc: hill-climbing to a goal-agenda entry, not the last
   bool dead_end_proven_{false};  // ehc: the state the hill-climbing stands on is a proven dead end
   // Plan neighbourhood search: the plan the registry's neighbourhood was built around, whether it
@@ -1389,9 +1396,11 @@ SearchResult configuredSearch(const Task& task, const StateBits& init, const Goa
 /// `ehc_lazy_after` evaluations, then run for `ehc_lazy_turn_lazy` evaluations after every
 /// `ehc_lazy_turn_ehc` of the hill-climbing's, inside the hill-climbing's own call (one thread:
 /// a turn costs a function call). It has a searcher (states) and a heuristic of its own. With
-/// `lazy_beside_both`, two lazy searches take their turns one after the other (the one with the
-/// default preferred operators first, then the one with LAMA-first's); the first final answer of
-/// either is the answer.
+/// `lazy_beside_both`, a second lazy search (LAMA-first's preferred operators) joins once the
+/// hill-climbing and the first have used `lazy_second_after` evaluations since the first started
+/// (or when the first ends without an answer), and the two take their turns one after the other;
+/// both count the landmarks of one graph, built once. The first final answer of either is the
+/// answer.
 class LazyBeside : public TurnTaker {
  public:
   LazyBeside(const Task& task, const StateBits& init, const Goal& goal, const SearchOptions& options,
@@ -1401,10 +1410,12 @@ class LazyBeside : public TurnTaker {
   }
 
   void evaluated() override {
+    if (!lanes_.empty()) ++ehc_since_start_;
     if (finished_ || --left_ > 0) return;
     left_ = options_.ehc_lazy_turn_ehc;
     start();
     for (size_t i = 0; i < lanes_.size() && !finished_; ++i) turn(i);
+    maybeAddSecond();
   }
   /// The lazy search has given a final answer (a plan or a proof): the hill-climbing stops.
   bool stopped() const override { return finished_ && isFinal(lanes_[winner_]); }
@@ -1420,7 +1431,10 @@ class LazyBeside : public TurnTaker {
   /// them if they have not started); the answer's counters include the others'.
   SearchResult& runToEnd() {
     start();
-    for (size_t i = 0; !finished_; i = (i + 1) % lanes_.size()) turn(i);
+    for (size_t i = 0; !finished_; i = (i + 1) % lanes_.size()) {
+      turn(i);
+      if (i + 1 == lanes_.size()) maybeAddSecond();
+    }
     SearchResult& r = lanes_[winner_].steps->result();
     for (size_t i = 0; i < lanes_.size(); ++i) {
       if (i != winner_) addRunCosts(r.stats, lanes_[i].searcher->statistics());
@@ -1439,7 +1453,12 @@ class LazyBeside : public TurnTaker {
     const SearchStatus st = l.steps->result().status;
     return st == SearchStatus::kSolved || st == SearchStatus::kUnsolvable;
   }
-  /// One turn of lane i (none if it has ended); records the winner once a lane answers or all end.
+  /// Whether a second lane (LAMA-first's preferred operators) is to join the first.
+  bool twoLanes() const { return options_.lazy_beside_both && !options_.lazy_plan_preferred; }
+  /// A second lane is to join and has not yet.
+  bool secondPending() const { return twoLanes() && lanes_.size() == 1; }
+  /// One turn of lane i (none if it has ended); records the winner once a lane answers or all end
+  /// (a second lane still to join joins then instead).
   void turn(size_t i) {
     Lane& l = lanes_[i];
     if (l.steps->done()) return;
@@ -1447,20 +1466,38 @@ class LazyBeside : public TurnTaker {
     if (!l.steps->done()) return;
     bool all_done = true;
     for (const Lane& x : lanes_) all_done = all_done && x.steps->done();
-    if (isFinal(l) || all_done) {
+    if (isFinal(l)) {
       finished_ = true;
       winner_ = i;
+    } else if (all_done) {
+      if (secondPending()) {
+        addLane(true);
+      } else {
+        finished_ = true;
+        winner_ = i;
+      }
     }
   }
   void start() {
     if (!lanes_.empty()) return;
+    if (options_.landmarks && options_.landmark_generator == LandmarkGenerator::kRhw && twoLanes()) {
+      landmarks_.emplace(rhwLandmarks(task_, init_, goal_, options_.rhw));
+    }
     addLane(options_.lazy_plan_preferred);
-    if (options_.lazy_beside_both && !options_.lazy_plan_preferred) addLane(true);
+    maybeAddSecond();
+  }
+  /// The second lane joins once the hill-climbing and the first lane have used
+  /// `lazy_second_after` evaluations since the first started.
+  void maybeAddSecond() {
+    if (finished_ || !secondPending()) return;
+    const uint64_t used = ehc_since_start_ + lanes_[0].searcher->statistics().evaluated;
+    if (used >= options_.lazy_second_after) addLane(true);
   }
   void addLane(bool plan_preferred) {
     Lane& l = lanes_.emplace_back();
     l.heuristic = makeHeuristic(defaultHeuristic(options_), task_, defaultCostType(options_, task_));
     l.searcher = std::make_unique<Searcher>(task_, init_, goal_, options_, *l.heuristic, term_);
+    if (landmarks_) l.searcher->shareLandmarkGraph(&*landmarks_);
     if (plan_preferred && l.heuristic->setRelaxedPlanPreferred(true)) l.searcher->preferNoLandmarkAchievers();
     l.steps.emplace(l.searcher->lazyInTurns(options_.ehc_lazy_turn_lazy));
   }
@@ -1471,6 +1508,8 @@ class LazyBeside : public TurnTaker {
   SearchOptions options_;
   const Termination& term_;
   uint64_t left_;  // hill-climbing evaluations before the lazy searches' next turns
+  uint64_t ehc_since_start_{0};  // hill-climbing evaluations since the first lane started
+  std::optional<LandmarkGraph> landmarks_;  // with two lanes (kRhw): the graph both count
   std::vector<Lane> lanes_;
   size_t winner_{0};  // with finished_: the lane that answered (or ended last)
   SearchStatistics sum_;

@@ -560,6 +560,7 @@ TEST(Search, LazySearchBesidePrefersTheRelaxedPlansOperatorsAndNoneOfTheLandmark
   EXPECT_EQ(again.stats.evaluated, lama.stats.evaluated);
   EXPECT_EQ(again.plan, lama.plan);
   req.search.lazy_plan_preferred = false;
+  req.search.lazy_beside_both = false;  // the default lazy search alone beside the hill-climbing
   PlanReply ff = plan(req, Termination());
   ASSERT_EQ(ff.status, PlanStatus::kSolved) << ff.message;
   EXPECT_TRUE(ff.stats.lazy_beside_won);
@@ -587,6 +588,7 @@ TEST(Search, TwoLazySearchesBesideTheHillClimbingGiveTheFirstAnswerOfEither) {
   // first: on hiking-4 LAMA-first's (the plan of the `lazy_plan_preferred` run), on depots-6 the
   // default one's (main's plan; LAMA-first's alone does not finish in 60 s). Both checked, with
   // more evaluations than that search's run (the other's are counted), the same in a second run.
+  // Both start together here (`lazy_second_after` 0); the default's delay is tested below.
   struct Case {
     std::string folder, instance;
     bool lama_first_wins;
@@ -598,10 +600,11 @@ TEST(Search, TwoLazySearchesBesideTheHillClimbingGiveTheFirstAnswerOfEither) {
     PlanRequest req = benchmarkRequest(c.folder, c.instance);
     req.timeout_seconds = 120;
     req.search.lazy_plan_preferred = c.lama_first_wins;
+    req.search.lazy_beside_both = false;
     PlanReply alone = plan(req, Termination());
     req.search.lazy_plan_preferred = false;
-    ASSERT_FALSE(req.search.lazy_beside_both);  // the default
     req.search.lazy_beside_both = true;
+    req.search.lazy_second_after = 0;
     PlanReply both = plan(req, Termination());
     PlanReply again = plan(req, Termination());
     ASSERT_EQ(alone.status, PlanStatus::kSolved) << alone.message;
@@ -612,6 +615,62 @@ TEST(Search, TwoLazySearchesBesideTheHillClimbingGiveTheFirstAnswerOfEither) {
     EXPECT_EQ(again.plan, both.plan);
     EXPECT_EQ(again.stats.evaluated, both.stats.evaluated);
   }
+}
+
+TEST(Search, SecondLazySearchJoinsOnlyAfterLazySecondAfterEvaluations) {
+  // The default: both lazy searches, the second (LAMA-first's preferred operators) joining once
+  // the hill-climbing and the first have used `lazy_second_after` evaluations since the first
+  // started. depots-6 ends before (about 14 000): the same plan and evaluations as the first lazy
+  // search alone beside the hill-climbing, and fewer than with both from the start. hiking-4 with
+  // the second after 16 000 (the first alone: 36 497 evaluations in all when written, 4 000 of
+  // them before it started, so the default's 32 000 is about when it answers): the second joins and its
+  // evaluations count, but the first, which had the turns alone until then, still answers first
+  // (its plan), while with both from the start the second's plan is the answer (the
+  // `lazy_plan_preferred` run's, which builds its own landmark graph: the shared one is the
+  // same). Checked plans, the same in a second run.
+  PlanRequest dp = benchmarkRequest("pddl/depots", "instance-6.pddl");
+  dp.timeout_seconds = 120;
+  ASSERT_TRUE(dp.search.lazy_beside_both);  // the default
+  ASSERT_EQ(dp.search.lazy_second_after, 32'000U);
+  PlanReply delayed = plan(dp, Termination());
+  PlanReply again = plan(dp, Termination());
+  dp.search.lazy_beside_both = false;
+  PlanReply one = plan(dp, Termination());
+  dp.search.lazy_beside_both = true;
+  dp.search.lazy_second_after = 0;
+  PlanReply together = plan(dp, Termination());
+  ASSERT_EQ(delayed.status, PlanStatus::kSolved) << delayed.message;  // replayed by the checker
+  ASSERT_EQ(one.status, PlanStatus::kSolved) << one.message;
+  ASSERT_EQ(together.status, PlanStatus::kSolved) << together.message;
+  EXPECT_TRUE(delayed.stats.lazy_beside_won);
+  EXPECT_EQ(delayed.plan, one.plan);
+  EXPECT_EQ(delayed.stats.evaluated, one.stats.evaluated);
+  EXPECT_LT(delayed.stats.evaluated, together.stats.evaluated);
+  EXPECT_EQ(again.plan, delayed.plan);
+  EXPECT_EQ(again.stats.evaluated, delayed.stats.evaluated);
+
+  PlanRequest hk = benchmarkRequest("pddl-more/hiking", "instance-4.pddl");
+  hk.timeout_seconds = 120;
+  hk.search.lazy_second_after = 16'000;  // the default joins about when the first answers
+  PlanReply hk_delayed = plan(hk, Termination());
+  PlanReply hk_again = plan(hk, Termination());
+  hk.search.lazy_second_after = 0;
+  PlanReply hk_together = plan(hk, Termination());
+  hk.search.lazy_beside_both = false;
+  PlanReply hk_one = plan(hk, Termination());
+  hk.search.lazy_plan_preferred = true;
+  PlanReply lama = plan(hk, Termination());
+  ASSERT_EQ(hk_delayed.status, PlanStatus::kSolved) << hk_delayed.message;
+  ASSERT_EQ(hk_together.status, PlanStatus::kSolved) << hk_together.message;
+  ASSERT_EQ(hk_one.status, PlanStatus::kSolved) << hk_one.message;
+  ASSERT_EQ(lama.status, PlanStatus::kSolved) << lama.message;
+  EXPECT_TRUE(hk_delayed.stats.lazy_beside_won);
+  EXPECT_EQ(hk_delayed.plan, hk_one.plan);
+  EXPECT_GT(hk_delayed.stats.evaluated, hk_one.stats.evaluated);  // the second joined
+  EXPECT_EQ(hk_together.plan, lama.plan);
+  EXPECT_NE(hk_together.plan, hk_one.plan);
+  EXPECT_EQ(hk_again.plan, hk_delayed.plan);
+  EXPECT_EQ(hk_again.stats.evaluated, hk_delayed.stats.evaluated);
 }
 
 TEST(Search, LazySearchBesideProvesUnsolvabilityAndGoesOnAloneWhenTheHillClimbingGivesUp) {

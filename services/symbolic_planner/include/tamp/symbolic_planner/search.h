@@ -11,7 +11,9 @@
 ///   first, then best-first). With `ehc_lazy_beside` (the default) that lazy search starts beside
 ///   a hill-climbing that has used `ehc_lazy_after` evaluations and the two take turns in one
 ///   thread; the first plan or proof wins, and a failed hill-climbing leaves the lazy search to go
-///   on from where it is (`lazy_plan_preferred`: with LAMA-first's preferred operators). With
+///   on from where it is (`lazy_plan_preferred`: with LAMA-first's preferred operators). A second
+///   lazy search, with LAMA-first's preferred operators, joins them once the two have used
+///   `lazy_second_after` evaluations (`lazy_beside_both`, the default). With
 ///   `ehc_ff_first` (the default) and a heuristic that has
 ///   FF-v2.3's variant (`Heuristic::setFFStyle`), a first hill-climbing run uses that variant
 ///   within a budget of evaluations (it tends to give shorter plans); when it fails or runs
@@ -176,10 +178,22 @@ struct SearchOptions {
   /// 60 s; LAMA-first itself needs 41 s on depots-6).
   bool lazy_plan_preferred{false};
   /// ehc_lazy_beside with `lazy_plan_preferred` off: a second lazy search beside the hill-climbing,
-  /// with LAMA-first's preferred operators; after each turn of the hill-climbing both lazy
-  /// searches take one (each a third of the evaluations; a half each once the hill-climbing gives
-  /// up), and the first final answer of either is the answer.
-  bool lazy_beside_both{false};
+  /// with LAMA-first's preferred operators (in a heuristic of its own, counting the landmarks of
+  /// the first's graph); once it has joined (`lazy_second_after`), after each turn of the
+  /// hill-climbing both lazy searches take one (each a third of the evaluations; a half each once
+  /// the hill-climbing gives up), and the first final answer of either is the answer. The two
+  /// kinds of preferred operators split the domains (docs/benchmarks.md, issue 14, thirtieth and
+  /// thirty-first rounds): the default's keep depots-6 / -20 and citycar-6, LAMA-first's solve
+  /// hiking-16 / -20 (FF's helpful actions on hiking are hundreds of drives, the relaxed plan's a
+  /// few).
+  bool lazy_beside_both{true};
+  /// lazy_beside_both: the second lazy search joins once the hill-climbing and the first lazy
+  /// search have used this many evaluations since the first started (or once the first ends
+  /// without an answer); 0: both start together. A search that ends sooner (airport-30: about
+  /// 3 400 after the first started; transport-30: about 44 000 in all) pays nothing or little
+  /// for the second; one that needs hundreds of thousands (hiking-16) loses a few
+  /// seconds (docs/benchmarks.md, issue 14, thirty-first round: 8 000, 16 000 and 32 000).
+  uint64_t lazy_second_after{32'000};
   uint64_t ehc_lazy_after{4000};
   uint64_t ehc_lazy_turn_ehc{100};
   uint64_t ehc_lazy_turn_lazy{100};

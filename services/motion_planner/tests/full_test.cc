@@ -144,7 +144,11 @@ TEST_F(FullTest, ABasePathKeepsItsClearanceWhereThereIsRoom) {
 }
 
 // A door only 4 cm wider than the robot: no path keeps the clearance, so the search goes on
-// without it and still finds the way through, collision-free.
+// without it and still finds the way through, collision-free at the planner's validity
+// resolution: states are checked about 1-2 cm apart, and between two free states 2 cm apart a
+// 0.3 m disc's edge sags at most 0.3 - sqrt(0.3^2 - 0.01^2) = 0.17 mm into a corner it passes.
+// (One CI run of session 28 measured -0.084 mm here: the clearance is dropped after
+// base_clearance_time_s of sampling, so which path is found depends on the machine's load.)
 TEST_F(FullTest, ADoorTooNarrowForTheClearanceIsStillPassed) {
   world::World w = testing::corridorWorld(false);
   // Narrow the door (y in [1.5, 2.5]) to [1.68, 2.32]: 0.64 m for a 0.6 m disc.
@@ -154,7 +158,8 @@ TEST_F(FullTest, ADoorTooNarrowForTheClearanceIsStillPassed) {
   const MotionResult r = mp.plan(request({2, 3, 0.5}, {8, 1, -1.0}), Termination::after(10.0));
   ASSERT_EQ(r.status, MotionStatus::kSolved) << r.reason;
   EXPECT_TRUE(r.stats.clearance_relaxed);
-  EXPECT_GE(discClearance(w, r.path, kRadius, 0.002), 0.0);
+  const double sag_m = kRadius - std::sqrt(kRadius * kRadius - 0.01 * 0.01);
+  EXPECT_GE(discClearance(w, r.path, kRadius, 0.002), -sag_m);
 }
 
 // A free direct motion is taken without sampling; one through a wall is not, and the sampled

@@ -2,8 +2,9 @@
 # The main job: installs the dependencies, builds (Release), and runs a scenario end to end with
 # every service as its own process on this machine.
 # Usage: deploy/run.sh [SCENARIO] [tamp run options]
-# The simulated robot runs at 4x real time unless a --realtime-factor is given (1 = real time);
-# executed and predicted times are simulated seconds either way.
+# The simulated robot runs at config/services/sim.yaml's pace (4x real time) unless a
+# --realtime-factor is given (1 = real time); executed and predicted times are simulated seconds
+# either way.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./deploy/install_deps.sh
@@ -16,8 +17,4 @@ if [ $# -gt 0 ] && [[ "$1" != -* ]]; then
 elif [ -f "$default_scenario" ]; then
   scenario=("$default_scenario")
 fi
-speed=(--realtime-factor 4)
-for a in "$@"; do
-  case "$a" in --realtime-factor|--realtime-factor=*) speed=() ;; esac
-done
-exec ./build/release/bin/tamp run "${scenario[@]}" "${speed[@]}" "$@"
+exec ./build/release/bin/tamp run "${scenario[@]}" "$@"

@@ -7,7 +7,12 @@
 #        [--netem "loss 10%"|"delay 50ms"|"duplicate 10%"|...] [--partition-at S --partition-for S]
 #        [--seed N] [--out DIR] [--run-id ID] [--one-host] [--ping N] [--loss PCT] [--duplicate PCT]
 #        [--kill SERVICE --kill-at S] [--kill-launcher HOST --kill-launcher-at S]
-#        [--delay MS [--jitter MS]] [--security DIR]
+#        [--delay MS [--jitter MS]] [--security DIR] [--realtime-factor F]
+#
+# --realtime-factor F (default 1, real time): the simulator's pace for this run, passed to it as
+# $TAMP_SIM_REALTIME_FACTOR through both launchers. The fault matrices of docs/reliability.md were
+# measured at real time, so a fault's seconds (--kill-at, --partition-at) land where they did
+# there, whatever config/services/sim.yaml's default pace is.
 #
 # --kill SERVICE --kill-at S: SIGKILL to that service's process S s after the mission started,
 # on whichever host runs it (its launcher restarts it). Every run (with or without a fault) is
@@ -61,6 +66,7 @@ ROOT=$(cd "$(dirname "$0")/../.." && pwd)
 DISCOVERY=server SCENARIO=$ROOT/config/scenarios/namo_corridor_short.yaml NETEM="" SEED=1
 PART_AT="" PART_FOR=5 OUT=${TMPDIR:-/tmp}/tamp-two-hosts RUN_ID="" ONE_HOST=0 PING=0 LOSS=0 DUP=0
 KILL="" KILL_AT="" KILL_LAUNCHER="" KILL_LAUNCHER_AT="" DELAY="" JITTER=0 SECURITY=""
+SPEED=1
 QUEUE_NUM=13  # the nfqueue of --delay, one per namespace
 while [ $# -gt 0 ]; do
   case $1 in
@@ -83,9 +89,12 @@ while [ $# -gt 0 ]; do
     --delay) DELAY=$2; shift 2;;
     --jitter) JITTER=$2; shift 2;;
     --security) SECURITY=$(realpath "$2"); shift 2;;
+    --realtime-factor) SPEED=$2; shift 2;;
     *) echo "two_hosts.sh: unknown option $1" >&2; exit 30;;
   esac
 done
+[[ $SPEED =~ ^[0-9]+(\.[0-9]+)?$ ]] || { echo "two_hosts.sh: --realtime-factor takes a number >= 0, got '$SPEED'" >&2; exit 30; }
+export TAMP_SIM_REALTIME_FACTOR=$SPEED
 case $DISCOVERY in server|servers|multicast) ;; *) echo "two_hosts.sh: --discovery server|servers|multicast, got '$DISCOVERY'" >&2; exit 30;; esac
 if [ "$DISCOVERY" = servers ] && [ "$ONE_HOST" = 1 ]; then
   echo "two_hosts.sh: --discovery servers puts a server on each host; not with --one-host" >&2; exit 30

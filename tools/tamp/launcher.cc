@@ -325,7 +325,24 @@ double secondsSince(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
+/// The heartbeat of `st`'s current process on `host` when it is alive but still starting (not
+/// ready) more than `ready_timeout_s` after the process started; null otherwise.
+const dds::ServiceInfo* notReadyInTime(const std::vector<dds::ServiceInfo>& services,
+                                       const process::ProcessStatus& st, const std::string& host,
+                                       double ready_timeout_s) {
+  const dds::ServiceInfo* seen = heardFrom(services, st, host);
+  if (seen == nullptr || seen->state != msg::SERVICE_STARTING) return nullptr;
+  return secondsSince(st.started) > ready_timeout_s ? seen : nullptr;
+}
+
 }  // namespace
+
+bool Launcher::readinessRestartsLeft(const std::string& name) const {
+  const process::ProcessSpec* spec = sup_.spec(name);
+  if (spec == nullptr || !spec->restart) return false;
+  const auto used = ready_restarts_.find(name);
+  return (used == ready_restarts_.end() ? 0 : used->second) < o_.deployment.ready_restarts;
+}
 
 // A new process is a new participant, which authenticates and matches with every other one
 // anew: what cures a pair that never matched (Fast DDS 2.9.1, secured: docs/reliability.md).
@@ -335,11 +352,10 @@ void Launcher::checkReadiness() {
   const int limit = o_.deployment.ready_restarts;
   for (const auto& st : sup_.status()) {
     if (st.phase != process::ProcessPhase::kRunning || st.pid <= 0) continue;
-    const process::ProcessSpec* spec = sup_.spec(st.name);
-    if (spec == nullptr || !spec->restart || ready_restarts_[st.name] >= limit) continue;
-    const dds::ServiceInfo* seen = heardFrom(services, st, host);
-    if (seen == nullptr || seen->state != msg::SERVICE_STARTING) continue;
-    if (secondsSince(st.started) <= o_.deployment.ready_timeout_s) continue;
+    if (!readinessRestartsLeft(st.name)) continue;
+    const dds::ServiceInfo* seen =
+        notReadyInTime(services, st, host, o_.deployment.ready_timeout_s);
+    if (seen == nullptr) continue;
     const int n = ++ready_restarts_[st.name];
     char why[512];
     std::snprintf(why, sizeof(why), "not ready within ready_timeout_s (%.1f s) of its start (%s): restarted, %d of %d",
@@ -351,14 +367,9 @@ void Launcher::checkReadiness() {
 bool Launcher::readinessGivenUp(const std::string& name) const {
   const auto st = sup_.status(name);
   if (!st || st->phase != process::ProcessPhase::kRunning) return false;
-  const process::ProcessSpec* spec = sup_.spec(name);
-  const auto used = ready_restarts_.find(name);
-  const bool more = spec != nullptr && spec->restart && o_.restart &&
-                    (used == ready_restarts_.end() ? 0 : used->second) < o_.deployment.ready_restarts;
-  if (more) return false;
-  const dds::ServiceInfo* seen = heardFrom(monitor_->services(), *st, thisHost());
-  return seen != nullptr && seen->state == msg::SERVICE_STARTING &&
-         secondsSince(st->started) > o_.deployment.ready_timeout_s;
+  if (o_.restart && readinessRestartsLeft(name)) return false;
+  return notReadyInTime(monitor_->services(), *st, thisHost(), o_.deployment.ready_timeout_s) !=
+         nullptr;
 }
 
 void Launcher::stop(double grace_s) {

@@ -116,6 +116,8 @@ class Launcher {
   void checkLiveness();
   /// Restarts a service alive but not ready for ready_timeout_s (at most ready_restarts times).
   void checkReadiness();
+  /// True when `name` is a restarted service with readiness restarts (ready_restarts) left.
+  bool readinessRestartsLeft(const std::string& name) const;
   Status startOneByOne();
 
   LaunchOptions o_;

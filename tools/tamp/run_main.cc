@@ -39,6 +39,81 @@
 
 namespace fs = std::filesystem;
 
+namespace {
+
+/// Waits until every service in `started` is alive and ready: alive within startup_timeout_s of
+/// its (re)start; ready as long as the launcher may still restart a service that stays not ready
+/// (ready_timeout_s, ready_restarts). Returns those given up on (also on a stop request).
+std::vector<std::string> waitUntilReady(tamp::launch::Launcher& launcher, const std::vector<std::string>& started,
+                                        const tamp::deploy::Deployment& deployment) {
+  const tamp::dds::HeartbeatMonitor& monitor = launcher.monitor();
+  tamp::process::Supervisor& sup = launcher.supervisor();
+  const tamp::Termination ready_wait = tamp::Termination::after(deployment.readyWait());
+  std::vector<std::string> not_alive;
+  for (const auto& name : started) {
+    while (!monitor.waitFor(name, 1, ready_wait.tightened(tamp::Deadline::in(0.1)), /*ready=*/true)) {
+      launcher.poll();
+      auto st = sup.status(name);
+      bool heard = false;
+      for (const auto& info : monitor.services()) heard = heard || (info.alive && info.name == name);
+      const bool ended = st && st->phase != tamp::process::ProcessPhase::kRunning &&
+                         st->phase != tamp::process::ProcessPhase::kBackoff;
+      const bool silent =
+          !heard && st && st->phase == tamp::process::ProcessPhase::kRunning &&
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - st->started).count() > deployment.startup_timeout_s;
+      if (ready_wait() || silent || launcher.readinessGivenUp(name) || tamp::cli::stopRequested() || ended) {
+        not_alive.push_back(name);
+        break;
+      }
+    }
+  }
+  return not_alive;
+}
+
+/// Every service answers on its echo endpoint: a real request/reply round trip through DDS, one
+/// line of a table each (those in `not_alive` say why not). kExitServiceError when a service that
+/// is not optional is not alive or does not answer, else kExitOk.
+int echoEach(tamp::launch::Launcher& launcher, const std::vector<std::string>& started,
+             const std::vector<std::string>& not_alive, const std::vector<std::string>& optional_names,
+             const fs::path& run_dir) {
+  const std::shared_ptr<tamp::dds::Participant>& participant = launcher.participant();
+  const tamp::dds::HeartbeatMonitor& monitor = launcher.monitor();
+  tamp::process::Supervisor& sup = launcher.supervisor();
+  int rc = tamp::cli::kExitOk;
+  std::printf("\n%-20s %8s %10s  %s\n", "SERVICE", "PID", "ROUND TRIP", "RESULT");
+  for (const auto& name : started) {
+    auto st = sup.status(name);
+    const bool alive = std::find(not_alive.begin(), not_alive.end(), name) == not_alive.end();
+    const bool optional = std::find(optional_names.begin(), optional_names.end(), name) != optional_names.end();
+    if (!alive) {
+      std::string why = st ? (st->last_exit.empty() ? "no heartbeat" : st->last_exit) : "?";
+      const char* label = "NOT ALIVE";
+      for (const auto& info : monitor.services())
+        if (info.alive && info.name == name) why = info.detail, label = "NOT READY";
+      std::printf("%-20s %8s %10s  %s (%s; see %s)%s\n", name.c_str(), "-", "-", label, why.c_str(),
+                  (run_dir / (name + ".log")).c_str(), optional ? " -- optional, going on" : "");
+      if (!optional) rc = tamp::cli::kExitServiceError;
+      continue;
+    }
+    tamp::dds::RpcClient<tamp::msg::EchoRequest, tamp::msg::EchoReply> echo(participant,
+                                                                             tamp::dds::echoService(name));
+    tamp::msg::EchoRequest req;
+    req.payload({1, 2, 3, 4});
+    tamp::Stopwatch sw;
+    auto rep = echo.call(req, tamp::dds::CallOptions{10.0, {}});
+    if (!rep) {
+      std::printf("%-20s %8d %10s  NO REPLY: %s\n", name.c_str(), st ? st->pid : -1, "-",
+                  rep.error().toString().c_str());
+      if (!optional) rc = tamp::cli::kExitServiceError;
+      continue;
+    }
+    std::printf("%-20s %8u %8.0fus  ok\n", name.c_str(), rep->pid(), sw.seconds() * 1e6);
+  }
+  return rc;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   CLI::App app{"Run the TAMP services on this machine (one DDS domain, supervised processes)", "tamp run"};
   std::string scenario;
@@ -184,59 +259,8 @@ int main(int argc, char** argv) {
   // second one would have to match every service anew (under DDS Security on Fast DDS 2.9.1, one
   // such pair in about twenty-five never matched: a service "not alive" that was; docs/reliability.md).
   const std::shared_ptr<tamp::dds::Participant> participant = launcher.participant();
-  const tamp::dds::HeartbeatMonitor& monitor = launcher.monitor();
-  // Alive within startup_timeout_s of its (re)start; ready as long as the launcher may still
-  // restart a service that stays not ready (ready_timeout_s, ready_restarts).
-  const tamp::Termination ready_wait = tamp::Termination::after(deployment->readyWait());
-  std::vector<std::string> not_alive;
-  for (const auto& name : started) {
-    while (!monitor.waitFor(name, 1, ready_wait.tightened(tamp::Deadline::in(0.1)), /*ready=*/true)) {
-      launcher.poll();
-      auto st = sup.status(name);
-      bool heard = false;
-      for (const auto& info : monitor.services()) heard = heard || (info.alive && info.name == name);
-      const bool ended = st && st->phase != tamp::process::ProcessPhase::kRunning &&
-                         st->phase != tamp::process::ProcessPhase::kBackoff;
-      const bool silent =
-          !heard && st && st->phase == tamp::process::ProcessPhase::kRunning &&
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - st->started).count() > deployment->startup_timeout_s;
-      if (ready_wait() || silent || launcher.readinessGivenUp(name) || tamp::cli::stopRequested() || ended) {
-        not_alive.push_back(name);
-        break;
-      }
-    }
-  }
-  // Every service answers on its echo endpoint: a real request/reply round trip through DDS.
-  int rc = tamp::cli::kExitOk;
-  std::printf("\n%-20s %8s %10s  %s\n", "SERVICE", "PID", "ROUND TRIP", "RESULT");
-  for (const auto& name : started) {
-    auto st = sup.status(name);
-    const bool alive = std::find(not_alive.begin(), not_alive.end(), name) == not_alive.end();
-    const bool optional = std::find(optional_names.begin(), optional_names.end(), name) != optional_names.end();
-    if (!alive) {
-      std::string why = st ? (st->last_exit.empty() ? "no heartbeat" : st->last_exit) : "?";
-      const char* label = "NOT ALIVE";
-      for (const auto& info : monitor.services())
-        if (info.alive && info.name == name) why = info.detail, label = "NOT READY";
-      std::printf("%-20s %8s %10s  %s (%s; see %s)%s\n", name.c_str(), "-", "-", label, why.c_str(),
-                  (run_dir / (name + ".log")).c_str(), optional ? " -- optional, going on" : "");
-      if (!optional) rc = tamp::cli::kExitServiceError;
-      continue;
-    }
-    tamp::dds::RpcClient<tamp::msg::EchoRequest, tamp::msg::EchoReply> echo(participant,
-                                                                             tamp::dds::echoService(name));
-    tamp::msg::EchoRequest req;
-    req.payload({1, 2, 3, 4});
-    tamp::Stopwatch sw;
-    auto rep = echo.call(req, tamp::dds::CallOptions{10.0, {}});
-    if (!rep) {
-      std::printf("%-20s %8d %10s  NO REPLY: %s\n", name.c_str(), st ? st->pid : -1, "-",
-                  rep.error().toString().c_str());
-      if (!optional) rc = tamp::cli::kExitServiceError;
-      continue;
-    }
-    std::printf("%-20s %8u %8.0fus  ok\n", name.c_str(), rep->pid(), sw.seconds() * 1e6);
-  }
+  const std::vector<std::string> not_alive = waitUntilReady(launcher, started, *deployment);
+  int rc = echoEach(launcher, started, not_alive, optional_names, run_dir);
   std::printf("\n");
   std::fflush(stdout);
   // The same table `tamp status` prints, from the heartbeats.

@@ -5,6 +5,9 @@
 #include <unistd.h>
 
 #include <cstdlib>
+#include <memory>
+#include <string>
+#include <vector>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -17,6 +20,33 @@ namespace tamp::dds {
 namespace {
 
 using ::testing::HasSubstr;
+
+/// A participant on this test's domain that discovers the others only through `servers`; null
+/// (and a test failure) when it cannot be made.
+std::shared_ptr<Participant> serverClient(const std::string& name,
+                                          const std::vector<DiscoveryServerAddress>& servers) {
+  ParticipantOptions o{testing::isolatedDomain(), kProfileUdp, name, {}};
+  for (const auto& s : servers) o.discovery_servers.push_back(s.toString());
+  auto p = Participant::create(o);
+  if (!p) ADD_FAILURE() << p.error().toString();
+  return p ? *p : nullptr;
+}
+
+/// A reader callback that pushes the id of every alive world object into `inbox`.
+auto pushAliveIds(testing::Inbox<std::string>& inbox) {
+  return [&inbox](const msg::WorldObject& o, const SampleMeta& meta) {
+    if (meta.alive) inbox.push(o.id());
+  };
+}
+
+/// A movable object `id` at the origin.
+msg::WorldObject movableObject(const std::string& id) {
+  msg::WorldObject o;
+  o.id(id);
+  o.kind(msg::OBJECT_MOVABLE);
+  o.pose().orientation().w(1.0);
+  return o;
+}
 
 TEST(DiscoveryServerAddressTest, ParsesIpv4AndPortAndNamesWhatIsWrong) {
   auto a = parseDiscoveryServer("10.0.0.1:11811");
@@ -58,29 +88,15 @@ TEST(DiscoveryServerTest, ClientsOfAServerExchangeSamples) {
                                        static_cast<uint16_t>(30000 + ::getpid() % 20000)};
   auto server = DiscoveryServer::start(address);
   ASSERT_TRUE(server.ok()) << server.error().toString();
-  auto client = [&](const std::string& name) {
-    ParticipantOptions o{testing::isolatedDomain(), kProfileUdp, name, {}};
-    o.discovery_servers = {address.toString()};
-    auto p = Participant::create(o);
-    if (!p) ADD_FAILURE() << p.error().toString();
-    return p ? *p : nullptr;
-  };
-  auto a = client("client_a");
-  auto b = client("client_b");
+  auto a = serverClient("client_a", {address});
+  auto b = serverClient("client_b", {address});
   ASSERT_TRUE(a && b);
   EXPECT_TRUE(a->usesDiscoveryServer());
   testing::Inbox<std::string> inbox;
-  Reader<msg::WorldObject> reader(b, topics::kWorldObjects,
-                                  [&](const msg::WorldObject& o, const SampleMeta& meta) {
-                                    if (meta.alive) inbox.push(o.id());
-                                  });
+  Reader<msg::WorldObject> reader(b, topics::kWorldObjects, pushAliveIds(inbox));
   Writer<msg::WorldObject> writer(a, topics::kWorldObjects);
   ASSERT_TRUE(writer.waitForReaders(Termination::after(10.0), 1));
-  msg::WorldObject o;
-  o.id("box_1");
-  o.kind(msg::OBJECT_MOVABLE);
-  o.pose().orientation().w(1.0);
-  ASSERT_TRUE(writer.write(o).ok());
+  ASSERT_TRUE(writer.write(movableObject("box_1")).ok());
   EXPECT_TRUE(inbox.waitFor([](const std::string& id) { return id == "box_1"; }, 10.0).has_value());
 }
 
@@ -95,30 +111,16 @@ TEST(DiscoveryServerTest, WithTwoServersANewParticipantIsFoundWhenOneServerIsGon
   ASSERT_TRUE(server0.ok()) << server0.error().toString();
   auto server1 = DiscoveryServer::start(second, 1);
   ASSERT_TRUE(server1.ok()) << server1.error().toString();
-  auto client = [&](const std::string& name) {
-    ParticipantOptions o{testing::isolatedDomain(), kProfileUdp, name, {}};
-    o.discovery_servers = {first.toString(), second.toString()};
-    auto p = Participant::create(o);
-    if (!p) ADD_FAILURE() << p.error().toString();
-    return p ? *p : nullptr;
-  };
-  auto a = client("client_a");
+  auto a = serverClient("client_a", {first, second});
   ASSERT_TRUE(a);
   Writer<msg::WorldObject> writer(a, topics::kWorldObjects);
   server0->reset();  // the first host's server goes (its launcher died)
-  auto b = client("client_b");
+  auto b = serverClient("client_b", {first, second});
   ASSERT_TRUE(b);
   testing::Inbox<std::string> inbox;
-  Reader<msg::WorldObject> reader(b, topics::kWorldObjects,
-                                  [&](const msg::WorldObject& o, const SampleMeta& meta) {
-                                    if (meta.alive) inbox.push(o.id());
-                                  });
+  Reader<msg::WorldObject> reader(b, topics::kWorldObjects, pushAliveIds(inbox));
   ASSERT_TRUE(writer.waitForReaders(Termination::after(20.0), 1)) << "not found through the second server";
-  msg::WorldObject o;
-  o.id("box_2");
-  o.kind(msg::OBJECT_MOVABLE);
-  o.pose().orientation().w(1.0);
-  ASSERT_TRUE(writer.write(o).ok());
+  ASSERT_TRUE(writer.write(movableObject("box_2")).ok());
   EXPECT_TRUE(inbox.waitFor([](const std::string& id) { return id == "box_2"; }, 10.0).has_value());
 }
 

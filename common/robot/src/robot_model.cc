@@ -123,6 +123,198 @@ struct ValueSource {
   double multiplier{1.0}, offset{0.0};
 };
 
+/// Where the elements of a URDF document stand, for the messages of fromUrdfString: the line of its
+/// <robot> and of every named <link> and <joint>.
+struct UrdfLines {
+  UrdfLines(const tinyxml2::XMLElement& robot_el, std::string source_name)
+      : source(std::move(source_name)), robot(robot_el.GetLineNum()) {
+    for (const auto* e = robot_el.FirstChildElement(); e != nullptr; e = e->NextSiblingElement()) {
+      const char* n = e->Attribute("name");
+      if (n == nullptr) continue;
+      if (std::string_view(e->Name()) == "link") links[n] = e->GetLineNum();
+      if (std::string_view(e->Name()) == "joint") joints[n] = e->GetLineNum();
+    }
+  }
+
+  Error error(ErrorCode code, const std::string& msg, int line = 0,
+              const std::string& field = "") const {
+    return Error(code, msg, SourceLocation{source, line, 0, field});
+  }
+  int ofLink(const std::string& n) const {
+    auto it = links.find(n);
+    return it == links.end() ? robot : it->second;
+  }
+  int ofJoint(const std::string& n) const {
+    auto it = joints.find(n);
+    return it == joints.end() ? robot : it->second;
+  }
+
+  std::string source;
+  int robot;
+  std::map<std::string, int> links, joints;
+};
+
+/// The joints' tree structure, checked before urdfdom: a link that is its own ancestor makes
+/// urdfdom build (and leak) a cyclic graph.
+Status checkJointTree(const tinyxml2::XMLElement& robot_el, const UrdfLines& lines) {
+  std::map<std::string, std::pair<std::string, std::string>> parent_of;  // child -> (parent, joint)
+  for (const auto* e = robot_el.FirstChildElement("joint"); e != nullptr;
+       e = e->NextSiblingElement("joint")) {
+    const char* jn = e->Attribute("name");
+    const auto* pe = e->FirstChildElement("parent");
+    const auto* ce = e->FirstChildElement("child");
+    if (jn == nullptr || pe == nullptr || ce == nullptr || pe->Attribute("link") == nullptr ||
+        ce->Attribute("link") == nullptr) {
+      continue;  // urdfdom reports these
+    }
+    const std::string parent = pe->Attribute("link"), child = ce->Attribute("link");
+    if (parent == child) {
+      return lines.error(
+          ErrorCode::kParseError,
+          "joint '" + std::string(jn) + "': parent and child are the same link '" + child + "'",
+          e->GetLineNum(), "joint." + std::string(jn));
+    }
+    auto [it, fresh] = parent_of.emplace(child, std::make_pair(parent, std::string(jn)));
+    if (!fresh) {
+      return lines.error(ErrorCode::kParseError,
+                         "link '" + child + "' is the child of two joints, '" + it->second.second +
+                             "' and '" + jn + "'",
+                         e->GetLineNum(), "joint." + std::string(jn));
+    }
+  }
+  for (const auto& [child, pj] : parent_of) {
+    std::string at = child;
+    for (size_t steps = 0; steps <= parent_of.size(); ++steps) {
+      auto up = parent_of.find(at);
+      if (up == parent_of.end()) break;
+      at = up->second.first;
+      if (at == child) {
+        return lines.error(ErrorCode::kParseError,
+                           "the joints form a cycle through link '" + child + "'",
+                           lines.ofJoint(pj.second), "joint." + pj.second);
+      }
+    }
+  }
+  return Status::Ok();
+}
+
+/// urdfdom's model of `xml`, with its diagnostics captured instead of printed; an error points at
+/// the element its message names, when it names one.
+Result<urdf::ModelInterfaceSharedPtr> parseWithUrdfdom(const std::string& xml,
+                                                       const UrdfLines& lines) {
+  urdf::ModelInterfaceSharedPtr model;
+  CaptureHandler capture;
+  const console_bridge::LogLevel old_level = console_bridge::getLogLevel();
+  console_bridge::useOutputHandler(&capture);
+  console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_ERROR);
+  try {
+    model = urdf::parseURDF(xml);
+  } catch (const std::exception& e) {
+    capture.messages.emplace_back(e.what());
+    model.reset();
+  }
+  console_bridge::restorePreviousOutputHandler();
+  console_bridge::setLogLevel(old_level);
+  if (!model || !model->getRoot()) {
+    std::string msg = "invalid URDF";
+    int line = lines.robot;
+    for (const auto& m : capture.messages) {
+      msg += ": " + m;
+      // Point at the element the message names, when it names one.
+      for (const auto& [n, l] : lines.links) {
+        if (m.find("[" + n + "]") != std::string::npos ||
+            m.find("'" + n + "'") != std::string::npos)
+          line = l;
+      }
+      for (const auto& [n, l] : lines.joints) {
+        if (m.find("[" + n + "]") != std::string::npos ||
+            m.find("'" + n + "'") != std::string::npos)
+          line = l;
+      }
+    }
+    return lines.error(ErrorCode::kParseError, msg, line);
+  }
+  return model;
+}
+
+/// The links from the root, parents before children (children by name).
+std::vector<urdf::LinkConstSharedPtr> linksInOrder(const urdf::ModelInterface& model) {
+  std::vector<urdf::LinkConstSharedPtr> order{model.getRoot()};
+  for (size_t i = 0; i < order.size(); ++i) {
+    std::vector<urdf::LinkSharedPtr> kids = order[i]->child_links;
+    std::sort(kids.begin(), kids.end(),
+              [](const auto& a, const auto& b) { return a->name < b->name; });
+    for (const auto& c : kids) order.push_back(c);
+  }
+  return order;
+}
+
+/// The URDF joint `uj` in this model's terms; nullopt for an unsupported type or a zero axis.
+/// Errors go to `errors`: those two, and limits that are not finite with lower <= upper.
+std::optional<Joint> toJoint(const urdf::JointSharedPtr& uj, const UrdfLines& lines,
+                             std::vector<Error>& errors) {
+  Joint j;
+  j.name = uj->name;
+  j.parent_link = uj->parent_link_name;
+  j.child_link = uj->child_link_name;
+  j.parent_T_joint = toEigen(uj->parent_to_joint_origin_transform);
+  j.axis = Eigen::Vector3d(uj->axis.x, uj->axis.y, uj->axis.z);
+  const int line = lines.ofJoint(uj->name);
+  switch (uj->type) {
+    case urdf::Joint::FIXED:
+      j.type = JointType::kFixed;
+      break;
+    case urdf::Joint::REVOLUTE:
+      j.type = JointType::kRevolute;
+      break;
+    case urdf::Joint::CONTINUOUS:
+      j.type = JointType::kContinuous;
+      break;
+    case urdf::Joint::PRISMATIC:
+      j.type = JointType::kPrismatic;
+      break;
+    default:
+      errors.push_back(
+          lines.error(ErrorCode::kUnsupported,
+                      "joint '" + uj->name +
+                          "': only fixed, revolute, continuous and prismatic joints are supported",
+                      line, "joint." + uj->name));
+      return std::nullopt;
+  }
+  if (j.type != JointType::kFixed) {
+    if (!(j.axis.norm() > 1e-9) || !j.axis.allFinite()) {
+      errors.push_back(lines.error(ErrorCode::kInvalidArgument,
+                                   "joint '" + uj->name + "': axis must be non-zero", line,
+                                   "joint." + uj->name + ".axis"));
+      return std::nullopt;
+    }
+    j.axis.normalize();
+  }
+  if (uj->limits) {
+    j.limits =
+        JointLimits{uj->limits->lower, uj->limits->upper, uj->limits->velocity, uj->limits->effort};
+  }
+  if (j.type == JointType::kContinuous) {
+    j.limits.lower = -std::numeric_limits<double>::infinity();
+    j.limits.upper = std::numeric_limits<double>::infinity();
+  } else if (j.type != JointType::kFixed) {
+    if (!std::isfinite(j.limits.lower) || !std::isfinite(j.limits.upper) ||
+        j.limits.lower > j.limits.upper) {
+      errors.push_back(lines.error(
+          ErrorCode::kInvalidArgument,
+          "joint '" + uj->name + "': limits must be finite with lower <= upper, got [" +
+              std::to_string(j.limits.lower) + ", " + std::to_string(j.limits.upper) + "]",
+          line, "joint." + uj->name + ".limit"));
+    }
+  }
+  if (uj->mimic) {
+    j.mimic = uj->mimic->joint_name;
+    j.mimic_multiplier = uj->mimic->multiplier;
+    j.mimic_offset = uj->mimic->offset;
+  }
+  return j;
+}
+
 }  // namespace
 
 struct RobotModel::Impl {
@@ -147,6 +339,13 @@ struct RobotModel::Impl {
   Eigen::Vector3d reach_origin{Eigen::Vector3d::Zero()};
   double reach_bound{std::numeric_limits<double>::infinity()};
   void boundReach();
+  // Steps of fromUrdfString (robot_model.cc).
+  Status addLinksAndJoints(const std::vector<urdf::LinkConstSharedPtr>& order,
+                           const std::map<std::string, int>& index, const UrdfLines& lines);
+  Status addArmChain(const std::map<std::string, int>& index, const UrdfLines& lines);
+  Status addCollisionGeometry(const std::vector<urdf::LinkConstSharedPtr>& order,
+                              const UrdfLines& lines);
+  void allowSelfCollisions(const std::map<std::string, int>& index);
   collision::RobotGeometry geometry;
   world::Polygon2 footprint;
   double base_radius{0.0};
@@ -310,115 +509,237 @@ Result<RobotModel> RobotModel::loadDescription(const std::filesystem::path& yaml
   return model;
 }
 
+/// Links, their parents and joints from the URDF links in `order` (linksInOrder), `index` their
+/// positions there. Errors: every joint that is not supported or not valid (toJoint).
+Status RobotModel::Impl::addLinksAndJoints(const std::vector<urdf::LinkConstSharedPtr>& order,
+                                           const std::map<std::string, int>& index,
+                                           const UrdfLines& lines) {
+  std::vector<Error> errors;
+  links.resize(order.size());
+  link_parent.assign(order.size(), -1);
+  link_joint.assign(order.size(), -1);
+  for (size_t i = 0; i < order.size(); ++i) {
+    links[i] = order[i]->name;
+    if (i == 0) continue;
+    const urdf::JointSharedPtr& uj = order[i]->parent_joint;
+    std::optional<Joint> j = toJoint(uj, lines, errors);
+    if (!j) continue;
+    link_parent[i] = index.at(uj->parent_link_name);
+    link_joint[i] = static_cast<int>(joints.size());
+    joints.push_back(std::move(*j));
+  }
+  if (!errors.empty()) return Error(errors.front().code, joinErrors(errors));
+  return Status::Ok();
+}
+
+/// The arm chain base -> tool, and the value source of every joint.
+Status RobotModel::Impl::addArmChain(const std::map<std::string, int>& index,
+                                     const UrdfLines& lines) {
+  auto li = index.find(options.tool_link);
+  if (li == index.end()) {
+    return lines.error(
+        ErrorCode::kInvalidArgument,
+        "tool link '" + options.tool_link + "' is not a link of robot '" + name + "'", lines.robot,
+        "tool_link");
+  }
+  tool_link = li->second;
+  std::vector<int> chain_joints;
+  for (int l = tool_link; l > 0; l = link_parent[static_cast<size_t>(l)])
+    chain_joints.push_back(link_joint[static_cast<size_t>(l)]);
+  std::reverse(chain_joints.begin(), chain_joints.end());
+  sources.assign(joints.size(), ValueSource{});
+  for (int ji : chain_joints) {
+    const Joint& j = joints[static_cast<size_t>(ji)];
+    KDL::Joint kj(j.name, KDL::Joint::None);
+    const KDL::Frame origin = toKdl(j.parent_T_joint);
+    const KDL::Vector axis = origin.M * KDL::Vector(j.axis.x(), j.axis.y(), j.axis.z());
+    if (j.type == JointType::kRevolute || j.type == JointType::kContinuous) {
+      kj = KDL::Joint(j.name, origin.p, axis, KDL::Joint::RotAxis);
+    } else if (j.type == JointType::kPrismatic) {
+      kj = KDL::Joint(j.name, origin.p, axis, KDL::Joint::TransAxis);
+    }
+    chain.addSegment(KDL::Segment(j.child_link, kj, origin));
+    if (j.type != JointType::kFixed && j.mimic.empty()) {
+      sources[static_cast<size_t>(ji)] =
+          ValueSource{ValueSource::kArm, static_cast<int>(arm_joints.size()), 1, 0};
+      arm_joints.push_back(j.name);
+      arm_joint_index.push_back(ji);
+      arm_limits.push_back(j.limits);
+    } else if (!j.mimic.empty()) {
+      return lines.error(
+          ErrorCode::kUnsupported,
+          "joint '" + j.name + "': mimic joints inside the arm chain are not supported",
+          lines.ofJoint(j.name), "joint." + j.name + ".mimic");
+    }
+  }
+  if (arm_joints.empty()) {
+    return lines.error(ErrorCode::kInvalidArgument,
+                       "the chain from '" + options.base_link + "' to '" + options.tool_link +
+                           "' has no movable joint",
+                       lines.ofLink(options.tool_link), "tool_link");
+  }
+  boundReach();
+  if (!options.gripper_joint.empty()) {
+    auto it = std::find_if(joints.begin(), joints.end(),
+                           [&](const Joint& j) { return j.name == options.gripper_joint; });
+    if (it == joints.end() || it->type != JointType::kPrismatic) {
+      return lines.error(ErrorCode::kInvalidArgument,
+                         "gripper joint '" + options.gripper_joint +
+                             "' must be a prismatic joint of robot '" + name + "'",
+                         it == joints.end() ? lines.robot : lines.ofJoint(it->name),
+                         "gripper_joint");
+    }
+    gripper_joint = static_cast<int>(it - joints.begin());
+    sources[static_cast<size_t>(gripper_joint)] = ValueSource{ValueSource::kGripper, 0, 1, 0};
+  }
+  for (size_t ji = 0; ji < joints.size(); ++ji) {
+    const Joint& j = joints[ji];
+    if (j.mimic.empty()) continue;
+    auto it = std::find_if(joints.begin(), joints.end(),
+                           [&](const Joint& o) { return o.name == j.mimic; });
+    if (it == joints.end() || !it->mimic.empty()) {
+      return lines.error(
+          ErrorCode::kInvalidArgument,
+          "joint '" + j.name + "' mimics '" + j.mimic + "', which is not a driven joint",
+          lines.ofJoint(j.name), "joint." + j.name + ".mimic");
+    }
+    sources[ji] = ValueSource{ValueSource::kMimic, static_cast<int>(it - joints.begin()),
+                              j.mimic_multiplier, j.mimic_offset};
+  }
+  if (!options.camera_frame.empty() && index.count(options.camera_frame) == 0) {
+    return lines.error(
+        ErrorCode::kInvalidArgument,
+        "camera frame '" + options.camera_frame + "' is not a link of robot '" + name + "'",
+        lines.robot, "camera_frame");
+  }
+  return Status::Ok();
+}
+
+/// Collision geometry, and the base footprint: the xy hull of base_link's shapes (boxes and discs
+/// projected).
+Status RobotModel::Impl::addCollisionGeometry(const std::vector<urdf::LinkConstSharedPtr>& order,
+                                              const UrdfLines& lines) {
+  std::vector<Error> errors;
+  geometry.links = links;
+  for (size_t i = 0; i < order.size(); ++i) {
+    for (const auto& c : order[i]->collision_array) {
+      if (!c || !c->geometry) continue;
+      collision::RobotPart part;
+      part.link = static_cast<int>(i);
+      part.link_T_shape = toEigen(c->origin);
+      const auto& g = c->geometry;
+      const int line = lines.ofLink(order[i]->name);
+      const std::string field = "link." + order[i]->name + ".collision";
+      if (auto b = std::dynamic_pointer_cast<urdf::Box>(g)) {
+        part.shape = world::Shape::box(b->dim.x, b->dim.y, b->dim.z);
+      } else if (auto cy = std::dynamic_pointer_cast<urdf::Cylinder>(g)) {
+        part.shape = world::Shape::cylinder(cy->radius, cy->length);
+      } else if (auto sp = std::dynamic_pointer_cast<urdf::Sphere>(g)) {
+        part.shape = world::Shape::sphere(sp->radius);
+      } else {
+        errors.push_back(
+            lines.error(ErrorCode::kUnsupported,
+                        "link '" + order[i]->name +
+                            "': only box, cylinder and sphere collision geometry is supported",
+                        line, field));
+        continue;
+      }
+      if (auto why = part.shape.invalidReason()) {
+        errors.push_back(lines.error(ErrorCode::kInvalidArgument,
+                                     "link '" + order[i]->name + "': " + *why, line, field));
+        continue;
+      }
+      geometry.parts.push_back(std::move(part));
+    }
+  }
+  if (!errors.empty()) return Error(errors.front().code, joinErrors(errors));
+
+  // Base footprint: the xy hull of base_link's shapes (boxes and discs projected).
+  Aabb fb;
+  for (const auto& p : geometry.parts) {
+    if (p.link != 0) continue;
+    fb.extend(p.shape.aabb(p.link_T_shape));
+  }
+  if (!fb.empty()) {
+    footprint = {{fb.min.x(), fb.min.y()},
+                 {fb.max.x(), fb.min.y()},
+                 {fb.max.x(), fb.max.y()},
+                 {fb.min.x(), fb.max.y()}};
+    base_radius = world::circumradius(footprint, Eigen::Vector2d::Zero());
+  }
+  return Status::Ok();
+}
+
+/// Allowed self-collisions: rigid groups (fixed joints), adjacent groups, and pairs touching in the
+/// zero configuration with the gripper closed and open.
+void RobotModel::Impl::allowSelfCollisions(const std::map<std::string, int>& index) {
+  std::vector<int> group(links.size());
+  std::iota(group.begin(), group.end(), 0);
+  for (size_t i = 1; i < links.size(); ++i) {
+    if (joints[static_cast<size_t>(link_joint[i])].type == JointType::kFixed)
+      group[i] = group[static_cast<size_t>(link_parent[i])];
+  }
+  std::set<std::pair<int, int>> allowed;
+  auto allow = [&](int a, int b) {
+    if (a != b) allowed.insert({std::min(a, b), std::max(a, b)});
+  };
+  const int n = static_cast<int>(links.size());
+  for (int a = 0; a < n; ++a) {
+    for (int b = a + 1; b < n; ++b) {
+      if (group[static_cast<size_t>(a)] == group[static_cast<size_t>(b)]) allow(a, b);
+    }
+  }
+  // Adjacent groups: a group's root link hangs from a link of the other group.
+  for (int a = 1; a < n; ++a) {
+    const int root_a = group[static_cast<size_t>(a)];
+    if (root_a == 0) continue;  // the base's group has no parent
+    const int parent_group = group[static_cast<size_t>(link_parent[static_cast<size_t>(root_a)])];
+    for (int b = 0; b < n; ++b) {
+      if (group[static_cast<size_t>(b)] == parent_group) allow(a, b);
+    }
+  }
+  {
+    collision::Scene scene;
+    scene.setRobot(geometry);
+    RobotState s;
+    s.arm.assign(arm_joints.size(), 0.0);
+    for (size_t k = 0; k < s.arm.size(); ++k)
+      s.arm[k] = std::clamp(0.0, arm_limits[k].lower, arm_limits[k].upper);
+    std::vector<Eigen::Isometry3d> P;
+    const double g_hi =
+        gripper_joint >= 0 ? joints[static_cast<size_t>(gripper_joint)].limits.upper : 0.0;
+    const double g_lo =
+        gripper_joint >= 0 ? joints[static_cast<size_t>(gripper_joint)].limits.lower : 0.0;
+    for (double g : {g_lo, g_hi}) {
+      s.gripper = g;
+      poses(s, P);
+      scene.setLinkPoses(P);
+      for (const auto& [a, b] : scene.selfCollisions()) allow(index.at(a), index.at(b));
+    }
+  }
+  geometry.allowed_self_collisions.assign(allowed.begin(), allowed.end());
+}
+
 Result<RobotModel> RobotModel::fromUrdfString(const std::string& xml, const std::string& source,
                                               const RobotModelOptions& options) {
-  auto err = [&](ErrorCode code, const std::string& msg, int line = 0,
-                 const std::string& field = "") {
-    return Error(code, msg, SourceLocation{source, line, 0, field});
-  };
-
   // 1. XML syntax, with a line number, and the line of every <link>/<joint> for later messages.
   tinyxml2::XMLDocument doc;
   if (doc.Parse(xml.c_str(), xml.size()) != tinyxml2::XML_SUCCESS) {
-    return err(ErrorCode::kParseError, "invalid XML: " + xmlErrorMessage(doc), doc.ErrorLineNum());
+    return Error(ErrorCode::kParseError, "invalid XML: " + xmlErrorMessage(doc),
+                 SourceLocation{source, doc.ErrorLineNum(), 0, ""});
   }
   const tinyxml2::XMLElement* robot_el = doc.RootElement();
   if (robot_el == nullptr || std::string_view(robot_el->Name()) != "robot") {
-    return err(ErrorCode::kParseError, "the root element must be <robot>",
-               robot_el ? robot_el->GetLineNum() : 1);
+    return Error(ErrorCode::kParseError, "the root element must be <robot>",
+                 SourceLocation{source, robot_el ? robot_el->GetLineNum() : 1, 0, ""});
   }
-  std::map<std::string, int> link_line, joint_line;
-  for (const auto* e = robot_el->FirstChildElement(); e != nullptr; e = e->NextSiblingElement()) {
-    const char* n = e->Attribute("name");
-    if (n == nullptr) continue;
-    if (std::string_view(e->Name()) == "link") link_line[n] = e->GetLineNum();
-    if (std::string_view(e->Name()) == "joint") joint_line[n] = e->GetLineNum();
-  }
-  auto lineOfLink = [&](const std::string& n) {
-    auto it = link_line.find(n);
-    return it == link_line.end() ? robot_el->GetLineNum() : it->second;
-  };
-  auto lineOfJoint = [&](const std::string& n) {
-    auto it = joint_line.find(n);
-    return it == joint_line.end() ? robot_el->GetLineNum() : it->second;
-  };
-
-  // Tree structure checked here, before urdfdom: a link that is its own ancestor makes urdfdom
-  // build (and leak) a cyclic graph.
-  {
-    std::map<std::string, std::pair<std::string, std::string>>
-        parent_of;  // child -> (parent, joint)
-    for (const auto* e = robot_el->FirstChildElement("joint"); e != nullptr;
-         e = e->NextSiblingElement("joint")) {
-      const char* jn = e->Attribute("name");
-      const auto* pe = e->FirstChildElement("parent");
-      const auto* ce = e->FirstChildElement("child");
-      if (jn == nullptr || pe == nullptr || ce == nullptr || pe->Attribute("link") == nullptr ||
-          ce->Attribute("link") == nullptr) {
-        continue;  // urdfdom reports these
-      }
-      const std::string parent = pe->Attribute("link"), child = ce->Attribute("link");
-      if (parent == child) {
-        return err(
-            ErrorCode::kParseError,
-            "joint '" + std::string(jn) + "': parent and child are the same link '" + child + "'",
-            e->GetLineNum(), "joint." + std::string(jn));
-      }
-      auto [it, fresh] = parent_of.emplace(child, std::make_pair(parent, std::string(jn)));
-      if (!fresh) {
-        return err(ErrorCode::kParseError,
-                   "link '" + child + "' is the child of two joints, '" + it->second.second +
-                       "' and '" + jn + "'",
-                   e->GetLineNum(), "joint." + std::string(jn));
-      }
-    }
-    for (const auto& [child, pj] : parent_of) {
-      std::string at = child;
-      for (size_t steps = 0; steps <= parent_of.size(); ++steps) {
-        auto up = parent_of.find(at);
-        if (up == parent_of.end()) break;
-        at = up->second.first;
-        if (at == child) {
-          return err(ErrorCode::kParseError, "the joints form a cycle through link '" + child + "'",
-                     lineOfJoint(pj.second), "joint." + pj.second);
-        }
-      }
-    }
-  }
+  const UrdfLines lines(*robot_el, source);
+  if (Status s = checkJointTree(*robot_el, lines); !s.ok()) return s.error();
 
   // 2. urdfdom, with its diagnostics captured instead of printed.
-  urdf::ModelInterfaceSharedPtr model;
-  CaptureHandler capture;
-  const console_bridge::LogLevel old_level = console_bridge::getLogLevel();
-  console_bridge::useOutputHandler(&capture);
-  console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_ERROR);
-  try {
-    model = urdf::parseURDF(xml);
-  } catch (const std::exception& e) {
-    capture.messages.emplace_back(e.what());
-    model.reset();
-  }
-  console_bridge::restorePreviousOutputHandler();
-  console_bridge::setLogLevel(old_level);
-  if (!model || !model->getRoot()) {
-    std::string msg = "invalid URDF";
-    int line = robot_el->GetLineNum();
-    for (const auto& m : capture.messages) {
-      msg += ": " + m;
-      // Point at the element the message names, when it names one.
-      for (const auto& [n, l] : link_line) {
-        if (m.find("[" + n + "]") != std::string::npos ||
-            m.find("'" + n + "'") != std::string::npos)
-          line = l;
-      }
-      for (const auto& [n, l] : joint_line) {
-        if (m.find("[" + n + "]") != std::string::npos ||
-            m.find("'" + n + "'") != std::string::npos)
-          line = l;
-      }
-    }
-    return err(ErrorCode::kParseError, msg, line);
-  }
+  auto parsed = parseWithUrdfdom(xml, lines);
+  if (!parsed) return parsed.error();
+  const urdf::ModelInterfaceSharedPtr& model = *parsed;
 
   RobotModel rm;
   Impl& m = *rm.impl_;
@@ -429,265 +750,24 @@ Result<RobotModel> RobotModel::fromUrdfString(const std::string& xml, const std:
   // 3. Topology: the base link must be the root (its planar motion is virtual, see header).
   const std::string root = model->getRoot()->name;
   if (root != options.base_link) {
-    return err(ErrorCode::kInvalidArgument,
-               "the base link '" + options.base_link +
-                   "' must be the root of the URDF tree, but the root is '" + root + "'",
-               lineOfLink(root), "base_link");
+    return lines.error(ErrorCode::kInvalidArgument,
+                       "the base link '" + options.base_link +
+                           "' must be the root of the URDF tree, but the root is '" + root + "'",
+                       lines.ofLink(root), "base_link");
   }
-  std::vector<Error> errors;
-  std::vector<urdf::LinkConstSharedPtr> order{model->getRoot()};
-  for (size_t i = 0; i < order.size(); ++i) {
-    std::vector<urdf::LinkSharedPtr> kids = order[i]->child_links;
-    std::sort(kids.begin(), kids.end(),
-              [](const auto& a, const auto& b) { return a->name < b->name; });
-    for (const auto& c : kids) order.push_back(c);
-  }
+  const std::vector<urdf::LinkConstSharedPtr> order = linksInOrder(*model);
   std::map<std::string, int> index;
   for (size_t i = 0; i < order.size(); ++i) index[order[i]->name] = static_cast<int>(i);
-  m.links.resize(order.size());
-  m.link_parent.assign(order.size(), -1);
-  m.link_joint.assign(order.size(), -1);
-  for (size_t i = 0; i < order.size(); ++i) {
-    const auto& L = order[i];
-    m.links[i] = L->name;
-    if (i == 0) continue;
-    const urdf::JointSharedPtr& uj = L->parent_joint;
-    Joint j;
-    j.name = uj->name;
-    j.parent_link = uj->parent_link_name;
-    j.child_link = uj->child_link_name;
-    j.parent_T_joint = toEigen(uj->parent_to_joint_origin_transform);
-    j.axis = Eigen::Vector3d(uj->axis.x, uj->axis.y, uj->axis.z);
-    const int line = lineOfJoint(uj->name);
-    switch (uj->type) {
-      case urdf::Joint::FIXED:
-        j.type = JointType::kFixed;
-        break;
-      case urdf::Joint::REVOLUTE:
-        j.type = JointType::kRevolute;
-        break;
-      case urdf::Joint::CONTINUOUS:
-        j.type = JointType::kContinuous;
-        break;
-      case urdf::Joint::PRISMATIC:
-        j.type = JointType::kPrismatic;
-        break;
-      default:
-        errors.push_back(
-            err(ErrorCode::kUnsupported,
-                "joint '" + uj->name +
-                    "': only fixed, revolute, continuous and prismatic joints are supported",
-                line, "joint." + uj->name));
-        continue;
-    }
-    if (j.type != JointType::kFixed) {
-      if (!(j.axis.norm() > 1e-9) || !j.axis.allFinite()) {
-        errors.push_back(err(ErrorCode::kInvalidArgument,
-                             "joint '" + uj->name + "': axis must be non-zero", line,
-                             "joint." + uj->name + ".axis"));
-        continue;
-      }
-      j.axis.normalize();
-    }
-    if (uj->limits) {
-      j.limits = JointLimits{uj->limits->lower, uj->limits->upper, uj->limits->velocity,
-                             uj->limits->effort};
-    }
-    if (j.type == JointType::kContinuous) {
-      j.limits.lower = -std::numeric_limits<double>::infinity();
-      j.limits.upper = std::numeric_limits<double>::infinity();
-    } else if (j.type != JointType::kFixed) {
-      if (!std::isfinite(j.limits.lower) || !std::isfinite(j.limits.upper) ||
-          j.limits.lower > j.limits.upper) {
-        errors.push_back(
-            err(ErrorCode::kInvalidArgument,
-                "joint '" + uj->name + "': limits must be finite with lower <= upper, got [" +
-                    std::to_string(j.limits.lower) + ", " + std::to_string(j.limits.upper) + "]",
-                line, "joint." + uj->name + ".limit"));
-      }
-    }
-    if (uj->mimic) {
-      j.mimic = uj->mimic->joint_name;
-      j.mimic_multiplier = uj->mimic->multiplier;
-      j.mimic_offset = uj->mimic->offset;
-    }
-    m.link_parent[i] = index.at(uj->parent_link_name);
-    m.link_joint[i] = static_cast<int>(m.joints.size());
-    m.joints.push_back(std::move(j));
-  }
-  if (!errors.empty()) return Error(errors.front().code, joinErrors(errors));
+  if (Status s = m.addLinksAndJoints(order, index, lines); !s.ok()) return s.error();
 
   // 4. The arm chain base -> tool, and the value source of every joint.
-  auto li = index.find(options.tool_link);
-  if (li == index.end()) {
-    return err(ErrorCode::kInvalidArgument,
-               "tool link '" + options.tool_link + "' is not a link of robot '" + m.name + "'",
-               robot_el->GetLineNum(), "tool_link");
-  }
-  m.tool_link = li->second;
-  std::vector<int> chain_joints;
-  for (int l = m.tool_link; l > 0; l = m.link_parent[static_cast<size_t>(l)])
-    chain_joints.push_back(m.link_joint[static_cast<size_t>(l)]);
-  std::reverse(chain_joints.begin(), chain_joints.end());
-  m.sources.assign(m.joints.size(), ValueSource{});
-  for (int ji : chain_joints) {
-    const Joint& j = m.joints[static_cast<size_t>(ji)];
-    KDL::Joint kj(j.name, KDL::Joint::None);
-    const KDL::Frame origin = toKdl(j.parent_T_joint);
-    const KDL::Vector axis = origin.M * KDL::Vector(j.axis.x(), j.axis.y(), j.axis.z());
-    if (j.type == JointType::kRevolute || j.type == JointType::kContinuous) {
-      kj = KDL::Joint(j.name, origin.p, axis, KDL::Joint::RotAxis);
-    } else if (j.type == JointType::kPrismatic) {
-      kj = KDL::Joint(j.name, origin.p, axis, KDL::Joint::TransAxis);
-    }
-    m.chain.addSegment(KDL::Segment(j.child_link, kj, origin));
-    if (j.type != JointType::kFixed && j.mimic.empty()) {
-      m.sources[static_cast<size_t>(ji)] =
-          ValueSource{ValueSource::kArm, static_cast<int>(m.arm_joints.size()), 1, 0};
-      m.arm_joints.push_back(j.name);
-      m.arm_joint_index.push_back(ji);
-      m.arm_limits.push_back(j.limits);
-    } else if (!j.mimic.empty()) {
-      return err(ErrorCode::kUnsupported,
-                 "joint '" + j.name + "': mimic joints inside the arm chain are not supported",
-                 lineOfJoint(j.name), "joint." + j.name + ".mimic");
-    }
-  }
-  if (m.arm_joints.empty()) {
-    return err(ErrorCode::kInvalidArgument,
-               "the chain from '" + options.base_link + "' to '" + options.tool_link +
-                   "' has no movable joint",
-               lineOfLink(options.tool_link), "tool_link");
-  }
-  m.boundReach();
-  if (!options.gripper_joint.empty()) {
-    auto it = std::find_if(m.joints.begin(), m.joints.end(),
-                           [&](const Joint& j) { return j.name == options.gripper_joint; });
-    if (it == m.joints.end() || it->type != JointType::kPrismatic) {
-      return err(ErrorCode::kInvalidArgument,
-                 "gripper joint '" + options.gripper_joint +
-                     "' must be a prismatic joint of robot '" + m.name + "'",
-                 it == m.joints.end() ? robot_el->GetLineNum() : lineOfJoint(it->name),
-                 "gripper_joint");
-    }
-    m.gripper_joint = static_cast<int>(it - m.joints.begin());
-    m.sources[static_cast<size_t>(m.gripper_joint)] = ValueSource{ValueSource::kGripper, 0, 1, 0};
-  }
-  for (size_t ji = 0; ji < m.joints.size(); ++ji) {
-    const Joint& j = m.joints[ji];
-    if (j.mimic.empty()) continue;
-    auto it = std::find_if(m.joints.begin(), m.joints.end(),
-                           [&](const Joint& o) { return o.name == j.mimic; });
-    if (it == m.joints.end() || !it->mimic.empty()) {
-      return err(ErrorCode::kInvalidArgument,
-                 "joint '" + j.name + "' mimics '" + j.mimic + "', which is not a driven joint",
-                 lineOfJoint(j.name), "joint." + j.name + ".mimic");
-    }
-    m.sources[ji] = ValueSource{ValueSource::kMimic, static_cast<int>(it - m.joints.begin()),
-                                j.mimic_multiplier, j.mimic_offset};
-  }
-  if (!options.camera_frame.empty() && index.count(options.camera_frame) == 0) {
-    return err(
-        ErrorCode::kInvalidArgument,
-        "camera frame '" + options.camera_frame + "' is not a link of robot '" + m.name + "'",
-        robot_el->GetLineNum(), "camera_frame");
-  }
+  if (Status s = m.addArmChain(index, lines); !s.ok()) return s.error();
 
   // 5. Collision geometry.
-  m.geometry.links = m.links;
-  for (size_t i = 0; i < order.size(); ++i) {
-    for (const auto& c : order[i]->collision_array) {
-      if (!c || !c->geometry) continue;
-      collision::RobotPart part;
-      part.link = static_cast<int>(i);
-      part.link_T_shape = toEigen(c->origin);
-      const auto& g = c->geometry;
-      const int line = lineOfLink(order[i]->name);
-      const std::string field = "link." + order[i]->name + ".collision";
-      if (auto b = std::dynamic_pointer_cast<urdf::Box>(g)) {
-        part.shape = world::Shape::box(b->dim.x, b->dim.y, b->dim.z);
-      } else if (auto cy = std::dynamic_pointer_cast<urdf::Cylinder>(g)) {
-        part.shape = world::Shape::cylinder(cy->radius, cy->length);
-      } else if (auto sp = std::dynamic_pointer_cast<urdf::Sphere>(g)) {
-        part.shape = world::Shape::sphere(sp->radius);
-      } else {
-        errors.push_back(err(ErrorCode::kUnsupported,
-                             "link '" + order[i]->name +
-                                 "': only box, cylinder and sphere collision geometry is supported",
-                             line, field));
-        continue;
-      }
-      if (auto why = part.shape.invalidReason()) {
-        errors.push_back(err(ErrorCode::kInvalidArgument, "link '" + order[i]->name + "': " + *why,
-                             line, field));
-        continue;
-      }
-      m.geometry.parts.push_back(std::move(part));
-    }
-  }
-  if (!errors.empty()) return Error(errors.front().code, joinErrors(errors));
+  if (Status s = m.addCollisionGeometry(order, lines); !s.ok()) return s.error();
 
-  // Base footprint: the xy hull of base_link's shapes (boxes and discs projected).
-  Aabb fb;
-  for (const auto& p : m.geometry.parts) {
-    if (p.link != 0) continue;
-    fb.extend(p.shape.aabb(p.link_T_shape));
-  }
-  if (!fb.empty()) {
-    m.footprint = {{fb.min.x(), fb.min.y()},
-                   {fb.max.x(), fb.min.y()},
-                   {fb.max.x(), fb.max.y()},
-                   {fb.min.x(), fb.max.y()}};
-    m.base_radius = world::circumradius(m.footprint, Eigen::Vector2d::Zero());
-  }
-
-  // 6. Allowed self-collisions: rigid groups (fixed joints), adjacent groups, and pairs touching in
-  // the zero configuration with the gripper closed and open.
-  std::vector<int> group(m.links.size());
-  std::iota(group.begin(), group.end(), 0);
-  for (size_t i = 1; i < m.links.size(); ++i) {
-    if (m.joints[static_cast<size_t>(m.link_joint[i])].type == JointType::kFixed)
-      group[i] = group[static_cast<size_t>(m.link_parent[i])];
-  }
-  std::set<std::pair<int, int>> allowed;
-  auto allow = [&](int a, int b) {
-    if (a != b) allowed.insert({std::min(a, b), std::max(a, b)});
-  };
-  const int n = static_cast<int>(m.links.size());
-  for (int a = 0; a < n; ++a) {
-    for (int b = a + 1; b < n; ++b) {
-      if (group[static_cast<size_t>(a)] == group[static_cast<size_t>(b)]) allow(a, b);
-    }
-  }
-  // Adjacent groups: a group's root link hangs from a link of the other group.
-  for (int a = 1; a < n; ++a) {
-    const int root_a = group[static_cast<size_t>(a)];
-    if (root_a == 0) continue;  // the base's group has no parent
-    const int parent_group = group[static_cast<size_t>(m.link_parent[static_cast<size_t>(root_a)])];
-    for (int b = 0; b < n; ++b) {
-      if (group[static_cast<size_t>(b)] == parent_group) allow(a, b);
-    }
-  }
-  {
-    collision::Scene scene;
-    scene.setRobot(m.geometry);
-    RobotState s;
-    s.arm.assign(m.arm_joints.size(), 0.0);
-    for (size_t k = 0; k < s.arm.size(); ++k)
-      s.arm[k] = std::clamp(0.0, m.arm_limits[k].lower, m.arm_limits[k].upper);
-    std::vector<Eigen::Isometry3d> P;
-    const double g_hi =
-        m.gripper_joint >= 0 ? m.joints[static_cast<size_t>(m.gripper_joint)].limits.upper : 0.0;
-    const double g_lo =
-        m.gripper_joint >= 0 ? m.joints[static_cast<size_t>(m.gripper_joint)].limits.lower : 0.0;
-    for (double g : {g_lo, g_hi}) {
-      s.gripper = g;
-      m.poses(s, P);
-      scene.setLinkPoses(P);
-      for (const auto& [a, b] : scene.selfCollisions()) allow(index.at(a), index.at(b));
-    }
-  }
-  m.geometry.allowed_self_collisions.assign(allowed.begin(), allowed.end());
+  // 6. Allowed self-collisions.
+  m.allowSelfCollisions(index);
   return rm;
 }
 

@@ -293,61 +293,41 @@ Result<NamoWorld> parseNamoBareSvg(const std::string& svg_text, const std::strin
 // ---- JSON + SVG
 // ----------------------------------------------------------------------------------
 
-Result<NamoWorld> parseNamoJson(const std::string& json_text, const std::string& json_name,
-                                const std::string& svg_text, const std::string& svg_name,
-                                const NamoOptions& options) {
-  if (Status s = validateOptions(options); !s) return s.error();
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(json_text);
-  } catch (const nlohmann::json::parse_error& e) {
-    // Byte offset -> line and column.
-    const size_t upto = std::min<size_t>(e.byte > 0 ? e.byte - 1 : 0, json_text.size());
-    const int line = 1 + static_cast<int>(std::count(
-                             json_text.begin(), json_text.begin() + static_cast<long>(upto), '\n'));
-    const size_t nl = json_text.rfind('\n', upto == 0 ? 0 : upto - 1);
-    const int col = static_cast<int>(upto - (nl == std::string::npos ? 0 : nl + 1)) + 1;
-    std::string what = e.what();
-    const auto p = what.find("parse error");
-    if (p != std::string::npos) {
-      const auto colon = what.find(": ", what.find(": ", p) + 2);
-      if (colon != std::string::npos) what = what.substr(colon + 2);
-    }
-    return Error(ErrorCode::kParseError, "invalid JSON: " + what,
-                 SourceLocation{json_name, line, col, ""});
+namespace {
+
+/// nlohmann's parse error `e`, at its line and column of `json_text`.
+Error jsonParseError(const nlohmann::json::parse_error& e, const std::string& json_text,
+                     const std::string& json_name) {
+  // Byte offset -> line and column.
+  const size_t upto = std::min<size_t>(e.byte > 0 ? e.byte - 1 : 0, json_text.size());
+  const int line = 1 + static_cast<int>(std::count(
+                           json_text.begin(), json_text.begin() + static_cast<long>(upto), '\n'));
+  const size_t nl = json_text.rfind('\n', upto == 0 ? 0 : upto - 1);
+  const int col = static_cast<int>(upto - (nl == std::string::npos ? 0 : nl + 1)) + 1;
+  std::string what = e.what();
+  const auto p = what.find("parse error");
+  if (p != std::string::npos) {
+    const auto colon = what.find(": ", what.find(": ", p) + 2);
+    if (colon != std::string::npos) what = what.substr(colon + 2);
   }
-  JsonCtx cx{json_name, {}};
+  return Error(ErrorCode::kParseError, "invalid JSON: " + what,
+               SourceLocation{json_name, line, col, ""});
+}
+
+/// Several errors found in one pass as one: the first's code, every message.
+Error joinedErrors(const std::vector<Error>& errors) {
+  return errors.size() == 1 ? errors.front() : Error(errors.front().code, joinErrors(errors));
+}
+
+/// An element of `things.entities`.
+struct Entity {
+  std::string name, type, geom_id, orient_id, field;
+  std::vector<std::string> whitelist;
+};
+
+/// `things.entities`; errors in `cx`.
+std::vector<Entity> readEntities(JsonCtx& cx, const nlohmann::json* entities) {
   using VT = nlohmann::json::value_t;
-  double geometry_scale = 0;
-  if (auto* gs = cx.get(j, "geometry_scale", "", true, VT::number_float))
-    geometry_scale = gs->get<double>();
-  bool workaround = false;
-  if (auto* nw = cx.get(j, "no_scaling_workaround", "", false, VT::boolean))
-    workaround = nw->get<bool>();
-  const nlohmann::json* things = cx.get(j, "things", "", true, VT::object);
-  const nlohmann::json* entities =
-      things ? cx.get(*things, "entities", "things", true, VT::array) : nullptr;
-  if (!cx.errors.empty())
-    return cx.errors.size() == 1 ? cx.errors.front()
-                                 : Error(cx.errors.front().code, joinErrors(cx.errors));
-  if (!(geometry_scale > 0) || !std::isfinite(geometry_scale)) {
-    return Error(ErrorCode::kInvalidArgument, "must be positive, got " + num(geometry_scale),
-                 SourceLocation{json_name, 0, 0, "geometry_scale"});
-  }
-
-  svg::Options so;
-  so.curve_segments = options.curve_segments;
-  auto doc = svg::parse(svg_text, svg_name, so);
-  if (!doc) return doc.error();
-  std::map<std::string, const svg::Element*> by_id;
-  for (const auto& e : doc->elements) {
-    if (!e.id.empty()) by_id.emplace(e.id, &e);
-  }
-
-  struct Entity {
-    std::string name, type, geom_id, orient_id, field;
-    std::vector<std::string> whitelist;
-  };
   std::vector<Entity> ents;
   for (size_t i = 0; i < entities->size(); ++i) {
     const std::string path = "things.entities[" + std::to_string(i) + "]";
@@ -376,9 +356,141 @@ Result<NamoWorld> parseNamoJson(const std::string& json_text, const std::string&
     }
     ents.push_back(std::move(en));
   }
-  if (!cx.errors.empty())
-    return cx.errors.size() == 1 ? cx.errors.front()
-                                 : Error(cx.errors.front().code, joinErrors(cx.errors));
+  return ents;
+}
+
+/// Every entity but `robot` as an obstacle of `b` at scale `s`: another robot is static, the
+/// types on the robot's whitelist are movable.
+void addObstacles(Builder& b, const std::vector<Entity>& ents, const Entity* robot,
+                  const std::map<std::string, const svg::Element*>& by_id, double s,
+                  const std::string& json_name, const std::string& svg_name,
+                  const NamoOptions& options) {
+  const std::set<std::string> whitelist(robot->whitelist.begin(), robot->whitelist.end());
+  for (const auto& e : ents) {
+    if (&e == robot) continue;
+    auto it = by_id.find(e.geom_id);
+    if (it == by_id.end()) {
+      b.out.warnings.push_back(json_name + ": " + e.field + ": could not find geometry '" +
+                               e.geom_id + "' of '" + e.name + "' in " + svg_name + "; skipped");
+      continue;
+    }
+    const std::string where = svg_name + ":" + std::to_string(it->second->line);
+    if (e.type == "robot") {
+      b.out.warnings.push_back(json_name + ": " + e.field + ": other robot '" + e.name +
+                               "' becomes a static obstacle");
+      b.addObstacle(sanitiseId(e.name, "robot"), "robot (other agent)", ObjectKind::kStatic,
+                    toWorld(it->second->points, s), options.wall_height, where);
+      continue;
+    }
+    const bool movable = whitelist.count(e.type) != 0;
+    b.addObstacle(sanitiseId(e.name, "object"), e.type + " (svg " + e.geom_id + ")",
+                  movable ? ObjectKind::kMovable : ObjectKind::kStatic,
+                  toWorld(it->second->points, s), heightForType(e.type, options), where);
+  }
+}
+
+/// `things.zones.goals` at scale `s`: every goal for a single robot, else goal_k for robot_k;
+/// errors in `cx`.
+void addGoals(Builder& b, JsonCtx& cx, const nlohmann::json* things, const Entity* robot,
+              const std::vector<const Entity*>& robots,
+              const std::map<std::string, const svg::Element*>& by_id, double s,
+              const std::string& json_name) {
+  using VT = nlohmann::json::value_t;
+  std::string robot_suffix;
+  {
+    const auto us = robot->name.find_last_of('_');
+    if (us != std::string::npos) robot_suffix = robot->name.substr(us + 1);
+  }
+  const nlohmann::json* zones = cx.get(*things, "zones", "things", false, VT::object);
+  const nlohmann::json* goals =
+      zones ? cx.get(*zones, "goals", "things.zones", false, VT::array) : nullptr;
+  for (size_t i = 0; goals != nullptr && i < goals->size(); ++i) {
+    const std::string path = "things.zones.goals[" + std::to_string(i) + "]";
+    const nlohmann::json& g = (*goals)[i];
+    std::string gname, gid, orient;
+    if (!g.is_object()) {
+      cx.fail(path, "expected an object");
+      continue;
+    }
+    if (g.contains("name") && g["name"].is_string()) gname = g["name"].get<std::string>();
+    if (const nlohmann::json* geo = cx.get(g, "geometry", path, false, VT::object)) {
+      if (auto* v = cx.get(*geo, "id", path + ".geometry", true, VT::string))
+        gid = v->get<std::string>();
+      if (auto* v = cx.get(*geo, "orientation_id", path + ".geometry", false, VT::string))
+        orient = v->get<std::string>();
+    }
+    if (gname.empty()) gname = gid;
+    if (robots.size() > 1) {
+      const auto us = gname.find_last_of('_');
+      if (us == std::string::npos || gname.substr(us + 1) != robot_suffix) continue;
+    }
+    if (const nlohmann::json* pose = cx.get(g, "pose", path, false, VT::array)) {
+      if (pose->size() == 3 && (*pose)[0].is_number() && (*pose)[1].is_number() &&
+          (*pose)[2].is_number()) {
+        const Pose2D p{(*pose)[0].get<double>(), (*pose)[1].get<double>(),
+                       wrapAngle((*pose)[2].get<double>() * M_PI / 180.0)};
+        b.out.goals.push_back(NamoGoal{sanitiseId(gname, "goal"), p, true});
+        b.extent.extend(Eigen::Vector3d(p.x, p.y, 0));
+      } else {
+        cx.fail(path + ".pose", "expected [x, y, theta_degrees]");
+      }
+      continue;
+    }
+    auto git = by_id.find(gid);
+    if (gid.empty() || git == by_id.end()) {
+      b.out.warnings.push_back(json_name + ": " + path + ": goal '" + gname +
+                               "': no SVG element '" + gid + "'; skipped");
+      continue;
+    }
+    std::optional<double> gh;
+    if (!orient.empty()) {
+      auto oit = by_id.find(orient);
+      if (oit != by_id.end()) gh = headingOf(*oit->second, s);
+    }
+    b.addGoal(sanitiseId(gname, "goal"), toWorld(git->second->points, s), gh);
+  }
+}
+
+}  // namespace
+
+Result<NamoWorld> parseNamoJson(const std::string& json_text, const std::string& json_name,
+                                const std::string& svg_text, const std::string& svg_name,
+                                const NamoOptions& options) {
+  if (Status s = validateOptions(options); !s) return s.error();
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(json_text);
+  } catch (const nlohmann::json::parse_error& e) {
+    return jsonParseError(e, json_text, json_name);
+  }
+  JsonCtx cx{json_name, {}};
+  using VT = nlohmann::json::value_t;
+  double geometry_scale = 0;
+  if (auto* gs = cx.get(j, "geometry_scale", "", true, VT::number_float))
+    geometry_scale = gs->get<double>();
+  bool workaround = false;
+  if (auto* nw = cx.get(j, "no_scaling_workaround", "", false, VT::boolean))
+    workaround = nw->get<bool>();
+  const nlohmann::json* things = cx.get(j, "things", "", true, VT::object);
+  const nlohmann::json* entities =
+      things ? cx.get(*things, "entities", "things", true, VT::array) : nullptr;
+  if (!cx.errors.empty()) return joinedErrors(cx.errors);
+  if (!(geometry_scale > 0) || !std::isfinite(geometry_scale)) {
+    return Error(ErrorCode::kInvalidArgument, "must be positive, got " + num(geometry_scale),
+                 SourceLocation{json_name, 0, 0, "geometry_scale"});
+  }
+
+  svg::Options so;
+  so.curve_segments = options.curve_segments;
+  auto doc = svg::parse(svg_text, svg_name, so);
+  if (!doc) return doc.error();
+  std::map<std::string, const svg::Element*> by_id;
+  for (const auto& e : doc->elements) {
+    if (!e.id.empty()) by_id.emplace(e.id, &e);
+  }
+
+  const std::vector<Entity> ents = readEntities(cx, entities);
+  if (!cx.errors.empty()) return joinedErrors(cx.errors);
 
   // The robot.
   std::vector<const Entity*> robots;
@@ -434,86 +546,9 @@ Result<NamoWorld> parseNamoJson(const std::string& json_text, const std::string&
                                robot->orient_id + "' not found; heading 0");
   }
   b.setRobot(toWorld(robot_uv, s), heading);
-  const std::set<std::string> whitelist(robot->whitelist.begin(), robot->whitelist.end());
-  for (const auto& e : ents) {
-    if (&e == robot) continue;
-    auto it = by_id.find(e.geom_id);
-    if (it == by_id.end()) {
-      b.out.warnings.push_back(json_name + ": " + e.field + ": could not find geometry '" +
-                               e.geom_id + "' of '" + e.name + "' in " + svg_name + "; skipped");
-      continue;
-    }
-    const std::string where = svg_name + ":" + std::to_string(it->second->line);
-    if (e.type == "robot") {
-      b.out.warnings.push_back(json_name + ": " + e.field + ": other robot '" + e.name +
-                               "' becomes a static obstacle");
-      b.addObstacle(sanitiseId(e.name, "robot"), "robot (other agent)", ObjectKind::kStatic,
-                    toWorld(it->second->points, s), options.wall_height, where);
-      continue;
-    }
-    const bool movable = whitelist.count(e.type) != 0;
-    b.addObstacle(sanitiseId(e.name, "object"), e.type + " (svg " + e.geom_id + ")",
-                  movable ? ObjectKind::kMovable : ObjectKind::kStatic,
-                  toWorld(it->second->points, s), heightForType(e.type, options), where);
-  }
-
-  // Goals: every goal for a single robot, else goal_k for robot_k.
-  std::string robot_suffix;
-  {
-    const auto us = robot->name.find_last_of('_');
-    if (us != std::string::npos) robot_suffix = robot->name.substr(us + 1);
-  }
-  const nlohmann::json* zones = cx.get(*things, "zones", "things", false, VT::object);
-  const nlohmann::json* goals =
-      zones ? cx.get(*zones, "goals", "things.zones", false, VT::array) : nullptr;
-  for (size_t i = 0; goals != nullptr && i < goals->size(); ++i) {
-    const std::string path = "things.zones.goals[" + std::to_string(i) + "]";
-    const nlohmann::json& g = (*goals)[i];
-    std::string gname, gid, orient;
-    if (!g.is_object()) {
-      cx.fail(path, "expected an object");
-      continue;
-    }
-    if (g.contains("name") && g["name"].is_string()) gname = g["name"].get<std::string>();
-    if (const nlohmann::json* geo = cx.get(g, "geometry", path, false, VT::object)) {
-      if (auto* v = cx.get(*geo, "id", path + ".geometry", true, VT::string))
-        gid = v->get<std::string>();
-      if (auto* v = cx.get(*geo, "orientation_id", path + ".geometry", false, VT::string))
-        orient = v->get<std::string>();
-    }
-    if (gname.empty()) gname = gid;
-    if (robots.size() > 1) {
-      const auto us = gname.find_last_of('_');
-      if (us == std::string::npos || gname.substr(us + 1) != robot_suffix) continue;
-    }
-    if (const nlohmann::json* pose = cx.get(g, "pose", path, false, VT::array)) {
-      if (pose->size() == 3 && (*pose)[0].is_number() && (*pose)[1].is_number() &&
-          (*pose)[2].is_number()) {
-        const Pose2D p{(*pose)[0].get<double>(), (*pose)[1].get<double>(),
-                       wrapAngle((*pose)[2].get<double>() * M_PI / 180.0)};
-        b.out.goals.push_back(NamoGoal{sanitiseId(gname, "goal"), p, true});
-        b.extent.extend(Eigen::Vector3d(p.x, p.y, 0));
-      } else {
-        cx.fail(path + ".pose", "expected [x, y, theta_degrees]");
-      }
-      continue;
-    }
-    auto git = by_id.find(gid);
-    if (gid.empty() || git == by_id.end()) {
-      b.out.warnings.push_back(json_name + ": " + path + ": goal '" + gname +
-                               "': no SVG element '" + gid + "'; skipped");
-      continue;
-    }
-    std::optional<double> gh;
-    if (!orient.empty()) {
-      auto oit = by_id.find(orient);
-      if (oit != by_id.end()) gh = headingOf(*oit->second, s);
-    }
-    b.addGoal(sanitiseId(gname, "goal"), toWorld(git->second->points, s), gh);
-  }
-  if (!cx.errors.empty())
-    return cx.errors.size() == 1 ? cx.errors.front()
-                                 : Error(cx.errors.front().code, joinErrors(cx.errors));
+  addObstacles(b, ents, robot, by_id, s, json_name, svg_name, options);
+  addGoals(b, cx, things, robot, robots, by_id, s, json_name);
+  if (!cx.errors.empty()) return joinedErrors(cx.errors);
   if (b.out.goals.empty())
     b.out.warnings.push_back(json_name + ": no usable goal for robot '" + robot->name + "'");
   if (Status st = b.finish(); !st)

@@ -544,71 +544,40 @@ Result<Scenario> parseScenarioFile(const std::string& yaml_text, const std::stri
   }
 }
 
-Result<Scenario> parseScenarioImpl(const std::string& yaml_text, const std::string& file_name,
-                                   bool name_is_file_stem) {
-  auto doc = config::parseYaml(yaml_text, file_name);
-  if (!doc) return doc.error();
-  FieldReader r(*doc);
-  if (!r.isMap()) {
-    if (!r.ok()) return r.errors().front();
-    return Error(ErrorCode::kInvalidArgument,
-                 "a scenario is a mapping (name:, robot:, world:, goal:, ...)",
-                 SourceLocation{file_name, 1, 1, ""});
+/// `pddl:` (domain, problem, init); without it, the default domain.
+void readPddl(FieldReader& r, Scenario& sc) {
+  FieldReader p = r.child("pddl", false);
+  if (r.has("pddl")) {
+    if (auto d = readPath(p, "domain", true, true)) sc.domain = *d;
+    if (auto pr = readPath(p, "problem", false, true)) sc.problem = *pr;
+    p.optional("init", sc.pddl_init);
+    p.refuseUnknownKeys();
+  } else {
+    sc.domain = configDir() / "pddl" / "mobile_manipulation.pddl";
   }
-  Scenario sc;
-  sc.file = file_name;
-  if (r.required("name", sc.name)) {
-    if (!isValidId(sc.name)) {
-      r.fail("name", "'" + sc.name + "' is not a valid id");
-    } else if (const std::string stem = std::filesystem::path(file_name).stem().string();
-               name_is_file_stem && sc.name != stem) {
-      // Runs, reports and config/pddl/problems/<name>.pddl are named by `name`, files by their
-      // stem: two names for one scenario would make both ambiguous.
-      r.fail("name", "'" + sc.name + "' differs from the file name '" + stem +
-                         "' (a scenario file is named <name>.yaml)");
-    }
-  }
-  r.optional("description", sc.description);
+}
 
-  // ---- pddl ----
-  {
-    FieldReader p = r.child("pddl", false);
-    if (r.has("pddl")) {
-      if (auto d = readPath(p, "domain", true, true)) sc.domain = *d;
-      if (auto pr = readPath(p, "problem", false, true)) sc.problem = *pr;
-      p.optional("init", sc.pddl_init);
-      p.refuseUnknownKeys();
-    } else {
-      sc.domain = configDir() / "pddl" / "mobile_manipulation.pddl";
-    }
-  }
-
-  // ---- robot description (first: graspability follows its payload and gripper) ----
+/// The robot's description (`robot.description`, else the default robot), loaded: first, as
+/// graspability follows its payload and gripper. Nullopt when it cannot be (the error recorded).
+std::optional<robot::RobotModel> readRobotModel(FieldReader& rb, Scenario& sc) {
   std::optional<robot::RobotModel> model;
-  FieldReader rb = r.child("robot");
-  {
-    auto desc = rb.has("description") ? readPath(rb, "description", true, true)
-                                      : std::optional<std::filesystem::path>(
-                                            configDir() / "robots" / "mobile_manipulator.yaml");
-    rb.ignore("description");
-    if (desc) {
-      sc.robot.description = *desc;
-      auto m = robot::RobotModel::loadDescription(*desc);
-      if (!m)
-        rb.fail("description", m.error().toString());
-      else
-        model = std::move(m).value();
-    }
+  auto desc = rb.has("description") ? readPath(rb, "description", true, true)
+                                    : std::optional<std::filesystem::path>(
+                                          configDir() / "robots" / "mobile_manipulator.yaml");
+  rb.ignore("description");
+  if (desc) {
+    sc.robot.description = *desc;
+    auto m = robot::RobotModel::loadDescription(*desc);
+    if (!m)
+      rb.fail("description", m.error().toString());
+    else
+      model = std::move(m).value();
   }
-  std::optional<GraspLimits> grasp_limits;
-  if (model) {
-    grasp_limits = GraspLimits{model->payload(), model->maxGraspWidth(),
-                               sc.robot.description.string()};
-  }
-  const GraspLimits* limits = grasp_limits ? &*grasp_limits : nullptr;
+  return model;
+}
 
-  // ---- world ----
-  FieldReader w = r.child("world");
+/// `world.namo`: the world loaded from a NAMO file, with its `namo_options`.
+void readNamoWorld(FieldReader& w, Scenario& sc, const GraspLimits* limits) {
   if (w.has("namo")) {
     const NamoOptions nopt = readNamoOptions(w, limits);
     if (auto path = readPath(w, "namo", true, true); path && w.ok()) {
@@ -625,7 +594,10 @@ Result<Scenario> parseScenarioImpl(const std::string& yaml_text, const std::stri
     w.ignore("namo_options");
     if (w.has("namo_options")) w.fail("namo_options", "only valid together with 'namo'");
   }
-  sc.world.setName(sc.name);
+}
+
+/// `world.workspace`: [xmin, ymin, xmax, ymax].
+void readWorkspace(FieldReader& w, Scenario& sc) {
   if (w.has("workspace")) {
     std::vector<double> b;
     if (w.required("workspace", b)) {
@@ -641,64 +613,72 @@ Result<Scenario> parseScenarioImpl(const std::string& yaml_text, const std::stri
   } else {
     w.ignore("workspace");
   }
-  for (FieldReader& e : w.sequence("regions", false)) {
-    Region g;
-    bool ok = e.required("id", g.id);
-    e.optional("label", g.label);
-    std::string kind = "floor";
-    e.optional("kind", kind);
-    if (auto k = regionKindFromString(kind))
-      g.kind = *k;
-    else {
-      e.fail("kind", "expected floor or table, got '" + kind + "'");
-      ok = false;
-    }
-    if (e.has("rect") == e.has("polygon")) {
-      e.fail("", "give exactly one of 'rect' ([xmin, ymin, xmax, ymax]) or 'polygon'");
-      ok = false;
-      e.ignore("rect");
-      e.ignore("polygon");
-    } else if (e.has("rect")) {
-      std::vector<double> b;
-      if (e.required("rect", b) && b.size() == 4 && b[0] < b[2] && b[1] < b[3]) {
-        g.polygon = {{b[0], b[1]}, {b[2], b[1]}, {b[2], b[3]}, {b[0], b[3]}};
-      } else {
-        e.fail("rect", "expected [xmin, ymin, xmax, ymax] with min < max");
-        ok = false;
-      }
+}
+
+/// One element of `world.regions`, added to the world.
+void readRegion(FieldReader& e, Scenario& sc) {
+  Region g;
+  bool ok = e.required("id", g.id);
+  e.optional("label", g.label);
+  std::string kind = "floor";
+  e.optional("kind", kind);
+  if (auto k = regionKindFromString(kind))
+    g.kind = *k;
+  else {
+    e.fail("kind", "expected floor or table, got '" + kind + "'");
+    ok = false;
+  }
+  if (e.has("rect") == e.has("polygon")) {
+    e.fail("", "give exactly one of 'rect' ([xmin, ymin, xmax, ymax]) or 'polygon'");
+    ok = false;
+    e.ignore("rect");
+    e.ignore("polygon");
+  } else if (e.has("rect")) {
+    std::vector<double> b;
+    if (e.required("rect", b) && b.size() == 4 && b[0] < b[2] && b[1] < b[3]) {
+      g.polygon = {{b[0], b[1]}, {b[2], b[1]}, {b[2], b[3]}, {b[0], b[3]}};
     } else {
-      ok &= readPolygon(e, "polygon", g.polygon);
-      g.polygon = cleanPolygon(g.polygon);
+      e.fail("rect", "expected [xmin, ymin, xmax, ymax] with min < max");
+      ok = false;
     }
-    e.optional("height", g.height);
-    e.refuseUnknownKeys();
-    if (!ok) continue;
-    for (const auto& v : g.polygon) {
-      if (auto why = outsideWorkspace(sc.world.workspace(), v.x(), v.y())) {
-        e.fail(e.has("rect") ? "rect" : "polygon", "corner " + *why);
-        break;
-      }
-    }
-    if (auto why = sharedId(sc.world, g.id, "region")) {
-      e.fail("id", *why + " (regions, locations and objects are PDDL objects: one id each)");
-      continue;
-    }
-    if (Status s = sc.world.addRegion(g); !s) e.fail("id", s.error().message);
+  } else {
+    ok &= readPolygon(e, "polygon", g.polygon);
+    g.polygon = cleanPolygon(g.polygon);
   }
-  for (FieldReader& e : w.sequence("locations", false)) {
-    Location l;
-    const bool ok = e.required("id", l.id) & e.required("pose", l.pose);
-    e.optional("label", l.label);
-    e.refuseUnknownKeys();
-    if (!ok) continue;
-    if (auto why = outsideWorkspace(sc.world.workspace(), l.pose.x, l.pose.y)) e.fail("pose", *why);
-    if (auto why = sharedId(sc.world, l.id, "location")) {
-      e.fail("id", *why + " (regions, locations and objects are PDDL objects: one id each)");
-      continue;
+  e.optional("height", g.height);
+  e.refuseUnknownKeys();
+  if (!ok) return;
+  for (const auto& v : g.polygon) {
+    if (auto why = outsideWorkspace(sc.world.workspace(), v.x(), v.y())) {
+      e.fail(e.has("rect") ? "rect" : "polygon", "corner " + *why);
+      break;
     }
-    if (Status s = sc.world.addLocation(l); !s) e.fail("id", s.error().message);
   }
-  // Objects; the held one may omit its pose (it follows the gripper).
+  if (auto why = sharedId(sc.world, g.id, "region")) {
+    e.fail("id", *why + " (regions, locations and objects are PDDL objects: one id each)");
+    return;
+  }
+  if (Status s = sc.world.addRegion(g); !s) e.fail("id", s.error().message);
+}
+
+/// One element of `world.locations`, added to the world.
+void readLocation(FieldReader& e, Scenario& sc) {
+  Location l;
+  const bool ok = e.required("id", l.id) & e.required("pose", l.pose);
+  e.optional("label", l.label);
+  e.refuseUnknownKeys();
+  if (!ok) return;
+  if (auto why = outsideWorkspace(sc.world.workspace(), l.pose.x, l.pose.y)) e.fail("pose", *why);
+  if (auto why = sharedId(sc.world, l.id, "location")) {
+    e.fail("id", *why + " (regions, locations and objects are PDDL objects: one id each)");
+    return;
+  }
+  if (Status s = sc.world.addLocation(l); !s) e.fail("id", s.error().message);
+}
+
+/// The id of the object held at the start (`robot.holding.object`), read before the objects:
+/// that one may omit its pose (it follows the gripper). Empty when none.
+std::string heldObjectId(const FieldReader& r) {
   std::string held_id;
   // (Indexing a missing key gives an invalid node: test IsDefined() before anything else.)
   if (const YAML::Node rn = valueOf(r, "robot"); rn.IsDefined() && rn.IsMap()) {
@@ -707,6 +687,12 @@ Result<Scenario> parseScenarioImpl(const std::string& yaml_text, const std::stri
         held_id = on.Scalar();
     }
   }
+  return held_id;
+}
+
+/// `world.objects` and `world.hidden_objects`, added to the world.
+void readObjects(FieldReader& w, Scenario& sc, const GraspLimits* limits,
+                 const std::string& held_id) {
   for (const char* list : {"objects", "hidden_objects"}) {
     const bool hidden = std::string_view(list) == "hidden_objects";
     for (FieldReader& e : w.sequence(list, false)) {
@@ -732,219 +718,344 @@ Result<Scenario> parseScenarioImpl(const std::string& yaml_text, const std::stri
       if (Status s = sc.world.addObject(*o); !s) e.fail("id", s.error().message);
     }
   }
+}
+
+/// `robot.start`: a location id or a pose (then location "start" is added).
+void readStart(FieldReader& rb, Scenario& sc) {
+  rb.ignore("start");
+  const YAML::Node st = valueOf(rb, "start");
+  if (!st.IsDefined()) {
+    if (sc.world.findLocation("start") != nullptr) {
+      sc.robot.start_location = "start";
+      sc.robot.start = sc.world.findLocation("start")->pose;
+    } else {
+      rb.fail("start", "missing required field (a location id or [x, y, theta])");
+    }
+  } else if (st.IsScalar()) {
+    const Location* l = sc.world.findLocation(st.Scalar());
+    if (l == nullptr)
+      rb.fail("start", "unknown location '" + st.Scalar() + "'");
+    else {
+      sc.robot.start_location = l->id;
+      sc.robot.start = l->pose;
+    }
+  } else if (rb.required("start", sc.robot.start)) {
+    if (auto why = outsideWorkspace(sc.world.workspace(), sc.robot.start.x, sc.robot.start.y))
+      rb.fail("start", *why);
+    sc.robot.start_location = "start";
+    const Location* l = sc.world.findLocation("start");
+    if (l == nullptr)
+      (void)sc.world.addLocation(Location{"start", "robot start", sc.robot.start});
+    else if (!(l->pose == sc.robot.start))
+      rb.fail("start", "differs from location 'start'; name the location instead");
+  }
+}
+
+/// `robot.arm`: a named configuration or joint values.
+void readArm(FieldReader& rb, Scenario& sc, const std::optional<robot::RobotModel>& model) {
+  rb.ignore("arm");
+  const YAML::Node arm = valueOf(rb, "arm");
+  if (model) {
+    if (!arm.IsDefined() || arm.IsScalar()) {
+      const std::string name = arm.IsDefined() ? arm.Scalar() : "stow";
+      if (auto q = model->namedConfiguration(name)) {
+        sc.robot.arm = *q;
+        sc.robot.arm_configuration = name;
+      } else {
+        std::string names;
+        for (const auto& n : model->namedConfigurationNames())
+          names += (names.empty() ? "" : ", ") + n;
+        rb.fail("arm", "unknown arm configuration '" + name + "' (robot has: " + names + ")");
+      }
+    } else if (rb.required("arm", sc.robot.arm)) {
+      if (sc.robot.arm.size() != model->armDof()) {
+        rb.fail("arm", "expected " + std::to_string(model->armDof()) + " joint values, got " +
+                           std::to_string(sc.robot.arm.size()));
+      } else if (!model->withinLimits(sc.robot.arm)) {
+        for (size_t k = 0; k < sc.robot.arm.size(); ++k) {
+          const auto& lim = model->armLimits()[k];
+          if (sc.robot.arm[k] < lim.lower || sc.robot.arm[k] > lim.upper) {
+            rb.fail("arm", model->armJointNames()[k] + " = " + num(sc.robot.arm[k]) +
+                               " is outside its limits [" + num(lim.lower) + ", " + num(lim.upper) +
+                               "]");
+          }
+        }
+      }
+    }
+  }
+}
+
+/// `robot.gripper`: open | closed | metres.
+void readGripper(FieldReader& rb, Scenario& sc, const std::optional<robot::RobotModel>& model) {
+  rb.ignore("gripper");
+  const YAML::Node g = valueOf(rb, "gripper");
+  if (model) {
+    sc.robot.gripper = model->options().gripper_closed;
+    if (g.IsDefined()) {
+      double v = 0;
+      std::string why;
+      if (g.IsScalar() && g.Scalar() == "open")
+        sc.robot.gripper = model->options().gripper_open;
+      else if (g.IsScalar() && g.Scalar() == "closed")
+        sc.robot.gripper = model->options().gripper_closed;
+      else if (config::convert(g, v, why) && v >= model->gripperLimits().lower &&
+               v <= model->gripperLimits().upper) {
+        sc.robot.gripper = v;
+      } else {
+        rb.fail("gripper", "expected open, closed or a value in [" +
+                               num(model->gripperLimits().lower) + ", " +
+                               num(model->gripperLimits().upper) + "] m");
+      }
+    }
+  }
+}
+
+/// `robot.holding`: the object in the gripper at the start (placed by placeHeldObject).
+void readHolding(FieldReader& rb) {
+  if (rb.has("holding")) {
+    FieldReader h = rb.child("holding");
+    std::string id;
+    Eigen::Isometry3d grasp = Eigen::Isometry3d::Identity();
+    h.required("object", id);
+    if (h.has("grasp"))
+      readPose3(h, "grasp", grasp);
+    else
+      h.ignore("grasp");
+    h.refuseUnknownKeys();
+  } else {
+    rb.ignore("holding");
+  }
+}
+
+/// `goal.base`: a location id or a pose (then location "goal" is added).
+void readGoalBase(FieldReader& g, Scenario& sc) {
+  g.ignore("base");
+  const YAML::Node b = valueOf(g, "base");
+  if (b.IsDefined()) {
+    if (b.IsScalar()) {
+      const Location* l = sc.world.findLocation(b.Scalar());
+      if (l == nullptr)
+        g.fail("base", "unknown location '" + b.Scalar() + "'");
+      else {
+        sc.goal.base = l->pose;
+        sc.goal.base_location = l->id;
+      }
+    } else {
+      Pose2D p;
+      if (g.required("base", p)) {
+        if (auto why = outsideWorkspace(sc.world.workspace(), p.x, p.y)) g.fail("base", *why);
+        sc.goal.base = p;
+        const Location* l = sc.world.findLocation("goal");
+        if (l == nullptr) {
+          (void)sc.world.addLocation(Location{"goal", "goal base pose", p});
+          sc.goal.base_location = "goal";
+        } else if (l->pose == p) {
+          sc.goal.base_location = "goal";
+        } else {
+          g.fail("base", "differs from location 'goal'; name the location instead");
+        }
+      }
+    }
+  }
+}
+
+/// `goal:` (pddl atoms, base, tolerances, objects in regions).
+void readGoal(FieldReader& r, Scenario& sc) {
+  FieldReader g = r.child("goal");
+  g.optional("pddl", sc.goal.pddl);
+  readGoalBase(g, sc);
+  g.optional("position_tolerance", sc.goal.position_tolerance);
+  g.optional("angle_tolerance", sc.goal.angle_tolerance);
+  if (!positive(sc.goal.position_tolerance)) g.fail("position_tolerance", "must be positive");
+  if (!positive(sc.goal.angle_tolerance)) g.fail("angle_tolerance", "must be positive");
+  for (FieldReader& e : g.sequence("objects_in_regions", false)) {
+    std::string o, rg;
+    if (e.required("object", o) & e.required("region", rg)) {
+      const Object* obj = sc.world.findObject(o);
+      if (obj == nullptr || obj->hidden || obj->kind != ObjectKind::kMovable) {
+        e.fail("object", "'" + o + "' is not a movable object known to the planner");
+      }
+      if (sc.world.findRegion(rg) == nullptr) e.fail("region", "unknown region '" + rg + "'");
+      sc.goal.object_in_region.emplace_back(o, rg);
+    }
+    e.refuseUnknownKeys();
+  }
+  g.refuseUnknownKeys();
+}
+
+/// One element of `faults`.
+Fault readFault(FieldReader& f, const Scenario& sc, const GraspLimits* limits) {
+  Fault fault;
+  std::string type;
+  if (f.required("type", type)) {
+    if (type == "drop_held")
+      fault.kind = FaultKind::kDropHeld;
+    else if (type == "object_appears")
+      fault.kind = FaultKind::kObjectAppears;
+    else if (type == "action_fails")
+      fault.kind = FaultKind::kActionFails;
+    else
+      f.fail("type",
+             "unknown fault '" + type + "' (expected drop_held, object_appears or action_fails)");
+  }
+  double t = 0;
+  int step = 0;
+  if (f.optional("at_time", t)) {
+    fault.at_time = t;
+    if (!(t >= 0)) f.fail("at_time", "must be >= 0 s, got " + num(t));
+  }
+  if (f.optional("at_step", step)) {
+    fault.at_step = step;
+    if (step < 0) f.fail("at_step", "must be >= 0, got " + std::to_string(step));
+  }
+  if (fault.at_time.has_value() == fault.at_step.has_value())
+    f.fail("", "give exactly one of 'at_time' (s) or 'at_step'");
+  f.optional("reason", fault.reason);
+  if (fault.kind == FaultKind::kObjectAppears) {
+    FieldReader o = f.child("object");
+    if (o.isMap()) {
+      fault.object = readObject(o, sc.world, false, limits);
+      if (fault.object && sc.world.findObject(fault.object->id) != nullptr) {
+        o.fail("id", "'" + fault.object->id + "' already exists in the world");
+      } else if (fault.object) {
+        if (auto why = sharedId(sc.world, fault.object->id, "object"))
+          o.fail("id", *why + " (regions, locations and objects are PDDL objects: one id each)");
+        const auto xy = fault.object->pose.translation();
+        if (auto why = outsideWorkspace(sc.world.workspace(), xy.x(), xy.y()))
+          o.fail(o.has("pose") ? "pose" : "at", *why);
+      }
+    }
+  } else {
+    f.ignore("object");
+    if (f.has("object")) f.fail("object", "only for object_appears");
+  }
+  const bool filtered = fault.kind == FaultKind::kActionFails || fault.kind == FaultKind::kDropHeld;
+  if (f.optional("action", fault.action) && filtered) {
+    if (!actionKindFromString(fault.action)) {
+      f.fail("action",
+             "unknown action '" + fault.action + "' (expected move_base, move_arm, pick or place)");
+    } else if (fault.kind == FaultKind::kDropHeld && !fault.at_step) {
+      f.fail("action", "a drop waits for an action of a kind only with at_step");
+    }
+  } else if (!fault.action.empty()) {
+    f.fail("action", "only for action_fails and drop_held");
+  }
+  f.refuseUnknownKeys();
+  return fault;
+}
+
+/// The held object (`robot.holding`): its pose from the grasp at the start state.
+void placeHeldObject(FieldReader& rb, Scenario& sc, const std::optional<robot::RobotModel>& model) {
+  FieldReader h = rb.child("holding");
+  std::string id;
+  h.required("object", id);
+  Eigen::Isometry3d grasp = Eigen::Isometry3d::Identity();
+  if (h.has("grasp")) readPose3(h, "grasp", grasp);
+  const Object* o = sc.world.findObject(id);
+  if (o == nullptr) {
+    h.fail("object", "unknown object '" + id + "'");
+  } else if (o->kind != ObjectKind::kMovable || !o->graspable) {
+    h.fail("object", "object '" + id + "' must be movable and graspable");
+  } else {
+    Object held = *o;
+    held.pose = model->toolPoseInWorld(sc.startState()) * grasp;
+    held.region.clear();
+    (void)sc.world.updateObject(held);
+    if (Status s = sc.world.setHeld(HeldObject{id, model->options().tool_link, grasp}); !s) {
+      h.fail("object", s.error().message);
+    }
+  }
+}
+
+/// The goal's and the initial state's atoms, over the planner's world.
+void checkAtoms(FieldReader& r, Scenario& sc) {
+  const World planner = sc.world.plannerView();
+  FieldReader g = r.child("goal");
+  for (size_t i = 0; i < sc.goal.pddl.size(); ++i) {
+    if (auto why = checkAtom(sc.goal.pddl[i], planner)) g.failAt("pddl", i, *why);
+  }
+  FieldReader p = r.child("pddl", false);
+  for (size_t i = 0; i < sc.pddl_init.size(); ++i) {
+    if (auto why = checkAtom(sc.pddl_init[i], planner)) p.failAt("init", i, *why);
+  }
+  if (sc.goal.empty()) g.fail("", "needs at least one of pddl, base, objects_in_regions");
+}
+
+/// The robot's start should be free: a warning otherwise (NAMO worlds at native scale may be
+/// tight).
+void warnStartInContact(Scenario& sc, const std::optional<robot::RobotModel>& model,
+                        const std::string& file_name) {
+  collision::Scene scene(sc.world);
+  scene.setRobot(model->collisionGeometry());
+  std::vector<Eigen::Isometry3d> poses;
+  model->linkPoses(sc.startState(), poses);
+  scene.setLinkPoses(poses);
+  (void)scene.attachHeld();
+  const auto hits = scene.robotCollisions();
+  if (!hits.empty()) {
+    std::string list;
+    for (const auto& h : hits) list += (list.empty() ? "" : ", ") + h;
+    sc.warnings.push_back(file_name + ": field 'robot.start': the robot starts in contact with " +
+                          list);
+  }
+}
+
+Result<Scenario> parseScenarioImpl(const std::string& yaml_text, const std::string& file_name,
+                                   bool name_is_file_stem) {
+  auto doc = config::parseYaml(yaml_text, file_name);
+  if (!doc) return doc.error();
+  FieldReader r(*doc);
+  if (!r.isMap()) {
+    if (!r.ok()) return r.errors().front();
+    return Error(ErrorCode::kInvalidArgument,
+                 "a scenario is a mapping (name:, robot:, world:, goal:, ...)",
+                 SourceLocation{file_name, 1, 1, ""});
+  }
+  Scenario sc;
+  sc.file = file_name;
+  if (r.required("name", sc.name)) {
+    if (!isValidId(sc.name)) {
+      r.fail("name", "'" + sc.name + "' is not a valid id");
+    } else if (const std::string stem = std::filesystem::path(file_name).stem().string();
+               name_is_file_stem && sc.name != stem) {
+      // Runs, reports and config/pddl/problems/<name>.pddl are named by `name`, files by their
+      // stem: two names for one scenario would make both ambiguous.
+      r.fail("name", "'" + sc.name + "' differs from the file name '" + stem +
+                         "' (a scenario file is named <name>.yaml)");
+    }
+  }
+  r.optional("description", sc.description);
+  readPddl(r, sc);
+
+  // ---- robot description (first: graspability follows its payload and gripper) ----
+  FieldReader rb = r.child("robot");
+  const std::optional<robot::RobotModel> model = readRobotModel(rb, sc);
+  std::optional<GraspLimits> grasp_limits;
+  if (model) {
+    grasp_limits =
+        GraspLimits{model->payload(), model->maxGraspWidth(), sc.robot.description.string()};
+  }
+  const GraspLimits* limits = grasp_limits ? &*grasp_limits : nullptr;
+
+  // ---- world ----
+  FieldReader w = r.child("world");
+  readNamoWorld(w, sc, limits);
+  sc.world.setName(sc.name);
+  readWorkspace(w, sc);
+  for (FieldReader& e : w.sequence("regions", false)) readRegion(e, sc);
+  for (FieldReader& e : w.sequence("locations", false)) readLocation(e, sc);
+  readObjects(w, sc, limits, heldObjectId(r));
   w.refuseUnknownKeys();
 
   // ---- robot ----
-  {
-    // start: a location id or a pose (then location "start" is added)
-    rb.ignore("start");
-    const YAML::Node st = valueOf(rb, "start");
-    if (!st.IsDefined()) {
-      if (sc.world.findLocation("start") != nullptr) {
-        sc.robot.start_location = "start";
-        sc.robot.start = sc.world.findLocation("start")->pose;
-      } else {
-        rb.fail("start", "missing required field (a location id or [x, y, theta])");
-      }
-    } else if (st.IsScalar()) {
-      const Location* l = sc.world.findLocation(st.Scalar());
-      if (l == nullptr)
-        rb.fail("start", "unknown location '" + st.Scalar() + "'");
-      else {
-        sc.robot.start_location = l->id;
-        sc.robot.start = l->pose;
-      }
-    } else if (rb.required("start", sc.robot.start)) {
-      if (auto why = outsideWorkspace(sc.world.workspace(), sc.robot.start.x, sc.robot.start.y))
-        rb.fail("start", *why);
-      sc.robot.start_location = "start";
-      const Location* l = sc.world.findLocation("start");
-      if (l == nullptr)
-        (void)sc.world.addLocation(Location{"start", "robot start", sc.robot.start});
-      else if (!(l->pose == sc.robot.start))
-        rb.fail("start", "differs from location 'start'; name the location instead");
-    }
-    // arm: a named configuration or joint values
-    rb.ignore("arm");
-    const YAML::Node arm = valueOf(rb, "arm");
-    if (model) {
-      if (!arm.IsDefined() || arm.IsScalar()) {
-        const std::string name = arm.IsDefined() ? arm.Scalar() : "stow";
-        if (auto q = model->namedConfiguration(name)) {
-          sc.robot.arm = *q;
-          sc.robot.arm_configuration = name;
-        } else {
-          std::string names;
-          for (const auto& n : model->namedConfigurationNames())
-            names += (names.empty() ? "" : ", ") + n;
-          rb.fail("arm", "unknown arm configuration '" + name + "' (robot has: " + names + ")");
-        }
-      } else if (rb.required("arm", sc.robot.arm)) {
-        if (sc.robot.arm.size() != model->armDof()) {
-          rb.fail("arm", "expected " + std::to_string(model->armDof()) + " joint values, got " +
-                             std::to_string(sc.robot.arm.size()));
-        } else if (!model->withinLimits(sc.robot.arm)) {
-          for (size_t k = 0; k < sc.robot.arm.size(); ++k) {
-            const auto& lim = model->armLimits()[k];
-            if (sc.robot.arm[k] < lim.lower || sc.robot.arm[k] > lim.upper) {
-              rb.fail("arm", model->armJointNames()[k] + " = " + num(sc.robot.arm[k]) +
-                                 " is outside its limits [" + num(lim.lower) + ", " +
-                                 num(lim.upper) + "]");
-            }
-          }
-        }
-      }
-    }
-    // gripper: open | closed | metres
-    rb.ignore("gripper");
-    const YAML::Node g = valueOf(rb, "gripper");
-    if (model) {
-      sc.robot.gripper = model->options().gripper_closed;
-      if (g.IsDefined()) {
-        double v = 0;
-        std::string why;
-        if (g.IsScalar() && g.Scalar() == "open")
-          sc.robot.gripper = model->options().gripper_open;
-        else if (g.IsScalar() && g.Scalar() == "closed")
-          sc.robot.gripper = model->options().gripper_closed;
-        else if (config::convert(g, v, why) && v >= model->gripperLimits().lower &&
-                 v <= model->gripperLimits().upper) {
-          sc.robot.gripper = v;
-        } else {
-          rb.fail("gripper", "expected open, closed or a value in [" +
-                                 num(model->gripperLimits().lower) + ", " +
-                                 num(model->gripperLimits().upper) + "] m");
-        }
-      }
-    }
-    // holding: the object in the gripper at the start
-    if (rb.has("holding")) {
-      FieldReader h = rb.child("holding");
-      std::string id;
-      Eigen::Isometry3d grasp = Eigen::Isometry3d::Identity();
-      h.required("object", id);
-      if (h.has("grasp"))
-        readPose3(h, "grasp", grasp);
-      else
-        h.ignore("grasp");
-      h.refuseUnknownKeys();
-    } else {
-      rb.ignore("holding");
-    }
-    rb.refuseUnknownKeys();
-  }
+  readStart(rb, sc);
+  readArm(rb, sc, model);
+  readGripper(rb, sc, model);
+  readHolding(rb);
+  rb.refuseUnknownKeys();
 
-  // ---- goal ----
-  {
-    FieldReader g = r.child("goal");
-    g.optional("pddl", sc.goal.pddl);
-    g.ignore("base");
-    const YAML::Node b = valueOf(g, "base");
-    if (b.IsDefined()) {
-      if (b.IsScalar()) {
-        const Location* l = sc.world.findLocation(b.Scalar());
-        if (l == nullptr)
-          g.fail("base", "unknown location '" + b.Scalar() + "'");
-        else {
-          sc.goal.base = l->pose;
-          sc.goal.base_location = l->id;
-        }
-      } else {
-        Pose2D p;
-        if (g.required("base", p)) {
-          if (auto why = outsideWorkspace(sc.world.workspace(), p.x, p.y)) g.fail("base", *why);
-          sc.goal.base = p;
-          const Location* l = sc.world.findLocation("goal");
-          if (l == nullptr) {
-            (void)sc.world.addLocation(Location{"goal", "goal base pose", p});
-            sc.goal.base_location = "goal";
-          } else if (l->pose == p) {
-            sc.goal.base_location = "goal";
-          } else {
-            g.fail("base", "differs from location 'goal'; name the location instead");
-          }
-        }
-      }
-    }
-    g.optional("position_tolerance", sc.goal.position_tolerance);
-    g.optional("angle_tolerance", sc.goal.angle_tolerance);
-    if (!positive(sc.goal.position_tolerance)) g.fail("position_tolerance", "must be positive");
-    if (!positive(sc.goal.angle_tolerance)) g.fail("angle_tolerance", "must be positive");
-    for (FieldReader& e : g.sequence("objects_in_regions", false)) {
-      std::string o, rg;
-      if (e.required("object", o) & e.required("region", rg)) {
-        const Object* obj = sc.world.findObject(o);
-        if (obj == nullptr || obj->hidden || obj->kind != ObjectKind::kMovable) {
-          e.fail("object", "'" + o + "' is not a movable object known to the planner");
-        }
-        if (sc.world.findRegion(rg) == nullptr) e.fail("region", "unknown region '" + rg + "'");
-        sc.goal.object_in_region.emplace_back(o, rg);
-      }
-      e.refuseUnknownKeys();
-    }
-    g.refuseUnknownKeys();
-  }
-
-  // ---- faults ----
-  for (FieldReader& f : r.sequence("faults", false)) {
-    Fault fault;
-    std::string type;
-    if (f.required("type", type)) {
-      if (type == "drop_held")
-        fault.kind = FaultKind::kDropHeld;
-      else if (type == "object_appears")
-        fault.kind = FaultKind::kObjectAppears;
-      else if (type == "action_fails")
-        fault.kind = FaultKind::kActionFails;
-      else
-        f.fail("type",
-               "unknown fault '" + type + "' (expected drop_held, object_appears or action_fails)");
-    }
-    double t = 0;
-    int step = 0;
-    if (f.optional("at_time", t)) {
-      fault.at_time = t;
-      if (!(t >= 0)) f.fail("at_time", "must be >= 0 s, got " + num(t));
-    }
-    if (f.optional("at_step", step)) {
-      fault.at_step = step;
-      if (step < 0) f.fail("at_step", "must be >= 0, got " + std::to_string(step));
-    }
-    if (fault.at_time.has_value() == fault.at_step.has_value())
-      f.fail("", "give exactly one of 'at_time' (s) or 'at_step'");
-    f.optional("reason", fault.reason);
-    if (fault.kind == FaultKind::kObjectAppears) {
-      FieldReader o = f.child("object");
-      if (o.isMap()) {
-        fault.object = readObject(o, sc.world, false, limits);
-        if (fault.object && sc.world.findObject(fault.object->id) != nullptr) {
-          o.fail("id", "'" + fault.object->id + "' already exists in the world");
-        } else if (fault.object) {
-          if (auto why = sharedId(sc.world, fault.object->id, "object"))
-            o.fail("id", *why + " (regions, locations and objects are PDDL objects: one id each)");
-          const auto xy = fault.object->pose.translation();
-          if (auto why = outsideWorkspace(sc.world.workspace(), xy.x(), xy.y()))
-            o.fail(o.has("pose") ? "pose" : "at", *why);
-        }
-      }
-    } else {
-      f.ignore("object");
-      if (f.has("object")) f.fail("object", "only for object_appears");
-    }
-    const bool filtered = fault.kind == FaultKind::kActionFails || fault.kind == FaultKind::kDropHeld;
-    if (f.optional("action", fault.action) && filtered) {
-      if (!actionKindFromString(fault.action)) {
-        f.fail("action", "unknown action '" + fault.action +
-                             "' (expected move_base, move_arm, pick or place)");
-      } else if (fault.kind == FaultKind::kDropHeld && !fault.at_step) {
-        f.fail("action", "a drop waits for an action of a kind only with at_step");
-      }
-    } else if (!fault.action.empty()) {
-      f.fail("action", "only for action_fails and drop_held");
-    }
-    f.refuseUnknownKeys();
-    sc.faults.push_back(std::move(fault));
-  }
+  readGoal(r, sc);
+  for (FieldReader& f : r.sequence("faults", false)) sc.faults.push_back(readFault(f, sc, limits));
 
   readSim(r, sc.sim);
   readPerception(r, sc.perception);
@@ -952,53 +1063,9 @@ Result<Scenario> parseScenarioImpl(const std::string& yaml_text, const std::stri
 
   // ---- cross-checks that need the whole file ----
   if (r.ok() && model) {
-    // The held object: pose from the grasp at the start state.
-    if (rb.has("holding")) {
-      FieldReader h = rb.child("holding");
-      std::string id;
-      h.required("object", id);
-      Eigen::Isometry3d grasp = Eigen::Isometry3d::Identity();
-      if (h.has("grasp")) readPose3(h, "grasp", grasp);
-      const Object* o = sc.world.findObject(id);
-      if (o == nullptr) {
-        h.fail("object", "unknown object '" + id + "'");
-      } else if (o->kind != ObjectKind::kMovable || !o->graspable) {
-        h.fail("object", "object '" + id + "' must be movable and graspable");
-      } else {
-        Object held = *o;
-        held.pose = model->toolPoseInWorld(sc.startState()) * grasp;
-        held.region.clear();
-        (void)sc.world.updateObject(held);
-        if (Status s = sc.world.setHeld(HeldObject{id, model->options().tool_link, grasp}); !s) {
-          h.fail("object", s.error().message);
-        }
-      }
-    }
-    // Goal atoms over the planner's world.
-    const World planner = sc.world.plannerView();
-    FieldReader g = r.child("goal");
-    for (size_t i = 0; i < sc.goal.pddl.size(); ++i) {
-      if (auto why = checkAtom(sc.goal.pddl[i], planner)) g.failAt("pddl", i, *why);
-    }
-    FieldReader p = r.child("pddl", false);
-    for (size_t i = 0; i < sc.pddl_init.size(); ++i) {
-      if (auto why = checkAtom(sc.pddl_init[i], planner)) p.failAt("init", i, *why);
-    }
-    if (sc.goal.empty()) g.fail("", "needs at least one of pddl, base, objects_in_regions");
-    // The robot's start should be free (a warning: NAMO worlds at native scale may be tight).
-    collision::Scene scene(sc.world);
-    scene.setRobot(model->collisionGeometry());
-    std::vector<Eigen::Isometry3d> poses;
-    model->linkPoses(sc.startState(), poses);
-    scene.setLinkPoses(poses);
-    (void)scene.attachHeld();
-    const auto hits = scene.robotCollisions();
-    if (!hits.empty()) {
-      std::string list;
-      for (const auto& h : hits) list += (list.empty() ? "" : ", ") + h;
-      sc.warnings.push_back(file_name + ": field 'robot.start': the robot starts in contact with " +
-                            list);
-    }
+    if (rb.has("holding")) placeHeldObject(rb, sc, model);
+    checkAtoms(r, sc);
+    warnStartInContact(sc, model, file_name);
   }
   if (!r.ok()) return r.errors().size() == 1 ? r.errors().front() : r.status().error();
   return sc;

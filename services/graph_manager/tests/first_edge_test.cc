@@ -8,6 +8,7 @@
 #include <deque>
 #include <functional>
 #include <map>
+#include <optional>
 
 #include <gtest/gtest.h>
 
@@ -557,30 +558,67 @@ class DrivingExecutor : public Executor {
   int failed_{0};
 };
 
+/// The graph manager's parameters in the mission tests below: no contingencies, motions asked one
+/// after the other.
+GraphManagerParams sequentialMissionParams() {
+  GraphManagerParams params;
+  params.max_contingencies = 0;
+  params.concurrent_motions = false;
+  return params;
+}
+
+/// Sets `source` to the world model `live` at `version`, with the robot stowed at `sc`'s start.
+void placeRobotAtStart(VersionedWorld& source, world::World live, std::uint64_t version,
+                       const world::Scenario& sc, const robot::RobotModel& robot) {
+  source.live = std::move(live);
+  source.at_version = version;
+  source.robot_now.valid = true;
+  source.robot_now.robot.base = sc.robot.start;
+  source.robot_now.robot.arm = *robot.namedConfiguration("stow");
+}
+
+/// Mission tests on namo_corridor: its scenario and robot, loaded once per test.
+class CorridorMissionTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    auto sc = world::loadScenario(configDir() / "scenarios" / "namo_corridor.yaml");
+    ASSERT_TRUE(sc.ok()) << sc.error().toString();
+    auto robot = robot::RobotModel::loadDescription(sc->robot.description);
+    ASSERT_TRUE(robot.ok());
+    scenario_.emplace(std::move(*sc));
+    robot_.emplace(std::move(*robot));
+  }
+
+  /// A graph manager from start to goal in the planner's world over `services`
+  /// (sequentialMissionParams).
+  GraphManager corridorManager(ScriptedServices& services) const {
+    return GraphManager(Abstraction(scenario_->plannerWorld(), *robot_), "",
+                        MissionGoal{{"(robot-at goal)"}}, services, sequentialMissionParams());
+  }
+
+  /// `source` at `version` of the planner's world, the robot stowed at the start.
+  void atStart(VersionedWorld& source, std::uint64_t version) const {
+    placeRobotAtStart(source, scenario_->plannerWorld(), version, *scenario_, *robot_);
+  }
+
+  std::optional<world::Scenario> scenario_;
+  std::optional<robot::RobotModel> robot_;
+};
+using MissionWorldVersionTest = CorridorMissionTest;
+using MissionAbortTest = CorridorMissionTest;
+
 // The services are asked in the world model the graph manager planned in: a motion planner whose
 // mirror lags behind (a host that discovered the world model later) waits for that version
 // instead of answering from an older or empty world. The two-host CI run drove into a box that
 // the motion planner had not received yet: no question carried a version. So do the grasp and
 // placement questions, and the commands, which the monitor validates.
-TEST(MissionWorldVersionTest, MotionQuestionsAndCommandsCarryTheWorldVersionTheGraphPlannedIn) {
-  auto sc = world::loadScenario(configDir() / "scenarios" / "namo_corridor.yaml");
-  ASSERT_TRUE(sc.ok()) << sc.error().toString();
-  auto robot = robot::RobotModel::loadDescription(sc->robot.description);
-  ASSERT_TRUE(robot.ok());
-  Abstraction a(sc->plannerWorld(), *robot);
+TEST_F(MissionWorldVersionTest, MotionQuestionsAndCommandsCarryTheWorldVersionTheGraphPlannedIn) {
   ScriptedServices services;
   services.plans = {{"(move_base start goal)"}};
   services.box_immovable = true;
-  GraphManagerParams params;
-  params.max_contingencies = 0;
-  params.concurrent_motions = false;
-  GraphManager gm(std::move(a), "", MissionGoal{{"(robot-at goal)"}}, services, params);
+  GraphManager gm = corridorManager(services);
   VersionedWorld source;
-  source.live = sc->plannerWorld();
-  source.at_version = 7;
-  source.robot_now.valid = true;
-  source.robot_now.robot.base = sc->robot.start;
-  source.robot_now.robot.arm = *robot->namedConfiguration("stow");
+  atStart(source, 7);
   DrivingExecutor robot_x(source);
   const MissionReport r = gm.runMission(source, robot_x);
   ASSERT_EQ(r.status, MissionOutcome::kSucceeded) << r.reason;
@@ -601,30 +639,19 @@ TEST(MissionWorldVersionTest, MotionQuestionsAndCommandsCarryTheWorldVersionTheG
 // is asked for after the abort. Before, the graph manager answered an abort only once
 // the Traverse had ended (namo_moghaddam_07: 12-30 s), after `tamp run` had stopped waiting, so a
 // mission out of time left no report.
-TEST(MissionAbortTest, AnAbortStopsTheTraverseBeforeItsEnd) {
+TEST_F(MissionAbortTest, AnAbortStopsTheTraverseBeforeItsEnd) {
   struct Outcome {
     MissionReport report;
     int motion_calls{0};
     std::size_t commands{0};
   };
-  auto run = [](bool abort) {
-    auto sc = world::loadScenario(configDir() / "scenarios" / "namo_corridor.yaml");
-    EXPECT_TRUE(sc.ok());
-    auto robot = robot::RobotModel::loadDescription(sc->robot.description);
-    EXPECT_TRUE(robot.ok());
+  auto run = [this](bool abort) {
     ScriptedServices services;
     services.plans = {{"(move_base start goal)"}};
     services.box_immovable = true;  // the box is crossed: sub-tasks, placements, pushes are asked for
-    GraphManagerParams params;
-    params.max_contingencies = 0;
-    params.concurrent_motions = false;
-    GraphManager gm(Abstraction(sc->plannerWorld(), *robot), "", MissionGoal{{"(robot-at goal)"}}, services, params);
+    GraphManager gm = corridorManager(services);
     VersionedWorld source;
-    source.live = sc->plannerWorld();
-    source.at_version = 1;
-    source.robot_now.valid = true;
-    source.robot_now.robot.base = sc->robot.start;
-    source.robot_now.robot.arm = *robot->namedConfiguration("stow");
+    atStart(source, 1);
     DrivingExecutor robot_x(source);
     MissionObserver observer;
     observer.abort_requested = [&] { return abort && services.motion_calls >= 1; };
@@ -657,18 +684,13 @@ MissionReport corridorMission(VersionedWorld& source, DrivingExecutor& x, Script
   for (const auto& o : more) EXPECT_TRUE(planned.addObject(o).ok());
   Abstraction a(planned, *robot);
   for (int i = 0; i < 8; ++i) services.plans.push_back({"(move_base start goal)"});
-  GraphManagerParams params;
-  params.max_contingencies = 0;
-  params.concurrent_motions = false;
+  GraphManagerParams params = sequentialMissionParams();
   params.max_replans = 6;
   GraphManager gm(std::move(a), "", MissionGoal{{"(robot-at goal)"}}, services, params);
   gm.setBelief(belief);
-  source.live = sc->plannerWorld();
-  for (const auto& o : more) EXPECT_TRUE(source.live.addObject(o).ok());
-  source.at_version = 1;
-  source.robot_now.valid = true;
-  source.robot_now.robot.base = sc->robot.start;
-  source.robot_now.robot.arm = *robot->namedConfiguration("stow");
+  world::World live = sc->plannerWorld();
+  for (const auto& o : more) EXPECT_TRUE(live.addObject(o).ok());
+  placeRobotAtStart(source, std::move(live), 1, *sc, *robot);
   return gm.runMission(source, x);
 }
 

@@ -49,6 +49,19 @@ Result<AddedObjects> addedFromMsg(const std::vector<msg::WorldObject>& in) {
   return out;
 }
 
+/// `m`'s object overrides and added objects, into `r`: the world every question to the motion
+/// planner is asked in.
+template <typename Msg, typename Request>
+Status worldEditsFromMsg(const Msg& m, Request& r) {
+  auto overrides = overridesFromMsg(m.object_overrides());
+  if (!overrides) return overrides.error();
+  r.object_overrides = std::move(*overrides);
+  auto added = addedFromMsg(m.added_objects());
+  if (!added) return added.error();
+  r.added_objects = std::move(*added);
+  return Status::Ok();
+}
+
 }  // namespace
 
 msg::MotionStatus toMsg(MotionStatus s) {
@@ -123,12 +136,7 @@ Result<MotionRequest> fromMsg(const msg::MotionRequest& m, const MotionPlanner& 
   }
   r.held_padding_m = m.held_padding_m();
   r.ignored_objects.assign(m.ignored_objects().begin(), m.ignored_objects().end());
-  auto overrides = overridesFromMsg(m.object_overrides());
-  if (!overrides) return overrides.error();
-  r.object_overrides = std::move(*overrides);
-  auto added = addedFromMsg(m.added_objects());
-  if (!added) return added.error();
-  r.added_objects = std::move(*added);
+  if (Status s = worldEditsFromMsg(m, r); !s.ok()) return s.error();
   const double w = m.movable_cost_weight();
   if (!std::isfinite(w) || w < 0) return bad("movable_cost_weight", "must be finite and >= 0");
   r.object_cost_scale = w;
@@ -209,12 +217,7 @@ Result<PlacementRequest> fromMsg(const msg::PlacementRequest& m) {
   }
   if (!std::isfinite(m.approach()) || m.approach() < 0) return bad("approach", "must be finite and >= 0");
   r.approach = m.approach();
-  auto overrides = overridesFromMsg(m.object_overrides());
-  if (!overrides) return overrides.error();
-  r.object_overrides = std::move(*overrides);
-  auto added = addedFromMsg(m.added_objects());
-  if (!added) return added.error();
-  r.added_objects = std::move(*added);
+  if (Status s = worldEditsFromMsg(m, r); !s.ok()) return s.error();
   return r;
 }
 
@@ -242,12 +245,7 @@ Result<GraspRequest> fromMsg(const msg::GraspRequest& m) {
     r.base_pose = *p;
   }
   r.max_grasps = m.max_grasps() == 0 ? 8u : std::min<std::uint32_t>(m.max_grasps(), 64u);
-  auto overrides = overridesFromMsg(m.object_overrides());
-  if (!overrides) return overrides.error();
-  r.object_overrides = std::move(*overrides);
-  auto added = addedFromMsg(m.added_objects());
-  if (!added) return added.error();
-  r.added_objects = std::move(*added);
+  if (Status s = worldEditsFromMsg(m, r); !s.ok()) return s.error();
   return r;
 }
 

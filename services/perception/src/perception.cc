@@ -9,6 +9,7 @@
 #include <limits>
 #include <map>
 #include <numbers>
+#include <optional>
 #include <set>
 #include <stdexcept>
 
@@ -189,6 +190,14 @@ struct Perception::Impl {
 
   Impl(world::World prior_world, PerceptionParams p)
       : params(std::move(p)), prior(std::move(prior_world)), world(prior), segmenter(params, prior) {}
+
+  // ---- the frame (processFrame) -----------------------------------------------------------------
+
+  struct SelfFilter;
+  struct FrameUpdate;
+  /// The robot's body and the held object cut from `input` (when a robot is given and the self
+  /// filter is on); result.stats.robot_points counts what was cut.
+  SelfFilter filterSelf(const PointCloudFrame& input, const RobotBody* robot, FrameResult& result);
 
   // ---- helpers ----------------------------------------------------------------------------------
 
@@ -557,66 +566,55 @@ Result<WorldEvent> Perception::removeObject(std::string_view id, const std::stri
 
 // ---- the frame ----------------------------------------------------------------------------------
 
-Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const Termination& term,
-                                             const RobotBody* robot) {
-  Impl& I = *impl_;
-  const PerceptionParams& P = I.params;
-  const TrackingParams& T = P.tracking;
-  FrameResult result;
-  Stopwatch total, watch;
-
-  if (Status s = validateFrame(input, P.max_points); !s.ok()) return s.error();
-  if (input.stamp_ns < I.last_stamp) {
-    return Error(ErrorCode::kInvalidArgument,
-                 "frame is older than the previous one (" + std::to_string(input.stamp_ns) + " < " +
-                     std::to_string(I.last_stamp) + " ns)",
-                 SourceLocation{"", 0, 0, "stamp_ns"});
-  }
-  result.times.validate = watch.millis();
-  result.stats.input_points = input.size();
-
-  // ---- the robot's own body and the held object (self_filter.h) ---------------------------------
-  // Decided here, applied to the tracks only once the frame is committed (below).
-  watch.reset();
-  const bool self_filter = robot != nullptr && P.self_filter.enabled;
-  Track* held = nullptr;
+/// What the self filter (self_filter.h) decided for a frame: the robot's body and the held object
+/// cut from its points. Applied to the tracks only once the frame is committed (FrameUpdate).
+struct Perception::Impl::SelfFilter {
+  bool enabled{false};
+  Track* held{nullptr};
   // Reported held, but tracked implausibly far from the gripper (perception restarted from the
   // prior while the robot carries it): no grasp to fix yet; it is relearned from the points at
-  // the gripper, as an object held but unknown is (below).
-  Track* held_elsewhere = nullptr;
-  Eigen::Isometry3d tool_T_held = I.tool_T_held;
-  std::optional<PointCloudFrame> filtered;
-  if (self_filter) {
-    if (auto it = I.tracks.find(robot->held_object_id);
-        !robot->held_object_id.empty() && it != I.tracks.end() &&
-        it->second.state != TrackInfo::State::kTentative) {
-      held = &it->second;
-      // A new grasp: the object is where it was last tracked, now rigidly on the tool link --
-      // when that is at the gripper at all.
-      if (I.held_id != held->id) {
-        if (pointInShape(held->shape, held->pose, robot->world_T_tool.translation(), P.self_filter.held_adopt_radius)) {
-          tool_T_held = robot->world_T_tool.inverse() * held->pose;
-        } else {
-          held_elsewhere = held;
-          held = nullptr;
-        }
+  // the gripper, as an object held but unknown is (FrameUpdate).
+  Track* held_elsewhere{nullptr};
+  Eigen::Isometry3d tool_T_held{Eigen::Isometry3d::Identity()};
+  std::optional<PointCloudFrame> filtered;  ///< the input without the robot's points, when enabled
+};
+
+Perception::Impl::SelfFilter Perception::Impl::filterSelf(const PointCloudFrame& input, const RobotBody* robot,
+                                                          FrameResult& result) {
+  const PerceptionParams& P = params;
+  SelfFilter f;
+  f.enabled = robot != nullptr && P.self_filter.enabled;
+  f.tool_T_held = tool_T_held;
+  if (!f.enabled) return f;
+  if (auto it = tracks.find(robot->held_object_id);
+      !robot->held_object_id.empty() && it != tracks.end() && it->second.state != TrackInfo::State::kTentative) {
+    f.held = &it->second;
+    // A new grasp: the object is where it was last tracked, now rigidly on the tool link --
+    // when that is at the gripper at all.
+    if (held_id != f.held->id) {
+      if (pointInShape(f.held->shape, f.held->pose, robot->world_T_tool.translation(), P.self_filter.held_adopt_radius)) {
+        f.tool_T_held = robot->world_T_tool.inverse() * f.held->pose;
+      } else {
+        f.held_elsewhere = f.held;
+        f.held = nullptr;
       }
     }
-    world::Object held_solid;
-    if (held != nullptr) {
-      held_solid.shape = held->shape;
-      held_solid.pose = robot->world_T_tool * tool_T_held;
-    }
-    filtered = input;
-    result.stats.robot_points = removeBodyPoints(*filtered, *robot, held != nullptr ? &held_solid : nullptr,
-                                                 P.self_filter.padding);
   }
-  const PointCloudFrame& frame = filtered ? *filtered : input;
-  result.times.self_filter = watch.millis();
+  world::Object held_solid;
+  if (f.held != nullptr) {
+    held_solid.shape = f.held->shape;
+    held_solid.pose = robot->world_T_tool * f.tool_T_held;
+  }
+  f.filtered = input;
+  result.stats.robot_points = removeBodyPoints(*f.filtered, *robot, f.held != nullptr ? &held_solid : nullptr,
+                                               P.self_filter.padding);
+  return f;
+}
 
-  auto seg = I.segmenter.run(frame, term);
-  if (!seg) return seg.error();
-  const Segmentation& S = *seg;
+namespace {
+
+/// Copies the segmentation's stage times, counts and support planes into `result`.
+void reportSegmentation(const Segmentation& S, FrameResult& result) {
   result.times.transform_crop = S.times.transform_crop;
   result.times.voxel = S.times.voxel;
   result.times.planes = S.times.planes;
@@ -630,26 +628,77 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
   result.stats.planes = static_cast<int>(S.planes.size());
   result.stats.clusters = static_cast<int>(S.clusters.size());
   result.planes = S.planes;
-  if (term()) {
-    return Error(term.reason() == StopReason::kStopRequested ? ErrorCode::kCancelled : ErrorCode::kTimeout,
-                 "stopped before shape fitting");
+}
+
+}  // namespace
+
+/// The steps of a committed frame (processFrame), in order: the held object, detections,
+/// association, tentative objects, undetected tracks, confirmations, world updates, occupancy;
+/// and the state they hand on.
+struct Perception::Impl::FrameUpdate {
+  FrameUpdate(Impl& impl, const RobotBody* robot_body, const SelfFilter& self, const PointCloudFrame& committed,
+              const Segmentation& segmentation, FrameResult& frame_result)
+      : I(impl),
+        P(impl.params),
+        T(impl.params.tracking),
+        robot(robot_body),
+        self_filter(self.enabled),
+        held(self.held),
+        held_elsewhere(self.held_elsewhere),
+        tool_T_held(self.tool_T_held),
+        frame(committed),
+        S(segmentation),
+        result(frame_result),
+        stamp(committed.stamp_ns),
+        sensor(committed.world_T_sensor.translation()) {}
+
+  Impl& I;
+  const PerceptionParams& P;
+  const TrackingParams& T;
+  const RobotBody* robot;
+  const bool self_filter;
+  Track* held;
+  Track* held_elsewhere;  ///< relearned at most once per frame (confirmTentatives)
+  const Eigen::Isometry3d tool_T_held;
+  const PointCloudFrame& frame;
+  const Segmentation& S;
+  FrameResult& result;
+  const int64_t stamp;
+  const Eigen::Vector3d sensor;
+  /// Held, but unknown to every track (the planner was not told about it): see detect().
+  bool held_unknown{false};
+  Eigen::Vector3d tool{Eigen::Vector3d::Zero()};  ///< the tool link's position, when a robot is given
+  std::vector<Eigen::Vector3f> unexplained;       ///< points for the occupancy map
+  std::vector<std::size_t> det_cluster;           ///< detection -> cluster index
+  std::vector<char> det_used;                     ///< detection -> matched or a fragment of a track
+  // Returns binned by direction, built when first asked: is a place seen free, hidden, or out of
+  // the image (the fits of tracked boxes ask whether a seen end is a face; gone objects below).
+  std::optional<RangeImage> image;
+
+  RangeImage& rangeImage() {
+    if (!image) image.emplace(frame, T.visibility_bin);
+    return *image;
   }
 
-  // Committed from here on: the rest is bounded and quick.
-  I.last_stamp = frame.stamp_ns;
-  ++I.frames;
-  const int64_t stamp = frame.stamp_ns;
-  const Eigen::Vector3d sensor = frame.world_T_sensor.translation();
-  const world::World before = I.world;
-
-  // The held object follows the gripper; a release (the state reports the gripper empty, or
-  // another object) leaves it where it was last carried, tracked as any other from then on.
-  if (self_filter) {
-    if (!I.held_id.empty() && (held == nullptr || held->id != I.held_id)) I.settleReleased(result, stamp, robot);
-    I.held_id = held != nullptr ? held->id : std::string();
-    I.tool_T_held = held != nullptr ? tool_T_held : Eigen::Isometry3d::Identity();
+  bool seenFree(const Eigen::Vector3d& p) {
+    const Eigen::Vector3d half(0.01, 0.01, 0.01);
+    return rangeImage().seenThrough(p - half, p + half, T.visibility_margin);
   }
-  if (held != nullptr) {
+
+  bool atTheGripper(const Eigen::Vector2d& xy, double zmin, double zmax) const {
+    const double r = P.self_filter.held_adopt_radius;
+    return held_unknown && (xy - tool.head<2>()).norm() <= r && tool.z() >= zmin - r && tool.z() <= zmax + r;
+  }
+
+  /// The held object follows the gripper; a release (the state reports the gripper empty, or
+  /// another object) leaves it where it was last carried, tracked as any other from then on.
+  void followHeld() {
+    if (self_filter) {
+      if (!I.held_id.empty() && (held == nullptr || held->id != I.held_id)) I.settleReleased(result, stamp, robot);
+      I.held_id = held != nullptr ? held->id : std::string();
+      I.tool_T_held = held != nullptr ? tool_T_held : Eigen::Isometry3d::Identity();
+    }
+    if (held == nullptr) return;
     held->pose = robot->world_T_tool * tool_T_held;
     held->misses = 0;
     if (held->state == TrackInfo::State::kGone) {
@@ -662,118 +711,111 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
     }
   }
 
-  // ---- shape fitting ------------------------------------------------------------------------
-  watch.reset();
-  // Unexplained points: small clusters that stand clearly above their support (a few returns
-  // hugging the floor are range noise, not an obstacle).
-  std::vector<Eigen::Vector3f> unexplained;
-  for (const auto& c : S.small_clusters) {
-    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-    double zmin = kInf, zmax = -kInf;
-    for (const auto& p : c) {
-      mean += p.head<2>().cast<double>();
-      zmin = std::min(zmin, double(p.z()));
-      zmax = std::max(zmax, double(p.z()));
-    }
-    mean /= static_cast<double>(c.size());
-    if (zmax > I.supportBelow(mean, zmin, S.planes) + P.clusters.min_height) {
-      unexplained.insert(unexplained.end(), c.begin(), c.end());
-    }
-  }
-  // Held, but unknown to every track (the planner was not told about it): the cluster at the
-  // gripper hangs from it, it does not stand on a support, and it is the object the robot holds.
-  const bool held_unknown = self_filter && held == nullptr && !robot->held_object_id.empty() &&
-                            (held_elsewhere != nullptr || (I.tracks.count(robot->held_object_id) == 0 &&
-                                                           I.world.findObject(robot->held_object_id) == nullptr));
-  const Eigen::Vector3d tool = robot != nullptr ? Eigen::Vector3d(robot->world_T_tool.translation()) : Eigen::Vector3d::Zero();
-  auto atTheGripper = [&](const Eigen::Vector2d& xy, double zmin, double zmax) {
-    const double r = P.self_filter.held_adopt_radius;
-    return held_unknown && (xy - tool.head<2>()).norm() <= r && tool.z() >= zmin - r && tool.z() <= zmax + r;
-  };
-  std::vector<std::size_t> det_cluster;  // detection -> cluster index
-  for (std::size_t ci = 0; ci < S.clusters.size(); ++ci) {
-    const auto& c = S.clusters[ci];
-    std::vector<Eigen::Vector3d> pts;
-    pts.reserve(c.size());
-    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-    double zmin = kInf, zmax = -kInf;
-    for (const auto& p : c) {
-      pts.emplace_back(p.cast<double>());
-      mean += p.head<2>().cast<double>();
-      zmin = std::min(zmin, double(p.z()));
-      zmax = std::max(zmax, double(p.z()));
-    }
-    mean /= static_cast<double>(c.size());
-    const double support = atTheGripper(mean, zmin, zmax) ? zmin : I.supportBelow(mean, zmin, S.planes);
-    Detection d = describeCluster(std::move(pts), support, P.clusters);
-    const double major = d.majorExtent();
-    if (d.height < P.clusters.min_height || major < P.clusters.min_size) {
-      // Too flat or too small to be an object: noise unless clearly above its support.
-      if (d.height > P.clusters.min_height) unexplained.insert(unexplained.end(), c.begin(), c.end());
-      continue;
-    }
-    if (major > P.clusters.max_size) {
-      unexplained.insert(unexplained.end(), c.begin(), c.end());
-      continue;
-    }
-    result.detections.push_back(std::move(d));
-    det_cluster.push_back(ci);
-  }
-  result.stats.detections = static_cast<int>(result.detections.size());
-  result.times.fitting = watch.millis();
-
-  // ---- association ------------------------------------------------------------------------------
-  watch.reset();
-  std::vector<Track*> candidates;
-  for (auto& [id, t] : I.tracks) {
-    t.matched = false;
-    t.pushed = false;
-    if (t.state != TrackInfo::State::kGone && id != I.held_id) candidates.push_back(&t);
-  }
-  const auto& dets = result.detections;
-  // Returns binned by direction, built when first asked: is a place seen free, hidden, or out of
-  // the image (the fits of tracked boxes ask whether a seen end is a face; gone objects below).
-  std::optional<RangeImage> image;
-  auto seenFree = [&](const Eigen::Vector3d& p) {
-    if (!image) image.emplace(frame, T.visibility_bin);
-    const Eigen::Vector3d half(0.01, 0.01, 0.01);
-    return image->seenThrough(p - half, p + half, T.visibility_margin);
-  };
-  std::vector<std::vector<double>> cost(dets.size(), std::vector<double>(candidates.size(), kInf));
-  std::vector<std::vector<ShapeFit>> fits(dets.size(), std::vector<ShapeFit>(candidates.size()));
-  for (std::size_t i = 0; i < dets.size(); ++i) {
-    for (std::size_t j = 0; j < candidates.size(); ++j) {
-      const Track& t = *candidates[j];
-      ShapeFit f;
-      if (t.size_known) {
-        f = fitShape(dets[i], t.shape, sensor, T, yawOf(t.pose), t.pose.translation().head<2>(), seenFree);
-        if (!f.compatible) continue;
-      } else {
-        f.pose = dets[i].pose;
-        f.height_error = dets[i].height - 2 * t.shape.halfHeight();
-        if (std::abs(f.height_error) > std::max(T.height_tolerance, 0.3 * dets[i].height)) continue;
-        // The detection's observed centre is biased towards the sensor; compare it with the
-        // track's by their footprints' overlap instead of their centres alone.
+  /// Clusters described as detections (result.detections); the rest unexplained points.
+  void detect() {
+    // Unexplained points: small clusters that stand clearly above their support (a few returns
+    // hugging the floor are range noise, not an obstacle).
+    for (const auto& c : S.small_clusters) {
+      Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+      double zmin = kInf, zmax = -kInf;
+      for (const auto& p : c) {
+        mean += p.head<2>().cast<double>();
+        zmin = std::min(zmin, double(p.z()));
+        zmax = std::max(zmax, double(p.z()));
       }
-      const double dist = (f.pose.translation().head<2>() - t.pose.translation().head<2>()).norm();
-      double gate = T.gate_distance;
-      if (!t.size_known) gate += 0.5 * footprintMajor(t.shape);
-      if (dist > gate) continue;
-      const bool round = t.shape.kind == world::ShapeKind::kCylinder || t.shape.kind == world::ShapeKind::kSphere;
-      const bool det_round = dets[i].kind == world::ShapeKind::kCylinder;
-      cost[i][j] = dist + 0.5 * f.residual + (t.state == TrackInfo::State::kTentative ? 0.05 : 0.0) +
-                   (round != det_round ? 0.05 : 0.0);
-      fits[i][j] = f;
+      mean /= static_cast<double>(c.size());
+      if (zmax > I.supportBelow(mean, zmin, S.planes) + P.clusters.min_height) {
+        unexplained.insert(unexplained.end(), c.begin(), c.end());
+      }
+    }
+    // Held, but unknown to every track (the planner was not told about it): the cluster at the
+    // gripper hangs from it, it does not stand on a support, and it is the object the robot holds.
+    held_unknown = self_filter && held == nullptr && !robot->held_object_id.empty() &&
+                   (held_elsewhere != nullptr || (I.tracks.count(robot->held_object_id) == 0 &&
+                                                  I.world.findObject(robot->held_object_id) == nullptr));
+    if (robot != nullptr) tool = robot->world_T_tool.translation();
+    for (std::size_t ci = 0; ci < S.clusters.size(); ++ci) {
+      const auto& c = S.clusters[ci];
+      std::vector<Eigen::Vector3d> pts;
+      pts.reserve(c.size());
+      Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+      double zmin = kInf, zmax = -kInf;
+      for (const auto& p : c) {
+        pts.emplace_back(p.cast<double>());
+        mean += p.head<2>().cast<double>();
+        zmin = std::min(zmin, double(p.z()));
+        zmax = std::max(zmax, double(p.z()));
+      }
+      mean /= static_cast<double>(c.size());
+      const double support = atTheGripper(mean, zmin, zmax) ? zmin : I.supportBelow(mean, zmin, S.planes);
+      Detection d = describeCluster(std::move(pts), support, P.clusters);
+      const double major = d.majorExtent();
+      if (d.height < P.clusters.min_height || major < P.clusters.min_size) {
+        // Too flat or too small to be an object: noise unless clearly above its support.
+        if (d.height > P.clusters.min_height) unexplained.insert(unexplained.end(), c.begin(), c.end());
+        continue;
+      }
+      if (major > P.clusters.max_size) {
+        unexplained.insert(unexplained.end(), c.begin(), c.end());
+        continue;
+      }
+      result.detections.push_back(std::move(d));
+      det_cluster.push_back(ci);
+    }
+    result.stats.detections = static_cast<int>(result.detections.size());
+  }
+
+  /// Detections assigned to the tracks they fit best (least cost), and those tracks updated.
+  void associate() {
+    std::vector<Track*> candidates;
+    for (auto& [id, t] : I.tracks) {
+      t.matched = false;
+      t.pushed = false;
+      if (t.state != TrackInfo::State::kGone && id != I.held_id) candidates.push_back(&t);
+    }
+    const auto& dets = result.detections;
+    auto seen_free = [this](const Eigen::Vector3d& p) { return seenFree(p); };
+    std::vector<std::vector<double>> cost(dets.size(), std::vector<double>(candidates.size(), kInf));
+    std::vector<std::vector<ShapeFit>> fits(dets.size(), std::vector<ShapeFit>(candidates.size()));
+    for (std::size_t i = 0; i < dets.size(); ++i) {
+      for (std::size_t j = 0; j < candidates.size(); ++j) {
+        const Track& t = *candidates[j];
+        ShapeFit f;
+        if (t.size_known) {
+          f = fitShape(dets[i], t.shape, sensor, T, yawOf(t.pose), t.pose.translation().head<2>(), seen_free);
+          if (!f.compatible) continue;
+        } else {
+          f.pose = dets[i].pose;
+          f.height_error = dets[i].height - 2 * t.shape.halfHeight();
+          if (std::abs(f.height_error) > std::max(T.height_tolerance, 0.3 * dets[i].height)) continue;
+          // The detection's observed centre is biased towards the sensor; compare it with the
+          // track's by their footprints' overlap instead of their centres alone.
+        }
+        const double dist = (f.pose.translation().head<2>() - t.pose.translation().head<2>()).norm();
+        double gate = T.gate_distance;
+        if (!t.size_known) gate += 0.5 * footprintMajor(t.shape);
+        if (dist > gate) continue;
+        const bool round = t.shape.kind == world::ShapeKind::kCylinder || t.shape.kind == world::ShapeKind::kSphere;
+        const bool det_round = dets[i].kind == world::ShapeKind::kCylinder;
+        cost[i][j] = dist + 0.5 * f.residual + (t.state == TrackInfo::State::kTentative ? 0.05 : 0.0) +
+                     (round != det_round ? 0.05 : 0.0);
+        fits[i][j] = f;
+      }
+    }
+    const std::vector<int> assign = solveAssignment(cost);
+
+    det_used.assign(dets.size(), 0);
+    for (std::size_t i = 0; i < dets.size(); ++i) {
+      if (assign[i] < 0) continue;
+      det_used[i] = 1;
+      Track& t = *candidates[static_cast<std::size_t>(assign[i])];
+      updateMatched(t, dets[i], fits[i][static_cast<std::size_t>(assign[i])]);
+      result.stats.matched += t.state == TrackInfo::State::kActive ? 1 : 0;
     }
   }
-  const std::vector<int> assign = solveAssignment(cost);
 
-  std::vector<char> det_used(dets.size(), 0);
-  for (std::size_t i = 0; i < dets.size(); ++i) {
-    if (assign[i] < 0) continue;
-    det_used[i] = 1;
-    Track& t = *candidates[static_cast<std::size_t>(assign[i])];
-    const ShapeFit& f = fits[i][static_cast<std::size_t>(assign[i])];
+  /// Track `t` seen again as `d`, fitted by `f`: its pose follows (snapped or smoothed).
+  void updateMatched(Track& t, const Detection& d, const ShapeFit& f) {
     t.matched = true;
     ++t.hits;
     t.misses = 0;
@@ -782,14 +824,14 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
     Eigen::Isometry3d meas = f.pose;
     const world::Shape shape_before = t.shape;
     if (!t.size_known) {
-      I.growShape(t, dets[i]);
+      I.growShape(t, d);
       // Refit the grown shape (anchored on the seen faces) for the pose.
-      meas = fitShape(dets[i], t.shape, sensor, T, yawOf(t.pose), t.pose.translation().head<2>(), seenFree,
-                      /*known_size=*/false)
+      meas = fitShape(d, t.shape, sensor, T, yawOf(t.pose), t.pose.translation().head<2>(),
+                      [this](const Eigen::Vector3d& p) { return seenFree(p); }, /*known_size=*/false)
                  .pose;
       log::get("perception")->debug("{} grown to {:.2f} x {:.2f}: detection rect {:.2f} x {:.2f} yaw {:.2f} at ({:.2f}, {:.2f}); fit ({:.2f}, {:.2f}) yaw {:.2f}, track ({:.2f}, {:.2f})",
-                                    t.id, t.shape.size.x(), t.shape.size.y(), dets[i].rect.extents.x(), dets[i].rect.extents.y(),
-                                    dets[i].rect.yaw, dets[i].pose.translation().x(), dets[i].pose.translation().y(),
+                                    t.id, t.shape.size.x(), t.shape.size.y(), d.rect.extents.x(), d.rect.extents.y(),
+                                    d.rect.yaw, d.pose.translation().x(), d.pose.translation().y(),
                                     meas.translation().x(), meas.translation().y(), yawOf(meas), t.pose.translation().x(),
                                     t.pose.translation().y());
     }
@@ -801,7 +843,7 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
     // seen end slid the whole estimate 0.2 m a frame off the crate (namo_room_hidden).
     if (jump > T.explained_margin && t.settling == 0 && (t.size_known || t.shape == shape_before) &&
         (t.from_prior || t.hits > 2) &&
-        explainedFraction(t, dets[i].points, T.explained_margin, sensor,
+        explainedFraction(t, d.points, T.explained_margin, sensor,
                           [&](double range) { return P.planes.noise_sigmas * P.sensor.stddev(range); }) >=
             T.explained_fraction) {
       meas = t.pose;
@@ -819,12 +861,12 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
       double dy = sym > 0 ? yaw_m - yaw_t - sym * std::round((yaw_m - yaw_t) / sym) : 0.0;
       t.pose = uprightPose(pos.x(), pos.y(), meas.translation().z(), sym > 0 ? wrapAngle(yaw_t + a * dy) : 0.0);
     }
-    result.stats.matched += t.state == TrackInfo::State::kActive ? 1 : 0;
   }
 
-  // Movable objects cannot be inside the base (keepOutOfBase): what it pushes stays ahead of it.
-  // The world model follows below, with the other tracks' updates.
-  if (self_filter) {
+  /// Movable objects cannot be inside the base (keepOutOfBase): what it pushes stays ahead of it.
+  /// The world model follows in updateWorld, with the other tracks' updates.
+  void keepOutOfBase() {
+    if (!self_filter) return;
     for (auto& [id, t] : I.tracks) {
       if (t.state != TrackInfo::State::kActive || t.kind != world::ObjectKind::kMovable || id == I.held_id ||
           id == robot->held_object_id)
@@ -838,15 +880,11 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
     }
   }
 
-  // Unmatched detections become tentative objects (class from the priors, else by size),
-  // unless they are mostly inside a tracked object (a fragment of it, e.g. a side face split
-  // off by range noise, or the part of it the image cuts off, too short to match it). Inside
-  // within the size tolerance plus the range noise where the point was seen: from afar a face
-  // spreads over a band a dozen centimetres deep, and the track may be a few centimetres off.
-  for (std::size_t i = 0; i < dets.size(); ++i) {
-    if (det_used[i]) continue;
-    const Detection& d = dets[i];
-    bool fragment = false;
+  /// Whether most of `d`'s points are inside a tracked object: a fragment of it, e.g. a side face
+  /// split off by range noise, or the part of it the image cuts off, too short to match it.
+  /// Inside within the size tolerance plus the range noise where the point was seen: from afar a
+  /// face spreads over a band a dozen centimetres deep, and the track may be a few centimetres off.
+  bool isFragment(const Detection& d) const {
     std::vector<double> margins;  // per point, the same for every track
     margins.reserve(d.points.size());
     for (const auto& p : d.points)
@@ -856,95 +894,108 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
       std::size_t inside = 0;
       for (std::size_t k = 0; k < d.points.size(); ++k)
         inside += pointInShape(t.shape, t.pose, d.points[k], margins[k]) ? 1 : 0;
-      if (2 * inside >= d.points.size()) {
-        fragment = true;
-        break;
+      if (2 * inside >= d.points.size()) return true;
+    }
+    return false;
+  }
+
+  /// Unmatched detections become tentative objects (class from the priors, else by size),
+  /// unless they are fragments of a tracked object (isFragment).
+  void addTentatives() {
+    const auto& dets = result.detections;
+    for (std::size_t i = 0; i < dets.size(); ++i) {
+      if (det_used[i]) continue;
+      const Detection& d = dets[i];
+      if (isFragment(d)) {
+        det_used[i] = 1;
+        continue;
+      }
+      Track t;
+      t.id = "tentative_" + std::to_string(I.next_tentative++);
+      t.state = TrackInfo::State::kTentative;
+      t.hits = 1;
+      t.first_seen_ns = stamp;
+      t.last_seen_ns = stamp;
+      t.confidence = 0.3;
+      t.matched = true;
+      if (const ObjectClass* c = I.bestClass(d, sensor)) {
+        t.cls = c;
+        t.label = c->label;
+        t.size_known = true;
+        t.shape = c->shape;
+        t.kind = c->kind;
+        t.mass = c->mass;
+        t.graspable = c->graspable;
+        t.pose = fitShape(d, c->shape, sensor, T).pose;
+      } else {
+        t.size_known = false;
+        t.shape = d.shape;
+        (d.kind == world::ShapeKind::kCylinder ? t.cylinder_votes : t.box_votes) = 1;
+        t.pose = d.pose;
+        t.label = d.kind == world::ShapeKind::kCylinder ? "cylinder" : "box";
+      }
+      I.tracks.emplace(t.id, std::move(t));
+    }
+  }
+
+  /// Expected objects not detected: seen empty (missed, then gone), hidden, or out of view.
+  void checkUndetected() {
+    std::vector<std::string> dropped;
+    for (auto& [id, t] : I.tracks) {
+      if (t.matched || t.state == TrackInfo::State::kGone || id == I.held_id || &t == held_elsewhere) continue;
+      world::Object o;
+      o.shape = t.shape;
+      o.pose = t.pose;
+      const ObjectVisibility v = rangeImage().checkObject(o, T.visibility_margin);
+      const bool decidable = v.testable >= T.gone_min_samples;
+      const bool seen_empty = decidable && v.throughFraction() >= T.gone_fraction && v.presentFraction() < T.present_fraction;
+      if (t.state == TrackInfo::State::kTentative) {
+        if (seen_empty || stamp - t.last_seen_ns > static_cast<int64_t>(T.tentative_timeout_s * 1e9)) dropped.push_back(id);
+        continue;
+      }
+      if (seen_empty && I.settleIfUnsupported(t, result, stamp, "seen empty in the air")) continue;
+      if (seen_empty) {
+        ++t.misses;
+        t.confidence *= 0.5;
+        if (t.misses >= T.gone_frames) {
+          t.state = TrackInfo::State::kGone;
+          (void)I.world.removeObject(t.id);
+          char why[160];
+          std::snprintf(why, sizeof(why), "not at %s although in view: %d of %d samples seen through in %d frame(s)",
+                        describePose(t.pose).c_str(), v.through, v.testable, t.misses);
+          I.pushEvent(result, EventType::kGone, t, t.pose, why, stamp);
+        }
+      } else if (decidable && v.presentFraction() >= T.present_fraction) {
+        t.misses = 0;  // something is there though no cluster matched (e.g. merged with a neighbour)
       }
     }
-    if (fragment) {
-      det_used[i] = 1;
-      continue;
-    }
-    Track t;
-    t.id = "tentative_" + std::to_string(I.next_tentative++);
-    t.state = TrackInfo::State::kTentative;
-    t.hits = 1;
-    t.first_seen_ns = stamp;
-    t.last_seen_ns = stamp;
-    t.confidence = 0.3;
-    t.matched = true;
-    if (const ObjectClass* c = I.bestClass(d, sensor)) {
-      t.cls = c;
-      t.label = c->label;
-      t.size_known = true;
-      t.shape = c->shape;
-      t.kind = c->kind;
-      t.mass = c->mass;
-      t.graspable = c->graspable;
-      t.pose = fitShape(d, c->shape, sensor, T).pose;
-    } else {
-      t.size_known = false;
-      t.shape = d.shape;
-      (d.kind == world::ShapeKind::kCylinder ? t.cylinder_votes : t.box_votes) = 1;
-      t.pose = d.pose;
-      t.label = d.kind == world::ShapeKind::kCylinder ? "cylinder" : "box";
-    }
-    I.tracks.emplace(t.id, std::move(t));
+    for (const auto& id : dropped) I.tracks.erase(id);
   }
-  double tracking_ms = watch.millis();
 
-  // ---- expected objects not detected: seen empty, hidden, or out of view ------------------------
-  watch.reset();
-  std::vector<std::string> dropped;
-  for (auto& [id, t] : I.tracks) {
-    if (t.matched || t.state == TrackInfo::State::kGone || id == I.held_id || &t == held_elsewhere) continue;
-    if (!image) image.emplace(frame, T.visibility_bin);
-    world::Object o;
-    o.shape = t.shape;
-    o.pose = t.pose;
-    const ObjectVisibility v = image->checkObject(o, T.visibility_margin);
-    const bool decidable = v.testable >= T.gone_min_samples;
-    const bool seen_empty = decidable && v.throughFraction() >= T.gone_fraction && v.presentFraction() < T.present_fraction;
-    if (t.state == TrackInfo::State::kTentative) {
-      if (seen_empty || stamp - t.last_seen_ns > static_cast<int64_t>(T.tentative_timeout_s * 1e9)) dropped.push_back(id);
-      continue;
+  /// Tentative objects seen often enough: the held object relearned, a gone object reacquired,
+  /// or a new object in the world model.
+  void confirmTentatives() {
+    std::vector<std::string> confirmed;
+    for (auto& [id, t] : I.tracks) {
+      if (t.state == TrackInfo::State::kTentative && t.matched && t.hits >= T.confirm_hits) confirmed.push_back(id);
     }
-    if (seen_empty && I.settleIfUnsupported(t, result, stamp, "seen empty in the air")) continue;
-    if (seen_empty) {
-      ++t.misses;
-      t.confidence *= 0.5;
-      if (t.misses >= T.gone_frames) {
-        t.state = TrackInfo::State::kGone;
-        (void)I.world.removeObject(t.id);
-        char why[160];
-        std::snprintf(why, sizeof(why), "not at %s although in view: %d of %d samples seen through in %d frame(s)",
-                      describePose(t.pose).c_str(), v.through, v.testable, t.misses);
-        I.pushEvent(result, EventType::kGone, t, t.pose, why, stamp);
+    for (const auto& tid : confirmed) {
+      Track t = std::move(I.tracks.at(tid));
+      I.tracks.erase(tid);
+      if (held_elsewhere != nullptr &&
+          atTheGripper(t.pose.translation().head<2>(), t.pose.translation().z() - t.shape.halfHeight(),
+                       t.pose.translation().z() + t.shape.halfHeight())) {
+        I.relearnHeld(*held_elsewhere, t, result, stamp);
+        held_elsewhere = nullptr;  // once per frame
+        continue;
       }
-    } else if (decidable && v.presentFraction() >= T.present_fraction) {
-      t.misses = 0;  // something is there though no cluster matched (e.g. merged with a neighbour)
+      if (reacquire(t)) continue;
+      addConfirmed(std::move(t));
     }
   }
-  for (const auto& id : dropped) I.tracks.erase(id);
-  result.times.visibility = watch.millis();
 
-  // ---- confirmations, reacquisitions, world updates ----------------------------------------------
-  watch.reset();
-  std::vector<std::string> confirmed;
-  for (auto& [id, t] : I.tracks) {
-    if (t.state == TrackInfo::State::kTentative && t.matched && t.hits >= T.confirm_hits) confirmed.push_back(id);
-  }
-  for (const auto& tid : confirmed) {
-    Track t = std::move(I.tracks.at(tid));
-    I.tracks.erase(tid);
-    if (held_elsewhere != nullptr &&
-        atTheGripper(t.pose.translation().head<2>(), t.pose.translation().z() - t.shape.halfHeight(),
-                     t.pose.translation().z() + t.shape.halfHeight())) {
-      I.relearnHeld(*held_elsewhere, t, result, stamp);
-      held_elsewhere = nullptr;  // once per frame
-      continue;
-    }
-    // A gone object of the same shape: reacquired under its id.
+  /// A gone object of the same shape as the confirmed `t` (the nearest): reacquired under its id.
+  bool reacquire(const Track& t) {
     Track* lost = nullptr;
     if (T.reacquire) {
       double best = kInf;
@@ -957,22 +1008,26 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
         }
       }
     }
-    if (lost != nullptr) {
-      const Eigen::Isometry3d was = lost->pose;
-      lost->state = TrackInfo::State::kActive;
-      lost->pose = t.pose;
-      lost->event_pose = t.pose;
-      lost->hits += t.hits;
-      lost->misses = 0;
-      lost->last_seen_ns = stamp;
-      lost->confidence = std::max(lost->confidence, t.confidence);
-      (void)I.world.addObject(I.objectOf(*lost));
-      char why[200];
-      std::snprintf(why, sizeof(why), "reacquired at %s, %.2f m from where it was lost",
-                    describePose(t.pose).c_str(), (t.pose.translation() - was.translation()).norm());
-      I.pushEvent(result, EventType::kMoved, *lost, lost->pose, why, stamp);
-      continue;
-    }
+    if (lost == nullptr) return false;
+    const Eigen::Isometry3d was = lost->pose;
+    lost->state = TrackInfo::State::kActive;
+    lost->pose = t.pose;
+    lost->event_pose = t.pose;
+    lost->hits += t.hits;
+    lost->misses = 0;
+    lost->last_seen_ns = stamp;
+    lost->confidence = std::max(lost->confidence, t.confidence);
+    (void)I.world.addObject(I.objectOf(*lost));
+    char why[200];
+    std::snprintf(why, sizeof(why), "reacquired at %s, %.2f m from where it was lost",
+                  describePose(t.pose).c_str(), (t.pose.translation() - was.translation()).norm());
+    I.pushEvent(result, EventType::kMoved, *lost, lost->pose, why, stamp);
+    return true;
+  }
+
+  /// The confirmed `t` as a new object of the world model, under a fresh id (the held object's,
+  /// when it is the unknown object at the gripper).
+  void addConfirmed(Track t) {
     if (!t.size_known) I.classifyBySize(t);
     // Held, but unknown to every track: the new object at the gripper is the one the robot holds.
     const double half = t.shape.halfHeight();
@@ -983,78 +1038,138 @@ Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const
     t.state = TrackInfo::State::kActive;
     t.event_pose = t.pose;
     const world::Object o = I.objectOf(t);
-    if (Status s = I.world.addObject(o); !s.ok()) continue;  // cannot happen: ids are fresh, shapes valid
+    if (Status s = I.world.addObject(o); !s.ok()) return;  // cannot happen: ids are fresh, shapes valid
     std::string why = std::string("new ") + std::string(world::toString(t.kind)) + " " + describeShape(t.shape) +
                       " at " + describePose(t.pose) + (t.cls != nullptr ? ", class " + t.cls->label : ", by size");
     I.pushEvent(result, EventType::kAdded, t, t.pose, why, stamp);
     I.tracks.emplace(t.id, std::move(t));
   }
 
-  for (auto& [id, t] : I.tracks) {
-    if (t.state != TrackInfo::State::kActive || !(t.matched || t.pushed)) continue;
-    const world::Object* o = I.world.findObject(id);
-    if (o == nullptr) continue;
-    const double dpos = (o->pose.translation() - t.pose.translation()).norm();
-    const double dyaw = yawError(t.shape, yawOf(o->pose), yawOf(t.pose));
-    const bool grew = !(o->shape == t.shape);
-    if (dpos > T.update_distance || dyaw > T.update_angle || grew) {
-      world::Object updated = I.objectOf(t);
-      if (!t.from_prior && !t.size_known && t.cls == nullptr) {
-        // Keep mass/kind consistent with the grown size.
-        Track tmp = t;
-        I.classifyBySize(tmp);
-        t.kind = tmp.kind;
-        t.mass = tmp.mass;
-        t.graspable = tmp.graspable;
-        updated = I.objectOf(t);
+  /// Active tracks seen or pushed in this frame: the world model follows them when they moved,
+  /// turned or grew, and a far enough move or turn is an event.
+  void updateWorld() {
+    for (auto& [id, t] : I.tracks) {
+      if (t.state != TrackInfo::State::kActive || !(t.matched || t.pushed)) continue;
+      const world::Object* o = I.world.findObject(id);
+      if (o == nullptr) continue;
+      const double dpos = (o->pose.translation() - t.pose.translation()).norm();
+      const double dyaw = yawError(t.shape, yawOf(o->pose), yawOf(t.pose));
+      const bool grew = !(o->shape == t.shape);
+      if (dpos > T.update_distance || dyaw > T.update_angle || grew) {
+        world::Object updated = I.objectOf(t);
+        if (!t.from_prior && !t.size_known && t.cls == nullptr) {
+          // Keep mass/kind consistent with the grown size.
+          Track tmp = t;
+          I.classifyBySize(tmp);
+          t.kind = tmp.kind;
+          t.mass = tmp.mass;
+          t.graspable = tmp.graspable;
+          updated = I.objectOf(t);
+        }
+        (void)I.world.updateObject(updated);
       }
-      (void)I.world.updateObject(updated);
+      const double moved = (t.event_pose.translation() - t.pose.translation()).norm();
+      const double turned = yawError(t.shape, yawOf(t.event_pose), yawOf(t.pose));
+      // A turn is an event when it also moves the footprint's farthest point as far as a move
+      // would: the fitted yaw of a small box wobbles by more than the angle without moving it.
+      const bool turned_far = turned > T.move_event_angle && turned * footprintReach(t.shape) > T.move_event_distance;
+      if (moved > T.move_event_distance || turned_far) {
+        char why[200];
+        std::snprintf(why, sizeof(why), "moved %.2f m, turned %.2f rad, now at %s", moved, turned,
+                      describePose(t.pose).c_str());
+        t.event_pose = t.pose;
+        I.pushEvent(result, EventType::kMoved, t, t.pose, why, stamp);
+      }
     }
-    const double moved = (t.event_pose.translation() - t.pose.translation()).norm();
-    const double turned = yawError(t.shape, yawOf(t.event_pose), yawOf(t.pose));
-    // A turn is an event when it also moves the footprint's farthest point as far as a move
-    // would: the fitted yaw of a small box wobbles by more than the angle without moving it.
-    const bool turned_far = turned > T.move_event_angle && turned * footprintReach(t.shape) > T.move_event_distance;
-    if (moved > T.move_event_distance || turned_far) {
-      char why[200];
-      std::snprintf(why, sizeof(why), "moved %.2f m, turned %.2f rad, now at %s", moved, turned,
-                    describePose(t.pose).c_str());
-      t.event_pose = t.pose;
-      I.pushEvent(result, EventType::kMoved, t, t.pose, why, stamp);
-    }
+    for (const auto& [id, t] : I.tracks) result.stats.tentative += t.state == TrackInfo::State::kTentative ? 1 : 0;
   }
-  for (const auto& [id, t] : I.tracks) result.stats.tentative += t.state == TrackInfo::State::kTentative ? 1 : 0;
-  tracking_ms += watch.millis();
-  result.times.tracking = tracking_ms;
 
-  // ---- occupancy of unexplained space -------------------------------------------------------------
-  watch.reset();
-  for (std::size_t i = 0; i < dets.size(); ++i) {
-    // Detections not (yet) part of a world object stay unexplained space until confirmed.
-    bool explained = false;
-    for (const auto& o : I.world.objects()) {
-      if (pointInShape(o.shape, o.pose, dets[i].pose.translation(), P.occupancy.explained_margin)) {
-        explained = true;
-        break;
+  /// Occupancy of unexplained space: detections not (yet) part of a world object stay
+  /// unexplained space until confirmed.
+  void integrateOccupancy() {
+    const auto& dets = result.detections;
+    for (std::size_t i = 0; i < dets.size(); ++i) {
+      bool explained = false;
+      for (const auto& o : I.world.objects()) {
+        if (pointInShape(o.shape, o.pose, dets[i].pose.translation(), P.occupancy.explained_margin)) {
+          explained = true;
+          break;
+        }
+      }
+      if (!explained) {
+        const auto& c = S.clusters[det_cluster[i]];
+        unexplained.insert(unexplained.end(), c.begin(), c.end());
       }
     }
-    if (!explained) {
-      const auto& c = S.clusters[det_cluster[i]];
-      unexplained.insert(unexplained.end(), c.begin(), c.end());
-    }
-  }
-  result.stats.unexplained_points = unexplained.size();
-  if (I.occupancy) {
+    result.stats.unexplained_points = unexplained.size();
+    if (!I.occupancy) return;
     I.occupancy->integrate(sensor, S.scan, unexplained);
-    if (I.occupancy->hitVoxels() > 0) {
-      if (!image) image.emplace(frame, T.visibility_bin);
-      I.occupancy->clearSeenThrough(*image, T.visibility_margin);
-    }
+    if (I.occupancy->hitVoxels() > 0) I.occupancy->clearSeenThrough(rangeImage(), T.visibility_margin);
     for (const auto& o : I.world.objects()) {
       if (o.kind == world::ObjectKind::kMovable || I.prior.findObject(o.id) == nullptr) I.occupancy->clearObject(o);
     }
     I.occupancy->updateInnerNodes();  // once per frame (see OccupancyMap)
   }
+};
+
+Result<FrameResult> Perception::processFrame(const PointCloudFrame& input, const Termination& term,
+                                             const RobotBody* robot) {
+  Impl& I = *impl_;
+  FrameResult result;
+  Stopwatch total, watch;
+
+  if (Status s = validateFrame(input, I.params.max_points); !s.ok()) return s.error();
+  if (input.stamp_ns < I.last_stamp) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "frame is older than the previous one (" + std::to_string(input.stamp_ns) + " < " +
+                     std::to_string(I.last_stamp) + " ns)",
+                 SourceLocation{"", 0, 0, "stamp_ns"});
+  }
+  result.times.validate = watch.millis();
+  result.stats.input_points = input.size();
+
+  watch.reset();
+  const Impl::SelfFilter self = I.filterSelf(input, robot, result);
+  const PointCloudFrame& frame = self.filtered ? *self.filtered : input;
+  result.times.self_filter = watch.millis();
+
+  auto seg = I.segmenter.run(frame, term);
+  if (!seg) return seg.error();
+  reportSegmentation(*seg, result);
+  if (term()) {
+    return Error(term.reason() == StopReason::kStopRequested ? ErrorCode::kCancelled : ErrorCode::kTimeout,
+                 "stopped before shape fitting");
+  }
+
+  // Committed from here on: the rest is bounded and quick.
+  I.last_stamp = frame.stamp_ns;
+  ++I.frames;
+  const world::World before = I.world;
+  Impl::FrameUpdate update(I, robot, self, frame, *seg, result);
+  update.followHeld();
+
+  watch.reset();
+  update.detect();
+  result.times.fitting = watch.millis();
+
+  watch.reset();
+  update.associate();
+  update.keepOutOfBase();
+  update.addTentatives();
+  double tracking_ms = watch.millis();
+
+  watch.reset();
+  update.checkUndetected();
+  result.times.visibility = watch.millis();
+
+  watch.reset();
+  update.confirmTentatives();
+  update.updateWorld();
+  tracking_ms += watch.millis();
+  result.times.tracking = tracking_ms;
+
+  watch.reset();
+  update.integrateOccupancy();
   result.times.occupancy = watch.millis();
 
   result.world_changed = !world::diff(before, I.world).empty();

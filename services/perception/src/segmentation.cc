@@ -427,37 +427,254 @@ Segmenter& Segmenter::operator=(Segmenter&&) noexcept = default;
 
 const Aabb& Segmenter::workspace() const { return impl_->workspace; }
 
+namespace {
+
+/// The frame's finite returns within the crop ranges, in the world frame and inside `workspace`;
+/// `lo` and `hi` their bounds. Counts out.valid_points.
+std::vector<Eigen::Vector3f> cropToWorkspace(const PointCloudFrame& frame, const Aabb& workspace,
+                                             const PerceptionParams& P, Segmentation& out, Eigen::Array3f& lo_out,
+                                             Eigen::Array3f& hi_out) {
+  std::vector<Eigen::Vector3f> cropped;
+  Eigen::Array3f cropped_lo = Eigen::Array3f::Constant(std::numeric_limits<float>::infinity());
+  Eigen::Array3f cropped_hi = -cropped_lo;
+  const Eigen::Matrix3f R = frame.world_T_sensor.linear().cast<float>();
+  const Eigen::Vector3f t = frame.world_T_sensor.translation().cast<float>();
+  const Eigen::Array3f lo = workspace.min.cast<float>().array();
+  const Eigen::Array3f hi = workspace.max.cast<float>().array();
+  const float r2min = static_cast<float>(P.crop.min_range * P.crop.min_range);
+  const float r2max = static_cast<float>(P.crop.max_range * P.crop.max_range);
+  const std::size_t n = frame.size();
+  cropped.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3f q(frame.xyz[3 * i], frame.xyz[3 * i + 1], frame.xyz[3 * i + 2]);
+    if (!std::isfinite(q.x())) continue;  // validated: a triplet is all finite or a no-return
+    ++out.valid_points;
+    const float r2 = q.squaredNorm();
+    if (r2 < r2min || r2 > r2max) continue;
+    const Eigen::Vector3f w = R * q + t;
+    if ((w.array() < lo).any() || (w.array() > hi).any()) continue;
+    cropped.push_back(w);
+    cropped_lo = cropped_lo.min(w.array());
+    cropped_hi = cropped_hi.max(w.array());
+  }
+  lo_out = cropped_lo;
+  hi_out = cropped_hi;
+  return cropped;
+}
+
+/// What pcl::SACSegmentation (RANSAC, perpendicular plane, optimised coefficients) does, with
+/// the model's faster inlier count. Its RANSAC is seeded with a constant (random = false):
+/// frames are reproducible.
+void segmentPlane(const std::shared_ptr<Cloud>& cloud, const pcl::Indices& indices, const PerceptionParams& P,
+                  pcl::PointIndices& inliers, pcl::ModelCoefficients& coeffs) {
+  inliers.indices.clear();
+  coeffs.values.clear();
+  auto model = std::make_shared<PerpendicularPlaneModel>(cloud, indices);
+  model->setAxis(Eigen::Vector3f::UnitZ());
+  model->setEpsAngle(P.planes.max_tilt);
+  pcl::RandomSampleConsensus<pcl::PointXYZ> sac(model, P.planes.distance_threshold);
+  sac.setProbability(0.99);
+  sac.setMaxIterations(P.planes.ransac_iterations);
+  if (!sac.computeModel(0)) return;
+  sac.getInliers(inliers.indices);
+  Eigen::VectorXf coeff(model->getModelSize()), refined(model->getModelSize());
+  sac.getModelCoefficients(coeff);
+  model->optimizeModelCoefficients(inliers.indices, coeff, refined);
+  coeffs.values.assign(refined.data(), refined.data() + refined.size());
+  model->selectWithinDistance(refined, P.planes.distance_threshold, inliers.indices);
+}
+
+/// The points of `search` within the plane `c`'s noise-aware band (the along-ray range noise
+/// projected on the plane normal, seen from `origin`); `search` keeps the others.
+std::vector<pcl::index_t> takeBandInliers(const Cloud& cloud, std::vector<pcl::index_t>& search,
+                                          const Eigen::Vector4f& c, const Eigen::Vector3f& origin,
+                                          const PerceptionParams& P) {
+  const Eigen::Vector3f n = c.head<3>();
+  std::vector<pcl::index_t> inliers;
+  std::vector<pcl::index_t> rest;
+  inliers.reserve(search.size());
+  rest.reserve(search.size());
+  const float base = static_cast<float>(P.planes.distance_threshold);
+  for (auto i : search) {
+    const Eigen::Vector3f q = cloud.points[static_cast<std::size_t>(i)].getVector3fMap();
+    const float dist = std::abs(n.dot(q) + c.w());
+    const Eigen::Vector3f ray = q - origin;
+    const float range = ray.norm();
+    const float cosine = range > 1e-6f ? std::abs(n.dot(ray)) / range : 1.0f;
+    const float band = std::max(base, static_cast<float>(P.planes.noise_sigmas * P.sensor.stddev(range)) * cosine);
+    (dist <= band ? inliers : rest).push_back(i);
+  }
+  search = std::move(rest);
+  return inliers;
+}
+
+/// Area from the distinct xy cells the inliers cover (range noise smears a surface over several
+/// voxel layers, so inliers x voxel^2 would overestimate it). Distinct cells counted in an
+/// open-addressing set (sorting them was ~2 % of a frame).
+double distinctCellArea(const Cloud& cloud, const std::vector<pcl::index_t>& inliers, double voxel_size) {
+  const double voxel_area = voxel_size * voxel_size;
+  std::size_t size = 1024;
+  while (size < 2 * inliers.size()) size *= 2;
+  std::vector<std::uint64_t> table(size, kNoCell);
+  std::size_t distinct = 0;
+  bool minus_one = false;  // cell (-1, -1), whose key is kNoCell
+  const float inv = 1.0f / static_cast<float>(voxel_size);
+  for (auto i : inliers) {
+    const auto& q = cloud.points[static_cast<std::size_t>(i)];
+    const auto ix = static_cast<std::int64_t>(std::floor(q.x * inv)), iy = static_cast<std::int64_t>(std::floor(q.y * inv));
+    const auto cell = static_cast<std::uint64_t>((ix << 32) ^ (iy & 0xffffffff));
+    if (cell == kNoCell) {
+      distinct += minus_one ? 0 : 1;
+      minus_one = true;
+      continue;
+    }
+    for (std::size_t h = (cell * 0x9E3779B97F4A7C15ull) >> 32 & (size - 1);; h = (h + 1) & (size - 1)) {
+      if (table[h] == cell) break;
+      if (table[h] == kNoCell) {
+        table[h] = cell;
+        ++distinct;
+        break;
+      }
+    }
+  }
+  return static_cast<double>(distinct) * voxel_area;
+}
+
+/// The prior region a plane at `height` matches: same height and most inliers over its polygon
+/// (tables first); null for none.
+const world::Region* matchRegion(const std::vector<world::Region>& regions, double height, const Cloud& cloud,
+                                 const std::vector<pcl::index_t>& inliers, const PerceptionParams& P) {
+  const world::Region* region = nullptr;
+  for (const auto& r : regions) {
+    if (std::abs(r.height - height) > P.planes.region_height_tolerance) continue;
+    std::size_t over = 0;
+    for (auto i : inliers) {
+      const auto& q = cloud.points[static_cast<std::size_t>(i)];
+      if (r.contains(Eigen::Vector2d(q.x, q.y))) ++over;
+    }
+    if (2 * over >= inliers.size() && (region == nullptr || r.kind == world::RegionKind::kTable)) region = &r;
+  }
+  return region;
+}
+
+/// The area of the inliers' xy convex hull.
+double inlierHullArea(const Cloud& cloud, const std::vector<pcl::index_t>& inliers) {
+  std::vector<Eigen::Vector2d> xy;
+  xy.reserve(inliers.size());
+  for (auto i : inliers) {
+    const auto& q = cloud.points[static_cast<std::size_t>(i)];
+    xy.emplace_back(q.x, q.y);
+  }
+  return std::abs(world::signedArea(convexHull(std::move(xy))));
+}
+
+/// Marks in `removed` the inliers a support plane removes and returns their xy: a table region's
+/// polygon bounds what its plane removes (a box top at table height elsewhere stays an object); a
+/// floor or an unmatched large plane removes all inliers.
+std::vector<Eigen::Vector2d> removeSupported(const Cloud& cloud, const std::vector<pcl::index_t>& inliers,
+                                             const world::Region* region, const PerceptionParams& P,
+                                             std::vector<char>& removed) {
+  const bool bounded = region != nullptr && region->kind == world::RegionKind::kTable;
+  world::Polygon2 grown;
+  if (bounded) {
+    const Eigen::Vector2d mid = world::areaCentroid(region->polygon);
+    for (const auto& v : region->polygon) {
+      const Eigen::Vector2d d = v - mid;
+      grown.push_back(d.norm() > 1e-9 ? Eigen::Vector2d(v + d.normalized() * P.planes.region_margin * 1.42) : v);
+    }
+  }
+  std::vector<Eigen::Vector2d> xy;
+  xy.reserve(inliers.size());
+  for (auto i : inliers) {
+    const auto& q = cloud.points[static_cast<std::size_t>(i)];
+    if (bounded && !world::containsPoint(grown, Eigen::Vector2d(q.x, q.y))) continue;
+    removed[static_cast<std::size_t>(i)] = 1;
+    xy.emplace_back(q.x, q.y);
+  }
+  return xy;
+}
+
+/// The support planes (out.planes, out.plane_points): RANSAC on an even subsample, inliers over
+/// every candidate point, matched to the prior `regions`; the points they remove marked in
+/// `removed`. A stop request or timeout between planes is an error.
+Status findSupportPlanes(const std::shared_ptr<Cloud>& cloud, const Eigen::Vector3f& origin, const PerceptionParams& P,
+                         const std::vector<world::Region>& regions, const Termination& term, Segmentation& out,
+                         std::vector<char>& removed) {
+  std::vector<pcl::index_t> search(cloud->size());
+  for (std::size_t i = 0; i < cloud->size(); ++i) search[i] = static_cast<pcl::index_t>(i);
+  std::vector<std::vector<Eigen::Vector2d>> plane_xy;  // inliers' xy per accepted plane (hulls)
+  for (int attempt = 0; attempt < P.planes.max_attempts; ++attempt) {
+    if (static_cast<int>(search.size()) < P.planes.min_points) break;
+    if (term()) return stopped(term, "the next support plane");
+    // The model from an even subsample; inliers over every candidate point.
+    const std::size_t stride =
+        (search.size() + static_cast<std::size_t>(P.planes.ransac_max_points) - 1) / static_cast<std::size_t>(P.planes.ransac_max_points);
+    pcl::Indices sub;
+    sub.reserve(search.size() / stride + 1);
+    for (std::size_t k = 0; k < search.size(); k += stride) sub.push_back(search[k]);
+    pcl::PointIndices sub_inliers;
+    pcl::ModelCoefficients coeffs;
+    segmentPlane(cloud, sub, P, sub_inliers, coeffs);
+    if (coeffs.values.size() != 4 || static_cast<int>(sub_inliers.indices.size() * stride) < P.planes.min_points) break;
+    Eigen::Vector4f c(coeffs.values[0], coeffs.values[1], coeffs.values[2], coeffs.values[3]);
+    c /= c.head<3>().norm();
+    if (c.z() < 0) c = -c;
+    // Every inlier leaves the plane search, accepted or not.
+    const std::vector<pcl::index_t> inliers = takeBandInliers(*cloud, search, c, origin, P);
+    if (static_cast<int>(inliers.size()) < P.planes.min_points) continue;
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    for (auto i : inliers) centroid += cloud->points[static_cast<std::size_t>(i)].getVector3fMap().cast<double>();
+    centroid /= static_cast<double>(inliers.size());
+    SupportPlane plane;
+    plane.coefficients = c.cast<double>();
+    plane.measured_height = -(plane.coefficients.x() * centroid.x() + plane.coefficients.y() * centroid.y() +
+                              plane.coefficients.w()) / plane.coefficients.z();
+    plane.height = plane.measured_height;
+    plane.inliers = static_cast<int>(inliers.size());
+    plane.area = distinctCellArea(*cloud, inliers, P.planes.voxel_size);
+    const world::Region* region = matchRegion(regions, plane.measured_height, *cloud, inliers, P);
+    // A rejected plane is an object's top: its points stay object points.
+    if (region == nullptr && plane.area < P.planes.min_support_area) continue;
+    // A large plane that matches no region must be a surface: its inliers must fill a good
+    // part of their hull. A horizontal slice through walls and objects (the band of a plane
+    // at some height cuts every vertical surface) can add up to the support area but fills
+    // little of the room it spans; taking it as a support cut every object there in two.
+    if (region == nullptr && plane.area < kMinSupportFill * inlierHullArea(*cloud, inliers)) continue;
+    if (region != nullptr) {
+      plane.region = region->id;
+      plane.height = region->height;
+    }
+    std::vector<Eigen::Vector2d> xy = removeSupported(*cloud, inliers, region, P, removed);
+    out.plane_points += xy.size();
+    // The same surface found twice (e.g. the far floor, noisier) merges into the first.
+    auto same = std::find_if(out.planes.begin(), out.planes.end(), [&](const SupportPlane& o) {
+      return o.region == plane.region && std::abs(o.height - plane.height) <= P.planes.region_height_tolerance;
+    });
+    if (same != out.planes.end()) {
+      auto& pts = plane_xy[static_cast<std::size_t>(same - out.planes.begin())];
+      pts.insert(pts.end(), xy.begin(), xy.end());
+      same->inliers += plane.inliers;
+      same->area += plane.area;
+      continue;
+    }
+    if (static_cast<int>(out.planes.size()) >= P.planes.max_planes) break;
+    out.planes.push_back(std::move(plane));
+    plane_xy.push_back(std::move(xy));
+  }
+  for (std::size_t k = 0; k < out.planes.size(); ++k) out.planes[k].hull = convexHull(std::move(plane_xy[k]));
+  return Status::Ok();
+}
+
+}  // namespace
+
 Result<Segmentation> Segmenter::run(const PointCloudFrame& frame, const Termination& term) const {
   const PerceptionParams& P = impl_->params;
   Segmentation out;
   Stopwatch watch;
 
   // ---- transform + crop ------------------------------------------------------------------------
-  std::vector<Eigen::Vector3f> cropped;
-  Eigen::Array3f cropped_lo = Eigen::Array3f::Constant(std::numeric_limits<float>::infinity());
-  Eigen::Array3f cropped_hi = -cropped_lo;
-  {
-    const Eigen::Matrix3f R = frame.world_T_sensor.linear().cast<float>();
-    const Eigen::Vector3f t = frame.world_T_sensor.translation().cast<float>();
-    const Eigen::Array3f lo = impl_->workspace.min.cast<float>().array();
-    const Eigen::Array3f hi = impl_->workspace.max.cast<float>().array();
-    const float r2min = static_cast<float>(P.crop.min_range * P.crop.min_range);
-    const float r2max = static_cast<float>(P.crop.max_range * P.crop.max_range);
-    const std::size_t n = frame.size();
-    cropped.reserve(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      const Eigen::Vector3f q(frame.xyz[3 * i], frame.xyz[3 * i + 1], frame.xyz[3 * i + 2]);
-      if (!std::isfinite(q.x())) continue;  // validated: a triplet is all finite or a no-return
-      ++out.valid_points;
-      const float r2 = q.squaredNorm();
-      if (r2 < r2min || r2 > r2max) continue;
-      const Eigen::Vector3f w = R * q + t;
-      if ((w.array() < lo).any() || (w.array() > hi).any()) continue;
-      cropped.push_back(w);
-      cropped_lo = cropped_lo.min(w.array());
-      cropped_hi = cropped_hi.max(w.array());
-    }
-  }
+  Eigen::Array3f cropped_lo, cropped_hi;
+  std::vector<Eigen::Vector3f> cropped = cropToWorkspace(frame, impl_->workspace, P, out, cropped_lo, cropped_hi);
   out.cropped_points = cropped.size();
   out.times.transform_crop = ms(watch);
   if (term()) return stopped(term, "the voxel filter").error();
@@ -475,173 +692,8 @@ Result<Segmentation> Segmenter::run(const PointCloudFrame& frame, const Terminat
   // ---- support planes --------------------------------------------------------------------------
   watch.reset();
   std::vector<char> removed(cloud->size(), 0);
-  {
-    const Eigen::Vector3f origin = frame.world_T_sensor.translation().cast<float>();
-    std::vector<pcl::index_t> search(cloud->size());
-    for (std::size_t i = 0; i < cloud->size(); ++i) search[i] = static_cast<pcl::index_t>(i);
-    // What pcl::SACSegmentation (RANSAC, perpendicular plane, optimised coefficients) does, with
-    // the model's faster inlier count. Its RANSAC is seeded with a constant (random = false):
-    // frames are reproducible.
-    const auto segment = [&](const pcl::Indices& indices, pcl::PointIndices& inliers, pcl::ModelCoefficients& coeffs) {
-      inliers.indices.clear();
-      coeffs.values.clear();
-      auto model = std::make_shared<PerpendicularPlaneModel>(cloud, indices);
-      model->setAxis(Eigen::Vector3f::UnitZ());
-      model->setEpsAngle(P.planes.max_tilt);
-      pcl::RandomSampleConsensus<pcl::PointXYZ> sac(model, P.planes.distance_threshold);
-      sac.setProbability(0.99);
-      sac.setMaxIterations(P.planes.ransac_iterations);
-      if (!sac.computeModel(0)) return;
-      sac.getInliers(inliers.indices);
-      Eigen::VectorXf coeff(model->getModelSize()), refined(model->getModelSize());
-      sac.getModelCoefficients(coeff);
-      model->optimizeModelCoefficients(inliers.indices, coeff, refined);
-      coeffs.values.assign(refined.data(), refined.data() + refined.size());
-      model->selectWithinDistance(refined, P.planes.distance_threshold, inliers.indices);
-    };
-    const double voxel_area = P.planes.voxel_size * P.planes.voxel_size;
-    std::vector<std::vector<Eigen::Vector2d>> plane_xy;  // inliers' xy per accepted plane (hulls)
-    for (int attempt = 0; attempt < P.planes.max_attempts; ++attempt) {
-      if (static_cast<int>(search.size()) < P.planes.min_points) break;
-      if (term()) return stopped(term, "the next support plane").error();
-      // The model from an even subsample; inliers over every candidate point.
-      const std::size_t stride =
-          (search.size() + static_cast<std::size_t>(P.planes.ransac_max_points) - 1) / static_cast<std::size_t>(P.planes.ransac_max_points);
-      pcl::Indices sub;
-      sub.reserve(search.size() / stride + 1);
-      for (std::size_t k = 0; k < search.size(); k += stride) sub.push_back(search[k]);
-      pcl::PointIndices sub_inliers;
-      pcl::ModelCoefficients coeffs;
-      segment(sub, sub_inliers, coeffs);
-      if (coeffs.values.size() != 4 || static_cast<int>(sub_inliers.indices.size() * stride) < P.planes.min_points) break;
-      Eigen::Vector4f c(coeffs.values[0], coeffs.values[1], coeffs.values[2], coeffs.values[3]);
-      c /= c.head<3>().norm();
-      if (c.z() < 0) c = -c;
-      const Eigen::Vector3f n = c.head<3>();
-      // Noise-aware band: the along-ray range noise projected on the plane normal.
-      std::vector<pcl::index_t> inliers;
-      std::vector<pcl::index_t> rest;
-      inliers.reserve(search.size());
-      rest.reserve(search.size());
-      const float base = static_cast<float>(P.planes.distance_threshold);
-      for (auto i : search) {
-        const Eigen::Vector3f q = cloud->points[static_cast<std::size_t>(i)].getVector3fMap();
-        const float dist = std::abs(n.dot(q) + c.w());
-        const Eigen::Vector3f ray = q - origin;
-        const float range = ray.norm();
-        const float cosine = range > 1e-6f ? std::abs(n.dot(ray)) / range : 1.0f;
-        const float band = std::max(base, static_cast<float>(P.planes.noise_sigmas * P.sensor.stddev(range)) * cosine);
-        (dist <= band ? inliers : rest).push_back(i);
-      }
-      search = std::move(rest);  // every inlier leaves the plane search, accepted or not
-      if (static_cast<int>(inliers.size()) < P.planes.min_points) continue;
-      Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-      for (auto i : inliers) centroid += cloud->points[static_cast<std::size_t>(i)].getVector3fMap().cast<double>();
-      centroid /= static_cast<double>(inliers.size());
-      SupportPlane plane;
-      plane.coefficients = c.cast<double>();
-      plane.measured_height = -(plane.coefficients.x() * centroid.x() + plane.coefficients.y() * centroid.y() +
-                                plane.coefficients.w()) / plane.coefficients.z();
-      plane.height = plane.measured_height;
-      plane.inliers = static_cast<int>(inliers.size());
-      {
-        // Area from the distinct xy cells the inliers cover (range noise smears a surface over
-        // several voxel layers, so inliers x voxel^2 would overestimate it).
-        // Distinct cells counted in an open-addressing set (sorting them was ~2 % of a frame).
-        std::size_t size = 1024;
-        while (size < 2 * inliers.size()) size *= 2;
-        std::vector<std::uint64_t> table(size, kNoCell);
-        std::size_t distinct = 0;
-        bool minus_one = false;  // cell (-1, -1), whose key is kNoCell
-        const float inv = 1.0f / static_cast<float>(P.planes.voxel_size);
-        for (auto i : inliers) {
-          const auto& q = cloud->points[static_cast<std::size_t>(i)];
-          const auto ix = static_cast<std::int64_t>(std::floor(q.x * inv)), iy = static_cast<std::int64_t>(std::floor(q.y * inv));
-          const auto cell = static_cast<std::uint64_t>((ix << 32) ^ (iy & 0xffffffff));
-          if (cell == kNoCell) {
-            distinct += minus_one ? 0 : 1;
-            minus_one = true;
-            continue;
-          }
-          for (std::size_t h = (cell * 0x9E3779B97F4A7C15ull) >> 32 & (size - 1);; h = (h + 1) & (size - 1)) {
-            if (table[h] == cell) break;
-            if (table[h] == kNoCell) {
-              table[h] = cell;
-              ++distinct;
-              break;
-            }
-          }
-        }
-        plane.area = static_cast<double>(distinct) * voxel_area;
-      }
-      // Match a prior region: same height and most inliers over its polygon (tables first).
-      const world::Region* region = nullptr;
-      for (const auto& r : impl_->regions) {
-        if (std::abs(r.height - plane.measured_height) > P.planes.region_height_tolerance) continue;
-        std::size_t over = 0;
-        for (auto i : inliers) {
-          const auto& q = cloud->points[static_cast<std::size_t>(i)];
-          if (r.contains(Eigen::Vector2d(q.x, q.y))) ++over;
-        }
-        if (2 * over >= inliers.size() && (region == nullptr || r.kind == world::RegionKind::kTable)) region = &r;
-      }
-      // A rejected plane is an object's top: its points stay object points.
-      if (region == nullptr && plane.area < P.planes.min_support_area) continue;
-      // A large plane that matches no region must be a surface: its inliers must fill a good
-      // part of their hull. A horizontal slice through walls and objects (the band of a plane
-      // at some height cuts every vertical surface) can add up to the support area but fills
-      // little of the room it spans; taking it as a support cut every object there in two.
-      if (region == nullptr) {
-        std::vector<Eigen::Vector2d> xy;
-        xy.reserve(inliers.size());
-        for (auto i : inliers) {
-          const auto& q = cloud->points[static_cast<std::size_t>(i)];
-          xy.emplace_back(q.x, q.y);
-        }
-        const double hull_area = std::abs(world::signedArea(convexHull(std::move(xy))));
-        if (plane.area < kMinSupportFill * hull_area) continue;
-      }
-      if (region != nullptr) {
-        plane.region = region->id;
-        plane.height = region->height;
-      }
-      // A table region's polygon bounds what its plane removes (a box top at table height
-      // elsewhere stays an object); a floor or an unmatched large plane removes all inliers.
-      const bool bounded = region != nullptr && region->kind == world::RegionKind::kTable;
-      world::Polygon2 grown;
-      if (bounded) {
-        const Eigen::Vector2d mid = world::areaCentroid(region->polygon);
-        for (const auto& v : region->polygon) {
-          const Eigen::Vector2d d = v - mid;
-          grown.push_back(d.norm() > 1e-9 ? Eigen::Vector2d(v + d.normalized() * P.planes.region_margin * 1.42) : v);
-        }
-      }
-      std::vector<Eigen::Vector2d> xy;
-      xy.reserve(inliers.size());
-      for (auto i : inliers) {
-        const auto& q = cloud->points[static_cast<std::size_t>(i)];
-        if (bounded && !world::containsPoint(grown, Eigen::Vector2d(q.x, q.y))) continue;
-        removed[static_cast<std::size_t>(i)] = 1;
-        xy.emplace_back(q.x, q.y);
-      }
-      out.plane_points += xy.size();
-      // The same surface found twice (e.g. the far floor, noisier) merges into the first.
-      auto same = std::find_if(out.planes.begin(), out.planes.end(), [&](const SupportPlane& o) {
-        return o.region == plane.region && std::abs(o.height - plane.height) <= P.planes.region_height_tolerance;
-      });
-      if (same != out.planes.end()) {
-        auto& pts = plane_xy[static_cast<std::size_t>(same - out.planes.begin())];
-        pts.insert(pts.end(), xy.begin(), xy.end());
-        same->inliers += plane.inliers;
-        same->area += plane.area;
-        continue;
-      }
-      if (static_cast<int>(out.planes.size()) >= P.planes.max_planes) break;
-      out.planes.push_back(std::move(plane));
-      plane_xy.push_back(std::move(xy));
-    }
-    for (std::size_t k = 0; k < out.planes.size(); ++k) out.planes[k].hull = convexHull(std::move(plane_xy[k]));
-  }
+  const Eigen::Vector3f origin = frame.world_T_sensor.translation().cast<float>();
+  if (Status s = findSupportPlanes(cloud, origin, P, impl_->regions, term, out, removed); !s.ok()) return s.error();
   out.times.planes = ms(watch);
   if (term()) return stopped(term, "static-object removal").error();
 

@@ -1,11 +1,13 @@
 #include "tamp/dds/endpoint.h"
 
 #include <cstring>
+#include <set>
 #include <sstream>
 #include <thread>
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/DataWriterListener.hpp>
 #include <fastdds/dds/publisher/Publisher.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
 #include <fastdds/dds/subscriber/DataReaderListener.hpp>
@@ -57,6 +59,33 @@ std::string guidString(const eprosima::fastrtps::rtps::GUID_t& g) {
 
 // ---- writer --------------------------------------------------------------------------------------
 
+/// Keeps the GUID prefixes (participants) of the matched readers: Fast DDS 2.9's
+/// DataWriter::get_matched_subscriptions() is not implemented (RETCODE_UNSUPPORTED).
+class WriterBase::Listener : public fdds::DataWriterListener {
+ public:
+  void on_publication_matched(fdds::DataWriter*, const fdds::PublicationMatchedStatus& info) override {
+    eprosima::fastrtps::rtps::GUID_t reader;
+    eprosima::fastrtps::rtps::iHandle2GUID(reader, info.last_subscription_handle);
+    std::ostringstream prefix;
+    prefix << reader.guidPrefix;
+    std::lock_guard lock(mutex_);
+    if (info.current_count_change > 0) {
+      participants_.insert(prefix.str());
+    } else if (info.current_count_change < 0) {
+      auto it = participants_.find(prefix.str());
+      if (it != participants_.end()) participants_.erase(it);
+    }
+  }
+  bool has(const std::string& prefix) const {
+    std::lock_guard lock(mutex_);
+    return participants_.count(prefix) != 0;
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::multiset<std::string> participants_;  // one entry per matched reader
+};
+
 WriterBase::WriterBase(std::shared_ptr<Participant> p, const std::string& topic,
                        const std::function<fdds::TopicDataType*()>& make_type, QosClass qos,
                        const WriterOptions& options)
@@ -64,7 +93,9 @@ WriterBase::WriterBase(std::shared_ptr<Participant> p, const std::string& topic,
   fdds::Topic* t = participant_->topic(topic, make_type);
   type_ = participant_->native()->find_type(t->get_type_name()).get();
   const std::string profile = options.profile.empty() ? writerProfile(qos) : options.profile;
-  writer_ = participant_->publisher()->create_datawriter_with_profile(t, profile);
+  listener_ = std::make_unique<Listener>();
+  writer_ = participant_->publisher()->create_datawriter_with_profile(t, profile, listener_.get(),
+                                                                      fdds::StatusMask::publication_matched());
   if (writer_ == nullptr) {
     throw std::runtime_error("cannot create a DDS writer on '" + topic + "' with profile '" + profile +
                              "' (is the profile defined in the XML profiles file?)");
@@ -112,6 +143,19 @@ bool WriterBase::waitForReaders(const Termination& until, int count) const {
   while (matchedReaders() < count) {
     if (until()) return false;
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return true;
+}
+
+bool WriterBase::matchesParticipantOf(const std::string& writer_guid) const {
+  // SampleMeta::writer_guid is "<prefix>|<entity id>"; the prefix names the participant.
+  return listener_->has(writer_guid.substr(0, writer_guid.find('|')));
+}
+
+bool WriterBase::waitForParticipantOf(const std::string& writer_guid, const Termination& until) const {
+  while (!matchesParticipantOf(writer_guid)) {
+    if (until()) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
   }
   return true;
 }

@@ -5,12 +5,14 @@
 #include <algorithm>
 #include <atomic>
 #include <cctype>
+#include <chrono>
 #include <cstdlib>
 #include <set>
 #include <sstream>
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/domain/DomainParticipantListener.hpp>
 #include <fastdds/dds/publisher/Publisher.hpp>
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/Topic.hpp>
@@ -136,6 +138,87 @@ int32_t nextParticipantId() {
   return static_cast<int32_t>((base + created.fetch_add(1)) % kSpreadIds);
 }
 
+
+/// Logs when each remote participant is discovered and authenticated (DDS Security), as seconds
+/// since this participant was created: the handshake time of each pair, which Debian's Fast DDS
+/// 2.9.1 does not log (its security logging is compiled out). A handshake of a second or more is
+/// logged at info level, others at debug. Participant callbacks only: the listener's status mask
+/// is none, so no entity's data or matching callback is routed here.
+class PeerLog : public fdds::DomainParticipantListener {
+ public:
+  PeerLog(std::string self, bool secured) : secured_(secured), self_(std::move(self)) {}
+
+  void on_participant_discovery(fdds::DomainParticipant*, eprosima::fastrtps::rtps::ParticipantDiscoveryInfo&& info) override {
+    using Info = eprosima::fastrtps::rtps::ParticipantDiscoveryInfo;
+    const double t = since();
+    const std::string guid = prefix(info.info.m_guid);
+    std::lock_guard lock(mutex_);
+    Peer& peer = peers_[guid];
+    peer.name = info.info.m_participantName.to_string();
+    if (info.status == Info::DISCOVERED_PARTICIPANT) {
+      peer.discovered = t;
+      report(guid, peer);
+    } else if (info.status == Info::REMOVED_PARTICIPANT || info.status == Info::DROPPED_PARTICIPANT) {
+      log::get("dds")->debug("{}: peer '{}' ({}) {} at +{:.2f} s", self_, peer.name, guid,
+                             info.status == Info::REMOVED_PARTICIPANT ? "removed" : "dropped", t);
+      peers_.erase(guid);
+    }
+  }
+
+#if HAVE_SECURITY
+  void onParticipantAuthentication(fdds::DomainParticipant*,
+                                   eprosima::fastrtps::rtps::ParticipantAuthenticationInfo&& info) override {
+    using Info = eprosima::fastrtps::rtps::ParticipantAuthenticationInfo;
+    const double t = since();
+    const std::string guid = prefix(info.guid);
+    std::lock_guard lock(mutex_);
+    if (info.status != Info::AUTHORIZED_PARTICIPANT) {
+      log::get("dds")->warn("{}: peer {} not authenticated (refused, or its handshake failed) at +{:.2f} s", self_,
+                            guid, t);
+      return;
+    }
+    Peer& peer = peers_[guid];
+    peer.authenticated = t;
+    report(guid, peer);
+  }
+#endif
+
+ private:
+  struct Peer {
+    std::string name;
+    double discovered{-1.0};
+    double authenticated{-1.0};
+    bool reported{false};
+  };
+
+  static std::string prefix(const eprosima::fastrtps::rtps::GUID_t& g) {
+    std::ostringstream ss;
+    ss << g.guidPrefix;
+    return ss.str();
+  }
+  double since() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - created_).count(); }
+
+  /// Once per peer, when what there is to know is known (secured: both events; plain: discovery).
+  void report(const std::string& guid, Peer& peer) {  // caller holds mutex_
+    if (peer.reported || peer.discovered < 0.0 || (secured_ && peer.authenticated < 0.0)) return;
+    peer.reported = true;
+    const double last = std::max(peer.discovered, peer.authenticated);
+    const auto level = last >= 1.0 && secured_ ? spdlog::level::info : spdlog::level::debug;
+    if (secured_) {
+      log::get("dds")->log(level, "{}: peer '{}' ({}) authenticated at +{:.2f} s, discovered at +{:.2f} s", self_,
+                           peer.name, guid, peer.authenticated, peer.discovered);
+    } else {
+      log::get("dds")->log(level, "{}: peer '{}' ({}) discovered at +{:.2f} s", self_, peer.name, guid, peer.discovered);
+    }
+  }
+
+  bool secured_;
+  std::string self_;
+  std::chrono::steady_clock::time_point created_{std::chrono::steady_clock::now()};
+  std::mutex mutex_;
+  std::map<std::string, Peer> peers_;
+};
+
 }  // namespace
 
 ParticipantOptions::SecurityFiles securityFiles(const std::filesystem::path& dir, const std::string& identity) {
@@ -254,16 +337,20 @@ Result<std::shared_ptr<Participant>> Participant::create(const ParticipantOption
   p->domain_id_ = *domain;
   p->name_ = qos.name().to_string();
   p->profile_ = profile;
+  p->peer_log_ = std::make_unique<PeerLog>(p->name_, security->has_value());
+  fdds::DomainParticipantListener* listener = p->peer_log_.get();
   if (qos.wire_protocol().participant_id < 0) {
     // An id already used in this process is refused: the next one, then Fast DDS's own choice.
     for (int attempt = 0; attempt < 8 && p->participant_ == nullptr; ++attempt) {
       qos.wire_protocol().participant_id = nextParticipantId();
-      p->participant_ = factory->create_participant(static_cast<fdds::DomainId_t>(*domain), qos);
+      p->participant_ = factory->create_participant(static_cast<fdds::DomainId_t>(*domain), qos, listener,
+                                                    fdds::StatusMask::none());
     }
     qos.wire_protocol().participant_id = -1;
   }
   if (p->participant_ == nullptr) {
-    p->participant_ = factory->create_participant(static_cast<fdds::DomainId_t>(*domain), qos);
+    p->participant_ =
+        factory->create_participant(static_cast<fdds::DomainId_t>(*domain), qos, listener, fdds::StatusMask::none());
   }
   if (p->participant_ == nullptr) {
     return Error(ErrorCode::kInternal,
@@ -288,6 +375,8 @@ Result<std::shared_ptr<Participant>> Participant::create(const ParticipantOption
   }
   return p;
 }
+
+Participant::Participant() = default;
 
 Participant::~Participant() {
   if (participant_ == nullptr) return;

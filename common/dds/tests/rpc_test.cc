@@ -161,5 +161,60 @@ TEST(RpcTest, AHandlerThatUsesItsWholeBudgetIsAnsweredInTime) {
   }
 }
 
+// A client sends once its own endpoints are matched, but the server's reply writer may match the
+// client's reply reader later: under DDS Security each side of a pair matches when the other's
+// crypto tokens arrive (the secured corridor mission lost planner replies that way on a loaded
+// 2-core VM). Modelled here by a client whose reply reader exists only after its request was
+// handled: a VOLATILE reply written at once went to no one. The server must wait for the
+// requesting participant's reader before it replies.
+TEST(RpcTest, AReplyWaitsForTheClientsReplyReaderToMatch) {
+  auto server_side = makeParticipant();
+  auto client_side = makeParticipant();
+  ASSERT_TRUE(server_side && client_side);
+  Server server(server_side, "tamp/test/late", echoHandler);
+  Writer<msg::EchoRequest> requests(client_side, TopicSpec<msg::EchoRequest>{"tamp/test/late/request", QosClass::kRpc});
+  ASSERT_TRUE(requests.waitForReaders(Termination::after(10.0)));
+  msg::EchoRequest req = echo({4, 2});
+  req.header().request_id("late#1");
+  req.header().client_id("late");
+  req.header().attempt(1);
+  req.header().budget_s(20.0);
+  ASSERT_TRUE(requests.write(req).ok());
+  // The echo is handled within milliseconds; its reply is ready long before the reader exists.
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  testing::Inbox<msg::EchoReply> replies;
+  Reader<msg::EchoReply> reader(client_side, TopicSpec<msg::EchoReply>{"tamp/test/late/reply", QosClass::kRpc},
+                                [&](const msg::EchoReply& r, const SampleMeta&) { replies.push(r); });
+  const auto rep = replies.waitFor([](const msg::EchoReply& r) { return r.header().request_id() == "late#1"; }, 10.0);
+  ASSERT_TRUE(rep.has_value()) << "the reply was written before the client's reply reader matched, and lost";
+  EXPECT_EQ(rep->payload(), (std::vector<uint8_t>{4, 2}));
+}
+
+// The wait is bounded: a client whose reply reader never matches does not hold the server, which
+// replies anyway after reply_match_wait_s and goes on serving others.
+TEST(RpcTest, AClientThatNeverListensDoesNotHoldTheServer) {
+  auto server_side = makeParticipant();
+  auto deaf_side = makeParticipant();
+  ASSERT_TRUE(server_side && deaf_side);
+  RpcServerOptions options;
+  options.reply_match_wait_s = 0.3;
+  Server server(server_side, "tamp/test/deaf", echoHandler, options);
+  Writer<msg::EchoRequest> requests(deaf_side, TopicSpec<msg::EchoRequest>{"tamp/test/deaf/request", QosClass::kRpc});
+  ASSERT_TRUE(requests.waitForReaders(Termination::after(10.0)));
+  msg::EchoRequest req = echo({1});
+  req.header().request_id("deaf#1");
+  req.header().client_id("deaf");
+  req.header().attempt(1);
+  req.header().budget_s(20.0);
+  ASSERT_TRUE(requests.write(req).ok());
+  Client client(server_side, "tamp/test/deaf");
+  const Stopwatch sw;
+  auto rep = client.call(echo({9}), CallOptions{10.0, {}});
+  ASSERT_TRUE(rep.ok()) << rep.error().toString();
+  EXPECT_EQ(rep->payload(), (std::vector<uint8_t>{9}));
+  EXPECT_LT(sw.seconds(), 5.0);
+  EXPECT_EQ(server.served(), 2u);
+}
+
 }  // namespace
 }  // namespace tamp::dds

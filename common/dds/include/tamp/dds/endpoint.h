@@ -89,6 +89,15 @@ class WriterBase {
   int readersEverMatched() const;
   /// Waits until at least `count` readers are matched or the termination fires.
   bool waitForReaders(const Termination& until, int count = 1) const;
+  /// True when this writer is matched with a reader of the participant (process) that wrote
+  /// `writer_guid` (a SampleMeta::writer_guid): what this writer writes now reaches that
+  /// participant. A reader's own matching is no proof of it: under DDS Security each side of a
+  /// pair matches when the other's crypto tokens arrive, so a client can hear a server's reply
+  /// writer while that writer does not know the client's reader yet, and VOLATILE samples written
+  /// before it does are never delivered to it.
+  bool matchesParticipantOf(const std::string& writer_guid) const;
+  /// Waits until matchesParticipantOf(writer_guid) or the termination fires.
+  bool waitForParticipantOf(const std::string& writer_guid, const Termination& until) const;
 
  protected:
   WriterBase(std::shared_ptr<Participant> p, const std::string& topic,
@@ -101,8 +110,10 @@ class WriterBase {
   uint32_t serializedSizeRaw(const void* sample) const;
 
  private:
+  class Listener;
   std::shared_ptr<Participant> participant_;
   std::string topic_name_;
+  std::unique_ptr<Listener> listener_;  // outlives writer_ (deleted in the destructor's body)
   eprosima::fastdds::dds::DataWriter* writer_{nullptr};
   eprosima::fastdds::dds::TopicDataType* type_{nullptr};
 };

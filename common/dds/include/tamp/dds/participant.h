@@ -32,6 +32,7 @@ class Publisher;
 class Subscriber;
 class Topic;
 class TopicDataType;
+class DomainParticipantListener;
 }  // namespace eprosima::fastdds::dds
 
 namespace tamp::dds {
@@ -115,7 +116,9 @@ class Participant : public std::enable_shared_from_this<Participant> {
   eprosima::fastdds::dds::DomainParticipant* native() const { return participant_; }
 
  private:
-  Participant() = default;
+  Participant();
+  /// Logs each peer's discovery and authentication time (participant.cc); outlives participant_.
+  std::unique_ptr<eprosima::fastdds::dds::DomainParticipantListener> peer_log_;
   eprosima::fastdds::dds::DomainParticipant* participant_{nullptr};
   eprosima::fastdds::dds::Publisher* publisher_{nullptr};
   eprosima::fastdds::dds::Subscriber* subscriber_{nullptr};

@@ -58,6 +58,13 @@ struct RpcServerOptions {
   int threads{1};
   size_t reply_cache_size{256};
   uint32_t max_request_bytes{0};  ///< 0: the ServiceSpec's limit
+  /// A reply is written only once the reply writer is matched with a reader of the requesting
+  /// participant, waiting for it at most this long (and never past the request's budget); 0: no
+  /// wait. A client matches the server (and sends) when *its* endpoints have matched; the
+  /// server's reply writer may match the client's reply reader later (under DDS Security, when
+  /// that reader's crypto tokens arrive), and a VOLATILE reply written before then is lost.
+  /// $TAMP_RPC_REPLY_MATCH_WAIT_S overrides it (measurements).
+  double reply_match_wait_s{5.0};
 };
 
 namespace detail {
@@ -65,6 +72,9 @@ namespace detail {
 std::string newClientId();
 std::string hostName();
 std::shared_ptr<spdlog::logger> rpcLog();
+/// `configured`, or $TAMP_RPC_REPLY_MATCH_WAIT_S when set (seconds, >= 0; a bad value is logged
+/// and ignored).
+double replyMatchWait(double configured);
 }  // namespace detail
 
 template <typename Req, typename Rep>
@@ -223,6 +233,7 @@ class RpcServer {
         options_(options),
         max_bytes_(options.max_request_bytes ? options.max_request_bytes : spec_limit),
         server_id_(detail::hostName() + ":" + std::to_string(::getpid())),
+        reply_match_wait_s_(detail::replyMatchWait(options.reply_match_wait_s)),
         writer_(p, TopicSpec<Rep>{reply_topic_.assign(service + "/reply").c_str(), QosClass::kRpc}) {
     require(static_cast<bool>(handler_), "RpcServer for '" + service + "' needs a handler");
     require(options.threads >= 1, "RpcServer threads must be >= 1, got " + std::to_string(options.threads));
@@ -263,6 +274,7 @@ class RpcServer {
     Req request;
     Deadline deadline;
     std::stop_token stop;
+    std::string client_writer;  ///< GUID of the request's writer: names the client's participant
   };
 
   void onRequest(const Req& req, const SampleMeta& meta) {
@@ -304,7 +316,7 @@ class RpcServer {
     order_.push_back(h.request_id());
     trimCache();
     const Deadline deadline = h.budget_s() > 0 ? Deadline::in(h.budget_s()) : Deadline::never();
-    queue_.push_back(Job{req, deadline, st.stop.get_token()});
+    queue_.push_back(Job{req, deadline, st.stop.get_token(), meta.writer_guid});
     lock.unlock();
     cv_.notify_one();
   }
@@ -351,9 +363,33 @@ class RpcServer {
           it->second.reply = rep;
         }
       }
+      awaitClient(job, st);
       if (Status s = writer_.write(rep); !s.ok()) {
         detail::rpcLog()->error("{}: cannot send reply {}: {}", service_, h.request_id(), s.error().toString());
       }
+    }
+  }
+
+  /// Before a reply: waits (bounded) until the reply writer is matched with the client's
+  /// participant, so that the reply is not written to no one (RpcServerOptions::reply_match_wait_s).
+  void awaitClient(const Job& job, const std::stop_token& st) {
+    if (job.client_writer.empty() || writer_.matchesParticipantOf(job.client_writer)) return;
+    if (reply_match_wait_s_ <= 0.0) {
+      detail::rpcLog()->warn("{}: reply {} written while the client's reply reader is not matched (no wait)", service_,
+                             job.request.header().request_id());
+      return;
+    }
+    Stopwatch waited;
+    const bool matched = writer_.waitForParticipantOf(
+        job.client_writer, Termination(job.deadline.min(Deadline::in(reply_match_wait_s_)), st));
+    const auto& h = job.request.header();
+    if (matched) {
+      detail::rpcLog()->info("{}: reply {} waited {:.3f} s for the client's reply reader to match", service_,
+                             h.request_id(), waited.seconds());
+    } else {
+      detail::rpcLog()->warn("{}: reply {}: the client's reply reader not matched within {:.3f} s; sent anyway (a "
+                             "retry of the request is answered from the reply cache)",
+                             service_, h.request_id(), waited.seconds());
     }
   }
 
@@ -381,6 +417,7 @@ class RpcServer {
   RpcServerOptions options_;
   uint32_t max_bytes_;
   std::string server_id_;
+  double reply_match_wait_s_;
   std::string request_topic_, reply_topic_;
   std::mutex mutex_;
   std::condition_variable_any cv_;

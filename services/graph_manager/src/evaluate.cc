@@ -79,15 +79,6 @@ MotionAnswer GraphManager::armMotion(const BranchContext& ctx, const std::vector
   return askMotion(q);
 }
 
-double GraphManager::lowerBound(const Edge& e) const {
-  if (e.kind != ActionKind::kMoveBase || e.tokens.size() < 3) return 0.0;
-  const bool push = isPush(e) && e.tokens.size() == 6;  // (push ?o ?r ?from ?to ?s)
-  const auto a = abstraction_.locationPose(e.tokens[push ? 3 : 1]);
-  const auto b = abstraction_.locationPose(e.tokens[push ? 4 : 2]);
-  if (!a || !b) return 0.0;
-  return std::hypot(a->x - b->x, a->y - b->y) / params_.lower_bound_base_speed;
-}
-
 MotionQuery GraphManager::baseQuery(const Edge& e, const BranchContext& ctx) const {
   MotionQuery q;
   q.group = Group::kBase;

@@ -53,6 +53,8 @@ const config::Schema<GraphManagerParams>& schema() {
         .field("held_padding_max_m", &P::held_padding_max_m,
                config::inRange(0.0, 0.25, config::Ends::kClosed, "m"))
         .field("lower_bound_base_speed", &P::lower_bound_base_speed, positive())
+        .field("model_bounds", &P::model_bounds)
+        .field("goal_bound", &P::goal_bound)
         .field("approach_m", &P::approach_m, positive())
         .field("plan_budget_s", &P::plan_budget_s, positive())
         .field("motion_budget_s", &P::motion_budget_s, positive())

@@ -72,7 +72,9 @@ GraphManager::GraphManager(Abstraction abstraction, std::string domain_pddl, Mis
       goal_(std::move(goal)),
       logged_(services),
       services_(logged_),
-      params_(params) {
+      params_(params),
+      // Invalid params are refused just below, with their own message.
+      drive_bound_(params.lower_bound_base_speed > 0.0 ? params.lower_bound_base_speed : 1.0) {
   if (auto why = params_.invalidReason()) throw std::invalid_argument("GraphManagerParams: " + *why);
   domain_pushes_ = pushesIn(domain_);
 }
@@ -331,8 +333,8 @@ struct GraphManager::Search {
       Edge& e = gm.graph_.edge(pick);
       if (e.to == v || onBranch(e.to)) continue;
       if (!std::isfinite(pick_cost)) continue;
-      if (!exhaustive && cost + pick_cost >= best) {
-        cut(pick, cost + pick_cost);
+      if (!exhaustive && cost + pick_cost + gm.toGoalBound(e.to) >= best) {
+        cut(pick, cost + pick_cost + gm.toGoalBound(e.to));
         continue;
       }
       if (e.kind == ActionKind::kMoveArm) {
@@ -345,8 +347,8 @@ struct GraphManager::Search {
       // Evaluating may grow the graph (variants, sub-tasks): the edge is looked up again.
       Edge& done = gm.graph_.edge(pick);
       if (!std::isfinite(c)) continue;
-      if (!exhaustive && cost + c >= best) {
-        cut(pick, cost + c);
+      if (!exhaustive && cost + c + gm.toGoalBound(done.to) >= best) {
+        cut(pick, cost + c + gm.toGoalBound(done.to));
         continue;
       }
       branch.push_back(pick);
@@ -373,8 +375,9 @@ struct GraphManager::Search {
       ++evaluations;
       const double c = gm.evaluate(arm, f, ctx, depth);
       if (!std::isfinite(c)) continue;
-      if (!exhaustive && cost + c >= best) {
-        cut(arm, cost + c);
+      const double to_goal = gm.toGoalBound(a.to);  // an arm motion leaves the base where it is
+      if (!exhaustive && cost + c + to_goal >= best) {
+        cut(arm, cost + c + to_goal);
         continue;
       }
       const auto sd = gm.graph_.edge(arm).effort_by_next[f].second;
@@ -389,8 +392,9 @@ struct GraphManager::Search {
         const Edge& fe = gm.graph_.edge(f);
         ++evaluations;
         const double cf = gm.evaluate(f, -1, next_ctx, depth);
-        if (std::isfinite(cf) && !exhaustive && cost + c + cf >= best) bounded.insert(branch.begin(), branch.end());
-        if (std::isfinite(cf) && (exhaustive || cost + c + cf < best) && !onBranch(fe.to)) {
+        const double after = std::isfinite(cf) ? cost + c + cf + gm.toGoalBound(fe.to) : kInfinity;
+        if (std::isfinite(cf) && !exhaustive && after >= best) bounded.insert(branch.begin(), branch.end());
+        if (std::isfinite(cf) && (exhaustive || after < best) && !onBranch(fe.to)) {
           branch.push_back(f);
           branch_sd2.push_back(fe.effort_stddev_s * fe.effort_stddev_s);
           steps.push_back(stepOf(fe, cf));
@@ -425,6 +429,7 @@ TraverseResult GraphManager::search(NodeId from, const BranchContext& context, b
       return r;
     }
   }
+  boundsForCurrentModels();
   Search s(*this, t0);
   s.first_edge_only = first_edge_only;
   s.dfs(from, context, 0.0, 0);

@@ -50,6 +50,7 @@
 
 #include "tamp/graph_manager/abstraction.h"
 #include "tamp/graph_manager/call_log.h"
+#include "tamp/graph_manager/bound.h"
 #include "tamp/graph_manager/clients.h"
 #include "tamp/graph_manager/graph.h"
 #include "tamp/graph_manager/params.h"
@@ -408,7 +409,18 @@ class GraphManager {
   /// Whether the arm is in a driving configuration (`stow` or `carry`, within
   /// stowed_tolerance_rad): what the symbol `stow` stands for.
   bool armStowed(const std::vector<double>& arm) const;
+  /// What an edge without a motion costs at least (bound.cc): a base motion, the drive bound of
+  /// its locations' distance; anything else 0.
   double lowerBound(const Edge& e) const;
+  /// Asks the effort estimator for the drive times drive_bound_ interpolates; without a usable
+  /// answer (or with params_.model_bounds off) the distance bound stays.
+  void calibrateBounds();
+  /// Before a Traverse: calibrates the bounds again when the estimator's model version changed
+  /// since the last calibration (a faster robot lowers them; stale bounds would not be admissible).
+  void boundsForCurrentModels();
+  /// What the rest of any branch from node `v` costs at least: the drive from v's location to the
+  /// goal's (0 when the goal names none, or params_.goal_bound is off).
+  double toGoalBound(NodeId v);
   /// Removal sub-tasks for the objects `e`'s lazy path crosses; returns how many of them it
   /// found the robot cannot move at all (added to fixed_objects_).
   int spawnSubtasks(EdgeId e, const BranchContext& ctx, int depth);
@@ -607,6 +619,10 @@ class GraphManager {
   /// step when it answers true, as when its budget runs out.
   std::function<bool()> interrupted_;
   double planning_s_{0.0};
+  DriveBound drive_bound_;  ///< what a base motion costs at least (calibrateBounds)
+  std::map<NodeId, double> to_goal_bound_;  ///< toGoalBound's answers for the current calibration
+  bool bounds_calibrated_{false};
+  std::optional<std::uint64_t> bound_version_;  ///< the model version drive_bound_ was asked under
   /// The margin a held object is planned with (params_.held_padding_step_m per static contact
   /// the robot was stopped before while holding; see Run::replan).
   double held_padding_m_{0.0};

@@ -62,6 +62,11 @@ struct GraphManagerParams {
   double held_padding_step_m{0.03};
   double held_padding_max_m{0.09};
   double lower_bound_base_speed{1.5};  ///< m/s, above the robot's top speed (admissible bound); > 0
+  /// Bound a base motion by the effort model's time of one straight drive of its length (bound.cc),
+  /// not only by the distance at lower_bound_base_speed.
+  bool model_bounds{true};
+  /// Cut a branch on its cost plus the drive bound from where it stands to the goal's location.
+  bool goal_bound{true};
   double approach_m{0.10};         ///< pick/place: gripper approach and retreat along z (m); > 0
   double plan_budget_s{5.0};       ///< per task-planner call; > 0
   double motion_budget_s{8.0};     ///< per motion call; > 0

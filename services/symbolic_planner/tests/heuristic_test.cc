@@ -578,7 +578,9 @@ TEST(Heuristic, FFThroughHaddSupportersIsTheCostBasedRelaxedPlanOnEveryTask) {
     });
     if (HasFatalFailure()) return;
     EXPECT_GT(states, 200U);
-    if (p.find("blocks") != std::string::npos) EXPECT_GT(differ, 0U);
+    if (p.find("blocks") != std::string::npos) {
+      EXPECT_GT(differ, 0U);
+    }
   }
 }
 

@@ -12,7 +12,7 @@
 ///   a hill-climbing that has used `ehc_lazy_after` evaluations and the two take turns in one
 ///   thread; the first plan or proof wins, and a failed hill-climbing leaves the lazy search to go
 ///   on from where it is (`lazy_plan_preferred`: with LAMA-first's preferred operators). A second
-///   lazy search, LAMA-first's (its preferred operators and, `lazy_second_hadd`, its h_FF through
+///   lazy search, with LAMA-first's preferred operators (and, `lazy_second_hadd`, its h_FF through
 ///   h_add's best supporters), joins them once the two have used `lazy_second_after` evaluations
 ///   (`lazy_beside_both`, the default). With
 ///   `ehc_ff_first` (the default) and a heuristic that has
@@ -200,9 +200,10 @@ struct SearchOptions {
   /// cost the same and the default h_FF takes FF's layered graph: with it, that search is
   /// LAMA-first's (its preferred operators, no landmark achievers among them, its h_FF). Only
   /// with the default heuristic (h_FF); the hill-climbing and the first lazy search keep theirs.
-  /// On by default (docs/benchmarks.md, issue 14, thirty-second round: blocks-80 solved, hiking
-  /// faster; airport-40, which the layered graph's second search solved, is left to the first).
-  /// On tasks whose operators differ in cost (cost + 1) h_FF is h_add's already: no change there.
+  /// Off by default (docs/benchmarks.md, issue 14, thirty-second round): on, it solves blocks-80
+  /// and pathways-18 and hiking-16 / -20 faster, but loses trucks-18 and airport-40's time, which
+  /// the layered graph's second search gives. On tasks whose operators differ in cost (cost + 1)
+  /// h_FF is h_add's already: no change there.
   bool lazy_second_hadd{false};
   uint64_t ehc_lazy_after{4000};
   uint64_t ehc_lazy_turn_ehc{100};

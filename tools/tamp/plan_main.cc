@@ -136,8 +136,10 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"ehc", "gbfs", "lazy", "wastar", "astar"}));
   app.add_option("--fallback", fallback, "ehc: the complete search after hill-climbing fails: lazy (default), gbfs")
       ->check(CLI::IsMember({"lazy", "gbfs"}));
-  app.add_option("--heuristic", heuristic, "ff, add, max, blind (default: ff; max for wastar/astar)")
-      ->check(CLI::IsMember({"ff", "add", "max", "blind"}));
+  app.add_option("--heuristic", heuristic,
+                 "ff, add, max, blind, ff-hadd (h_FF through h_add's supporters on every task) (default: ff; max "
+                 "for wastar/astar)")
+      ->check(CLI::IsMember({"ff", "add", "max", "blind", "ff-hadd"}));
   app.add_option("--cost-type", cost_type,
                  "how action costs enter the heuristic: unit, cost, plusone (default: plusone for ehc/gbfs "
                  "on tasks with costs, cost for wastar/astar)")
@@ -240,6 +242,11 @@ int main(int argc, char** argv) {
   app.add_option("--lazy-beside-both", lazy_beside_both,
                  "ehc: two lazy searches beside the hill-climbing in turns, one with the default preferred "
                  "operators, one with LAMA-first's (joining after --lazy-second-after): true or false (default true)");
+  bool lazy_second_hadd = defaults.lazy_second_hadd;
+  app.add_option("--lazy-second-hadd", lazy_second_hadd,
+                 "ehc, --lazy-beside-both: the second lazy search's h_FF through h_add's best supporters (Fast "
+                 "Downward's ff(), LAMA-first's) also where the operators cost the same: true or false (default " +
+                     std::string(defaults.lazy_second_hadd ? "true" : "false") + ")");
   uint64_t lazy_second_after = defaults.lazy_second_after;
   app.add_option("--lazy-second-after", lazy_second_after,
                  "ehc, --lazy-beside-both: the second lazy search joins after this many evaluations of the "
@@ -291,6 +298,7 @@ int main(int argc, char** argv) {
   req.search.lazy_plan_preferred = lazy_plan_preferred;
   req.search.lazy_beside_both = lazy_beside_both;
   req.search.lazy_second_after = lazy_second_after;
+  req.search.lazy_second_hadd = lazy_second_hadd;
   req.search.ehc_h2_restart = h2_restart;
   req.search.ehc_h2_test_gap_max = h2_test_gap_max;
   req.search.ehc_ff_first_h2_restart = ff_first_h2_restart;
@@ -306,6 +314,7 @@ int main(int argc, char** argv) {
   if (heuristic == "add") req.search.heuristic = sp::HeuristicKind::kAdd;
   if (heuristic == "max") req.search.heuristic = sp::HeuristicKind::kMax;
   if (heuristic == "blind") req.search.heuristic = sp::HeuristicKind::kBlind;
+  if (heuristic == "ff-hadd") req.search.heuristic = sp::HeuristicKind::kFFHadd;
   if (cost_type == "unit") req.search.cost_type = sp::CostType::kUnit;
   if (cost_type == "cost") req.search.cost_type = sp::CostType::kCost;
   if (cost_type == "plusone") req.search.cost_type = sp::CostType::kPlusOne;

@@ -12,6 +12,10 @@
 # landed results.
 #   services/symbolic_planner/bench/run_ipc_bench.sh [BUILD_DIR] [SET...]
 #   (default build/planner, Release; default sets: pddl pddl-adl pddl-more)
+# Beside it, for the rounds of issue 14: sweep_set.sh (one set with one binary under one hold of
+# the lock, a CSV per domain, extra planner arguments), probe.sh (single runs on named instances)
+# and ipc_compare.py (two runs instance by instance; one run against the FF / LAMA-first
+# references; coverage of several runs).
 set -euo pipefail
 cd "$(dirname "$0")/../../.."
 build=${1:-build/planner}

@@ -1202,6 +1202,8 @@ std::unique_ptr<Heuristic> makeHeuristic(HeuristicKind kind, const Task& task, C
       }
       return std::make_unique<RelaxationHeuristic>(task, cost_type, RelaxationHeuristic::Mode::kFF);
     }
+    case HeuristicKind::kFFHadd:
+      return std::make_unique<RelaxationHeuristic>(task, cost_type, RelaxationHeuristic::Mode::kFF);
     case HeuristicKind::kAdd: return std::make_unique<RelaxationHeuristic>(task, cost_type, RelaxationHeuristic::Mode::kAdd);
     case HeuristicKind::kMax: return std::make_unique<RelaxationHeuristic>(task, cost_type, RelaxationHeuristic::Mode::kMax);
     case HeuristicKind::kBlind: return std::make_unique<BlindHeuristic>(task);

@@ -1495,7 +1495,12 @@ class LazyBeside : public TurnTaker {
   }
   void addLane(bool plan_preferred) {
     Lane& l = lanes_.emplace_back();
-    l.heuristic = makeHeuristic(defaultHeuristic(options_), task_, defaultCostType(options_, task_));
+    HeuristicKind kind = defaultHeuristic(options_);
+    // The second lane (LAMA-first's): h_FF through h_add's best supporters, as Fast Downward's.
+    if (lanes_.size() == 2 && options_.lazy_second_hadd && kind == HeuristicKind::kFF) {
+      kind = HeuristicKind::kFFHadd;
+    }
+    l.heuristic = makeHeuristic(kind, task_, defaultCostType(options_, task_));
     l.searcher = std::make_unique<Searcher>(task_, init_, goal_, options_, *l.heuristic, term_);
     if (landmarks_) l.searcher->shareLandmarkGraph(&*landmarks_);
     if (plan_preferred && l.heuristic->setRelaxedPlanPreferred(true)) l.searcher->preferNoLandmarkAchievers();

@@ -98,7 +98,7 @@ TEST_P(HeuristicContract, ZeroAtGoalNonNegativeAndDeadEndsOnRandomWalks) {
 INSTANTIATE_TEST_SUITE_P(
     All, HeuristicContract,
     ::testing::Combine(::testing::Values(HeuristicKind::kFF, HeuristicKind::kAdd,
-                                         HeuristicKind::kMax, HeuristicKind::kBlind),
+                                         HeuristicKind::kMax, HeuristicKind::kBlind, HeuristicKind::kFFHadd),
                        ::testing::Values(CostType::kUnit, CostType::kCost, CostType::kPlusOne)));
 
 // The cost-based exploration keeps per-evaluation records that each evaluation resets (issue 14,
@@ -517,6 +517,70 @@ TEST(Heuristic, RelaxedPlanPreferredAreTheRelaxedPlansOwnApplicableOperatorsAmon
   ASSERT_NO_FATAL_FAILURE(loadSolvedInstance("pddl/gripper/domain.pddl", "pddl/gripper/instance-4.pddl", in));
   for (HeuristicKind k : {HeuristicKind::kAdd, HeuristicKind::kBlind}) {
     EXPECT_FALSE(makeHeuristic(k, in.task(), CostType::kUnit)->setRelaxedPlanPreferred(true));
+  }
+}
+
+TEST(Heuristic, FFThroughHaddSupportersIsTheCostBasedRelaxedPlanOnEveryTask) {
+  // kFFHadd (the second lazy search's h_FF with `lazy_second_hadd`, Fast Downward's ff()): on a
+  // task whose operators differ in cost it is kFF (both the relaxed plan through h_add's best
+  // supporters): the same values and preferred operators. On unit-cost tasks, where kFF takes
+  // FF's layered graph, it is still h_add's: in every state of random walks (fixed seed) h_max
+  // <= it <= h_add (one relaxed plan, each operator once), a dead end exactly where h_add's, and
+  // on blocks-20 it differs from the layered graph's in some states (a layered h_FF would fail).
+  SolvedInstance cost_in;
+  ASSERT_NO_FATAL_FAILURE(
+      loadSolvedInstance("pddl-more/transport/domain.pddl", "pddl-more/transport/instance-6.pddl", cost_in));
+  {
+    auto ff = makeHeuristic(HeuristicKind::kFF, cost_in.task(), CostType::kPlusOne);
+    auto hadd_ff = makeHeuristic(HeuristicKind::kFFHadd, cost_in.task(), CostType::kPlusOne);
+    ff->setGoal(cost_in.goal);
+    hadd_ff->setGoal(cost_in.goal);
+    ASSERT_TRUE(ff->setRelaxedPlanPreferred(true));
+    ASSERT_TRUE(hadd_ff->setRelaxedPlanPreferred(true));
+    size_t states = 0;
+    forEachRandomWalkState(cost_in.task(), cost_in.init, /*seed=*/5, /*walks=*/5, /*steps=*/40,
+                           [&](const StateBits& cur, int walk, int step) {
+                             ASSERT_EQ(hadd_ff->evaluate(cur.data()), ff->evaluate(cur.data()))
+                                 << "walk " << walk << " step " << step;
+                             ASSERT_EQ(hadd_ff->preferred(), ff->preferred());
+                             ++states;
+                           });
+    if (HasFatalFailure()) return;
+    EXPECT_GT(states, 100U);
+  }
+  for (const char* prob : {"pddl/blocks/instance-20.pddl", "pddl-more/hiking/instance-4.pddl"}) {
+    SCOPED_TRACE(prob);
+    const std::string p = prob;
+    SolvedInstance in;
+    ASSERT_NO_FATAL_FAILURE(loadSolvedInstance(p.substr(0, p.rfind('/')) + "/domain.pddl", p, in));
+    const Task& t = in.task();
+    auto layered = makeHeuristic(HeuristicKind::kFF, t, CostType::kUnit);
+    auto hadd_ff = makeHeuristic(HeuristicKind::kFFHadd, t, CostType::kUnit);
+    auto hadd = makeHeuristic(HeuristicKind::kAdd, t, CostType::kUnit);
+    auto hmax = makeHeuristic(HeuristicKind::kMax, t, CostType::kUnit);
+    for (auto* h : {layered.get(), hadd_ff.get(), hadd.get(), hmax.get()}) h->setGoal(in.goal);
+    EXPECT_TRUE(hadd_ff->computesPreferred());
+    size_t states = 0, differ = 0;
+    forEachRandomWalkState(t, in.init, /*seed=*/11, /*walks=*/10, /*steps=*/60, [&](const StateBits& cur, int walk,
+                                                                                    int step) {
+      const Cost v = hadd_ff->evaluate(cur.data());
+      const Cost a = hadd->evaluate(cur.data());
+      const Cost m = hmax->evaluate(cur.data());
+      ++states;
+      if (a == Heuristic::kDeadEnd) {
+        ASSERT_EQ(v, Heuristic::kDeadEnd) << "walk " << walk << " step " << step;
+        return;
+      }
+      ASSERT_LE(m, v) << "walk " << walk << " step " << step;
+      ASSERT_LE(v, a) << "walk " << walk << " step " << step;
+      for (OpId o : hadd_ff->preferred()) ASSERT_TRUE(t.applicable(cur.data(), o));
+      differ += v != layered->evaluate(cur.data()) ? 1 : 0;
+    });
+    if (HasFatalFailure()) return;
+    EXPECT_GT(states, 200U);
+    if (p.find("blocks") != std::string::npos) {
+      EXPECT_GT(differ, 0U);
+    }
   }
 }
 

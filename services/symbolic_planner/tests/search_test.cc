@@ -605,6 +605,7 @@ TEST(Search, TwoLazySearchesBesideTheHillClimbingGiveTheFirstAnswerOfEither) {
     req.search.lazy_plan_preferred = false;
     req.search.lazy_beside_both = true;
     req.search.lazy_second_after = 0;
+    req.search.lazy_second_hadd = false;  // the second as the `lazy_plan_preferred` run's (tested below)
     PlanReply both = plan(req, Termination());
     PlanReply again = plan(req, Termination());
     ASSERT_EQ(alone.status, PlanStatus::kSolved) << alone.message;
@@ -655,6 +656,7 @@ TEST(Search, SecondLazySearchJoinsOnlyAfterLazySecondAfterEvaluations) {
   PlanReply hk_delayed = plan(hk, Termination());
   PlanReply hk_again = plan(hk, Termination());
   hk.search.lazy_second_after = 0;
+  hk.search.lazy_second_hadd = false;  // the `lazy_plan_preferred` run's heuristic (see below)
   PlanReply hk_together = plan(hk, Termination());
   hk.search.lazy_beside_both = false;
   PlanReply hk_one = plan(hk, Termination());
@@ -671,6 +673,37 @@ TEST(Search, SecondLazySearchJoinsOnlyAfterLazySecondAfterEvaluations) {
   EXPECT_NE(hk_together.plan, hk_one.plan);
   EXPECT_EQ(hk_again.plan, hk_delayed.plan);
   EXPECT_EQ(hk_again.stats.evaluated, hk_delayed.stats.evaluated);
+}
+
+TEST(Search, SecondLazySearchTakesItsRelaxedPlanThroughHaddSupporters) {
+  // `lazy_second_hadd` (off by default): the second lazy search's h_FF is Fast Downward's (the relaxed
+  // plan through h_add's best supporters) also on unit-cost tasks, where the others take FF's
+  // layered graph, so that search is LAMA-first's. hiking-4 with both from the start: the second
+  // answers, with the plan of a single `lazy_plan_preferred` lazy search on `kFFHadd` (it searches
+  // as it would alone), not the plan it gives with the layered graph; checked, the same in a
+  // second run. Off, the second's plan is the layered graph's (the test above).
+  PlanRequest hk = benchmarkRequest("pddl-more/hiking", "instance-4.pddl");
+  hk.timeout_seconds = 120;
+  ASSERT_FALSE(hk.search.lazy_second_hadd);  // the default
+  hk.search.lazy_second_hadd = true;
+  hk.search.lazy_second_after = 0;
+  PlanReply hadd = plan(hk, Termination());
+  PlanReply again = plan(hk, Termination());
+  hk.search.lazy_second_hadd = false;
+  PlanReply layered = plan(hk, Termination());
+  hk.search.lazy_beside_both = false;
+  hk.search.lazy_plan_preferred = true;
+  hk.search.heuristic = HeuristicKind::kFFHadd;
+  PlanReply alone = plan(hk, Termination());
+  ASSERT_EQ(hadd.status, PlanStatus::kSolved) << hadd.message;  // replayed by the checker
+  ASSERT_EQ(layered.status, PlanStatus::kSolved) << layered.message;
+  ASSERT_EQ(alone.status, PlanStatus::kSolved) << alone.message;
+  EXPECT_TRUE(hadd.stats.lazy_beside_won);
+  EXPECT_TRUE(alone.stats.lazy_beside_won);
+  EXPECT_EQ(hadd.plan, alone.plan);
+  EXPECT_NE(hadd.plan, layered.plan);
+  EXPECT_EQ(again.plan, hadd.plan);
+  EXPECT_EQ(again.stats.evaluated, hadd.stats.evaluated);
 }
 
 TEST(Search, LazySearchBesideProvesUnsolvabilityAndGoesOnAloneWhenTheHillClimbingGivesUp) {

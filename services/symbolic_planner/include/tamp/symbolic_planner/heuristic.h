@@ -13,6 +13,10 @@
 /// - `hff`: the cost of a relaxed plan extracted backwards through the best supporters of `hadd`
 ///   (Hoffmann & Nebel 2001, with FD's h_add supporters), with FF's *helpful actions*: the
 ///   operators applicable in the state that add a sub-goal of the relaxed plan's first layer.
+///   Where every operator costs the same, FF's own layered planning graph instead (the same
+///   value scale; its relaxed plan takes each sub-goal's achiever from the first layer).
+/// - `hff_hadd`: h_FF through h_add's best supporters whatever the costs (Fast Downward's `ff()`,
+///   and so LAMA-first's), also where `hff` would take FF's layered graph.
 ///
 /// Contract (tested for every heuristic): h(s) = 0 when s satisfies the goal, h(s) >= 0, and
 /// `kDeadEnd` exactly when the goal is unreachable even under the relaxation (so `kDeadEnd`
@@ -34,7 +38,13 @@ enum class CostType {
   kPlusOne,  ///< cost + 1 (LAMA's choice for zero-cost actions in satisficing search)
 };
 
-enum class HeuristicKind { kFF, kAdd, kMax, kBlind };
+enum class HeuristicKind {
+  kFF,      ///< h_FF: FF's layered graph on uniform costs, h_add's best supporters otherwise
+  kAdd,     ///< h_add
+  kMax,     ///< h_max
+  kBlind,   ///< 0 at the goal, 1 elsewhere
+  kFFHadd,  ///< h_FF through h_add's best supporters on every task (Fast Downward's ff())
+};
 
 class Heuristic {
  public:

@@ -12,8 +12,9 @@
 ///   a hill-climbing that has used `ehc_lazy_after` evaluations and the two take turns in one
 ///   thread; the first plan or proof wins, and a failed hill-climbing leaves the lazy search to go
 ///   on from where it is (`lazy_plan_preferred`: with LAMA-first's preferred operators). A second
-///   lazy search, with LAMA-first's preferred operators, joins them once the two have used
-///   `lazy_second_after` evaluations (`lazy_beside_both`, the default). With
+///   lazy search, with LAMA-first's preferred operators (and, `lazy_second_hadd`, its h_FF through
+///   h_add's best supporters), joins them once the two have used `lazy_second_after` evaluations
+///   (`lazy_beside_both`, the default). With
 ///   `ehc_ff_first` (the default) and a heuristic that has
 ///   FF-v2.3's variant (`Heuristic::setFFStyle`), a first hill-climbing run uses that variant
 ///   within a budget of evaluations (it tends to give shorter plans); when it fails or runs
@@ -194,6 +195,16 @@ struct SearchOptions {
   /// for the second; one that needs hundreds of thousands (hiking-16) loses a few
   /// seconds (docs/benchmarks.md, issue 14, thirty-first round: 8 000, 16 000 and 32 000).
   uint64_t lazy_second_after{32'000};
+  /// lazy_beside_both: the second lazy search's h_FF takes its relaxed plan through h_add's best
+  /// supporters (`HeuristicKind::kFFHadd`, Fast Downward's `ff()`), also where the operators
+  /// cost the same and the default h_FF takes FF's layered graph: with it, that search is
+  /// LAMA-first's (its preferred operators, no landmark achievers among them, its h_FF). Only
+  /// with the default heuristic (h_FF); the hill-climbing and the first lazy search keep theirs.
+  /// Off by default (docs/benchmarks.md, issue 14, thirty-second round): on, it solves blocks-80
+  /// and pathways-18 and hiking-16 / -20 faster, but loses trucks-18 and airport-40's time, which
+  /// the layered graph's second search gives. On tasks whose operators differ in cost (cost + 1)
+  /// h_FF is h_add's already: no change there.
+  bool lazy_second_hadd{false};
   uint64_t ehc_lazy_after{4000};
   uint64_t ehc_lazy_turn_ehc{100};
   uint64_t ehc_lazy_turn_lazy{100};

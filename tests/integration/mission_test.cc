@@ -61,6 +61,12 @@ TEST(MissionTest, CorridorEffortPolicyMovesTheLightBoxAndReachesTheGoal) {
   EXPECT_GE(first["per_service"]["motion"]["calls"].get<int>(), 2) << first.dump(1);
   EXPECT_EQ(first["calls"].size(), first["critical_calls"].get<std::size_t>());
   EXPECT_LE(first["critical_calls_s"].get<double>(), m.report["planning_time_to_first_action_s"].get<double>() + 1e-6);
+  // The last run's report is also where a script finds it without the run's id: OUT/report.json,
+  // and OUT/latest points at the run folder.
+  const fs::path out = m.run_dir.parent_path();
+  EXPECT_EQ(readFile(out / "report.json"), readFile(m.run_dir / "report.json"));
+  ASSERT_TRUE(fs::is_symlink(out / "latest")) << m.output;
+  EXPECT_EQ(fs::canonical(out / "latest"), fs::canonical(m.run_dir));
 }
 
 // A hall that is one large floor region: the first plan picks the parcel from wherever "reaches"
@@ -404,6 +410,22 @@ TEST(MissionTest, AMissionOutOfTimeIsAbortedAndStillLeavesItsReport) {
   // At twice real time four seconds are not enough to reach the goal (8.5, 1.2) from (1.5, 1.2).
   EXPECT_GT(distance(m.truth["robot"], 8.5, 1.2), 1.0) << m.truth.dump();
   EXPECT_EQ(m.output.find("ended with signal 9"), std::string::npos) << "a service had to be killed: " << m.output;
+}
+
+// The report is the mission's result: one that cannot be written is an error (exit 50, what and
+// where), not a silent success. OUT/report.json is a folder here, so the copy there fails; the
+// run folder's own report was written first and stays.
+TEST(MissionTest, AReportThatCannotBeWrittenIsAnOutputError) {
+  const fs::path out = tempFile("tamp_mission_unwritable_report");
+  fs::remove_all(out);
+  fs::create_directories(out / "report.json" / "in_the_way");
+  fs::create_directories(out / "deploy" / "store");
+  const Mission m = runWith(out, fastDeployment(out / "deploy", 5.0), "namo_corridor_short.yaml");
+  EXPECT_EQ(m.exit_code, 50) << m.output;
+  EXPECT_NE(m.output.find("the report was not written"), std::string::npos) << m.output;
+  EXPECT_NE(m.output.find((out / "report.json").string()), std::string::npos) << m.output;
+  ASSERT_TRUE(m.report.is_object()) << m.output;
+  EXPECT_EQ(m.report["status"], "succeeded");
 }
 
 TEST(MissionTest, ABadScenarioIsAnInputErrorBeforeAnyServiceStarts) {

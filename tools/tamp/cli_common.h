@@ -3,7 +3,8 @@
 /// Conventions shared by the `tamp-*` subcommand executables (tools/tamp/*_main.cc).
 ///
 /// Exit codes follow Fast Downward's ranges: 0 success, 10-19 no solution (proven), 20-29 out of
-/// time/memory, 30-39 input or usage errors, 40-49 a service/peer problem.
+/// time/memory, 30-39 input or usage errors, 40-49 a service/peer problem, 50 an output that could not
+/// be written.
 
 #include <csignal>
 #include <initializer_list>
@@ -15,6 +16,7 @@ inline constexpr int kExitNoSolution = 10;
 inline constexpr int kExitTimeout = 20;
 inline constexpr int kExitInputError = 30;
 inline constexpr int kExitServiceError = 40;
+inline constexpr int kExitOutputError = 50;
 
 /// Set once one of the signals of `stopOnSignals` arrived: the tool's loops end and it cleans up.
 inline volatile std::sig_atomic_t g_stop_requested = 0;

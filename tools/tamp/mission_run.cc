@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <fstream>
 #include <mutex>
+#include <optional>
 #include <thread>
 
 #include <nlohmann/json.hpp>
@@ -97,9 +98,45 @@ void writeWorldPictures(const world::Scenario& sc, const nlohmann::json& report,
   }
 }
 
-void writeArtefacts(const msg::MissionStatus& st, const MissionOptions& o) {
+/// Writes `text` to `file` through a temporary in the same folder and a rename, so a reader never
+/// sees half a report. The error, or nothing.
+std::optional<std::string> writeAtomically(const fs::path& file, const std::string& text) {
+  const fs::path tmp = file.string() + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::trunc);
+    out << text;
+    out.flush();
+    if (!out) return "cannot write " + tmp.string();
+  }
+  std::error_code ec;
+  fs::rename(tmp, file, ec);
+  if (ec) return "cannot rename " + tmp.string() + " to " + file.string() + ": " + ec.message();
+  return std::nullopt;
+}
+
+/// `latest_dir/latest` -> the run folder (relative when inside latest_dir), replaced atomically.
+std::optional<std::string> pointLatestAt(const fs::path& latest_dir, const fs::path& run_dir) {
+  const fs::path link = latest_dir / "latest";
+  const fs::path tmp = latest_dir / ".latest.tmp";
+  std::error_code ec;
+  fs::remove(tmp, ec);
+  const fs::path rel = run_dir.lexically_relative(latest_dir);
+  fs::create_directory_symlink(rel.empty() || *rel.begin() == ".." ? run_dir : rel, tmp, ec);
+  if (!ec) fs::rename(tmp, link, ec);
+  if (ec) return "cannot link " + link.string() + " to " + run_dir.string() + ": " + ec.message();
+  return std::nullopt;
+}
+
+/// The run's artefacts; the error of a report that could not be written, or nothing. The graph
+/// and the pictures are best effort (a missing graphviz is said, not fatal).
+std::optional<std::string> writeArtefacts(const msg::MissionStatus& st, const MissionOptions& o) {
   const fs::path dir = o.out_dir;
-  std::ofstream(dir / "report.json") << st.report_json() << "\n";
+  const std::string report_text = st.report_json() + "\n";
+  if (auto bad = writeAtomically(dir / "report.json", report_text)) return bad;
+  if (!o.latest_dir.empty()) {
+    if (auto bad = writeAtomically(o.latest_dir / "report.json", report_text)) return bad;
+    if (auto bad = pointLatestAt(o.latest_dir, dir)) return bad;
+  }
   if (!st.graph_dot().empty()) {
     std::ofstream(dir / "graph.dot") << st.graph_dot();
     const std::string cmd = "dot -Tsvg '" + (dir / "graph.dot").string() + "' -o '" + (dir / "graph.svg").string() +
@@ -109,6 +146,7 @@ void writeArtefacts(const msg::MissionStatus& st, const MissionOptions& o) {
   auto report = nlohmann::json::parse(st.report_json(), nullptr, false);
   auto sc = world::loadScenario(o.scenario);
   if (!report.is_discarded() && sc) writeWorldPictures(*sc, report, dir);
+  return std::nullopt;
 }
 
 int exitCodeOf(const nlohmann::json& report, msg::MissionState state) {
@@ -256,10 +294,17 @@ int runMission(const std::shared_ptr<dds::Participant>& p, const MissionOptions&
   }
   const msg::MissionStatus final_status = *last;
   lock.unlock();
-  writeArtefacts(final_status, o);
+  const auto written = writeArtefacts(final_status, o);
   const auto report = nlohmann::json::parse(final_status.report_json(), nullptr, false);
   printSummary(report);
+  if (written) {
+    std::fprintf(stderr, "tamp run: the report was not written: %s\n", written->c_str());
+    return cli::kExitOutputError;
+  }
   std::printf("tamp run: report, graph and pictures in %s\n", o.out_dir.c_str());
+  if (!o.latest_dir.empty())
+    std::printf("tamp run: report also at %s (%s -> this run)\n", (o.latest_dir / "report.json").c_str(),
+                (o.latest_dir / "latest").c_str());
   return timed_out ? cli::kExitTimeout : exitCodeOf(report, final_status.state());
 }
 

@@ -19,13 +19,17 @@ struct MissionOptions {
   std::string policy{"effort"};
   unsigned seed{0};
   double timeout_s{900.0};
-  std::filesystem::path out_dir;
+  std::filesystem::path out_dir;  ///< this run's folder: report.json, graph, pictures
+  /// When set (tamp run's --out), the run's report is also left at `latest_dir/report.json` and
+  /// `latest_dir/latest` links to `out_dir`, so a script finds the last run without its id.
+  std::filesystem::path latest_dir;
 };
 
 /// Loads the scenario (and its robot): the error (file:line: field) or nothing.
 std::optional<std::string> checkScenario(const std::string& file);
 
-/// Runs the mission and returns the exit code (0, 10, 20, 30, 40). `poll` is called while
+/// Runs the mission and returns the exit code (0, 10, 20, 30, 40; 50 when its report could not be
+/// written). `poll` is called while
 /// waiting; it returns true to abort.
 int runMission(const std::shared_ptr<dds::Participant>& participant, const MissionOptions& options,
                const std::function<bool()>& poll);

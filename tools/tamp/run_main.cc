@@ -286,6 +286,7 @@ int main(int argc, char** argv) {
     mo.seed = seed;
     mo.timeout_s = mission_timeout;
     mo.out_dir = run_dir;
+    mo.latest_dir = run_dir.parent_path();
     rc = tamp::runner::runMission(participant, mo, [&] {
       launcher.poll();
       return tamp::cli::stopRequested();

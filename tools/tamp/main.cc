@@ -39,7 +39,7 @@ int usage(const fs::path& dir, std::ostream& os) {
         "Subcommands (each has --help):\n";
   for (const auto& s : subcommands(dir)) os << "  " << s << "\n";
   os << "\nExit codes: 0 success, 10-19 no solution, 20-29 out of time/memory, 30-39 input error,\n"
-        "40-49 service unavailable.\n";
+        "40-49 service unavailable, 50 an output could not be written.\n";
   return 0;
 }
 

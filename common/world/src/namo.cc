@@ -99,7 +99,7 @@ struct Builder {
     o.shape = Shape::prism(std::move(local), height);
     o.pose.translation() = Eigen::Vector3d(c.x(), c.y(), 0.5 * height);
     if (kind == ObjectKind::kMovable) {
-      o.mass = std::clamp(opt.density * std::abs(signedArea(clean)) * height, 1.0, 150.0);
+      o.mass = std::clamp(opt.density * std::abs(signedArea(clean)) * height, 1.0, std::max(1.0, opt.max_mass));
       o.graspable = o.mass <= opt.max_graspable_mass;
       o.region = "floor";
     }
@@ -199,6 +199,7 @@ std::optional<std::string> NamoOptions::invalidReason() const {
   if (!pos(wall_height)) return "wall_height must be positive, got " + num(wall_height);
   if (!pos(movable_height)) return "movable_height must be positive, got " + num(movable_height);
   if (!pos(density)) return "density must be positive, got " + num(density);
+  if (!(std::isfinite(max_mass) && max_mass >= 1.0)) return "max_mass must be >= 1 kg, got " + num(max_mass);
   if (!(max_graspable_mass >= 0))
     return "max_graspable_mass must be >= 0, got " + num(max_graspable_mass);
   if (!pos(bare_robot_side)) return "bare_robot_side must be positive, got " + num(bare_robot_side);

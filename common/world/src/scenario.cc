@@ -199,8 +199,9 @@ double narrowestWidth(const Shape& s) {
 
 /// The robot's limits on grasping (from its description), for the graspability rules.
 struct GraspLimits {
-  double payload{0.0};    ///< kg
-  double max_width{0.0};  ///< m
+  double payload{0.0};     ///< kg
+  double max_width{0.0};   ///< m
+  double push_limit{0.0};  ///< kg, the heaviest object the base pushes
   std::string source;     ///< the robot description file, for messages
 };
 
@@ -466,7 +467,10 @@ void readPerception(FieldReader& r, PerceptionPriors& p) {
 
 NamoOptions readNamoOptions(FieldReader& w, const GraspLimits* limits) {
   NamoOptions o;
-  if (limits != nullptr) o.max_graspable_mass = limits->payload;
+  if (limits != nullptr) {
+    o.max_graspable_mass = limits->payload;
+    o.max_mass = std::max({1.0, limits->payload, limits->push_limit});
+  }
   if (!w.has("namo_options")) {
     w.ignore("namo_options");
     return o;
@@ -478,6 +482,7 @@ NamoOptions readNamoOptions(FieldReader& w, const GraspLimits* limits) {
   n.optional("wall_height", o.wall_height);
   n.optional("movable_height", o.movable_height);
   n.optional("density", o.density);
+  n.optional("max_mass", o.max_mass);
   if (n.optional("max_graspable_mass", o.max_graspable_mass) && limits != nullptr &&
       o.max_graspable_mass > limits->payload) {
     n.fail("max_graspable_mass", "must not exceed the robot's payload of " +
@@ -1033,7 +1038,7 @@ Result<Scenario> parseScenarioImpl(const std::string& yaml_text, const std::stri
   std::optional<GraspLimits> grasp_limits;
   if (model) {
     grasp_limits =
-        GraspLimits{model->payload(), model->maxGraspWidth(), sc.robot.description.string()};
+        GraspLimits{model->payload(), model->maxGraspWidth(), model->pushLimit(), sc.robot.description.string()};
   }
   const GraspLimits* limits = grasp_limits ? &*grasp_limits : nullptr;
 
@@ -1081,6 +1086,7 @@ Result<Scenario> loadScenario(const std::filesystem::path& file) {
     NamoOptions o;
     o.robot_radius = model->baseRadius();
     o.max_graspable_mass = model->payload();
+    o.max_mass = std::max({1.0, model->payload(), model->pushLimit()});
     auto nw = loadNamo(file, o);
     if (!nw) return nw.error();
     Scenario sc;

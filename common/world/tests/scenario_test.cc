@@ -459,6 +459,53 @@ TEST(ScenarioGraspabilityTest, NamoMassRuleFollowsThePayload) {
   EXPECT_GT(direct_movable, 0);
 }
 
+// A NAMO world's movables are movable by the benchmark's own rule; the masses are the loader's
+// assumption, so a scenario caps them at the most its robot can move (the larger of payload and
+// push limit). A scenario may set the cap higher, and heavier movables are then ones this robot
+// cannot move; a cap below 1 kg is an error naming the field.
+TEST(ScenarioGraspabilityTest, NamoMassesAreCappedAtWhatTheRobotCanMove) {
+  const double can_move = std::max(robotModel().payload(), robotModel().pushLimit());
+  ASSERT_GT(can_move, 25.0);
+  // Moghaddam world 04 at our robot's scale: its largest box is above the push limit at 60 kg/m^3.
+  auto text = readTextFile(scenarioDir() / "namo_moghaddam_07.yaml");
+  ASSERT_TRUE(text.ok());
+  const std::string w04 = replaced(replaced(*text, "benchmark_07.svg", "benchmark_04.svg"), "  namo: ",
+                                   "  namo_options: {robot_radius: 0.39}\n  namo: ");
+  auto heaviestOf = [](const Scenario& sc, int* at_cap, double cap) {
+    double heaviest = 0;
+    for (const auto& o : sc.world.objects()) {
+      if (o.kind != ObjectKind::kMovable) continue;
+      heaviest = std::max(heaviest, o.mass);
+      if (at_cap != nullptr && o.mass == cap) ++*at_cap;
+    }
+    return heaviest;
+  };
+  auto capped = parseScenario(w04, (scenarioDir() / "w04.yaml").string());
+  ASSERT_TRUE(capped.ok()) << capped.error().toString();
+  int at_cap = 0;
+  EXPECT_DOUBLE_EQ(heaviestOf(*capped, &at_cap, can_move), can_move);
+  EXPECT_GT(at_cap, 0);
+  const std::string with_cap = replaced(w04, "robot_radius: 0.39}", "robot_radius: 0.39, max_mass: 150}");
+  auto raised = parseScenario(with_cap, (scenarioDir() / "raised.yaml").string());
+  ASSERT_TRUE(raised.ok()) << raised.error().toString();
+  EXPECT_GT(heaviestOf(*raised, nullptr, 0.0), can_move);
+  auto bad = parseScenario(replaced(with_cap, "max_mass: 150", "max_mass: 0"),
+                           (scenarioDir() / "bad_cap.yaml").string());
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().toString().find("world.namo_options"), std::string::npos) << bad.error().toString();
+  EXPECT_NE(bad.error().toString().find("max_mass must be >= 1 kg, got 0"), std::string::npos)
+      << bad.error().toString();
+  // A NAMO file loaded on its own is capped the same way.
+  auto direct = loadScenario(fs::path(TAMP_BENCHMARKS_DIR) /
+                             "namo/moghaddam_planning_2016_benchmark/moghaddam_planning_2016_benchmark_04.svg");
+  ASSERT_TRUE(direct.ok()) << direct.error().toString();
+  for (const auto& o : direct->world.objects()) {
+    if (o.kind == ObjectKind::kMovable) {
+      EXPECT_LE(o.mass, can_move) << o.id;
+    }
+  }
+}
+
 TEST(ScenarioErrorsTest, MinimalLoads) {
   auto r = parseScenario(kMinimal, kFile);
   ASSERT_TRUE(r.ok()) << r.error().toString();

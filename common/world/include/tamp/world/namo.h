@@ -24,7 +24,9 @@
 /// pillars and bare static obstacles `wall_height` (1.0 m); by type: box 0.5, chair 0.9,
 /// stool 0.45, table 0.75, sofa 0.8, cabinet 1.2, bed 0.5, other/bare movables
 /// `movable_height` (0.5 m). Mass of a movable = `density` (60 kg/m^3) x footprint area x
-/// height, clamped to [1, 150] kg; graspable iff mass <= `max_graspable_mass` -- the robot's
+/// height, clamped to [1, `max_mass`] kg. A NAMO world's movables are, by the benchmark's own
+/// rule, movable by its robot; the masses are this loader's assumption, so a scenario caps them
+/// at the most its robot can move (the larger of its payload and push limit). Graspable iff mass <= `max_graspable_mass` -- the robot's
 /// payload when a scenario loads the world (tamp::robot::RobotModel::payload(), 25 kg for the
 /// shipped robot) -- the PDDL domain moves objects by pick and place only, so "graspable" means
 /// "can be moved".
@@ -47,6 +49,11 @@ struct NamoOptions {
   double wall_height{1.0};             ///< m, walls, pillars and bare static obstacles
   double movable_height{0.5};          ///< m, movables of unknown type and bare movables
   double density{60.0};                ///< kg/m^3, mass rule for movables
+  /// kg: the heaviest a movable is made. The scenario loader sets it to the most the robot can
+  /// move (max of payload and push limit: the benchmark's movables are movable); a scenario may
+  /// set it higher, and heavier movables are then ones this robot cannot move. 150 kg for direct
+  /// callers.
+  double max_mass{150.0};
   /// kg: heavier movables are not graspable. The scenario loader sets it to the robot's payload
   /// and refuses a larger value; 25 kg (the shipped robot's payload) for direct callers.
   double max_graspable_mass{25.0};

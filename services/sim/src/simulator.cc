@@ -978,6 +978,29 @@ struct Simulator::Impl {
   Result<std::vector<int>> validate(const ActionCommand& c) const;
   /// The action's timeline; `nominal`: no noise and no stall, the random stream untouched.
   Result<Active> plan(const ActionCommand& c, const std::vector<int>& columns, bool nominal = false);
+  /// An action being planned: its phases so far, where the robot is after them, the commanded
+  /// waypoints as full joint vectors.
+  struct Draft {
+    Active a;
+    Vec cur;
+    std::vector<Vec> wp;
+    bool nominal{false};
+  };
+  void addPause(Draft& d, double seconds);
+  /// A jerk-limited move along `path` (parameter length `length`), then now and then a stall.
+  void addMotion(Draft& d, GeoPath path, double length, const Limits& lim);
+  void planBase(Draft& d);
+  void planArm(Draft& d, const std::vector<int>& cols);
+  void planHand(Draft& d);
+  /// The dense tool path of waypoints [from, to] (`tool`: each waypoint's tool position).
+  GeoPath toolPath(const std::vector<Vec>& wp, const std::vector<Eigen::Vector3d>& tool, std::size_t from,
+                   std::size_t to);
+  Eigen::Vector3d toolAt(const Vec& q);
+  /// Contacts that belong to a pick or place: the picked object and its supports, the placed
+  /// object and the supports where it really ends (`at_grasp`: the grasp waypoint).
+  void ignoreTaskContacts(Active& a, const world::Object* obj, const Vec& at_grasp);
+  /// Phase times: the true timing stretched by the execution noise (none when nominal).
+  void stampTimeline(Draft& d);
 };
 
 Result<std::vector<int>> Simulator::Impl::validate(const ActionCommand& c) const {
@@ -1091,176 +1114,212 @@ Result<std::vector<int>> Simulator::Impl::validate(const ActionCommand& c) const
 }
 
 Result<Active> Simulator::Impl::plan(const ActionCommand& c, const std::vector<int>& cols, bool nominal) {
-  const DynamicsParams& dyn = params.dynamics;
-  Active a;
-  a.cmd = c;
-  Vec cur = current();
+  Draft d;
+  d.a.cmd = c;
+  d.nominal = nominal;
+  d.cur = current();
   // Waypoints as full joint vectors (joints not commanded keep their current value).
-  std::vector<Vec> wp;
   for (const auto& p : c.trajectory.points) {
-    Vec q = cur;
+    Vec q = d.cur;
     for (std::size_t j = 0; j < cols.size(); ++j) q[cols[j]] = p.positions[j];
-    wp.push_back(q);
+    d.wp.push_back(q);
   }
-  auto pause = [&](double d) {
-    if (d <= 0.0) return;
-    Phase ph;
-    ph.kind = Phase::Kind::kPause;
-    ph.nominal = d;
-    ph.start = ph.end = cur;
-    a.phases.push_back(std::move(ph));
-  };
-  // A jerk-limited move along `path` (parameter length `length`), then now and then a stall.
-  auto motion = [&](GeoPath path, double length, const Limits& lim) {
-    Phase ph;
-    ph.kind = Phase::Kind::kMotion;
-    ph.length = length;
-    ph.profile = MotionProfile::restToRest(length, lim.speed, lim.accel, lim.jerk);
-    ph.nominal = ph.profile.duration();
-    ph.start = path.q.front();
-    ph.end = path.q.back();
-    ph.path = std::move(path);
-    cur = ph.end;
-    a.phases.push_back(std::move(ph));
-    if (!nominal && dyn.stall.probability > 0.0 &&
-        std::uniform_real_distribution<double>(0.0, 1.0)(rng) < dyn.stall.probability) {
-      pause(std::uniform_real_distribution<double>(dyn.stall.min_s, dyn.stall.max_s)(rng));
-    }
-  };
-
   if (c.kind == ActionKind::kMoveBase) {
-    // Stop-and-turn along the steps the motion planner and the execution monitor check
-    // (effort_model::baseSteps: the geometry); each turn and drive timed by the robot's own
-    // S-curve. A push is slowed by the pushed object's mass as a load is.
-    const world::Object* pushed = c.object_id.empty() ? nullptr : world.findObject(c.object_id);
-    a.mass = pushed ? pushed->mass : heldMass();
-    const double f = loadFactor(dyn, a.mass);
-    pause(dyn.base.latency_s);
-    std::vector<Pose2D> poses;
-    for (const Vec& q : wp) poses.push_back(Pose2D{q[0], q[1], q[2]});
-    for (const auto& step : effort_model::baseSteps(poses)) {
-      GeoPath g;
-      if (step.kind == effort_model::BaseStep::Kind::kTurn) {
-        Vec end = cur;
-        end[2] = cur[2] + angleDiff(step.target_heading, cur[2]);
-        g.q = {cur, end};
-        g.u = {0.0, std::abs(end[2] - cur[2])};
-        const double turn = g.u.back();
-        motion(std::move(g), turn, scaled(dyn.base.angular(), f));
-      } else {
-        g.q = {cur};
-        g.u = {0.0};
-        for (std::size_t i : step.points) {
-          Vec n = g.q.back();
-          n[0] = wp[i][0];
-          n[1] = wp[i][1];
-          g.u.push_back(g.u.back() + std::hypot(n[0] - g.q.back()[0], n[1] - g.q.back()[1]));
-          g.q.push_back(n);
-        }
-        const double length = g.u.back();
-        motion(std::move(g), length, scaled(dyn.base.linear(), f));
-      }
-      pause(dyn.base.settle_s);
-    }
+    planBase(d);
   } else if (c.kind == ActionKind::kMoveArm) {
-    a.mass = heldMass();
-    pause(dyn.arm.latency_s);
-    const std::size_t n = cols.size();
-    std::vector<std::vector<double>> arm(wp.size(), std::vector<double>(n));
-    for (std::size_t i = 0; i < wp.size(); ++i) {
-      for (std::size_t j = 0; j < n; ++j) arm[i][j] = wp[i][cols[j]];
+    planArm(d, cols);
+  } else {
+    planHand(d);
+  }
+  stampTimeline(d);
+  // Objects touching the robot at the start do not block it (it may back away from them).
+  for (const auto& id : objectsTouching(d.a.phases.front().start)) {
+    if (std::find(d.a.ignore_objects.begin(), d.a.ignore_objects.end(), id) == d.a.ignore_objects.end()) {
+      d.a.ignore_objects.push_back(id);
     }
-    // Each run one jerk-limited S-curve along the commanded polyline (through every waypoint, as
-    // the planner checked it), then a settle pause.
-    for (const auto& run : armRuns(arm, c.trajectory.joint_names, joint_speed, dyn.arm, loadFactor(dyn, a.mass))) {
-      GeoPath g;
-      g.q = {cur};
+  }
+  return std::move(d.a);
+}
+
+void Simulator::Impl::addPause(Draft& d, double seconds) {
+  if (seconds <= 0.0) return;
+  Phase ph;
+  ph.kind = Phase::Kind::kPause;
+  ph.nominal = seconds;
+  ph.start = ph.end = d.cur;
+  d.a.phases.push_back(std::move(ph));
+}
+
+void Simulator::Impl::addMotion(Draft& d, GeoPath path, double length, const Limits& lim) {
+  const DynamicsParams& dyn = params.dynamics;
+  Phase ph;
+  ph.kind = Phase::Kind::kMotion;
+  ph.length = length;
+  ph.profile = MotionProfile::restToRest(length, lim.speed, lim.accel, lim.jerk);
+  ph.nominal = ph.profile.duration();
+  ph.start = path.q.front();
+  ph.end = path.q.back();
+  ph.path = std::move(path);
+  d.cur = ph.end;
+  d.a.phases.push_back(std::move(ph));
+  if (!d.nominal && dyn.stall.probability > 0.0 &&
+      std::uniform_real_distribution<double>(0.0, 1.0)(rng) < dyn.stall.probability) {
+    addPause(d, std::uniform_real_distribution<double>(dyn.stall.min_s, dyn.stall.max_s)(rng));
+  }
+}
+
+void Simulator::Impl::planBase(Draft& d) {
+  // Stop-and-turn along the steps the motion planner and the execution monitor check
+  // (effort_model::baseSteps: the geometry); each turn and drive timed by the robot's own
+  // S-curve. A push is slowed by the pushed object's mass as a load is.
+  const DynamicsParams& dyn = params.dynamics;
+  const ActionCommand& c = d.a.cmd;
+  const world::Object* pushed = c.object_id.empty() ? nullptr : world.findObject(c.object_id);
+  d.a.mass = pushed ? pushed->mass : heldMass();
+  const double f = loadFactor(dyn, d.a.mass);
+  addPause(d, dyn.base.latency_s);
+  std::vector<Pose2D> poses;
+  for (const Vec& q : d.wp) poses.push_back(Pose2D{q[0], q[1], q[2]});
+  for (const auto& step : effort_model::baseSteps(poses)) {
+    GeoPath g;
+    if (step.kind == effort_model::BaseStep::Kind::kTurn) {
+      Vec end = d.cur;
+      end[2] = d.cur[2] + angleDiff(step.target_heading, d.cur[2]);
+      g.q = {d.cur, end};
+      g.u = {0.0, std::abs(end[2] - d.cur[2])};
+      const double turn = g.u.back();
+      addMotion(d, std::move(g), turn, scaled(dyn.base.angular(), f));
+    } else {
+      g.q = {d.cur};
       g.u = {0.0};
-      for (std::size_t k = 1; k < run.points.size(); ++k) {
-        g.q.push_back(wp[run.points[k]]);
-        g.u.push_back(run.u[k]);
+      for (std::size_t i : step.points) {
+        Vec n = g.q.back();
+        n[0] = d.wp[i][0];
+        n[1] = d.wp[i][1];
+        g.u.push_back(g.u.back() + std::hypot(n[0] - g.q.back()[0], n[1] - g.q.back()[1]));
+        g.q.push_back(n);
       }
       const double length = g.u.back();
-      motion(std::move(g), length, run.limits);
-      pause(dyn.arm.settle_s);
+      addMotion(d, std::move(g), length, scaled(dyn.base.linear(), f));
     }
-  } else {
-    // Pick / place: approach to the grasp waypoint along the tool path, gripper, retreat.
-    const world::Object* obj = world.findObject(c.object_id);
-    wp.front() = cur;
-    std::vector<Eigen::Vector3d> tool;
-    auto toolAt = [&](const Vec& q) {
-      robot.linkPoses(toState(q), link_poses);
-      return link_poses[tool_link].translation();
-    };
-    for (const Vec& q : wp) tool.push_back(toolAt(q));
-    std::size_t g = 0;
-    double far = -1.0;
-    for (std::size_t i = 0; i < wp.size(); ++i) {
-      const double d = (tool[i] - tool[0]).norm();
-      if (d > far + 1e-12) {
-        far = d;
-        g = i;
-      }
+    addPause(d, dyn.base.settle_s);
+  }
+}
+
+void Simulator::Impl::planArm(Draft& d, const std::vector<int>& cols) {
+  const DynamicsParams& dyn = params.dynamics;
+  d.a.mass = heldMass();
+  addPause(d, dyn.arm.latency_s);
+  const std::size_t n = cols.size();
+  std::vector<std::vector<double>> arm(d.wp.size(), std::vector<double>(n));
+  for (std::size_t i = 0; i < d.wp.size(); ++i) {
+    for (std::size_t j = 0; j < n; ++j) arm[i][j] = d.wp[i][cols[j]];
+  }
+  // Each run one jerk-limited S-curve along the commanded polyline (through every waypoint, as
+  // the planner checked it), then a settle pause.
+  for (const auto& run : armRuns(arm, d.a.cmd.trajectory.joint_names, joint_speed, dyn.arm, loadFactor(dyn, d.a.mass))) {
+    GeoPath g;
+    g.q = {d.cur};
+    g.u = {0.0};
+    for (std::size_t k = 1; k < run.points.size(); ++k) {
+      g.q.push_back(d.wp[run.points[k]]);
+      g.u.push_back(run.u[k]);
     }
-    // The mass carried: a pick that will fail at the grasp waypoint (as the world is now) carries
-    // nothing on its retreat; a place carries the held object on its approach.
-    if (c.kind == ActionKind::kPick) {
-      a.mass = obj && pickFailure(c, wp[g]).empty() ? obj->mass : 0.0;
-    } else {
-      a.mass = world.held() && world.held()->object_id == c.object_id ? heldMass() : 0.0;
-    }
-    const double f = loadFactor(dyn, a.mass);
-    // Dense tool path of waypoints [from, to].
-    auto toolPath = [&](std::size_t from, std::size_t to) {
-      GeoPath p;
-      p.q = {wp[from]};
-      p.u = {0.0};
-      Eigen::Vector3d last = tool[from];
-      for (std::size_t i = from + 1; i <= to; ++i) {
-        const int n = std::max(1, static_cast<int>(std::ceil(displacementBound(wp[i - 1], wp[i]) /
-                                                             params.max_step_m)));
-        for (int k = 1; k <= n; ++k) {
-          const Vec q = wp[i - 1] + (static_cast<double>(k) / n) * (wp[i] - wp[i - 1]);
-          const Eigen::Vector3d x = toolAt(q);
-          p.u.push_back(p.u.back() + (x - last).norm());
-          p.q.push_back(q);
-          last = x;
-        }
-      }
-      return p;
-    };
-    GeoPath approach = toolPath(0, g);
-    GeoPath retreat = toolPath(g, wp.size() - 1);
-    a.approach_m = approach.u.back();
-    a.retreat_m = retreat.u.back();
-    const bool pick = c.kind == ActionKind::kPick;
-    const double fa = pick ? 1.0 : f, fr = pick ? f : 1.0;
-    if (approach.q.size() > 1) motion(std::move(approach), a.approach_m, scaled(dyn.hand.approach(), fa));
-    Phase grip;
-    grip.kind = Phase::Kind::kGripper;
-    grip.nominal = pick ? dyn.hand.close_s : dyn.hand.open_s;
-    grip.start = grip.end = cur;
-    a.gripper_phase = static_cast<int>(a.phases.size());
-    a.phases.push_back(std::move(grip));
-    if (retreat.q.size() > 1) motion(std::move(retreat), a.retreat_m, scaled(dyn.hand.approach(), fr));
-    // Contacts that belong to the task.
-    if (pick) {
-      a.ignore_objects.push_back(c.object_id);
-      if (obj) {
-        for (const auto& s : supportsOf(*obj, obj->pose)) a.ignore_pairs.emplace_back(obj->id, s);
-      }
-    } else if (obj && c.object_pose) {
-      // Where the object really ends at the end of the place motion (its grasp as held, not the
-      // commanded pose the robot computed from what it believed of the object).
-      const Eigen::Isometry3d at_end = world.held() && world.held()->object_id == obj->id
-                                           ? robot.toolPoseInWorld(toState(wp[g])) * world.held()->link_T_object
-                                           : *c.object_pose;
-      for (const auto& s : supportsOf(*obj, at_end, kPlacePress)) a.ignore_pairs.emplace_back(obj->id, s);
+    const double length = g.u.back();
+    addMotion(d, std::move(g), length, run.limits);
+    addPause(d, dyn.arm.settle_s);
+  }
+}
+
+GeoPath Simulator::Impl::toolPath(const std::vector<Vec>& wp, const std::vector<Eigen::Vector3d>& tool,
+                                  std::size_t from, std::size_t to) {
+  GeoPath p;
+  p.q = {wp[from]};
+  p.u = {0.0};
+  Eigen::Vector3d last = tool[from];
+  for (std::size_t i = from + 1; i <= to; ++i) {
+    const int n = std::max(1, static_cast<int>(std::ceil(displacementBound(wp[i - 1], wp[i]) / params.max_step_m)));
+    for (int k = 1; k <= n; ++k) {
+      const Vec q = wp[i - 1] + (static_cast<double>(k) / n) * (wp[i] - wp[i - 1]);
+      const Eigen::Vector3d x = toolAt(q);
+      p.u.push_back(p.u.back() + (x - last).norm());
+      p.q.push_back(q);
+      last = x;
     }
   }
+  return p;
+}
+
+Eigen::Vector3d Simulator::Impl::toolAt(const Vec& q) {
+  robot.linkPoses(toState(q), link_poses);
+  return link_poses[tool_link].translation();
+}
+
+void Simulator::Impl::planHand(Draft& d) {
+  // Pick / place: approach to the grasp waypoint along the tool path, gripper, retreat.
+  const DynamicsParams& dyn = params.dynamics;
+  const ActionCommand& c = d.a.cmd;
+  Active& a = d.a;
+  const world::Object* obj = world.findObject(c.object_id);
+  d.wp.front() = d.cur;
+  std::vector<Eigen::Vector3d> tool;
+  for (const Vec& q : d.wp) tool.push_back(toolAt(q));
+  // The grasp waypoint: the one whose tool is farthest from the start's.
+  std::size_t g = 0;
+  double far = -1.0;
+  for (std::size_t i = 0; i < d.wp.size(); ++i) {
+    const double dist = (tool[i] - tool[0]).norm();
+    if (dist > far + 1e-12) {
+      far = dist;
+      g = i;
+    }
+  }
+  // The mass carried: a pick that will fail at the grasp waypoint (as the world is now) carries
+  // nothing on its retreat; a place carries the held object on its approach.
+  const bool pick = c.kind == ActionKind::kPick;
+  if (pick) {
+    a.mass = obj && pickFailure(c, d.wp[g]).empty() ? obj->mass : 0.0;
+  } else {
+    a.mass = world.held() && world.held()->object_id == c.object_id ? heldMass() : 0.0;
+  }
+  const double f = loadFactor(dyn, a.mass);
+  GeoPath approach = toolPath(d.wp, tool, 0, g);
+  GeoPath retreat = toolPath(d.wp, tool, g, d.wp.size() - 1);
+  a.approach_m = approach.u.back();
+  a.retreat_m = retreat.u.back();
+  const double fa = pick ? 1.0 : f, fr = pick ? f : 1.0;
+  if (approach.q.size() > 1) addMotion(d, std::move(approach), a.approach_m, scaled(dyn.hand.approach(), fa));
+  Phase grip;
+  grip.kind = Phase::Kind::kGripper;
+  grip.nominal = pick ? dyn.hand.close_s : dyn.hand.open_s;
+  grip.start = grip.end = d.cur;
+  a.gripper_phase = static_cast<int>(a.phases.size());
+  a.phases.push_back(std::move(grip));
+  if (retreat.q.size() > 1) addMotion(d, std::move(retreat), a.retreat_m, scaled(dyn.hand.approach(), fr));
+  ignoreTaskContacts(a, obj, d.wp[g]);
+}
+
+void Simulator::Impl::ignoreTaskContacts(Active& a, const world::Object* obj, const Vec& at_grasp) {
+  const ActionCommand& c = a.cmd;
+  if (c.kind == ActionKind::kPick) {
+    a.ignore_objects.push_back(c.object_id);
+    if (obj) {
+      for (const auto& s : supportsOf(*obj, obj->pose)) a.ignore_pairs.emplace_back(obj->id, s);
+    }
+  } else if (obj && c.object_pose) {
+    // Where the object really ends at the end of the place motion (its grasp as held, not the
+    // commanded pose the robot computed from what it believed of the object).
+    const Eigen::Isometry3d at_end = world.held() && world.held()->object_id == obj->id
+                                         ? robot.toolPoseInWorld(toState(at_grasp)) * world.held()->link_T_object
+                                         : *c.object_pose;
+    for (const auto& s : supportsOf(*obj, at_end, kPlacePress)) a.ignore_pairs.emplace_back(obj->id, s);
+  }
+}
+
+void Simulator::Impl::stampTimeline(Draft& d) {
+  Active& a = d.a;
   // The timeline: the true timing stretched by the execution noise (none for the nominal one).
-  a.k = !nominal && params.duration_noise > 0.0
+  a.k = !d.nominal && params.duration_noise > 0.0
             ? std::exp(params.duration_noise * std::normal_distribution<double>(0.0, 1.0)(rng))
             : 1.0;
   double t = 0.0;
@@ -1273,16 +1332,9 @@ Result<Active> Simulator::Impl::plan(const ActionCommand& c, const std::vector<i
   a.end = t;
   if (a.phases.empty()) {  // nothing to do (a single-point motion)
     Phase ph;
-    ph.start = ph.end = cur;
+    ph.start = ph.end = d.cur;
     a.phases.push_back(ph);
   }
-  // Objects touching the robot at the start do not block it (it may back away from them).
-  for (const auto& id : objectsTouching(a.phases.front().start)) {
-    if (std::find(a.ignore_objects.begin(), a.ignore_objects.end(), id) == a.ignore_objects.end()) {
-      a.ignore_objects.push_back(id);
-    }
-  }
-  return a;
 }
 
 // ---- Simulator --------------------------------------------------------------------------------

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <future>
 #include <sstream>
 
 #include "tamp/world/polygon.h"
@@ -26,6 +27,32 @@ std::vector<std::string> atomTokens(const std::string& atom) {
 
 namespace {
 double angleDiff(double a, double b) { return std::abs(std::remainder(a - b, 2 * M_PI)); }
+
+/// From this many (pose, region) pairs on, reachAll splits them between two threads.
+constexpr std::size_t kParallelReachFrom = 4;
+
+/// world::reachesRegion for each pair, in order. Each is an inverse-kinematics search (up to 24
+/// restarts of 300 iterations when the region lies within the arm's reach sphere but is not
+/// reached: most of the graph manager's own time in a replanning that adds push stands and
+/// slots), independent of the others and deterministic (fixed seed and restarts), so the pairs
+/// are split between this thread and one more (alternately: the costly ones cluster) and the
+/// answers are those of the serial loop.
+std::vector<char> reachAll(const robot::RobotModel& robot,
+                           const std::vector<std::pair<const Pose2D*, const world::Region*>>& pairs) {
+  std::vector<char> out(pairs.size(), 0);
+  auto run = [&](std::size_t first, std::size_t step) {
+    for (std::size_t i = first; i < pairs.size(); i += step)
+      out[i] = world::reachesRegion(robot, *pairs[i].first, *pairs[i].second) ? 1 : 0;
+  };
+  if (pairs.size() < kParallelReachFrom) {
+    run(0, 1);
+    return out;
+  }
+  auto other = std::async(std::launch::async, run, std::size_t{1}, std::size_t{2});
+  run(0, 2);
+  other.get();
+  return out;
+}
 }  // namespace
 
 Abstraction::Abstraction(world::World world, robot::RobotModel robot, AbstractionParams params)
@@ -41,15 +68,27 @@ void Abstraction::setWorld(world::World world) { world_ = std::move(world); }
 
 void Abstraction::addReaches(const std::string& location, const Pose2D& pose) {
   reaches_.insert("(reaches " + location + " stow)");
+  std::vector<std::pair<const Pose2D*, const world::Region*>> pairs;
+  std::vector<const std::string*> ids;
   for (const auto& [id, region] : regions_) {
-    if (world::reachesRegion(robot_, pose, region)) reaches_.insert("(reaches " + location + " " + armconfOver(id) + ")");
+    pairs.emplace_back(&pose, &region);
+    ids.push_back(&id);
   }
+  const std::vector<char> reached = reachAll(robot_, pairs);
+  for (std::size_t i = 0; i < ids.size(); ++i)
+    if (reached[i]) reaches_.insert("(reaches " + location + " " + armconfOver(*ids[i]) + ")");
 }
 
 void Abstraction::addRegionReaches(const std::string& region_symbol, const world::Region& region) {
+  std::vector<std::pair<const Pose2D*, const world::Region*>> pairs;
+  std::vector<const std::string*> ids;
   for (const auto& [id, pose] : locations_) {
-    if (world::reachesRegion(robot_, pose, region)) reaches_.insert("(reaches " + id + " " + armconfOver(region_symbol) + ")");
+    pairs.emplace_back(&pose, &region);
+    ids.push_back(&id);
   }
+  const std::vector<char> reached = reachAll(robot_, pairs);
+  for (std::size_t i = 0; i < ids.size(); ++i)
+    if (reached[i]) reaches_.insert("(reaches " + *ids[i] + " " + armconfOver(region_symbol) + ")");
 }
 
 std::string Abstraction::findLocation(const Pose2D& pose) const {
@@ -176,6 +215,11 @@ void Abstraction::addPush(const std::string& object, const std::string& support,
 }
 
 bool Abstraction::isRegion(const std::string& id) const { return regions_.count(id) > 0; }
+
+const world::Region* Abstraction::region(const std::string& id) const {
+  auto it = regions_.find(id);
+  return it == regions_.end() ? nullptr : &it->second;
+}
 
 namespace {
 /// `hint`, or `hint_2`, ... the first that `taken` does not know.

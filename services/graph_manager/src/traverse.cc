@@ -214,10 +214,14 @@ struct GraphManager::Search {
   std::vector<EdgeId> branch;
   std::vector<double> branch_sd2;
   /// traverseFirstEdge: below the first edge (with the manipulation an arm motion prepares) of
-  /// the first complete branch, nothing more is explored; every other way on from the start is,
-  /// against that branch's cost (first_edge.cc).
+  /// the best complete branch so far, nothing more is explored; every other way on from the
+  /// start is, against that branch's cost (first_edge.cc).
   bool first_edge_only{false};
   std::vector<EdgeId> first_edge;
+  /// First edges that were settled (their subtree explored no further) and then lost to a better
+  /// branch through another first edge: tried again from the start against the new best, since
+  /// what was left unexplored below them may beat it.
+  std::set<EdgeId> revisit;
 
   bool settled() const {
     return first_edge_only && !first_edge.empty() && branch.size() >= first_edge.size() &&
@@ -259,7 +263,18 @@ struct GraphManager::Search {
   void complete(double branch_cost) {
     ++completions;
     const double cost = branch_cost + gm.oraclePenalty(steps);
-    if (first_edge_only && first_edge.empty() && !branch.empty()) first_edge = gm.firstEdgeOf(branch);
+    if (first_edge_only && !branch.empty() && (first_edge.empty() || cost < best)) {
+      // The first edge to settle is the best branch's: a better branch through another first
+      // edge takes over, and the one it replaces is explored again below (revisit).
+      std::vector<EdgeId> f = gm.firstEdgeOf(branch);
+      if (!first_edge.empty() && f != first_edge) {
+        // The same arm motion into another manipulation: the arm edge is tried again too (the
+        // manipulation settled before is explored again below it, the new one stays settled).
+        revisit.insert(first_edge.front());
+        if (f.front() != first_edge.front()) revisit.erase(f.front());
+      }
+      first_edge = std::move(f);
+    }
     if (cost < best) {
       best = cost;
       best_branch = branch;
@@ -319,6 +334,13 @@ struct GraphManager::Search {
         if (x.state == EdgeState::kUnevaluated && x.lower_bound_s == 0.0) x.lower_bound_s = gm.lowerBound(x);
         const double k = known(e);
         if (pick < 0 || k < pick_cost) pick = e, pick_cost = k;
+      }
+      if (pick < 0 && branch.empty() && !revisit.empty()) {
+        // At the start: first edges that lost their place to a better branch are tried again
+        // (their subtree was cut short while they were settled), now against the better cost.
+        for (EdgeId e : revisit) tried.erase(e);
+        revisit.clear();
+        continue;
       }
       if (pick < 0) {
         // Every way on was tried and none reached the goal: an object whose every removal failed

@@ -85,6 +85,44 @@ TEST(AbstractionTest, AnObjectOnALargeRegionRefinedToASlotIsReachedOnlyWhereTheA
   EXPECT_FALSE(a.isReached("over_nowhere"));
 }
 
+// The reach facts of new locations and slots are computed on two threads (abstraction.cc,
+// reachAll): the same facts as world::reachesRegion asked pair by pair, reached and not, for a
+// grid of stands round the box and slots beside it.
+TEST(AbstractionTest, ReachFactsOfNewLocationsAndSlotsAreThoseOfTheSerialCheck) {
+  auto f = load("namo_corridor");
+  Abstraction a(f.sc.plannerWorld(), f.robot);
+  const Eigen::Isometry3d box = f.sc.world.object("box").pose;
+  std::vector<std::pair<std::string, Pose2D>> stands;
+  for (int i = 0; i < 5; ++i) {
+    for (int j = 0; j < 4; ++j) {
+      const Pose2D p{box.translation().x() - 1.0 + 0.25 * i, box.translation().y() - 0.6 + 0.3 * j, 0.2 * (i - j)};
+      stands.emplace_back(a.locationFor(p, "stand", 0.0), p);
+    }
+  }
+  std::vector<std::pair<std::string, world::Region>> slots;
+  for (int k = 0; k < 4; ++k) {
+    Eigen::Isometry3d pose = box;
+    pose.translation() += Eigen::Vector3d(-0.3 + 0.2 * k, 0.15 * (k % 2), 0.0);
+    const std::string s = a.addSlot("box", "box_floor", pose);
+    const world::Region* r = a.region(s);
+    ASSERT_NE(r, nullptr);
+    slots.emplace_back(s, *r);
+  }
+  const std::vector<std::string> statics = a.staticAtoms();
+  int reached = 0, not_reached = 0;
+  for (const auto& [l, pose] : stands) {
+    for (const auto& [s, region] : slots) {
+      const bool expected = world::reachesRegion(f.robot, pose, region);
+      EXPECT_EQ(has(statics, "(reaches " + l + " " + Abstraction::armconfOver(s) + ")"), expected) << l << " " << s;
+      ++(expected ? reached : not_reached);
+    }
+    const world::Region& floor = *a.region("box_floor");
+    EXPECT_EQ(has(statics, "(reaches " + l + " over_box_floor)"), world::reachesRegion(f.robot, pose, floor)) << l;
+  }
+  EXPECT_GT(reached, 0);
+  EXPECT_GT(not_reached, 0);
+}
+
 TEST(AbstractionTest, ASlotIsARegionWithItsOwnConfigurationAndBindsTheObjectPose) {
   auto f = load("namo_corridor");
   Abstraction a(f.sc.plannerWorld(), f.robot);

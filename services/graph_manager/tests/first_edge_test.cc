@@ -31,6 +31,8 @@ class ScriptedServices : public ServiceClients {
   std::deque<std::vector<std::vector<std::string>>> states;
   std::vector<double> pregrasp;  ///< of the one grasp offered
   Eigen::Vector2d slow_from{1e9, 1e9};
+  /// When set, only paths from `slow_from` that end within 0.1 m of it are slower.
+  std::optional<Eigen::Vector2d> slow_to;
   double slow_factor{1.0};
   int motion_calls{0};
   int batches{0};                   ///< motions() calls (concurrent queries)
@@ -172,7 +174,8 @@ class ScriptedServices : public ServiceClients {
       const auto& w = q.path.waypoints;
       for (std::size_t i = 1; i < w.size(); ++i)
         a.mean_s += std::hypot(w[i][0] - w[i - 1][0], w[i][1] - w[i - 1][1]);
-      if (!w.empty() && std::hypot(w[0][0] - slow_from.x(), w[0][1] - slow_from.y()) < 0.1)
+      if (!w.empty() && std::hypot(w[0][0] - slow_from.x(), w[0][1] - slow_from.y()) < 0.1 &&
+          (!slow_to || std::hypot(w.back()[0] - slow_to->x(), w.back()[1] - slow_to->y()) < 0.1))
         a.mean_s *= slow_factor;
       out.push_back(a);
     }
@@ -199,7 +202,7 @@ class FirstEdgeTest : public ::testing::Test {
     EXPECT_TRUE(robot.ok());
     Abstraction a(sc->plannerWorld(), *robot);
     for (const auto& [name, x, y] :
-         {std::tuple{"a", 5.0, 2.2}, std::tuple{"b", 5.0, -1.5}, std::tuple{"c", 5.0, 6.6}})
+         {std::tuple{"a", 5.0, 2.2}, std::tuple{"b", 5.0, -1.5}, std::tuple{"c", c_.x(), c_.y()}})
       EXPECT_EQ(a.locationFor(Pose2D{x, y, 0.0}, name), name);
     GraphManagerParams params;
     params.max_contingencies = 0;
@@ -229,6 +232,7 @@ class FirstEdgeTest : public ::testing::Test {
   }
 
   bool goal_bound_{false};
+  Eigen::Vector2d c_{5.0, 6.6};  ///< where location c stands
 
   static std::vector<std::string> actions(const GraphManager& gm,
                                           const std::vector<EdgeId>& branch) {
@@ -317,7 +321,11 @@ TEST_F(FirstEdgeTest, TheFirstEdgeIsDecidedWithoutPricingBelowIt) {
   EXPECT_NEAR(f.cost_s, t.cost_s, 1e-9);
 }
 
-TEST_F(FirstEdgeTest, WhenAnotherWayOnBeatsTheFirstBranchTheFullTraverseDecides) {
+// The first complete branch (start-a-goal) loses to start-b-goal: start-b is settled in its
+// place, and start-a, whose subtree was cut short, is tried again against the new cost (a->c is
+// priced and cut). Proven without a full Traverse (before session 30 the search ended unproven
+// here and a full Traverse followed).
+TEST_F(FirstEdgeTest, WhenAnotherWayOnBeatsTheFirstBranchItsFirstEdgeIsProvenInItsPlace) {
   // a->goal three times slower: start-a-goal costs 3.6 + 10.9 s, start-b-goal 8.8 s wins.
   ScriptedServices full_services;
   full_services.slow_from = {5.0, 2.2};
@@ -334,8 +342,40 @@ TEST_F(FirstEdgeTest, WhenAnotherWayOnBeatsTheFirstBranchTheFullTraverseDecides)
   Setup s = make(services);
   const TraverseResult t = s.gm->traverseFirstEdge(s.gm->root(), s.ctx);
   ASSERT_TRUE(t.found) << t.reason;
-  EXPECT_EQ(t.proven_edges, 0u)
-      << "start-a's first branch lost: not proven, the full search decided";
+  EXPECT_EQ(t.proven_edges, 1u) << "start-b, proven in start-a's place";
+  EXPECT_EQ(actions(*s.gm, t.branch), actions(*full.gm, f.branch));
+  EXPECT_NEAR(t.cost_s, f.cost_s, 1e-9);
+  EXPECT_EQ(services.motion_calls, 5) << "start-a, a-goal, start-b, b-goal, then a->c when start-a is tried again "
+                                          "(c->goal cut on its bound)";
+  ASSERT_EQ(s.gm->decisions().size(), 1u);
+  EXPECT_EQ(s.gm->decisions().front().node, "n" + std::to_string(s.gm->root()));
+}
+
+// The first edge that lost its place is explored again, and what was left below it can win it
+// back: c stands just past the goal (a->c is explored after a->goal, whose bound is lower), a->goal
+// is three times slower. start-a-goal (14.6 s) is completed first, start-b-goal (8.8 s) beats it,
+// then start-a-c-goal (7.8 s) beats that: start-a is the first edge, as the full Traverse says.
+// Settling start-b for good would send the robot the dearer way.
+TEST_F(FirstEdgeTest, AFirstEdgeThatLostItsPlaceIsExploredAgainAndCanWinItBack) {
+  c_ = {8.7, 1.0};
+  ScriptedServices full_services;
+  full_services.slow_from = {5.0, 2.2};
+  full_services.slow_to = Eigen::Vector2d(8.5, 1.2);
+  full_services.slow_factor = 3.0;
+  Setup full = make(full_services);
+  const TraverseResult f = full.gm->traverse(full.gm->root(), full.ctx);
+  ASSERT_TRUE(f.found) << f.reason;
+  EXPECT_EQ(actions(*full.gm, f.branch),
+            (std::vector<std::string>{"(move_base start a)", "(move_base a c)", "(move_base c goal)"}));
+
+  ScriptedServices services;
+  services.slow_from = full_services.slow_from;
+  services.slow_to = full_services.slow_to;
+  services.slow_factor = full_services.slow_factor;
+  Setup s = make(services);
+  const TraverseResult t = s.gm->traverseFirstEdge(s.gm->root(), s.ctx);
+  ASSERT_TRUE(t.found) << t.reason;
+  EXPECT_EQ(t.proven_edges, 1u);
   EXPECT_EQ(actions(*s.gm, t.branch), actions(*full.gm, f.branch));
   EXPECT_NEAR(t.cost_s, f.cost_s, 1e-9);
 }

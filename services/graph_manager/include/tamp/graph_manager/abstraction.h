@@ -106,6 +106,9 @@ class Abstraction {
                const std::string& to, const std::string& slot);
   /// True when the region or slot `id` exists.
   bool isRegion(const std::string& id) const;
+  /// The geometry of region or slot `id` (a slot: a square of slot_half_size_m round its pose),
+  /// or null.
+  const world::Region* region(const std::string& id) const;
   /// A PDDL item that stands for an object not known yet (the conditional branch "the gripper
   /// holds something the planner does not know"): `hint`, or `hint_2`, ... if a world id has it.
   /// Listed by objects(); no static facts (it is never picked, only put down).

@@ -262,7 +262,7 @@ struct SearchOptions {
   /// run uses beside it. At most `unit_first_time_share` (0, the default): the unit-cost run ends
   /// at its first share and the cost + 1 run starts after it (the fourth to thirty-second rounds).
   /// Off by default (docs/benchmarks.md, issue 14, thirty-third round): at 0.3, transport-18 is
-  /// solved (23.4 s of 29), but citycar-6's first plan comes at the very end of its 59 s (the
+  /// solved (23.4 s of 29), but citycar-6's first plan comes after at least 54 s of its 59 (the
   /// unit-cost run takes 17.7 s of it, in vain) and citycar-11 takes 31.7 s instead of 21.
   /// Must be in [0, 1].
   double unit_beside_time_share{0.0};

@@ -123,6 +123,8 @@ int main(int argc, char** argv) {
   uint64_t fallback_budget = defaults.ehc_fallback_budget_per_h, fallback_min = defaults.ehc_fallback_budget_min,
            fallback_max = defaults.ehc_fallback_budget_max;
   double unit_first_share = defaults.unit_first_time_share;
+  double unit_beside_share = defaults.unit_beside_time_share;
+  uint64_t unit_beside_turn = defaults.unit_beside_turn;
   double neighbourhood_share = defaults.neighbourhood_time_share;
   bool neighbourhood_grow = defaults.neighbourhood_grow;
   int64_t heap_reserve_mib = 64;
@@ -190,6 +192,14 @@ int main(int argc, char** argv) {
   app.add_option("--unit-first-share", unit_first_share,
                  "the share of the time left that the unit-cost first run may use, in (0, 1]")
       ->check(CLI::Range(1e-9, 1.0));
+  app.add_option("--unit-beside-share", unit_beside_share,
+                 "the unit-cost first run that has not answered within --unit-first-share goes on beside the "
+                 "cost + 1 run, in turns, until it has used this share of the time left in all, in [0, 1] "
+                 "(at most --unit-first-share: it stops at its first share, the cost + 1 run after it)")
+      ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--unit-beside-turn", unit_beside_turn,
+                 "evaluations per turn of each of the unit-cost and cost + 1 runs in turns (> 0)")
+      ->check(CLI::Range(uint64_t{1}, UINT64_MAX));
   app.add_option("--neighbourhood-share", neighbourhood_share,
                  "with --anytime: the share of its time for plan neighbourhood graph search on the first plan, "
                  "before LAMA's weighted A* iterations, in [0, 1] (0 = none)")
@@ -247,6 +257,11 @@ int main(int argc, char** argv) {
                  "ehc, --lazy-beside-both: the second lazy search's h_FF through h_add's best supporters (Fast "
                  "Downward's ff(), LAMA-first's) also where the operators cost the same: true or false (default " +
                      std::string(defaults.lazy_second_hadd ? "true" : "false") + ")");
+  uint64_t lazy_hadd_lane_budget = defaults.lazy_hadd_lane_budget;
+  app.add_option("--lazy-hadd-lane-budget", lazy_hadd_lane_budget,
+                 "ehc, --lazy-beside-both without --lazy-second-hadd, operators of one cost: a third lazy search "
+                 "with LAMA-first's h_FF (h_add's supporters) joins with the second and is dropped after this many "
+                 "evaluations (0: none; default " + std::to_string(defaults.lazy_hadd_lane_budget) + ")");
   uint64_t lazy_second_after = defaults.lazy_second_after;
   app.add_option("--lazy-second-after", lazy_second_after,
                  "ehc, --lazy-beside-both: the second lazy search joins after this many evaluations of the "
@@ -299,6 +314,7 @@ int main(int argc, char** argv) {
   req.search.lazy_beside_both = lazy_beside_both;
   req.search.lazy_second_after = lazy_second_after;
   req.search.lazy_second_hadd = lazy_second_hadd;
+  req.search.lazy_hadd_lane_budget = lazy_hadd_lane_budget;
   req.search.ehc_h2_restart = h2_restart;
   req.search.ehc_h2_test_gap_max = h2_test_gap_max;
   req.search.ehc_ff_first_h2_restart = ff_first_h2_restart;
@@ -308,6 +324,8 @@ int main(int argc, char** argv) {
   req.search.anytime_seconds = anytime;
   req.search.unit_cost_first = !no_unit_first;
   req.search.unit_first_time_share = unit_first_share;
+  req.search.unit_beside_time_share = unit_beside_share;
+  req.search.unit_beside_turn = unit_beside_turn;
   req.search.neighbourhood_time_share = neighbourhood_share;
   req.search.neighbourhood_grow = neighbourhood_grow;
   if (heuristic == "ff") req.search.heuristic = sp::HeuristicKind::kFF;
@@ -332,7 +350,7 @@ int main(int argc, char** argv) {
                  "; status %s; parse %.4f s, ground %.4f s, search %.4f s, check %.4f s; facts %zu, operators %zu; "
                  "expanded %llu, evaluated %llu, initial h %lld; ehc plateau retries %llu (%llu abandoned); ehc fallbacks "
                  "%llu (%llu in a goal-agenda entry before the last); anytime %llu "
-                 "iterations, %llu improvements; landmarks %llu (%llu disjunctive, %llu greedy-necessary, %llu reasonable orders); ehc h^2 restarts %llu (%llu tests, %llu dead ends)%s%s%s%s%s",
+                 "iterations, %llu improvements; landmarks %llu (%llu disjunctive, %llu greedy-necessary, %llu reasonable orders); ehc h^2 restarts %llu (%llu tests, %llu dead ends)%s%s%s%s%s%s",
                  sp::toString(reply.status).c_str(), reply.stats.parse_seconds, reply.stats.ground_seconds,
                  reply.stats.search_seconds, reply.stats.check_seconds, reply.stats.facts, reply.stats.operators,
                  static_cast<unsigned long long>(reply.stats.expanded),
@@ -358,7 +376,10 @@ int main(int argc, char** argv) {
                  reply.stats.lazy_beside_won       ? "; lazy search beside ehc gave the answer"
                  : reply.stats.lazy_beside_started ? "; lazy search beside ehc started"
                                                    : "",
-                 reply.stats.unit_first_failed ? "; unit-cost first run failed, first plan with cost + 1" : "");
+                 reply.stats.unit_first_failed ? "; unit-cost first run failed, first plan with cost + 1" : "",
+                 !reply.stats.unit_beside         ? ""
+                 : reply.stats.unit_first_failed ? " (the unit-cost run in turns beside it)"
+                                                 : "; unit-cost first run answered in turns beside the cost + 1 run");
     if (reply.stats.neighbourhood_runs > 0) {
       std::fprintf(stderr, "; plan neighbourhood searches %llu, %llu improvements, up to %llu states, %.3f s",
                    static_cast<unsigned long long>(reply.stats.neighbourhood_runs),

@@ -350,6 +350,7 @@ PlanReply PlanningSession::solve(const Query& q, const Termination& term) {
   reply.stats.neighbourhood_states = sr.stats.neighbourhood_states;
   reply.stats.neighbourhood_seconds = sr.stats.neighbourhood_seconds;
   reply.stats.unit_first_failed = sr.stats.unit_first_failed;
+  reply.stats.unit_beside = sr.stats.unit_beside;
   reply.stats.landmarks = sr.stats.landmarks;
   reply.stats.landmarks_disjunctive = sr.stats.landmarks_disjunctive;
   reply.stats.landmark_gn_orders = sr.stats.landmark_gn_orders;

@@ -10,11 +10,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <condition_variable>
 #include <coroutine>
 #include <exception>
 #include <functional>
+#include <mutex>
 #include <optional>
 #include <stdexcept>
+#include <stop_token>
+#include <thread>
 #include <utility>
 
 namespace tamp::symbolic_planner {
@@ -69,6 +73,149 @@ class TurnTaker {
   virtual ~TurnTaker() = default;
   virtual void evaluated() = 0;
   virtual bool stopped() const = 0;
+};
+
+/// What a search running in turns with another one on another thread calls after each of its
+/// evaluations (`SearchOptions::unit_beside_time_share`): the thread's hook (`t_evaluation_hook`)
+/// may hand the control to the other search there.
+class EvaluationHook {
+ public:
+  virtual ~EvaluationHook() = default;
+  virtual void evaluated() = 0;
+};
+
+/// The hook of this thread's searches (none: nullptr).
+thread_local EvaluationHook* t_evaluation_hook = nullptr;
+
+/// Sets this thread's evaluation hook for its scope.
+class ScopedEvaluationHook {
+ public:
+  explicit ScopedEvaluationHook(EvaluationHook* hook) : previous_(std::exchange(t_evaluation_hook, hook)) {}
+  ~ScopedEvaluationHook() { t_evaluation_hook = previous_; }
+  ScopedEvaluationHook(const ScopedEvaluationHook&) = delete;
+  ScopedEvaluationHook& operator=(const ScopedEvaluationHook&) = delete;
+
+ private:
+  EvaluationHook* previous_;
+};
+
+/// A search run on a thread of its own that never runs at the same time as its caller: `resume()`
+/// hands it the control and waits until it hands it back, after a number of evaluations, at a
+/// time point (checked every 16 evaluations), or at its end. One of the two threads runs at a
+/// time, so a search in turns with another evaluates the same states in every run (where a turn
+/// ends at a time point aside). Its `Termination` has the caller's deadline and a stop token of
+/// its own, also stopped by the caller's; `cancel()` stops it and runs it to its (near) end, which
+/// frees its states.
+class SearchFiber : public EvaluationHook {
+ public:
+  using Body = std::function<SearchResult(const Termination&)>;
+
+  SearchFiber(Body body, const Termination& term)
+      : link_(term.token(), StopRequest{&stop_}),
+        term_(term.deadline(), stop_.get_token()),
+        body_(std::move(body)),
+        thread_([this] { main(); }) {}
+  ~SearchFiber() override {
+    try {
+      cancel();
+    } catch (...) {  // its exception has no caller left to go to
+    }
+    thread_.join();
+  }
+  SearchFiber(const SearchFiber&) = delete;
+  SearchFiber& operator=(const SearchFiber&) = delete;
+
+  /// Runs the search until it has done `evaluations` more evaluations, `until` has passed, or it
+  /// has ended; an exception thrown in it comes out here.
+  void resume(uint64_t evaluations, std::optional<Clock::time_point> until) {
+    if (done_) return;
+    until_evaluations_ = evaluations > UINT64_MAX - evaluated_ ? UINT64_MAX : evaluated_ + evaluations;
+    until_ = until;
+    Stopwatch sw;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      running_ = true;
+      cv_.notify_all();
+      cv_.wait(lock, [this] { return !running_; });
+    }
+    seconds_ += sw.seconds();
+    if (done_ && error_) std::rethrow_exception(std::exchange(error_, nullptr));
+  }
+  /// Stops the search and runs it to its end (a few evaluations at most), or, not yet started,
+  /// ends it without running it (its result then says kCancelled).
+  void cancel() {
+    if (done_) return;
+    stop_.request_stop();
+    if (!started_) abandoned_ = true;
+    while (!done_) resume(UINT64_MAX, std::nullopt);
+  }
+  bool done() const { return done_; }
+  /// The search's answer (once done).
+  SearchResult& result() { return result_; }
+  /// The time it has run, in seconds.
+  double seconds() const { return seconds_; }
+
+  void evaluated() override {
+    ++evaluated_;
+    if (evaluated_ < until_evaluations_ &&
+        (!until_ || (evaluated_ & 15) != 0 || Clock::now() < *until_)) {
+      return;
+    }
+    std::unique_lock<std::mutex> lock(mutex_);
+    running_ = false;
+    cv_.notify_all();
+    cv_.wait(lock, [this] { return running_; });
+  }
+
+ private:
+  struct StopRequest {
+    std::stop_source* source;
+    void operator()() const { source->request_stop(); }
+  };
+
+  void main() {
+    t_evaluation_hook = this;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      cv_.wait(lock, [this] { return running_; });
+      started_ = true;
+      if (abandoned_) {
+        result_.status = SearchStatus::kCancelled;
+        done_ = true;
+        running_ = false;
+        cv_.notify_all();
+        return;
+      }
+    }
+    try {
+      result_ = body_(term_);
+    } catch (...) {
+      error_ = std::current_exception();
+    }
+    std::lock_guard<std::mutex> lock(mutex_);
+    done_ = true;
+    running_ = false;
+    cv_.notify_all();
+  }
+
+  std::stop_source stop_;
+  std::stop_callback<StopRequest> link_;
+  Termination term_;
+  Body body_;
+  // Written by one thread while the other waits on the mutex: the hand-over orders them.
+  SearchResult result_;
+  std::exception_ptr error_;
+  uint64_t evaluated_{0};
+  uint64_t until_evaluations_{0};
+  std::optional<Clock::time_point> until_;
+  double seconds_{0.0};
+  bool started_{false};
+  bool abandoned_{false};
+  bool done_{false};
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  bool running_{false};  // the fiber's turn (guarded by mutex_)
+  std::thread thread_;   // last: started once the members above are made
 };
 
 /// All states of one search in one pool; an open-addressing hash set of ids.
@@ -506,6 +653,7 @@ class Searcher {
       pref_pool_.insert(pref_pool_.end(), p.begin(), p.end());
     }
     if (turns_ != nullptr) turns_->evaluated();
+    if (t_evaluation_hook != nullptr) t_evaluation_hook->evaluated();
     return h;
   }
 
@@ -1304,6 +1452,11 @@ void SearchOptions::validate() const {
   if (neighbourhood_first_states == 0) {
     throw std::invalid_argument("SearchOptions::neighbourhood_first_states must be > 0");
   }
+  if (!(unit_beside_time_share >= 0.0 && unit_beside_time_share <= 1.0)) {
+    throw std::invalid_argument("SearchOptions::unit_beside_time_share must be in [0, 1], got " +
+                                std::to_string(unit_beside_time_share));
+  }
+  if (unit_beside_turn == 0) throw std::invalid_argument("SearchOptions::unit_beside_turn must be > 0, got 0");
   if (!(unit_first_time_share > 0.0 && unit_first_time_share <= 1.0)) {
     throw std::invalid_argument("SearchOptions::unit_first_time_share must be in (0, 1], got " +
                                 std::to_string(unit_first_time_share));
@@ -1392,6 +1545,15 @@ SearchResult configuredSearch(const Task& task, const StateBits& init, const Goa
   return s.run();
 }
 
+/// True when the operators do not all cost the same (plan cost is not plan length).
+bool costsVary(const Task& task) {
+  if (task.unit_cost) return false;
+  for (const Operator& op : task.ops) {
+    if (op.cost != task.ops.front().cost) return true;
+  }
+  return false;
+}
+
 /// SearchOptions::ehc_lazy_beside: the lazy search, started once the hill-climbing has used
 /// `ehc_lazy_after` evaluations, then run for `ehc_lazy_turn_lazy` evaluations after every
 /// `ehc_lazy_turn_ehc` of the hill-climbing's, inside the hill-climbing's own call (one thread:
@@ -1407,6 +1569,7 @@ class LazyBeside : public TurnTaker {
              const Termination& term)
       : task_(task), init_(init), goal_(goal), options_(options), term_(term), left_(options.ehc_lazy_after) {
     options_.algorithm = SearchAlgorithm::kLazy;
+    lanes_.reserve(3);
   }
 
   void evaluated() override {
@@ -1422,8 +1585,8 @@ class LazyBeside : public TurnTaker {
   bool started() const { return !lanes_.empty(); }
   /// The lazy searches' counters so far (they must have started).
   const SearchStatistics& statistics() {
-    sum_ = lanes_[0].searcher->statistics();
-    for (size_t i = 1; i < lanes_.size(); ++i) addRunCosts(sum_, lanes_[i].searcher->statistics());
+    sum_ = laneStatistics(lanes_[0]);
+    for (size_t i = 1; i < lanes_.size(); ++i) addRunCosts(sum_, laneStatistics(lanes_[i]));
     return sum_;
   }
   bool finished() const { return finished_; }
@@ -1437,7 +1600,7 @@ class LazyBeside : public TurnTaker {
     }
     SearchResult& r = lanes_[winner_].steps->result();
     for (size_t i = 0; i < lanes_.size(); ++i) {
-      if (i != winner_) addRunCosts(r.stats, lanes_[i].searcher->statistics());
+      if (i != winner_) addRunCosts(r.stats, laneStatistics(lanes_[i]));
     }
     return r;
   }
@@ -1447,11 +1610,25 @@ class LazyBeside : public TurnTaker {
     std::unique_ptr<Heuristic> heuristic;
     std::unique_ptr<Searcher> searcher;
     std::optional<SearchCoroutine> steps;
+    uint64_t budget{0};  // > 0: dropped once it has used this many evaluations
+    bool dropped{false};  // then its search, states and heuristic are freed
+    SearchStatistics dropped_statistics;  // its counters when dropped
+    bool ended() const { return dropped || steps->done(); }
   };
+  static const SearchStatistics& laneStatistics(const Lane& l) {
+    return l.dropped ? l.dropped_statistics : l.searcher->statistics();
+  }
   static bool isFinal(const Lane& l) {
-    if (!l.steps->done()) return false;
+    if (l.dropped || !l.steps->done()) return false;
     const SearchStatus st = l.steps->result().status;
     return st == SearchStatus::kSolved || st == SearchStatus::kUnsolvable;
+  }
+  static void drop(Lane& l) {
+    l.dropped_statistics = l.searcher->statistics();
+    l.dropped = true;
+    l.steps.reset();  // the coroutine frame first: it refers to the searcher
+    l.searcher.reset();
+    l.heuristic.reset();
   }
   /// Whether a second lane (LAMA-first's preferred operators) is to join the first.
   bool twoLanes() const { return options_.lazy_beside_both && !options_.lazy_plan_preferred; }
@@ -1461,20 +1638,23 @@ class LazyBeside : public TurnTaker {
   /// (a second lane still to join joins then instead).
   void turn(size_t i) {
     Lane& l = lanes_[i];
-    if (l.steps->done()) return;
+    if (l.ended()) return;
     l.steps->resume();
-    if (!l.steps->done()) return;
+    if (!l.steps->done()) {
+      if (l.budget == 0 || l.searcher->statistics().evaluated < l.budget) return;
+      drop(l);
+    }
     bool all_done = true;
-    for (const Lane& x : lanes_) all_done = all_done && x.steps->done();
+    for (const Lane& x : lanes_) all_done = all_done && x.ended();
     if (isFinal(l)) {
       finished_ = true;
       winner_ = i;
     } else if (all_done) {
       if (secondPending()) {
-        addLane(true);
+        addSecondLanes();
       } else {
         finished_ = true;
-        winner_ = i;
+        winner_ = l.dropped ? 0 : i;  // the first lane is never dropped
       }
     }
   }
@@ -1491,15 +1671,25 @@ class LazyBeside : public TurnTaker {
   void maybeAddSecond() {
     if (finished_ || !secondPending()) return;
     const uint64_t used = ehc_since_start_ + lanes_[0].searcher->statistics().evaluated;
-    if (used >= options_.lazy_second_after) addLane(true);
+    if (used >= options_.lazy_second_after) addSecondLanes();
   }
-  void addLane(bool plan_preferred) {
-    Lane& l = lanes_.emplace_back();
-    HeuristicKind kind = defaultHeuristic(options_);
-    // The second lane (LAMA-first's): h_FF through h_add's best supporters, as Fast Downward's.
-    if (lanes_.size() == 2 && options_.lazy_second_hadd && kind == HeuristicKind::kFF) {
-      kind = HeuristicKind::kFFHadd;
+  /// The second lane and, with `lazy_hadd_lane_budget`, where h_FF takes FF's layered graph
+  /// (the operators cost the same), the third: LAMA-first's h_FF through h_add's supporters.
+  void addSecondLanes() {
+    addLane(true, options_.lazy_second_hadd, 0);
+    const CostType ct = defaultCostType(options_, task_);
+    if (options_.lazy_hadd_lane_budget > 0 && !options_.lazy_second_hadd &&
+        defaultHeuristic(options_) == HeuristicKind::kFF && (ct == CostType::kUnit || !costsVary(task_))) {
+      addLane(true, true, options_.lazy_hadd_lane_budget);
     }
+  }
+  /// A lane; `hadd`: h_FF through h_add's best supporters, as Fast Downward's (with the default
+  /// heuristic only); `budget` > 0: the lane is dropped after that many evaluations.
+  void addLane(bool plan_preferred, bool hadd = false, uint64_t budget = 0) {
+    Lane& l = lanes_.emplace_back();
+    l.budget = budget;
+    HeuristicKind kind = defaultHeuristic(options_);
+    if (hadd && kind == HeuristicKind::kFF) kind = HeuristicKind::kFFHadd;
     l.heuristic = makeHeuristic(kind, task_, defaultCostType(options_, task_));
     l.searcher = std::make_unique<Searcher>(task_, init_, goal_, options_, *l.heuristic, term_);
     if (landmarks_) l.searcher->shareLandmarkGraph(&*landmarks_);
@@ -1579,26 +1769,105 @@ SearchResult firstPlan(const Task& task, const StateBits& init, const Goal& goal
   return configuredSearch(task, init, goal, options, heuristic, term, nullptr);
 }
 
-/// True when the operators do not all cost the same (plan cost is not plan length).
-bool costsVary(const Task& task) {
-  if (task.unit_cost) return false;
-  for (const Operator& op : task.ops) {
-    if (op.cost != task.ops.front().cost) return true;
-  }
-  return false;
+/// A plan or a proof: the answer of a search that ends the others.
+bool isFinalAnswer(const SearchResult& r) {
+  return r.status == SearchStatus::kSolved || r.status == SearchStatus::kUnsolvable;
 }
+
+/// The cost + 1 run's evaluation hook with the unit-cost run beside it
+/// (`SearchOptions::unit_beside_time_share`): after every `turn` evaluations of its own, the
+/// unit-cost run (`unit`) runs as many, while it has time left of its `budget` seconds in all;
+/// past it, it is stopped. Once it has given a plan or a proof, the cost + 1 run is stopped
+/// (`plus_stop`).
+class UnitTurns : public EvaluationHook {
+ public:
+  UnitTurns(SearchFiber& unit, uint64_t turn, double budget, std::stop_source& plus_stop)
+      : unit_(unit), turn_(turn), left_(turn), budget_(budget), plus_stop_(plus_stop) {}
+
+  void evaluated() override {
+    if (unit_.done() || --left_ > 0) return;
+    left_ = turn_;
+    const double time_left = budget_ - unit_.seconds();
+    if (time_left > 0) {
+      unit_.resume(turn_, Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                             std::chrono::duration<double>(time_left)));
+    }
+    if (unit_.done()) {
+      if (isFinalAnswer(unit_.result())) plus_stop_.request_stop();
+    } else if (unit_.seconds() >= budget_) {
+      unit_.cancel();  // its share is used up: its states are freed
+    }
+  }
+
+ private:
+  SearchFiber& unit_;
+  uint64_t turn_;
+  uint64_t left_;
+  double budget_;
+  std::stop_source& plus_stop_;
+};
 
 /// The first plan of the anytime phase (SearchOptions::unit_cost_first): with unit costs within a
 /// share of the time left, then, if that run ran out of time or memory or gave up, with
-/// `heuristic` (cost + 1) from the start.
+/// `heuristic` (cost + 1) from the start; with `unit_beside_time_share`, the unit-cost run goes
+/// on beside the cost + 1 run, in turns.
 SearchResult unitCostFirstPlan(const Task& task, const StateBits& init, const Goal& goal, const SearchOptions& options,
                                Heuristic& heuristic, const Termination& term) {
+  const double left = term.deadline().secondsLeft();
+  if (std::isfinite(left) && options.unit_beside_time_share > options.unit_first_time_share) {
+    SearchOptions unit_options = options;
+    unit_options.cost_type = CostType::kUnit;  // also for the heuristic of a lazy search beside
+    SearchFiber unit(
+        [&](const Termination& t) {
+          std::unique_ptr<Heuristic> unit_h = makeHeuristic(defaultHeuristic(options), task, CostType::kUnit);
+          return firstPlan(task, init, goal, unit_options, *unit_h, t);
+        },
+        term);
+    const auto in = [](double seconds) {
+      return Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+    };
+    unit.resume(UINT64_MAX, in(options.unit_first_time_share * left));  // alone first
+    if (unit.done()) {
+      const SearchStatus st = unit.result().status;
+      const bool retry = st == SearchStatus::kOutOfMemory || st == SearchStatus::kFailed ||
+                         (st == SearchStatus::kTimeout && !term());
+      if (!retry) return std::move(unit.result());
+    }
+    // The cost + 1 run from the start, the unit-cost run (if it goes on) in turns beside it.
+    std::stop_source plus_stop;
+    struct StopRequest {
+      std::stop_source* source;
+      void operator()() const { source->request_stop(); }
+    };
+    std::stop_callback<StopRequest> link(term.token(), StopRequest{&plus_stop});
+    const Termination plus_term(term.deadline(), plus_stop.get_token());
+    const bool beside = !unit.done();
+    UnitTurns turns(unit, options.unit_beside_turn, options.unit_beside_time_share * left, plus_stop);
+    SearchResult plus;
+    {
+      ScopedEvaluationHook hook(beside ? &turns : nullptr);
+      plus = firstPlan(task, init, goal, options, heuristic, plus_term);
+    }
+    if (!unit.done() && (plus.status == SearchStatus::kFailed || plus.status == SearchStatus::kOutOfMemory)) {
+      unit.resume(UINT64_MAX, std::nullopt);  // the cost + 1 run gave up: the unit-cost run alone
+    }
+    if (unit.done() && isFinalAnswer(unit.result())) {
+      SearchResult r = std::move(unit.result());
+      addRunCosts(r.stats, plus.stats);
+      r.stats.unit_beside = true;
+      return r;
+    }
+    unit.cancel();
+    plus.stats.unit_first_failed = true;
+    plus.stats.unit_beside = beside;
+    addRunCosts(plus.stats, unit.result().stats);
+    return plus;
+  }
   SearchResult unit;
   {
     SearchOptions unit_options = options;
     unit_options.cost_type = CostType::kUnit;  // also for the heuristic of a lazy search beside
     std::unique_ptr<Heuristic> unit_h = makeHeuristic(defaultHeuristic(options), task, CostType::kUnit);
-    const double left = term.deadline().secondsLeft();
     const Termination share =
         std::isfinite(left) ? term.tightened(Deadline::in(options.unit_first_time_share * left)) : term;
     unit = firstPlan(task, init, goal, unit_options, *unit_h, share);

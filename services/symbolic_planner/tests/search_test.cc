@@ -606,6 +606,7 @@ TEST(Search, TwoLazySearchesBesideTheHillClimbingGiveTheFirstAnswerOfEither) {
     req.search.lazy_beside_both = true;
     req.search.lazy_second_after = 0;
     req.search.lazy_second_hadd = false;  // the second as the `lazy_plan_preferred` run's (tested below)
+    req.search.lazy_hadd_lane_budget = 0;  // two lazy searches (the third: tested below)
     PlanReply both = plan(req, Termination());
     PlanReply again = plan(req, Termination());
     ASSERT_EQ(alone.status, PlanStatus::kSolved) << alone.message;
@@ -652,6 +653,7 @@ TEST(Search, SecondLazySearchJoinsOnlyAfterLazySecondAfterEvaluations) {
 
   PlanRequest hk = benchmarkRequest("pddl-more/hiking", "instance-4.pddl");
   hk.timeout_seconds = 120;
+  hk.search.lazy_hadd_lane_budget = 0;  // two lazy searches (the third: tested below)
   hk.search.lazy_second_after = 16'000;  // the default joins about when the first answers
   PlanReply hk_delayed = plan(hk, Termination());
   PlanReply hk_again = plan(hk, Termination());
@@ -685,6 +687,7 @@ TEST(Search, SecondLazySearchTakesItsRelaxedPlanThroughHaddSupporters) {
   PlanRequest hk = benchmarkRequest("pddl-more/hiking", "instance-4.pddl");
   hk.timeout_seconds = 120;
   ASSERT_FALSE(hk.search.lazy_second_hadd);  // the default
+  hk.search.lazy_hadd_lane_budget = 0;  // `layered` below: two lazy searches (the third: tested below)
   hk.search.lazy_second_hadd = true;
   hk.search.lazy_second_after = 0;
   PlanReply hadd = plan(hk, Termination());
@@ -704,6 +707,61 @@ TEST(Search, SecondLazySearchTakesItsRelaxedPlanThroughHaddSupporters) {
   EXPECT_NE(hadd.plan, layered.plan);
   EXPECT_EQ(again.plan, hadd.plan);
   EXPECT_EQ(again.stats.evaluated, hadd.stats.evaluated);
+}
+
+TEST(Search, ThirdLazySearchOnHaddSupportersJoinsWithTheSecondAndIsDroppedAtItsBudget) {
+  // `lazy_hadd_lane_budget`: a third lazy search, the second's but for its h_FF (h_add's
+  // supporters), joins with the second. The searches' own states do not depend on the turns, so
+  // (1) dropped after its first turn (a budget of 1) it leaves the answer of the two others, plus
+  // its initial state and a turn of evaluations (101); (2) with a budget it does not reach, the answer is the
+  // plan of one of the two lanes with LAMA-first's preferred operators (layered graph or h_add's
+  // supporters) and, on hiking-4, the third's; checked, the same in a second run.
+  PlanRequest hk = benchmarkRequest("pddl-more/hiking", "instance-4.pddl");
+  hk.timeout_seconds = 120;
+  hk.search.lazy_second_after = 0;
+  ASSERT_EQ(hk.search.lazy_hadd_lane_budget, 50'000U);  // the default
+  hk.search.lazy_hadd_lane_budget = 0;
+  PlanReply two = plan(hk, Termination());
+  hk.search.lazy_hadd_lane_budget = 1;
+  PlanReply dropped = plan(hk, Termination());
+  hk.search.lazy_hadd_lane_budget = 1'000'000;
+  PlanReply three = plan(hk, Termination());
+  PlanReply again = plan(hk, Termination());
+  hk.search.lazy_hadd_lane_budget = 0;
+  hk.search.lazy_second_hadd = true;
+  PlanReply hadd = plan(hk, Termination());
+  for (const PlanReply* r : {&two, &dropped, &three, &again, &hadd}) {
+    ASSERT_EQ(r->status, PlanStatus::kSolved) << r->message;  // replayed by the checker
+    EXPECT_TRUE(r->stats.lazy_beside_won);
+  }
+  EXPECT_EQ(dropped.plan, two.plan);
+  EXPECT_GT(dropped.stats.evaluated, two.stats.evaluated);
+  EXPECT_LE(dropped.stats.evaluated, two.stats.evaluated + 101);  // its initial state and one turn
+  EXPECT_NE(hadd.plan, two.plan);  // the two h_FF's lanes give different plans: the test can tell
+  EXPECT_EQ(three.plan, hadd.plan);  // h_add's supporters answer first on hiking-4
+  EXPECT_EQ(again.plan, three.plan);
+  EXPECT_EQ(again.stats.evaluated, three.stats.evaluated);
+
+  // Where the operators differ in cost (cost + 1), h_FF is h_add's already: no third lane.
+  PlanRequest tr = benchmarkRequest("pddl-more/transport", "instance-6.pddl");
+  tr.timeout_seconds = 120;
+  tr.search.ehc_lazy_after = 1;
+  tr.search.lazy_second_after = 0;
+  tr.search.lazy_hadd_lane_budget = 0;
+  PlanReply tr_two = plan(tr, Termination());
+  tr.search.lazy_hadd_lane_budget = 1'000'000;
+  PlanReply tr_three = plan(tr, Termination());
+  ASSERT_EQ(tr_two.status, PlanStatus::kSolved) << tr_two.message;
+  ASSERT_EQ(tr_three.status, PlanStatus::kSolved) << tr_three.message;
+  EXPECT_EQ(tr_three.plan, tr_two.plan);
+  EXPECT_EQ(tr_three.stats.evaluated, tr_two.stats.evaluated);
+  tr.search.cost_type = CostType::kUnit;  // with unit costs it joins
+  PlanReply unit_three = plan(tr, Termination());
+  tr.search.lazy_hadd_lane_budget = 0;
+  PlanReply unit_two = plan(tr, Termination());
+  ASSERT_EQ(unit_three.status, PlanStatus::kSolved) << unit_three.message;
+  ASSERT_EQ(unit_two.status, PlanStatus::kSolved) << unit_two.message;
+  EXPECT_NE(unit_three.stats.evaluated, unit_two.stats.evaluated);
 }
 
 TEST(Search, LazySearchBesideProvesUnsolvabilityAndGoesOnAloneWhenTheHillClimbingGivesUp) {
@@ -1064,10 +1122,12 @@ TEST(Search, UnitCostFirstRunFallsBackToCostPlusOneWhenOutOfTimeShareOrMemory) {
   req.check_plan = true;
   req.search.anytime_seconds = 0.2;
   req.search.unit_first_time_share = 1e-9;
+  req.search.unit_beside_time_share = 0;  // the unit-cost run ends at its share (the next test: beside)
   req.timeout_seconds = 120;
   PlanReply r = plan(req, Termination());
   ASSERT_EQ(r.status, PlanStatus::kSolved) << r.message;
   EXPECT_TRUE(r.stats.unit_first_failed);
+  EXPECT_FALSE(r.stats.unit_beside);
   // The whole share: the unit-cost run finds the first plan itself.
   req.search.unit_first_time_share = 1.0;
   r = plan(req, Termination());
@@ -1099,6 +1159,89 @@ TEST(Search, UnitCostFirstRunFallsBackToCostPlusOneWhenOutOfTimeShareOrMemory) {
   EXPECT_TRUE(r.stats.unit_first_failed);
 }
 
+/// The plan's steps, one string.
+std::string planText(const PlanReply& r) {
+  std::string out;
+  for (const auto& st : r.plan) out += st.toString() + "\n";
+  return out;
+}
+
+TEST(Search, UnitCostRunGoesOnBesideTheCostPlusOneRunInTurns) {
+  // pegsol-18 (a cost domain): the unit-cost run's first share (1e-9 of the time left) ends at
+  // its first time check, 16 evaluations in; it then goes on beside the cost + 1 run, 1000
+  // evaluations a turn each, with the whole time left (no second deadline): every turn ends at
+  // a count of evaluations, so the run is the same in every run. The winner's plan is the plan
+  // it finds alone (the turns change neither run's states), and the effort counted is both runs'.
+  PlanRequest req = benchmarkRequest("pddl-more/pegsol", "instance-18.pddl");
+  req.check_plan = true;
+  req.timeout_seconds = 120;
+  req.search.anytime_seconds = 1e-9;  // the first plan, as found (no time to improve it)
+  req.search.unit_first_time_share = 1e-9;
+  req.search.unit_beside_time_share = 1.0;
+  PlanReply turns = plan(req, Termination());
+  ASSERT_EQ(turns.status, PlanStatus::kSolved) << turns.message;
+  EXPECT_TRUE(turns.stats.unit_beside);
+  PlanReply again = plan(req, Termination());
+  ASSERT_EQ(again.status, PlanStatus::kSolved) << again.message;
+  EXPECT_EQ(planText(again), planText(turns));
+  EXPECT_EQ(again.stats.evaluated, turns.stats.evaluated);
+  EXPECT_EQ(again.stats.unit_first_failed, turns.stats.unit_first_failed);
+
+  req.search.unit_first_time_share = 1.0;  // the unit-cost run alone
+  req.search.unit_beside_time_share = 0;
+  PlanReply unit = plan(req, Termination());
+  ASSERT_EQ(unit.status, PlanStatus::kSolved) << unit.message;
+  EXPECT_FALSE(unit.stats.unit_first_failed);
+  req.search.unit_cost_first = false;  // the cost + 1 run alone
+  PlanReply plus = plan(req, Termination());
+  ASSERT_EQ(plus.status, PlanStatus::kSolved) << plus.message;
+  const PlanReply& winner = turns.stats.unit_first_failed ? plus : unit;
+  const PlanReply& loser = turns.stats.unit_first_failed ? unit : plus;
+  EXPECT_EQ(planText(turns), planText(winner));
+  // The winner's evaluations, and at most one turn more of the loser's than the winner's (turns
+  // of 1000 after the unit-cost run's first 16).
+  EXPECT_GT(turns.stats.evaluated, winner.stats.evaluated);
+  EXPECT_LT(turns.stats.evaluated, winner.stats.evaluated + std::min<uint64_t>(loser.stats.evaluated, winner.stats.evaluated + 1100));
+  EXPECT_NE(unit.stats.evaluated, plus.stats.evaluated);  // the two runs differ: the test can tell them apart
+  EXPECT_NE(planText(unit), planText(plus));
+}
+
+TEST(Search, UnitCostRunBesideStopsAtItsShareAndOnTheCallersStop) {
+  // The unit-cost run's share of the time left in all just above its first share: it is
+  // stopped at its first turn beside the cost + 1 run, which gives the plan.
+  PlanRequest req = benchmarkRequest("pddl-more/pegsol", "instance-18.pddl");
+  req.check_plan = true;
+  req.timeout_seconds = 120;
+  req.search.anytime_seconds = 1e-9;
+  req.search.unit_first_time_share = 1e-9;
+  req.search.unit_beside_time_share = 2e-9;
+  PlanReply r = plan(req, Termination());
+  ASSERT_EQ(r.status, PlanStatus::kSolved) << r.message;
+  EXPECT_TRUE(r.stats.unit_first_failed);
+  EXPECT_TRUE(r.stats.unit_beside);
+  req.search.unit_cost_first = false;
+  PlanReply plus = plan(req, Termination());
+  ASSERT_EQ(plus.status, PlanStatus::kSolved) << plus.message;
+  EXPECT_EQ(planText(r), planText(plus));
+
+  // A stop requested while both run ends both (the unit-cost one on its own thread) at once.
+  PlanRequest hard = benchmarkRequest("pddl-more/transport", "instance-30.pddl");
+  hard.search.anytime_seconds = 5;
+  hard.search.unit_first_time_share = 1e-9;
+  hard.search.unit_beside_time_share = 1.0;
+  hard.timeout_seconds = 600;
+  std::stop_source stop;
+  std::thread stopper([&stop] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+    stop.request_stop();
+  });
+  Stopwatch sw;
+  PlanReply cancelled = plan(hard, Termination(Deadline::never(), stop.get_token()));
+  stopper.join();
+  EXPECT_EQ(cancelled.status, PlanStatus::kCancelled) << cancelled.message;
+  EXPECT_LT(sw.seconds(), 5.0);
+}
+
 TEST(Search, OptionsAreValidated) {
   SearchOptions o;
   o.weight = 0.5;
@@ -1113,6 +1256,16 @@ TEST(Search, OptionsAreValidated) {
     EXPECT_THROW(o.validate(), std::invalid_argument) << bad;
   }
   o.unit_first_time_share = 1.0;
+  EXPECT_NO_THROW(o.validate());
+  for (double bad : {-0.1, 1.5, std::nan("")}) {
+    o.unit_beside_time_share = bad;
+    EXPECT_THROW(o.validate(), std::invalid_argument) << bad;
+  }
+  o.unit_beside_time_share = 0;
+  EXPECT_NO_THROW(o.validate());
+  o.unit_beside_turn = 0;
+  EXPECT_THROW(o.validate(), std::invalid_argument);
+  o.unit_beside_turn = 1;
   EXPECT_NO_THROW(o.validate());
   for (double bad : {-0.1, 1.5, std::nan("")}) {
     o.neighbourhood_time_share = bad;

@@ -105,6 +105,7 @@ struct PlanStatistics {
   uint64_t neighbourhood_states{0};        ///< states of the largest of them
   double neighbourhood_seconds{0.0};       ///< ... and their time
   bool unit_first_failed{false};  ///< the unit-cost first run failed; see SearchOptions::unit_cost_first
+  bool unit_beside{false};  ///< the unit-cost run went on beside the cost + 1 run (SearchOptions::unit_beside_time_share)
   uint64_t landmarks{0};  ///< landmarks of the lazy search's landmark count (0: not used)
   uint64_t landmarks_disjunctive{0};  ///< ... of which disjunctive
   uint64_t landmark_gn_orders{0};     ///< ... greedy-necessary orders between them

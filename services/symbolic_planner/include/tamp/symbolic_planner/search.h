@@ -14,7 +14,9 @@
 ///   on from where it is (`lazy_plan_preferred`: with LAMA-first's preferred operators). A second
 ///   lazy search, with LAMA-first's preferred operators (and, `lazy_second_hadd`, its h_FF through
 ///   h_add's best supporters), joins them once the two have used `lazy_second_after` evaluations
-///   (`lazy_beside_both`, the default). With
+///   (`lazy_beside_both`, the default); where h_FF takes FF's layered graph, a third, the second
+///   with h_add's supporters (LAMA-first's), joins with it for `lazy_hadd_lane_budget`
+///   evaluations. With
 ///   `ehc_ff_first` (the default) and a heuristic that has
 ///   FF-v2.3's variant (`Heuristic::setFFStyle`), a first hill-climbing run uses that variant
 ///   within a budget of evaluations (it tends to give shorter plans); when it fails or runs
@@ -205,6 +207,17 @@ struct SearchOptions {
   /// the layered graph's second search gives. On tasks whose operators differ in cost (cost + 1)
   /// h_FF is h_add's already: no change there.
   bool lazy_second_hadd{false};
+  /// lazy_beside_both with `lazy_second_hadd` off, the default heuristic (h_FF) and operators that
+  /// cost the same (where h_FF takes FF's layered graph): a third lazy search joins with the
+  /// second, the same but for its h_FF, through h_add's best supporters (LAMA-first's lazy search
+  /// but for its turns), and takes its turns until it has used this many evaluations; then it is
+  /// dropped and its states freed. The two h_FF split the domains in that search (the
+  /// thirty-second round: h_add's solves blocks-80 and pathways-18 within thousands of its
+  /// evaluations, the layered graph's trucks-18 after millions), so the third gets a small
+  /// budget that costs the second little where it needs millions (docs/benchmarks.md, issue 14,
+  /// thirty-third round: blocks-80 needs more than 25 000 and at most 50 000; trucks-18's
+  /// second search then runs beside 50 000 more evaluations). 0: no third lazy search.
+  uint64_t lazy_hadd_lane_budget{50'000};
   uint64_t ehc_lazy_after{4000};
   uint64_t ehc_lazy_turn_ehc{100};
   uint64_t ehc_lazy_turn_lazy{100};
@@ -237,6 +250,23 @@ struct SearchOptions {
   /// the time left; the anytime iterations always use cost + 1. false: cost + 1 at once.
   bool unit_cost_first{true};
   double unit_first_time_share{0.1};  ///< must be in (0, 1]
+  /// unit_cost_first with a deadline: when the unit-cost run has not answered within its
+  /// `unit_first_time_share`, it is not dropped: the cost + 1 run starts from the start beside
+  /// it, and the two take turns of `unit_beside_turn` evaluations each (the unit-cost run on a
+  /// thread of its own, but never running at the same time as the caller's: the same
+  /// evaluations in every run but for where its time share ends), until the unit-cost run has
+  /// used this share of the time left in all (its first share included); then it is stopped
+  /// and its states freed, and the cost + 1 run goes on alone. The first plan or proof of either
+  /// is the answer. A unit-cost run that needs more than its first share (transport-18) gets up to
+  /// this share, a cost + 1 run that needs most of the time (citycar-6) loses what the unit-cost
+  /// run uses beside it. At most `unit_first_time_share` (0, the default): the unit-cost run ends
+  /// at its first share and the cost + 1 run starts after it (the fourth to thirty-second rounds).
+  /// Off by default (docs/benchmarks.md, issue 14, thirty-third round): at 0.3, transport-18 is
+  /// solved (23.4 s of 29), but citycar-6's first plan comes after at least 54 s of its 59 (the
+  /// unit-cost run takes 17.7 s of it, in vain) and citycar-11 takes 31.7 s instead of 21.
+  /// Must be in [0, 1].
+  double unit_beside_time_share{0.0};
+  uint64_t unit_beside_turn{1000};  ///< must be > 0
   /// Anytime phase: before the weighted iterations, plan neighbourhood graph search (Nakhost and
   /// Mueller, ICAPS 2010) on the first plan, for up to this share of the phase's time: the plan's
   /// states and the states reached from them breadth-first, up to a number of states that
@@ -317,6 +347,8 @@ struct SearchStatistics {
   /// `unit_cost_first`: the unit-cost run ran out of its time share or memory, or gave up, and the
   /// first plan came from the cost + 1 run; its effort is included in the counters above.
   bool unit_first_failed{false};
+  /// `unit_beside_time_share`: the unit-cost run went on beside the cost + 1 run (whichever answered).
+  bool unit_beside{false};
   double seconds{0.0};
 };
 

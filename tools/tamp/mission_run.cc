@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_common.h"
+#include "tamp/core/paths.h"
 #include "tamp/dds/convert.h"
 #include "tamp/dds/endpoint.h"
 #include "tamp/dds/topics.h"
@@ -101,16 +102,7 @@ void writeWorldPictures(const world::Scenario& sc, const nlohmann::json& report,
 /// Writes `text` to `file` through a temporary in the same folder and a rename, so a reader never
 /// sees half a report. The error, or nothing.
 std::optional<std::string> writeAtomically(const fs::path& file, const std::string& text) {
-  const fs::path tmp = file.string() + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::trunc);
-    out << text;
-    out.flush();
-    if (!out) return "cannot write " + tmp.string();
-  }
-  std::error_code ec;
-  fs::rename(tmp, file, ec);
-  if (ec) return "cannot rename " + tmp.string() + " to " + file.string() + ": " + ec.message();
+  if (Status s = writeFileAtomically(file, text, "the report"); !s) return s.error().message;
   return std::nullopt;
 }
 

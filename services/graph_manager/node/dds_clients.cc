@@ -471,6 +471,7 @@ Observation DdsWorldSource::robot() {
   o.robot = *st;
   o.robot.base = Pose2D{s->base().x(), s->base().y(), s->base().theta()};
   o.held_object_id = s->held_object_id();
+  o.moving = s->moving();
   o.valid = true;
   return o;
 }

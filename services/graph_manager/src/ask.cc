@@ -1,6 +1,8 @@
 // The graph manager's questions to the motion planner's services, through the memo of answers
 // given in the world as it stands (query_memo.h). Counters count the questions the services
 // answered; `memo_hits` those answered from memory.
+#include <algorithm>
+
 #include "tamp/graph_manager/graph_manager.h"
 
 namespace tamp::graph_manager {
@@ -10,7 +12,19 @@ MotionQuery GraphManager::withHeldMargin(MotionQuery q) const {
   q.held_padding_m = in_hand ? held_padding_m_ : 0.0;
   q.world_version = world_version_;
   q.added = unseenObjects();
+  std::vector<std::string> skip = q.ignored;
+  if (!q.held.object_id.empty()) skip.push_back(q.held.object_id);
+  addCorrections(q.overrides, skip);
   return q;
+}
+
+void GraphManager::addCorrections(std::vector<ObjectOverride>& overrides, const std::vector<std::string>& skip) const {
+  for (const auto& [id, c] : corrections_) {
+    auto named = [&](const ObjectOverride& o) { return o.object_id == id; };
+    if (std::find(skip.begin(), skip.end(), id) != skip.end() || std::any_of(overrides.begin(), overrides.end(), named))
+      continue;
+    overrides.push_back(ObjectOverride{id, false, c.pose});
+  }
 }
 
 namespace {
@@ -69,6 +83,7 @@ std::vector<MotionAnswer> GraphManager::askMotions(const std::vector<MotionQuery
 Result<std::vector<GraspOption>> GraphManager::askGrasps(GraspQuery q) {
   q.world_version = world_version_;
   q.added = unseenObjects();
+  addCorrections(q.overrides);
   if (const std::vector<GraspOption>* kept = params_.memoise_answers ? memo_.grasps(q) : nullptr) {
     ++counters_.memo_hits;
     return *kept;
@@ -82,6 +97,7 @@ Result<std::vector<GraspOption>> GraphManager::askGrasps(GraspQuery q) {
 Result<std::vector<PlacementOption>> GraphManager::askPlacements(PlacementQuery q) {
   q.world_version = world_version_;
   q.added = unseenObjects();
+  addCorrections(q.overrides, {q.object_id});
   ++counters_.placement_calls;
   return services_.placements(q);
 }

@@ -191,6 +191,9 @@ struct GraphManager::Run {
   bool replan(const MissionEvent& ev, EdgeId failed, std::string& why);
   /// Waits (drop_settle_timeout_s at most) until the world model has `object` resting on a support.
   void awaitSettled(const std::string& object);
+  /// The robot's state once it reports itself at rest, waiting at most params.rest_wait_s (then
+  /// the newest state, moving or not).
+  Observation restingRobot();
   /// After an overrun: until the effort estimator has refitted since the action was sent, at most
   /// params.refit_wait_s.
   void awaitRefit();
@@ -568,6 +571,9 @@ void GraphManager::Run::succeeded(EdgeId id, EdgeId next, const EdgeCommand& cmd
       report.moved_from.emplace_back(o->id, o->pose);
     report.moved_to.emplace_back(cmd.object_id, *cmd.object_target);
   }
+  // Picked, placed or pushed: the object is where the action took it; a stop's evidence of where
+  // it stood before is over.
+  if (!cmd.object_id.empty()) gm.corrections_.erase(cmd.object_id);
   ctx = gm.advance(id, next, ctx);
   const Observation now = source.robot();
   if (now.valid) {
@@ -655,6 +661,17 @@ void GraphManager::Run::awaitRefit() {
   }
 }
 
+Observation GraphManager::Run::restingRobot() {
+  const auto t0 = Clock::now();
+  Observation o = source.robot();
+  while (o.valid && o.moving && since(t0) < gm.params_.rest_wait_s && !abortRequested()) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    o = source.robot();
+  }
+  if (o.moving) log::get("graph_manager")->warn("the robot still reports itself moving {:.1f} s after it was stopped", since(t0));
+  return o;
+}
+
 void GraphManager::Run::awaitSettled(const std::string& object) {
   const auto t0 = Clock::now();
   DropSettleWatch watch(object, gm.params_.drop_confirm_s);
@@ -707,8 +724,10 @@ bool GraphManager::Run::replan(const MissionEvent& ev, EdgeId failed, std::strin
   // motion by the world model, so planning again where the graph believes that object is would
   // be refused again (a pushed chair whose estimate lags 11 cm behind its slot); it is taken
   // where perception sees it.
-  const Observation now = source.robot();
-  world::World live = source.world();
+  // Stopped before an object: where it stopped is evidence (below), so the state must be the stop's.
+  const Observation now = ev.kind == EventKind::kActionBlocked ? restingRobot() : source.robot();
+  const world::World perceived = source.world();
+  world::World live = perceived;
   std::vector<std::string> fresh;
   std::vector<world::Object> changed, refused;
   const bool names_object = ev.kind == EventKind::kActionFailed || ev.kind == EventKind::kActionBlocked;
@@ -752,12 +771,31 @@ bool GraphManager::Run::replan(const MissionEvent& ev, EdgeId failed, std::strin
     if (known) gm.widenHeldMargin(held_before.object_id, ev.object_id);
   }
   rec.held_padding_m = gm.held_padding_m_;
+  // Stopped before a movable with nothing in the hand: the robot's body at the stop is where the
+  // object begins (contact.h). Planning round the estimate again would drive into it again.
+  // A command refused because of a corrected object: the monitor checks commands against the
+  // world model, which still has it where it was seen; planning round the correction again would
+  // be refused again. The world model's estimate wins.
+  if (ev.kind == EventKind::kActionFailed && gm.corrections_.erase(ev.object_id) > 0)
+    log::get("graph_manager")->info("'{}': a command was refused with the world model's estimate of it; its contact correction ends",
+                                    ev.object_id);
+  gm.applyContactCorrections(perceived, live);
+  bool corrected = false;
+  if (ev.kind == EventKind::kActionBlocked && held_before.object_id.empty() && now.valid && !ev.object_id.empty()) {
+    if (auto c = gm.correctByContact(perceived, live, ev.object_id, now.robot)) {
+      corrected = true;
+      rec.corrected_object = ev.object_id;
+      rec.corrected_m = c->shift_m;
+    }
+  }
+  if (!gm.corrections_.empty()) gm.abstraction_.setWorld(live);
   // Failed, refused or stopped because of an object the graph did not know, or knew elsewhere or
   // smaller (the world model changed since the edge was planned, e.g. a new object's estimate
   // still growing onto the path): the world changed under the plan, the action did not fail, so
   // it is not counted towards max_action_failures (max_replans still bounds the attempts).
+  // The world model corrected by the stop is a world changed under the plan as well.
   const bool stale = names_object && !ev.object_id.empty() &&
-                     (reshaped || std::find(fresh.begin(), fresh.end(), ev.object_id) != fresh.end() ||
+                     (reshaped || corrected || std::find(fresh.begin(), fresh.end(), ev.object_id) != fresh.end() ||
                       std::any_of(changed.begin(), changed.end(),
                                   [&](const world::Object& o) { return o.id == ev.object_id; }));
   changed.insert(changed.end(), refused.begin(), refused.end());

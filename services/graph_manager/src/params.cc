@@ -52,6 +52,9 @@ const config::Schema<GraphManagerParams>& schema() {
         .field("held_padding_step_m", &P::held_padding_step_m, config::nonNegative("m"))
         .field("held_padding_max_m", &P::held_padding_max_m,
                config::inRange(0.0, 0.25, config::Ends::kClosed, "m"))
+        .field("contact_correction_max_m", &P::contact_correction_max_m,
+               config::inRange(0.0, 0.5, config::Ends::kClosed, "m"))
+        .field("rest_wait_s", &P::rest_wait_s, config::nonNegative("s"))
         .field("lower_bound_base_speed", &P::lower_bound_base_speed, positive())
         .field("model_bounds", &P::model_bounds)
         .field("goal_bound", &P::goal_bound)

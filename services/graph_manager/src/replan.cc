@@ -6,6 +6,7 @@
 #include <set>
 
 #include "tamp/core/log.h"
+#include "tamp/graph_manager/contact.h"
 #include "tamp/graph_manager/graph_manager.h"
 #include "object_geometry.h"
 #include "state_atoms.h"
@@ -156,6 +157,48 @@ bool GraphManager::widenHeldMargin(const std::string& held, const std::string& b
                                   "({} motions to plan again)",
                                   blocker, held, held_padding_m_, n);
   return true;
+}
+
+namespace {
+/// The world model seeing a corrected object this much farther from where it had it when the
+/// robot stopped (m) has seen it anew: the correction ends. Below it, estimate noise.
+constexpr double kCorrectionHoldM = 0.03;
+}  // namespace
+
+std::optional<ContactCorrection> GraphManager::correctByContact(const world::World& perceived, world::World& live,
+                                                                const std::string& object,
+                                                                const robot::RobotState& stop) {
+  const world::Object* o = live.findObject(object);
+  const world::Object* p = perceived.findObject(object);
+  if (!o || !p || o->kind != world::ObjectKind::kMovable || !(params_.contact_correction_max_m > 0)) return std::nullopt;
+  const Eigen::Isometry3d seen = p->pose;
+  auto c = touchingPose(*o, abstraction_.robot(), stop, params_.contact_correction_max_m);
+  if (!c) {
+    log::get("graph_manager")->info("stopped before '{}': its estimate agrees with the stop (or is too far off to tell)", object);
+    return std::nullopt;
+  }
+  const Eigen::Vector3d a = o->pose.translation(), b = c->pose.translation();
+  (void)live.setObjectPose(object, c->pose);
+  corrections_[object] = ContactCorrected{c->pose, seen};
+  log::get("graph_manager")
+      ->info("stopped before '{}': it stands {:.3f} m nearer than the world model has it; planned at ({:.3f}, {:.3f}) "
+             "instead of ({:.3f}, {:.3f}) until the world model sees it move",
+             object, c->shift_m, b.x(), b.y(), a.x(), a.y());
+  return c;
+}
+
+void GraphManager::applyContactCorrections(const world::World& perceived, world::World& live) {
+  for (auto it = corrections_.begin(); it != corrections_.end();) {
+    const world::Object* o = perceived.findObject(it->first);
+    if (!o || (o->pose.translation() - it->second.seen.translation()).norm() > kCorrectionHoldM) {
+      log::get("graph_manager")->info("'{}': the world model {}; its contact correction ends", it->first,
+                                      o ? "sees it moved" : "lost it");
+      it = corrections_.erase(it);
+      continue;
+    }
+    if (live.findObject(it->first)) (void)live.setObjectPose(it->first, it->second.pose);
+    ++it;
+  }
 }
 
 std::string GraphManager::heldAt(NodeId n) const {

@@ -133,6 +133,10 @@ std::string reportJson(const MissionReport& r, const std::string& scenario, cons
                           {"how", rp.how},
                           {"rejoined", rp.rejoined},
                           {"held_padding_m", rp.held_padding_m},
+                          {"contact_correction", rp.corrected_object.empty()
+                                                     ? nlohmann::json(nullptr)
+                                                     : nlohmann::json{{"object", rp.corrected_object},
+                                                                      {"shift_m", rp.corrected_m}}},
                           {"planner_calls", rp.planner_calls},
                           {"motion_calls", rp.motion_calls},
                           {"planning_s", rp.planning_s},

@@ -95,9 +95,11 @@ class ScriptedServices : public ServiceClients {
   }
   std::vector<double> held_paddings;  ///< of every motion query holding an object
   std::vector<std::uint64_t> world_versions;  ///< MotionQuery::world_version of every query
+  std::vector<std::vector<ObjectOverride>> overrides_asked;  ///< MotionQuery::overrides of every query
   MotionAnswer motion(const MotionQuery& q) override {
     ++motion_calls;
     world_versions.push_back(q.world_version);
+    overrides_asked.push_back(q.overrides);
     if (!q.held.object_id.empty()) held_paddings.push_back(q.held_padding_m);
     if (q.mode == Mode::kLazy) fixed_asked.push_back(q.fixed);
     MotionAnswer a;
@@ -598,10 +600,12 @@ class DrivingExecutor : public Executor {
   std::string fail_naming;
   ExecOutcome fail_outcome{ExecOutcome::kFailed};  ///< refused (kFailed) or stopped (kBlocked)
   std::function<void(int)> before_failure;
+  std::optional<Pose2D> stop_at;  ///< where a failed command leaves the robot (none: where it was)
   ExecutionReport execute(const EdgeCommand& c, double) override {
     world_versions.push_back(c.world_version);
     if (failed_ < fail_first) {
       if (before_failure) before_failure(failed_);
+      if (stop_at) world_.robot_now.robot.base = *stop_at;
       ++failed_;
       ExecutionReport r;
       r.outcome = fail_outcome;
@@ -821,6 +825,58 @@ TEST(MissionFailureCountTest, StopsBeforeAnObjectWhoseEstimateGrewAreNotCountedA
   EXPECT_NE(known.reason.find("max_action_failures"), std::string::npos) << known.reason;
 }
 
+// A stop before an object that the world model has farther off than the robot's body (a face
+// perception never saw: namo_doorway's pushed crate, CI of 2026-12-07) is evidence of where it
+// stands: from then on every motion question has the object touching the robot where it stopped,
+// and the stop is not counted towards max_action_failures (the world changed under the plan).
+// Two stops before the corridor's box, 5 cm ahead of the robot's front where it stopped: the
+// first corrects it, the second (now touching) is counted, the third drive goes. The same two
+// stops with the robot stopped far from the box (no evidence) fail at max_action_failures.
+TEST(MissionContactTest, AStopBeforeAnObjectMovesItsEstimateToTouchTheRobotInEveryLaterQuestion) {
+  auto sc = world::loadScenario(configDir() / "scenarios" / "namo_corridor.yaml");
+  ASSERT_TRUE(sc.ok());
+  auto robot = robot::RobotModel::loadDescription(sc->robot.description);
+  ASSERT_TRUE(robot.ok());
+  const Eigen::Vector3d box = sc->plannerWorld().object("box").pose.translation();
+  const double half = sc->plannerWorld().object("box").shape.size.x() / 2;
+  double front = 0.0;
+  for (const auto& v : robot->baseFootprint()) front = std::max(front, v.x());
+  auto mission = [&](std::optional<Pose2D> stop, ScriptedServices& services) {
+    VersionedWorld source;
+    DrivingExecutor x(source);
+    x.fail_first = 2;
+    x.fail_naming = "box";
+    x.fail_outcome = ExecOutcome::kBlocked;
+    x.stop_at = stop;
+    return corridorMission(source, x, services);
+  };
+  ScriptedServices beside;
+  const MissionReport r = mission(Pose2D{box.x() - half - front - 0.05, box.y(), 0.0}, beside);
+  ASSERT_EQ(r.status, MissionOutcome::kSucceeded) << r.reason;
+  ASSERT_EQ(r.replanning.size(), 2u);
+  EXPECT_EQ(r.replanning[0].corrected_object, "box");
+  EXPECT_NEAR(r.replanning[0].corrected_m, 0.05, 0.01);
+  EXPECT_TRUE(r.replanning[1].corrected_object.empty()) << "touching already: nothing to correct";
+  // Every motion question after the first stop has the box 5 cm nearer, where the robot stopped.
+  int with_box = 0;
+  for (std::size_t i = 0; i < beside.overrides_asked.size(); ++i)
+    for (const auto& o : beside.overrides_asked[i])
+      if (o.object_id == "box") {
+        ++with_box;
+        EXPECT_NEAR(o.pose.translation().x(), box.x() - 0.05, 0.01);
+        EXPECT_NEAR(o.pose.translation().y(), box.y(), 1e-3);
+      }
+  EXPECT_GE(with_box, 1) << "no question after the stop carried the box's correction";
+  const nlohmann::json j = nlohmann::json::parse(reportJson(r, "namo_corridor", "effort", 1));
+  EXPECT_EQ(j["replanning"][0]["contact_correction"]["object"], "box") << j["replanning"].dump(1);
+  EXPECT_TRUE(j["replanning"][1]["contact_correction"].is_null());
+  ScriptedServices far;
+  const MissionReport none = mission(std::nullopt, far);
+  EXPECT_EQ(none.status, MissionOutcome::kFailed);
+  EXPECT_NE(none.reason.find("max_action_failures"), std::string::npos) << none.reason;
+  for (const auto& q : far.overrides_asked)
+    for (const auto& o : q) EXPECT_NE(o.object_id, "box");
+}
 
 // What perception found that the scenario did not list is in the report, where the world model
 // has it at the mission's end, with its outline in the world (tamp run draws it in world.png, so

@@ -245,6 +245,7 @@ struct Observation {
   robot::RobotState robot;
   std::string held_object_id;
   bool valid{false};
+  bool moving{false};  ///< the robot reports itself in motion (a state taken while it still moved)
 };
 
 }  // namespace tamp::graph_manager

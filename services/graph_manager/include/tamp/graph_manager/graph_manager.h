@@ -52,6 +52,7 @@
 #include "tamp/graph_manager/call_log.h"
 #include "tamp/graph_manager/bound.h"
 #include "tamp/graph_manager/clients.h"
+#include "tamp/graph_manager/contact.h"
 #include "tamp/graph_manager/graph.h"
 #include "tamp/graph_manager/params.h"
 #include "tamp/graph_manager/query_memo.h"
@@ -173,6 +174,10 @@ struct ReplanRecord {
   std::string how;
   std::vector<std::string> rejoined;  ///< the nodes ahead that a sub-task reached
   double held_padding_m{0.0};         ///< the held object's planning margin from this event on
+  /// The object the robot was stopped before, moved by the stop's evidence (correctByContact),
+  /// and by how much (m); empty / 0 when the estimate already agreed with the stop.
+  std::string corrected_object;
+  double corrected_m{0.0};
   int planner_calls{0};
   int motion_calls{0};
   double planning_s{0.0};
@@ -362,6 +367,16 @@ class GraphManager {
   /// stopped before `blocker` (known where it is) while holding `held`, and forgets the motions planned
   /// with an object in the hand. False when the margin was already at its maximum.
   bool widenHeldMargin(const std::string& held, const std::string& blocker);
+  /// After the robot, holding nothing that touched, was stopped before movable `object` at
+  /// `stop`: the object is moved in `live` (and kept there for the mission's questions, see
+  /// `corrections_`) to touch the robot's body, when `live` has it farther off (contact.h; call
+  /// after applyContactCorrections, so that a second stop corrects the first correction).
+  /// `perceived`: the world model as it came. The correction, or none.
+  std::optional<ContactCorrection> correctByContact(const world::World& perceived, world::World& live,
+                                                    const std::string& object, const robot::RobotState& stop);
+  /// The contact corrections still standing applied to `live`; those whose object the world
+  /// model (`perceived`) has seen move since, or lost, are dropped.
+  void applyContactCorrections(const world::World& perceived, world::World& live);
   /// The object held in node `n`'s state, or "".
   std::string heldAt(NodeId n) const;
   /// Prices every evaluated, unexecuted motion again (the effort models may have been refitted).
@@ -591,8 +606,12 @@ class GraphManager {
   void clearWorldCaches();
   /// The motion and grasp services, through `memo_` (ask.cc): counted in `counters_` when asked.
   MotionAnswer askMotion(const MotionQuery& q);
-  /// `q` with the mission's margin around a held object (not one pushed by the base).
+  /// `q` with the mission's margin around a held object (not one pushed by the base), and the
+  /// contact corrections of objects the query does not place itself.
   MotionQuery withHeldMargin(MotionQuery q) const;
+  /// The contact corrections (`corrections_`) as overrides, added to `overrides` for the objects
+  /// they do not already name, except `skip` (ignored or held by the query).
+  void addCorrections(std::vector<ObjectOverride>& overrides, const std::vector<std::string>& skip = {}) const;
   /// Independent motion queries at once (ServiceClients::motions), those not in the memo.
   std::vector<MotionAnswer> askMotions(const std::vector<MotionQuery>& qs);
   /// Grasps and placements asked in the world model version the graph plans in (as motions).
@@ -626,6 +645,16 @@ class GraphManager {
   /// The margin a held object is planned with (params_.held_padding_step_m per static contact
   /// the robot was stopped before while holding; see Run::replan).
   double held_padding_m_{0.0};
+  /// Objects the robot was stopped before where the world model did not have them
+  /// (correctByContact): where the stop puts them, and where the world model had them then. The
+  /// motion planner and the grasp and placement services plan with the world model, so every
+  /// question carries these as overrides; the world model seeing the object elsewhere (by more
+  /// than `kCorrectionHoldM`) ends one.
+  struct ContactCorrected {
+    Eigen::Isometry3d pose;
+    Eigen::Isometry3d seen;
+  };
+  std::map<std::string, ContactCorrected> corrections_;
   /// The newest world model version the mission took from its WorldSource (0: unknown): motion
   /// questions and commands carry it, so no service answers from an older world than the graph's.
   std::uint64_t world_version_{0};

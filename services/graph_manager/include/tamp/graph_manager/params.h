@@ -61,6 +61,15 @@ struct GraphManagerParams {
   /// (0: never grown); the maximum is at most 0.25 m.
   double held_padding_step_m{0.03};
   double held_padding_max_m{0.09};
+  /// Stopped before a movable object with nothing in the hand that could have touched it: the
+  /// object's estimate is moved to touch the robot's body where it stopped (contact.h), when it
+  /// stood at most this far off (m, in [0, 0.5]; 0: never). Farther, the stop is no evidence
+  /// about that estimate.
+  double contact_correction_max_m{0.15};
+  /// Before reading where the robot stopped: wait at most this long (s, >= 0) for a robot state
+  /// that says it is at rest (the last state sent while it still moved is up to a state period
+  /// behind the stop).
+  double rest_wait_s{1.0};
   double lower_bound_base_speed{1.5};  ///< m/s, above the robot's top speed (admissible bound); > 0
   /// Bound a base motion by the effort model's time of one straight drive of its length (bound.cc),
   /// not only by the distance at lower_bound_base_speed.

@@ -163,8 +163,10 @@ export TAMP_DOMAIN_ID=$(( (RANDOM % 100) + 100 )) TAMP_DDS_PROFILE=tamp_udp  # S
 
 PIDS=()
 cleanup() {
-  for p in "${PIDS[@]}"; do kill -TERM "$p" 2>/dev/null || true; done
-  for p in "${PIDS[@]}"; do wait "$p" 2>/dev/null || true; done
+  # One after the other, the robot's launcher before the workstation's: the execution monitor
+  # hands its last execution records to the effort estimator as it stops (both sides stopped at
+  # once lost the mission's last record in the secured CI run of 2026-12-07).
+  for p in "${PIDS[@]}"; do kill -TERM "$p" 2>/dev/null || true; wait "$p" 2>/dev/null || true; done
   # Services whose launcher was killed (--kill-launcher) are orphans: stopped here, as the launcher
   # would have (the simulator writes its final world on it), waited for at most 10 s.
   local orphans="tamp_[a-z_]*_service --name .*--run-id $RUN_ID( |\$)"

@@ -102,7 +102,7 @@ void writeWorldPictures(const world::Scenario& sc, const nlohmann::json& report,
 /// Writes `text` to `file` through a temporary in the same folder and a rename, so a reader never
 /// sees half a report. The error, or nothing.
 std::optional<std::string> writeAtomically(const fs::path& file, const std::string& text) {
-  if (Status s = writeFileAtomically(file, text, "the report"); !s) return s.error().message;
+  if (Status s = writeFileAtomically(file, text, "the report"); !s) return s.error().toString();
   return std::nullopt;
 }
 

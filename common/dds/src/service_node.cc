@@ -114,6 +114,12 @@ int ServiceNode::run() {
   log::get(name_)->info("{} stopping", name_);
   heartbeat_->setStallLimit(0.0);  // the clean stop may take longer than a turn
   heartbeat_->setState(msg::SERVICE_STOPPING);
+  lock.unlock();
+  try {
+    onStop();
+  } catch (const std::exception& e) {
+    log::get(name_)->error("onStop failed: {}", e.what());
+  }
   return 0;
 }
 

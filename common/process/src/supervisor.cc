@@ -336,30 +336,22 @@ void Supervisor::stopAll(double grace_s) {
   for (auto& c : children_) {
     c.stopping = true;
     if (c.st.phase == ProcessPhase::kBackoff) c.st.phase = ProcessPhase::kExited;
-    if (c.st.phase == ProcessPhase::kRunning && c.st.pid > 0) {
-      kill(-c.st.pid, SIGTERM);
-      kill(-c.st.pid, SIGCONT);  // a stopped process handles SIGTERM only once continued
-    }
   }
-  const auto end = std::chrono::steady_clock::now() + seconds(grace_s);
-  while (true) {
-    bool any = false;
-    for (auto& c : children_) {
-      if (c.st.phase != ProcessPhase::kRunning || c.st.pid <= 0) continue;
-      if (!reap(c, false)) any = true;
-    }
-    if (!any) break;
-    if (std::chrono::steady_clock::now() >= end) {
-      for (auto& c : children_) {
-        if (c.st.phase == ProcessPhase::kRunning && c.st.pid > 0) {
-          log::get("supervisor")->warn("{} did not stop within {:.1f} s: SIGKILL", c.spec.name, grace_s);
-          kill(-c.st.pid, SIGKILL);
-          (void)reap(c, true);
-        }
+  for (auto it = children_.rbegin(); it != children_.rend(); ++it) {
+    auto& c = *it;
+    if (c.st.phase != ProcessPhase::kRunning || c.st.pid <= 0) continue;
+    kill(-c.st.pid, SIGTERM);
+    kill(-c.st.pid, SIGCONT);  // a stopped process handles SIGTERM only once continued
+    const auto end = std::chrono::steady_clock::now() + seconds(grace_s);
+    while (!reap(c, false)) {
+      if (std::chrono::steady_clock::now() >= end) {
+        log::get("supervisor")->warn("{} did not stop within {:.1f} s: SIGKILL", c.spec.name, grace_s);
+        kill(-c.st.pid, SIGKILL);
+        (void)reap(c, true);
+        break;
       }
-      break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
 }
 

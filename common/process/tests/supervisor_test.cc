@@ -90,6 +90,41 @@ TEST(SupervisorTest, StopAllTerminatesAndEscalates) {
   EXPECT_EQ(s.status("polite")->last_exit.rfind("signal 15", 0), 0u);
 }
 
+// Children stop one after the other, the last added first: a deployment lists a service after
+// those it uses, so the execution monitor hands its last records to the effort estimator before
+// the estimator stops (the secured two-host CI run of 2026-12-07 lost the mission's last record:
+// every service was stopped at once). Here "user" takes 0.3 s to stop and "used" none: stopped
+// together, "used" would be done first.
+TEST(SupervisorTest, StopAllStopsChildrenInTheReverseOfTheOrderTheyWereAdded) {
+  const auto dir = std::filesystem::temp_directory_path() / ("tamp_sup_order_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const std::string order = (dir / "order").string();
+  // Each shell sets its trap, then says so in a file of its own, then idles.
+  auto shell = [&](const std::string& name, const std::string& on_term) {
+    return "trap '" + on_term + "echo " + name + " >> " + order + "; exit 0' TERM; touch " + (dir / name).string() +
+           "; while :; do sleep 0.02; done";
+  };
+  Supervisor s;
+  s.add(makeSpec("used", "/bin/sh", {"-c", shell("used", "")}, {}, {}, true, 5, 0.01));
+  s.add(makeSpec("user", "/bin/sh", {"-c", shell("user", "sleep 0.3; ")}, {}, {}, true, 5, 0.01));
+  ASSERT_TRUE(s.startAll().ok());
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (!(std::filesystem::exists(dir / "used") && std::filesystem::exists(dir / "user")) &&
+         std::chrono::steady_clock::now() < deadline)
+    std::this_thread::yield();
+  ASSERT_TRUE(std::filesystem::exists(dir / "used") && std::filesystem::exists(dir / "user")) << "the shells never started";
+  s.stopAll(2.0);
+  std::ifstream in(order);
+  std::string first, second;
+  in >> first >> second;
+  EXPECT_EQ(first, "user");
+  EXPECT_EQ(second, "used");
+  EXPECT_EQ(s.status("user")->phase, ProcessPhase::kExited);
+  EXPECT_EQ(s.status("used")->phase, ProcessPhase::kExited);
+  std::filesystem::remove_all(dir);
+}
+
 TEST(SupervisorTest, EnvironmentAndLogFile) {
   const auto log = std::filesystem::temp_directory_path() / ("tamp_sup_" + std::to_string(::getpid()) + ".log");
   std::filesystem::remove(log);

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <optional>
 #include <stdexcept>
+#include <thread>
 
 #include "tamp/core/log.h"
 #include "tamp/core/paths.h"
@@ -27,6 +28,11 @@ Error bad(const std::string& field, const std::string& message) {
 
 /// A record not acknowledged by the effort estimator is sent again after this long (s).
 constexpr double kRecordResendPeriodS = 2.0;
+/// A clean stop waits at most this long for the effort estimator to acknowledge the records still
+/// in the outbox (the last action's, sent a moment before the mission ended and the run stopped).
+constexpr double kStopDrainS = 2.0;
+/// ... sending each again this often meanwhile.
+constexpr double kStopResendPeriodS = 0.5;
 
 }  // namespace
 
@@ -134,6 +140,7 @@ msg::ExecuteStatus toMsg(const StatusUpdate& s) {
   m.blocking_object_id(s.blocking_object_id);
   m.measured_duration_s(s.measured_duration_s);
   m.held_object_id(s.held_object_id);
+  m.stopped_at_contact(s.stopped_at_contact);
   return m;
 }
 
@@ -465,6 +472,30 @@ void ExecutionMonitorNode::sendDueRecords() {
       logger()->error("execution record '{}' not forwarded: {}", e.record_id, s.error().toString());
     }
   }
+}
+
+void ExecutionMonitorNode::onStop() {
+  auto pending = [this] {
+    std::lock_guard lock(records_mu_);
+    return outbox_.pending();
+  };
+  if (pending() == 0) return;
+  const double until = now() + kStopDrainS;
+  while (pending() > 0 && now() < until) {
+    {
+      std::lock_guard lock(records_mu_);
+      for (const auto& e : outbox_.due(now(), kStopResendPeriodS)) {
+        if (auto record = dds::fromCdr<msg::ExecutionRecord>(e.payload)) (void)record_writer_->write(*record);
+      }
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  if (const std::size_t left = pending(); left > 0)
+    logger()->warn("stopping with {} execution record(s) not acknowledged within {:.1f} s; kept in {} and sent again "
+                   "when a monitor starts on it",
+                   left, kStopDrainS, outbox_.path().string());
+  else
+    logger()->info("every execution record acknowledged before the stop");
 }
 
 void ExecutionMonitorNode::spinOnce() {

@@ -62,6 +62,9 @@ class ExecutionMonitorNode : public dds::ServiceNode {
 
  protected:
   void spinOnce() override;
+  /// Waits (kStopDrainS at most) for the effort estimator to acknowledge the records still in
+  /// the outbox, sending them again meanwhile.
+  void onStop() override;
   /// Not ready until a robot state arrived: a command before it would fail its precondition.
   std::string notReadyBecause() const override;
   double spinPeriodSeconds() const override { return 0.05; }

@@ -355,6 +355,7 @@ struct ExecutionMonitor::Impl {
           case RobotOutcome::kBlocked:
             s.state = ExecState::kBlocked;
             s.blocking_object_id = r->blocking_object_id;
+            s.stopped_at_contact = true;
             s.reason = "blocked: the robot stopped before '" + r->blocking_object_id + "'" +
                        (r->reason.empty() ? "" : ": " + r->reason);
             fail(FailureType::kBlocked, r->blocking_object_id, s.reason);

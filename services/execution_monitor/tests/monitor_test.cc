@@ -208,6 +208,7 @@ TEST_F(MonitorTest, NewObstacleOnTheRemainingPathCancelsAndBlocks) {
   ASSERT_NE(f, nullptr);
   EXPECT_EQ(f->state, ExecState::kBlocked) << f->reason;
   EXPECT_EQ(f->blocking_object_id, "crate");
+  EXPECT_FALSE(f->stopped_at_contact) << "stopped by the monitor on a prediction, not at contact";
   EXPECT_DOUBLE_EQ(f->measured_duration_s, 1.4);
   ASSERT_EQ(out.failures.size(), 1u);
   EXPECT_EQ(out.failures[0].type, FailureType::kNewObstacle);
@@ -326,6 +327,8 @@ TEST_F(MonitorTest, RobotOutcomesMapToStatusesAndFailures) {
     } else {
       EXPECT_TRUE(out.failures.empty()) << id;
     }
+    // Only the robot's own stop before an object is a stop at contact.
+    EXPECT_EQ(f->stopped_at_contact, c.outcome == RobotOutcome::kBlocked) << id;
     if (c.outcome == RobotOutcome::kBlocked) {
       EXPECT_EQ(f->blocking_object_id, "hidden_wall");
     }

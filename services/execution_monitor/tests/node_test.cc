@@ -594,7 +594,9 @@ TEST(MonitorConversionsTest, MalformedMessagesNameTheField) {
   su.blocking_object_id = "crate";
   su.measured_duration_s = 1.5;
   su.held_object_id = "cup";
+  su.stopped_at_contact = true;
   const msg::ExecuteStatus es = toMsg(su);
+  EXPECT_TRUE(es.stopped_at_contact());
   EXPECT_EQ(es.state(), msg::ExecState::EXEC_BLOCKED);
   EXPECT_EQ(es.blocking_object_id(), "crate");
   EXPECT_DOUBLE_EQ(es.measured_duration_s(), 1.5);

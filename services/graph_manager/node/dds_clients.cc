@@ -442,6 +442,7 @@ ExecutionReport DdsExecutor::finalOf(std::unique_lock<std::mutex>& lock, const s
   r.reason = s.reason();
   r.blocking_object_id = s.blocking_object_id();
   r.held_object_id = s.held_object_id();
+  r.stopped_at_contact = s.stopped_at_contact();
   return r;
 }
 

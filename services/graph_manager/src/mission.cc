@@ -189,6 +189,29 @@ struct GraphManager::Run {
   std::optional<MissionEvent> watch(const Edge& done, const EdgeCommand& cmd, const ExecutionReport& rep);
   /// Online replanning after `ev`; false when the mission must give up (`why` says why).
   bool replan(const MissionEvent& ev, EdgeId failed, std::string& why);
+  /// The branch ahead: from the failed edge (or the next one) on.
+  std::vector<EdgeId> aheadOf(EdgeId failed) const;
+  /// The world as replanning takes it in: the world model, and the graph's own beliefs where it
+  /// strays from them within the tolerance (takeInWorld).
+  struct Intake {
+    world::World perceived;              ///< the world model as it came
+    world::World live;                   ///< as the graph plans with it
+    std::vector<std::string> fresh;      ///< movables new to the graph
+    std::vector<world::Object> changed;  ///< movables seen beyond the tolerance from where expected
+    std::vector<world::Object> refused;  ///< the one the event named, taken where it is seen
+    bool reshaped{false};                ///< the named object's extent changed
+  };
+  Intake takeInWorld(const MissionEvent& ev);
+  /// What a stop teaches: a margin round the held object, or where the object stopped before
+  /// is (contact corrections, applied to `in.live`). True when the stop corrected the world.
+  bool learnFromStop(const MissionEvent& ev, const Observation& now, const HeldGrasp& held_before, Intake& in,
+                     ReplanRecord& rec);
+  /// The failed edge planned again in the world as it is now; a failure unless `stale`.
+  void forgetFailedEdge(EdgeId failed, const MissionEvent& ev, bool stale);
+  /// A node for where the robot is, sub-tasks from it to the nodes `ahead`, else a plan from it
+  /// (false, with `why`, when there is none).
+  bool rejoinFromHere(const MissionEvent& ev, EdgeId failed, const std::vector<EdgeId>& ahead, const Intake& in,
+                      const Observation& now, ReplanRecord& rec, std::string& why);
   /// Waits (drop_settle_timeout_s at most) until the world model has `object` resting on a support.
   void awaitSettled(const std::string& object);
   /// The robot's state once it reports itself at rest, waiting at most params.rest_wait_s (then
@@ -694,6 +717,131 @@ void GraphManager::Run::awaitSettled(const std::string& object) {
   }
 }
 
+std::vector<EdgeId> GraphManager::Run::aheadOf(EdgeId failed) const {
+  if (failed < 0) return branch;
+  std::vector<EdgeId> ahead;
+  auto it = std::find(branch.begin(), branch.end(), failed);
+  ahead.assign(it == branch.end() ? branch.begin() : it, branch.end());
+  if (it == branch.end()) ahead.insert(ahead.begin(), failed);
+  return ahead;
+}
+
+GraphManager::Run::Intake GraphManager::Run::takeInWorld(const MissionEvent& ev) {
+  // What the world is now: perception's objects, but where the graph knows an object to be (its
+  // prior, or where the mission put it) within the tolerance, that pose: a partial view strays
+  // further than a place does, and a stray estimate would unbind the slot. The exception: the
+  // object that a refused or stopped motion named. The monitor judges a motion by the world
+  // model, so planning again where the graph believes that object is would be refused again (a
+  // pushed chair whose estimate lags 11 cm behind its slot); it is taken where perception sees it.
+  Intake in;
+  in.perceived = source.world();
+  in.live = in.perceived;
+  const bool names_object = ev.kind == EventKind::kActionFailed || ev.kind == EventKind::kActionBlocked;
+  for (const auto& o : in.live.objects()) {
+    if (o.kind != world::ObjectKind::kMovable) continue;
+    const auto expected = expectedPose(o.id);
+    if (!expected) in.fresh.push_back(o.id);
+    if (!expected || (expected->translation() - o.pose.translation()).norm() > gm.params_.moved_object_tolerance_m)
+      in.changed.push_back(o);
+    else if (names_object && o.id == ev.object_id)
+      in.refused.push_back(o);
+    else
+      (void)in.live.setObjectPose(o.id, *expected);
+  }
+  // The named object's extent changed since the graph last took the world in (an estimate grown,
+  // shrunk or turned: a new object seen from more sides): the world changed under the plan as
+  // much as when it moved.
+  in.reshaped = names_object && !ev.object_id.empty() && [&] {
+    const world::Object* before = gm.abstraction_.world().findObject(ev.object_id);
+    const world::Object* after = in.live.findObject(ev.object_id);
+    if (!before || !after) return false;
+    const Eigen::Vector3d a = before->aabb().max - before->aabb().min, b = after->aabb().max - after->aabb().min;
+    return (a - b).cwiseAbs().maxCoeff() > kReshapedM;
+  }();
+  return in;
+}
+
+bool GraphManager::Run::learnFromStop(const MissionEvent& ev, const Observation& now, const HeldGrasp& held_before,
+                                      Intake& in, ReplanRecord& rec) {
+  // Stopped before an object the plan knew where it is (a wall, or a movable where the graph
+  // expects it) while holding one: the plan cleared it with the held object where the graph
+  // believes it sits in the hand, and the robot did not. Held objects are planned with a
+  // margin from now on.
+  if (ev.kind == EventKind::kActionBlocked && !held_before.object_id.empty()) {
+    const world::Object* blocker = in.live.findObject(ev.object_id);
+    auto named = [&](const world::Object& o) { return o.id == ev.object_id; };
+    const bool known = blocker && std::find(in.fresh.begin(), in.fresh.end(), ev.object_id) == in.fresh.end() &&
+                       std::none_of(in.changed.begin(), in.changed.end(), named);
+    if (known) gm.widenHeldMargin(held_before.object_id, ev.object_id);
+  }
+  rec.held_padding_m = gm.held_padding_m_;
+  // A command refused because of a corrected object: the monitor checks commands against the
+  // world model, which still has it where it was seen; planning round the correction again would
+  // be refused again. The world model's estimate wins.
+  if (ev.kind == EventKind::kActionFailed && gm.corrections_.erase(ev.object_id) > 0)
+    log::get("graph_manager")->info("'{}': a command was refused with the world model's estimate of it; its contact correction ends",
+                                    ev.object_id);
+  gm.applyContactCorrections(in.perceived, in.live);
+  // The robot stopped itself before a movable with nothing in the hand (not the monitor on a
+  // prediction): the robot's body at the stop is where the object begins (contact.h). Planning
+  // round the estimate again would drive into it again.
+  bool corrected = false;
+  if (ev.at_contact && held_before.object_id.empty() && now.valid && !ev.object_id.empty()) {
+    if (auto c = gm.correctByContact(in.perceived, in.live, ev.object_id, now.robot)) {
+      corrected = true;
+      rec.corrected_object = ev.object_id;
+      rec.corrected_m = c->shift_m;
+    }
+  }
+  if (!gm.corrections_.empty()) gm.abstraction_.setWorld(in.live);
+  return corrected;
+}
+
+void GraphManager::Run::forgetFailedEdge(EdgeId failed, const MissionEvent& ev, bool stale) {
+  // Planned again in the world as it is now, unless it failed too often (then infeasible).
+  Edge& f = gm.graph_.edge(failed);
+  if (stale)
+    log::get("graph_manager")
+        ->info("{}: not counted as a failure: '{}' changed in the world model since it was planned", f.action,
+               ev.object_id);
+  else
+    gm.noteFailure(f);
+  f.state = EdgeState::kUnevaluated;
+  f.motion.reset();
+  f.motion_by_next.clear();
+  f.effort_by_next.clear();
+  f.subtasks_spawned = false;
+}
+
+bool GraphManager::Run::rejoinFromHere(const MissionEvent& ev, EdgeId failed, const std::vector<EdgeId>& ahead,
+                                       const Intake& in, const Observation& now, ReplanRecord& rec, std::string& why) {
+  // The arm out of its driving configuration: where the node before the event had it.
+  std::string armconf = "stow";
+  const NodeId was = failed >= 0 ? gm.graph_.edge(failed).from : current;
+  if (!gm.armStowed(ctx.state.arm) && !gm.graph_.node(was).atoms.empty()) {
+    armconf = gm.abstraction_.bind(gm.graph_.node(was).atoms).armconf;
+    // The node had the arm stowed and the robot has it out (a move_arm out of stow that ended,
+    // or stopped part-way, without its result reaching the graph): a symbol of its own, which a
+    // plan can only leave; a base motion with the arm out would be refused.
+    if (armconf == "stow") armconf = gm.abstraction_.addObservedArmconf("arm_observed");
+  }
+  const auto atoms = gm.abstraction_.dynamicAtoms(in.live, ctx.state.base, armconf, now.valid ? now.held_object_id : "");
+  current = gm.graph_.addNode(atoms, "observed after " + ev.action);
+  const auto joined = gm.rejoin(current, ahead, in.fresh, "re-join after " + std::string(toString(ev.kind)));
+  for (NodeId n : joined) rec.rejoined.push_back("n" + std::to_string(n));
+  rec.how = "re-join";
+  if (!joined.empty()) return true;
+  rec.how = "from scratch";
+  if (gm.graph_.out(current).empty() && !gm.isGoal(current)) {
+    auto plan = gm.planFrom(current, gm.goal_.atoms, "plan after " + std::string(toString(ev.kind)));
+    if (!plan) {
+      why = "replanning after " + std::string(toString(ev.kind)) + " (" + ev.detail + "): " + plan.error().message;
+      return false;
+    }
+  }
+  return true;
+}
+
 bool GraphManager::Run::replan(const MissionEvent& ev, EdgeId failed, std::string& why) {
   const auto t0 = Clock::now();
   const std::size_t calls0 = gm.logged_.mark();
@@ -707,144 +855,39 @@ bool GraphManager::Run::replan(const MissionEvent& ev, EdgeId failed, std::strin
   ++report.replans;
   ReplanRecord rec;
   rec.event = ev;
-  // The branch ahead: from the failed edge (or the next one) on.
-  std::vector<EdgeId> ahead;
-  if (failed >= 0) {
-    auto it = std::find(branch.begin(), branch.end(), failed);
-    ahead.assign(it == branch.end() ? branch.begin() : it, branch.end());
-    if (it == branch.end()) ahead.insert(ahead.begin(), failed);
-  } else {
-    ahead = branch;
-  }
+  const std::vector<EdgeId> ahead = aheadOf(failed);
   if (ev.kind == EventKind::kObjectDropped) awaitSettled(!ev.object_id.empty() ? ev.object_id : ctx.held.object_id);
-  // What the robot and the world are now: perception's objects, but where the graph knows an
-  // object to be (its prior, or where the mission put it) within the tolerance, that pose: a
-  // partial view strays further than a place does, and a stray estimate would unbind the slot.
-  // The exception: the object that a refused or stopped motion named. The monitor judges a
-  // motion by the world model, so planning again where the graph believes that object is would
-  // be refused again (a pushed chair whose estimate lags 11 cm behind its slot); it is taken
-  // where perception sees it.
-  // Stopped before an object: where it stopped is evidence (below), so the state must be the stop's.
-  const Observation now = ev.kind == EventKind::kActionBlocked ? restingRobot() : source.robot();
-  const world::World perceived = source.world();
-  world::World live = perceived;
-  std::vector<std::string> fresh;
-  std::vector<world::Object> changed, refused;
-  const bool names_object = ev.kind == EventKind::kActionFailed || ev.kind == EventKind::kActionBlocked;
-  for (const auto& o : live.objects()) {
-    if (o.kind != world::ObjectKind::kMovable) continue;
-    const auto expected = expectedPose(o.id);
-    if (!expected) fresh.push_back(o.id);
-    if (!expected || (expected->translation() - o.pose.translation()).norm() > gm.params_.moved_object_tolerance_m)
-      changed.push_back(o);
-    else if (names_object && o.id == ev.object_id)
-      refused.push_back(o);
-    else
-      (void)live.setObjectPose(o.id, *expected);
-  }
-  // The named object's extent changed since the graph last took the world in (an estimate grown,
-  // shrunk or turned: a new object seen from more sides): the world changed under the plan as
-  // much as when it moved.
-  const bool reshaped = names_object && !ev.object_id.empty() && [&] {
-    const world::Object* before = gm.abstraction_.world().findObject(ev.object_id);
-    const world::Object* after = live.findObject(ev.object_id);
-    if (!before || !after) return false;
-    const Eigen::Vector3d a = before->aabb().max - before->aabb().min, b = after->aabb().max - after->aabb().min;
-    return (a - b).cwiseAbs().maxCoeff() > kReshapedM;
-  }();
-  gm.abstraction_.setWorld(live);
+  // Stopped before an object: where it stopped is evidence (learnFromStop), so the state must be the stop's.
+  const Observation now = ev.at_contact ? restingRobot() : source.robot();
+  Intake in = takeInWorld(ev);
+  gm.abstraction_.setWorld(in.live);
   gm.clearWorldCaches();
   const HeldGrasp held_before = ctx.held;
   if (now.valid) ctx = gm.contextOf(now);
   // Still holding what the branch picked: the grasp is the one it executed. The world model
   // cannot tell (perception filters the held object, whose modelled pose is where it was seen).
   if (!ctx.held.object_id.empty() && ctx.held.object_id == held_before.object_id) ctx.held = held_before;
-  // Stopped before an object the plan knew where it is (a wall, or a movable where the graph
-  // expects it) while holding one: the plan cleared it with the held object where the graph
-  // believes it sits in the hand, and the robot did not. Held objects are planned with a
-  // margin from now on.
-  if (ev.kind == EventKind::kActionBlocked && !held_before.object_id.empty()) {
-    const world::Object* blocker = live.findObject(ev.object_id);
-    auto named = [&](const world::Object& o) { return o.id == ev.object_id; };
-    const bool known = blocker && std::find(fresh.begin(), fresh.end(), ev.object_id) == fresh.end() &&
-                       std::none_of(changed.begin(), changed.end(), named);
-    if (known) gm.widenHeldMargin(held_before.object_id, ev.object_id);
-  }
-  rec.held_padding_m = gm.held_padding_m_;
-  // Stopped before a movable with nothing in the hand: the robot's body at the stop is where the
-  // object begins (contact.h). Planning round the estimate again would drive into it again.
-  // A command refused because of a corrected object: the monitor checks commands against the
-  // world model, which still has it where it was seen; planning round the correction again would
-  // be refused again. The world model's estimate wins.
-  if (ev.kind == EventKind::kActionFailed && gm.corrections_.erase(ev.object_id) > 0)
-    log::get("graph_manager")->info("'{}': a command was refused with the world model's estimate of it; its contact correction ends",
-                                    ev.object_id);
-  gm.applyContactCorrections(perceived, live);
-  bool corrected = false;
-  if (ev.kind == EventKind::kActionBlocked && held_before.object_id.empty() && now.valid && !ev.object_id.empty()) {
-    if (auto c = gm.correctByContact(perceived, live, ev.object_id, now.robot)) {
-      corrected = true;
-      rec.corrected_object = ev.object_id;
-      rec.corrected_m = c->shift_m;
-    }
-  }
-  if (!gm.corrections_.empty()) gm.abstraction_.setWorld(live);
+  const bool corrected = learnFromStop(ev, now, held_before, in, rec);
   // Failed, refused or stopped because of an object the graph did not know, or knew elsewhere or
   // smaller (the world model changed since the edge was planned, e.g. a new object's estimate
-  // still growing onto the path): the world changed under the plan, the action did not fail, so
-  // it is not counted towards max_action_failures (max_replans still bounds the attempts).
-  // The world model corrected by the stop is a world changed under the plan as well.
+  // still growing onto the path), or where the stop corrected it: the world changed under the
+  // plan, the action did not fail, so it is not counted towards max_action_failures (max_replans
+  // still bounds the attempts).
+  auto named = [&](const world::Object& o) { return o.id == ev.object_id; };
+  const bool names_object = ev.kind == EventKind::kActionFailed || ev.kind == EventKind::kActionBlocked;
   const bool stale = names_object && !ev.object_id.empty() &&
-                     (reshaped || corrected || std::find(fresh.begin(), fresh.end(), ev.object_id) != fresh.end() ||
-                      std::any_of(changed.begin(), changed.end(),
-                                  [&](const world::Object& o) { return o.id == ev.object_id; }));
-  changed.insert(changed.end(), refused.begin(), refused.end());
-  gm.invalidateNear(changed);
-  if (failed >= 0) {
-    // Planned again in the world as it is now, unless it failed too often (then infeasible).
-    Edge& f = gm.graph_.edge(failed);
-    if (stale)
-      log::get("graph_manager")
-          ->info("{}: not counted as a failure: '{}' changed in the world model since it was planned", f.action,
-                 ev.object_id);
-    else
-      gm.noteFailure(f);
-    f.state = EdgeState::kUnevaluated;
-    f.motion.reset();
-    f.motion_by_next.clear();
-    f.effort_by_next.clear();
-    f.subtasks_spawned = false;
-  }
+                     (in.reshaped || corrected || std::find(in.fresh.begin(), in.fresh.end(), ev.object_id) != in.fresh.end() ||
+                      std::any_of(in.changed.begin(), in.changed.end(), named));
+  std::vector<world::Object> near = in.changed;
+  near.insert(near.end(), in.refused.begin(), in.refused.end());
+  gm.invalidateNear(near);
+  if (failed >= 0) forgetFailedEdge(failed, ev, stale);
   if (ev.kind == EventKind::kOverrun) {
     awaitRefit();
     gm.reprice();
     rec.how = "re-traverse";
-  } else {
-    // The arm out of its driving configuration: where the node before the event had it.
-    std::string armconf = "stow";
-    const NodeId was = failed >= 0 ? gm.graph_.edge(failed).from : current;
-    if (!gm.armStowed(ctx.state.arm) && !gm.graph_.node(was).atoms.empty()) {
-      armconf = gm.abstraction_.bind(gm.graph_.node(was).atoms).armconf;
-      // The node had the arm stowed and the robot has it out (a move_arm out of stow that ended,
-      // or stopped part-way, without its result reaching the graph): a symbol of its own, which a
-      // plan can only leave; a base motion with the arm out would be refused.
-      if (armconf == "stow") armconf = gm.abstraction_.addObservedArmconf("arm_observed");
-    }
-    const auto atoms = gm.abstraction_.dynamicAtoms(live, ctx.state.base, armconf, now.valid ? now.held_object_id : "");
-    current = gm.graph_.addNode(atoms, "observed after " + ev.action);
-    const auto joined = gm.rejoin(current, ahead, fresh, "re-join after " + std::string(toString(ev.kind)));
-    for (NodeId n : joined) rec.rejoined.push_back("n" + std::to_string(n));
-    rec.how = "re-join";
-    if (joined.empty()) {
-      rec.how = "from scratch";
-      if (gm.graph_.out(current).empty() && !gm.isGoal(current)) {
-        auto plan = gm.planFrom(current, gm.goal_.atoms, "plan after " + std::string(toString(ev.kind)));
-        if (!plan) {
-          why = "replanning after " + std::string(toString(ev.kind)) + " (" + ev.detail + "): " + plan.error().message;
-          return false;
-        }
-      }
-    }
+  } else if (!rejoinFromHere(ev, failed, ahead, in, now, rec, why)) {
+    return false;
   }
   rec.at_node = "n" + std::to_string(current);
   rec.planner_calls = gm.counters_.planner_calls - planner0;
@@ -926,7 +969,7 @@ MissionReport GraphManager::Run::run() {
     e.state = EdgeState::kFailed;
     e.reason = std::string(toString(rep.outcome)) + ": " + rep.reason;
     if (observer.on_action) observer.on_action(a, done_effort, branch_total);
-    MissionEvent ev{eventOf(rep), e.action, rep.blocking_object_id, e.reason};
+    MissionEvent ev{eventOf(rep), e.action, rep.blocking_object_id, e.reason, rep.stopped_at_contact};
     if (!replan(ev, id, why)) return finish(MissionOutcome::kFailed, why);
   }
   report.status = MissionOutcome::kSucceeded;

@@ -181,9 +181,9 @@ std::optional<ContactCorrection> GraphManager::correctByContact(const world::Wor
   (void)live.setObjectPose(object, c->pose);
   corrections_[object] = ContactCorrected{c->pose, seen};
   log::get("graph_manager")
-      ->info("stopped before '{}': it stands {:.3f} m nearer than the world model has it; planned at ({:.3f}, {:.3f}) "
-             "instead of ({:.3f}, {:.3f}) until the world model sees it move",
-             object, c->shift_m, b.x(), b.y(), a.x(), a.y());
+      ->info("stopped before '{}': it stands {:.3f} m {} the robot than the world model has it; planned at ({:.3f}, "
+             "{:.3f}) instead of ({:.3f}, {:.3f}) until the world model sees it move",
+             object, std::abs(c->shift_m), c->shift_m > 0 ? "nearer" : "farther from", b.x(), b.y(), a.x(), a.y());
   return c;
 }
 

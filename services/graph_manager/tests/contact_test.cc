@@ -71,6 +71,29 @@ TEST_F(ContactTest, AnEstimateFiveCentimetresOffIsMovedToTouchTheRobotWhereItSto
   EXPECT_FALSE(touchingPose(there, *robot_, stop_, 0.15).has_value());
 }
 
+// The robot strayed into the gap the estimate left it and stopped before the object: the object
+// does not overlap where the robot stands, so the estimate is moved out of the body, the shortest
+// way, until it is just clear of it.
+TEST_F(ContactTest, AnEstimateThatOverlapsTheRobotWhereItStoppedIsMovedOutOfIt) {
+  stopSouthOf(0.05);
+  stop_.base.y += 0.07;  // 2 cm into the estimate
+  ASSERT_LE(gap(crate_), 0.0);
+  const auto c = touchingPose(crate_, *robot_, stop_, 0.15);
+  ASSERT_TRUE(c.has_value());
+  EXPECT_LT(c->shift_m, -0.015);
+  EXPECT_GT(c->shift_m, -0.03);
+  const Eigen::Vector3d moved = c->pose.translation() - crate_.pose.translation();
+  EXPECT_GT(moved.y(), 0.015) << "away from the robot, north: " << moved.transpose();
+  world::Object there = crate_;
+  there.pose = c->pose;
+  const double after = gap(there);
+  EXPECT_GT(after, 0.0);
+  EXPECT_LE(after, 0.003);
+  EXPECT_FALSE(touchingPose(there, *robot_, stop_, 0.15).has_value());
+  // More than the bound inside: the stop says nothing of this estimate.
+  EXPECT_FALSE(touchingPose(crate_, *robot_, stop_, 0.01).has_value());
+}
+
 TEST_F(ContactTest, AnEstimateThatAlreadyTouchesTheRobotIsKept) {
   stopSouthOf(0.001);
   EXPECT_FALSE(touchingPose(crate_, *robot_, stop_, 0.15).has_value());

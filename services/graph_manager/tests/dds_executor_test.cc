@@ -64,5 +64,36 @@ TEST(DdsExecutorTest, ACommandOutWhenTheMonitorRestartedIsSentToTheNewOne) {
   EXPECT_GE(seen.load(), 1);
 }
 
+// A stop reaches the graph manager with what stopped the robot: the robot itself at contact
+// (evidence of where the object is: contact.h), or the monitor on a prediction.
+TEST(DdsExecutorTest, ABlockedOutcomeSaysWhetherTheRobotStoppedAtContact) {
+  auto gm = makeParticipant();
+  ASSERT_TRUE(gm);
+  DdsExecutor executor(gm, "mission-1");
+  auto monitor = makeParticipant();
+  ASSERT_TRUE(monitor);
+  dds::Writer<msg::ExecuteStatus> status(monitor, dds::topics::kExecuteStatus);
+  std::atomic<bool> at_contact{true};
+  dds::Reader<msg::ExecuteCommand> commands(
+      monitor, dds::topics::kExecuteCommand, [&](const msg::ExecuteCommand& c, const dds::SampleMeta&) {
+        msg::ExecuteStatus s;
+        s.command_id(c.command_id());
+        s.state(msg::ExecState::EXEC_BLOCKED);
+        s.blocking_object_id("crate");
+        s.stopped_at_contact(at_contact.load());
+        s.reason("blocked");
+        (void)status.write(s);
+      });
+  for (bool contact : {true, false}) {
+    at_contact = contact;
+    EdgeCommand c = aCommand();
+    c.command_id += contact ? "-contact" : "-monitor";
+    const ExecutionReport r = executor.execute(c, 20.0);
+    EXPECT_EQ(r.outcome, ExecOutcome::kBlocked) << r.reason;
+    EXPECT_EQ(r.blocking_object_id, "crate");
+    EXPECT_EQ(r.stopped_at_contact, contact);
+  }
+}
+
 }  // namespace
 }  // namespace tamp::graph_manager

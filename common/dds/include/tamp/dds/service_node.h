@@ -85,6 +85,9 @@ class ServiceNode {
   virtual void spinOnce() {}
   /// How often spinOnce() runs.
   virtual double spinPeriodSeconds() const { return 0.1; }
+  /// Once, on the run() thread, after stop() and before run() returns (the participant still
+  /// up): a last, bounded chance to hand over what the service holds (default: nothing).
+  virtual void onStop() {}
   /// Sum of requests served/failed by the node's servers, for the heartbeat (default: echo only).
   virtual std::pair<uint64_t, uint64_t> requestCounters() const;
   /// What the service still waits for before it can do its work (e.g. "no robot state yet");

@@ -120,7 +120,11 @@ class Supervisor {
   /// The caller found `name` dead although it runs (e.g. no heartbeat): SIGKILL to its process
   /// group, then restarted like a crash, with `reason` as its last exit. False if not running.
   bool declareDead(const std::string& name, const std::string& reason);
-  /// SIGTERM to all, waits up to `grace_s`, then SIGKILL; reaps everything.
+  /// Stops the children one after the other, in the reverse of the order they were added (a
+  /// deployment lists a service after those it uses, so a service that hands over what it holds
+  /// when it stops, like the execution monitor's unacknowledged records to the effort estimator,
+  /// does so while they still run): SIGTERM, up to `grace_s` for it to exit, then SIGKILL. Reaps
+  /// everything.
   void stopAll(double grace_s = 3.0);
   /// Forgets every process without stopping it (a supervisor that hands its services over).
   void release();

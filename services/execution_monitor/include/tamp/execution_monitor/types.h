@@ -78,6 +78,9 @@ struct StatusUpdate {
   std::string blocking_object_id;   ///< kBlocked (and path preconditions): the object in the way
   double measured_duration_s{0.0};  ///< final states: the robot's measured duration (0: not run)
   std::string held_object_id;       ///< final states: held afterwards ("" = empty)
+  /// kBlocked: the robot itself stopped before contact with `blocking_object_id`, not the
+  /// monitor on a predicted collision.
+  bool stopped_at_contact{false};
 };
 
 enum class FailureType {

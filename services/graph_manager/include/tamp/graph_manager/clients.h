@@ -221,6 +221,9 @@ struct ExecutionReport {
   std::string reason;
   std::string blocking_object_id;
   std::string held_object_id;
+  /// kBlocked: the robot itself stopped before contact with `blocking_object_id` (evidence of
+  /// where it is), not the monitor on a predicted collision.
+  bool stopped_at_contact{false};
 };
 
 /// Executes one edge on the robot (through the execution monitor) and blocks until it ends.

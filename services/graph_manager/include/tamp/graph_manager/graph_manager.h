@@ -149,6 +149,9 @@ struct MissionEvent {
   std::string action;     ///< the action it happened in or after
   std::string object_id;  ///< the object concerned, if any
   std::string detail;
+  /// kActionBlocked: the robot itself stopped before contact with `object_id`
+  /// (ExecutionReport::stopped_at_contact).
+  bool at_contact{false};
 };
 
 /// Where the time from an event to the next command went (issue 12's latency), filled when the
@@ -175,7 +178,8 @@ struct ReplanRecord {
   std::vector<std::string> rejoined;  ///< the nodes ahead that a sub-task reached
   double held_padding_m{0.0};         ///< the held object's planning margin from this event on
   /// The object the robot was stopped before, moved by the stop's evidence (correctByContact),
-  /// and by how much (m); empty / 0 when the estimate already agreed with the stop.
+  /// and by how much (m; > 0 towards the robot, < 0 away: ContactCorrection::shift_m); empty / 0
+  /// when the estimate already agreed with the stop.
   std::string corrected_object;
   double corrected_m{0.0};
   int planner_calls{0};

@@ -5,11 +5,16 @@
 #include <sys/mman.h>
 #include <unistd.h>
 
+#include <chrono>
+#include <condition_variable>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
+#include <mutex>
+#include <optional>
 #include <string>
+#include <thread>
 
 #include <CLI/CLI.hpp>
 
@@ -105,6 +110,63 @@ void reserveHeap(int64_t mib) {
   if (begin - at > kChunkHeader && end > begin) heap_gap = std::malloc(begin - at - kChunkHeader);
 }
 
+/// How long after its deadline the planner may take to stop before the watchdog ends it.
+constexpr double kWatchdogGraceSeconds = 0.5;
+
+/// The process-level bound of `--timeout` (issue 14, thirty-fourth round). The planner checks its
+/// deadline in every loop known to be long (grounding, relevance analysis, searches; evaluations
+/// one at a time where they are slow) and frees its open lists in large chunks, so it stops
+/// within a fraction of a second of it; but a phase that does not check (an unseen domain's
+/// grounding or landmark graph, a search freeing gigabytes) must not keep `tamp plan` running.
+/// A thread waits until the deadline plus the grace; unless the answer has been claimed by then
+/// (`claimAnswer()`), it prints the timeout answer (stdout "; timeout", a message naming the
+/// watchdog on stderr) and ends the process with the timeout code at once (`_exit`: no
+/// destructors; the OS takes the memory back). Holding the mutex while it does so keeps the main
+/// thread from printing a plan at the same time.
+class Watchdog {
+ public:
+  Watchdog(tamp::Clock::time_point deadline, double grace_seconds, bool stats)
+      : at_(deadline + std::chrono::duration_cast<tamp::Clock::duration>(std::chrono::duration<double>(grace_seconds))),
+        grace_(grace_seconds),
+        stats_(stats),
+        thread_([this] { watch(); }) {}
+  ~Watchdog() {
+    claimAnswer();
+    thread_.join();
+  }
+  Watchdog(const Watchdog&) = delete;
+  Watchdog& operator=(const Watchdog&) = delete;
+
+  /// The planner has answered: the watchdog stands down. Blocks forever (the process is ending)
+  /// when the watchdog has fired already.
+  void claimAnswer() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    claimed_ = true;
+    cv_.notify_all();
+  }
+
+ private:
+  void watch() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    if (cv_.wait_until(lock, at_, [this] { return claimed_; })) return;
+    if (stats_) std::fprintf(stderr, "; status timeout; stopped by tamp plan's watchdog\n");
+    std::fprintf(stderr, "search timeout (the planner had not stopped %.1f s after its deadline: ended by tamp plan's "
+                 "watchdog)\n", grace_);
+    std::fputs("; timeout\n", stdout);
+    std::fflush(stdout);
+    std::fflush(stderr);
+    _exit(tamp::cli::kExitTimeout);
+  }
+
+  const tamp::Clock::time_point at_;
+  const double grace_;
+  const bool stats_;
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  bool claimed_{false};
+  std::thread thread_;  // last: started once the members above are set
+};
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -158,6 +220,14 @@ int main(int argc, char** argv) {
   app.add_option("--validate", validate_plan, "check this plan file against DOMAIN PROBLEM instead of planning");
   app.add_flag("--stats", stats, "print statistics to stderr");
   app.add_flag("--no-check", no_check, "do not replay the plan with the independent checker");
+  bool no_watchdog = false;
+  double debug_stall = 0.0;
+  // Hidden: the planner sleeps this long before it starts, its deadline unchecked (a phase that does
+  // not check it); for the watchdog's test only.
+  app.add_option("--debug-stall-seconds", debug_stall)->check(CLI::Range(0.0, 3600.0))->group("");
+  app.add_flag("--no-watchdog", no_watchdog,
+               "with --timeout: no watchdog (by default one ends the process with the timeout answer when the "
+               "planner has not stopped 0.5 s after its deadline)");
   app.add_flag("--no-fallback", no_fallback, "ehc: do not fall back to best-first search");
   app.add_flag("--no-goal-agenda", no_agenda, "ehc: pursue all goals at once (no FF goal agenda)");
   app.add_flag("--ehc-first-improvement", first_improvement,
@@ -344,7 +414,13 @@ int main(int argc, char** argv) {
   // grounding piece by piece at exit costs 0.2-0.3 ms per run, which is what a process-per-instance
   // benchmark measures; the OS reclaims it. Reachable through this static, so no leak report.
   static sp::Planner* const planner = new sp::Planner(1);
-  const sp::PlanReply reply = planner->solve(req, tamp::Termination());
+  // One deadline for the planner and the watchdog, from here.
+  const tamp::Termination term = timeout > 0 ? tamp::Termination(tamp::Deadline::in(timeout)) : tamp::Termination();
+  std::optional<Watchdog> watchdog;
+  if (timeout > 0 && !no_watchdog) watchdog.emplace(term.deadline().time(), kWatchdogGraceSeconds, stats);
+  if (debug_stall > 0) std::this_thread::sleep_for(std::chrono::duration<double>(debug_stall));
+  const sp::PlanReply reply = planner->solve(req, term);
+  if (watchdog) watchdog->claimAnswer();
   if (stats) {
     std::fprintf(stderr,
                  "; status %s; parse %.4f s, ground %.4f s, search %.4f s, check %.4f s; facts %zu, operators %zu; "

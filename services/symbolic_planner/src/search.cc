@@ -676,11 +676,20 @@ class Searcher {
   /// since the last check (one evaluation of a task with 10^5 operators takes milliseconds, and
   /// a hill-climbing node may evaluate hundreds of successors); returns a terminal status or
   /// nullopt.
+  ///
+  /// Where evaluations are slow (more than kSlowCheckGap between two checks: a task with 10^5
+  /// operators, 10-20 ms an evaluation on scanalyzer-30), the clock is read after every
+  /// evaluation, so that the deadline is overrun by one evaluation at most; back to every
+  /// kEvalsPerCheck once the checks come quickly again. Only when a limit is seen changes with
+  /// it, never which states are evaluated.
   std::optional<SearchStatus> checkLimits() {
     if (turns_ != nullptr && turns_->stopped()) return SearchStatus::kCancelled;
-    const bool few_evaluations = stats_.evaluated < evaluated_at_check_ + kEvalsPerCheck;
+    const bool few_evaluations = stats_.evaluated < evaluated_at_check_ + evals_per_check_;
     if ((++checks_ & 255) != 0 && few_evaluations) return std::nullopt;
     evaluated_at_check_ = stats_.evaluated;
+    const Clock::time_point now = Clock::now();
+    evals_per_check_ = now - last_check_ > kSlowCheckGap ? 1 : kEvalsPerCheck;
+    last_check_ = now;
     const StopReason why = term_.reason();
     if (why == StopReason::kDeadline) return SearchStatus::kTimeout;
     if (why == StopReason::kStopRequested) return SearchStatus::kCancelled;
@@ -949,6 +958,48 @@ class Searcher {
     uint32_t parent;
     OpId op;
   };
+  /// A FIFO of lazy entries in chunks that double from 64 entries up to 8 192 (64 KiB): the same
+  /// order as a std::deque, but freed in one call per chunk. A std::deque's 512-byte blocks made
+  /// freeing a lazy search's open lists take seconds past the deadline: citycar-6's unit-cost run
+  /// and childsnack-8, 1.6-2.4 s in glibc's free() of millions of blocks (docs/benchmarks.md,
+  /// issue 14, thirty-fourth round).
+  class EntryFifo {
+   public:
+    void push_back(const LazyEntry& e) {
+      if (first_ == chunks_.size() || tail_ == chunks_.back().cap) {
+        chunks_.push_back({std::make_unique_for_overwrite<LazyEntry[]>(next_cap_), next_cap_});
+        next_cap_ = std::min<uint32_t>(next_cap_ * 2, kMaxChunk);
+        tail_ = 0;
+      }
+      chunks_.back().data[tail_++] = e;
+    }
+    const LazyEntry& front() const { return chunks_[first_].data[head_]; }
+    void pop_front() {
+      if (++head_ < chunks_[first_].cap) return;
+      chunks_[first_++].data.reset();
+      head_ = 0;
+      if (first_ == chunks_.size()) {
+        chunks_.clear();
+        first_ = 0;
+      } else if (2 * first_ >= chunks_.size()) {
+        chunks_.erase(chunks_.begin(), chunks_.begin() + static_cast<std::ptrdiff_t>(first_));
+        first_ = 0;
+      }
+    }
+    bool empty() const { return first_ == chunks_.size() || (first_ + 1 == chunks_.size() && head_ == tail_); }
+
+   private:
+    static constexpr uint32_t kMaxChunk = 8192;
+    struct Chunk {
+      std::unique_ptr<LazyEntry[]> data;
+      uint32_t cap;
+    };
+    std::vector<Chunk> chunks_;  // chunks_[first_] is the front chunk
+    size_t first_{0};
+    uint32_t head_{0};  // next entry of the front chunk
+    uint32_t tail_{0};  // entries of the back chunk in use
+    uint32_t next_cap_{64};
+  };
   /// Bucket open list (Fast Downward's for integer keys): one FIFO per key, so equal keys pop in
   /// insertion order, as a heap with an insertion counter would, at 8 bytes per entry (the heap
   /// entry was 24) and O(log #keys) per push/pop. Buckets are freed as they are emptied.
@@ -979,8 +1030,8 @@ class Searcher {
     size_t bytes() const { return size_ * sizeof(LazyEntry) + buckets_.size() * 128; }
 
    private:
-    std::map<Cost, std::deque<LazyEntry>> buckets_;
-    std::deque<LazyEntry>* last_{nullptr};  // bucket of the last push (successors share keys)
+    std::map<Cost, EntryFifo> buckets_;
+    EntryFifo* last_{nullptr};  // bucket of the last push (successors share keys)
     Cost last_key_{0};
     size_t size_{0};
   };
@@ -1111,7 +1162,7 @@ class Searcher {
   std::unique_ptr<LandmarkCounter> makeLandmarkCounter() const {
     if (opt_.landmark_generator == LandmarkGenerator::kRhw) {
       return std::make_unique<LandmarkCounter>(
-          task_, shared_landmarks_ != nullptr ? *shared_landmarks_ : rhwLandmarks(task_, init_, goal_, opt_.rhw),
+          task_, shared_landmarks_ != nullptr ? *shared_landmarks_ : rhwLandmarks(task_, init_, goal_, opt_.rhw, term_),
           LandmarkProgression::kPastAndFuture);
     }
     return std::make_unique<LandmarkCounter>(task_, init_, goal_);
@@ -1240,6 +1291,7 @@ class Searcher {
         op_[sid] = o;
         if (task_.goalReached(succ_.data(), goal_)) return finish(SearchStatus::kSolved, path(sid, kNone));
         const Cost h = evaluate(sid);
+        if (auto st = checkLimits()) return finish(*st);
         if (h == Heuristic::kDeadEnd) {
           flag_[sid] |= 1;
           continue;
@@ -1287,6 +1339,7 @@ class Searcher {
         const Cost ng = gid + (task_.unit_cost ? 1 : task_.ops[o].cost);
         if (is_new) {
           const Cost h = evaluate(sid);
+          if (auto st = checkLimits()) return finish(*st);
           if (h == Heuristic::kDeadEnd) {
             flag_[sid] |= 3;  // closed + dead
             continue;
@@ -1327,6 +1380,9 @@ class Searcher {
   SearchStatistics stats_;
   uint64_t checks_{0};
   uint64_t evaluated_at_check_{0};            ///< stats_.evaluated at the last clock read
+  uint64_t evals_per_check_{kEvalsPerCheck};  ///< 1 while evaluations are slow (checkLimits)
+  Clock::time_point last_check_{Clock::now()};
+  static constexpr std::chrono::milliseconds kSlowCheckGap{20};
   static constexpr uint64_t kEvalsPerCheck = 16;
   size_t open_bytes_{0};
   std::vector<uint32_t> stamp_;  // ehc: BFS iteration that reached each state
@@ -1358,7 +1414,7 @@ class Searcher {
     for (const GoalConjunct& c : goal_.conjuncts) {
       uint64_t work = 0;
       const std::optional<bool> reached =
-          MutexTable::reachesTogether(task_, h2_state_, c.pos, opt_.ehc_h2_mutexes, &work);
+          MutexTable::reachesTogether(task_, h2_state_, c.pos, opt_.ehc_h2_mutexes, &work, term_);
       h2_work_ += work;
       if (!reached || *reached) return false;
     }
@@ -1661,7 +1717,7 @@ class LazyBeside : public TurnTaker {
   void start() {
     if (!lanes_.empty()) return;
     if (options_.landmarks && options_.landmark_generator == LandmarkGenerator::kRhw && twoLanes()) {
-      landmarks_.emplace(rhwLandmarks(task_, init_, goal_, options_.rhw));
+      landmarks_.emplace(rhwLandmarks(task_, init_, goal_, options_.rhw, term_));
     }
     addLane(options_.lazy_plan_preferred);
     maybeAddSecond();

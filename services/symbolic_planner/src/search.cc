@@ -82,6 +82,10 @@ class EvaluationHook {
  public:
   virtual ~EvaluationHook() = default;
   virtual void evaluated() = 0;
+  /// A hill-climbing run committed to a better state.
+  virtual void climbed() {}
+  /// A lazy search reached a state with `count` landmarks left, fewer than any before it.
+  virtual void landmarksLeft(Cost /*count*/) {}
 };
 
 /// The hook of this thread's searches (none: nullptr).
@@ -154,6 +158,18 @@ class SearchFiber : public EvaluationHook {
   SearchResult& result() { return result_; }
   /// The time it has run, in seconds.
   double seconds() const { return seconds_; }
+  /// Its evaluations so far, and how many it had done when it last made progress: a
+  /// hill-climbing step to a better state, or a landmark count below every one before in any of
+  /// its lazy searches (0: none yet).
+  uint64_t evaluations() const { return evaluated_; }
+  uint64_t evaluationsAtProgress() const { return evaluated_at_progress_; }
+
+  void climbed() override { evaluated_at_progress_ = evaluated_; }
+  void landmarksLeft(Cost count) override {
+    if (count >= fewest_landmarks_) return;
+    fewest_landmarks_ = count;
+    evaluated_at_progress_ = evaluated_;
+  }
 
   void evaluated() override {
     ++evaluated_;
@@ -206,6 +222,8 @@ class SearchFiber : public EvaluationHook {
   SearchResult result_;
   std::exception_ptr error_;
   uint64_t evaluated_{0};
+  uint64_t evaluated_at_progress_{0};
+  Cost fewest_landmarks_{std::numeric_limits<Cost>::max()};
   uint64_t until_evaluations_{0};
   std::optional<Clock::time_point> until_;
   double seconds_{0.0};
@@ -906,6 +924,7 @@ class Searcher {
       plan.insert(plan.end(), seg.begin(), seg.end());
       cur = found;
       parent_[cur] = kNone;
+      if (t_evaluation_hook != nullptr) t_evaluation_hook->climbed();
       if (task_.goalReached(reg_.get(cur), goal)) {
         // The goal of an agenda entry is where the next entry starts: not from a dead end. (A
         // goal state itself is not tested, as without test_later.)
@@ -1148,6 +1167,7 @@ class Searcher {
       if (lm && hlm[sid] < best_lm) {
         best_lm = hlm[sid];
         progress = true;
+        if (t_evaluation_hook != nullptr) t_evaluation_hook->landmarksLeft(best_lm);
       }
       if (progress) {
         prio[1] -= opt_.preferred_boost;
@@ -1513,6 +1533,10 @@ void SearchOptions::validate() const {
                                 std::to_string(unit_beside_time_share));
   }
   if (unit_beside_turn == 0) throw std::invalid_argument("SearchOptions::unit_beside_turn must be > 0, got 0");
+  if (!(unit_beside_stall_share >= 0.0 && unit_beside_stall_share <= 1.0)) {
+    throw std::invalid_argument("SearchOptions::unit_beside_stall_share must be in [0, 1], got " +
+                                std::to_string(unit_beside_stall_share));
+  }
   if (!(unit_first_time_share > 0.0 && unit_first_time_share <= 1.0)) {
     throw std::invalid_argument("SearchOptions::unit_first_time_share must be in (0, 1], got " +
                                 std::to_string(unit_first_time_share));
@@ -1837,12 +1861,23 @@ bool isFinalAnswer(const SearchResult& r) {
 /// (`plus_stop`).
 class UnitTurns : public EvaluationHook {
  public:
-  UnitTurns(SearchFiber& unit, uint64_t turn, double budget, std::stop_source& plus_stop)
-      : unit_(unit), turn_(turn), left_(turn), budget_(budget), plus_stop_(plus_stop) {}
+  UnitTurns(SearchFiber& unit, uint64_t turn, double budget, double stall_share, std::stop_source& plus_stop)
+      : unit_(unit), turn_(turn), left_(turn), budget_(budget), stall_share_(stall_share), plus_stop_(plus_stop) {}
+
+  /// `unit_beside_stall_share`: the unit-cost run has made no progress in the last share of its
+  /// evaluations.
+  static bool stalled(const SearchFiber& unit, double stall_share) {
+    return stall_share > 0 && static_cast<double>(unit.evaluations() - unit.evaluationsAtProgress()) >
+                                  stall_share * static_cast<double>(unit.evaluations());
+  }
 
   void evaluated() override {
     if (unit_.done() || --left_ > 0) return;
     left_ = turn_;
+    if (stalled(unit_, stall_share_)) {
+      unit_.cancel();  // no progress of late: its states are freed
+      return;
+    }
     const double time_left = budget_ - unit_.seconds();
     if (time_left > 0) {
       unit_.resume(turn_, Clock::now() + std::chrono::duration_cast<Clock::duration>(
@@ -1860,6 +1895,7 @@ class UnitTurns : public EvaluationHook {
   uint64_t turn_;
   uint64_t left_;
   double budget_;
+  double stall_share_;
   std::stop_source& plus_stop_;
 };
 
@@ -1897,8 +1933,10 @@ SearchResult unitCostFirstPlan(const Task& task, const StateBits& init, const Go
     };
     std::stop_callback<StopRequest> link(term.token(), StopRequest{&plus_stop});
     const Termination plus_term(term.deadline(), plus_stop.get_token());
+    if (!unit.done() && UnitTurns::stalled(unit, options.unit_beside_stall_share)) unit.cancel();
     const bool beside = !unit.done();
-    UnitTurns turns(unit, options.unit_beside_turn, options.unit_beside_time_share * left, plus_stop);
+    UnitTurns turns(unit, options.unit_beside_turn, options.unit_beside_time_share * left,
+                    options.unit_beside_stall_share, plus_stop);
     SearchResult plus;
     {
       ScopedEvaluationHook hook(beside ? &turns : nullptr);

@@ -5,11 +5,19 @@
 #include <sys/mman.h>
 #include <unistd.h>
 
+#include <sys/time.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <csignal>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <iostream>
 #include <string>
+#include <thread>
 
 #include <CLI/CLI.hpp>
 
@@ -105,6 +113,65 @@ void reserveHeap(int64_t mib) {
   if (begin - at > kChunkHeader && end > begin) heap_gap = std::malloc(begin - at - kChunkHeader);
 }
 
+/// How long after its deadline the planner may take to stop before the watchdog ends it (the
+/// handler's message says so).
+constexpr double kWatchdogGraceSeconds = 0.5;
+
+/// The process-level bound of `--timeout` (issue 14, thirty-fourth round). The planner checks its
+/// deadline in every loop known to be long (grounding, relevance analysis, h^2 tables,
+/// searches; evaluations one at a time where they are slow) and frees its open lists in large
+/// chunks, so it stops within a fraction of a second of it; but a phase that does not check (an
+/// unseen domain's grounding, a search freeing gigabytes) must not keep `tamp plan` running. A
+/// real-time timer (setitimer: no thread to start, which a run of milliseconds would pay for)
+/// goes off at the deadline plus the grace; unless the answer has been claimed by then
+/// (`claimAnswer()`), its handler writes the timeout answer (stdout "; timeout", a message naming
+/// the watchdog on stderr) and ends the process with the timeout code at once (`_exit`: no
+/// destructors; the OS takes the memory back). It may run on any thread (the planner's turns
+/// run one on a thread of its own); it uses only write() and _exit().
+std::atomic<bool> g_answer_claimed{false};
+std::atomic<bool> g_watchdog_stats{false};
+
+void onWatchdog(int) {
+  if (g_answer_claimed.load()) return;
+  auto put = [](int fd, const char* text) {
+    size_t n = std::strlen(text);
+    while (n > 0) {
+      const ssize_t w = write(fd, text, n);
+      if (w <= 0) return;
+      text += w;
+      n -= static_cast<size_t>(w);
+    }
+  };
+  if (g_watchdog_stats.load()) put(2, "; status timeout; stopped by tamp plan's watchdog\n");
+  put(2, "search timeout (the planner had not stopped 0.5 s after its deadline: ended by tamp plan's watchdog)\n");
+  put(1, "; timeout\n");
+  _exit(tamp::cli::kExitTimeout);
+}
+
+/// Arms the watchdog `seconds` from now.
+void armWatchdog(double seconds, bool stats) {
+  static_assert(kWatchdogGraceSeconds == 0.5, "the handler's message says 0.5 s");
+  g_watchdog_stats = stats;
+  struct sigaction sa {};
+  sa.sa_handler = onWatchdog;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = SA_RESTART;
+  sigaction(SIGALRM, &sa, nullptr);
+  itimerval v{};
+  const double whole = std::floor(seconds);
+  v.it_value.tv_sec = static_cast<time_t>(whole);
+  v.it_value.tv_usec = static_cast<suseconds_t>((seconds - whole) * 1e6) + 1;  // never 0 (= disarmed)
+  setitimer(ITIMER_REAL, &v, nullptr);
+}
+
+/// The planner has answered: the watchdog stands down (a handler already past its check is
+/// ending the process; this thread then prints nothing more before it does).
+void claimAnswer() {
+  g_answer_claimed = true;
+  itimerval off{};
+  setitimer(ITIMER_REAL, &off, nullptr);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -125,6 +192,7 @@ int main(int argc, char** argv) {
   double unit_first_share = defaults.unit_first_time_share;
   double unit_beside_share = defaults.unit_beside_time_share;
   uint64_t unit_beside_turn = defaults.unit_beside_turn;
+  double unit_beside_stall = defaults.unit_beside_stall_share;
   double neighbourhood_share = defaults.neighbourhood_time_share;
   bool neighbourhood_grow = defaults.neighbourhood_grow;
   int64_t heap_reserve_mib = 64;
@@ -158,6 +226,14 @@ int main(int argc, char** argv) {
   app.add_option("--validate", validate_plan, "check this plan file against DOMAIN PROBLEM instead of planning");
   app.add_flag("--stats", stats, "print statistics to stderr");
   app.add_flag("--no-check", no_check, "do not replay the plan with the independent checker");
+  bool no_watchdog = false;
+  double debug_stall = 0.0;
+  // Hidden: the planner sleeps this long before it starts, its deadline unchecked (a phase that does
+  // not check it); for the watchdog's test only.
+  app.add_option("--debug-stall-seconds", debug_stall)->check(CLI::Range(0.0, 3600.0))->group("");
+  app.add_flag("--no-watchdog", no_watchdog,
+               "with --timeout: no watchdog (by default one ends the process with the timeout answer when the "
+               "planner has not stopped 0.5 s after its deadline)");
   app.add_flag("--no-fallback", no_fallback, "ehc: do not fall back to best-first search");
   app.add_flag("--no-goal-agenda", no_agenda, "ehc: pursue all goals at once (no FF goal agenda)");
   app.add_flag("--ehc-first-improvement", first_improvement,
@@ -196,6 +272,10 @@ int main(int argc, char** argv) {
                  "the unit-cost first run that has not answered within --unit-first-share goes on beside the "
                  "cost + 1 run, in turns, until it has used this share of the time left in all, in [0, 1] "
                  "(at most --unit-first-share: it stops at its first share, the cost + 1 run after it)")
+      ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--unit-beside-stall", unit_beside_stall,
+                 "with --unit-beside-share: the unit-cost run is stopped once it has made no progress (a hill-climbing "
+                 "step, a landmark count below every one before) in this share of its evaluations, in [0, 1] (0: never)")
       ->check(CLI::Range(0.0, 1.0));
   app.add_option("--unit-beside-turn", unit_beside_turn,
                  "evaluations per turn of each of the unit-cost and cost + 1 runs in turns (> 0)")
@@ -326,6 +406,7 @@ int main(int argc, char** argv) {
   req.search.unit_first_time_share = unit_first_share;
   req.search.unit_beside_time_share = unit_beside_share;
   req.search.unit_beside_turn = unit_beside_turn;
+  req.search.unit_beside_stall_share = unit_beside_stall;
   req.search.neighbourhood_time_share = neighbourhood_share;
   req.search.neighbourhood_grow = neighbourhood_grow;
   if (heuristic == "ff") req.search.heuristic = sp::HeuristicKind::kFF;
@@ -344,7 +425,13 @@ int main(int argc, char** argv) {
   // grounding piece by piece at exit costs 0.2-0.3 ms per run, which is what a process-per-instance
   // benchmark measures; the OS reclaims it. Reachable through this static, so no leak report.
   static sp::Planner* const planner = new sp::Planner(1);
-  const sp::PlanReply reply = planner->solve(req, tamp::Termination());
+  // One deadline for the planner and the watchdog, from here.
+  const tamp::Termination term = timeout > 0 ? tamp::Termination(tamp::Deadline::in(timeout)) : tamp::Termination();
+  const bool watchdog = timeout > 0 && !no_watchdog;
+  if (watchdog) armWatchdog(timeout + kWatchdogGraceSeconds, stats);
+  if (debug_stall > 0) std::this_thread::sleep_for(std::chrono::duration<double>(debug_stall));
+  const sp::PlanReply reply = planner->solve(req, term);
+  if (watchdog) claimAnswer();
   if (stats) {
     std::fprintf(stderr,
                  "; status %s; parse %.4f s, ground %.4f s, search %.4f s, check %.4f s; facts %zu, operators %zu; "

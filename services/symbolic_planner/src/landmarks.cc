@@ -512,13 +512,14 @@ class RhwBuilder {
 }  // namespace
 
 LandmarkGraph rhwLandmarks(const Task& task, const StateBits& init, const Goal& goal,
-                           const RhwLandmarkOptions& options) {
+                           const RhwLandmarkOptions& options, const Termination& term) {
   options.validate();
   if (!positiveConjunctiveGoal(goal)) return {};
   RhwBuilder builder(task, init, options);
   LandmarkGraph graph = builder.run(goal.conjuncts[0].pos);
-  if (options.reasonable_orders && !graph.empty()) {
-    const MutexTable mutexes(task, init, options.mutexes);
+  if (options.reasonable_orders && !graph.empty() && !term()) {
+    const MutexTable mutexes(task, init, options.mutexes, term);
+    if (term()) return graph;
     addReasonableOrders(task, init, mutexes, graph, options.max_interference_tests);
   }
   return graph;

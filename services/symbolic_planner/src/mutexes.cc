@@ -37,22 +37,24 @@ struct ChangeClock {
 
 }  // namespace
 
-MutexTable::MutexTable(const Task& task, const StateBits& init, const H2MutexOptions& options) {
-  compute(task, init, options, nullptr);
+MutexTable::MutexTable(const Task& task, const StateBits& init, const H2MutexOptions& options,
+                       const Termination& term) {
+  compute(task, init, options, nullptr, term);
 }
 
 std::optional<bool> MutexTable::reachesTogether(const Task& task, const StateBits& from,
                                                 const std::vector<FactId>& facts,
-                                                const H2MutexOptions& options, uint64_t* work) {
+                                                const H2MutexOptions& options, uint64_t* work,
+                                                const Termination& term) {
   MutexTable t;
-  t.compute(task, from, options, &facts);
+  t.compute(task, from, options, &facts, term);
   if (work != nullptr) *work = t.work_;
   if (t.n_ == 0) return std::nullopt;
   return t.stop_left_ == 0;
 }
 
 void MutexTable::compute(const Task& task, const StateBits& init, const H2MutexOptions& options,
-                         const std::vector<FactId>* stop_facts) {
+                         const std::vector<FactId>* stop_facts, const Termination& term) {
   options.validate();
   if (init.size() < task.numWords()) {
     throw std::invalid_argument("MutexTable: the initial state has " + std::to_string(init.size()) +
@@ -100,6 +102,12 @@ void MutexTable::compute(const Task& task, const StateBits& init, const H2MutexO
   for (bool changed = true; changed;) {
     changed = false;
     for (OpId o = 0; o < task.ops.size(); ++o) {
+      if ((o & 63) == 0 && term()) {
+        const uint64_t work = work_;
+        *this = MutexTable();
+        work_ = work;
+        return;
+      }
       if (!clock.stale(task.ops[o], o)) continue;
       clock.op_tick[o] = ++clock.now;
       tick_ = clock.now + 1;

@@ -292,13 +292,22 @@ PlanReply PlanningSession::solve(const Query& q, const Termination& term) {
   // 4. The task to search: pruned to what is relevant to the goal (see Query::prune_irrelevant).
   const Task* task = task_.get();
   std::vector<HeuristicCache>* tables = &heuristics_;
+  // The caller's deadline between the phases (each checks it inside too, but for the heuristic's
+  // tables, linear in the operators): a deadline that passed during one ends the query at once.
+  auto stoppedReply = [&](const char* phase) {
+    reply.status = term.reason() == StopReason::kStopRequested ? PlanStatus::kCancelled : PlanStatus::kTimeout;
+    reply.message = std::string(phase) + " " + toString(reply.status);
+    return reply;
+  };
+  if (term()) return stoppedReply("grounding");
   if (q.prune_irrelevant && !prune_tried_ && heuristics_.empty()) {
-    prune_tried_ = true;
-    pruned_ = pruneIrrelevant(*task_, goal);
+    pruned_ = pruneIrrelevant(*task_, goal, term);
+    prune_tried_ = !pruned_.stats.stopped;  // a stopped analysis is run again by the next query
     pruned_for_ = goal;
     pruned_heuristics_.clear();
     reply.stats.relevance_ran = true;
     reply.stats.relevance = pruned_.stats;
+    if (pruned_.stats.stopped) return stoppedReply("relevance analysis");
   }
   if (q.prune_irrelevant && pruned_.pruned() && sameGoal(goal, pruned_for_)) {
     init = pruned_.projectState(init.data(), init.size());
@@ -321,6 +330,7 @@ PlanReply PlanningSession::solve(const Query& q, const Termination& term) {
     tables->push_back({hk, ct, makeHeuristic(hk, *task, ct)});
     h = tables->back().h.get();
   }
+  if (term()) return stoppedReply("heuristic set-up");
   Stopwatch ssw;
   SearchResult sr = search(*task, init, goal, opt, *h, term);
   reply.stats.search_seconds = ssw.seconds();

@@ -296,7 +296,7 @@ StateBits PrunedTask::projectState(const uint64_t* s, size_t original_words) con
   return out;
 }
 
-PrunedTask pruneIrrelevant(const Task& task, const Goal& goal) {
+PrunedTask pruneIrrelevant(const Task& task, const Goal& goal, const Termination& term) {
   Stopwatch sw;
   PrunedTask out;
   const size_t nf = task.numFacts();
@@ -312,8 +312,18 @@ PrunedTask pruneIrrelevant(const Task& task, const Goal& goal) {
   st.facts_before = st.facts_after = nf;
   st.ops_before = st.ops_relevant = st.ops_after = task.ops.size();
   if (goal.unsatisfiable()) return out;  // nothing to reach: the search says so at once
+  auto stopped = [&] {
+    st.stopped = true;
+    st.seconds = sw.seconds();
+    out.fact_map.clear();
+    out.op_origin.clear();
+    out.goal = Goal{};
+    return out;
+  };
+  if (term()) return stopped();
   Analysis a(task, goal);
   a.run();
+  if (term()) return stopped();
   if (!a.complete()) {
     st.unsafe = true;
     st.seconds = sw.seconds();
@@ -333,6 +343,7 @@ PrunedTask pruneIrrelevant(const Task& task, const Goal& goal) {
   {
     U64IdMap seen(task.ops.size());
     for (OpId o = 0; o < task.ops.size(); ++o) {
+      if ((o & 1023) == 1023 && term()) return stopped();
       if (!a.opRelevant(o)) continue;
       ++relevant;
       op_hash[o] = hashOnKept(task.ops[o], o, a, out.fact_map, st.cond_effects_dropped);
@@ -361,6 +372,7 @@ PrunedTask pruneIrrelevant(const Task& task, const Goal& goal) {
   out.op_origin.reserve(relevant);
   SameHashChains same(hashes_meet ? relevant : 0);
   for (OpId o = 0; o < task.ops.size(); ++o) {
+    if ((o & 1023) == 1023 && term()) return stopped();
     if (!a.opRelevant(o)) continue;
     const Operator& src = task.ops[o];
     Operator op = projectOperator(src, o, a, out.fact_map);
@@ -392,6 +404,7 @@ PrunedTask pruneIrrelevant(const Task& task, const Goal& goal) {
     mapKept(c.neg, out.fact_map, gc.neg);
     out.goal.conjuncts.push_back(std::move(gc));
   }
+  if (term()) return stopped();
   pruned->finalize();
   out.task = std::move(pruned);
   st.seconds = sw.seconds();

@@ -82,6 +82,10 @@ class EvaluationHook {
  public:
   virtual ~EvaluationHook() = default;
   virtual void evaluated() = 0;
+  /// A hill-climbing run committed to a better state.
+  virtual void climbed() {}
+  /// A lazy search reached a state with `count` landmarks left, fewer than any before it.
+  virtual void landmarksLeft(Cost /*count*/) {}
 };
 
 /// The hook of this thread's searches (none: nullptr).
@@ -154,6 +158,18 @@ class SearchFiber : public EvaluationHook {
   SearchResult& result() { return result_; }
   /// The time it has run, in seconds.
   double seconds() const { return seconds_; }
+  /// Its evaluations so far, and how many it had done when it last made progress: a
+  /// hill-climbing step to a better state, or a landmark count below every one before in any of
+  /// its lazy searches (0: none yet).
+  uint64_t evaluations() const { return evaluated_; }
+  uint64_t evaluationsAtProgress() const { return evaluated_at_progress_; }
+
+  void climbed() override { evaluated_at_progress_ = evaluated_; }
+  void landmarksLeft(Cost count) override {
+    if (count >= fewest_landmarks_) return;
+    fewest_landmarks_ = count;
+    evaluated_at_progress_ = evaluated_;
+  }
 
   void evaluated() override {
     ++evaluated_;
@@ -206,6 +222,8 @@ class SearchFiber : public EvaluationHook {
   SearchResult result_;
   std::exception_ptr error_;
   uint64_t evaluated_{0};
+  uint64_t evaluated_at_progress_{0};
+  Cost fewest_landmarks_{std::numeric_limits<Cost>::max()};
   uint64_t until_evaluations_{0};
   std::optional<Clock::time_point> until_;
   double seconds_{0.0};
@@ -676,11 +694,20 @@ class Searcher {
   /// since the last check (one evaluation of a task with 10^5 operators takes milliseconds, and
   /// a hill-climbing node may evaluate hundreds of successors); returns a terminal status or
   /// nullopt.
+  ///
+  /// Where evaluations are slow (more than kSlowCheckGap between two checks: a task with 10^5
+  /// operators, 10-20 ms an evaluation on scanalyzer-30), the clock is read after every
+  /// evaluation, so that the deadline is overrun by one evaluation at most; back to every
+  /// kEvalsPerCheck once the checks come quickly again. Only when a limit is seen changes with
+  /// it, never which states are evaluated.
   std::optional<SearchStatus> checkLimits() {
     if (turns_ != nullptr && turns_->stopped()) return SearchStatus::kCancelled;
-    const bool few_evaluations = stats_.evaluated < evaluated_at_check_ + kEvalsPerCheck;
+    const bool few_evaluations = stats_.evaluated < evaluated_at_check_ + evals_per_check_;
     if ((++checks_ & 255) != 0 && few_evaluations) return std::nullopt;
     evaluated_at_check_ = stats_.evaluated;
+    const Clock::time_point now = Clock::now();
+    evals_per_check_ = now - last_check_ > kSlowCheckGap ? 1 : kEvalsPerCheck;
+    last_check_ = now;
     const StopReason why = term_.reason();
     if (why == StopReason::kDeadline) return SearchStatus::kTimeout;
     if (why == StopReason::kStopRequested) return SearchStatus::kCancelled;
@@ -897,6 +924,7 @@ class Searcher {
       plan.insert(plan.end(), seg.begin(), seg.end());
       cur = found;
       parent_[cur] = kNone;
+      if (t_evaluation_hook != nullptr) t_evaluation_hook->climbed();
       if (task_.goalReached(reg_.get(cur), goal)) {
         // The goal of an agenda entry is where the next entry starts: not from a dead end. (A
         // goal state itself is not tested, as without test_later.)
@@ -949,6 +977,48 @@ class Searcher {
     uint32_t parent;
     OpId op;
   };
+  /// A FIFO of lazy entries in chunks that double from 64 entries up to 8 192 (64 KiB): the same
+  /// order as a std::deque, but freed in one call per chunk. A std::deque's 512-byte blocks made
+  /// freeing a lazy search's open lists take seconds past the deadline: citycar-6's unit-cost run
+  /// and childsnack-8, 1.6-2.4 s in glibc's free() of millions of blocks (docs/benchmarks.md,
+  /// issue 14, thirty-fourth round).
+  class EntryFifo {
+   public:
+    void push_back(const LazyEntry& e) {
+      if (first_ == chunks_.size() || tail_ == chunks_.back().cap) {
+        chunks_.push_back({std::make_unique_for_overwrite<LazyEntry[]>(next_cap_), next_cap_});
+        next_cap_ = std::min<uint32_t>(next_cap_ * 2, kMaxChunk);
+        tail_ = 0;
+      }
+      chunks_.back().data[tail_++] = e;
+    }
+    const LazyEntry& front() const { return chunks_[first_].data[head_]; }
+    void pop_front() {
+      if (++head_ < chunks_[first_].cap) return;
+      chunks_[first_++].data.reset();
+      head_ = 0;
+      if (first_ == chunks_.size()) {
+        chunks_.clear();
+        first_ = 0;
+      } else if (2 * first_ >= chunks_.size()) {
+        chunks_.erase(chunks_.begin(), chunks_.begin() + static_cast<std::ptrdiff_t>(first_));
+        first_ = 0;
+      }
+    }
+    bool empty() const { return first_ == chunks_.size() || (first_ + 1 == chunks_.size() && head_ == tail_); }
+
+   private:
+    static constexpr uint32_t kMaxChunk = 8192;
+    struct Chunk {
+      std::unique_ptr<LazyEntry[]> data;
+      uint32_t cap;
+    };
+    std::vector<Chunk> chunks_;  // chunks_[first_] is the front chunk
+    size_t first_{0};
+    uint32_t head_{0};  // next entry of the front chunk
+    uint32_t tail_{0};  // entries of the back chunk in use
+    uint32_t next_cap_{64};
+  };
   /// Bucket open list (Fast Downward's for integer keys): one FIFO per key, so equal keys pop in
   /// insertion order, as a heap with an insertion counter would, at 8 bytes per entry (the heap
   /// entry was 24) and O(log #keys) per push/pop. Buckets are freed as they are emptied.
@@ -979,8 +1049,8 @@ class Searcher {
     size_t bytes() const { return size_ * sizeof(LazyEntry) + buckets_.size() * 128; }
 
    private:
-    std::map<Cost, std::deque<LazyEntry>> buckets_;
-    std::deque<LazyEntry>* last_{nullptr};  // bucket of the last push (successors share keys)
+    std::map<Cost, EntryFifo> buckets_;
+    EntryFifo* last_{nullptr};  // bucket of the last push (successors share keys)
     Cost last_key_{0};
     size_t size_{0};
   };
@@ -1097,6 +1167,7 @@ class Searcher {
       if (lm && hlm[sid] < best_lm) {
         best_lm = hlm[sid];
         progress = true;
+        if (t_evaluation_hook != nullptr) t_evaluation_hook->landmarksLeft(best_lm);
       }
       if (progress) {
         prio[1] -= opt_.preferred_boost;
@@ -1111,7 +1182,7 @@ class Searcher {
   std::unique_ptr<LandmarkCounter> makeLandmarkCounter() const {
     if (opt_.landmark_generator == LandmarkGenerator::kRhw) {
       return std::make_unique<LandmarkCounter>(
-          task_, shared_landmarks_ != nullptr ? *shared_landmarks_ : rhwLandmarks(task_, init_, goal_, opt_.rhw),
+          task_, shared_landmarks_ != nullptr ? *shared_landmarks_ : rhwLandmarks(task_, init_, goal_, opt_.rhw, term_),
           LandmarkProgression::kPastAndFuture);
     }
     return std::make_unique<LandmarkCounter>(task_, init_, goal_);
@@ -1240,6 +1311,7 @@ class Searcher {
         op_[sid] = o;
         if (task_.goalReached(succ_.data(), goal_)) return finish(SearchStatus::kSolved, path(sid, kNone));
         const Cost h = evaluate(sid);
+        if (auto st = checkLimits()) return finish(*st);
         if (h == Heuristic::kDeadEnd) {
           flag_[sid] |= 1;
           continue;
@@ -1287,6 +1359,7 @@ class Searcher {
         const Cost ng = gid + (task_.unit_cost ? 1 : task_.ops[o].cost);
         if (is_new) {
           const Cost h = evaluate(sid);
+          if (auto st = checkLimits()) return finish(*st);
           if (h == Heuristic::kDeadEnd) {
             flag_[sid] |= 3;  // closed + dead
             continue;
@@ -1327,6 +1400,9 @@ class Searcher {
   SearchStatistics stats_;
   uint64_t checks_{0};
   uint64_t evaluated_at_check_{0};            ///< stats_.evaluated at the last clock read
+  uint64_t evals_per_check_{kEvalsPerCheck};  ///< 1 while evaluations are slow (checkLimits)
+  Clock::time_point last_check_{Clock::now()};
+  static constexpr std::chrono::milliseconds kSlowCheckGap{20};
   static constexpr uint64_t kEvalsPerCheck = 16;
   size_t open_bytes_{0};
   std::vector<uint32_t> stamp_;  // ehc: BFS iteration that reached each state
@@ -1358,7 +1434,7 @@ class Searcher {
     for (const GoalConjunct& c : goal_.conjuncts) {
       uint64_t work = 0;
       const std::optional<bool> reached =
-          MutexTable::reachesTogether(task_, h2_state_, c.pos, opt_.ehc_h2_mutexes, &work);
+          MutexTable::reachesTogether(task_, h2_state_, c.pos, opt_.ehc_h2_mutexes, &work, term_);
       h2_work_ += work;
       if (!reached || *reached) return false;
     }
@@ -1457,6 +1533,10 @@ void SearchOptions::validate() const {
                                 std::to_string(unit_beside_time_share));
   }
   if (unit_beside_turn == 0) throw std::invalid_argument("SearchOptions::unit_beside_turn must be > 0, got 0");
+  if (!(unit_beside_stall_share >= 0.0 && unit_beside_stall_share <= 1.0)) {
+    throw std::invalid_argument("SearchOptions::unit_beside_stall_share must be in [0, 1], got " +
+                                std::to_string(unit_beside_stall_share));
+  }
   if (!(unit_first_time_share > 0.0 && unit_first_time_share <= 1.0)) {
     throw std::invalid_argument("SearchOptions::unit_first_time_share must be in (0, 1], got " +
                                 std::to_string(unit_first_time_share));
@@ -1661,7 +1741,7 @@ class LazyBeside : public TurnTaker {
   void start() {
     if (!lanes_.empty()) return;
     if (options_.landmarks && options_.landmark_generator == LandmarkGenerator::kRhw && twoLanes()) {
-      landmarks_.emplace(rhwLandmarks(task_, init_, goal_, options_.rhw));
+      landmarks_.emplace(rhwLandmarks(task_, init_, goal_, options_.rhw, term_));
     }
     addLane(options_.lazy_plan_preferred);
     maybeAddSecond();
@@ -1781,12 +1861,23 @@ bool isFinalAnswer(const SearchResult& r) {
 /// (`plus_stop`).
 class UnitTurns : public EvaluationHook {
  public:
-  UnitTurns(SearchFiber& unit, uint64_t turn, double budget, std::stop_source& plus_stop)
-      : unit_(unit), turn_(turn), left_(turn), budget_(budget), plus_stop_(plus_stop) {}
+  UnitTurns(SearchFiber& unit, uint64_t turn, double budget, double stall_share, std::stop_source& plus_stop)
+      : unit_(unit), turn_(turn), left_(turn), budget_(budget), stall_share_(stall_share), plus_stop_(plus_stop) {}
+
+  /// `unit_beside_stall_share`: the unit-cost run has made no progress in the last share of its
+  /// evaluations.
+  static bool stalled(const SearchFiber& unit, double stall_share) {
+    return stall_share > 0 && static_cast<double>(unit.evaluations() - unit.evaluationsAtProgress()) >
+                                  stall_share * static_cast<double>(unit.evaluations());
+  }
 
   void evaluated() override {
     if (unit_.done() || --left_ > 0) return;
     left_ = turn_;
+    if (stalled(unit_, stall_share_)) {
+      unit_.cancel();  // no progress of late: its states are freed
+      return;
+    }
     const double time_left = budget_ - unit_.seconds();
     if (time_left > 0) {
       unit_.resume(turn_, Clock::now() + std::chrono::duration_cast<Clock::duration>(
@@ -1804,6 +1895,7 @@ class UnitTurns : public EvaluationHook {
   uint64_t turn_;
   uint64_t left_;
   double budget_;
+  double stall_share_;
   std::stop_source& plus_stop_;
 };
 
@@ -1841,8 +1933,10 @@ SearchResult unitCostFirstPlan(const Task& task, const StateBits& init, const Go
     };
     std::stop_callback<StopRequest> link(term.token(), StopRequest{&plus_stop});
     const Termination plus_term(term.deadline(), plus_stop.get_token());
+    if (!unit.done() && UnitTurns::stalled(unit, options.unit_beside_stall_share)) unit.cancel();
     const bool beside = !unit.done();
-    UnitTurns turns(unit, options.unit_beside_turn, options.unit_beside_time_share * left, plus_stop);
+    UnitTurns turns(unit, options.unit_beside_turn, options.unit_beside_time_share * left,
+                    options.unit_beside_stall_share, plus_stop);
     SearchResult plus;
     {
       ScopedEvaluationHook hook(beside ? &turns : nullptr);

@@ -8,6 +8,7 @@
 #include <set>
 #include <tuple>
 #include <stdexcept>
+#include <stop_token>
 #include <string>
 
 #include "tamp/symbolic_planner/relevance.h"
@@ -75,6 +76,38 @@ const char* kDecorProblem = R"(
   (:goal (at r3))
   (:metric minimize (total-cost)))
 )";
+
+TEST(Relevance, AStoppedAnalysisPrunesNothingAndSaysSo) {
+  auto s = PlanningSession::fromText(kDecorDomain, kDecorProblem);
+  ASSERT_TRUE(s.ok()) << s.error().toString();
+  Query q = problemQuery(**s);
+  q.prune_irrelevant = false;
+  ASSERT_EQ((*s)->solve(q, Termination()).status, PlanStatus::kSolved);
+  const Task& t = *(*s)->task();
+  const Goal goal = goalOf({static_cast<FactId>(factOf(t, "(at r3)"))});
+  ASSERT_TRUE(pruneIrrelevant(t, goal).pruned());  // the same analysis unstopped prunes
+  std::stop_source stop;
+  stop.request_stop();
+  const PrunedTask p = pruneIrrelevant(t, goal, Termination(Deadline::never(), stop.get_token()));
+  EXPECT_FALSE(p.pruned());
+  EXPECT_TRUE(p.stats.stopped);
+  EXPECT_FALSE(p.stats.unsafe);
+  EXPECT_TRUE(p.fact_map.empty());
+  const PrunedTask late = pruneIrrelevant(t, goal, Termination(Deadline::in(-1.0)));
+  EXPECT_FALSE(late.pruned());
+  EXPECT_TRUE(late.stats.stopped);
+  // A session whose query is stopped during the analysis answers so, and the next query runs it.
+  auto s2 = PlanningSession::fromText(kDecorDomain, kDecorProblem);
+  ASSERT_TRUE(s2.ok());
+  Query q2 = problemQuery(**s2);
+  q2.prune_irrelevant = true;
+  const PlanReply stopped = (*s2)->solve(q2, Termination(Deadline::never(), stop.get_token()));
+  EXPECT_EQ(stopped.status, PlanStatus::kCancelled) << stopped.message;
+  const PlanReply again = (*s2)->solve(q2, Termination());
+  ASSERT_EQ(again.status, PlanStatus::kSolved) << again.message;
+  EXPECT_TRUE(again.stats.relevance_ran);
+  EXPECT_TRUE(again.stats.pruned);
+}
 
 TEST(Relevance, DropsWhatNoGoalNeedsAndKeepsTheCheapestOfTheSameOperators) {
   auto s = PlanningSession::fromText(kDecorDomain, kDecorProblem);

@@ -1206,6 +1206,40 @@ TEST(Search, UnitCostRunGoesOnBesideTheCostPlusOneRunInTurns) {
   EXPECT_NE(planText(unit), planText(plus));
 }
 
+TEST(Search, UnitCostRunBesideIsStoppedOnceItMakesNoProgress) {
+  // pegsol-18, as above: the unit-cost run's first share ends at its first time check, 16
+  // evaluations in, inside an evaluation (before the step it may take after it). With a stall
+  // share that no run can meet (1.0), the run is the one without it (the same plan and
+  // evaluations); with one that any evaluation since the last progress exceeds, the unit-cost run
+  // is stopped at the end of its first share, before any turn: the cost + 1 run's plan.
+  PlanRequest req = benchmarkRequest("pddl-more/pegsol", "instance-18.pddl");
+  req.check_plan = true;
+  req.timeout_seconds = 120;
+  req.search.anytime_seconds = 1e-9;
+  req.search.unit_first_time_share = 1e-9;
+  req.search.unit_beside_time_share = 1.0;
+  PlanReply turns = plan(req, Termination());
+  ASSERT_EQ(turns.status, PlanStatus::kSolved) << turns.message;
+  ASSERT_TRUE(turns.stats.unit_beside);
+  req.search.unit_beside_stall_share = 1.0;
+  PlanReply never = plan(req, Termination());
+  ASSERT_EQ(never.status, PlanStatus::kSolved) << never.message;
+  EXPECT_EQ(planText(never), planText(turns));
+  EXPECT_EQ(never.stats.evaluated, turns.stats.evaluated);
+  EXPECT_TRUE(never.stats.unit_beside);
+  req.search.unit_beside_stall_share = 1e-9;
+  PlanReply stalled = plan(req, Termination());
+  ASSERT_EQ(stalled.status, PlanStatus::kSolved) << stalled.message;
+  EXPECT_TRUE(stalled.stats.unit_first_failed);
+  EXPECT_FALSE(stalled.stats.unit_beside);  // stopped before the cost + 1 run started
+  req.search.unit_cost_first = false;
+  PlanReply plus = plan(req, Termination());
+  ASSERT_EQ(plus.status, PlanStatus::kSolved) << plus.message;
+  EXPECT_EQ(planText(stalled), planText(plus));
+  EXPECT_GT(stalled.stats.evaluated, plus.stats.evaluated);  // the unit-cost run's 16 counted
+  EXPECT_LT(stalled.stats.evaluated, plus.stats.evaluated + 200);
+}
+
 TEST(Search, UnitCostRunBesideStopsAtItsShareAndOnTheCallersStop) {
   // The unit-cost run's share of the time left in all just above its first share: it is
   // stopped at its first turn beside the cost + 1 run, which gives the plan.
@@ -1262,6 +1296,13 @@ TEST(Search, OptionsAreValidated) {
     EXPECT_THROW(o.validate(), std::invalid_argument) << bad;
   }
   o.unit_beside_time_share = 0;
+  for (double bad : {-0.1, 1.5, std::nan("")}) {
+    o.unit_beside_stall_share = bad;
+    EXPECT_THROW(o.validate(), std::invalid_argument) << bad;
+  }
+  o.unit_beside_stall_share = 0.5;
+  EXPECT_NO_THROW(o.validate());
+  o.unit_beside_stall_share = 0;
   EXPECT_NO_THROW(o.validate());
   o.unit_beside_turn = 0;
   EXPECT_THROW(o.validate(), std::invalid_argument);

@@ -109,9 +109,11 @@ struct RhwLandmarkOptions {
 
 /// The RHW landmarks of reaching `goal` from `init` (see the file comment); empty where
 /// `zhuGivanLandmarks` is (disjunctive or negative goals, a relaxed-unreachable goal).
+/// `term` stops the h^2 table of the reasonable orders (the graph is then returned without
+/// them: a caller whose deadline passed is about to stop anyway).
 /// @throws std::invalid_argument when `options` are invalid.
 LandmarkGraph rhwLandmarks(const Task& task, const StateBits& init, const Goal& goal,
-                           const RhwLandmarkOptions& options);
+                           const RhwLandmarkOptions& options, const Termination& term = Termination());
 
 /// Hoffmann, Porteous & Sebastia's reasonable orders ("Ordered landmarks in planning", JAIR 22,
 /// 2004) as Fast Downward approximates them (`LandmarkFactoryReasonableOrdersHPS`): A ->r B

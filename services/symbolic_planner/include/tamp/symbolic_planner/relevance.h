@@ -31,6 +31,7 @@
 #include <memory>
 #include <vector>
 
+#include "tamp/core/termination.h"
 #include "tamp/symbolic_planner/task.h"
 
 namespace tamp::symbolic_planner {
@@ -43,6 +44,7 @@ struct RelevanceStats {
   size_t ops_after{0};      ///< ... after merging operators that are the same on the kept facts
   size_t cond_effects_dropped{0};  ///< conditional effects of kept operators on no kept fact
   bool unsafe{false};       ///< the completeness check failed: nothing was pruned
+  bool stopped{false};      ///< the caller's Termination stopped the analysis: nothing was pruned
   double seconds{0.0};
 };
 
@@ -60,8 +62,10 @@ struct PrunedTask {
 };
 
 /// Prunes `task` to what is relevant to `goal` (see the file comment). `result.task` is null
-/// when nothing can be dropped or pruning is not known to be complete (`stats.unsafe`).
+/// when nothing can be dropped or pruning is not known to be complete (`stats.unsafe`), or when
+/// `term` stopped the analysis (`stats.stopped`; it is checked every 1 024 operators of its
+/// loops: 0.25-0.45 s on scanalyzer-30's 207 360 operators).
 /// @throws std::invalid_argument when a goal fact is out of range.
-PrunedTask pruneIrrelevant(const Task& task, const Goal& goal);
+PrunedTask pruneIrrelevant(const Task& task, const Goal& goal, const Termination& term = Termination());
 
 }  // namespace tamp::symbolic_planner

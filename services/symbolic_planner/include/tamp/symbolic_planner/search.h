@@ -267,6 +267,16 @@ struct SearchOptions {
   /// Must be in [0, 1].
   double unit_beside_time_share{0.0};
   uint64_t unit_beside_turn{1000};  ///< must be > 0
+  /// unit_beside_time_share: the unit-cost run goes on beside the cost + 1 run only while it makes
+  /// progress: it is stopped (at the end of its first share, or at a turn) once it has made none
+  /// in the last `unit_beside_stall_share` of its evaluations (progress: a hill-climbing step to
+  /// a better state, or a landmark count below every one before in its lazy searches). 0: no
+  /// such stop (its time share alone). Measured in docs/benchmarks.md, issue 14, thirty-fourth
+  /// round: transport-18's unit-cost run lowers its landmark count every few hundred
+  /// evaluations; citycar-6's and -11's reach their lowest within their first second. At 0.5
+  /// (with `unit_beside_time_share` 0.6) it solves transport-18 and keeps citycar's time, but
+  /// loses transport-30 (its first plan comes late already): off. Must be in [0, 1].
+  double unit_beside_stall_share{0.0};
   /// Anytime phase: before the weighted iterations, plan neighbourhood graph search (Nakhost and
   /// Mueller, ICAPS 2010) on the first plan, for up to this share of the phase's time: the plan's
   /// states and the states reached from them breadth-first, up to a number of states that

@@ -438,7 +438,7 @@ void ExecutionMonitorNode::onRecord(const msg::ExecutionRecord& m) {
         return;
       }
     }
-    sendDueRecords();
+    sendDueRecords(kRecordResendPeriodS);
   } catch (const std::exception& e) {
     logger()->error("record '{}': {}", m.record_id(), e.what());
   }
@@ -458,9 +458,9 @@ void ExecutionMonitorNode::onRecordAck(const msg::RecordAck& m) {
   }
 }
 
-void ExecutionMonitorNode::sendDueRecords() {
+void ExecutionMonitorNode::sendDueRecords(double resend_period_s) {
   std::lock_guard lock(records_mu_);
-  for (const auto& e : outbox_.due(now(), kRecordResendPeriodS)) {
+  for (const auto& e : outbox_.due(now(), resend_period_s)) {
     auto record = dds::fromCdr<msg::ExecutionRecord>(e.payload);
     if (!record) {
       logger()->error("execution record '{}' in the outbox cannot be read back; dropped", e.record_id);
@@ -482,12 +482,7 @@ void ExecutionMonitorNode::onStop() {
   if (pending() == 0) return;
   const double until = now() + kStopDrainS;
   while (pending() > 0 && now() < until) {
-    {
-      std::lock_guard lock(records_mu_);
-      for (const auto& e : outbox_.due(now(), kStopResendPeriodS)) {
-        if (auto record = dds::fromCdr<msg::ExecutionRecord>(e.payload)) (void)record_writer_->write(*record);
-      }
-    }
+    sendDueRecords(kStopResendPeriodS);
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   if (const std::size_t left = pending(); left > 0)
@@ -500,7 +495,7 @@ void ExecutionMonitorNode::onStop() {
 
 void ExecutionMonitorNode::spinOnce() {
   try {
-    sendDueRecords();
+    sendDueRecords(kRecordResendPeriodS);
   } catch (const std::exception& e) {
     logger()->error("records: {}", e.what());
   }

@@ -81,8 +81,8 @@ class ExecutionMonitorNode : public dds::ServiceNode {
   void onRecord(const msg::ExecutionRecord& m);
   void onRecordAck(const msg::RecordAck& m);
   /// Sends the records the estimator has not acknowledged: new ones, and the others every
-  /// kRecordResendPeriodS.
-  void sendDueRecords();
+  /// `resend_period_s` (kRecordResendPeriodS while running, shorter while stopping).
+  void sendDueRecords(double resend_period_s);
   /// With $TAMP_RUN_DIR (set by `tamp launch`): <run_dir>/execution_monitor.sent, read back into
   /// the monitor (`resume`) and appended before every command sent to the robot.
   void openJournal();

@@ -934,6 +934,10 @@ struct Perception::Impl::FrameUpdate {
         t.pose = d.pose;
         t.label = d.kind == world::ShapeKind::kCylinder ? "cylinder" : "box";
       }
+      log::get("perception")->debug("{}: a detection no track explains, rect {:.2f} x {:.2f} yaw {:.2f} at ({:.2f}, {:.2f}), "
+                                    "{} points, sensor at ({:.2f}, {:.2f}, {:.2f})",
+                                    t.id, d.rect.extents.x(), d.rect.extents.y(), d.rect.yaw, d.pose.translation().x(),
+                                    d.pose.translation().y(), d.points.size(), sensor.x(), sensor.y(), sensor.z());
       I.tracks.emplace(t.id, std::move(t));
     }
   }

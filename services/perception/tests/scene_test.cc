@@ -13,6 +13,10 @@
 #include "tamp/core/paths.h"
 #include "tamp/world/scenario.h"
 #include "tamp/perception/perception.h"
+#include "tamp/perception/self_filter.h"
+#include "tamp/sim/params.h"
+#include "tamp/sim/setup.h"
+#include "tamp/sim/simulator.h"
 #include "test_scenes.h"
 
 namespace tamp::perception {
@@ -709,6 +713,47 @@ TEST(SceneTest, FarViewsOfThreeSmallObjectsSideBySideKeepEachOnItsOwnTrack) {
       EXPECT_LT((e.pose.translation() - truth.object(e.object_id).pose.translation()).head<2>().norm(), 0.03)
           << "seed " << seed << ": " << e.description;
   }
+}
+
+// namo_moghaddam_07's start: walls fill most of the image, the floor is a fifth of the points,
+// and three boxes stand 0.3 m apart on it before the robot. In one frame of 50, RANSAC missed the
+// floor and took a plane tilted 4 degrees through a strip of it and the boxes; rejected, that
+// strip left the plane search, and the rest of the floor joined the boxes into one detection of
+// 1.7 x 1.9 m that no track explained: a mission got a "new static box" there that closed its way.
+// Frames of the simulator's own camera, where the robot stands; no detection may be larger than
+// the boxes, nor any object added.
+TEST(SceneTest, TheFloorIsFoundInEveryFrameWhereWallsFillTheImage) {
+  const std::filesystem::path scenario = configDir() / "scenarios" / "namo_moghaddam_07.yaml";
+  auto sc = world::loadScenario(scenario);
+  ASSERT_TRUE(sc.ok()) << sc.error().toString();
+  auto params = loadPerceptionParams(configDir() / "services" / "perception.yaml");
+  ASSERT_TRUE(params.ok()) << params.error().toString();
+  auto sim_params = sim::loadSimParams(configDir() / "services" / "sim.yaml");
+  ASSERT_TRUE(sim_params.ok()) << sim_params.error().toString();
+  sim_params->scenario = scenario.string();
+  auto setup = sim::loadSetup(*sim_params);
+  ASSERT_TRUE(setup.ok()) << setup.error().toString();
+  sim::Simulator simulator(setup->world, setup->robot, setup->initial, *sim_params);
+  double largest = 0.0;  // the largest footprint diagonal of a movable object
+  for (const auto& o : sc->world.objects()) {
+    if (o.kind != world::ObjectKind::kMovable) continue;
+    const Aabb b = o.shape.localAabb();
+    largest = std::max(largest, (b.max - b.min).head<2>().norm());
+  }
+  Perception perception(sc->plannerWorld(), *params);
+  int oversized = 0;
+  std::vector<std::string> added;
+  for (int k = 0; k < 150; ++k) {
+    const PointCloudFrame f = simulator.captureCloud(kSecond * (k + 1));
+    const RobotBody body = robotBodyAt(simulator.robot(), simulator.robotState().state, {}, f.stamp_ns);
+    auto r = perception.processFrame(f, Termination(), &body);
+    ASSERT_TRUE(r.ok()) << r.error().toString();
+    for (const auto& d : r->detections) oversized += d.majorExtent() > largest ? 1 : 0;
+    for (const auto& e : r->events)
+      if (e.type == EventType::kAdded) added.push_back("frame " + std::to_string(k) + ": " + e.description);
+  }
+  EXPECT_EQ(oversized, 0) << "detections larger than any box (" << largest << " m)";
+  EXPECT_TRUE(added.empty()) << added.size() << " added, the first: " << added.front();
 }
 
 }  // namespace

@@ -215,16 +215,23 @@ TEST(MissionTest, ChairsInTheMouthsOfTwoCorridorsArePushedOutOfTheWay) {
 // drive again round them, through boxes it can push. It failed with "no branch" until session
 // 13 under every policy. Judged by the simulator's world: the robot at the goal, movable_10 where
 // it stood, something pushed, nothing picked.
-// Disabled in CI: it succeeded in 3 of 4 effort runs (2026-12-05): its first Traverse needs 22-26 s
-// of the 30 s `traverse_budget_s` (lazy paths round the fixed objects: 1-3 s each, in a static world
-// whose roadmap is new), so on a loaded machine the budget runs out ("no branch ... within the
-// evaluation budget"). Run it with --gtest_also_run_disabled_tests.
-TEST(MissionTest, DISABLED_AWayRoundWhatTheRobotCannotMoveIsOpenedByPushingOthers) {
+// Its first Traverse takes 20-30 s of lazy paths (docs/benchmarks.md), the whole of the shipped
+// 30 s `traverse_budget_s` on a loaded machine, where it ran out ("no branch ... within the
+// evaluation budget"; disabled in CI from session 14 to 32). The time is the benchmark's to
+// measure, not this test's: the run's graph manager has 120 s. (The other failure of its runs, a
+// floor plane missed by RANSAC that made a "new static box" over three of the boxes, was fixed in
+// perception in session 32: SceneTest.TheFloorIsFoundInEveryFrameWhereWallsFillTheImage.)
+TEST(MissionTest, AWayRoundWhatTheRobotCannotMoveIsOpenedByPushingOthers) {
   auto sc = world::loadScenario(configDir() / "scenarios" / "namo_moghaddam_07.yaml");
   ASSERT_TRUE(sc.ok()) << sc.error().toString();
   const world::Location* goal = sc->world.findLocation("goal");
   ASSERT_NE(goal, nullptr);
-  const Mission m = run("namo_moghaddam_07.yaml");
+  const fs::path out = tempFile("tamp_mission_namo_moghaddam_07");
+  fs::remove_all(out);
+  fs::create_directories(out / "deploy" / "store");
+  const fs::path deployment =
+      withServiceKeys(fastDeployment(out / "deploy", 2.0), "graph_manager", {{"traverse_budget_s", "120.0"}});
+  const Mission m = runWith(out, deployment, "namo_moghaddam_07.yaml");
   ASSERT_EQ(m.exit_code, 0) << m.output;
   ASSERT_TRUE(m.truth.is_object()) << m.output;
   EXPECT_EQ(m.report["status"], "succeeded") << m.report["reason"];

@@ -4,8 +4,10 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <regex>
 #include <set>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -44,6 +46,25 @@ inline fs::path fastDeployment(const fs::path& dir, double factor) {
                            (dir / "effort_estimator.yaml").string());
   std::ofstream(dir / "deploy.yaml") << dep;
   return dir / "deploy.yaml";
+}
+
+/// `deployment` (written by fastDeployment into `dir`) with `service`'s configuration file
+/// copied into `dir` and the top-level `keys` set to the given values: each key must be in the
+/// shipped file (a test of a setting that is not there fails here, not silently).
+inline fs::path withServiceKeys(const fs::path& deployment, const std::string& service,
+                                const std::map<std::string, std::string>& keys) {
+  const fs::path dir = deployment.parent_path();
+  std::string cfg = readFile(configDir() / "services" / (service + ".yaml"));
+  for (const auto& [key, value] : keys) {
+    const std::regex line("(^|\n)" + key + ": [^\n#]+");
+    if (!std::regex_search(cfg, line)) throw std::invalid_argument(service + ".yaml has no top-level key " + key);
+    cfg = std::regex_replace(cfg, line, "$1" + key + ": " + value + " ");
+  }
+  std::ofstream(dir / (service + ".yaml")) << cfg;
+  std::string dep = readFile(deployment);
+  dep = std::regex_replace(dep, std::regex("\\{config\\}/services/" + service + "\\.yaml"), (dir / (service + ".yaml")).string());
+  std::ofstream(deployment) << dep;
+  return deployment;
 }
 
 /// `tamp run` of `scenario` with `deployment`, its run folder under `out` (kept: several runs may

@@ -508,13 +508,13 @@ std::vector<pcl::index_t> takeBandInliers(const Cloud& cloud, std::vector<pcl::i
   return inliers;
 }
 
-/// How many points of `search` lie in plane `c`'s band (takeBandInliers' test).
-std::size_t bandCount(const Cloud& cloud, const std::vector<pcl::index_t>& search, const Eigen::Vector4f& c,
+/// How many of the points `indices` lie in plane `c`'s band (takeBandInliers' test).
+std::size_t bandCount(const Cloud& cloud, const pcl::Indices& indices, const Eigen::Vector4f& c,
                       const Eigen::Vector3f& origin, const PerceptionParams& P) {
   const Eigen::Vector3f n = c.head<3>();
   const float base = static_cast<float>(P.planes.distance_threshold);
   std::size_t count = 0;
-  for (auto i : search) {
+  for (auto i : indices) {
     const Eigen::Vector3f q = cloud.points[static_cast<std::size_t>(i)].getVector3fMap();
     const Eigen::Vector3f ray = q - origin;
     const float range = ray.norm();
@@ -525,44 +525,44 @@ std::size_t bandCount(const Cloud& cloud, const std::vector<pcl::index_t>& searc
   return count;
 }
 
-/// The level plane at the most common height of `search` (a histogram of z in bins of the
-/// plane threshold; the mean height of the points within a threshold of the fullest bin).
-Eigen::Vector4f commonLevel(const Cloud& cloud, const std::vector<pcl::index_t>& search, const PerceptionParams& P) {
+/// The level plane at the most common height of the points `indices` (a histogram of z in bins
+/// of the plane threshold; the mean height of the points within a threshold of the fullest bin,
+/// the lowest of equally full ones).
+Eigen::Vector4f commonLevel(const Cloud& cloud, const pcl::Indices& indices, const PerceptionParams& P) {
   const double bin = P.planes.distance_threshold;
-  std::unordered_map<std::int64_t, std::size_t> counts;
-  for (auto i : search) ++counts[static_cast<std::int64_t>(std::floor(cloud.points[static_cast<std::size_t>(i)].z / bin))];
-  std::int64_t best = 0;
-  std::size_t most = 0;
-  for (const auto& [b, n] : counts) {
-    if (n > most || (n == most && b < best)) {  // ties: the lower (deterministic whatever the map's order)
-      most = n;
-      best = b;
-    }
+  float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+  for (auto i : indices) {
+    lo = std::min(lo, cloud.points[static_cast<std::size_t>(i)].z);
+    hi = std::max(hi, cloud.points[static_cast<std::size_t>(i)].z);
   }
-  const double centre = (static_cast<double>(best) + 0.5) * bin;
+  if (!(lo <= hi)) return {0.0f, 0.0f, 1.0f, 0.0f};
+  std::vector<std::size_t> counts(static_cast<std::size_t>((hi - lo) / bin) + 1, 0);
+  for (auto i : indices) ++counts[static_cast<std::size_t>((cloud.points[static_cast<std::size_t>(i)].z - lo) / bin)];
+  const auto fullest = static_cast<double>(std::max_element(counts.begin(), counts.end()) - counts.begin());
+  const double centre = lo + (fullest + 0.5) * bin;
   double sum = 0.0;
   std::size_t n = 0;
-  for (auto i : search) {
+  for (auto i : indices) {
     const double z = cloud.points[static_cast<std::size_t>(i)].z;
     if (std::abs(z - centre) > bin) continue;
     sum += z;
     ++n;
   }
-  return {0.0f, 0.0f, 1.0f, static_cast<float>(n > 0 ? -sum / static_cast<double>(n) : -centre)};
+  return {0.0f, 0.0f, 1.0f, static_cast<float>(-sum / static_cast<double>(std::max<std::size_t>(n, 1)))};
 }
 
-/// The plane of the two that holds more points of `search` in its band: RANSAC's `c`, or the
-/// level plane at the most common height (commonLevel). RANSAC draws a few hundred samples from a
-/// subsample: where walls fill most of the image and the floor is a fifth of the points, it can
-/// miss the floor and settle on a plane tilted by a few degrees through a strip of it and the
-/// boxes on it. That plane, rejected, took its strip out of the search, and the rest of the floor
-/// stayed as object points joining the boxes into one "new object" (namo_moghaddam_07, one
+/// The plane of the two that holds more of RANSAC's subsample `sub` in its band: RANSAC's `c`,
+/// or the level plane at the subsample's most common height (commonLevel). RANSAC draws a few
+/// hundred samples: where walls fill most of the image and the floor is a fifth of the points,
+/// it can miss the floor and settle on a plane tilted by a few degrees through a strip of it and
+/// the boxes on it. That plane, rejected, took its strip out of the search, and the rest of the
+/// floor stayed as object points joining the boxes into one "new object" (namo_moghaddam_07, one
 /// frame in 50). Support surfaces are level in this world model (regions have a height, objects
-/// stand upright), so the level plane is always a candidate; the consensus over every point decides.
-Eigen::Vector4f betterOfLevel(const Cloud& cloud, const std::vector<pcl::index_t>& search, const Eigen::Vector4f& c,
+/// stand upright), so the level plane is always a candidate, and the consensus decides.
+Eigen::Vector4f betterOfLevel(const Cloud& cloud, const pcl::Indices& sub, const Eigen::Vector4f& c,
                               const Eigen::Vector3f& origin, const PerceptionParams& P) {
-  const Eigen::Vector4f level = commonLevel(cloud, search, P);
-  return bandCount(cloud, search, level, origin, P) > bandCount(cloud, search, c, origin, P) ? level : c;
+  const Eigen::Vector4f level = commonLevel(cloud, sub, P);
+  return bandCount(cloud, sub, level, origin, P) > bandCount(cloud, sub, c, origin, P) ? level : c;
 }
 
 /// Area from the distinct xy cells the inliers cover (range noise smears a surface over several
@@ -676,7 +676,7 @@ Status findSupportPlanes(const std::shared_ptr<Cloud>& cloud, const Eigen::Vecto
     Eigen::Vector4f c(coeffs.values[0], coeffs.values[1], coeffs.values[2], coeffs.values[3]);
     c /= c.head<3>().norm();
     if (c.z() < 0) c = -c;
-    c = betterOfLevel(*cloud, search, c, origin, P);
+    c = betterOfLevel(*cloud, sub, c, origin, P);
     // Every inlier leaves the plane search, accepted or not.
     const std::vector<pcl::index_t> inliers = takeBandInliers(*cloud, search, c, origin, P);
     if (static_cast<int>(inliers.size()) < P.planes.min_points) continue;

@@ -756,5 +756,29 @@ TEST(SceneTest, TheFloorIsFoundInEveryFrameWhereWallsFillTheImage) {
   EXPECT_TRUE(added.empty()) << added.size() << " added, the first: " << added.front();
 }
 
+// An object the planner does not know, standing 3 mm from a known one (closer than the 5 cm
+// clustering tolerance): it is found as a new object, not taken for a fragment of the known one,
+// and the known one stays where it is. (Adjacency alone never joined them; what joined the boxes
+// of TheFloorIsFoundInEveryFrameWhereWallsFillTheImage was floor left between them.)
+TEST(SceneTest, AnUnknownObjectAgainstAKnownOneIsFound) {
+  for (const double size : {0.25, 0.4}) {
+    world::World truth("touching");
+    ASSERT_TRUE(truth.addRegion(testing::floorRegion()).ok());
+    ASSERT_TRUE(truth.addObject(box("known", 0.6, 0.6, 0.5, 3.0, 0.0, 0.0)).ok());
+    world::Object surprise = box("surprise", size, size, 0.3, 3.0, 0.3 + 0.003 + size / 2, 0.0);
+    surprise.hidden = true;
+    ASSERT_TRUE(truth.addObject(surprise).ok());
+    Perception perception(truth.plannerView(), PerceptionParams());
+    Runner run(perception);
+    for (int k = 0; k < 4; ++k) run.frame(truth, testing::mastCamera(0.5, 0.0, 0.1));
+    const auto added = run.eventsOf(EventType::kAdded);
+    ASSERT_EQ(added.size(), 1u) << "size " << size;
+    EXPECT_LT((added[0].pose.translation().head<2>() - surprise.pose.translation().head<2>()).norm(), 0.1)
+        << "size " << size << ": " << added[0].description;
+    EXPECT_LT((perception.world().object("known").pose.translation() - truth.object("known").pose.translation()).norm(), 0.03)
+        << "size " << size;
+  }
+}
+
 }  // namespace
 }  // namespace tamp::perception

@@ -1240,6 +1240,60 @@ TEST(Search, UnitCostRunBesideIsStoppedOnceItMakesNoProgress) {
   EXPECT_LT(stalled.stats.evaluated, plus.stats.evaluated + 200);
 }
 
+TEST(Search, UnitCostRunThatMakesProgressGoesOnAloneBeforeTheCostPlusOneRun) {
+  // pegsol-18, as above (the unit-cost run's first share ends 16 evaluations in), with
+  // `unit_progress_alone`: a unit-cost run that never counts as stalled (stall share 1.0) goes on
+  // alone to its end, with no cost + 1 evaluation at all: the plan and the evaluations of the
+  // unit-cost run alone (in turns, the count has the other run's evaluations too). One that is
+  // stalled at the end of its first share (1e-9), or whose share in all is used up at once (2e-9
+  // of the time left), is stopped, and the cost + 1 run alone gives its plan, after the unit-cost
+  // run's few evaluations.
+  PlanRequest req = benchmarkRequest("pddl-more/pegsol", "instance-18.pddl");
+  req.check_plan = true;
+  req.timeout_seconds = 120;
+  req.search.anytime_seconds = 1e-9;
+  req.search.unit_first_time_share = 1.0;  // the unit-cost run alone, by its first share
+  PlanReply unit = plan(req, Termination());
+  ASSERT_EQ(unit.status, PlanStatus::kSolved) << unit.message;
+  ASSERT_FALSE(unit.stats.unit_first_failed);
+  req.search.unit_cost_first = false;  // the cost + 1 run alone
+  PlanReply plus = plan(req, Termination());
+  ASSERT_EQ(plus.status, PlanStatus::kSolved) << plus.message;
+  ASSERT_NE(planText(unit), planText(plus));  // the test can tell the two runs' plans apart
+  req.search.unit_cost_first = true;
+
+  req.search.unit_first_time_share = 1e-9;
+  req.search.unit_beside_time_share = 1.0;
+  req.search.unit_beside_stall_share = 1.0;
+  PlanReply turns = plan(req, Termination());
+  ASSERT_EQ(turns.status, PlanStatus::kSolved) << turns.message;
+  req.search.unit_progress_alone = true;
+  PlanReply alone = plan(req, Termination());
+  ASSERT_EQ(alone.status, PlanStatus::kSolved) << alone.message;
+  EXPECT_FALSE(alone.stats.unit_first_failed);
+  EXPECT_FALSE(alone.stats.unit_beside);
+  EXPECT_EQ(planText(alone), planText(unit));
+  EXPECT_EQ(alone.stats.evaluated, unit.stats.evaluated);
+  EXPECT_TRUE(planText(turns) != planText(alone) || turns.stats.evaluated > alone.stats.evaluated);
+
+  req.search.unit_beside_stall_share = 1e-9;  // stalled at the end of its first share
+  PlanReply stalled = plan(req, Termination());
+  ASSERT_EQ(stalled.status, PlanStatus::kSolved) << stalled.message;
+  EXPECT_TRUE(stalled.stats.unit_first_failed);
+  EXPECT_FALSE(stalled.stats.unit_beside);
+  EXPECT_EQ(planText(stalled), planText(plus));
+  EXPECT_GT(stalled.stats.evaluated, plus.stats.evaluated);  // the unit-cost run's 16 counted
+  EXPECT_LT(stalled.stats.evaluated, plus.stats.evaluated + 200);
+
+  req.search.unit_beside_stall_share = 1.0;
+  req.search.unit_beside_time_share = 2e-9;  // its share in all used up at its first step
+  PlanReply spent = plan(req, Termination());
+  ASSERT_EQ(spent.status, PlanStatus::kSolved) << spent.message;
+  EXPECT_TRUE(spent.stats.unit_first_failed);
+  EXPECT_EQ(planText(spent), planText(plus));
+  EXPECT_LT(spent.stats.evaluated, plus.stats.evaluated + 1200);  // at most one step of 1000 more
+}
+
 TEST(Search, UnitCostRunBesideStopsAtItsShareAndOnTheCallersStop) {
   // The unit-cost run's share of the time left in all just above its first share: it is
   // stopped at its first turn beside the cost + 1 run, which gives the plan.

@@ -277,6 +277,16 @@ struct SearchOptions {
   /// (with `unit_beside_time_share` 0.6) it solves transport-18 and keeps citycar's time, but
   /// loses transport-30 (its first plan comes late already): off. Must be in [0, 1].
   double unit_beside_stall_share{0.0};
+  /// unit_beside_time_share with unit_beside_stall_share: the unit-cost run that is still making
+  /// progress at the end of its first share goes on **alone** (the cost + 1 run not yet started),
+  /// in steps of `unit_beside_turn` evaluations, until it answers, makes no progress in the last
+  /// `unit_beside_stall_share` of its evaluations, or has used `unit_beside_time_share` of the
+  /// time left; then it is stopped and the cost + 1 run starts from the start, alone, with the
+  /// time left. Unlike the turns, a unit-cost run that answers gets all its time at once, and the
+  /// cost + 1 run, when it starts, all the rest (transport-30 needs 11-14 s of the one or about
+  /// 23 s of the other in its 29 s: in turns neither answers; docs/benchmarks.md, issue 14,
+  /// thirty-fifth round). false (the default): in turns.
+  bool unit_progress_alone{false};
   /// Anytime phase: before the weighted iterations, plan neighbourhood graph search (Nakhost and
   /// Mueller, ICAPS 2010) on the first plan, for up to this share of the phase's time: the plan's
   /// states and the states reached from them breadth-first, up to a number of states that

@@ -1178,6 +1178,8 @@ TEST(Search, UnitCostRunGoesOnBesideTheCostPlusOneRunInTurns) {
   req.search.anytime_seconds = 1e-9;  // the first plan, as found (no time to improve it)
   req.search.unit_first_time_share = 1e-9;
   req.search.unit_beside_time_share = 1.0;
+  req.search.unit_beside_stall_share = 0;  // in turns, whatever its progress
+  req.search.unit_progress_alone = false;
   PlanReply turns = plan(req, Termination());
   ASSERT_EQ(turns.status, PlanStatus::kSolved) << turns.message;
   EXPECT_TRUE(turns.stats.unit_beside);
@@ -1218,6 +1220,8 @@ TEST(Search, UnitCostRunBesideIsStoppedOnceItMakesNoProgress) {
   req.search.anytime_seconds = 1e-9;
   req.search.unit_first_time_share = 1e-9;
   req.search.unit_beside_time_share = 1.0;
+  req.search.unit_beside_stall_share = 0;
+  req.search.unit_progress_alone = false;  // in turns (the next test: alone)
   PlanReply turns = plan(req, Termination());
   ASSERT_EQ(turns.status, PlanStatus::kSolved) << turns.message;
   ASSERT_TRUE(turns.stats.unit_beside);
@@ -1265,6 +1269,7 @@ TEST(Search, UnitCostRunThatMakesProgressGoesOnAloneBeforeTheCostPlusOneRun) {
   req.search.unit_first_time_share = 1e-9;
   req.search.unit_beside_time_share = 1.0;
   req.search.unit_beside_stall_share = 1.0;
+  req.search.unit_progress_alone = false;
   PlanReply turns = plan(req, Termination());
   ASSERT_EQ(turns.status, PlanStatus::kSolved) << turns.message;
   req.search.unit_progress_alone = true;
@@ -1303,6 +1308,8 @@ TEST(Search, UnitCostRunBesideStopsAtItsShareAndOnTheCallersStop) {
   req.search.anytime_seconds = 1e-9;
   req.search.unit_first_time_share = 1e-9;
   req.search.unit_beside_time_share = 2e-9;
+  req.search.unit_beside_stall_share = 0;
+  req.search.unit_progress_alone = false;
   PlanReply r = plan(req, Termination());
   ASSERT_EQ(r.status, PlanStatus::kSolved) << r.message;
   EXPECT_TRUE(r.stats.unit_first_failed);
@@ -1317,6 +1324,8 @@ TEST(Search, UnitCostRunBesideStopsAtItsShareAndOnTheCallersStop) {
   hard.search.anytime_seconds = 5;
   hard.search.unit_first_time_share = 1e-9;
   hard.search.unit_beside_time_share = 1.0;
+  hard.search.unit_beside_stall_share = 0;
+  hard.search.unit_progress_alone = false;
   hard.timeout_seconds = 600;
   std::stop_source stop;
   std::thread stopper([&stop] {

@@ -193,6 +193,7 @@ int main(int argc, char** argv) {
   double unit_beside_share = defaults.unit_beside_time_share;
   uint64_t unit_beside_turn = defaults.unit_beside_turn;
   double unit_beside_stall = defaults.unit_beside_stall_share;
+  bool unit_progress_alone = defaults.unit_progress_alone;
   double neighbourhood_share = defaults.neighbourhood_time_share;
   bool neighbourhood_grow = defaults.neighbourhood_grow;
   int64_t heap_reserve_mib = 64;
@@ -277,6 +278,9 @@ int main(int argc, char** argv) {
                  "with --unit-beside-share: the unit-cost run is stopped once it has made no progress (a hill-climbing "
                  "step, a landmark count below every one before) in this share of its evaluations, in [0, 1] (0: never)")
       ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--unit-progress-alone", unit_progress_alone,
+                 "with --unit-beside-share and --unit-beside-stall: the unit-cost run that makes progress goes on "
+                 "alone (the cost + 1 run after it, with the time left) instead of in turns (true/false)");
   app.add_option("--unit-beside-turn", unit_beside_turn,
                  "evaluations per turn of each of the unit-cost and cost + 1 runs in turns (> 0)")
       ->check(CLI::Range(uint64_t{1}, UINT64_MAX));
@@ -407,6 +411,7 @@ int main(int argc, char** argv) {
   req.search.unit_beside_time_share = unit_beside_share;
   req.search.unit_beside_turn = unit_beside_turn;
   req.search.unit_beside_stall_share = unit_beside_stall;
+  req.search.unit_progress_alone = unit_progress_alone;
   req.search.neighbourhood_time_share = neighbourhood_share;
   req.search.neighbourhood_grow = neighbourhood_grow;
   if (heuristic == "ff") req.search.heuristic = sp::HeuristicKind::kFF;

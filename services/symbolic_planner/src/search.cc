@@ -1919,11 +1919,26 @@ SearchResult unitCostFirstPlan(const Task& task, const StateBits& init, const Go
       return Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
     };
     unit.resume(UINT64_MAX, in(options.unit_first_time_share * left));  // alone first
+    if (options.unit_progress_alone) {
+      // While it makes progress, the unit-cost run goes on alone, up to its share in all.
+      const double budget = options.unit_beside_time_share * left;
+      while (!unit.done() && !UnitTurns::stalled(unit, options.unit_beside_stall_share) && unit.seconds() < budget) {
+        unit.resume(options.unit_beside_turn, in(budget - unit.seconds()));
+      }
+    }
     if (unit.done()) {
       const SearchStatus st = unit.result().status;
       const bool retry = st == SearchStatus::kOutOfMemory || st == SearchStatus::kFailed ||
                          (st == SearchStatus::kTimeout && !term());
       if (!retry) return std::move(unit.result());
+    }
+    if (options.unit_progress_alone) {
+      // Stalled, out of its share, or given up: the cost + 1 run alone with the time left.
+      unit.cancel();
+      SearchResult r = firstPlan(task, init, goal, options, heuristic, term);
+      r.stats.unit_first_failed = true;
+      addRunCosts(r.stats, unit.result().stats);
+      return r;
     }
     // The cost + 1 run from the start, the unit-cost run (if it goes on) in turns beside it.
     std::stop_source plus_stop;

@@ -1178,6 +1178,8 @@ TEST(Search, UnitCostRunGoesOnBesideTheCostPlusOneRunInTurns) {
   req.search.anytime_seconds = 1e-9;  // the first plan, as found (no time to improve it)
   req.search.unit_first_time_share = 1e-9;
   req.search.unit_beside_time_share = 1.0;
+  req.search.unit_beside_stall_share = 0;  // in turns, whatever its progress
+  req.search.unit_progress_alone = false;
   PlanReply turns = plan(req, Termination());
   ASSERT_EQ(turns.status, PlanStatus::kSolved) << turns.message;
   EXPECT_TRUE(turns.stats.unit_beside);
@@ -1218,6 +1220,8 @@ TEST(Search, UnitCostRunBesideIsStoppedOnceItMakesNoProgress) {
   req.search.anytime_seconds = 1e-9;
   req.search.unit_first_time_share = 1e-9;
   req.search.unit_beside_time_share = 1.0;
+  req.search.unit_beside_stall_share = 0;
+  req.search.unit_progress_alone = false;  // in turns (the next test: alone)
   PlanReply turns = plan(req, Termination());
   ASSERT_EQ(turns.status, PlanStatus::kSolved) << turns.message;
   ASSERT_TRUE(turns.stats.unit_beside);
@@ -1240,6 +1244,61 @@ TEST(Search, UnitCostRunBesideIsStoppedOnceItMakesNoProgress) {
   EXPECT_LT(stalled.stats.evaluated, plus.stats.evaluated + 200);
 }
 
+TEST(Search, UnitCostRunThatMakesProgressGoesOnAloneBeforeTheCostPlusOneRun) {
+  // pegsol-18, as above (the unit-cost run's first share ends 16 evaluations in), with
+  // `unit_progress_alone`: a unit-cost run that never counts as stalled (stall share 1.0) goes on
+  // alone to its end, with no cost + 1 evaluation at all: the plan and the evaluations of the
+  // unit-cost run alone (in turns, the count has the other run's evaluations too). One that is
+  // stalled at the end of its first share (1e-9), or whose share in all is used up at once (2e-9
+  // of the time left), is stopped, and the cost + 1 run alone gives its plan, after the unit-cost
+  // run's few evaluations.
+  PlanRequest req = benchmarkRequest("pddl-more/pegsol", "instance-18.pddl");
+  req.check_plan = true;
+  req.timeout_seconds = 120;
+  req.search.anytime_seconds = 1e-9;
+  req.search.unit_first_time_share = 1.0;  // the unit-cost run alone, by its first share
+  PlanReply unit = plan(req, Termination());
+  ASSERT_EQ(unit.status, PlanStatus::kSolved) << unit.message;
+  ASSERT_FALSE(unit.stats.unit_first_failed);
+  req.search.unit_cost_first = false;  // the cost + 1 run alone
+  PlanReply plus = plan(req, Termination());
+  ASSERT_EQ(plus.status, PlanStatus::kSolved) << plus.message;
+  ASSERT_NE(planText(unit), planText(plus));  // the test can tell the two runs' plans apart
+  req.search.unit_cost_first = true;
+
+  req.search.unit_first_time_share = 1e-9;
+  req.search.unit_beside_time_share = 1.0;
+  req.search.unit_beside_stall_share = 1.0;
+  req.search.unit_progress_alone = false;
+  PlanReply turns = plan(req, Termination());
+  ASSERT_EQ(turns.status, PlanStatus::kSolved) << turns.message;
+  req.search.unit_progress_alone = true;
+  PlanReply alone = plan(req, Termination());
+  ASSERT_EQ(alone.status, PlanStatus::kSolved) << alone.message;
+  EXPECT_FALSE(alone.stats.unit_first_failed);
+  EXPECT_FALSE(alone.stats.unit_beside);
+  EXPECT_EQ(planText(alone), planText(unit));
+  EXPECT_EQ(alone.stats.evaluated, unit.stats.evaluated);
+  EXPECT_TRUE(planText(turns) != planText(alone) || turns.stats.evaluated > alone.stats.evaluated);
+
+  req.search.unit_beside_stall_share = 1e-9;  // stalled at the end of its first share
+  PlanReply stalled = plan(req, Termination());
+  ASSERT_EQ(stalled.status, PlanStatus::kSolved) << stalled.message;
+  EXPECT_TRUE(stalled.stats.unit_first_failed);
+  EXPECT_FALSE(stalled.stats.unit_beside);
+  EXPECT_EQ(planText(stalled), planText(plus));
+  EXPECT_GT(stalled.stats.evaluated, plus.stats.evaluated);  // the unit-cost run's 16 counted
+  EXPECT_LT(stalled.stats.evaluated, plus.stats.evaluated + 200);
+
+  req.search.unit_beside_stall_share = 1.0;
+  req.search.unit_beside_time_share = 2e-9;  // its share in all used up at its first step
+  PlanReply spent = plan(req, Termination());
+  ASSERT_EQ(spent.status, PlanStatus::kSolved) << spent.message;
+  EXPECT_TRUE(spent.stats.unit_first_failed);
+  EXPECT_EQ(planText(spent), planText(plus));
+  EXPECT_LT(spent.stats.evaluated, plus.stats.evaluated + 1200);  // at most one step of 1000 more
+}
+
 TEST(Search, UnitCostRunBesideStopsAtItsShareAndOnTheCallersStop) {
   // The unit-cost run's share of the time left in all just above its first share: it is
   // stopped at its first turn beside the cost + 1 run, which gives the plan.
@@ -1249,6 +1308,8 @@ TEST(Search, UnitCostRunBesideStopsAtItsShareAndOnTheCallersStop) {
   req.search.anytime_seconds = 1e-9;
   req.search.unit_first_time_share = 1e-9;
   req.search.unit_beside_time_share = 2e-9;
+  req.search.unit_beside_stall_share = 0;
+  req.search.unit_progress_alone = false;
   PlanReply r = plan(req, Termination());
   ASSERT_EQ(r.status, PlanStatus::kSolved) << r.message;
   EXPECT_TRUE(r.stats.unit_first_failed);
@@ -1263,6 +1324,8 @@ TEST(Search, UnitCostRunBesideStopsAtItsShareAndOnTheCallersStop) {
   hard.search.anytime_seconds = 5;
   hard.search.unit_first_time_share = 1e-9;
   hard.search.unit_beside_time_share = 1.0;
+  hard.search.unit_beside_stall_share = 0;
+  hard.search.unit_progress_alone = false;
   hard.timeout_seconds = 600;
   std::stop_source stop;
   std::thread stopper([&stop] {

@@ -259,13 +259,14 @@ struct SearchOptions {
   /// and its states freed, and the cost + 1 run goes on alone. The first plan or proof of either
   /// is the answer. A unit-cost run that needs more than its first share (transport-18) gets up to
   /// this share, a cost + 1 run that needs most of the time (citycar-6) loses what the unit-cost
-  /// run uses beside it. At most `unit_first_time_share` (0, the default): the unit-cost run ends
-  /// at its first share and the cost + 1 run starts after it (the fourth to thirty-second rounds).
-  /// Off by default (docs/benchmarks.md, issue 14, thirty-third round): at 0.3, transport-18 is
-  /// solved (23.4 s of 29), but citycar-6's first plan comes after at least 54 s of its 59 (the
-  /// unit-cost run takes 17.7 s of it, in vain) and citycar-11 takes 31.7 s instead of 21.
-  /// Must be in [0, 1].
-  double unit_beside_time_share{0.0};
+  /// run uses beside it. At most `unit_first_time_share` (0, the default until the thirty-fifth
+  /// round): the unit-cost run ends at its first share and the cost + 1 run starts after it.
+  /// In turns alone (thirty-third round): at 0.3, transport-18 is solved (23.4 s of 29), but
+  /// citycar-6's first plan comes after at least 54 s of its 59 (the unit-cost run takes 17.7 s
+  /// of it, in vain) and citycar-11 takes 31.7 s instead of 21. The default, 0.6, is this
+  /// share with `unit_beside_stall_share` 0.5 and `unit_progress_alone` (docs/benchmarks.md,
+  /// issue 14, thirty-fifth round). Must be in [0, 1].
+  double unit_beside_time_share{0.6};
   uint64_t unit_beside_turn{1000};  ///< must be > 0
   /// unit_beside_time_share: the unit-cost run goes on beside the cost + 1 run only while it makes
   /// progress: it is stopped (at the end of its first share, or at a turn) once it has made none
@@ -274,9 +275,23 @@ struct SearchOptions {
   /// such stop (its time share alone). Measured in docs/benchmarks.md, issue 14, thirty-fourth
   /// round: transport-18's unit-cost run lowers its landmark count every few hundred
   /// evaluations; citycar-6's and -11's reach their lowest within their first second. At 0.5
-  /// (with `unit_beside_time_share` 0.6) it solves transport-18 and keeps citycar's time, but
-  /// loses transport-30 (its first plan comes late already): off. Must be in [0, 1].
-  double unit_beside_stall_share{0.0};
+  /// (with `unit_beside_time_share` 0.6) in turns it solves transport-18 and keeps citycar's
+  /// time, but loses transport-30 (its first plan comes late already); so does 0.75 (thirty-fifth
+  /// round). The default, 0.5, with `unit_progress_alone`. Must be in [0, 1].
+  double unit_beside_stall_share{0.5};
+  /// unit_beside_time_share with unit_beside_stall_share: the unit-cost run that is still making
+  /// progress at the end of its first share goes on **alone** (the cost + 1 run not yet started),
+  /// in steps of `unit_beside_turn` evaluations, until it answers, makes no progress in the last
+  /// `unit_beside_stall_share` of its evaluations, or has used `unit_beside_time_share` of the
+  /// time left; then it is stopped and the cost + 1 run starts from the start, alone, with the
+  /// time left. Unlike the turns, a unit-cost run that answers gets all its time at once, and the
+  /// cost + 1 run, when it starts, all the rest (transport-30 needs 11-14 s of the one or about
+  /// 23 s of the other in its 29 s: in turns neither answers; docs/benchmarks.md, issue 14,
+  /// thirty-fifth round: transport 5 of 5, transport-18 and -30 in 14-16 s, nothing lost on the
+  /// cost domains of pddl-more and pddl-adl; the unit-cost run went on alone only on transport-18
+  /// and -30, sokoban-30 and tetris-4 (1.0-1.3 s more there); citycar's and pegsol-30's are
+  /// stalled at the end of their first share, as before). The default; false: in turns.
+  bool unit_progress_alone{true};
   /// Anytime phase: before the weighted iterations, plan neighbourhood graph search (Nakhost and
   /// Mueller, ICAPS 2010) on the first plan, for up to this share of the phase's time: the plan's
   /// states and the states reached from them breadth-first, up to a number of states that

@@ -95,12 +95,18 @@ const config::Schema<MotionPlannerParams>& schema() {
         .field("oriented_refinements", &R::oriented_refinements, nonNegative())
         .field("first_turn_s", &R::first_turn_s, nonNegative())
         .field("time_share", &R::time_share, nonNegative())
+        .field("lazy_time_share", &R::lazy_time_share, nonNegative())
         .rule("min_cell_size", [](const R& r) -> std::optional<std::string> {
           if (std::isfinite(r.min_cell_size) && r.min_cell_size > 0 &&
               r.min_cell_size <= r.cell_size) {
             return std::nullopt;
           }
           return "must be in (0, cell_size], got " + formatNumber(r.min_cell_size);
+        })
+        .rule("lazy_time_share", [](const R& r) -> std::optional<std::string> {
+          if (!(r.lazy_time_share <= r.time_share))
+            return "must be at most time_share (" + formatNumber(r.time_share) + "), got " + formatNumber(r.lazy_time_share);
+          return std::nullopt;
         });
     using T = TimingParams;
     s.section("timing", &P::timing)

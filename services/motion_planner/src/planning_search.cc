@@ -302,7 +302,7 @@ Outcome Planning::sample(const Stopwatch& phase, bool solved) {
     planner->solve(ptcOf(slice_term));
     ++res.stats.sampling_slices;
     solved = pdef->hasExactSolution();
-    if (!solved && proofTurn(slice * P.proof.time_share)) return noPath();
+    if (!solved && proofTurn(slice * (lazy ? P.proof.lazy_time_share : P.proof.time_share))) return noPath();
     slice *= 2;
   }
   res.stats.sampling_ms = phase.millis() - res.stats.proof_ms;

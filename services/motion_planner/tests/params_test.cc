@@ -55,5 +55,16 @@ TEST(ParamsTest, ValidateNamesTheField) {
   EXPECT_NE(s.error().message.find("cost.base_speed"), std::string::npos);
 }
 
+TEST(ParamsTest, TheLazyProofShareIsAtMostTheFullModeOne) {
+  MotionPlannerParams p;
+  p.proof.time_share = 0.5;
+  p.proof.lazy_time_share = 0.5;
+  EXPECT_TRUE(p.validate().ok());
+  p.proof.lazy_time_share = 0.6;
+  const Status s = p.validate();
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.error().message.find("proof.lazy_time_share"), std::string::npos) << s.error().message;
+}
+
 }  // namespace
 }  // namespace tamp::motion_planner

@@ -13,6 +13,7 @@
 #include <sstream>
 #include <thread>
 
+#include "tamp/core/format.h"
 #include "tamp/core/log.h"
 
 extern char** environ;
@@ -276,7 +277,7 @@ void Supervisor::onExit(Child& c, const std::string& how, int exit_code, bool cl
   emit(ProcessEventKind::kRestartScheduled, c, how, backoff);
 }
 
-bool Supervisor::reap(Child& c, bool block, const std::string& cause) {
+bool Supervisor::reap(Child& c, bool block, const std::string& cause, const std::string& note) {
   if (c.st.phase != ProcessPhase::kRunning || c.st.pid <= 0) return false;
   if (c.st.adopted) {
     // Not our child: its exit status went to whoever reaps orphans. Poll for its disappearance.
@@ -287,14 +288,14 @@ bool Supervisor::reap(Child& c, bool block, const std::string& cause) {
       }
     }
     if (processRunning(c.st.pid)) return false;
-    onExit(c, !cause.empty() ? cause : c.stopping ? "stopped (adopted: exit status unknown)" : "ended (adopted: exit status unknown)",
+    onExit(c, (!cause.empty() ? cause : c.stopping ? "stopped (adopted: exit status unknown)" : "ended (adopted: exit status unknown)") + note,
            -1, c.stopping);
     return true;
   }
   int wstatus = 0;
   if (waitpid(c.st.pid, &wstatus, block ? 0 : WNOHANG) != c.st.pid) return false;
   const int code = WIFEXITED(wstatus) ? WEXITSTATUS(wstatus) : 128 + WTERMSIG(wstatus);
-  onExit(c, cause.empty() ? describeExit(wstatus) : cause, code, WIFEXITED(wstatus) && WEXITSTATUS(wstatus) == 0);
+  onExit(c, (cause.empty() ? describeExit(wstatus) : cause) + note, code, WIFEXITED(wstatus) && WEXITSTATUS(wstatus) == 0);
   return true;
 }
 
@@ -337,22 +338,43 @@ void Supervisor::stopAll(double grace_s) {
     c.stopping = true;
     if (c.st.phase == ProcessPhase::kBackoff) c.st.phase = ProcessPhase::kExited;
   }
-  for (auto it = children_.rbegin(); it != children_.rend(); ++it) {
-    auto& c = *it;
-    if (c.st.phase != ProcessPhase::kRunning || c.st.pid <= 0) continue;
+  using Clock = std::chrono::steady_clock;
+  const auto running = [](const Child& c) { return c.st.phase == ProcessPhase::kRunning && c.st.pid > 0; };
+  const auto terminate = [](const Child& c) {
     kill(-c.st.pid, SIGTERM);
     kill(-c.st.pid, SIGCONT);  // a stopped process handles SIGTERM only once continued
-    const auto end = std::chrono::steady_clock::now() + seconds(grace_s);
+  };
+  // Waits for `c` until `end`, then kills it (its last exit noted "(did not stop within ...)").
+  const auto awaitOrKill = [this, grace_s](Child& c, Clock::time_point end, const std::string& why) {
     while (!reap(c, false)) {
-      if (std::chrono::steady_clock::now() >= end) {
-        log::get("supervisor")->warn("{} did not stop within {:.1f} s: SIGKILL", c.spec.name, grace_s);
+      if (Clock::now() >= end) {
+        log::get("supervisor")->warn("{} did not stop within {:.1f} s{}: SIGKILL", c.spec.name, grace_s, why);
         kill(-c.st.pid, SIGKILL);
-        (void)reap(c, true);
-        break;
+        (void)reap(c, true, {}, " (did not stop within " + formatNumber(grace_s) + " s" + why + ")");
+        return;
       }
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
+  };
+  // One after the other, each with its grace, until twice the grace has gone by: services that
+  // do not stop must not make the stop last as many graces as there are services.
+  const auto in_turn_end = Clock::now() + 2 * seconds(grace_s);
+  auto it = children_.rbegin();
+  for (; it != children_.rend() && Clock::now() < in_turn_end; ++it) {
+    if (!running(*it)) continue;
+    terminate(*it);
+    awaitOrKill(*it, Clock::now() + seconds(grace_s), "");
   }
+  // The rest together, with one grace.
+  std::vector<Child*> rest;
+  for (; it != children_.rend(); ++it)
+    if (running(*it)) rest.push_back(&*it);
+  if (rest.empty()) return;
+  log::get("supervisor")->warn("the stop took {:.1f} s: the last {} service(s) are stopped together", 2 * grace_s,
+                               rest.size());
+  for (Child* c : rest) terminate(*c);
+  const auto end = Clock::now() + seconds(grace_s);
+  for (Child* c : rest) awaitOrKill(*c, end, " of the stop's last phase");
 }
 
 void Supervisor::release() { children_.clear(); }

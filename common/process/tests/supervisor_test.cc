@@ -125,6 +125,42 @@ TEST(SupervisorTest, StopAllStopsChildrenInTheReverseOfTheOrderTheyWereAdded) {
   std::filesystem::remove_all(dir);
 }
 
+// Services that ignore SIGTERM: the first two (in stop order) are waited for one grace each and
+// killed; then twice the grace has gone by, and the other two are stopped together with one grace
+// (before, each would have had a grace of its own: four graces).
+TEST(SupervisorTest, ServicesThatDoNotStopAreStoppedTogetherAfterTwoGraces) {
+  const auto dir = std::filesystem::temp_directory_path() / ("tamp_sup_hung_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  Supervisor s;
+  const std::vector<std::string> names{"a", "b", "c", "d"};
+  for (const auto& n : names)
+    s.add(makeSpec(n, "/bin/sh", {"-c", "trap '' TERM; touch " + (dir / n).string() + "; while :; do sleep 0.02; done"}, {},
+                   {}, true, 5, 0.01));
+  ASSERT_TRUE(s.startAll().ok());
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  auto started = [&] {
+    for (const auto& n : names)
+      if (!std::filesystem::exists(dir / n)) return false;
+    return true;
+  };
+  while (!started() && std::chrono::steady_clock::now() < deadline) std::this_thread::yield();
+  ASSERT_TRUE(started()) << "the shells never started";
+  s.stopAll(0.2);
+  for (const auto& n : names) EXPECT_EQ(s.status(n)->phase, ProcessPhase::kExited) << n;
+  // Stopped in the reverse order: d and c one after the other, then b and a together.
+  auto endsWith = [](const std::string& str, const std::string& tail) {
+    return str.size() >= tail.size() && str.compare(str.size() - tail.size(), tail.size(), tail) == 0;
+  };
+  for (const char* n : {"d", "c"})
+    EXPECT_TRUE(endsWith(s.status(n)->last_exit, "(did not stop within 0.2 s)")) << n << ": " << s.status(n)->last_exit;
+  for (const char* n : {"b", "a"})
+    EXPECT_TRUE(endsWith(s.status(n)->last_exit, "(did not stop within 0.2 s of the stop's last phase)"))
+        << n << ": " << s.status(n)->last_exit;
+  for (const auto& n : names) EXPECT_EQ(s.status(n)->last_exit.rfind("signal 9", 0), 0u) << n << ": " << s.status(n)->last_exit;
+  std::filesystem::remove_all(dir);
+}
+
 TEST(SupervisorTest, EnvironmentAndLogFile) {
   const auto log = std::filesystem::temp_directory_path() / ("tamp_sup_" + std::to_string(::getpid()) + ".log");
   std::filesystem::remove(log);

@@ -123,8 +123,10 @@ class Supervisor {
   /// Stops the children one after the other, in the reverse of the order they were added (a
   /// deployment lists a service after those it uses, so a service that hands over what it holds
   /// when it stops, like the execution monitor's unacknowledged records to the effort estimator,
-  /// does so while they still run): SIGTERM, up to `grace_s` for it to exit, then SIGKILL. Reaps
-  /// everything.
+  /// does so while they still run): SIGTERM, up to `grace_s` for it to exit, then SIGKILL. Once
+  /// twice `grace_s` has gone by (services that did not stop), the rest get SIGTERM together and
+  /// one `grace_s` more: a stop lasts at most about 3 `grace_s` however many services hang. Reaps
+  /// everything; a killed process's last exit says so (`signal 9 ... (did not stop within ...)`).
   void stopAll(double grace_s = 3.0);
   /// Forgets every process without stopping it (a supervisor that hands its services over).
   void release();
@@ -145,7 +147,7 @@ class Supervisor {
   void onExit(Child& c, const std::string& how, int exit_code, bool clean);
   /// True (and the exit handled) when the child ended.
   /// `cause`: what ended it when we know better than its exit status (declareDead).
-  bool reap(Child& c, bool block, const std::string& cause = {});
+  bool reap(Child& c, bool block, const std::string& cause = {}, const std::string& note = {});
   void emit(ProcessEventKind kind, const Child& c, std::string detail = {}, double backoff_s = 0) const;
   void checkUnique(const std::string& name) const;
   std::vector<Child> children_;

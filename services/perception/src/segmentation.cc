@@ -484,44 +484,38 @@ void segmentPlane(const std::shared_ptr<Cloud>& cloud, const pcl::Indices& indic
   model->selectWithinDistance(refined, P.planes.distance_threshold, inliers.indices);
 }
 
-/// The points of `search` within the plane `c`'s noise-aware band (the along-ray range noise
-/// projected on the plane normal, seen from `origin`); `search` keeps the others.
+/// Whether `q` lies in plane `c`'s noise-aware band: within the plane threshold, or within the
+/// along-ray range noise (seen from `origin`) projected on the plane normal, whichever is wider.
+bool inBand(const Eigen::Vector3f& q, const Eigen::Vector4f& c, const Eigen::Vector3f& origin,
+            const PerceptionParams& P) {
+  const Eigen::Vector3f n = c.head<3>();
+  const Eigen::Vector3f ray = q - origin;
+  const float range = ray.norm();
+  const float cosine = range > 1e-6f ? std::abs(n.dot(ray)) / range : 1.0f;
+  const float band = std::max(static_cast<float>(P.planes.distance_threshold),
+                              static_cast<float>(P.planes.noise_sigmas * P.sensor.stddev(range)) * cosine);
+  return std::abs(n.dot(q) + c.w()) <= band;
+}
+
+/// The points of `search` in the plane `c`'s band (inBand); `search` keeps the others.
 std::vector<pcl::index_t> takeBandInliers(const Cloud& cloud, std::vector<pcl::index_t>& search,
                                           const Eigen::Vector4f& c, const Eigen::Vector3f& origin,
                                           const PerceptionParams& P) {
-  const Eigen::Vector3f n = c.head<3>();
   std::vector<pcl::index_t> inliers;
   std::vector<pcl::index_t> rest;
   inliers.reserve(search.size());
   rest.reserve(search.size());
-  const float base = static_cast<float>(P.planes.distance_threshold);
-  for (auto i : search) {
-    const Eigen::Vector3f q = cloud.points[static_cast<std::size_t>(i)].getVector3fMap();
-    const float dist = std::abs(n.dot(q) + c.w());
-    const Eigen::Vector3f ray = q - origin;
-    const float range = ray.norm();
-    const float cosine = range > 1e-6f ? std::abs(n.dot(ray)) / range : 1.0f;
-    const float band = std::max(base, static_cast<float>(P.planes.noise_sigmas * P.sensor.stddev(range)) * cosine);
-    (dist <= band ? inliers : rest).push_back(i);
-  }
+  for (auto i : search)
+    (inBand(cloud.points[static_cast<std::size_t>(i)].getVector3fMap(), c, origin, P) ? inliers : rest).push_back(i);
   search = std::move(rest);
   return inliers;
 }
 
-/// How many of the points `indices` lie in plane `c`'s band (takeBandInliers' test).
+/// How many of the points `indices` lie in plane `c`'s band (inBand).
 std::size_t bandCount(const Cloud& cloud, const pcl::Indices& indices, const Eigen::Vector4f& c,
                       const Eigen::Vector3f& origin, const PerceptionParams& P) {
-  const Eigen::Vector3f n = c.head<3>();
-  const float base = static_cast<float>(P.planes.distance_threshold);
   std::size_t count = 0;
-  for (auto i : indices) {
-    const Eigen::Vector3f q = cloud.points[static_cast<std::size_t>(i)].getVector3fMap();
-    const Eigen::Vector3f ray = q - origin;
-    const float range = ray.norm();
-    const float cosine = range > 1e-6f ? std::abs(n.dot(ray)) / range : 1.0f;
-    const float band = std::max(base, static_cast<float>(P.planes.noise_sigmas * P.sensor.stddev(range)) * cosine);
-    count += std::abs(n.dot(q) + c.w()) <= band ? 1 : 0;
-  }
+  for (auto i : indices) count += inBand(cloud.points[static_cast<std::size_t>(i)].getVector3fMap(), c, origin, P) ? 1 : 0;
   return count;
 }
 

@@ -28,29 +28,10 @@ struct Mission {
   fs::path run_dir;  ///< OUT/RUN_ID of this run (empty when tamp run made none)
 };
 
-/// A deployment like config/deploy/local.yaml whose simulator runs `factor` times faster than
-/// real time (the product's own services and parameters otherwise).
-inline fs::path fastDeployment(const fs::path& dir, double factor) {
-  fs::create_directories(dir);
-  std::string sim = readFile(configDir() / "services" / "sim.yaml");
-  sim = std::regex_replace(sim, std::regex("realtime_factor: [0-9.]+"), "realtime_factor: " + std::to_string(factor));
-  std::ofstream(dir / "sim.yaml") << sim;
-  std::string dep = readFile(configDir() / "deploy" / "local.yaml");
-  dep = std::regex_replace(dep, std::regex("\\{config\\}/services/sim.yaml"), (dir / "sim.yaml").string());
-  // A fresh effort-estimator store: the decisions under test start from the default time models,
-  // not from whatever earlier runs on this machine taught the estimator.
-  std::string est = readFile(configDir() / "services" / "effort_estimator.yaml");
-  est = std::regex_replace(est, std::regex("store_directory: [^\\n#]+"), "store_directory: " + (dir / "store").string() + " ");
-  std::ofstream(dir / "effort_estimator.yaml") << est;
-  dep = std::regex_replace(dep, std::regex("\\{config\\}/services/effort_estimator.yaml"),
-                           (dir / "effort_estimator.yaml").string());
-  std::ofstream(dir / "deploy.yaml") << dep;
-  return dir / "deploy.yaml";
-}
-
-/// `deployment` (written by fastDeployment into `dir`) with `service`'s configuration file
-/// copied into `dir` and the top-level `keys` set to the given values: each key must be in the
-/// shipped file (a test of a setting that is not there fails here, not silently).
+/// `deployment` (a file of its own, e.g. fastDeployment's) with `service`'s shipped configuration
+/// copied beside it and the top-level `keys` set to the given values: each key must be in the
+/// shipped file (a test of a setting that is not there fails here, not silently). A second call
+/// for the same service starts again from the shipped file.
 inline fs::path withServiceKeys(const fs::path& deployment, const std::string& service,
                                 const std::map<std::string, std::string>& keys) {
   const fs::path dir = deployment.parent_path();
@@ -65,6 +46,18 @@ inline fs::path withServiceKeys(const fs::path& deployment, const std::string& s
   dep = std::regex_replace(dep, std::regex("\\{config\\}/services/" + service + "\\.yaml"), (dir / (service + ".yaml")).string());
   std::ofstream(deployment) << dep;
   return deployment;
+}
+
+/// A deployment like config/deploy/local.yaml whose simulator runs `factor` times faster than
+/// real time (the product's own services and parameters otherwise).
+inline fs::path fastDeployment(const fs::path& dir, double factor) {
+  fs::create_directories(dir);
+  const fs::path deployment = dir / "deploy.yaml";
+  std::ofstream(deployment) << readFile(configDir() / "deploy" / "local.yaml");
+  withServiceKeys(deployment, "sim", {{"realtime_factor", std::to_string(factor)}});
+  // A fresh effort-estimator store: the decisions under test start from the default time models,
+  // not from whatever earlier runs on this machine taught the estimator.
+  return withServiceKeys(deployment, "effort_estimator", {{"store_directory", (dir / "store").string()}});
 }
 
 /// `tamp run` of `scenario` with `deployment`, its run folder under `out` (kept: several runs may

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <future>
+#include <limits>
 #include <set>
 #include <thread>
 
@@ -151,8 +152,9 @@ struct GraphManager::Run {
     std::vector<EdgeId> proven;  ///< the first edges of `branch`
     NodeId from{-1};             ///< the end of `proven`
     BranchContext ctx;           ///< the branch's context there
-    std::size_t replanning{0};   ///< the replanning it follows (report.replanning index)
+    std::size_t replanning{0};   ///< the replanning it follows (report.replanning index), or:
   };
+  static constexpr std::size_t kNoReplanning = std::numeric_limits<std::size_t>::max();  ///< the start's
   std::optional<Continuation> continuation;
 
   MissionReport run();
@@ -272,7 +274,8 @@ bool GraphManager::Run::planBranch(std::string& why) {
   const int evaluations0 = gm.counters_.evaluations;
   // After an event the next command waits for the first edge only (first_edge.cc).
   continuation.reset();
-  auto search = [&] { return event_at && gm.params_.replan_first_edge ? gm.traverseFirstEdge(current, ctx) : gm.traverse(current, ctx); };
+  const bool first_edge = event_at ? gm.params_.replan_first_edge : gm.params_.first_edge_at_start;
+  auto search = [&] { return first_edge ? gm.traverseFirstEdge(current, ctx) : gm.traverse(current, ctx); };
   TraverseResult t = search();
   if (abortRequested()) {
     why = t.reason;
@@ -321,7 +324,7 @@ bool GraphManager::Run::planBranch(std::string& why) {
     c.proven.assign(branch.begin(), branch.begin() + static_cast<std::ptrdiff_t>(t.proven_edges));
     c.from = gm.graph_.edge(c.proven.back()).to;
     c.ctx = gm.advanceAlong(c.proven, ctx);
-    c.replanning = report.replanning.empty() ? 0 : report.replanning.size() - 1;
+    c.replanning = event_at && !report.replanning.empty() ? report.replanning.size() - 1 : kNoReplanning;
     continuation = std::move(c);
   }
   if (observer.on_graph) observer.on_graph(gm.graph_, branch, current);

@@ -71,6 +71,7 @@ const config::Schema<GraphManagerParams>& schema() {
         .field("refit_wait_s", &P::refit_wait_s, config::nonNegative("s"))
         .field("max_rejoin_targets", &P::max_rejoin_targets, atLeast(1))
         .field("replan_first_edge", &P::replan_first_edge)
+        .field("first_edge_at_start", &P::first_edge_at_start)
         .field("concurrent_motions", &P::concurrent_motions)
         .field("memoise_answers", &P::memoise_answers)
         .field("max_contingencies", &P::max_contingencies, atLeast(0))

@@ -474,10 +474,13 @@ TraverseResult GraphManager::search(NodeId from, const BranchContext& context, b
   r.found = true;
   r.branch = s.best_branch;
   // The first edge is proven best when the best branch found goes through it and every other way
-  // on was explored within the budget (first_edge.cc).
-  if (first_edge_only && !s.exhausted && !s.first_edge.empty() && r.branch.size() >= s.first_edge.size() &&
-      std::equal(s.first_edge.begin(), s.first_edge.end(), r.branch.begin()))
+  // on was explored within the budget; with the budget spent it is only the best so far
+  // (first_edge.cc).
+  if (first_edge_only && !s.first_edge.empty() && r.branch.size() >= s.first_edge.size() &&
+      std::equal(s.first_edge.begin(), s.first_edge.end(), r.branch.begin())) {
     r.proven_edges = s.first_edge.size();
+    r.proven = !s.exhausted;
+  }
   r.cost_s = s.best;
   r.stddev_s = std::sqrt(s.best_sd2);
   // Below a proven first edge nothing was explored: only its decisions are recorded (the rest of

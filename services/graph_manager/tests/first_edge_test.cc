@@ -213,6 +213,7 @@ class FirstEdgeTest : public ::testing::Test {
     params.memoise_answers = memoise;
     // Off unless asked: the counts below are worked out with each edge's own bound only.
     params.goal_bound = goal_bound_;
+    if (max_evaluations_) params.max_evaluations = *max_evaluations_;
     Setup s;
     s.gm = std::make_unique<GraphManager>(std::move(a), "", MissionGoal{{"(robot-at goal)"}},
                                           services, params);
@@ -234,6 +235,7 @@ class FirstEdgeTest : public ::testing::Test {
   }
 
   bool goal_bound_{false};
+  std::optional<int> max_evaluations_;
   Eigen::Vector2d c_{5.0, 6.6};  ///< where location c stands
 
   static std::vector<std::string> actions(const GraphManager& gm,
@@ -302,6 +304,7 @@ TEST_F(FirstEdgeTest, TheFirstEdgeIsDecidedWithoutPricingBelowIt) {
   const TraverseResult t = s.gm->traverseFirstEdge(s.gm->root(), s.ctx);
   ASSERT_TRUE(t.found) << t.reason;
   EXPECT_EQ(t.proven_edges, 1u);
+  EXPECT_TRUE(t.proven);
   EXPECT_EQ(actions(*s.gm, t.branch), actions(*full.gm, f.branch));
   EXPECT_EQ(services.motion_calls, 3)
       << "start-a, a-goal, start-b: nothing below start-a after its first branch";
@@ -321,6 +324,22 @@ TEST_F(FirstEdgeTest, TheFirstEdgeIsDecidedWithoutPricingBelowIt) {
   EXPECT_EQ(actions(*s.gm, rest.branch), (std::vector<std::string>{"(move_base a goal)"}));
   EXPECT_NEAR(t.cost_s - s.gm->graph().edge(first.front()).effort_mean_s, rest.cost_s, 1e-9);
   EXPECT_NEAR(f.cost_s, t.cost_s, 1e-9);
+}
+
+// The budget runs out after the first complete branch (start-a, a-goal), before start-b is
+// bounded: its first edge is the best so far, executed unproven, and no full Traverse follows
+// (before session 33 one did, with a budget of its own: two deadlines before the command).
+TEST_F(FirstEdgeTest, AFirstEdgeNotProvenWithinTheBudgetIsTheBestSoFar) {
+  max_evaluations_ = 2;
+  ScriptedServices services;
+  Setup s = make(services);
+  const TraverseResult t = s.gm->traverseFirstEdge(s.gm->root(), s.ctx);
+  ASSERT_TRUE(t.found) << t.reason;
+  EXPECT_FALSE(t.proven);
+  EXPECT_EQ(t.proven_edges, 1u);
+  EXPECT_EQ(actions(*s.gm, t.branch), (std::vector<std::string>{"(move_base start a)", "(move_base a goal)"}));
+  EXPECT_EQ(t.evaluations, 2);
+  EXPECT_EQ(services.motion_calls, 2) << "start-b is not priced, by this search or a full one after it";
 }
 
 // The first complete branch (start-a-goal) loses to start-b-goal: start-b is settled in its
@@ -378,6 +397,7 @@ TEST_F(FirstEdgeTest, AFirstEdgeThatLostItsPlaceIsExploredAgainAndCanWinItBack) 
   const TraverseResult t = s.gm->traverseFirstEdge(s.gm->root(), s.ctx);
   ASSERT_TRUE(t.found) << t.reason;
   EXPECT_EQ(t.proven_edges, 1u);
+  EXPECT_TRUE(t.proven);
   EXPECT_EQ(actions(*s.gm, t.branch), actions(*full.gm, f.branch));
   EXPECT_NEAR(t.cost_s, f.cost_s, 1e-9);
 }

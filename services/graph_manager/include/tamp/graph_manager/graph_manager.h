@@ -111,9 +111,13 @@ struct TraverseResult {
   double time_s{0.0};
   int evaluations{0};
   std::string reason;          ///< when not found
-  /// traverseFirstEdge: the first this many edges of `branch` are proven best (0: the whole
-  /// branch is, or nothing is); the rest is the first complete branch found through them.
+  /// traverseFirstEdge: the first this many edges of `branch` are decided (0: the whole branch
+  /// is, or nothing is); the rest is the first complete branch found through them, to be priced
+  /// again from their end while the robot executes them.
   std::size_t proven_edges{0};
+  /// Whether those edges are proven best (every other way on was bounded by the branch's cost),
+  /// or only the best found when the Traverse's budget ran out.
+  bool proven{false};
 };
 
 struct ExecutedAction {

@@ -117,6 +117,10 @@ struct GraphManagerParams {
   /// namo_corridor_slippery; the cause was arm paths clipping objects between checked states,
   /// fixed by the swept check, docs/benchmarks.md.)
   bool replan_first_edge{true};
+  /// The mission's first command too (and every Traverse not after an event) goes out once its
+  /// first edge is proven best, the rest priced while the robot executes it, as
+  /// `replan_first_edge` does after an event (issue 11: time to the first command).
+  bool first_edge_at_start{false};
   /// Conditional planning: the nodes of the first plan given a prebuilt "the gripper is not
   /// empty" branch before execution starts (the start and the states before each pick, in plan
   /// order); each costs up to `max_rejoin_targets` planner calls at the start; >= 0 (0: none).

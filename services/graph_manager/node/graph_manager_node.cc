@@ -231,109 +231,178 @@ void GraphManagerNode::publish(const std::string& mission, msg::MissionState sta
   if (Status s = status_.write(current_); !s) logger()->warn("mission status: {}", s.error().message);
 }
 
-void GraphManagerNode::runOne(const msg::MissionCommand& c, const MissionRecord* resumed) {
-  const auto t0 = std::chrono::steady_clock::now();
-  current_ = msg::MissionStatus{};
-  const std::string id = c.mission_id();
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+/// The journal's record of a mission: a new one from the command, or the resumed one taken up
+/// once more.
+MissionRecord recordOf(const msg::MissionCommand& c, Policy fallback, const MissionRecord* resumed) {
   MissionRecord record;
   if (resumed) {
     record = *resumed;
     ++record.resumptions;
-  } else {
-    record.mission_id = id;
-    record.scenario_path = c.scenario_path();
-    record.policy = std::string(toString(fromMsg(c.policy(), params_.policy)));
-    record.seed = c.seed();
-    record.max_replans = static_cast<int>(c.max_replans());
-    record.goal.assign(c.goal().begin(), c.goal().end());
+    return record;
   }
-  journal(record);
-  auto fail = [&](MissionOutcome o, const std::string& why) {
-    MissionReport r;
-    r.status = o;
-    r.reason = why;
-    r.resumptions = record.resumptions;
-    current_.report_json(reportJson(r, c.scenario_path(), "", c.seed()));
-    record.finished = true;
-    record.outcome = std::string(toString(o));
-    record.reason = why;
-    journal(record);
-    publish(id, msg::MissionState::MISSION_FAILED, why);
-  };
-  const std::string scenario_path = c.scenario_path().empty() ? args_.scenario_file : c.scenario_path();
-  auto sc = world::loadScenario(scenario_path);
-  if (!sc) return fail(MissionOutcome::kInputError, "bad scenario: " + sc.error().toString());
-  auto robot = robot::RobotModel::loadDescription(sc->robot.description);
-  if (!robot) return fail(MissionOutcome::kInputError, "bad robot description: " + robot.error().toString());
-  auto domain = readTextFile(sc->domain);
-  if (!domain) return fail(MissionOutcome::kInputError, "bad PDDL domain: " + domain.error().toString());
+  record.mission_id = c.mission_id();
+  record.scenario_path = c.scenario_path();
+  record.policy = std::string(toString(fromMsg(c.policy(), fallback)));
+  record.seed = c.seed();
+  record.max_replans = static_cast<int>(c.max_replans());
+  record.goal.assign(c.goal().begin(), c.goal().end());
+  return record;
+}
 
-  GraphManagerParams p = params_;
-  p.policy = fromMsg(c.policy(), params_.policy);
+/// What a mission is planned from: its scenario, the robot it names, the PDDL domain.
+struct MissionInputs {
+  std::string scenario_path;
+  world::Scenario scenario;
+  robot::RobotModel robot;
+  std::string domain;
+};
+
+/// The command's scenario (else the node's); each failure names what was bad.
+Result<MissionInputs> loadInputs(const msg::MissionCommand& c, const std::string& node_scenario) {
+  const std::string path = c.scenario_path().empty() ? node_scenario : c.scenario_path();
+  auto sc = world::loadScenario(path);
+  if (!sc) return Error(sc.error().code, "bad scenario: " + sc.error().toString());
+  auto robot = robot::RobotModel::loadDescription(sc->robot.description);
+  if (!robot) return Error(robot.error().code, "bad robot description: " + robot.error().toString());
+  auto domain = readTextFile(sc->domain);
+  if (!domain) return Error(domain.error().code, "bad PDDL domain: " + domain.error().toString());
+  return MissionInputs{path, std::move(*sc), std::move(*robot), std::move(*domain)};
+}
+
+/// The node's parameters with the command's policy, seed and replanning bound.
+GraphManagerParams paramsFor(const msg::MissionCommand& c, GraphManagerParams p) {
+  p.policy = fromMsg(c.policy(), p.policy);
   if (c.seed() != 0) p.seed = c.seed();
   if (c.max_replans() > 0) p.max_replans = static_cast<int>(c.max_replans());
+  return p;
+}
 
-  clients_.setRobot(*robot);
-  executor_.setMission(id);
-  source_.setRobot(*robot);
-  publish(id, msg::MissionState::MISSION_PLANNING, "waiting for the world model and the robot state");
-  if (Status ready = source_.waitReady(Termination::after(30.0)); !ready)
-    return fail(MissionOutcome::kUnavailable, ready.error().message + " within 30 s (perception, sim running?)");
+/// The command's own goal replaces the scenario's (atoms over the world's ids; the planner
+/// refuses unknown names, which fails the mission as an input error).
+Status applyCommandGoal(const msg::MissionCommand& c, MissionGoal& goal) {
+  if (c.goal().empty()) return Status::Ok();
+  goal.atoms.clear();
+  for (std::size_t i = 0; i < c.goal().size(); ++i) {
+    const std::string& a = c.goal()[i];
+    if (atomTokens(a).empty() || a.find('(') == std::string::npos)
+      return Error(ErrorCode::kInvalidArgument, "goal[" + std::to_string(i) + "]: not a PDDL atom: '" + a + "'");
+    goal.atoms.push_back(a);
+  }
+  return Status::Ok();
+}
 
-  // Policy oracle: efforts are the simulator's true durations and the world is the true one
-  // (hidden objects included); the simulator serves its truth only in an evaluation run.
-  ServiceClients* services = &clients_;
-  WorldSource* source = &source_;
-  std::optional<OracleWorldSource> oracle_source;
-  if (p.policy == Policy::kOracle) {
-    auto truth = oracle_clients_.oracle();
-    if (!truth)
-      return fail(MissionOutcome::kUnavailable,
-                  "policy oracle: " + truth.error().message +
-                      " (the simulator serves its truth only in an evaluation run: tamp run --policy oracle sets "
-                      "TAMP_ORACLE=1 for it)");
-    logger()->info("mission {}: oracle: {} hidden object(s), {} scripted fault(s), {} commands accepted", id,
-                   truth->hidden.size(), truth->faults.size(), truth->action_count);
-    oracle_source.emplace(source_, truth->hidden);
-    services = &oracle_clients_;
-    source = &*oracle_source;
-  }
-  Abstraction abs(source->world(), *robot);
-  auto goal = goalOf(*sc, *robot, abs);
-  if (!goal) return fail(MissionOutcome::kInputError, "bad goal: " + goal.error().toString());
-  if (!c.goal().empty()) {
-    // The command's own goal replaces the scenario's (atoms over the world's ids; the planner
-    // refuses unknown names, which fails the mission as an input error).
-    goal->atoms.clear();
-    for (std::size_t i = 0; i < c.goal().size(); ++i) {
-      const std::string& a = c.goal()[i];
-      if (atomTokens(a).empty() || a.find('(') == std::string::npos)
-        return fail(MissionOutcome::kInputError, "goal[" + std::to_string(i) + "]: not a PDDL atom: '" + a + "'");
-      goal->atoms.push_back(a);
-    }
-  }
-  GraphManager gm(std::move(abs), *domain, *goal, *services, p);
-  // What the planner is told: the scenario's planner view (a hidden object in the gripper is not
-  // in it). The robot's own report of the hand selects the conditional branch.
-  // A resumed mission believes what the robot reports.
-  const world::World told = sc->world.plannerView();
+/// What the planner is told: the scenario's planner view (a hidden object in the gripper is not
+/// in it); the robot's own report of the hand selects the conditional branch. A resumed mission
+/// believes what the robot reports.
+Belief beliefOf(const world::Scenario& sc, bool resumed) {
+  const world::World told = sc.world.plannerView();
   std::set<std::string> told_ids;
   for (const auto& o : told.objects()) told_ids.insert(o.id);
-  if (!resumed) gm.setBelief(Belief{told.held() ? told.held()->object_id : std::string(), told_ids});
-  else gm.setBelief(Belief{std::nullopt, told_ids});
-  logger()->info("mission {}: scenario {}, policy {}, goal {} atoms", id, sc->name, toString(p.policy), goal->atoms.size());
+  if (resumed) return Belief{std::nullopt, told_ids};
+  return Belief{told.held() ? told.held()->object_id : std::string(), told_ids};
+}
 
+/// The graph as published after every Traverse, with the best branch and its cost.
+msg::GraphSnapshot snapshotOf(const std::string& mission, const ReachabilityGraph& g, const std::vector<EdgeId>& best,
+                              NodeId node) {
+  msg::GraphSnapshot s;
+  s.mission_id(mission);
+  s.version(g.version());
+  s.current_node("n" + std::to_string(node));
+  for (const Node& n : g.nodes()) {
+    msg::GraphNode m;
+    m.id("n" + std::to_string(n.id));
+    m.atoms(n.atoms);
+    m.healthy(n.healthy);
+    s.nodes().push_back(m);
+  }
+  for (const Edge& e : g.edges()) {
+    msg::GraphEdge m;
+    m.id("e" + std::to_string(e.id));
+    m.from_node("n" + std::to_string(e.from));
+    m.to_node("n" + std::to_string(e.to));
+    m.action(e.action);
+    m.kind(dds::toMsg(e.kind));
+    m.state(static_cast<msg::EdgeState>(static_cast<int>(e.state)));
+    m.effort_mean_s(std::isfinite(e.effort_mean_s) ? e.effort_mean_s : -1.0);
+    m.effort_stddev_s(e.effort_stddev_s);
+    if (e.motion) m.blocking_objects(e.motion->blocking);
+    s.edges().push_back(m);
+  }
+  double cost = 0.0;
+  for (EdgeId e : best) {
+    s.best_branch().push_back("e" + std::to_string(e));
+    cost += std::isfinite(g.edge(e).effort_mean_s) ? g.edge(e).effort_mean_s : 0.0;
+  }
+  s.best_cost_s(cost);
+  return s;
+}
+
+ResumePoint resumePointOf(const MissionRecord& record, const MissionRecord& resumed) {
+  ResumePoint at;
+  at.resumptions = record.resumptions;
+  at.actions = resumed.actions;
+  at.in_flight = resumed.in_flight;
+  at.in_flight_action = resumed.in_flight_action;
+  at.in_flight_budget_s = resumed.in_flight_budget_s;
+  return at;
+}
+
+msg::MissionState finalStateOf(MissionOutcome o) {
+  return o == MissionOutcome::kSucceeded ? msg::MissionState::MISSION_SUCCEEDED
+         : o == MissionOutcome::kAborted ? msg::MissionState::MISSION_ABORTED
+                                         : msg::MissionState::MISSION_FAILED;
+}
+
+}  // namespace
+
+void GraphManagerNode::failMission(const msg::MissionCommand& c, MissionRecord& record, MissionOutcome o,
+                                   const std::string& why) {
+  MissionReport r;
+  r.status = o;
+  r.reason = why;
+  r.resumptions = record.resumptions;
+  current_.report_json(reportJson(r, c.scenario_path(), "", c.seed()));
+  record.finished = true;
+  record.outcome = std::string(toString(o));
+  record.reason = why;
+  journal(record);
+  publish(c.mission_id(), msg::MissionState::MISSION_FAILED, why);
+}
+
+Result<GraphManagerNode::Backends> GraphManagerNode::backendsFor(const std::string& mission, Policy policy,
+                                                                 std::optional<OracleWorldSource>& oracle_source) {
+  if (policy != Policy::kOracle) return Backends{&clients_, &source_};
+  // Policy oracle: efforts are the simulator's true durations and the world is the true one
+  // (hidden objects included); the simulator serves its truth only in an evaluation run.
+  auto truth = oracle_clients_.oracle();
+  if (!truth)
+    return Error(ErrorCode::kUnavailable, "policy oracle: " + truth.error().message +
+                                              " (the simulator serves its truth only in an evaluation run: tamp run "
+                                              "--policy oracle sets TAMP_ORACLE=1 for it)");
+  logger()->info("mission {}: oracle: {} hidden object(s), {} scripted fault(s), {} commands accepted", mission,
+                 truth->hidden.size(), truth->faults.size(), truth->action_count);
+  oracle_source.emplace(source_, truth->hidden);
+  return Backends{&oracle_clients_, &*oracle_source};
+}
+
+MissionObserver GraphManagerNode::observerFor(const std::string& mission, Clock::time_point t0) {
   MissionObserver obs;
-  obs.on_state = [&](const std::string& s, const std::string& m) {
-    current_.elapsed_s(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  obs.on_state = [this, mission, t0](const std::string& s, const std::string& m) {
+    current_.elapsed_s(since(t0));
     const auto st = stateOf(s);
     if (st == msg::MissionState::MISSION_SUCCEEDED || st == msg::MissionState::MISSION_FAILED ||
         st == msg::MissionState::MISSION_ABORTED)
-      return;  // the final status carries the report, below
+      return;  // the final status carries the report (finishMission)
     if (s == "executing") current_.current_action(m);
-    publish(id, st, m);
+    publish(mission, st, m);
   };
-  obs.on_action = [&](const ExecutedAction& a, double done, double total) {
+  obs.on_action = [this, mission](const ExecutedAction& a, double done, double total) {
     current_.last_action(a.action + (a.variant == "around" ? " [around]" : ""));
     current_.last_predicted_s(a.predicted_s);
     current_.last_measured_s(a.measured_s);
@@ -341,75 +410,75 @@ void GraphManagerNode::runOne(const msg::MissionCommand& c, const MissionRecord*
     current_.done_predicted_s(done);
     current_.predicted_total_s(total);
     if (a.outcome == "succeeded") current_.actions_done(current_.actions_done() + 1);
-    publish(id, msg::MissionState::MISSION_EXECUTING, a.action + " " + a.outcome);
+    publish(mission, msg::MissionState::MISSION_EXECUTING, a.action + " " + a.outcome);
   };
-  obs.on_graph = [&](const ReachabilityGraph& g, const std::vector<EdgeId>& best, NodeId node) {
-    msg::GraphSnapshot s;
-    s.mission_id(id);
-    s.version(g.version());
-    s.current_node("n" + std::to_string(node));
-    for (const Node& n : g.nodes()) {
-      msg::GraphNode m;
-      m.id("n" + std::to_string(n.id));
-      m.atoms(n.atoms);
-      m.healthy(n.healthy);
-      s.nodes().push_back(m);
-    }
-    double cost = 0.0;
-    for (const Edge& e : g.edges()) {
-      msg::GraphEdge m;
-      m.id("e" + std::to_string(e.id));
-      m.from_node("n" + std::to_string(e.from));
-      m.to_node("n" + std::to_string(e.to));
-      m.action(e.action);
-      m.kind(dds::toMsg(e.kind));
-      m.state(static_cast<msg::EdgeState>(static_cast<int>(e.state)));
-      m.effort_mean_s(std::isfinite(e.effort_mean_s) ? e.effort_mean_s : -1.0);
-      m.effort_stddev_s(e.effort_stddev_s);
-      if (e.motion) m.blocking_objects(e.motion->blocking);
-      s.edges().push_back(m);
-    }
-    for (EdgeId e : best) {
-      s.best_branch().push_back("e" + std::to_string(e));
-      cost += std::isfinite(g.edge(e).effort_mean_s) ? g.edge(e).effort_mean_s : 0.0;
-    }
-    s.best_cost_s(cost);
+  obs.on_graph = [this, mission](const ReachabilityGraph& g, const std::vector<EdgeId>& best, NodeId node) {
     current_.actions_planned(static_cast<uint32_t>(best.size()) + current_.actions_done());
-    if (Status st = graph_.write(s); !st) logger()->warn("graph snapshot: {}", st.error().message);
+    if (Status st = graph_.write(snapshotOf(mission, g, best, node)); !st)
+      logger()->warn("graph snapshot: {}", st.error().message);
   };
-  obs.abort_requested = [&] { return abort_.load(); };
+  obs.abort_requested = [this] { return abort_.load(); };
+  return obs;
+}
 
+void GraphManagerNode::finishMission(const std::string& mission, MissionRecord& record, const MissionReport& r,
+                                     const std::string& scenario_path, const GraphManagerParams& p,
+                                     Clock::time_point t0) {
+  record.finished = true;
+  record.outcome = std::string(toString(r.status));
+  record.reason = r.reason;
+  journal(record);
+  current_.elapsed_s(since(t0));
+  current_.replans(static_cast<uint32_t>(r.replans));
+  current_.report_json(reportJson(r, scenario_path, std::string(toString(p.policy)), p.seed));
+  current_.graph_dot(r.graph_dot);
+  logger()->info("mission {}: {} ({}) executed {:.1f} s, predicted {:.1f} s, planning {:.2f} s", mission,
+                 toString(r.status), r.reason, r.executed_effort_s, r.predicted_effort_s, r.planning_time_s);
+  publish(mission, finalStateOf(r.status), r.reason);
+}
+
+void GraphManagerNode::runOne(const msg::MissionCommand& c, const MissionRecord* resumed) {
+  const auto t0 = Clock::now();
+  current_ = msg::MissionStatus{};
+  const std::string id = c.mission_id();
+  MissionRecord record = recordOf(c, params_.policy, resumed);
+  journal(record);
+  auto in = loadInputs(c, args_.scenario_file);
+  if (!in) return failMission(c, record, MissionOutcome::kInputError, in.error().message);
+  const GraphManagerParams p = paramsFor(c, params_);
+
+  clients_.setRobot(in->robot);
+  executor_.setMission(id);
+  source_.setRobot(in->robot);
+  publish(id, msg::MissionState::MISSION_PLANNING, "waiting for the world model and the robot state");
+  if (Status ready = source_.waitReady(Termination::after(30.0)); !ready)
+    return failMission(c, record, MissionOutcome::kUnavailable,
+                       ready.error().message + " within 30 s (perception, sim running?)");
+  std::optional<OracleWorldSource> oracle_source;
+  auto backends = backendsFor(id, p.policy, oracle_source);
+  if (!backends) return failMission(c, record, MissionOutcome::kUnavailable, backends.error().message);
+
+  Abstraction abs(backends->source->world(), in->robot);
+  auto goal = goalOf(in->scenario, in->robot, abs);
+  if (!goal) return failMission(c, record, MissionOutcome::kInputError, "bad goal: " + goal.error().toString());
+  if (Status s = applyCommandGoal(c, *goal); !s) return failMission(c, record, MissionOutcome::kInputError, s.error().message);
+  GraphManager gm(std::move(abs), in->domain, *goal, *backends->services, p);
+  gm.setBelief(beliefOf(in->scenario, resumed != nullptr));
+  logger()->info("mission {}: scenario {}, policy {}, goal {} atoms", id, in->scenario.name, toString(p.policy),
+                 goal->atoms.size());
+
+  const MissionObserver obs = observerFor(id, t0);
   std::optional<JournalingExecutor> journaled;
   if (journal_) journaled.emplace(executor_, *journal_, record);
   Executor& executor = journaled ? static_cast<Executor&>(*journaled) : executor_;
   MissionReport r;
   if (resumed) {
-    ResumePoint at;
-    at.resumptions = record.resumptions;
-    at.actions = resumed->actions;
-    at.in_flight = resumed->in_flight;
-    at.in_flight_action = resumed->in_flight_action;
-    at.in_flight_budget_s = resumed->in_flight_budget_s;
     publish(id, msg::MissionState::MISSION_PLANNING, "resuming after a restart of the graph manager");
-    r = gm.resumeMission(at, *source, executor, obs);
+    r = gm.resumeMission(resumePointOf(record, *resumed), *backends->source, executor, obs);
   } else {
-    r = gm.runMission(*source, executor, obs);
+    r = gm.runMission(*backends->source, executor, obs);
   }
-  record.finished = true;
-  record.outcome = std::string(toString(r.status));
-  record.reason = r.reason;
-  journal(record);
-  current_.elapsed_s(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-  current_.replans(static_cast<uint32_t>(r.replans));
-  current_.report_json(reportJson(r, scenario_path, std::string(toString(p.policy)), p.seed));
-  current_.graph_dot(r.graph_dot);
-  logger()->info("mission {}: {} ({}) executed {:.1f} s, predicted {:.1f} s, planning {:.2f} s", id,
-                 toString(r.status), r.reason, r.executed_effort_s, r.predicted_effort_s, r.planning_time_s);
-  publish(id,
-          r.status == MissionOutcome::kSucceeded ? msg::MissionState::MISSION_SUCCEEDED
-          : r.status == MissionOutcome::kAborted ? msg::MissionState::MISSION_ABORTED
-                                                 : msg::MissionState::MISSION_FAILED,
-          r.reason);
+  finishMission(id, record, r, in->scenario_path, p, t0);
 }
 
 }  // namespace tamp::graph_manager

@@ -7,10 +7,12 @@
 /// monitor through dds_clients.h.
 
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <deque>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <thread>
 
 #include "dds_clients.h"
@@ -47,6 +49,24 @@ class GraphManagerNode : public dds::ServiceNode {
   /// Journals `record` (a warning when it cannot be written: the executor then refuses to send).
   void journal(const MissionRecord& record);
   void publish(const std::string& mission, msg::MissionState state, const std::string& message);
+
+  // runOne's steps.
+  using Clock = std::chrono::steady_clock;
+  /// Where a mission's efforts, motions and world come from: the services, or the oracle's.
+  struct Backends {
+    ServiceClients* services;
+    WorldSource* source;
+  };
+  /// The services for `policy`; the oracle's (its world kept in `oracle_source`) for the oracle.
+  Result<Backends> backendsFor(const std::string& mission, Policy policy,
+                               std::optional<OracleWorldSource>& oracle_source);
+  /// Publishes the mission's progress: states, actions, graph snapshots; and the abort flag.
+  MissionObserver observerFor(const std::string& mission, Clock::time_point t0);
+  /// A mission that failed before it ran: journaled and published with its reason.
+  void failMission(const msg::MissionCommand& c, MissionRecord& record, MissionOutcome o, const std::string& why);
+  /// A mission that ran: journaled, and its final status published with the report.
+  void finishMission(const std::string& mission, MissionRecord& record, const MissionReport& r,
+                     const std::string& scenario_path, const GraphManagerParams& p, Clock::time_point t0);
 
   dds::ServiceArgs args_;
   GraphManagerParams params_;

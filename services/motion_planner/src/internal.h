@@ -471,6 +471,8 @@ class StaticRoadmap {
   /// groups): entries are dropped when a movable near them changes (syncMovables).
   struct MovableCache;
   std::unique_ptr<MovableCache> mcache_;
+  /// One request's search (roadmap_search.cc).
+  class Search;
   /// Brings the cache to the request's movables; returns false when it cannot be used.
   bool syncMovables(const Oracle& oracle, std::vector<int>& global_to_request);
   std::vector<std::uint64_t> request_stamp_;  ///< per node: 0, or the last request using it
@@ -483,6 +485,21 @@ class StaticRoadmap {
   int neighbors_{12};
   void addEdge(int a, int b, bool valid);
   int pushNode(const ob::State* s);
+};
+
+/// Touched movables are stored by roadmap-wide movable number (`ids`), so that entries survive
+/// requests whose movable lists (ignored objects, new objects) differ.
+struct StaticRoadmap::MovableCache {
+  struct Entry {
+    bool cached{false};
+    std::vector<int> touched;  ///< roadmap movable numbers, sorted
+    double x0{0}, y0{0}, x1{0}, y1{0};  ///< xy box of the base positions (node, edge ends)
+  };
+  std::vector<Entry> nodes, edges;
+  std::unordered_map<std::string, int> ids;
+  std::vector<std::shared_ptr<const world::Object>> seen;  ///< as last present (null: absent since)
+  std::vector<Aabb> last_box;                               ///< where it was when last present
+  double reach{-1.0};
 };
 
 /// Effort-aware shortcutting: replaces vertices i..j by the straight segment when it is

@@ -1,20 +1,11 @@
-// The cached static roadmap and the effort-aware roadmap search of the lazy mode (see
-// motion_planner.h, "Worth executing" and "Roadmap cache").
+// The cached static roadmap of the lazy mode (see motion_planner.h, "Worth executing" and
+// "Roadmap cache"); its effort-aware search is in roadmap_search.cc.
 //
 // Nodes: uniform samples of the static free space (own seeded generator), the starts and goals of
 // earlier requests and the lazy KPIECE paths of requests the roadmap could not answer (cut every
 // `path_node_spacing`); edges: each new node to its k nearest nodes, and a lazy path's own
 // segments (statically valid already). An edge's static validity is evaluated at most once per
 // roadmap; the movables it touches are evaluated per request (they change between requests).
-// Edge cost from u to v along e:
-//   w(u, e, v) = length(e) x seconds_per_unit + sum of cost(o) over objects touched along e but
-//                not at u   (an object is paid when the path enters it)
-// which, before e is evaluated in this request, is bounded below by using the objects touched at
-// v instead of along e. A* (admissible heuristic: distance to the nearest goal x
-// seconds_per_unit) finds the best path under the current costs; its unevaluated edges are
-// evaluated in order (static validity unless known, then the movables touched, densely; all of
-// them, also after an invalid one); the search repeats until a path is found whose every edge is evaluated and whose
-// cost did not rise (LazySP).
 #include <algorithm>
 #include <cmath>
 #include <iostream>  // NearestNeighborsGNATNoThreadSafety.h uses std::cout without including it
@@ -31,18 +22,6 @@
 
 namespace tamp::motion_planner::detail {
 namespace {
-
-/// Sum of costs of objects in `in` but not in `minus` (both sorted).
-double enteringCost(const Oracle& oracle, const std::vector<int>& in, const std::vector<int>& minus) {
-  double c = 0.0;
-  auto it = minus.begin();
-  for (int o : in) {
-    while (it != minus.end() && *it < o) ++it;
-    if (it != minus.end() && *it == o) continue;
-    c += oracle.movables()[static_cast<std::size_t>(o)].cost_s;
-  }
-  return c;
-}
 
 bool sameObject(const std::shared_ptr<const world::Object>& a, const std::shared_ptr<const world::Object>& b) {
   if (a == b) return true;
@@ -64,21 +43,6 @@ bool StaticWorldKey::operator==(const StaticWorldKey& o) const {
   }
   return true;
 }
-
-/// Touched movables are stored by roadmap-wide movable number (`ids`), so that entries survive
-/// requests whose movable lists (ignored objects, new objects) differ.
-struct StaticRoadmap::MovableCache {
-  struct Entry {
-    bool cached{false};
-    std::vector<int> touched;  ///< roadmap movable numbers, sorted
-    double x0{0}, y0{0}, x1{0}, y1{0};  ///< xy box of the base positions (node, edge ends)
-  };
-  std::vector<Entry> nodes, edges;
-  std::unordered_map<std::string, int> ids;
-  std::vector<std::shared_ptr<const world::Object>> seen;  ///< as last present (null: absent since)
-  std::vector<Aabb> last_box;                               ///< where it was when last present
-  double reach{-1.0};
-};
 
 struct StaticRoadmap::Impl {
   ompl::NearestNeighborsGNATNoThreadSafety<int> nn;
@@ -533,237 +497,6 @@ std::pair<int, int> StaticRoadmap::addPath(const og::PathGeometric& path, double
   }
   space_->freeState(s);
   return {first, prev};
-}
-
-std::optional<og::PathGeometric> StaticRoadmap::search(Oracle& oracle, const ob::SpaceInformationPtr& si, int start,
-                                                       const std::vector<int>& goals, const LazyParams& params,
-                                                       double resolution, double seconds_per_unit,
-                                                       const Termination& termination, PlanningStats& stats,
-                                                       int max_new_invalid, std::vector<int>* route_objects) {
-  const Termination term = termination.tightened(Deadline::in(params.optimize_budget_s));
-  const std::size_t n = nodes_.size();
-  stats.roadmap_nodes = n;
-  stats.roadmap_edges = edges_.size();
-  if (goals.empty()) return std::nullopt;
-  std::vector<char> is_goal(n, 0);
-  for (int g : goals) is_goal[static_cast<std::size_t>(g)] = 1;
-
-  // Per request: the movables touched at nodes and along edges, the heuristic (all lazily).
-  std::vector<char> have_touched(n, 0);
-  std::vector<std::vector<int>> node_touched(n);
-  // Cross-request cache (rigid base groups): movable numbers <-> this request's indices.
-  std::vector<int> g2r;
-  const bool use_cache = syncMovables(oracle, g2r);
-  std::vector<int> r2g;
-  if (use_cache) {
-    r2g.assign(oracle.movables().size(), -1);
-    for (std::size_t g = 0; g < g2r.size(); ++g) {
-      if (g2r[g] >= 0) r2g[static_cast<std::size_t>(g2r[g])] = static_cast<int>(g);
-    }
-  }
-  auto fromCache = [&](const MovableCache::Entry& e, std::vector<int>& out) {
-    out.clear();
-    for (int g : e.touched) {
-      const int r = g2r[static_cast<std::size_t>(g)];
-      if (r >= 0) out.push_back(r);  // absent objects (ignored, removed) dropped
-    }
-    std::sort(out.begin(), out.end());
-  };
-  auto toCache = [&](MovableCache::Entry& e, const std::vector<int>& touched, const ob::State* a, const ob::State* b) {
-    e.touched.clear();
-    for (int r : touched) e.touched.push_back(r2g[static_cast<std::size_t>(r)]);
-    const Pose2D pa = oracle.group().basePose(a), pb = oracle.group().basePose(b);
-    e.x0 = std::min(pa.x, pb.x);
-    e.x1 = std::max(pa.x, pb.x);
-    e.y0 = std::min(pa.y, pb.y);
-    e.y1 = std::max(pa.y, pb.y);
-    e.cached = true;
-  };
-  auto touchedAt = [&](int i) -> const std::vector<int>& {
-    const auto u = static_cast<std::size_t>(i);
-    if (!have_touched[u]) {
-      if (use_cache && mcache_->nodes[u].cached) {
-        fromCache(mcache_->nodes[u], node_touched[u]);
-      } else {
-        oracle.touched(nodes_[u], node_touched[u]);
-        if (use_cache) toCache(mcache_->nodes[u], node_touched[u], nodes_[u], nodes_[u]);
-      }
-      have_touched[u] = 1;
-    }
-    return node_touched[u];
-  };
-  std::vector<double> h(n, -1.0);
-  auto heuristic = [&](int i) {
-    const auto u = static_cast<std::size_t>(i);
-    if (h[u] < 0) {
-      double d = std::numeric_limits<double>::infinity();
-      for (int g : goals) d = std::min(d, space_->distance(nodes_[u], nodes_[static_cast<std::size_t>(g)]));
-      h[u] = d * seconds_per_unit;
-    }
-    return h[u];
-  };
-  std::vector<char> evaluated(edges_.size(), 0);  // in this request (movables)
-  std::vector<std::vector<int>> edge_touched(edges_.size());
-  // Weights per direction (2 * edge + (u is the edge's b)), computed once: a node's movables are
-  // fixed within a request, so only an edge's evaluation changes its two weights (forgetWeight).
-  std::vector<double> weights(2 * edges_.size(), -1.0);
-  auto weight = [&](int u, int ei) {
-    const Edge& e = edges_[static_cast<std::size_t>(ei)];
-    double& w = weights[2 * static_cast<std::size_t>(ei) + (e.a == u ? 0 : 1)];
-    if (w < 0) {
-      const int v = e.a == u ? e.b : e.a;
-      const auto& objs = evaluated[static_cast<std::size_t>(ei)] ? edge_touched[static_cast<std::size_t>(ei)] : touchedAt(v);
-      w = e.len * seconds_per_unit + enteringCost(oracle, objs, touchedAt(u));
-    }
-    return w;
-  };
-  auto forgetWeight = [&](std::size_t ei) { weights[2 * ei] = weights[2 * ei + 1] = -1.0; };
-
-  std::vector<double> g(n);
-  std::vector<int> parent_edge(n);
-  std::vector<char> closed(n);
-  std::vector<int> expanded;  // closed nodes of the last A* run, for the heuristic's update
-  expanded.reserve(n);
-  using QItem = std::pair<double, int>;
-  enum class Outcome { kFound, kDisconnected, kBudget, kUnconnected };
-  std::vector<std::pair<int, int>> route;  // (from node, edge) start -> goal
-  // LazySP; `known_only`: over the edges known to be statically valid (no static checks, only
-  // the movables along them are evaluated).
-  bool changed = false;
-  // After an edge's evaluation: a raised weight means the route must be searched again; a
-  // lowered one (a stale cross-request cache entry) would break the learned heuristic's bound,
-  // which then starts over from the distance.
-  auto settle = [&](double before, double after) {
-    if (after > before + 1e-9) {
-      changed = true;
-    } else if (after < before - 1e-9) {
-      std::fill(h.begin(), h.end(), -1.0);
-    }
-  };
-  auto lazySp = [&](bool known_only, int max_evaluations, int invalid_cap) {
-    int evaluations = 0;
-    int new_invalid = 0;
-    while (!term()) {
-      ++stats.search_iterations;
-      std::fill(g.begin(), g.end(), std::numeric_limits<double>::infinity());
-      std::fill(parent_edge.begin(), parent_edge.end(), -1);
-      std::fill(closed.begin(), closed.end(), 0);
-      expanded.clear();
-      std::priority_queue<QItem, std::vector<QItem>, std::greater<>> open;
-      g[static_cast<std::size_t>(start)] = 0.0;
-      open.emplace(heuristic(start), start);
-      int reached = -1;
-      while (!open.empty()) {
-        const int u = open.top().second;
-        open.pop();
-        if (closed[static_cast<std::size_t>(u)]) continue;
-        closed[static_cast<std::size_t>(u)] = 1;
-        if (is_goal[static_cast<std::size_t>(u)]) {
-          reached = u;
-          break;
-        }
-        expanded.push_back(u);
-        for (int ei : adj_[static_cast<std::size_t>(u)]) {
-          const Edge& e = edges_[static_cast<std::size_t>(ei)];
-          if (e.status == Edge::kInvalid || (known_only && e.status != Edge::kValid)) continue;
-          const int v = e.a == u ? e.b : e.a;
-          if (closed[static_cast<std::size_t>(v)]) continue;
-          const double gv = g[static_cast<std::size_t>(u)] + weight(u, ei);
-          if (gv < g[static_cast<std::size_t>(v)]) {
-            g[static_cast<std::size_t>(v)] = gv;
-            parent_edge[static_cast<std::size_t>(v)] = ei;
-            open.emplace(gv + heuristic(v), v);
-          }
-        }
-      }
-      if (reached < 0) return Outcome::kDisconnected;
-      // Adaptive A* (Koenig & Likhachev, AAMAS 2005): g(goal) - g(u) is a lower bound of u's
-      // cost to the goal under the current weights, and stays one (and consistent) because
-      // evaluating an edge only raises its weight. Later iterations then expand little more than
-      // the region where the route changed, instead of most of the roadmap each time.
-      const double g_goal = g[static_cast<std::size_t>(reached)];
-      for (int u : expanded) {
-        const auto uu = static_cast<std::size_t>(u);
-        h[uu] = std::max(h[uu], g_goal - g[uu]);
-      }
-      expanded.clear();
-      route.clear();
-      for (int v = reached; v != start;) {
-        const int ei = parent_edge[static_cast<std::size_t>(v)];
-        const Edge& e = edges_[static_cast<std::size_t>(ei)];
-        const int u = e.a == v ? e.b : e.a;
-        route.emplace_back(u, ei);
-        v = u;
-      }
-      std::reverse(route.begin(), route.end());
-      changed = false;
-      for (const auto& [u, ei] : route) {
-        const auto eu = static_cast<std::size_t>(ei);
-        if (evaluated[eu]) continue;
-        Edge& e = edges_[eu];
-        if (use_cache && e.status == Edge::kValid && mcache_->edges[eu].cached) {  // free: no budget
-          const double before = weight(u, ei);
-          fromCache(mcache_->edges[eu], edge_touched[eu]);
-          evaluated[eu] = 1;
-          forgetWeight(eu);
-          settle(before, weight(u, ei));
-          continue;
-        }
-        if (term() || evaluations >= max_evaluations) return Outcome::kBudget;
-        const double before = weight(u, ei);
-        SegmentInfo info = evaluateSegment(oracle, nodes_[static_cast<std::size_t>(e.a)],
-                                           nodes_[static_cast<std::size_t>(e.b)], resolution, e.status == Edge::kValid);
-        ++evaluations;
-        ++stats.edges_evaluated;
-        if (!info.valid) {
-          // The rest of the route is evaluated too: on a new roadmap most candidates cross a
-          // wall somewhere, and one A* run per invalid edge found would dominate the time.
-          e.status = Edge::kInvalid;
-          changed = true;
-          if (invalid_cap > 0 && !e.recheck && ++new_invalid >= invalid_cap) return Outcome::kUnconnected;
-          continue;
-        }
-        e.status = Edge::kValid;
-        evaluated[eu] = 1;
-        edge_touched[eu] = std::move(info.touched);
-        forgetWeight(eu);
-        if (use_cache) {
-          toCache(mcache_->edges[eu], edge_touched[eu], nodes_[static_cast<std::size_t>(e.a)],
-                  nodes_[static_cast<std::size_t>(e.b)]);
-        }
-        settle(before, weight(u, ei));
-      }
-      if (!changed) return Outcome::kFound;
-    }
-    return Outcome::kBudget;
-  };
-  Outcome outcome = lazySp(false, params.roadmap_max_evaluations, max_new_invalid);
-  if (outcome == Outcome::kFound) {
-    stats.optimize_completed = true;
-  } else if (outcome == Outcome::kBudget) {
-    // Anytime completion (evaluation budget spent, not after `max_new_invalid`: a roadmap that
-    // keeps finding walls is left to lazy KPIECE): the best path over the edges known to be
-    // statically valid (earlier requests, lazy KPIECE paths, this search); their movables are
-    // evaluated as needed.
-    outcome = lazySp(true, std::numeric_limits<int>::max(), 0);
-  }
-  if (outcome != Outcome::kFound) return std::nullopt;
-  if (route_objects) {  // every route edge is evaluated (kFound)
-    route_objects->clear();
-    for (const auto& [u, ei] : route) {
-      const auto& t = edge_touched[static_cast<std::size_t>(ei)];
-      route_objects->insert(route_objects->end(), t.begin(), t.end());
-    }
-    std::sort(route_objects->begin(), route_objects->end());
-    route_objects->erase(std::unique(route_objects->begin(), route_objects->end()), route_objects->end());
-  }
-  og::PathGeometric out(si);
-  out.append(nodes_[static_cast<std::size_t>(start)]);
-  for (const auto& [u, ei] : route) {
-    const Edge& e = edges_[static_cast<std::size_t>(ei)];
-    out.append(nodes_[static_cast<std::size_t>(e.a == u ? e.b : e.a)]);
-  }
-  return out;
 }
 
 }  // namespace tamp::motion_planner::detail

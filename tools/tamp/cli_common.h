@@ -8,6 +8,9 @@
 
 #include <csignal>
 #include <initializer_list>
+#include <iostream>
+
+#include "tamp/core/error.h"
 
 namespace tamp::cli {
 
@@ -17,6 +20,12 @@ inline constexpr int kExitTimeout = 20;
 inline constexpr int kExitInputError = 30;
 inline constexpr int kExitServiceError = 40;
 inline constexpr int kExitOutputError = 50;
+
+/// Prints "`tool`: `error`" on stderr and returns `exit_code`, for `return cli::fail(...)`.
+inline int fail(const char* tool, const Error& error, int exit_code) {
+  std::cerr << tool << ": " << error.toString() << "\n";
+  return exit_code;
+}
 
 /// Set once one of the signals of `stopOnSignals` arrived: the tool's loops end and it cleans up.
 inline volatile std::sig_atomic_t g_stop_requested = 0;

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdio>
 #include <cstring>
 #include <ctime>
 #include <fstream>
@@ -78,6 +79,15 @@ std::string makeRunId(const std::string& prefix) {
   std::snprintf(suffix, sizeof(suffix), "%04x",
                 static_cast<unsigned>((rd() ^ static_cast<unsigned>(::getpid())) & 0xffff));
   return prefix + "-" + stamp + "-" + suffix;
+}
+
+void printUncleanEnds(const char* tool, const process::Supervisor& sup) {
+  for (const auto& st : sup.status()) {
+    if (st.last_exit != "exit 0" && st.last_exit.rfind("signal 15", 0) != 0 &&
+        st.last_exit.rfind("stopped", 0) != 0) {
+      std::printf("%s: %s ended with %s\n", tool, st.name.c_str(), st.last_exit.c_str());
+    }
+  }
 }
 
 Launcher::Launcher(LaunchOptions options) : o_(std::move(options)) {

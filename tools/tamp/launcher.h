@@ -61,6 +61,10 @@ struct LaunchOptions {
 /// Generates a run id: "<prefix>-YYYYmmdd-HHMMSS-<4 hex>" (unique enough for concurrent runs).
 std::string makeRunId(const std::string& prefix);
 
+/// After a stop: prints "`tool`: NAME ended with HOW" on stdout for every service of `sup` that
+/// did not end cleanly (exit 0, SIGTERM, or stopped after its adoption by this supervisor).
+void printUncleanEnds(const char* tool, const process::Supervisor& sup);
+
 class Launcher {
  public:
   explicit Launcher(LaunchOptions options);

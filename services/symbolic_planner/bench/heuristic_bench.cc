@@ -73,6 +73,16 @@ Instance load(const std::string& domain_file, const std::string& problem_file) {
 void evaluateAll(benchmark::State& st, const Instance& in, sp::HeuristicKind kind, sp::CostType ct) {
   auto h = sp::makeHeuristic(kind, *in.task, ct);
   h->setGoal(in.goal);
+  // What the states evaluate to, so that two builds can be compared: the sum of the finite values,
+  // the number of dead ends, and a hash of the helpful actions (order included), mod 2^40.
+  double hsum = 0, dead = 0;
+  uint64_t pref = 0;
+  for (const auto& s : in.states) {
+    const sp::Cost v = h->evaluate(s.data());
+    (v == sp::Heuristic::kDeadEnd ? dead : hsum) += v == sp::Heuristic::kDeadEnd ? 1 : static_cast<double>(v);
+    for (sp::OpId o : h->preferred()) pref = (pref ^ o) * 0x100000001B3ULL;
+    pref = (pref ^ 0xFFFFFFFFULL) * 0x100000001B3ULL;
+  }
   int64_t sum = 0;
   for (auto _ : st) {
     for (const auto& s : in.states) sum += static_cast<int64_t>(h->evaluate(s.data()) % 1000003);
@@ -81,6 +91,9 @@ void evaluateAll(benchmark::State& st, const Instance& in, sp::HeuristicKind kin
   st.SetItemsProcessed(st.iterations() * static_cast<int64_t>(in.states.size()));
   st.counters["ops"] = static_cast<double>(in.task->ops.size());
   st.counters["facts"] = static_cast<double>(in.task->numFacts());
+  st.counters["hsum"] = hsum;
+  st.counters["dead"] = dead;
+  st.counters["pref"] = static_cast<double>(pref & ((1ULL << 40) - 1));
 }
 
 void registerInstance(const std::string& domain_file, const std::string& problem_file) {

@@ -425,6 +425,51 @@ bool holdsAll(const uint64_t* s, const std::vector<FactId>& facts) {
   return true;
 }
 
+/// Relaxed dead ends remembered by their closure: the facts relaxed-reachable from them, closed under
+/// every relaxed operator. A state whose true facts all lie in such a closure reaches no fact
+/// outside it, so no goal conjunct either: it is a relaxed dead end too, known without exploring
+/// (the same value and no helpful actions, as the exploration would give). Successive evaluations
+/// are of neighbouring states: on trucks-18 most of the lazy search's evaluations are dead ends
+/// next to one evaluated just before. Keeps the last `kSlots` closures; `clear()` when the goal
+/// changes.
+class DeadEndMemo {
+ public:
+  static constexpr size_t kSlots = 4;
+
+  void clear(size_t words) {
+    words_ = words;
+    bits_.assign(kSlots * words, 0);
+    used_ = next_ = 0;
+  }
+  /// Does a remembered closure contain every fact true in `s`?
+  bool covers(const uint64_t* s) const {
+    for (size_t k = 0; k < used_; ++k) {
+      const uint64_t* c = &bits_[k * words_];
+      size_t w = 0;
+      while (w < words_ && (s[w] & ~c[w]) == 0) ++w;
+      if (w == words_) return true;
+    }
+    return false;
+  }
+  /// Remembers a dead end's closure, given as the facts fact(0) .. fact(n - 1) (over the oldest
+  /// one when every slot is taken).
+  template <typename FactAt>
+  void add(size_t n, const FactAt& fact) {
+    uint64_t* c = &bits_[next_ * words_];
+    std::fill(c, c + words_, 0);
+    for (size_t i = 0; i < n; ++i) {
+      const FactId f = fact(i);
+      c[f >> 6] |= uint64_t{1} << (f & 63);
+    }
+    next_ = (next_ + 1) % kSlots;
+    used_ = std::min(used_ + 1, kSlots);
+  }
+
+ private:
+  size_t words_{0}, used_{0}, next_{0};
+  std::vector<uint64_t> bits_;  ///< kSlots closures of words_ words each
+};
+
 // -------------------------------------------------------------------------------------------------
 /// FF's own heuristic (Hoffmann & Nebel 2001, Sec. 4.3) for tasks in which every operator costs the
 /// same (h = that cost times the number of operators in the relaxed plan): a layered relaxed planning graph built breadth-first only up to the first layer that contains
@@ -472,14 +517,17 @@ class LayeredFF : public Heuristic {
     op_mark_.assign(task.ops.size(), 0);
     // Each fact is reached once and each rop activated and touched once per evaluation; one
     // spare slot for the branch-free appends below.
-    facts_.resize(nf);
+    facts_.resize(nf + 1);
     active_.resize(nr + 1);
     touched_.resize(nr + 1);
+    group_marked_.resize(nr + 1);
+    layer_end_.resize(nf + 1);  // a layer reaches at least one new fact, or is the last
   }
 
   void setGoal(const Goal& goal) override {
     goal_ = goal;
     goals_.set(goal_, task_.numFacts());
+    dead_ends_.clear(task_.numWords());
     several_conjuncts_ = goal_.conjuncts.size() > 1;
     // The order in which the first layer's rops activate decides which conjunct of a disjunctive
     // goal is taken; only the full count of layer 0 keeps it (see `buildGraph`).
@@ -500,22 +548,24 @@ class LayeredFF : public Heuristic {
     preferred_.clear();
     if (goal_.conjuncts.empty()) return kInf;
     if (task_.goalReached(s, goal_)) return 0;
+    if (dead_ends_.covers(s)) return kInf;
     const int conj = buildGraph(s);
-    if (conj < 0) return kInf;
+    if (conj < 0) {  // the facts reached are the closure of s
+      dead_ends_.add(num_facts_, [this](size_t i) { return facts_[i]; });
+      return kInf;
+    }
     return extract(s, goal_.conjuncts[static_cast<size_t>(conj)]) * unit_;
   }
 
  private:
   void reset() {
     for (size_t i = 0; i < num_facts_; ++i) level_[facts_[i]] = kNone;
-    for (size_t i = 0; i < num_active_; ++i) rop_level_[active_[i]] = kNone;
-    for (size_t i = 0; i < num_touched_; ++i) {
-      const uint32_t r = touched_[i];
-      ctr_[r].unsat = ctr_[r].base;
-      group_done_[r] = member_true_[r] != 0;
-    }
+    for (size_t i = 0; i < num_leveled_; ++i) rop_level_[active_[i]] = kNone;
+    for (size_t i = 0; i < num_touched_; ++i) ctr_[touched_[i]].unsat = ctr_[touched_[i]].base;
+    // A merged rop marked in the evaluation was unmarked at rest (no member fact in the base).
+    for (size_t i = 0; i < num_group_marked_; ++i) group_done_[group_marked_[i]] = 0;
     for (size_t i = 0; i < num_node_touched_; ++i) node_ctr_[node_touched_[i]].unsat = node_ctr_[node_touched_[i]].base;
-    num_facts_ = num_active_ = num_touched_ = num_node_touched_ = 0;
+    num_facts_ = num_leveled_ = num_touched_ = num_group_marked_ = num_node_touched_ = 0;
   }
 
   // The base state (`base_`): the counters at rest (`Counter::base`, `group_done_`) count the
@@ -617,17 +667,20 @@ class LayeredFF : public Heuristic {
     const uint32_t* const member_of = R_.member_of.data();
     const uint32_t* const member_of_begin = R_.member_of_begin.data();
     uint8_t* const group_done = group_done_.data();
-    size_t nfacts = 0, nactive = 0, ntouched = 0, nnode_touched = 0;
-    auto reach = [&](FactId f, uint32_t lvl) {
-      level[f] = lvl;
-      facts[nfacts++] = f;
+    uint32_t* const group_marked = group_marked_.data();
+    size_t nfacts = 0, nactive = 0, ntouched = 0, nnode_touched = 0, ngroup_marked = 0;
+    auto countGoal = [&](FactId f) {
       if (goals_.isGoal(f)) {
         goals_.forEach(f, [&](uint32_t c) {
           if (--remaining_[c] == 0 && done < 0) done = static_cast<int>(c);
         });
       }
     };
-    forEachTrueFact(s, words, nf, [&](FactId f) { reach(f, 0); });
+    forEachTrueFact(s, words, nf, [&](FactId f) {
+      level[f] = 0;
+      facts[nfacts++] = f;
+      countGoal(f);
+    });
     // Layer 0's facts are counted already when incremental (the base is s).
     size_t start_ft = incremental_ ? nfacts : 0, start_ef = 0;
     for (uint32_t time = 0;; ++time) {
@@ -680,6 +733,7 @@ class LayeredFF : public Heuristic {
           const uint32_t r = member_of[k];
           if (group_done[r]) continue;
           group_done[r] = 1;
+          group_marked[ngroup_marked++] = r;
           const uint32_t u = ctr[r].unsat;
           touched[ntouched] = r;
           ntouched += u == ctr[r].base;
@@ -692,21 +746,36 @@ class LayeredFF : public Heuristic {
         for (uint32_t r : incremental_ ? zero_ : R_.no_pre) active[nactive++] = r;
       }
       const size_t stop_ef = nactive;
+      layer_end_[time] = static_cast<uint32_t>(stop_ef);
+      // The next layer's facts in the order their first adder reaches them, appended without a
+      // branch (most adds reach a fact reached before); then their goal conjuncts, in that order.
+      const uint32_t next = time + 1;
       for (size_t i = start_ef; i < stop_ef; ++i) {
         const uint32_t r = active[i];
-        rop_level[r] = time;
         for (uint32_t k = add_begin[r], e = add_begin[r + 1]; k < e; ++k) {
           const FactId g = add[k];
-          if (level[g] == kNone) reach(g, time + 1);
+          const uint32_t l = level[g];
+          level[g] = std::min(l, next);  // a reached fact's level is below `next`; kNone is not
+          facts[nfacts] = g;
+          nfacts += l == kNone;
         }
       }
+      for (size_t i = stop_ft; i < nfacts; ++i) countGoal(facts[i]);
       if (stop_ft == nfacts) break;  // fixpoint without the goals (done < 0)
       start_ft = stop_ft;
       start_ef = stop_ef;
     }
+    // The rops' layers, which only the extraction reads: not written for a dead end.
+    if (done >= 0) {
+      size_t i = 0;
+      for (uint32_t t = 0; t < max_level_; ++t) {
+        for (; i < layer_end_[t]; ++i) rop_level[active[i]] = t;
+      }
+      num_leveled_ = i;
+    }
     num_facts_ = nfacts;
-    num_active_ = nactive;
     num_touched_ = ntouched;
+    num_group_marked_ = ngroup_marked;
     num_node_touched_ = nnode_touched;
     return done;
   }
@@ -915,7 +984,11 @@ class LayeredFF : public Heuristic {
   std::vector<uint32_t> level_, rop_level_;
   std::vector<FactId> facts_;
   std::vector<uint32_t> active_, touched_, node_touched_;
-  size_t num_facts_{0}, num_active_{0}, num_touched_{0}, num_node_touched_{0};
+  std::vector<uint32_t> group_marked_;  ///< merged rops whose `group_done_` the evaluation set
+  std::vector<uint32_t> layer_end_;     ///< layer -> the end of its rops in `active_`
+  /// Entries of each list that the last evaluation wrote (`num_leveled_`: of `active_`, whose
+  /// `rop_level_` it set).
+  size_t num_facts_{0}, num_leveled_{0}, num_touched_{0}, num_group_marked_{0}, num_node_touched_{0};
   // Extraction (epoch-stamped).
   uint32_t epoch_{0};
   std::vector<uint64_t> true_a_, true_b_;
@@ -926,6 +999,7 @@ class LayeredFF : public Heuristic {
   std::vector<OpId> plan_first_;
   std::vector<OpId> layer0_;       ///< collectHelpful(): a sub-goal's adders applicable in the state
   bool several_conjuncts_{false};  ///< the goal is a disjunction of conjuncts
+  DeadEndMemo dead_ends_;
   std::vector<std::vector<FactId>> goals_at_;
   std::vector<OpId> preferred_;
 };
@@ -938,17 +1012,21 @@ class FactHeap {
   bool empty() const { return v_.empty(); }
   void push(Cost c, FactId f) {
     v_.push_back({c, f});
-    std::push_heap(v_.begin(), v_.end(), cmp);
+    std::push_heap(v_.begin(), v_.end(), Greater{});
   }
   std::pair<Cost, FactId> pop() {
-    std::pop_heap(v_.begin(), v_.end(), cmp);
+    std::pop_heap(v_.begin(), v_.end(), Greater{});
     auto e = v_.back();
     v_.pop_back();
     return e;
   }
 
  private:
-  static bool cmp(const std::pair<Cost, FactId>& a, const std::pair<Cost, FactId>& b) { return a.first > b.first; }
+  /// A type rather than a function pointer, so that the heap's sift loops inline it (5 % of
+  /// citycar-6's run was the calls).
+  struct Greater {
+    bool operator()(const std::pair<Cost, FactId>& a, const std::pair<Cost, FactId>& b) const { return a.first > b.first; }
+  };
   std::vector<std::pair<Cost, FactId>> v_;
 };
 
@@ -965,8 +1043,7 @@ class RelaxationHeuristic : public Heuristic {
     for (OpId o = 0; o < task.ops.size(); ++o) op_cost_.push_back(adjustedCost(task.ops[o], ct, task.unit_cost));
     fact_cost_.assign(nf, kInf);
     supporter_.assign(nf, UINT32_MAX);
-    unsat_.resize(R_.size());
-    rop_cost_.resize(R_.size());
+    rop_.assign(R_.size(), RopState{});
     goal_stamp_.assign(nf, 0);
     fact_mark_.assign(nf, 0);
     op_mark_.assign(task.ops.size(), 0);
@@ -974,6 +1051,7 @@ class RelaxationHeuristic : public Heuristic {
 
   void setGoal(const Goal& goal) override {
     goal_ = goal;
+    dead_ends_.clear(task_.numWords());
     // Goal facts: a counter per conjunct for early termination.
     goal_of_.assign(task_.numFacts(), {});
     for (uint32_t c = 0; c < goal_.conjuncts.size(); ++c) {
@@ -993,6 +1071,7 @@ class RelaxationHeuristic : public Heuristic {
     preferred_.clear();
     if (goal_.conjuncts.empty()) return kInf;
     if (task_.goalReached(s, goal_)) return 0;
+    if (dead_ends_.covers(s)) return kInf;
     explore(s);
     // Best conjunct.
     Cost best = kInf;
@@ -1012,19 +1091,43 @@ class RelaxationHeuristic : public Heuristic {
         best_c = static_cast<int>(c);
       }
     }
-    if (best == kInf) return kInf;
+    if (best == kInf) {  // the exploration ran to its fixpoint: the facts reached are the closure
+      reached_.clear();
+      for (FactId f = 0; f < fact_cost_.size(); ++f) {
+        if (fact_cost_[f] != kInf) reached_.push_back(f);
+      }
+      dead_ends_.add(reached_.size(), [this](size_t i) { return reached_[i]; });
+      return kInf;
+    }
     if (mode_ != Mode::kFF) return best;
     return extract(s, goal_.conjuncts[static_cast<size_t>(best_c)]);
   }
 
  private:
+  /// Per rop: the cost of its reached preconditions (their sum or maximum) and how many are not
+  /// reached, next to each other (one cache miss per edge, not two), valid when `stamp` is the
+  /// evaluation's (`rop()`; no pass over every rop per evaluation).
+  struct RopState {
+    Cost cost{0};
+    uint32_t unsat{0};
+    uint32_t stamp{0};
+  };
+  /// A rop's counters in this evaluation, (0, |pre|) when it was not touched yet.
+  RopState& rop(uint32_t r) {
+    RopState& x = rop_[r];
+    if (x.stamp != stamp_) x = {0, R_.count[r], stamp_};
+    return x;
+  }
+
   void explore(const uint64_t* s) {
     const size_t nf = task_.numFacts();
     std::fill(fact_cost_.begin(), fact_cost_.end(), kInf);
-    std::copy(R_.count.begin(), R_.count.end(), unsat_.begin());
-    std::fill(rop_cost_.begin(), rop_cost_.end(), 0);
     heap_.clear();
-    ++stamp_;
+    if (++stamp_ == 0) {  // the stamps wrapped: none may look current
+      for (RopState& x : rop_) x.stamp = 0;
+      std::fill(goal_stamp_.begin(), goal_stamp_.end(), 0);
+      stamp_ = 1;
+    }
     remaining_.assign(goal_.conjuncts.size(), 0);
     for (uint32_t c = 0; c < goal_.conjuncts.size(); ++c) remaining_[c] = static_cast<uint32_t>(goal_.conjuncts[c].pos.size());
     const size_t words = task_.numWords();
@@ -1046,12 +1149,9 @@ class RelaxationHeuristic : public Heuristic {
       if (done) break;
       for (uint32_t i = R_.pre_of_begin[f]; i < R_.pre_of_begin[f + 1]; ++i) {
         const uint32_t r = R_.pre_of[i];
-        if (mode_ == Mode::kMax) {
-          rop_cost_[r] = std::max(rop_cost_[r], c);
-        } else {
-          rop_cost_[r] += c;
-        }
-        if (--unsat_[r] == 0) fire(r, rop_cost_[r]);
+        RopState& x = rop(r);
+        x.cost = mode_ == Mode::kMax ? std::max(x.cost, c) : x.cost + c;
+        if (--x.unsat == 0) fire(r, x.cost);
       }
     }
   }
@@ -1154,8 +1254,9 @@ class RelaxationHeuristic : public Heuristic {
   RelaxedOps R_;
   std::vector<Cost> op_cost_;
   // Per evaluation.
-  std::vector<Cost> fact_cost_, rop_cost_;
-  std::vector<uint32_t> supporter_, unsat_;
+  std::vector<Cost> fact_cost_;
+  std::vector<uint32_t> supporter_;
+  std::vector<RopState> rop_;
   std::vector<uint32_t> goal_stamp_;
   uint32_t stamp_{0};
   FactHeap heap_;
@@ -1164,6 +1265,8 @@ class RelaxationHeuristic : public Heuristic {
   std::vector<FactId> stack_, g1_;
   std::vector<OpId> preferred_;
   bool plan_preferred_{false};  ///< setRelaxedPlanPreferred
+  DeadEndMemo dead_ends_;
+  std::vector<FactId> reached_;
 };
 
 class BlindHeuristic : public Heuristic {

@@ -517,7 +517,7 @@ class LayeredFF : public Heuristic {
     op_mark_.assign(task.ops.size(), 0);
     // Each fact is reached once and each rop activated and touched once per evaluation; one
     // spare slot for the branch-free appends below.
-    facts_.resize(nf + 1);
+    facts_.resize(nf);
     active_.resize(nr + 1);
     touched_.resize(nr + 1);
     group_marked_.resize(nr + 1);
@@ -669,18 +669,16 @@ class LayeredFF : public Heuristic {
     uint8_t* const group_done = group_done_.data();
     uint32_t* const group_marked = group_marked_.data();
     size_t nfacts = 0, nactive = 0, ntouched = 0, nnode_touched = 0, ngroup_marked = 0;
-    auto countGoal = [&](FactId f) {
+    auto reach = [&](FactId f, uint32_t lvl) {
+      level[f] = lvl;
+      facts[nfacts++] = f;
       if (goals_.isGoal(f)) {
         goals_.forEach(f, [&](uint32_t c) {
           if (--remaining_[c] == 0 && done < 0) done = static_cast<int>(c);
         });
       }
     };
-    forEachTrueFact(s, words, nf, [&](FactId f) {
-      level[f] = 0;
-      facts[nfacts++] = f;
-      countGoal(f);
-    });
+    forEachTrueFact(s, words, nf, [&](FactId f) { reach(f, 0); });
     // Layer 0's facts are counted already when incremental (the base is s).
     size_t start_ft = incremental_ ? nfacts : 0, start_ef = 0;
     for (uint32_t time = 0;; ++time) {
@@ -747,20 +745,13 @@ class LayeredFF : public Heuristic {
       }
       const size_t stop_ef = nactive;
       layer_end_[time] = static_cast<uint32_t>(stop_ef);
-      // The next layer's facts in the order their first adder reaches them, appended without a
-      // branch (most adds reach a fact reached before); then their goal conjuncts, in that order.
-      const uint32_t next = time + 1;
       for (size_t i = start_ef; i < stop_ef; ++i) {
         const uint32_t r = active[i];
         for (uint32_t k = add_begin[r], e = add_begin[r + 1]; k < e; ++k) {
           const FactId g = add[k];
-          const uint32_t l = level[g];
-          level[g] = std::min(l, next);  // a reached fact's level is below `next`; kNone is not
-          facts[nfacts] = g;
-          nfacts += l == kNone;
+          if (level[g] == kNone) reach(g, time + 1);
         }
       }
-      for (size_t i = stop_ft; i < nfacts; ++i) countGoal(facts[i]);
       if (stop_ft == nfacts) break;  // fixpoint without the goals (done < 0)
       start_ft = stop_ft;
       start_ef = stop_ef;

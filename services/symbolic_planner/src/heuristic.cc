@@ -520,8 +520,6 @@ class LayeredFF : public Heuristic {
     facts_.resize(nf);
     active_.resize(nr + 1);
     touched_.resize(nr + 1);
-    group_marked_.resize(nr + 1);
-    layer_end_.resize(nf + 1);  // a layer reaches at least one new fact, or is the last
   }
 
   void setGoal(const Goal& goal) override {
@@ -560,12 +558,14 @@ class LayeredFF : public Heuristic {
  private:
   void reset() {
     for (size_t i = 0; i < num_facts_; ++i) level_[facts_[i]] = kNone;
-    for (size_t i = 0; i < num_leveled_; ++i) rop_level_[active_[i]] = kNone;
-    for (size_t i = 0; i < num_touched_; ++i) ctr_[touched_[i]].unsat = ctr_[touched_[i]].base;
-    // A merged rop marked in the evaluation was unmarked at rest (no member fact in the base).
-    for (size_t i = 0; i < num_group_marked_; ++i) group_done_[group_marked_[i]] = 0;
+    for (size_t i = 0; i < num_active_; ++i) rop_level_[active_[i]] = kNone;
+    for (size_t i = 0; i < num_touched_; ++i) {
+      const uint32_t r = touched_[i];
+      ctr_[r].unsat = ctr_[r].base;
+      group_done_[r] = member_true_[r] != 0;
+    }
     for (size_t i = 0; i < num_node_touched_; ++i) node_ctr_[node_touched_[i]].unsat = node_ctr_[node_touched_[i]].base;
-    num_facts_ = num_leveled_ = num_touched_ = num_group_marked_ = num_node_touched_ = 0;
+    num_facts_ = num_active_ = num_touched_ = num_node_touched_ = 0;
   }
 
   // The base state (`base_`): the counters at rest (`Counter::base`, `group_done_`) count the
@@ -667,8 +667,7 @@ class LayeredFF : public Heuristic {
     const uint32_t* const member_of = R_.member_of.data();
     const uint32_t* const member_of_begin = R_.member_of_begin.data();
     uint8_t* const group_done = group_done_.data();
-    uint32_t* const group_marked = group_marked_.data();
-    size_t nfacts = 0, nactive = 0, ntouched = 0, nnode_touched = 0, ngroup_marked = 0;
+    size_t nfacts = 0, nactive = 0, ntouched = 0, nnode_touched = 0;
     auto reach = [&](FactId f, uint32_t lvl) {
       level[f] = lvl;
       facts[nfacts++] = f;
@@ -731,7 +730,6 @@ class LayeredFF : public Heuristic {
           const uint32_t r = member_of[k];
           if (group_done[r]) continue;
           group_done[r] = 1;
-          group_marked[ngroup_marked++] = r;
           const uint32_t u = ctr[r].unsat;
           touched[ntouched] = r;
           ntouched += u == ctr[r].base;
@@ -744,9 +742,9 @@ class LayeredFF : public Heuristic {
         for (uint32_t r : incremental_ ? zero_ : R_.no_pre) active[nactive++] = r;
       }
       const size_t stop_ef = nactive;
-      layer_end_[time] = static_cast<uint32_t>(stop_ef);
       for (size_t i = start_ef; i < stop_ef; ++i) {
         const uint32_t r = active[i];
+        rop_level[r] = time;
         for (uint32_t k = add_begin[r], e = add_begin[r + 1]; k < e; ++k) {
           const FactId g = add[k];
           if (level[g] == kNone) reach(g, time + 1);
@@ -756,17 +754,9 @@ class LayeredFF : public Heuristic {
       start_ft = stop_ft;
       start_ef = stop_ef;
     }
-    // The rops' layers, which only the extraction reads: not written for a dead end.
-    if (done >= 0) {
-      size_t i = 0;
-      for (uint32_t t = 0; t < max_level_; ++t) {
-        for (; i < layer_end_[t]; ++i) rop_level[active[i]] = t;
-      }
-      num_leveled_ = i;
-    }
     num_facts_ = nfacts;
+    num_active_ = nactive;
     num_touched_ = ntouched;
-    num_group_marked_ = ngroup_marked;
     num_node_touched_ = nnode_touched;
     return done;
   }
@@ -975,11 +965,7 @@ class LayeredFF : public Heuristic {
   std::vector<uint32_t> level_, rop_level_;
   std::vector<FactId> facts_;
   std::vector<uint32_t> active_, touched_, node_touched_;
-  std::vector<uint32_t> group_marked_;  ///< merged rops whose `group_done_` the evaluation set
-  std::vector<uint32_t> layer_end_;     ///< layer -> the end of its rops in `active_`
-  /// Entries of each list that the last evaluation wrote (`num_leveled_`: of `active_`, whose
-  /// `rop_level_` it set).
-  size_t num_facts_{0}, num_leveled_{0}, num_touched_{0}, num_group_marked_{0}, num_node_touched_{0};
+  size_t num_facts_{0}, num_active_{0}, num_touched_{0}, num_node_touched_{0};
   // Extraction (epoch-stamped).
   uint32_t epoch_{0};
   std::vector<uint64_t> true_a_, true_b_;
@@ -1003,21 +989,17 @@ class FactHeap {
   bool empty() const { return v_.empty(); }
   void push(Cost c, FactId f) {
     v_.push_back({c, f});
-    std::push_heap(v_.begin(), v_.end(), Greater{});
+    std::push_heap(v_.begin(), v_.end(), cmp);
   }
   std::pair<Cost, FactId> pop() {
-    std::pop_heap(v_.begin(), v_.end(), Greater{});
+    std::pop_heap(v_.begin(), v_.end(), cmp);
     auto e = v_.back();
     v_.pop_back();
     return e;
   }
 
  private:
-  /// A type rather than a function pointer, so that the heap's sift loops inline it (5 % of
-  /// citycar-6's run was the calls).
-  struct Greater {
-    bool operator()(const std::pair<Cost, FactId>& a, const std::pair<Cost, FactId>& b) const { return a.first > b.first; }
-  };
+  static bool cmp(const std::pair<Cost, FactId>& a, const std::pair<Cost, FactId>& b) { return a.first > b.first; }
   std::vector<std::pair<Cost, FactId>> v_;
 };
 
@@ -1034,7 +1016,8 @@ class RelaxationHeuristic : public Heuristic {
     for (OpId o = 0; o < task.ops.size(); ++o) op_cost_.push_back(adjustedCost(task.ops[o], ct, task.unit_cost));
     fact_cost_.assign(nf, kInf);
     supporter_.assign(nf, UINT32_MAX);
-    rop_.assign(R_.size(), RopState{});
+    unsat_.resize(R_.size());
+    rop_cost_.resize(R_.size());
     goal_stamp_.assign(nf, 0);
     fact_mark_.assign(nf, 0);
     op_mark_.assign(task.ops.size(), 0);
@@ -1095,30 +1078,13 @@ class RelaxationHeuristic : public Heuristic {
   }
 
  private:
-  /// Per rop: the cost of its reached preconditions (their sum or maximum) and how many are not
-  /// reached, next to each other (one cache miss per edge, not two), valid when `stamp` is the
-  /// evaluation's (`rop()`; no pass over every rop per evaluation).
-  struct RopState {
-    Cost cost{0};
-    uint32_t unsat{0};
-    uint32_t stamp{0};
-  };
-  /// A rop's counters in this evaluation, (0, |pre|) when it was not touched yet.
-  RopState& rop(uint32_t r) {
-    RopState& x = rop_[r];
-    if (x.stamp != stamp_) x = {0, R_.count[r], stamp_};
-    return x;
-  }
-
   void explore(const uint64_t* s) {
     const size_t nf = task_.numFacts();
     std::fill(fact_cost_.begin(), fact_cost_.end(), kInf);
+    std::copy(R_.count.begin(), R_.count.end(), unsat_.begin());
+    std::fill(rop_cost_.begin(), rop_cost_.end(), 0);
     heap_.clear();
-    if (++stamp_ == 0) {  // the stamps wrapped: none may look current
-      for (RopState& x : rop_) x.stamp = 0;
-      std::fill(goal_stamp_.begin(), goal_stamp_.end(), 0);
-      stamp_ = 1;
-    }
+    ++stamp_;
     remaining_.assign(goal_.conjuncts.size(), 0);
     for (uint32_t c = 0; c < goal_.conjuncts.size(); ++c) remaining_[c] = static_cast<uint32_t>(goal_.conjuncts[c].pos.size());
     const size_t words = task_.numWords();
@@ -1140,9 +1106,12 @@ class RelaxationHeuristic : public Heuristic {
       if (done) break;
       for (uint32_t i = R_.pre_of_begin[f]; i < R_.pre_of_begin[f + 1]; ++i) {
         const uint32_t r = R_.pre_of[i];
-        RopState& x = rop(r);
-        x.cost = mode_ == Mode::kMax ? std::max(x.cost, c) : x.cost + c;
-        if (--x.unsat == 0) fire(r, x.cost);
+        if (mode_ == Mode::kMax) {
+          rop_cost_[r] = std::max(rop_cost_[r], c);
+        } else {
+          rop_cost_[r] += c;
+        }
+        if (--unsat_[r] == 0) fire(r, rop_cost_[r]);
       }
     }
   }
@@ -1245,9 +1214,8 @@ class RelaxationHeuristic : public Heuristic {
   RelaxedOps R_;
   std::vector<Cost> op_cost_;
   // Per evaluation.
-  std::vector<Cost> fact_cost_;
-  std::vector<uint32_t> supporter_;
-  std::vector<RopState> rop_;
+  std::vector<Cost> fact_cost_, rop_cost_;
+  std::vector<uint32_t> supporter_, unsat_;
   std::vector<uint32_t> goal_stamp_;
   uint32_t stamp_{0};
   FactHeap heap_;

@@ -1,9 +1,11 @@
 // Time per evaluation of the delete-relaxation heuristics on fixed states (issue 14, twenty-fourth
 // round): the search's counts of a time-bounded run are no per-evaluation measure (its phases
 // start and stop by time), so this evaluates the same states every repetition. The states: the
-// initial state and random walks from it (fixed seed), the goal the problem's. Cost-based h_FF
+// initial state and random walks from it (fixed seed), the goal the problem's, on the task pruned to
+// what is relevant to it (as the planner searches it; since the thirty-sixth round). Cost-based h_FF
 // (cost + 1, what the search uses on tasks whose operators differ in cost), h_add, and h_FF with
-// unit costs (the layered graph).
+// unit costs (the layered graph); the `Children` variants evaluate states next to each other, as a
+// search does (each of the first states, then its successors; up to 4096 states).
 //
 //   tamp_symbolic_planner_heuristic_bench [--benchmark_filter=...] [DOMAIN PROBLEM]...
 //   (default instances: shipped ones of tests/data/benchmarks; more as DOMAIN PROBLEM pairs)
@@ -20,6 +22,7 @@
 #include "tamp/symbolic_planner/grounding.h"
 #include "tamp/symbolic_planner/heuristic.h"
 #include "tamp/symbolic_planner/pddl.h"
+#include "tamp/symbolic_planner/relevance.h"
 #include "../tests/random_walks.h"
 
 namespace sp = tamp::symbolic_planner;
@@ -31,6 +34,9 @@ struct Instance {
   std::shared_ptr<const sp::Task> task;
   sp::Goal goal;
   std::vector<sp::StateBits> states;
+  /// Each of the first states followed by its successors, as a search evaluates them (a state's
+  /// children differ from it in a few facts; the layered graph moves its layer 0 through those).
+  std::vector<sp::StateBits> children;
 };
 
 std::string readOrThrow(const std::string& path) {
@@ -65,22 +71,55 @@ Instance load(const std::string& domain_file, const std::string& problem_file) {
   in.label = p.parent_path().filename().string() + "/" + p.stem().string();
   in.task = orThrow(grounder->buildTask(init, negated, true, tamp::Termination()), "task");
   in.goal = orThrow(grounder->groundGoal(problem.goal, *in.task, init), "goal");
-  in.states = sampleStates(*in.task, grounder->initialState(*in.task, init), 255, 60);
+  sp::StateBits start = grounder->initialState(*in.task, init);
+  // The task the planner searches: pruned to what is relevant to the goal (when that is safe).
+  if (auto pruned = sp::pruneIrrelevant(*in.task, in.goal); pruned.pruned()) {
+    start = pruned.projectState(start.data(), in.task->numWords());
+    in.task = pruned.task;
+    in.goal = pruned.goal;
+  }
+  in.states = sampleStates(*in.task, start, 255, 60);
+  std::vector<sp::OpId> ops;
+  for (const auto& s : in.states) {
+    if (in.children.size() >= 4096) break;
+    in.children.push_back(s);
+    ops.clear();
+    in.task->applicableOps(s.data(), ops);
+    for (sp::OpId o : ops) {
+      in.children.emplace_back(s.size());
+      in.task->apply(s.data(), o, in.children.back().data());
+    }
+  }
   return in;
 }
 
 /// Evaluates every state once per iteration; the rate is evaluations per second.
-void evaluateAll(benchmark::State& st, const Instance& in, sp::HeuristicKind kind, sp::CostType ct) {
+void evaluateAll(benchmark::State& st, const Instance& in, sp::HeuristicKind kind, sp::CostType ct,
+                 const std::vector<sp::StateBits> Instance::*which = &Instance::states) {
+  const std::vector<sp::StateBits>& states = in.*which;
   auto h = sp::makeHeuristic(kind, *in.task, ct);
   h->setGoal(in.goal);
+  // What the states evaluate to, so that two builds can be compared: the sum of the finite values,
+  // the number of dead ends, and a hash of the helpful actions (order included), mod 2^40.
+  double hsum = 0, dead = 0;
+  uint64_t pref = 0;
+  for (const auto& s : states) {
+    const sp::Cost v = h->evaluate(s.data());
+    (v == sp::Heuristic::kDeadEnd ? dead : hsum) += v == sp::Heuristic::kDeadEnd ? 1 : static_cast<double>(v);
+    for (sp::OpId o : h->preferred()) pref = (pref ^ o) * 0x100000001B3ULL;
+    pref = (pref ^ 0xFFFFFFFFULL) * 0x100000001B3ULL;
+  }
   int64_t sum = 0;
   for (auto _ : st) {
-    for (const auto& s : in.states) sum += static_cast<int64_t>(h->evaluate(s.data()) % 1000003);
+    for (const auto& s : states) sum += static_cast<int64_t>(h->evaluate(s.data()) % 1000003);
   }
   benchmark::DoNotOptimize(sum);
-  st.SetItemsProcessed(st.iterations() * static_cast<int64_t>(in.states.size()));
+  st.SetItemsProcessed(st.iterations() * static_cast<int64_t>(states.size()));
   st.counters["ops"] = static_cast<double>(in.task->ops.size());
   st.counters["facts"] = static_cast<double>(in.task->numFacts());
+  st.counters["hsum"] = hsum;
+  st.counters["dead"] = dead;
+  st.counters["pref"] = static_cast<double>(pref & ((1ULL << 40) - 1));
 }
 
 void registerInstance(const std::string& domain_file, const std::string& problem_file) {
@@ -93,9 +132,15 @@ void registerInstance(const std::string& domain_file, const std::string& problem
     benchmark::RegisterBenchmark(("BM_CostAdd/" + in->label).c_str(), [in](benchmark::State& st) {
       evaluateAll(st, *in, sp::HeuristicKind::kAdd, sp::CostType::kPlusOne);
     })->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("BM_CostFFChildren/" + in->label).c_str(), [in](benchmark::State& st) {
+      evaluateAll(st, *in, sp::HeuristicKind::kFF, sp::CostType::kPlusOne, &Instance::children);
+    })->Unit(benchmark::kMicrosecond);
   }
   benchmark::RegisterBenchmark(("BM_UnitFF/" + in->label).c_str(), [in](benchmark::State& st) {
     evaluateAll(st, *in, sp::HeuristicKind::kFF, sp::CostType::kUnit);
+  })->Unit(benchmark::kMicrosecond);
+  benchmark::RegisterBenchmark(("BM_UnitFFChildren/" + in->label).c_str(), [in](benchmark::State& st) {
+    evaluateAll(st, *in, sp::HeuristicKind::kFF, sp::CostType::kUnit, &Instance::children);
   })->Unit(benchmark::kMicrosecond);
 }
 

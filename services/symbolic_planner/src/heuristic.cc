@@ -425,6 +425,51 @@ bool holdsAll(const uint64_t* s, const std::vector<FactId>& facts) {
   return true;
 }
 
+/// Relaxed dead ends remembered by their closure: the facts relaxed-reachable from them, closed under
+/// every relaxed operator. A state whose true facts all lie in such a closure reaches no fact
+/// outside it, so no goal conjunct either: it is a relaxed dead end too, known without exploring
+/// (the same value and no helpful actions, as the exploration would give). Successive evaluations
+/// are of neighbouring states: on trucks-18 most of the lazy search's evaluations are dead ends
+/// next to one evaluated just before. Keeps the last `kSlots` closures; `clear()` when the goal
+/// changes.
+class DeadEndMemo {
+ public:
+  static constexpr size_t kSlots = 4;
+
+  void clear(size_t words) {
+    words_ = words;
+    bits_.assign(kSlots * words, 0);
+    used_ = next_ = 0;
+  }
+  /// Does a remembered closure contain every fact true in `s`?
+  bool covers(const uint64_t* s) const {
+    for (size_t k = 0; k < used_; ++k) {
+      const uint64_t* c = &bits_[k * words_];
+      size_t w = 0;
+      while (w < words_ && (s[w] & ~c[w]) == 0) ++w;
+      if (w == words_) return true;
+    }
+    return false;
+  }
+  /// Remembers a dead end's closure, given as the facts fact(0) .. fact(n - 1) (over the oldest
+  /// one when every slot is taken).
+  template <typename FactAt>
+  void add(size_t n, const FactAt& fact) {
+    uint64_t* c = &bits_[next_ * words_];
+    std::fill(c, c + words_, 0);
+    for (size_t i = 0; i < n; ++i) {
+      const FactId f = fact(i);
+      c[f >> 6] |= uint64_t{1} << (f & 63);
+    }
+    next_ = (next_ + 1) % kSlots;
+    used_ = std::min(used_ + 1, kSlots);
+  }
+
+ private:
+  size_t words_{0}, used_{0}, next_{0};
+  std::vector<uint64_t> bits_;  ///< kSlots closures of words_ words each
+};
+
 // -------------------------------------------------------------------------------------------------
 /// FF's own heuristic (Hoffmann & Nebel 2001, Sec. 4.3) for tasks in which every operator costs the
 /// same (h = that cost times the number of operators in the relaxed plan): a layered relaxed planning graph built breadth-first only up to the first layer that contains
@@ -480,6 +525,7 @@ class LayeredFF : public Heuristic {
   void setGoal(const Goal& goal) override {
     goal_ = goal;
     goals_.set(goal_, task_.numFacts());
+    dead_ends_.clear(task_.numWords());
     several_conjuncts_ = goal_.conjuncts.size() > 1;
     // The order in which the first layer's rops activate decides which conjunct of a disjunctive
     // goal is taken; only the full count of layer 0 keeps it (see `buildGraph`).
@@ -500,8 +546,12 @@ class LayeredFF : public Heuristic {
     preferred_.clear();
     if (goal_.conjuncts.empty()) return kInf;
     if (task_.goalReached(s, goal_)) return 0;
+    if (dead_ends_.covers(s)) return kInf;
     const int conj = buildGraph(s);
-    if (conj < 0) return kInf;
+    if (conj < 0) {  // the facts reached are the closure of s
+      dead_ends_.add(num_facts_, [this](size_t i) { return facts_[i]; });
+      return kInf;
+    }
     return extract(s, goal_.conjuncts[static_cast<size_t>(conj)]) * unit_;
   }
 
@@ -926,6 +976,7 @@ class LayeredFF : public Heuristic {
   std::vector<OpId> plan_first_;
   std::vector<OpId> layer0_;       ///< collectHelpful(): a sub-goal's adders applicable in the state
   bool several_conjuncts_{false};  ///< the goal is a disjunction of conjuncts
+  DeadEndMemo dead_ends_;
   std::vector<std::vector<FactId>> goals_at_;
   std::vector<OpId> preferred_;
 };
@@ -974,6 +1025,7 @@ class RelaxationHeuristic : public Heuristic {
 
   void setGoal(const Goal& goal) override {
     goal_ = goal;
+    dead_ends_.clear(task_.numWords());
     // Goal facts: a counter per conjunct for early termination.
     goal_of_.assign(task_.numFacts(), {});
     for (uint32_t c = 0; c < goal_.conjuncts.size(); ++c) {
@@ -993,6 +1045,7 @@ class RelaxationHeuristic : public Heuristic {
     preferred_.clear();
     if (goal_.conjuncts.empty()) return kInf;
     if (task_.goalReached(s, goal_)) return 0;
+    if (dead_ends_.covers(s)) return kInf;
     explore(s);
     // Best conjunct.
     Cost best = kInf;
@@ -1012,7 +1065,14 @@ class RelaxationHeuristic : public Heuristic {
         best_c = static_cast<int>(c);
       }
     }
-    if (best == kInf) return kInf;
+    if (best == kInf) {  // the exploration ran to its fixpoint: the facts reached are the closure
+      reached_.clear();
+      for (FactId f = 0; f < fact_cost_.size(); ++f) {
+        if (fact_cost_[f] != kInf) reached_.push_back(f);
+      }
+      dead_ends_.add(reached_.size(), [this](size_t i) { return reached_[i]; });
+      return kInf;
+    }
     if (mode_ != Mode::kFF) return best;
     return extract(s, goal_.conjuncts[static_cast<size_t>(best_c)]);
   }
@@ -1164,6 +1224,8 @@ class RelaxationHeuristic : public Heuristic {
   std::vector<FactId> stack_, g1_;
   std::vector<OpId> preferred_;
   bool plan_preferred_{false};  ///< setRelaxedPlanPreferred
+  DeadEndMemo dead_ends_;
+  std::vector<FactId> reached_;
 };
 
 class BlindHeuristic : public Heuristic {

@@ -402,6 +402,63 @@ TEST(Heuristic, LayerZeroCountedFromThePreviousStateChangesNoValueNorHelpfulActi
   }
 }
 
+TEST(Heuristic, DeadEndsRememberedByTheirClosureChangeNoValueNorHelpfulAction) {
+  // Every relaxation heuristic remembers the closure of its last relaxed dead ends and answers a
+  // state inside one without exploring (thirty-sixth round). Reference: a second object whose
+  // goal is set again before every evaluation (which forgets them). The states as a search
+  // evaluates them: each state of random walks (fixed seed), then each of its successors, so
+  // that dead ends come next to each other. trucks and pegsol: many dead ends (pegsol's
+  // operators differ in cost: the cost-based exploration under cost + 1); citycar: conditional
+  // effects, costs.
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"pddl-more/trucks/domain.pddl", "pddl-more/trucks/instance-6.pddl"},
+      {"pddl-more/pegsol/domain.pddl", "pddl-more/pegsol/instance-6.pddl"},
+      {"pddl-adl/citycar/domain.pddl", "pddl-adl/citycar/instance-1.pddl"},
+  };
+  for (const auto& [dom, prob] : cases) {
+    SCOPED_TRACE(prob);
+    SolvedInstance in;
+    ASSERT_NO_FATAL_FAILURE(loadSolvedInstance(dom, prob, in));
+    const Task& t = in.task();
+    std::vector<StateBits> states;
+    std::vector<OpId> ops;
+    forEachRandomWalkState(t, in.init, /*seed=*/36, /*walks=*/10, /*steps=*/40,
+                           [&](const StateBits& cur, int, int) {
+                             states.push_back(cur);
+                             ops.clear();
+                             t.applicableOps(cur.data(), ops);
+                             for (OpId o : ops) {
+                               states.emplace_back(cur.size());
+                               t.apply(cur.data(), o, states.back().data());
+                             }
+                           });
+    const std::vector<std::tuple<HeuristicKind, CostType, bool>> kinds = {
+        {HeuristicKind::kFF, CostType::kUnit, false}, {HeuristicKind::kFF, CostType::kUnit, true},
+        {HeuristicKind::kFF, CostType::kPlusOne, false}, {HeuristicKind::kFFHadd, CostType::kUnit, false},
+        {HeuristicKind::kAdd, CostType::kPlusOne, false}, {HeuristicKind::kMax, CostType::kUnit, false},
+    };
+    for (const auto& [kind, ct, ff_style] : kinds) {
+      SCOPED_TRACE(static_cast<int>(kind) * 10 + static_cast<int>(ct));
+      auto memo = makeHeuristic(kind, t, ct);
+      auto fresh = makeHeuristic(kind, t, ct);
+      memo->setFFStyle(ff_style);
+      fresh->setFFStyle(ff_style);
+      memo->setGoal(in.goal);
+      size_t dead = 0, positive = 0;
+      for (size_t i = 0; i < states.size(); ++i) {
+        fresh->setGoal(in.goal);
+        const Cost want = fresh->evaluate(states[i].data());
+        ASSERT_EQ(memo->evaluate(states[i].data()), want) << "state " << i;
+        ASSERT_EQ(memo->preferred(), fresh->preferred()) << "state " << i;
+        dead += want == Heuristic::kDeadEnd ? 1 : 0;
+        positive += want > 0 && want != Heuristic::kDeadEnd ? 1 : 0;
+      }
+      EXPECT_GT(dead * 10, states.size()) << dead;  // dead ends to remember
+      EXPECT_GT(positive * 40, states.size()) << positive;  // trucks-6: 184 of 5 153
+    }
+  }
+}
+
 TEST(Heuristic, HelpfulActionsAreTheApplicableAddersOfTheFirstLayerSubGoalsOnRandomWalks) {
   // The helpful actions (the default order) are taken from the sub-goals' adders at layer 0
   // rather than by testing every achiever for applicability: in every state of random walks

@@ -100,29 +100,18 @@ bool GraphManager::plannedIn(EdgeId id, EdgeId next, const BranchContext& ctx) c
 }
 
 TraverseResult GraphManager::traverseFirstEdge(NodeId from, const BranchContext& context) {
+  // The best branch found always goes through the settled first edge (both follow the cheapest
+  // complete branch), so a found branch has its first edge decided. When the budget ran out
+  // before every other way on was bounded, that edge is the best so far and is executed, as a
+  // full search out of budget executes its best branch so far (before session 33 a full search
+  // followed here, with a budget of its own: two deadlines before namo_moghaddam_07's command).
   TraverseResult r = search(from, context, true);
-  // Not found: no branch was completed, so nothing was left unexplored (the full search's answer).
-  if (!r.found || r.proven || r.branch.empty()) return r;
-  if (r.proven_edges > 0) {
-    // The budget ran out before every other way on was bounded: the best first edge so far is
-    // executed, as a full search out of budget executes its best branch so far (a full search
-    // after this one doubled the Traverse's deadline: namo_moghaddam_07's first command).
+  if (r.found && !r.proven && !r.branch.empty())
     log::get("graph_manager")
         ->info("first-edge search from n{}: not proven within the budget ({} evaluations, {:.1f} s); the best first "
                "edge so far is executed",
                from, r.evaluations, r.time_s);
-    return r;
-  }
-  // No complete branch went through a first edge that stayed settled: the full search decides
-  // (the edges priced so far are kept in the graph).
-  const double first_s = r.time_s;
-  log::get("graph_manager")
-      ->debug("first-edge search from n{}: no first edge settled after {} evaluations, {:.3f} s; the full search "
-              "decides",
-              from, r.evaluations, r.time_s);
-  TraverseResult full = search(from, context, false);
-  full.time_s += first_s;
-  return full;
+  return r;
 }
 
 }  // namespace tamp::graph_manager
